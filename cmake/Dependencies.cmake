@@ -1,0 +1,11 @@
+# Every find_package of the project lives here; targets link imported targets only.
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(Ceres REQUIRED)
+find_package(OpenCV REQUIRED COMPONENTS core calib3d)
+find_package(yaml-cpp REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(OpenMP REQUIRED COMPONENTS CXX)
+if(UWSCAN_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()

@@ -1,0 +1,125 @@
+#include "scanner/flat_viewport.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "scanner/error.hpp"
+#include "scanner/refraction.hpp"
+
+namespace uwscan::scanner {
+namespace {
+
+void Require(bool ok, const char* field, const char* expected) {
+  if (!ok) throw Error(std::string("viewport: field '") + field + "' must be " + expected);
+}
+
+// Intersects a ray with the plane normal . x = offset; kParallel / kBehind as values.
+RayHit HitFace(const Ray& ray, const Eigen::Vector3d& normal, double offset) {
+  const double denom = normal.dot(ray.direction);
+  if (std::abs(denom) <= 1e-15) return RayHit::Miss(HitStatus::kParallel);
+  const double t = (offset - normal.dot(ray.origin)) / denom;
+  if (t < 0.0) return RayHit::Miss(HitStatus::kBehind);
+  return RayHit{HitStatus::kHit, t, ray.At(t)};
+}
+
+// Crosses one face: intersection with the face, then Snell's law into the next medium.
+RayTrace CrossFace(const Ray& ray, const Eigen::Vector3d& normal, double offset, double n_from,
+                   double n_to) {
+  const RayHit hit = HitFace(ray, normal, offset);
+  if (!hit.ok()) return RayTrace{hit.status, ray};
+  const std::optional<Eigen::Vector3d> refracted = Refract(ray.direction, normal, n_from, n_to);
+  if (!refracted) return RayTrace{HitStatus::kTotalInternalReflection, ray};
+  return RayTrace{HitStatus::kHit, Ray{hit.point, *refracted}};
+}
+
+// In the plane of refraction: the radial reach of the path at axial depth `depth_m` beyond
+// the centre, as a function of s = sin(angle in air), and its derivative.
+struct Reach {
+  double value;
+  double derivative;
+};
+Reach RadialReach(double s, const std::array<double, 3>& lengths,
+                  const std::array<double, 3>& ratios) {
+  Reach r{0.0, 0.0};
+  for (int i = 0; i < 3; ++i) {
+    const double sin_i = ratios[i] * s;
+    const double cos2 = 1.0 - sin_i * sin_i;
+    const double cos_i = std::sqrt(cos2);
+    r.value += lengths[i] * sin_i / cos_i;
+    r.derivative += lengths[i] * ratios[i] / (cos2 * cos_i);
+  }
+  return r;
+}
+
+}  // namespace
+
+void FlatViewport::Check() const {
+  Require(normal.allFinite() && std::abs(normal.norm() - 1.0) < 1e-9, "normal",
+          "a finite unit vector");
+  Require(std::isfinite(distance_m), "distance_m", "finite (metres)");
+  Require(std::isfinite(thickness_m) && thickness_m >= 0.0 && thickness_m < 1.0, "thickness_m",
+          "in [0, 1) metres");
+  Require(std::isfinite(n_air) && n_air >= 1.0 && n_air < 3.0, "n_air", "in [1, 3)");
+  Require(std::isfinite(n_glass) && n_glass >= n_air && n_glass < 3.0, "n_glass",
+          "in [n_air, 3)");
+  Require(std::isfinite(n_water) && n_water >= n_air && n_water < 3.0, "n_water",
+          "in [n_air, 3)");
+}
+
+RayTrace TraceOut(const FlatViewport& v, const Ray& ray_in_air) {
+  const RayTrace in_glass = CrossFace(ray_in_air, v.normal, v.distance_m, v.n_air, v.n_glass);
+  if (!in_glass.ok()) return in_glass;
+  return CrossFace(in_glass.ray, v.normal, v.OuterOffset(), v.n_glass, v.n_water);
+}
+
+RayTrace TraceIn(const FlatViewport& v, const Ray& ray_in_water) {
+  const RayTrace in_glass =
+      CrossFace(ray_in_water, v.normal, v.OuterOffset(), v.n_water, v.n_glass);
+  if (!in_glass.ok()) return in_glass;
+  return CrossFace(in_glass.ray, v.normal, v.distance_m, v.n_glass, v.n_air);
+}
+
+DirectionResult DirectionThroughViewport(const FlatViewport& v,
+                                         const Eigen::Vector3d& center_in_air,
+                                         const Eigen::Vector3d& point_in_water) {
+  const Eigen::Vector3d& n = v.normal;
+  const double to_inner = v.distance_m - n.dot(center_in_air);
+  const Eigen::Vector3d offset = point_in_water - center_in_air;
+  const double depth = n.dot(offset);
+  const double in_water = depth - to_inner - v.thickness_m;
+  if (to_inner < 0.0 || in_water <= 0.0) return DirectionResult{HitStatus::kBehind};
+
+  const Eigen::Vector3d radial = offset - depth * n;
+  const double rho = radial.norm();
+  // On the axis (to round-off) the path is straight along the normal.
+  if (rho <= 1e-15 * depth) return DirectionResult{HitStatus::kHit, n, 0};
+
+  const std::array<double, 3> lengths = {to_inner, v.thickness_m, in_water};
+  const std::array<double, 3> ratios = {1.0, v.n_air / v.n_glass, v.n_air / v.n_water};
+  // s = sin(angle in air) lies in [0, s_max): the reach grows monotonically to infinity there.
+  double s_max = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    if (lengths[i] > 0.0) s_max = std::min(s_max, 1.0 / ratios[i]);
+  }
+  double lo = 0.0, hi = s_max;
+  // Start from the straight line: refraction into water only steepens the air angle.
+  double s = std::min(rho / std::hypot(rho, depth), 0.5 * (lo + hi));
+  int iteration = 0;
+  for (; iteration < 200; ++iteration) {
+    const Reach r = RadialReach(s, lengths, ratios);
+    const double f = r.value - rho;
+    if (f == 0.0) break;
+    (f > 0.0 ? hi : lo) = s;
+    double next = s - f / r.derivative;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);  // Newton left the bracket
+    const double step = std::abs(next - s);
+    s = next;
+    if (step <= 2e-16 * s || hi - lo <= 4e-16 * hi) break;
+  }
+  const double cos_air = std::sqrt(1.0 - s * s);
+  return DirectionResult{HitStatus::kHit, cos_air * n + s * (radial / rho), iteration + 1};
+}
+
+}  // namespace uwscan::scanner
