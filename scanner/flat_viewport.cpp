@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "scanner/error.hpp"
@@ -15,11 +16,16 @@ void Require(bool ok, const char* field, const char* expected) {
   if (!ok) throw Error(std::string("viewport: field '") + field + "' must be " + expected);
 }
 
-// Intersects a ray with the plane normal . x = offset; kParallel / kBehind as values.
+// Intersects a ray with the plane normal . x = offset; kParallel / kBehind as values. An
+// origin on the face to round-off (as the rays returned here start) counts as on it, t = 0.
 RayHit HitFace(const Ray& ray, const Eigen::Vector3d& normal, double offset) {
   const double denom = normal.dot(ray.direction);
   if (std::abs(denom) <= 1e-15) return RayHit::Miss(HitStatus::kParallel);
-  const double t = (offset - normal.dot(ray.origin)) / denom;
+  const double gap = offset - normal.dot(ray.origin);
+  const double round_off = 8.0 * std::numeric_limits<double>::epsilon() *
+                           (std::abs(offset) + ray.origin.cwiseAbs().sum());
+  if (std::abs(gap) <= round_off) return RayHit{HitStatus::kHit, 0.0, ray.origin};
+  const double t = gap / denom;
   if (t < 0.0) return RayHit::Miss(HitStatus::kBehind);
   return RayHit{HitStatus::kHit, t, ray.At(t)};
 }
@@ -69,9 +75,23 @@ void FlatViewport::Check() const {
 }
 
 RayTrace TraceOut(const FlatViewport& v, const Ray& ray_in_air) {
-  const RayTrace in_glass = CrossFace(ray_in_air, v.normal, v.distance_m, v.n_air, v.n_glass);
-  if (!in_glass.ok()) return in_glass;
-  return CrossFace(in_glass.ray, v.normal, v.OuterOffset(), v.n_glass, v.n_water);
+  // Closed form for parallel faces (this is on every triangulation's hot path): the component
+  // of the unit direction along the faces scales by n_air / n_medium in each medium, so the
+  // glass only shifts the ray sideways and the water direction follows from air directly.
+  const Eigen::Vector3d& n = v.normal;
+  const double cos_air = n.dot(ray_in_air.direction);
+  if (std::abs(cos_air) <= 1e-15) return RayTrace{HitStatus::kParallel, ray_in_air};
+  const double t = (v.distance_m - n.dot(ray_in_air.origin)) / cos_air;
+  if (cos_air < 0.0 || t < 0.0) return RayTrace{HitStatus::kBehind, ray_in_air};
+  const Eigen::Vector3d along_faces = ray_in_air.direction - cos_air * n;
+  const double sin2_air = along_faces.squaredNorm();
+  const double eta_glass = v.n_air / v.n_glass, eta_water = v.n_air / v.n_water;
+  // n_glass, n_water >= n_air (Check), so neither square root can go negative.
+  const double cos_glass = std::sqrt(std::max(0.0, 1.0 - eta_glass * eta_glass * sin2_air));
+  const double cos_water = std::sqrt(std::max(0.0, 1.0 - eta_water * eta_water * sin2_air));
+  const Eigen::Vector3d exit = ray_in_air.At(t) +
+                               v.thickness_m * ((eta_glass / cos_glass) * along_faces + n);
+  return RayTrace{HitStatus::kHit, Ray{exit, eta_water * along_faces + cos_water * n}};
 }
 
 RayTrace TraceIn(const FlatViewport& v, const Ray& ray_in_water) {

@@ -1,6 +1,7 @@
 #include "scanner/pinhole_camera.hpp"
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -25,6 +26,29 @@ Eigen::Matrix2d DistortJacobian(const PinholeCamera& c, const Eigen::Vector2d& x
   J(1, 0) = 2.0 * x * y * dradial_dr2 + 2.0 * c.p2 * y + 2.0 * c.p1 * x;
   J(1, 1) = radial + 2.0 * y * y * dradial_dr2 + 2.0 * c.p2 * x + 6.0 * c.p1 * y;
   return J;
+}
+
+// True when the radial map r -> r (1 + k1 r^2 + k2 r^4 + k3 r^6) increases strictly on [0, r],
+// i.e. a radius r^2 = u lies on the branch of the model through the origin. The derivative is
+// g(u) = 1 + 3 k1 u + 5 k2 u^2 + 7 k3 u^3 with g(0) = 1; if g(u) > 0 it can only dip to zero
+// inside (0, u) at a minimum, where g'(u) = 3 k1 + 10 k2 u + 21 k3 u^2 vanishes.
+bool OnOriginBranch(const PinholeCamera& c, double u) {
+  const auto g = [&c](double w) {
+    return 1.0 + w * (3.0 * c.k1 + w * (5.0 * c.k2 + w * 7.0 * c.k3));
+  };
+  if (!(g(u) > 0.0)) return false;
+  const double a = 21.0 * c.k3, b = 10.0 * c.k2, k = 3.0 * c.k1;
+  std::array<double, 2> critical = {-1.0, -1.0};
+  if (a == 0.0) {
+    if (b != 0.0) critical[0] = -k / b;
+  } else if (const double disc = b * b - 4.0 * a * k; disc >= 0.0) {
+    critical[0] = (-b + std::sqrt(disc)) / (2.0 * a);
+    critical[1] = (-b - std::sqrt(disc)) / (2.0 * a);
+  }
+  for (const double w : critical) {
+    if (w > 0.0 && w < u && !(g(w) > 0.0)) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -67,11 +91,14 @@ std::optional<Eigen::Vector2d> PinholeCamera::Undistort(const Eigen::Vector2d& u
     const Eigen::Vector2d step = J.inverse() * residual;
     xy -= step;
     if (step.lpNorm<Eigen::Infinity>() <= 1e-15 * (1.0 + xy.lpNorm<Eigen::Infinity>())) {
+      // Newton may converge on an outer branch of the polynomial (beyond the fold): wrong.
+      if (!OnOriginBranch(*this, xy.squaredNorm())) return std::nullopt;
       return xy;
     }
   }
   // Newton stalls at the last ulps on some inputs; accept when the residual is at round-off.
-  if ((Distort(xy) - target).lpNorm<Eigen::Infinity>() <= 1e-14 * (1.0 + target.norm())) {
+  if ((Distort(xy) - target).lpNorm<Eigen::Infinity>() <= 1e-14 * (1.0 + target.norm()) &&
+      OnOriginBranch(*this, xy.squaredNorm())) {
     return xy;
   }
   return std::nullopt;

@@ -1,0 +1,148 @@
+#include "apps/bench_commands.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "apps/json_output.hpp"
+#include "apps/progress_bar.hpp"
+#include "bench/deformation_experiment.hpp"
+#include "bench/triangulation_benchmark.hpp"
+#include "scanner/scanner_model.hpp"
+
+namespace uwscan::app {
+namespace {
+
+// The seed's triangulation comparison (seed 000, "Triangulation method comparison").
+constexpr double kSeedRayRaySeconds = 21.0;
+constexpr double kSeedRayConeSeconds = 5.0;
+constexpr double kSeedRayConeMeanErrM = 0.05e-3;
+constexpr double kSeedRayConeStdErrM = 0.062e-3;
+
+constexpr double kPi = 3.14159265358979323846;
+
+scanner::ScannerModel LoadModel(const std::string& path) {
+  return path.empty() ? scanner::DefaultScannerModel() : scanner::LoadScannerModel(path);
+}
+
+nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
+  nlohmann::json methods = nlohmann::json::object();
+  for (const auto& [name, m] : r.methods) {
+    methods[name] = {{"points_per_s", m.points_per_s},     {"mean_err_m", m.mean_err_m},
+                     {"std_err_m", m.std_err_m},           {"max_err_m", m.max_err_m},
+                     {"seconds", m.seconds},               {"triangulated", m.triangulated}};
+  }
+  const double ratio = r.methods.at("ray_ray").seconds / r.methods.at("ray_cone").seconds;
+  return {{"points", r.points},
+          {"setup_s", r.setup_s},
+          {"exact_vs_truth_max_m", r.exact_vs_truth_max_m},
+          {"methods", methods},
+          {"ray_ray_over_ray_cone_time", ratio},
+          {"seed",
+           {{"ray_ray_s", kSeedRayRaySeconds},
+            {"ray_cone_s", kSeedRayConeSeconds},
+            {"ray_ray_over_ray_cone_time", kSeedRayRaySeconds / kSeedRayConeSeconds},
+            {"ray_cone_mean_err_m", kSeedRayConeMeanErrM},
+            {"ray_cone_std_err_m", kSeedRayConeStdErrM}}}};
+}
+
+void PrintTriangulationTable(const bench::TriangulationBenchResult& r) {
+  std::printf("Triangulation of %lld stripe pixels on one core (errors against exact ray-ray)\n\n",
+              static_cast<long long>(r.points));
+  std::printf("| method | points/s | time s | mean err mm | std err mm | max err mm | points |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|\n");
+  for (const char* name : {"ray_plane", "ray_cone", "ray_ray"}) {
+    const bench::MethodFigures& m = r.methods.at(name);
+    std::printf("| %s | %.3g | %.3f | %.4f | %.4f | %.4f | %lld |\n", name, m.points_per_s,
+                m.seconds, m.mean_err_m * 1e3, m.std_err_m * 1e3, m.max_err_m * 1e3,
+                static_cast<long long>(m.triangulated));
+  }
+  const double ratio = r.methods.at("ray_ray").seconds / r.methods.at("ray_cone").seconds;
+  std::printf("\nray-ray / ray-cone time: %.1fx (seed: %.0f s / %.0f s = %.1fx); ray-cone error "
+              "mean %.4f mm, std %.4f mm (seed: %.2f mm, %.3f mm)\n",
+              ratio, kSeedRayRaySeconds, kSeedRayConeSeconds,
+              kSeedRayRaySeconds / kSeedRayConeSeconds, r.methods.at("ray_cone").mean_err_m * 1e3,
+              r.methods.at("ray_cone").std_err_m * 1e3, kSeedRayConeMeanErrM * 1e3,
+              kSeedRayConeStdErrM * 1e3);
+  std::printf("exact ray-ray against the generating points: max %.3g m; tables built in %.2f s\n",
+              r.exact_vs_truth_max_m, r.setup_s);
+}
+
+struct TriangulationArgs {
+  std::int64_t points = 1'000'000;
+  std::uint64_t seed = 1;
+  std::string scanner_path;
+  std::string json_path;
+};
+
+void RunTriangulation(const TriangulationArgs& args) {
+  bench::TriangulationBenchOptions options;
+  options.points = args.points;
+  options.seed = args.seed;
+  const scanner::ScannerModel model = LoadModel(args.scanner_path);
+  bench::TriangulationBenchResult result;
+  {
+    ProgressBar bar;
+    result = bench::RunTriangulationBenchmark(model, options, bar.Callback());
+  }
+  PrintTriangulationTable(result);
+  if (!args.json_path.empty()) WriteJsonFile(args.json_path, ToJson(result));
+}
+
+void AddTriangulationOptions(CLI::App& command, TriangulationArgs& args) {
+  command.add_option("--points", args.points, "stripe pixels to triangulate")
+      ->check(CLI::PositiveNumber);
+  command.add_option("--seed", args.seed, "random seed of the generated pixels");
+  command.add_option("--scanner", args.scanner_path, "scanner YAML (default: embedded)")
+      ->check(CLI::ExistingFile);
+}
+
+void RunDeformation(const std::string& json_path) {
+  std::vector<bench::DeformationRow> rows;
+  {
+    ProgressBar bar;
+    rows = bench::RunDeformationExperiment(bench::DeformationOptions{}, bar.Callback());
+  }
+  std::printf("Light-surface deformation: 35 rays, 55 deg, n = 1 / 1.49 / 1.33, 5 points per ray\n"
+              "at 100 mm intervals up to 1.5 m from the viewport; RMS orthogonal fit residual\n\n");
+  std::printf("| incidence deg | plane rms mm | cone rms mm |\n|---:|---:|---:|\n");
+  nlohmann::json json_rows = nlohmann::json::array();
+  for (const bench::DeformationRow& row : rows) {
+    const double degrees = row.incidence_rad * 180.0 / kPi;
+    std::printf("| %.1f | %.4f | %.6f%s |\n", degrees, row.plane_rms_m * 1e3, row.cone_rms_m * 1e3,
+                row.cone_converged ? "" : " (not converged)");
+    json_rows.push_back({{"incidence_deg", degrees},
+                         {"plane_rms_m", row.plane_rms_m},
+                         {"cone_rms_m", row.cone_rms_m},
+                         {"cone_converged", row.cone_converged}});
+  }
+  if (!json_path.empty()) WriteJsonFile(json_path, {{"rows", json_rows}});
+}
+
+}  // namespace
+
+void AddBenchCommands(CLI::App& bench) {
+  auto triangulation_args = std::make_shared<TriangulationArgs>();
+  CLI::App* triangulation = bench.add_subcommand(
+      "triangulation", "ray-plane vs ray-cone vs exact ray-ray: speed and accuracy");
+  AddTriangulationOptions(*triangulation, *triangulation_args);
+  triangulation->add_option("--json", triangulation_args->json_path, "write the figures as JSON");
+  triangulation->callback([triangulation_args] { RunTriangulation(*triangulation_args); });
+
+  auto deformation_json = std::make_shared<std::string>();
+  CLI::App* deformation = bench.add_subcommand(
+      "deformation", "the seed's plane-vs-cone fit of a refracted laser fan per incidence angle");
+  deformation->add_option("--json", *deformation_json, "write the rows as JSON");
+  deformation->callback([deformation_json] { RunDeformation(*deformation_json); });
+}
+
+void AddDemoCommand(CLI::App& app) {
+  auto args = std::make_shared<TriangulationArgs>();
+  CLI::App* demo = app.add_subcommand(
+      "demo", "triangulation comparison on the default scanner (the main job, for now)");
+  AddTriangulationOptions(*demo, *args);
+  demo->callback([args] { RunTriangulation(*args); });
+}
+
+}  // namespace uwscan::app

@@ -1,0 +1,12 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace uwscan::app {
+
+// Writes JSON to `path` atomically (a temporary file renamed over the target), so an earlier
+// file stays readable if anything fails. Throws uwscan::Error naming the path.
+void WriteJsonFile(const std::string& path, const nlohmann::json& value);
+
+}  // namespace uwscan::app

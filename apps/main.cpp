@@ -1,0 +1,32 @@
+// uwscan: the command-line program. Parses arguments and calls the libraries; errors end with
+// a one-line reason on stderr and a non-zero exit.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "apps/bench_commands.hpp"
+#include "scanner/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"uwscan: underwater laser scanner perception toolkit"};
+  app.set_version_flag("--version", std::string("uwscan ") + UWSCAN_VERSION);
+  app.require_subcommand(1);
+
+  uwscan::app::AddDemoCommand(app);
+  CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
+  bench->require_subcommand(1);
+  uwscan::app::AddBenchCommands(*bench);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const uwscan::Error& e) {
+    std::fprintf(stderr, "uwscan: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "uwscan: internal error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,185 @@
+#include "bench/triangulation_benchmark.hpp"
+
+#include <chrono>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "scanner/error.hpp"
+#include "scanner/ray_ray_triangulator.hpp"
+#include "scanner/surface_triangulators.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct Frame {
+  int step = 0;
+  std::vector<Eigen::Vector2d> peaks_px;
+  std::vector<Eigen::Vector3d> truth_C;
+};
+
+// A stripe detector scans the image row by row and emits its peaks in that order.
+void SortLikeADetector(Frame* frame) {
+  std::vector<size_t> order(frame->peaks_px.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const Eigen::Vector2d& pa = frame->peaks_px[a];
+    const Eigen::Vector2d& pb = frame->peaks_px[b];
+    return pa.y() != pb.y() ? pa.y() < pb.y() : pa.x() < pb.x();
+  });
+  Frame sorted;
+  sorted.step = frame->step;
+  for (size_t i : order) {
+    sorted.peaks_px.push_back(frame->peaks_px[i]);
+    sorted.truth_C.push_back(frame->truth_C[i]);
+  }
+  *frame = std::move(sorted);
+}
+
+// Draws exact fan points in the depth range and keeps those the camera sees.
+std::vector<Frame> MakeFrames(const scanner::ScannerModel& model,
+                              const TriangulationBenchOptions& o, const Progress& progress) {
+  std::mt19937_64 rng(o.seed);
+  const scanner::GalvoLaser& laser = model.laser;
+  std::uniform_int_distribution<int> step_dist(laser.step_min, laser.step_max);
+  const double half_aperture = 0.5 * laser.aperture_rad;
+  std::uniform_real_distribution<double> angle_dist(-half_aperture, half_aperture);
+  std::uniform_real_distribution<double> depth_dist(o.depth_min_m, o.depth_max_m);
+
+  std::vector<Frame> frames;
+  std::int64_t total = 0;
+  while (total < o.points) {
+    Frame frame;
+    frame.step = step_dist(rng);
+    const scanner::LaserFan fan = laser.FanAtStep(frame.step);
+    const std::int64_t want = std::min<std::int64_t>(o.points_per_frame, o.points - total);
+    // Bounded attempts: a step whose fan the camera hardly sees yields a short frame.
+    for (std::int64_t attempt = 0; attempt < 20 * want && std::ssize(frame.peaks_px) < want;
+         ++attempt) {
+      const double angle = angle_dist(rng);
+      const double depth = depth_dist(rng);
+      const scanner::RayTrace ray = fan.RayInWater(std::tan(angle));
+      if (!ray.ok() || ray.ray.direction.z() <= 1e-6) continue;
+      const Eigen::Vector3d p = ray.ray.At((depth - ray.ray.origin.z()) / ray.ray.direction.z());
+      const std::optional<Eigen::Vector2d> uv = model.camera.ProjectPointInWater(p);
+      if (!uv || !model.camera.camera.InImage(*uv)) continue;
+      frame.peaks_px.push_back(*uv);
+      frame.truth_C.push_back(p);
+    }
+    SortLikeADetector(&frame);
+    total += std::ssize(frame.peaks_px);
+    if (!frame.peaks_px.empty()) frames.push_back(std::move(frame));
+    if (progress) progress("generating stripe pixels", static_cast<double>(total) / o.points);
+  }
+  return frames;
+}
+
+// Triangulates every frame `repeats` times; returns the fastest pass's time spent in
+// TriangulateFrame only (the fastest pass is the one least disturbed by the shared machine).
+double RunMethod(const scanner::Triangulator& method, const std::vector<Frame>& frames,
+                 int repeats, std::vector<std::vector<scanner::TriangulatedPoint>>* results,
+                 const Progress& progress) {
+  results->resize(frames.size());
+  for (size_t f = 0; f < frames.size(); ++f) (*results)[f].resize(frames[f].peaks_px.size());
+  double best = std::numeric_limits<double>::infinity();
+  for (int pass = 0; pass < repeats; ++pass) {
+    const Clock::time_point start = Clock::now();
+    for (size_t f = 0; f < frames.size(); ++f) {
+      method.TriangulateFrame(frames[f].step, frames[f].peaks_px, (*results)[f]);
+    }
+    best = std::min(best, SecondsSince(start));
+    if (progress) progress(ToString(method.method()), (pass + 1.0) / repeats);
+  }
+  return best;
+}
+
+// Mean, standard deviation and maximum of |method - reference| over points both produced.
+void CompareTo(const std::vector<std::vector<scanner::TriangulatedPoint>>& result,
+               const std::vector<std::vector<scanner::TriangulatedPoint>>& reference,
+               MethodFigures* figures) {
+  double sum = 0.0, sum2 = 0.0, max = 0.0;
+  std::int64_t n = 0, triangulated = 0;
+  for (size_t f = 0; f < result.size(); ++f) {
+    for (size_t i = 0; i < result[f].size(); ++i) {
+      if (!result[f][i].ok()) continue;
+      ++triangulated;
+      if (!reference[f][i].ok()) continue;
+      const double e = (result[f][i].p_C - reference[f][i].p_C).norm();
+      sum += e, sum2 += e * e, max = std::max(max, e), ++n;
+    }
+  }
+  figures->triangulated = triangulated;
+  if (n == 0) return;
+  figures->mean_err_m = sum / n;
+  figures->std_err_m = std::sqrt(std::max(0.0, sum2 / n - figures->mean_err_m * figures->mean_err_m));
+  figures->max_err_m = max;
+}
+
+}  // namespace
+
+void TriangulationBenchOptions::Check() const {
+  if (points < 1) throw Error("bench triangulation: --points must be >= 1");
+  if (points_per_frame < 1) throw Error("bench triangulation: points_per_frame must be >= 1");
+  if (!(depth_min_m > 0.0 && depth_max_m > depth_min_m)) {
+    throw Error("bench triangulation: need 0 < depth_min_m < depth_max_m");
+  }
+  if (repeats < 1) throw Error("bench triangulation: repeats must be >= 1");
+  if (camera_grid_px < 1) throw Error("bench triangulation: camera_grid_px must be >= 1");
+  surfaces.Check();
+}
+
+TriangulationBenchResult RunTriangulationBenchmark(const scanner::ScannerModel& model,
+                                                   const TriangulationBenchOptions& o,
+                                                   const Progress& progress) {
+  o.Check();
+  model.Check();
+  TriangulationBenchResult result;
+
+  Clock::time_point start = Clock::now();
+  if (progress) progress("fitting planes and cones per mirror step", 0.0);
+  auto rays = std::make_shared<const scanner::CameraRayTable>(model.camera, o.camera_grid_px);
+  auto surfaces = std::make_shared<const scanner::LightSurfaceTable>(model.laser, o.surfaces);
+  const scanner::RayPlaneTriangulator ray_plane(rays, surfaces);
+  const scanner::RayConeTriangulator ray_cone(rays, surfaces);
+  const scanner::RayRayTriangulator ray_ray(model);
+  result.setup_s = SecondsSince(start);
+  if (progress) progress("fitting planes and cones per mirror step", 1.0);
+
+  const std::vector<Frame> frames = MakeFrames(model, o, progress);
+  for (const Frame& f : frames) result.points += std::ssize(f.peaks_px);
+
+  std::vector<std::vector<scanner::TriangulatedPoint>> exact, approximate;
+  MethodFigures& exact_figures = result.methods[ToString(scanner::TriangulationMethod::kRayRay)];
+  exact_figures.seconds = RunMethod(ray_ray, frames, o.repeats, &exact, progress);
+  CompareTo(exact, exact, &exact_figures);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    for (size_t i = 0; i < frames[f].truth_C.size(); ++i) {
+      if (!exact[f][i].ok()) continue;
+      result.exact_vs_truth_max_m =
+          std::max(result.exact_vs_truth_max_m, (exact[f][i].p_C - frames[f].truth_C[i]).norm());
+    }
+  }
+  for (const scanner::Triangulator* method :
+       {static_cast<const scanner::Triangulator*>(&ray_plane),
+        static_cast<const scanner::Triangulator*>(&ray_cone)}) {
+    MethodFigures& figures = result.methods[ToString(method->method())];
+    figures.seconds = RunMethod(*method, frames, o.repeats, &approximate, progress);
+    CompareTo(approximate, exact, &figures);
+  }
+  for (auto& [name, figures] : result.methods) {
+    figures.points_per_s = figures.seconds > 0.0 ? result.points / figures.seconds : 0.0;
+  }
+  return result;
+}
+
+}  // namespace uwscan::bench

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "bench/progress.hpp"
+#include "scanner/light_surface_table.hpp"
+#include "scanner/scanner_model.hpp"
+#include "scanner/triangulator.hpp"
+
+namespace uwscan::bench {
+
+// What accuracy costs in time: the same stripe pixels triangulated by ray-plane, ray-cone and
+// exact ray-ray on one core. Pixels come from exact points on the laser fan (uniform over the
+// fan aperture, the mirror sweep and the camera depth range), projected exactly through the
+// camera viewport, grouped in frames of `points_per_frame` peaks as a scanner delivers them.
+struct TriangulationBenchOptions {
+  std::int64_t points = 1'000'000;
+  int points_per_frame = 1000;
+  double depth_min_m = 0.5;  // seed's working range
+  double depth_max_m = 1.5;
+  std::uint64_t seed = 1;
+  int repeats = 3;  // passes per method; the fastest is reported
+  int camera_grid_px = 4;
+  scanner::LightSurfaceTableOptions surfaces;
+
+  void Check() const;
+};
+
+struct MethodFigures {
+  double seconds = 0.0;  // triangulation time only, one core, fastest pass
+  double points_per_s = 0.0;
+  std::int64_t triangulated = 0;  // points with a result
+  // Against exact ray-ray on the points both produced.
+  double mean_err_m = 0.0;
+  double std_err_m = 0.0;
+  double max_err_m = 0.0;
+};
+
+struct TriangulationBenchResult {
+  std::int64_t points = 0;
+  double setup_s = 0.0;              // tables: camera rays, plane and cone fits per step
+  double exact_vs_truth_max_m = 0.0;  // ray-ray against the generating points
+  std::map<std::string, MethodFigures> methods;  // keyed by ToString(method)
+};
+
+TriangulationBenchResult RunTriangulationBenchmark(const scanner::ScannerModel& model,
+                                                   const TriangulationBenchOptions& options,
+                                                   const Progress& progress = {});
+
+}  // namespace uwscan::bench

@@ -1,0 +1,97 @@
+#include "scanner/surface_triangulators.hpp"
+
+#include <cassert>
+#include <cmath>
+
+#include "scanner/error.hpp"
+
+namespace uwscan::scanner {
+namespace {
+
+// How many peaks ahead the camera-ray table is prefetched (about one memory latency of work).
+constexpr size_t kPrefetchAhead = 8;
+
+void MarkAll(std::span<TriangulatedPoint> out, HitStatus status) {
+  for (TriangulatedPoint& p : out) p = TriangulatedPoint{Eigen::Vector3d::Zero(), status};
+}
+
+}  // namespace
+
+void TriangulationOptions::Check() const {
+  if (!(min_angle_rad >= 0.0 && min_angle_rad < 1.0)) {
+    throw Error("triangulation: min_angle_rad must be in [0, 1) rad");
+  }
+}
+
+RayPlaneTriangulator::RayPlaneTriangulator(std::shared_ptr<const CameraRayTable> rays,
+                                           std::shared_ptr<const LightSurfaceTable> surfaces,
+                                           const TriangulationOptions& options)
+    : rays_(std::move(rays)),
+      surfaces_(std::move(surfaces)),
+      min_sin2_angle_(std::pow(std::sin(options.min_angle_rad), 2)) {
+  options.Check();
+  if (!rays_ || !surfaces_) throw Error("ray-plane triangulator: missing tables");
+}
+
+void RayPlaneTriangulator::TriangulateFrame(int mirror_step,
+                                            std::span<const Eigen::Vector2d> peaks_px,
+                                            std::span<TriangulatedPoint> out) const {
+  assert(out.size() == peaks_px.size());
+  const LightSurfaces* surface = surfaces_->At(mirror_step);
+  if (surface == nullptr) return MarkAll(out, HitStatus::kOutsideSurface);
+  const Eigen::Vector3d n = surface->plane.normal;
+  const double offset = surface->plane.offset_m;
+  Ray ray;
+  for (size_t i = 0; i < peaks_px.size(); ++i) {
+    if (i + kPrefetchAhead < peaks_px.size()) {
+      rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
+    }
+    TriangulatedPoint& result = out[i];
+    if (!rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray)) {
+      result.status = HitStatus::kNoIntersection;
+      continue;
+    }
+    const double denom = n.dot(ray.direction);
+    const double t = (offset - n.dot(ray.origin)) / denom;
+    // Grazing rays: |cos| of the angle to the normal below sin(min_angle) * |d|.
+    if (denom * denom <= min_sin2_angle_ * ray.direction.squaredNorm()) {
+      result.status = HitStatus::kParallel;
+    } else if (t < 0.0) {
+      result.status = HitStatus::kBehind;
+    } else {
+      result.p_C = ray.origin + t * ray.direction;
+      result.status = HitStatus::kHit;
+    }
+  }
+}
+
+RayConeTriangulator::RayConeTriangulator(std::shared_ptr<const CameraRayTable> rays,
+                                         std::shared_ptr<const LightSurfaceTable> surfaces)
+    : rays_(std::move(rays)), surfaces_(std::move(surfaces)) {
+  if (!rays_ || !surfaces_) throw Error("ray-cone triangulator: missing tables");
+}
+
+void RayConeTriangulator::TriangulateFrame(int mirror_step,
+                                           std::span<const Eigen::Vector2d> peaks_px,
+                                           std::span<TriangulatedPoint> out) const {
+  assert(out.size() == peaks_px.size());
+  const LightSurfaces* surface = surfaces_->At(mirror_step);
+  if (surface == nullptr) return MarkAll(out, HitStatus::kOutsideSurface);
+  const PreparedCone cone = PrepareCone(surface->cone);
+  Ray ray;
+  for (size_t i = 0; i < peaks_px.size(); ++i) {
+    if (i + kPrefetchAhead < peaks_px.size()) {
+      rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
+    }
+    TriangulatedPoint& result = out[i];
+    if (!rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray)) {
+      result.status = HitStatus::kNoIntersection;
+      continue;
+    }
+    const RayHit hit = IntersectRayCone(ray, cone);
+    result.status = hit.status;
+    result.p_C = hit.point;
+  }
+}
+
+}  // namespace uwscan::scanner

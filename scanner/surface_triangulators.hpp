@@ -1,0 +1,50 @@
+#pragma once
+
+#include <memory>
+
+#include "scanner/camera_ray_table.hpp"
+#include "scanner/light_surface_table.hpp"
+#include "scanner/triangulator.hpp"
+
+namespace uwscan::scanner {
+
+// Options shared by the triangulators.
+struct TriangulationOptions {
+  // Below this angle between the camera ray and the light surface (plane, cone) or the laser
+  // ray (ray-ray) the point is reported kParallel: depth would be unreliable.
+  double min_angle_rad = 0.5 * 3.14159265358979323846 / 180.0;
+  void Check() const;
+};
+
+// Camera ray (from the table) against the plane fitted to the step's light surface.
+class RayPlaneTriangulator final : public Triangulator {
+ public:
+  RayPlaneTriangulator(std::shared_ptr<const CameraRayTable> rays,
+                       std::shared_ptr<const LightSurfaceTable> surfaces,
+                       const TriangulationOptions& options = {});
+  TriangulationMethod method() const override { return TriangulationMethod::kRayPlane; }
+  void TriangulateFrame(int mirror_step, std::span<const Eigen::Vector2d> peaks_px,
+                        std::span<TriangulatedPoint> out) const override;
+
+ private:
+  std::shared_ptr<const CameraRayTable> rays_;
+  std::shared_ptr<const LightSurfaceTable> surfaces_;
+  double min_sin2_angle_;
+};
+
+// Camera ray (from the table) against the elliptic cone fitted to the step's light surface,
+// in closed form.
+class RayConeTriangulator final : public Triangulator {
+ public:
+  RayConeTriangulator(std::shared_ptr<const CameraRayTable> rays,
+                      std::shared_ptr<const LightSurfaceTable> surfaces);
+  TriangulationMethod method() const override { return TriangulationMethod::kRayCone; }
+  void TriangulateFrame(int mirror_step, std::span<const Eigen::Vector2d> peaks_px,
+                        std::span<TriangulatedPoint> out) const override;
+
+ private:
+  std::shared_ptr<const CameraRayTable> rays_;
+  std::shared_ptr<const LightSurfaceTable> surfaces_;
+};
+
+}  // namespace uwscan::scanner
