@@ -203,7 +203,8 @@ ConeFit FitCone(std::span<const Eigen::Vector3d> points_in_C,
 
   ConeFit fit;
   fit.converged = summary.termination_type == ceres::CONVERGENCE;
-  fit.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+  // summary.iterations starts with the evaluation at the initial point (iteration 0).
+  fit.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);
   EllipticCone& cone = fit.cone;
   const auto& q = params.q_wxyz;
   cone.T_C_Q.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();

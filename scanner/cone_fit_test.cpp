@@ -12,6 +12,7 @@
 
 #include "scanner/error.hpp"
 #include "scanner/light_cone.hpp"
+#include "scanner/light_plane.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -236,8 +237,8 @@ TEST(FitCone, ThrowsOnBadInput) {
   EXPECT_THROW(fit(data.points_C, nan_vector, data.apex_hint_C), Error);
   EXPECT_THROW(fit(data.points_C, data.propagation_dir_C, nan_vector), Error);
   EXPECT_THROW(fit(data.points_C, Eigen::Vector3d::Zero(), data.apex_hint_C), Error);
-  // Propagation along the normal of the fan's plane: no axis in the plane.
-  const Eigen::Vector3d normal_C = data.truth.T_C_Q.linear().col(1);
+  // Propagation along the normal of the points' plane: no axis in the plane.
+  const Eigen::Vector3d normal_C = FitPlane(data.points_C).plane.normal;
   EXPECT_THROW(fit(data.points_C, normal_C, data.apex_hint_C), Error);
   // Apex hint in front of the points.
   EXPECT_THROW(

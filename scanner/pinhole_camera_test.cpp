@@ -110,10 +110,10 @@ TEST_P(PinholeCameraBothTest, UndistortMatchesConvergedOpenCvOverWholeImage) {
   std::vector<cv::Point2d> pixels;
   for (const Eigen::Vector2d& uv : grid) pixels.emplace_back(uv.x(), uv.y());
   std::vector<cv::Point2d> expected;
-  cv::undistortPoints(pixels, expected, CameraMatrix(camera), DistortionCoefficients(camera),
-                      cv::noArray(), cv::noArray(),
-                      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 1000,
-                                       1e-15));
+  cv::undistortPoints(
+      pixels, expected, CameraMatrix(camera), DistortionCoefficients(camera), cv::noArray(),
+      cv::noArray(),
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 1000, 1e-15));
   double max_error = 0.0;
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const std::optional<Eigen::Vector2d> xy = camera.Undistort(grid[i]);
@@ -232,8 +232,8 @@ TEST_P(PinholeCameraFoldTest, UndistortReportsWhereTheRadialModelFoldsOver) {
         ASSERT_TRUE(xy.has_value()) << "rd " << rd << " angle " << angle;
       }
       if (rd > rd_fold) {
-        ASSERT_FALSE(xy.has_value()) << "rd " << rd << " angle " << angle << " gave "
-                                     << xy->transpose();
+        ASSERT_FALSE(xy.has_value())
+            << "rd " << rd << " angle " << angle << " gave " << xy->transpose();
       }
       if (xy) {  // whatever is returned must be the true inverse on the origin's branch
         EXPECT_LT(xy->norm(), r_fold) << "rd " << rd << " angle " << angle;

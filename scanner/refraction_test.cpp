@@ -24,9 +24,7 @@ Eigen::Vector3d RandomUnit(std::mt19937& rng) {
   return Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
 }
 
-double SinToNormal(const Eigen::Vector3d& d, const Eigen::Vector3d& n) {
-  return d.cross(n).norm();
-}
+double SinToNormal(const Eigen::Vector3d& d, const Eigen::Vector3d& n) { return d.cross(n).norm(); }
 
 // A unit direction at `angle_rad` from the normal n, heading along n, in the plane of n and t.
 Eigen::Vector3d AtAngle(const Eigen::Vector3d& n, const Eigen::Vector3d& t, double angle_rad) {
@@ -155,7 +153,7 @@ TEST(RefractionTest, ReflectPreservesAngleAndLength) {
     for (const Eigen::Vector3d& normal : {n, Eigen::Vector3d(-n)}) {
       const Eigen::Vector3d r = Reflect(d, normal);
       EXPECT_NEAR(r.norm(), d.norm(), 1e-15 * d.norm());
-      EXPECT_NEAR(r.dot(n), -d.dot(n), 1e-15 * d.norm());      // angle to the normal kept
+      EXPECT_NEAR(r.dot(n), -d.dot(n), 1e-15 * d.norm());        // angle to the normal kept
       EXPECT_LT((r - r.dot(n) * n - (d - d.dot(n) * n)).norm(),  // tangential part unchanged
                 1e-14 * d.norm());
       EXPECT_LT((Reflect(r, normal) - d).norm(), 1e-14 * d.norm());  // an involution

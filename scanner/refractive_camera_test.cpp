@@ -39,8 +39,7 @@ double MaxRoundTripErrorPx(const RefractiveCamera& camera) {
   double max_error_px = 0.0;
   for (const Eigen::Vector2d& uv : WholeImageGrid(camera.camera)) {
     const RayTrace in_water = camera.PixelToRayInWater(uv);
-    EXPECT_TRUE(in_water.ok()) << "pixel " << uv.transpose() << ": "
-                               << ToString(in_water.status);
+    EXPECT_TRUE(in_water.ok()) << "pixel " << uv.transpose() << ": " << ToString(in_water.status);
     if (!in_water.ok()) continue;
     for (double range_m : {0.2, 1.0, 5.0}) {
       const std::optional<Eigen::Vector2d> back =
@@ -71,8 +70,8 @@ TEST(RefractiveCameraTest, RoundTripOverWholeImageViewportTilted20Deg) {
       Eigen::AngleAxisd(20.0 * kDeg, Eigen::Vector3d(0.6, 0.8, 0.0)) * Eigen::Vector3d::UnitZ();
   ASSERT_NO_THROW(camera.Check());
   const double max_error_px = MaxRoundTripErrorPx(camera);
-  std::cout << "[ measured ] viewport tilted 20 deg: max pixel round-trip error "
-            << max_error_px << " px\n";
+  std::cout << "[ measured ] viewport tilted 20 deg: max pixel round-trip error " << max_error_px
+            << " px\n";
 }
 
 TEST(RefractiveCameraTest, PointsNotInFrontOfTheViewportDoNotProject) {

@@ -30,7 +30,7 @@ FlatViewport ReadViewport(const yaml::Context& where, const YAML::Node& node) {
   FlatViewport v;
   v.normal = yaml::Vector3(where, node, "normal");
   if (std::abs(v.normal.norm() - 1.0) > 1e-6) {
-    yaml::Fail(yaml::Enter(where, "normal"), node, "expected a unit vector");
+    yaml::Fail(yaml::Enter(where, "normal"), node["normal"], "expected a unit vector");
   }
   v.normal.normalize();
   v.distance_m = yaml::Number(where, node, "distance_m");

@@ -83,7 +83,8 @@ Eigen::Isometry3d Pose(const Context& where, const YAML::Node& node, const std::
   const Eigen::Vector3d t = Vector3(here, pose, "translation_m");
   const Eigen::Vector4d q = Vector(here, pose, "rotation_xyzw", 4);
   if (std::abs(q.norm() - 1.0) > 1e-6) {
-    Fail(Enter(here, "rotation_xyzw"), pose, "expected a unit quaternion [qx, qy, qz, qw]");
+    Fail(Enter(here, "rotation_xyzw"), pose["rotation_xyzw"],
+         "expected a unit quaternion [qx, qy, qz, qw]");
   }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
