@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -9,6 +10,7 @@
 #include "apps/progress_bar.hpp"
 #include "bench/deformation_experiment.hpp"
 #include "bench/triangulation_benchmark.hpp"
+#include "scanner/error.hpp"
 #include "scanner/scanner_model.hpp"
 
 namespace uwscan::app {
@@ -21,6 +23,15 @@ constexpr double kSeedRayConeMeanErrM = 0.05e-3;
 constexpr double kSeedRayConeStdErrM = 0.062e-3;
 
 constexpr double kPi = 3.14159265358979323846;
+
+// Fails before a long run rather than after it when the JSON could not be written.
+void CheckOutputPath(const std::string& path) {
+  if (path.empty()) return;
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw Error(path + ": cannot write: folder '" + parent.string() + "' does not exist");
+  }
+}
 
 scanner::ScannerModel LoadModel(const std::string& path) {
   return path.empty() ? scanner::DefaultScannerModel() : scanner::LoadScannerModel(path);
@@ -77,6 +88,7 @@ struct TriangulationArgs {
 };
 
 void RunTriangulation(const TriangulationArgs& args) {
+  CheckOutputPath(args.json_path);
   bench::TriangulationBenchOptions options;
   options.points = args.points;
   options.seed = args.seed;
@@ -99,6 +111,7 @@ void AddTriangulationOptions(CLI::App& command, TriangulationArgs& args) {
 }
 
 void RunDeformation(const std::string& json_path) {
+  CheckOutputPath(json_path);
   std::vector<bench::DeformationRow> rows;
   {
     ProgressBar bar;

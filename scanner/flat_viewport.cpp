@@ -40,21 +40,24 @@ RayTrace CrossFace(const Ray& ray, const Eigen::Vector3d& normal, double offset,
   return RayTrace{HitStatus::kHit, Ray{hit.point, *refracted}};
 }
 
-// In the plane of refraction: the radial reach of the path at axial depth `depth_m` beyond
-// the centre, as a function of s = sin(angle in air), and its derivative.
+// In the plane of refraction: the radial reach of the path at the point's depth as a function
+// of u = tan(angle in air), and its derivative. In a medium whose sine is k times the air's,
+// tan = k u / sqrt(1 + (1 - k^2) u^2). With u (not the sine) as unknown the reach is linear in
+// air plus concave terms, so Newton started on the near side converges without overshoot
+// even at grazing angles, where the sine would be pinned against 1.
 struct Reach {
   double value;
   double derivative;
 };
-Reach RadialReach(double s, const std::array<double, 3>& lengths,
+Reach RadialReach(double u, const std::array<double, 3>& lengths,
                   const std::array<double, 3>& ratios) {
   Reach r{0.0, 0.0};
   for (int i = 0; i < 3; ++i) {
-    const double sin_i = ratios[i] * s;
-    const double cos2 = 1.0 - sin_i * sin_i;
-    const double cos_i = std::sqrt(cos2);
-    r.value += lengths[i] * sin_i / cos_i;
-    r.derivative += lengths[i] * ratios[i] / (cos2 * cos_i);
+    const double k = ratios[i];
+    const double w = 1.0 + (1.0 - k * k) * u * u;
+    const double root = std::sqrt(w);
+    r.value += lengths[i] * k * u / root;
+    r.derivative += lengths[i] * k / (w * root);
   }
   return r;
 }
@@ -118,28 +121,29 @@ DirectionResult DirectionThroughViewport(const FlatViewport& v,
 
   const std::array<double, 3> lengths = {to_inner, v.thickness_m, in_water};
   const std::array<double, 3> ratios = {1.0, v.n_air / v.n_glass, v.n_air / v.n_water};
-  // s = sin(angle in air) lies in [0, s_max): the reach grows monotonically to infinity there.
-  double s_max = 1.0;
-  for (int i = 0; i < 3; ++i) {
-    if (lengths[i] > 0.0) s_max = std::min(s_max, 1.0 / ratios[i]);
-  }
-  double lo = 0.0, hi = s_max;
-  // Start from the straight line: refraction into water only steepens the air angle.
-  double s = std::min(rho / std::hypot(rho, depth), 0.5 * (lo + hi));
+  // The root lies in [rho / depth, rho / to_inner]: refraction into denser media only
+  // steepens the air angle, and the air leg alone must not overshoot. With the centre on the
+  // inner face the reach is bounded; then points beyond it cannot be seen (kNoIntersection).
+  double lo = rho / depth;
+  double hi = to_inner > 0.0 ? rho / to_inner : 1e12;
+  double u = lo;
   int iteration = 0;
-  for (; iteration < 200; ++iteration) {
-    const Reach r = RadialReach(s, lengths, ratios);
+  for (; iteration < 100; ++iteration) {
+    const Reach r = RadialReach(u, lengths, ratios);
     const double f = r.value - rho;
     if (f == 0.0) break;
-    (f > 0.0 ? hi : lo) = s;
-    double next = s - f / r.derivative;
+    (f > 0.0 ? hi : lo) = u;
+    double next = u - f / r.derivative;
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);  // Newton left the bracket
-    const double step = std::abs(next - s);
-    s = next;
-    if (step <= 2e-16 * s || hi - lo <= 4e-16 * hi) break;
+    const double step = std::abs(next - u);
+    u = next;
+    if (step <= 2e-16 * u || hi - lo <= 4e-16 * hi) break;
   }
-  const double cos_air = std::sqrt(1.0 - s * s);
-  return DirectionResult{HitStatus::kHit, cos_air * n + s * (radial / rho), iteration + 1};
+  if (std::abs(RadialReach(u, lengths, ratios).value - rho) > 1e-9 * (rho + depth)) {
+    return DirectionResult{HitStatus::kNoIntersection};
+  }
+  const double cos_air = 1.0 / std::sqrt(1.0 + u * u);
+  return DirectionResult{HitStatus::kHit, cos_air * (n + u * (radial / rho)), iteration + 1};
 }
 
 }  // namespace uwscan::scanner

@@ -44,9 +44,10 @@ RayTrace TraceIn(const FlatViewport& viewport, const Ray& ray_in_water);
 
 // The direction in air, leaving `center_in_air`, whose refracted path through the viewport
 // passes exactly through `point_in_water`. Solved in the plane of refraction (the plane
-// through the centre containing the normal and the point) as one unknown, the sine of the
+// through the centre containing the normal and the point) as one unknown, the tangent of the
 // angle in air, by Newton's method kept inside a bracket that always contains the root.
-// kBehind when the point is not beyond the outer face or the centre not inside the housing.
+// kBehind when the point is not beyond the outer face or the centre not inside the housing;
+// kNoIntersection when the centre lies on the inner face and the point is beyond reach.
 struct DirectionResult {
   HitStatus status = HitStatus::kNoIntersection;
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();

@@ -1,0 +1,123 @@
+// Runs the `uwscan` program the way a user does and checks what it prints and writes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+struct CommandRun {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+CommandRun RunUwscan(const std::string& arguments) {
+  const std::string command = std::string(UWSCAN_BIN) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::filesystem::path TempPath(const std::string& name) {
+  return std::filesystem::temp_directory_path() /
+         ("uwscan_cli_test_" + std::to_string(getpid()) + "_" + name);
+}
+
+nlohmann::json ReadJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST(Cli, VersionAndHelp) {
+  const CommandRun version = RunUwscan("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_NE(version.output.find("uwscan"), std::string::npos);
+  const CommandRun help = RunUwscan("bench triangulation --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("--points"), std::string::npos);
+}
+
+TEST(Cli, BadInputEndsWithOneLineReason) {
+  const CommandRun no_command = RunUwscan("");
+  EXPECT_NE(no_command.exit_code, 0);
+  const CommandRun unknown = RunUwscan("frobnicate");
+  EXPECT_NE(unknown.exit_code, 0);
+  const CommandRun missing = RunUwscan("bench triangulation --scanner /nonexistent/scanner.yaml");
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find("/nonexistent/scanner.yaml"), std::string::npos);
+  const CommandRun negative = RunUwscan("bench triangulation --points -5");
+  EXPECT_NE(negative.exit_code, 0);
+}
+
+TEST(Cli, MalformedScannerFileNamesTheField) {
+  const std::filesystem::path yaml = TempPath("bad.yaml");
+  std::ifstream in(std::string(UWSCAN_SOURCE_DIR) + "/data/scanners/galvo_default.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = text.find("fx_px: 1750.0");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 13, "fx_px: fast");
+  std::ofstream(yaml) << text;
+  const CommandRun run = RunUwscan("bench triangulation --points 10 --scanner " + yaml.string());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("camera.fx_px"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(yaml.string() + ":"), std::string::npos) << run.output;
+  std::filesystem::remove(yaml);
+}
+
+TEST(Cli, TriangulationBenchWritesItsJson) {
+  const std::filesystem::path json = TempPath("triangulation.json");
+  const CommandRun run = RunUwscan("bench triangulation --points 20000 --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("| ray_cone |"), std::string::npos);
+  const nlohmann::json j = ReadJson(json);
+  for (const char* method : {"ray_plane", "ray_cone", "ray_ray"}) {
+    const nlohmann::json& m = j.at("methods").at(method);
+    EXPECT_GT(m.at("points_per_s").get<double>(), 0.0) << method;
+    for (const char* key : {"mean_err_m", "std_err_m", "max_err_m"}) {
+      EXPECT_TRUE(m.at(key).is_number()) << method << " " << key;
+    }
+  }
+  // Accuracy holds whatever the machine's speed: ray-cone within the seed's 0.05 mm, ray-plane
+  // visibly worse, exact ray-ray on its own generating points to numerical precision.
+  EXPECT_LT(j["methods"]["ray_cone"]["mean_err_m"].get<double>(), 0.05e-3);
+  EXPECT_GT(j["methods"]["ray_plane"]["mean_err_m"].get<double>(),
+            10 * j["methods"]["ray_cone"]["mean_err_m"].get<double>());
+  EXPECT_LT(j["exact_vs_truth_max_m"].get<double>(), 1e-9);
+  EXPECT_EQ(j["points"].get<int>(), 20000);
+  std::filesystem::remove(json);
+}
+
+TEST(Cli, DeformationBenchReproducesTheSeedsTrend) {
+  const std::filesystem::path json = TempPath("deformation.json");
+  const CommandRun run = RunUwscan("bench deformation --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json rows = ReadJson(json).at("rows");
+  ASSERT_EQ(rows.size(), 21u);
+  EXPECT_DOUBLE_EQ(rows[0]["incidence_deg"].get<double>(), 0.0);
+  EXPECT_NEAR(rows[20]["incidence_deg"].get<double>(), 22.0, 1e-9);
+  // At normal incidence the fan stays a plane; beyond it the plane error grows with the angle
+  // while the cone keeps fitting far better.
+  EXPECT_LT(rows[0]["plane_rms_m"].get<double>(), 1e-9);
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_GT(rows[i]["plane_rms_m"].get<double>(), rows[i - 1]["plane_rms_m"].get<double>());
+    EXPECT_LT(rows[i]["cone_rms_m"].get<double>(), 0.1 * rows[i]["plane_rms_m"].get<double>());
+  }
+  std::filesystem::remove(json);
+}
+
+TEST(Cli, JsonWriteFailureKeepsNothingHalfWritten) {
+  const CommandRun run = RunUwscan("bench deformation --json /nonexistent-dir/out.json");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("/nonexistent-dir/out.json"), std::string::npos);
+}
+
+}  // namespace
