@@ -9,3 +9,20 @@ find_package(OpenMP REQUIRED COMPONENTS CXX)
 if(UWSCAN_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
+
+# PCL: its component targets carry VTK, Qt and OpenNI in their link interface. uwscan links
+# the component libraries themselves through one interface target, so that only the viewer
+# links VTK (DESIGN.md, "Known traps").
+find_package(PCL 1.13 REQUIRED COMPONENTS common io kdtree search features filters
+             segmentation sample_consensus registration)
+add_library(uwscan_pcl INTERFACE)
+target_include_directories(uwscan_pcl SYSTEM INTERFACE ${PCL_INCLUDE_DIRS})
+foreach(component common io io_ply kdtree search octree features filters segmentation
+                  sample_consensus registration)
+  find_library(UWSCAN_PCL_${component} pcl_${component} REQUIRED)
+  target_link_libraries(uwscan_pcl INTERFACE ${UWSCAN_PCL_${component}})
+endforeach()
+target_link_libraries(uwscan_pcl INTERFACE Eigen3::Eigen FLANN::FLANN)
+
+# Open3D is only a peer in the registration benchmark: built against when present.
+find_package(Open3D QUIET)

@@ -12,6 +12,7 @@ struct ConeFitOptions {
   double function_tolerance = 1e-16;   // relative cost decrease that ends the fit, >= 0
   double parameter_tolerance = 1e-14;  // relative step size that ends the fit, >= 0
   double beta_margin_rad = 0.05;       // lit range = fitted beta range widened by this, >= 0
+  bool algebraic_start = true;         // also try the algebraic quadric start (see FitCone)
 
   // Throws uwscan::Error naming the field when a value is out of range.
   void Check() const;
@@ -32,11 +33,17 @@ struct ConeFit {
 // squared orthogonal distances. The per-point blocks are eliminated by a Schur complement, so
 // the cost per iteration is linear in the number of points (a few ms for 2000 points).
 //
-// Start: the total least squares plane of the points (FitPlane); y_Q = its normal, z_Q =
-// propagation_dir_in_C projected into it, x_Q = y_Q x z_Q, the apex = apex_hint_in_C projected
-// onto it; a = 1.05 max |x_Q / z_Q|, b = 1e-3 (nearly the plane; b is free in sign), h_i =
-// z_Q,i, beta_i = acos(x_Q,i / (a z_Q,i)). A good apex hint is the mirror (the apex of the
-// undistorted fan); the fit moves the apex to where refraction puts it.
+// Starts. (1) The plane start: the total least squares plane of the points (FitPlane); y_Q =
+// its normal, z_Q = propagation_dir_in_C projected into it, x_Q = y_Q x z_Q, the apex =
+// apex_hint_in_C projected onto it; a = 1.05 max |x_Q / z_Q|, b = 1e-3 (nearly the plane; b
+// is free in sign), h_i = z_Q,i, beta_i = acos(x_Q,i / (a z_Q,i)). A good apex hint is the
+// mirror (the apex of the undistorted fan). (2) With options.algebraic_start, the algebraic
+// quadric through the points read as a cone (apex = its centre, axis = its odd eigenvector).
+// The fit runs from whichever start has the lower cost. Why two: for a fan refracted well off
+// the viewport normal the optimum has its axis tilted out of the fan's plane and its apex far
+// from the mirror; LM crawls there from the plane start along a flat valley (300-500
+// iterations on the default scanner's steps +-50..100), but needs ~70-150 from start (2).
+// Planar points have no algebraic cone, and the plane start is then exact.
 // Result: a > 0 and beta_i normalised to the lit sheet; beta_min/max = range of the fitted
 // beta_i widened by options.beta_margin_rad, clamped to [0, pi]; h_min_m = 0. Points that are
 // exactly planar give |b| ~ 0 (the plane y_Q = 0). Single threaded and deterministic.

@@ -13,6 +13,7 @@
 #include "scanner/error.hpp"
 #include "scanner/light_cone.hpp"
 #include "scanner/light_plane.hpp"
+#include "scanner/ray.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -104,10 +105,21 @@ double MaxHitDifference(const EllipticCone& truth, const EllipticCone& fitted, i
   return worst;
 }
 
-TEST(FitCone, RecoversExactConeFromPerturbedStart) {
+// Both starts: the seed paper's plane start (perturbed: apex hint and propagation direction are
+// off) and the algebraic quadric start, which is exact on exact cone data.
+class FitConeStart : public ::testing::TestWithParam<bool> {
+ protected:
+  static ConeFitOptions Options() {
+    ConeFitOptions options;
+    options.algebraic_start = GetParam();
+    return options;
+  }
+};
+
+TEST_P(FitConeStart, RecoversExactCone) {
   for (const std::uint64_t seed : {1u, 2u, 3u}) {
     const ConeData data = MakeConeData(0.6, 0.05, 175, 0.0, seed);
-    const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C);
+    const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C, Options());
     EXPECT_TRUE(fit.converged) << "seed " << seed;
     EXPECT_LT(fit.rms_m, 1e-9) << "seed " << seed;
     EXPECT_LT(fit.max_abs_m, 1e-8) << "seed " << seed;
@@ -147,9 +159,9 @@ TEST(FitCone, LitRangeIsFittedBetaRangeWidenedByMargin) {
   EXPECT_LE(clamped.cone.beta_max_rad, kPi);
 }
 
-TEST(FitCone, PlanarDataGivesFlatCone) {
+TEST_P(FitConeStart, PlanarDataGivesFlatCone) {
   const ConeData data = MakeConeData(0.6, 0.0, 175, 0.0, 5);
-  const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C);
+  const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C, Options());
   EXPECT_LT(std::abs(fit.cone.b), 1e-6);
   EXPECT_LT(fit.rms_m, 1e-9);
   int misses = 0;
@@ -159,10 +171,10 @@ TEST(FitCone, PlanarDataGivesFlatCone) {
   EXPECT_EQ(misses, 0);
 }
 
-TEST(FitCone, NoisyDataRmsMatchesSigma) {
+TEST_P(FitConeStart, NoisyDataRmsMatchesSigma) {
   const double sigma_m = 2e-4;
   const ConeData data = MakeConeData(0.6, 0.05, 1000, sigma_m, 6);
-  const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C);
+  const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C, Options());
   EXPECT_TRUE(fit.converged);
   // Only the normal component of isotropic noise remains: rms ~ sigma (1 +- 1/sqrt(2n)),
   // minus the 8 + 2n of 3n degrees of freedom the fit absorbs along the surface.
@@ -175,15 +187,81 @@ TEST(FitCone, NoisyDataRmsMatchesSigma) {
   EXPECT_EQ(misses, 0);
 }
 
-TEST(FitCone, StartFarFromOptimumStillConverges) {
+TEST_P(FitConeStart, StartFarFromOptimumStillConverges) {
   // Apex hint 10 cm off and propagation direction ~17 deg off.
   const ConeData data = MakeConeData(0.6, 0.05, 175, 0.0, 7, 0.3, 0.1);
-  const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C);
+  const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C, Options());
   EXPECT_TRUE(fit.converged);
   EXPECT_LT(fit.rms_m, 1e-9);
   int misses = 0;
   EXPECT_LT(MaxHitDifference(data.truth, fit.cone, 300, 107, &misses), 1e-8);
   EXPECT_EQ(misses, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(FitCone, FitConeStart, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return std::string(info.param ? "AlgebraicStart" : "PlaneStart");
+                         });
+
+// A laser fan behind a flat viewport, refracted by Snell's law (air 1.0 -> water 1.33): the
+// light surface the cone model stands for, which is not exactly a cone. The mirror is at
+// (0.3, 0, 0), the interface is z = 0.05, the fan spans +-0.45 rad along y and is steered by
+// `steer_rad` about y; points at depths 0.4 ... 1.6 m, 35 rays x 5.
+struct RefractedFan {
+  std::vector<Eigen::Vector3d> points_C;
+  Eigen::Vector3d central_dir_C;
+  Eigen::Vector3d mirror_C{0.3, 0.0, 0.0};
+};
+
+RefractedFan MakeRefractedFan(double steer_rad) {
+  RefractedFan fan;
+  const Eigen::Vector3d d0(std::sin(steer_rad), 0.0, std::cos(steer_rad));
+  const auto refract = [](const Eigen::Vector3d& d) {
+    const Eigen::Vector2d tangential = d.head<2>() / 1.33;
+    return Eigen::Vector3d(tangential.x(), tangential.y(),
+                           std::sqrt(1.0 - tangential.squaredNorm()));
+  };
+  for (int i = 0; i < 35; ++i) {
+    const double fan_angle = -0.45 + 0.9 * i / 34.0;
+    const Eigen::Vector3d d =
+        std::cos(fan_angle) * d0 + std::sin(fan_angle) * Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d on_interface = fan.mirror_C + (0.05 - fan.mirror_C.z()) / d.z() * d;
+    const Eigen::Vector3d d_water = refract(d);
+    if (i == 17) fan.central_dir_C = d_water;
+    for (int j = 0; j < 5; ++j) {
+      const double depth_m = 0.4 + 0.3 * j;
+      fan.points_C.push_back(on_interface + (depth_m - on_interface.z()) / d_water.z() * d_water);
+    }
+  }
+  return fan;
+}
+
+TEST(FitCone, RefractedFanFromAlgebraicStartConvergesToThePlaneStartsOptimum) {
+  for (const double steer_rad : {0.3, -0.6}) {
+    const RefractedFan fan = MakeRefractedFan(steer_rad);
+    const PlaneFit plane = FitPlane(fan.points_C);
+    const ConeFit fit = FitCone(fan.points_C, fan.central_dir_C, fan.mirror_C);
+    ConeFitOptions slow;
+    slow.algebraic_start = false;
+    slow.max_iterations = 5000;
+    const ConeFit reference = FitCone(fan.points_C, fan.central_dir_C, fan.mirror_C, slow);
+    ASSERT_TRUE(fit.converged) << steer_rad;
+    ASSERT_TRUE(reference.converged) << steer_rad;
+    EXPECT_GT(plane.rms_m, 1e-3) << steer_rad;  // the fan visibly bends
+    EXPECT_LT(fit.rms_m, 0.02 * plane.rms_m) << steer_rad;
+    EXPECT_NEAR(fit.rms_m, reference.rms_m, 1e-6 * reference.rms_m) << steer_rad;
+    EXPECT_LT(fit.iterations, reference.iterations) << steer_rad;
+    // Same surface: rays from the camera centre through the samples hit both cones alike.
+    const PreparedCone a = PrepareCone(fit.cone);
+    const PreparedCone b = PrepareCone(reference.cone);
+    for (const Eigen::Vector3d& p : fan.points_C) {
+      const Ray ray{Eigen::Vector3d::Zero(), p.normalized()};
+      const RayHit hit_a = IntersectRayCone(ray, a);
+      const RayHit hit_b = IntersectRayCone(ray, b);
+      ASSERT_TRUE(hit_a.ok() && hit_b.ok());
+      EXPECT_LT((hit_a.point - hit_b.point).norm(), 1e-7);
+    }
+  }
 }
 
 TEST(FitCone, InvariantUnderRigidMotionOfTheInput) {
@@ -216,6 +294,7 @@ TEST(FitCone, IterationLimitIsReportedNotThrown) {
   const ConeData data = MakeConeData(0.6, 0.05, 175, 0.0, 11, 0.3, 0.1);
   ConeFitOptions options;
   options.max_iterations = 1;
+  options.algebraic_start = false;  // the other start is exact on exact data
   ConeFit fit;
   ASSERT_NO_THROW(fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C, options));
   EXPECT_FALSE(fit.converged);

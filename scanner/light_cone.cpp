@@ -1,5 +1,6 @@
 #include "scanner/light_cone.hpp"
 
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -59,8 +60,20 @@ PreparedCone PrepareCone(const EllipticCone& cone) {
   prepared.cos_beta_min = std::cos(cone.beta_min_rad);
   prepared.cos_beta_max = std::cos(cone.beta_max_rad);
   prepared.h_min_m = cone.h_min_m;
+  prepared.coefficient_tol = detail::kConeCoefficientTol * (1.0 + cone.b * cone.b);
+  prepared.origin_size = prepared.s_origin.lpNorm<1>();
   return prepared;
 }
+
+namespace detail {
+
+RayHit ConeMissWithRoots(double t1, double t2) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const bool ahead = (t1 >= 0.0 && t1 < kInf) || (t2 >= 0.0 && t2 < kInf);
+  return RayHit::Miss(ahead ? HitStatus::kOutsideSurface : HitStatus::kBehind);
+}
+
+}  // namespace detail
 
 RayHit IntersectRayCone(const Ray& ray_in_C, const EllipticCone& cone) {
   return IntersectRayCone(ray_in_C, PrepareCone(cone));

@@ -47,6 +47,8 @@ struct PreparedCone {
   double cos_beta_min = 1.0;  // the lit range as bounds on cos(beta) = u / h
   double cos_beta_max = -1.0;
   double h_min_m = 0.0;
+  double coefficient_tol = 0.0;  // detail::kConeCoefficientTol * (1 + b^2)
+  double origin_size = 0.0;      // |s_origin|_1: rounding in s scales with it (metres)
 };
 
 // Checks the cone (throws uwscan::Error as EllipticCone::Check) and prepares it.
@@ -58,9 +60,14 @@ namespace detail {
 // coefficient is rounding noise. They are computed to ~1e-16 of that, so 1e-12 leaves four
 // digits of margin (and treats rays within ~1e-12 rad of a generator as parallel to it).
 inline constexpr double kConeCoefficientTol = 1e-12;
-// A root whose height is within this fraction of the coordinates' magnitude of the apex is the
-// apex itself up to rounding, where beta is undefined: it is never lit.
+// A line whose moment about the apex is below this fraction of |o| |d| (o measured with the
+// cone's own offset, which sets the rounding in o) passes through the apex up to rounding: its
+// only intersection is the apex, where beta is undefined, and it is never lit.
 inline constexpr double kConeApexTol = 1e-12;
+
+// kOutsideSurface when a finite root lies ahead (t >= 0), else kBehind. Out of line: misses are
+// the rare path, and a smaller IntersectRayCone is one the compiler inlines.
+RayHit ConeMissWithRoots(double t1, double t2);
 
 }  // namespace detail
 
@@ -79,8 +86,9 @@ inline constexpr double kConeApexTol = 1e-12;
 // keep full relative precision for any b, so |b| = 1e-9 and b = 0 behave like the plane
 // y_Q = 0 to rounding. The roots come from the cancellation-free pair
 //   q = -(B + sign(B) |b| sqrt(D)),  t1 = q / A,  t2 = C / q.
-// A root is lit when t >= 0, z_Q > h_min_m (and clear of the apex), y_Q has the sign of b (the
-// lit sheet; no test for b = 0) and cos(beta_max) z_Q <= u <= cos(beta_min) z_Q.
+// A root is lit when t >= 0, z_Q > h_min_m, y_Q has the sign of b (the lit sheet; no test for
+// b = 0) and cos(beta_max) z_Q <= u <= cos(beta_min) z_Q, unless the line passes through the
+// apex (to rounding), whose only intersection is the apex itself.
 //
 // Edges, reported as values, never NaN:
 //   kParallel        A = B = 0 to rounding: the line lies on the cone or is parallel to it in
@@ -110,9 +118,9 @@ inline RayHit IntersectRayCone(const Ray& ray_in_C, const PreparedCone& cone) {
 
   // Rounding in o and d is relative to their size, not to the size of each product (which
   // may be exactly zero, e.g. for an origin on the apex), so the zero tests scale with them.
-  const double o_size = std::abs(o.x()) + std::abs(o.y()) + std::abs(o.z());
+  const double o_size = std::abs(o.x()) + std::abs(o.y()) + std::abs(o.z()) + cone.origin_size;
   const double d_size = std::abs(d.x()) + std::abs(d.y()) + std::abs(d.z());
-  const double tol = detail::kConeCoefficientTol * (1.0 + bb) * d_size;
+  const double tol = cone.coefficient_tol * d_size;
   const bool qa_zero = std::abs(qa) <= tol * d_size;
   if (qa_zero && std::abs(qb) <= tol * o_size) {
     return RayHit::Miss(HitStatus::kParallel);
@@ -129,23 +137,26 @@ inline RayHit IntersectRayCone(const Ray& ray_in_C, const PreparedCone& cone) {
   const double t1 = q / qa;  // q = 0 only at a double root t = 0: then t1 = 0, t2 = NaN
   const double t2 = qc / q;
 
-  // Noise in the computed z_Q grows with the coordinates; the apex guard scales with them.
+  // A line through the apex meets the cone nowhere else (unless it lies on it: kParallel
+  // above), and a root anywhere near the apex has z_Q ~ rounding: one test per ray.
+  const double apex_tol = detail::kConeApexTol * o_size * d_size;
+  const bool through_apex = m.squaredNorm() <= apex_tol * apex_tol;
   const auto lit = [&](double t) {
     const double u = o.x() + t * d.x();
     const double y = o.y() + t * d.y();
     const double z = o.z() + t * d.z();
-    const double z_floor = std::max(cone.h_min_m, detail::kConeApexTol * (o_size + t * d_size));
-    return t >= 0.0 && t < kInf && z > z_floor && y * cone.b >= 0.0 && u >= cone.cos_beta_max * z &&
-           u <= cone.cos_beta_min * z;
+    return t >= 0.0 && t < kInf && z > cone.h_min_m && y * cone.b >= 0.0 &&
+           u >= cone.cos_beta_max * z && u <= cone.cos_beta_min * z;
   };
-  const bool lit1 = lit(t1);
-  const bool lit2 = lit(t2);
-  if (lit1 || lit2) {
-    const double t = (lit1 && (!lit2 || t1 <= t2)) ? t1 : t2;
-    return RayHit{HitStatus::kHit, t, ray_in_C.At(t)};
+  if (!through_apex) {
+    // The nearer root first: seen from outside the cone it is the lit one in the common case,
+    // so the farther root is rarely tested. fmin/fmax drop a NaN root (t2 when q = 0).
+    const double t_near = std::fmin(t1, t2);
+    const double t_far = std::fmax(t1, t2);
+    if (lit(t_near)) return RayHit{HitStatus::kHit, t_near, ray_in_C.At(t_near)};
+    if (lit(t_far)) return RayHit{HitStatus::kHit, t_far, ray_in_C.At(t_far)};
   }
-  const bool ahead = (t1 >= 0.0 && t1 < kInf) || (t2 >= 0.0 && t2 < kInf);
-  return RayHit::Miss(ahead ? HitStatus::kOutsideSurface : HitStatus::kBehind);
+  return detail::ConeMissWithRoots(t1, t2);
 }
 
 // Convenience form: prepares the cone (with its checks and two cosines) on every call. Use the
