@@ -11,10 +11,12 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scanner/error.hpp"
@@ -39,7 +41,9 @@ struct ConePointResidual {
                       h_beta[0]};
     T c_C[3];
     ceres::UnitQuaternionRotatePoint(q_wxyz, c_Q, c_C);
-    for (int i = 0; i < 3; ++i) residual[i] = c_C[i] + t_C_Q[i] - T(p_C[i]);
+    for (int i = 0; i < 3; ++i) {
+      residual[i] = c_C[i] + t_C_Q[i] - T(p_C[i]);
+    }
     return true;
   }
 
@@ -68,7 +72,9 @@ void CheckConeInput(std::span<const Eigen::Vector3d> points_in_C,
   if (!propagation_dir_in_C.allFinite() || propagation_dir_in_C.norm() == 0.0) {
     throw Error("FitCone: propagation_dir_in_C must be finite and non-zero");
   }
-  if (!apex_hint_in_C.allFinite()) throw Error("FitCone: apex_hint_in_C must be finite");
+  if (!apex_hint_in_C.allFinite()) {
+    throw Error("FitCone: apex_hint_in_C must be finite");
+  }
 }
 
 // The start of the seed paper's fit: the light surface is nearly the plane of the points, so
@@ -126,21 +132,22 @@ ConeParameters PlaneStart(std::span<const Eigen::Vector3d> points_in_C,
   return params;
 }
 
-// A second start, for strongly bent fans: the algebraic (linear least squares) quadric
+// The second start (see FitCone): the algebraic (linear least squares) quadric
 // x^T M x + 2 w^T x + c = 0 through the points, read as a cone: apex = its centre -M^-1 w, axis =
-// the eigenvector of M whose eigenvalue has the odd sign, a and b from the other two. Why: a
-// fan refracted well off the viewport normal is best fitted by a cone whose axis is tilted out
-// of the fan's plane and whose apex lies far from the mirror; from the plane start LM reaches
-// it only after hundreds of short steps along a curved, nearly flat valley (b, the tilt and a
-// trade off), while this start usually lands within a few percent of it. nullopt when the
-// quadric is not an elliptic cone (e.g. for planar points, where the plane start is right).
+// the eigenvector of M whose eigenvalue has the odd sign, a and b from the other two. On bent
+// fans it lands within a few percent of the optimum. nullopt when the quadric is not an
+// elliptic cone (e.g. for planar points, where the plane start is right).
 std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> points_in_C) {
   const Eigen::Index n = static_cast<Eigen::Index>(points_in_C.size());
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points_in_C) centroid += p;
+  for (const Eigen::Vector3d& p : points_in_C) {
+    centroid += p;
+  }
   centroid /= static_cast<double>(n);
   double scale = 0.0;
-  for (const Eigen::Vector3d& p : points_in_C) scale += (p - centroid).squaredNorm();
+  for (const Eigen::Vector3d& p : points_in_C) {
+    scale += (p - centroid).squaredNorm();
+  }
   scale = std::sqrt(scale / static_cast<double>(n));
   // Centred and scaled to unit spread so that the ten monomials have comparable sizes.
   Eigen::Matrix<double, Eigen::Dynamic, 10> design(n, 10);
@@ -164,17 +171,25 @@ std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> poin
   if (positives == 0 || positives == 3) return std::nullopt;  // an ellipsoid, not a cone
   int k_axis = 0;
   for (int k = 0; k < 3; ++k) {
-    if ((lambda(k) > 0.0) == (positives == 1)) k_axis = k;
+    if ((lambda(k) > 0.0) == (positives == 1)) {
+      k_axis = k;
+    }
   }
   const Eigen::Vector3d apex_C = centroid + scale * (-M.inverse() * w);
-  if (!apex_C.allFinite()) return std::nullopt;
+  if (!apex_C.allFinite()) {
+    return std::nullopt;
+  }
 
   // Orient the axis towards the points and take as y_Q the other eigenvector closer to the
   // fan's mean direction: the lit sheet is centred on beta = pi/2, i.e. on the y_Q side.
   Eigen::Vector3d z_axis = eigen.eigenvectors().col(k_axis);
   Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points_in_C) mean_dir += (p - apex_C).normalized();
-  if (mean_dir.dot(z_axis) < 0.0) z_axis = -z_axis;
+  for (const Eigen::Vector3d& p : points_in_C) {
+    mean_dir += (p - apex_C).normalized();
+  }
+  if (mean_dir.dot(z_axis) < 0.0) {
+    z_axis = -z_axis;
+  }
   const int k1 = (k_axis + 1) % 3;
   const int k2 = (k_axis + 2) % 3;
   const bool k1_is_y = std::abs(eigen.eigenvectors().col(k1).dot(mean_dir)) >=
@@ -193,7 +208,9 @@ std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> poin
   params.q_wxyz = {q.w(), q.x(), q.y(), q.z()};
   params.t_C_Q = {apex_C.x(), apex_C.y(), apex_C.z()};
   double sum_y = 0.0;
-  for (const Eigen::Vector3d& p : points_in_C) sum_y += y_axis.dot(p - apex_C);
+  for (const Eigen::Vector3d& p : points_in_C) {
+    sum_y += y_axis.dot(p - apex_C);
+  }
   const double a = 1.0 / std::sqrt(inv_a_sq);
   const double b = std::copysign(1.0 / std::sqrt(inv_b_sq), sum_y);  // the points' sheet
   params.ab = {a, b};
@@ -261,7 +278,9 @@ ceres::Solver::Summary Solve(std::span<const Eigen::Vector3d> points_in_C,
 void Normalise(ConeParameters& params) {
   if (params.ab[0] < 0.0) {
     params.ab[0] = -params.ab[0];
-    for (auto& hb : params.h_beta) hb[1] = kPi - hb[1];
+    for (auto& hb : params.h_beta) {
+      hb[1] = kPi - hb[1];
+    }
   }
   double sum_sin = 0.0;
   for (auto& hb : params.h_beta) {
@@ -270,7 +289,9 @@ void Normalise(ConeParameters& params) {
   }
   if (sum_sin < 0.0) {
     params.ab[1] = -params.ab[1];
-    for (auto& hb : params.h_beta) hb[1] = -hb[1];
+    for (auto& hb : params.h_beta) {
+      hb[1] = -hb[1];
+    }
   }
 }
 
@@ -282,7 +303,9 @@ void ConeFitOptions::Check() const {
     message << "ConeFitOptions." << field << ": expected " << expected << ", got " << got;
     throw Error(message.str());
   };
-  if (max_iterations <= 0) fail("max_iterations", "> 0", max_iterations);
+  if (max_iterations <= 0) {
+    fail("max_iterations", "> 0", max_iterations);
+  }
   if (!(std::isfinite(function_tolerance) && function_tolerance >= 0.0)) {
     fail("function_tolerance", "a finite value >= 0", function_tolerance);
   }

@@ -227,7 +227,9 @@ RefractedFan MakeRefractedFan(double steer_rad) {
         std::cos(fan_angle) * d0 + std::sin(fan_angle) * Eigen::Vector3d::UnitY();
     const Eigen::Vector3d on_interface = fan.mirror_C + (0.05 - fan.mirror_C.z()) / d.z() * d;
     const Eigen::Vector3d d_water = refract(d);
-    if (i == 17) fan.central_dir_C = d_water;
+    if (i == 17) {
+      fan.central_dir_C = d_water;
+    }
     for (int j = 0; j < 5; ++j) {
       const double depth_m = 0.4 + 0.3 * j;
       fan.points_C.push_back(on_interface + (depth_m - on_interface.z()) / d_water.z() * d_water);
@@ -269,7 +271,9 @@ TEST(FitCone, InvariantUnderRigidMotionOfTheInput) {
   std::mt19937_64 rng(9);
   const Eigen::Isometry3d G = RandomPose(rng);
   std::vector<Eigen::Vector3d> moved;
-  for (const Eigen::Vector3d& p : data.points_C) moved.push_back(G * p);
+  for (const Eigen::Vector3d& p : data.points_C) {
+    moved.push_back(G * p);
+  }
   const ConeFit fit = FitCone(data.points_C, data.propagation_dir_C, data.apex_hint_C);
   const ConeFit fit_moved =
       FitCone(moved, G.linear() * data.propagation_dir_C, G * data.apex_hint_C);
@@ -325,7 +329,9 @@ TEST(FitCone, ThrowsOnBadInput) {
       Error);
   // Collinear points do not span the fan's plane.
   std::vector<Eigen::Vector3d> line;
-  for (int i = 0; i < 10; ++i) line.push_back(Eigen::Vector3d(0.0, 0.0, 0.5 + 0.1 * i));
+  for (int i = 0; i < 10; ++i) {
+    line.push_back(Eigen::Vector3d(0.0, 0.0, 0.5 + 0.1 * i));
+  }
   EXPECT_THROW(fit(line, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::Zero()), Error);
 }
 

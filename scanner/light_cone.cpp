@@ -1,6 +1,7 @@
 #include "scanner/light_cone.hpp"
 
-#include <limits>
+#include <cmath>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -32,8 +33,12 @@ void CheckRigid(const Eigen::Isometry3d& T_C_Q) {
 
 void EllipticCone::Check() const {
   CheckRigid(T_C_Q);
-  if (!(std::isfinite(a) && a > 0.0)) ThrowField("a", "a finite value > 0", a);
-  if (!std::isfinite(b)) ThrowField("b", "a finite value", b);
+  if (!(std::isfinite(a) && a > 0.0)) {
+    ThrowField("a", "a finite value > 0", a);
+  }
+  if (!std::isfinite(b)) {
+    ThrowField("b", "a finite value", b);
+  }
   if (!(beta_min_rad >= 0.0 && beta_min_rad <= std::numbers::pi)) {
     ThrowField("beta_min_rad", "a value in [0, pi]", beta_min_rad);
   }
@@ -64,16 +69,6 @@ PreparedCone PrepareCone(const EllipticCone& cone) {
   prepared.origin_size = prepared.s_origin.lpNorm<1>();
   return prepared;
 }
-
-namespace detail {
-
-RayHit ConeMissWithRoots(double t1, double t2) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  const bool ahead = (t1 >= 0.0 && t1 < kInf) || (t2 >= 0.0 && t2 < kInf);
-  return RayHit::Miss(ahead ? HitStatus::kOutsideSurface : HitStatus::kBehind);
-}
-
-}  // namespace detail
 
 RayHit IntersectRayCone(const Ray& ray_in_C, const EllipticCone& cone) {
   return IntersectRayCone(ray_in_C, PrepareCone(cone));

@@ -355,13 +355,17 @@ Reference ReferenceIntersect(const EllipticCone& cone, const Eigen::Vector3d& o_
     return ref;  // near-degenerate: the double-precision answer may legitimately differ
   }
   ref.usable = true;
-  if (disc < 0) return ref;
+  if (disc < 0) {
+    return ref;
+  }
   std::array<L, 2> roots = {(-qb - std::sqrt(disc)) / qa, (-qb + std::sqrt(disc)) / qa};
   std::sort(roots.begin(), roots.end());
   bool ahead = false;
   for (const L t : roots) {
     if (t < 0) {
-      if (t > -1e-6L) ref.usable = false;
+      if (t > -1e-6L) {
+        ref.usable = false;
+      }
       continue;
     }
     ahead = true;
@@ -370,7 +374,9 @@ Reference ReferenceIntersect(const EllipticCone& cone, const Eigen::Vector3d& o_
     const L margin =
         std::min({std::fabs(beta - L(cone.beta_min_rad)), std::fabs(beta - L(cone.beta_max_rad)),
                   std::fabs(z - L(cone.h_min_m))});
-    if (margin < 1e-6L) ref.usable = false;
+    if (margin < 1e-6L) {
+      ref.usable = false;
+    }
     if (beta >= cone.beta_min_rad && beta <= cone.beta_max_rad && z > cone.h_min_m) {
       ref.status = HitStatus::kHit;
       ref.t = static_cast<double>(t);
@@ -399,7 +405,9 @@ TEST(IntersectRayCone, RandomRaysAgreeWithLongDoubleReference) {
       const Eigen::Vector3d d_Q =
           Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
       const Reference ref = ReferenceIntersect(cone, o_Q, d_Q);
-      if (!ref.usable) continue;
+      if (!ref.usable) {
+        continue;
+      }
       const RayHit hit = IntersectRayCone(RayFromQ(cone, o_Q, d_Q), prepared);
       ++compared;
       ++seen[static_cast<int>(ref.status)];

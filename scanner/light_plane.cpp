@@ -37,10 +37,14 @@ PlaneFit FitPlane(std::span<const Eigen::Vector3d> points) {
   // Centre first: the singular vectors of the raw coordinates would mix the plane offset into
   // the normal and lose digits for planes far from the origin.
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points) centroid += p;
+  for (const Eigen::Vector3d& p : points) {
+    centroid += p;
+  }
   centroid /= static_cast<double>(n);
   Eigen::MatrixX3d centred(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i) centred.row(i) = (points[i] - centroid).transpose();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    centred.row(i) = (points[i] - centroid).transpose();
+  }
 
   // SVD of the data rather than an eigen-decomposition of its covariance: squaring the data
   // would halve the digits of a nearly degenerate (thin) point set.

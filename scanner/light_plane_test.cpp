@@ -107,7 +107,9 @@ TEST(FitPlane, ThrowsOnTooFewPoints) {
 TEST(FitPlane, ThrowsOnCollinearOrCoincidentPoints) {
   std::vector<Eigen::Vector3d> line;
   const Eigen::Vector3d dir = Eigen::Vector3d(0.3, -0.4, 0.5).normalized();
-  for (int i = 0; i < 10; ++i) line.push_back(Eigen::Vector3d(1.0, 2.0, 3.0) + 0.37 * i * dir);
+  for (int i = 0; i < 10; ++i) {
+    line.push_back(Eigen::Vector3d(1.0, 2.0, 3.0) + 0.37 * i * dir);
+  }
   EXPECT_THROW(FitPlane(line), Error);
   // A thread 1e-12 m thick over 3 m is still a line.
   line[4] += 1e-12 * dir.unitOrthogonal();

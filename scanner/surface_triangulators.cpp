@@ -1,8 +1,10 @@
 #include "scanner/surface_triangulators.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
+#include "scanner/cone_batch.hpp"
 #include "scanner/error.hpp"
 
 namespace uwscan::scanner {
@@ -78,19 +80,31 @@ void RayConeTriangulator::TriangulateFrame(int mirror_step,
   const LightSurfaces* surface = surfaces_->At(mirror_step);
   if (surface == nullptr) return MarkAll(out, HitStatus::kOutsideSurface);
   const PreparedCone cone = PrepareCone(surface->cone);
+  // Blocks of rays through the vectorised intersection; pixels outside the table keep a dummy
+  // ray in their lane and are reported as misses.
+  RayBlock rays;
+  HitBlock hits;
+  bool in_image[RayBlock::kSize];
   Ray ray;
-  for (size_t i = 0; i < peaks_px.size(); ++i) {
-    if (i + kPrefetchAhead < peaks_px.size()) {
-      rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
+  for (size_t start = 0; start < peaks_px.size(); start += RayBlock::kSize) {
+    const size_t count = std::min(RayBlock::kSize, peaks_px.size() - start);
+    for (size_t lane = 0; lane < RayBlock::kSize; ++lane) {
+      const size_t i = start + lane;
+      if (i + kPrefetchAhead < peaks_px.size()) {
+        rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
+      }
+      in_image[lane] = lane < count && rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray);
+      if (!in_image[lane]) ray = Ray{};
+      rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(), rays.oz[lane] = ray.origin.z();
+      rays.dx[lane] = ray.direction.x(), rays.dy[lane] = ray.direction.y();
+      rays.dz[lane] = ray.direction.z();
     }
-    TriangulatedPoint& result = out[i];
-    if (!rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray)) {
-      result.status = HitStatus::kNoIntersection;
-      continue;
+    IntersectRayConeBlock(cone, rays, &hits);
+    for (size_t lane = 0; lane < count; ++lane) {
+      TriangulatedPoint& result = out[start + lane];
+      result.status = in_image[lane] ? hits.Status(lane) : HitStatus::kNoIntersection;
+      result.p_C = Eigen::Vector3d(hits.x[lane], hits.y[lane], hits.z[lane]);
     }
-    const RayHit hit = IntersectRayCone(ray, cone);
-    result.status = hit.status;
-    result.p_C = hit.point;
   }
 }
 
