@@ -26,3 +26,6 @@ target_link_libraries(uwscan_pcl INTERFACE Eigen3::Eigen FLANN::FLANN)
 
 # Open3D is only a peer in the registration benchmark: built against when present.
 find_package(Open3D QUIET)
+
+# Meshes (PLY/OFF/STL/OBJ) for scenes and benchmark objects.
+find_package(assimp REQUIRED)
