@@ -46,15 +46,18 @@ void SortLikeADetector(Frame* frame) {
   *frame = std::move(sorted);
 }
 
-// Draws exact fan points in the depth range and keeps those the camera sees.
+// Draws frames as a scanner sees them: at each mirror step the fan lights a smooth surface
+// (depth a random sinusoid of the fan angle, its mean anywhere in the depth range), so the
+// stripe crosses the image with one peak per fan sample. Points the camera cannot see are
+// dropped; the frame's peaks are then sorted like a detector's output.
 std::vector<Frame> MakeFrames(const scanner::ScannerModel& model,
                               const TriangulationBenchOptions& o, const Progress& progress) {
   std::mt19937_64 rng(o.seed);
   const scanner::GalvoLaser& laser = model.laser;
   std::uniform_int_distribution<int> step_dist(laser.step_min, laser.step_max);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
   const double half_aperture = 0.5 * laser.aperture_rad;
-  std::uniform_real_distribution<double> angle_dist(-half_aperture, half_aperture);
-  std::uniform_real_distribution<double> depth_dist(o.depth_min_m, o.depth_max_m);
+  const double span = o.depth_max_m - o.depth_min_m;
 
   std::vector<Frame> frames;
   std::int64_t total = 0;
@@ -62,12 +65,15 @@ std::vector<Frame> MakeFrames(const scanner::ScannerModel& model,
     Frame frame;
     frame.step = step_dist(rng);
     const scanner::LaserFan fan = laser.FanAtStep(frame.step);
+    const double amplitude = 0.1 * span * unit(rng);
+    const double mean = o.depth_min_m + amplitude + (span - 2.0 * amplitude) * unit(rng);
+    const double frequency = 2.0 + 10.0 * unit(rng), phase = 6.283 * unit(rng);
     const std::int64_t want = std::min<std::int64_t>(o.points_per_frame, o.points - total);
-    // Bounded attempts: a step whose fan the camera hardly sees yields a short frame.
-    for (std::int64_t attempt = 0; attempt < 20 * want && std::ssize(frame.peaks_px) < want;
-         ++attempt) {
-      const double angle = angle_dist(rng);
-      const double depth = depth_dist(rng);
+    // Twice as many fan samples as wanted peaks: the camera sees only part of the fan.
+    const std::int64_t samples = 2 * want;
+    for (std::int64_t k = 0; k < samples && std::ssize(frame.peaks_px) < want; ++k) {
+      const double angle = -half_aperture + (k + unit(rng)) * (2.0 * half_aperture / samples);
+      const double depth = mean + amplitude * std::sin(frequency * angle + phase);
       const scanner::RayTrace ray = fan.RayInWater(std::tan(angle));
       if (!ray.ok() || ray.ray.direction.z() <= 1e-6) continue;
       const Eigen::Vector3d p = ray.ray.At((depth - ray.ray.origin.z()) / ray.ray.direction.z());
