@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "apps/bench_commands.hpp"
+#include "apps/perception_commands.hpp"
 #include "scanner/error.hpp"
 
 int main(int argc, char** argv) {
@@ -13,9 +14,11 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   uwscan::app::AddDemoCommand(app);
+  uwscan::app::AddRegisterCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);
+  uwscan::app::AddPerceptionBenchCommands(*bench);
 
   try {
     app.parse(argc, argv);

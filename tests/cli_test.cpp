@@ -6,6 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -118,6 +121,83 @@ TEST(Cli, JsonWriteFailureKeepsNothingHalfWritten) {
   const CommandRun run = RunUwscan("bench deformation --json /nonexistent-dir/out.json");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.output.find("/nonexistent-dir/out.json"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Cli, RegistrationBenchComparesThePipelines) {
+  const std::filesystem::path json = TempPath("registration.json");
+  const CommandRun run =
+      RunUwscan("bench registration --pairs-per-mesh 1 --no-real-scans --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  for (const char* name : {"uwscan", "pcl"}) {
+    const nlohmann::json& p = j.at("pipelines").at(name);
+    EXPECT_EQ(p.at("pairs").get<int>(), 9) << name;
+    EXPECT_GT(p.at("seconds_per_pair").get<double>(), 0.0) << name;
+  }
+  // Non-symmetric objects must register; the symmetric ones (cylinder, spool, pinion) have no
+  // unique answer, so the rate cannot be 1.
+  EXPECT_GE(j["pipelines"]["uwscan"]["success_rate"].get<double>(), 4.0 / 9.0);
+  EXPECT_EQ(j.at("pairs").size(), j.at("pipelines").size() * 9);
+  std::filesystem::remove(json);
+}
+
+TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
+  // A surface with three different bumps (no symmetry) and a moved copy of it, as XYZ text.
+  const std::filesystem::path target = TempPath("target.xyz"), source = TempPath("source.xyz");
+  const std::filesystem::path json = TempPath("register.json");
+  {
+    std::ofstream t(target), s(source);
+    const Eigen::AngleAxisd R(0.3, Eigen::Vector3d(1, 2, 3).normalized());
+    const Eigen::Vector3d shift(0.05, -0.02, 0.03);
+    for (int i = 0; i < 120; ++i) {
+      for (int k = 0; k < 120; ++k) {
+        const double x = i * 0.004, y = k * 0.004;
+        const auto bump = [&](double cx, double cy, double height, double width) {
+          return height * std::exp(-((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (width * width));
+        };
+        const Eigen::Vector3d p(x, y, bump(0.12, 0.30, 0.08, 0.05) + bump(0.35, 0.12, 0.05, 0.03) +
+                                          bump(0.30, 0.38, 0.03, 0.08));
+        t << p.x() << " " << p.y() << " " << p.z() << "\n";
+        const Eigen::Vector3d q = R * p + shift;
+        s << q.x() << " " << q.y() << " " << q.z() << "\n";
+      }
+    }
+  }
+  const CommandRun run =
+      RunUwscan("register " + source.string() + " " + target.string() + " --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  EXPECT_GT(j["fitness"].get<double>(), 0.9);
+  Eigen::Matrix4d T;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) T(r, c) = j["T_target_source"][r][c].get<double>();
+  }
+  // Truth: source = R target + shift, so T_target_source = (R, shift)^-1.
+  Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
+  truth.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  truth.translation() = Eigen::Vector3d(0.05, -0.02, 0.03);
+  truth = truth.inverse();
+  const Eigen::Matrix3d dR = truth.linear().transpose() * T.topLeftCorner<3, 3>();
+  EXPECT_LT(std::acos(std::clamp((dR.trace() - 1.0) / 2.0, -1.0, 1.0)), 0.5 * M_PI / 180.0);
+  const Eigen::Vector3d centre(0.24, 0.24, 0.02);
+  EXPECT_LT((T.topLeftCorner<3, 3>() * centre + T.topRightCorner<3, 1>() - truth * centre).norm(),
+            2e-3);
+  for (const auto& f : {target, source, json}) std::filesystem::remove(f);
+}
+
+TEST(Cli, RegisterRejectsMissingAndEmptyClouds) {
+  const CommandRun missing = RunUwscan("register /nonexistent/a.ply /nonexistent/b.ply");
+  EXPECT_NE(missing.exit_code, 0);
+  const std::filesystem::path empty = TempPath("empty.xyz");
+  std::ofstream(empty) << "";
+  const CommandRun run = RunUwscan("register " + empty.string() + " " + empty.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find(empty.string()), std::string::npos) << run.output;
+  std::filesystem::remove(empty);
 }
 
 }  // namespace

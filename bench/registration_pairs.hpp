@@ -1,0 +1,51 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "perception/point_cloud.hpp"
+
+namespace uwscan::bench {
+
+// A registration problem with its answer: align `source` onto `target`.
+struct RegistrationPair {
+  std::string name;
+  perception::PointCloud source;
+  perception::PointCloud target;
+  Eigen::Isometry3d T_target_source_true = Eigen::Isometry3d::Identity();
+  double object_size_m = 0.0;  // bounding-box diagonal of the target, for the success test
+};
+
+struct RegistrationPairOptions {
+  int mesh_samples = 40000;           // surface samples per mesh before the views are cut
+  double mesh_size_m = 0.5;           // meshes are scaled to this bounding-box diagonal
+  double noise_sigma_m = 0.0005;      // Gaussian noise added to every view
+  double view_separation_rad = 0.6;   // angle between the two viewpoints of a mesh pair
+  int pairs_per_mesh = 2;
+  std::uint64_t seed = 1;
+  bool real_scans = true;             // add pairs built from bun0.pcd and table_scene_lms400.pcd
+
+  void Check() const;
+};
+
+// Pairs from the cached real data (scripts/fetch_data.sh): CGAL meshes sampled into two
+// partial views each (back faces culled, different viewpoints, so the overlap is partial),
+// and the real scans against randomly resampled, noisy copies of themselves. Every source is
+// moved by a random rigid motion (any rotation, translation up to the object size).
+// Throws uwscan::Error naming the missing file when the cache is incomplete.
+std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,
+                                                    const RegistrationPairOptions& options);
+
+// Rotation error (rad) of an estimate against the truth, and its translation error (m) where
+// it matters: the displacement it gives `at_point` (the source's centre) against the truth's.
+struct PoseError {
+  double rotation_rad;
+  double translation_m;
+};
+PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth,
+                       const Eigen::Vector3d& at_point);
+
+}  // namespace uwscan::bench

@@ -1,0 +1,384 @@
+#include "perception/cloud_io.hpp"
+
+#include <fcntl.h>
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "scanner/error.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kMaxFloat32Coordinate_m = 1000.0;  // ulp 6.1e-5 m: rounding under 31 um
+
+enum class Format { kPcd, kPly, kXyz };
+
+std::string Quoted(const fs::path& path) {
+  // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + std::string.
+  std::string quoted(1, '\'');
+  quoted.append(path.string());
+  quoted.push_back('\'');
+  return quoted;
+}
+
+std::optional<Format> FormatOf(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".pcd") return Format::kPcd;
+  if (ext == ".ply") return Format::kPly;
+  if (ext == ".xyz") return Format::kXyz;
+  return std::nullopt;
+}
+
+// Absolute points (and normals, when the file has them) as read, before any filtering.
+struct RawCloud {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3d> normals;
+};
+
+const pcl::PCLPointField* FindField(const pcl::PCLPointCloud2& blob,
+                                    std::initializer_list<const char*> names) {
+  for (const char* name : names) {
+    for (const pcl::PCLPointField& field : blob.fields) {
+      if (field.name == name) return &field;
+    }
+  }
+  return nullptr;
+}
+
+// One scalar of a field, converted to double.
+double FieldValue(const std::uint8_t* point, const pcl::PCLPointField& field) {
+  const std::uint8_t* at = point + field.offset;
+  auto get = [at](auto value) {
+    std::memcpy(&value, at, sizeof(value));
+    return static_cast<double>(value);
+  };
+  switch (field.datatype) {
+    case pcl::PCLPointField::INT8: return get(std::int8_t{});
+    case pcl::PCLPointField::UINT8: return get(std::uint8_t{});
+    case pcl::PCLPointField::INT16: return get(std::int16_t{});
+    case pcl::PCLPointField::UINT16: return get(std::uint16_t{});
+    case pcl::PCLPointField::INT32: return get(std::int32_t{});
+    case pcl::PCLPointField::UINT32: return get(std::uint32_t{});
+    case pcl::PCLPointField::FLOAT32: return get(float{});
+    case pcl::PCLPointField::FLOAT64: return get(double{});
+    default: return std::nan("");
+  }
+}
+
+std::size_t FieldSize(std::uint8_t datatype) {
+  switch (datatype) {
+    case pcl::PCLPointField::INT8:
+    case pcl::PCLPointField::UINT8: return 1;
+    case pcl::PCLPointField::INT16:
+    case pcl::PCLPointField::UINT16: return 2;
+    case pcl::PCLPointField::INT32:
+    case pcl::PCLPointField::UINT32:
+    case pcl::PCLPointField::FLOAT32: return 4;
+    case pcl::PCLPointField::FLOAT64: return 8;
+    default: return 0;
+  }
+}
+
+RawCloud FromBlob(const pcl::PCLPointCloud2& blob, const fs::path& path) {
+  const pcl::PCLPointField* xyz[3] = {FindField(blob, {"x"}), FindField(blob, {"y"}),
+                                      FindField(blob, {"z"})};
+  const pcl::PCLPointField* n[3] = {FindField(blob, {"normal_x", "nx"}),
+                                    FindField(blob, {"normal_y", "ny"}),
+                                    FindField(blob, {"normal_z", "nz"})};
+  if (!xyz[0] || !xyz[1] || !xyz[2]) {
+    throw Error("ReadCloud: " + Quoted(path) + " has no x, y and z fields");
+  }
+  const bool has_normals = n[0] && n[1] && n[2];
+  for (const pcl::PCLPointField* field : {xyz[0], xyz[1], xyz[2], n[0], n[1], n[2]}) {
+    if (!field) continue;
+    const std::size_t size = FieldSize(field->datatype);
+    if (size == 0 || field->offset + size > blob.point_step) {
+      throw Error("ReadCloud: " + Quoted(path) + ": field '" + field->name +
+                  "' has an unsupported type or lies outside the point record");
+    }
+  }
+  const std::size_t width = blob.width, height = blob.height;
+  if (blob.data.size() < (height == 0 ? 0 : (height - 1) * std::size_t{blob.row_step}) +
+                             width * std::size_t{blob.point_step}) {
+    throw Error("ReadCloud: " + Quoted(path) + ": the point data is shorter than its header says");
+  }
+  RawCloud raw;
+  raw.points.reserve(width * height);
+  if (has_normals) raw.normals.reserve(width * height);
+  for (std::size_t row = 0; row < height; ++row) {
+    for (std::size_t col = 0; col < width; ++col) {
+      const std::uint8_t* point =
+          blob.data.data() + row * blob.row_step + col * std::size_t{blob.point_step};
+      raw.points.emplace_back(FieldValue(point, *xyz[0]), FieldValue(point, *xyz[1]),
+                              FieldValue(point, *xyz[2]));
+      if (has_normals) {
+        raw.normals.emplace_back(FieldValue(point, *n[0]), FieldValue(point, *n[1]),
+                                 FieldValue(point, *n[2]));
+      }
+    }
+  }
+  return raw;
+}
+
+RawCloud ReadXyz(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("ReadCloud: cannot open " + Quoted(path));
+  RawCloud raw;
+  std::string line;
+  for (std::size_t line_number = 1; std::getline(in, line); ++line_number) {
+    const char* p = line.data();
+    const char* end = p + line.size();
+    auto skip_separators = [&] {
+      while (p < end && (std::isspace(static_cast<unsigned char>(*p)) || *p == ',')) ++p;
+    };
+    skip_separators();
+    if (p == end || *p == '#') continue;
+    Eigen::Vector3d point;
+    for (int a = 0; a < 3; ++a) {
+      skip_separators();
+      if (p < end && *p == '+') ++p;  // from_chars takes no leading '+'
+      double value = 0.0;
+      const std::from_chars_result parsed = std::from_chars(p, end, value);
+      if (parsed.ec != std::errc() || parsed.ptr == p) {
+        throw Error("ReadCloud: " + Quoted(path) + " line " + std::to_string(line_number) +
+                    ": expected three numbers x y z, got '" + line.substr(0, 80) + "'");
+      }
+      point[a] = value;
+      p = parsed.ptr;
+    }
+    raw.points.push_back(point);
+  }
+  if (in.bad()) throw Error("ReadCloud: error while reading " + Quoted(path));
+  return raw;
+}
+
+// fsync a file by name, so the rename that follows cannot publish an unwritten file.
+bool SyncFile(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return false;
+  const bool ok = ::fsync(fd) == 0;
+  return ::close(fd) == 0 && ok;
+}
+
+pcl::PCLPointCloud2 ToBlob(const PointCloud& cloud, Format format) {
+  double max_abs = 0.0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    max_abs = std::max(max_abs, cloud.Point(i).cwiseAbs().maxCoeff());
+  }
+  const bool doubles = max_abs >= kMaxFloat32Coordinate_m;
+  const std::uint8_t xyz_type = doubles ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32;
+  const std::uint32_t xyz_size = doubles ? 8 : 4;
+
+  pcl::PCLPointCloud2 blob;
+  auto add_field = [&blob](const char* name, std::uint8_t type, std::uint32_t size) {
+    pcl::PCLPointField field;
+    field.name = name;
+    field.offset = blob.point_step;
+    field.datatype = type;
+    field.count = 1;
+    blob.fields.push_back(field);
+    blob.point_step += size;
+  };
+  add_field("x", xyz_type, xyz_size);
+  add_field("y", xyz_type, xyz_size);
+  add_field("z", xyz_type, xyz_size);
+  const bool normals = cloud.has_normals();
+  if (normals) {
+    const bool ply = format == Format::kPly;
+    add_field(ply ? "nx" : "normal_x", pcl::PCLPointField::FLOAT32, 4);
+    add_field(ply ? "ny" : "normal_y", pcl::PCLPointField::FLOAT32, 4);
+    add_field(ply ? "nz" : "normal_z", pcl::PCLPointField::FLOAT32, 4);
+  }
+  blob.width = static_cast<std::uint32_t>(cloud.size());
+  blob.height = 1;
+  blob.is_dense = true;
+  blob.row_step = blob.point_step * blob.width;
+  blob.data.resize(blob.row_step);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    std::uint8_t* at = blob.data.data() + i * blob.point_step;
+    const Eigen::Vector3d p = cloud.Point(i);
+    for (int a = 0; a < 3; ++a) {
+      if (doubles) {
+        std::memcpy(at + 8 * a, &p[a], 8);
+      } else {
+        const float value = static_cast<float>(p[a]);
+        std::memcpy(at + 4 * a, &value, 4);
+      }
+    }
+    if (normals) std::memcpy(at + 3 * xyz_size, cloud.normals[i].data(), 12);
+  }
+  return blob;
+}
+
+// PLY written directly (PCL 1.13's PLYWriter ignores the ASCII precision, printing 6 digits):
+// one vertex element with the blob's fields, in the host's byte order when binary.
+bool WritePly(const fs::path& path, const pcl::PCLPointCloud2& blob, bool binary, int precision) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return false;
+  const char* format = !binary ? "ascii"
+                       : std::endian::native == std::endian::little ? "binary_little_endian"
+                                                                    : "binary_big_endian";
+  out << "ply\nformat " << format << " 1.0\ncomment uwscan: absolute coordinates in metres\n"
+      << "element vertex " << blob.width * blob.height << "\n";
+  for (const pcl::PCLPointField& field : blob.fields) {
+    out << "property " << (field.datatype == pcl::PCLPointField::FLOAT64 ? "double" : "float")
+        << " " << field.name << "\n";
+  }
+  out << "end_header\n";
+  if (binary) {
+    out.write(reinterpret_cast<const char*>(blob.data.data()),
+              static_cast<std::streamsize>(blob.data.size()));
+  } else {
+    out.precision(precision);
+    for (std::size_t i = 0; i < std::size_t{blob.width} * blob.height; ++i) {
+      const std::uint8_t* point = blob.data.data() + i * blob.point_step;
+      for (std::size_t f = 0; f < blob.fields.size(); ++f) {
+        out << (f ? " " : "") << FieldValue(point, blob.fields[f]);
+      }
+      out << "\n";
+    }
+  }
+  out.close();
+  return static_cast<bool>(out);
+}
+
+}  // namespace
+
+PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
+  const std::optional<Format> format = FormatOf(path);
+  if (!format) {
+    throw Error("ReadCloud: " + Quoted(path) +
+                ": unknown extension (expected .pcd, .ply or .xyz)");
+  }
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error("ReadCloud: " + Quoted(path) + ": no such file");
+  if (!fs::is_regular_file(path, ec)) {
+    throw Error("ReadCloud: " + Quoted(path) + ": not a regular file");
+  }
+
+  RawCloud raw;
+  if (*format == Format::kXyz) {
+    raw = ReadXyz(path);
+  } else {
+    pcl::PCLPointCloud2 blob;
+    int status = -1;
+    try {
+      if (*format == Format::kPcd) {
+        // PCL 1.13's PCDReader::read crashes on a file without a PCD header: check it first.
+        pcl::PCDReader reader;
+        Eigen::Vector4f origin;
+        Eigen::Quaternionf orientation;
+        int version = 0, data_type = 0;
+        unsigned int data_index = 0;
+        status = reader.readHeader(path.string(), blob, origin, orientation, version, data_type,
+                                   data_index);
+        if (status >= 0 && blob.fields.empty()) status = -1;
+        if (status >= 0 && std::size_t{blob.width} * blob.height > 0) {
+          status = reader.read(path.string(), blob);
+        }
+      } else {
+        pcl::PLYReader reader;
+        status = reader.read(path.string(), blob);
+      }
+    } catch (const std::exception& e) {
+      throw Error("ReadCloud: " + Quoted(path) + ": cannot be parsed (" + e.what() + ")");
+    }
+    if (status < 0) {
+      throw Error("ReadCloud: " + Quoted(path) + ": cannot be parsed as " +
+                  (*format == Format::kPcd ? "PCD" : "PLY"));
+    }
+    raw = FromBlob(blob, path);
+  }
+
+  CloudReadStats local;
+  local.num_in_file = raw.points.size();
+  local.has_normals = !raw.normals.empty();
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3f> normals;
+  points.reserve(raw.points.size());
+  for (std::size_t i = 0; i < raw.points.size(); ++i) {
+    const bool finite = raw.points[i].allFinite() &&
+                        (raw.normals.empty() || raw.normals[i].allFinite());
+    if (!finite) continue;
+    points.push_back(raw.points[i]);
+    if (local.has_normals) normals.push_back(raw.normals[i].cast<float>());
+  }
+  local.num_dropped_non_finite = raw.points.size() - points.size();
+  if (points.empty()) {
+    throw Error("ReadCloud: " + Quoted(path) + " holds no finite point (" +
+                std::to_string(local.num_in_file) + " in the file, " +
+                std::to_string(local.num_dropped_non_finite) + " dropped as NaN or infinite)");
+  }
+  PointCloud cloud = MakeCloud(points);
+  cloud.normals = std::move(normals);
+  if (stats) *stats = local;
+  return cloud;
+}
+
+void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool binary) {
+  const std::optional<Format> format = FormatOf(path);
+  if (!format || *format == Format::kXyz) {
+    throw Error("WriteCloud: " + Quoted(path) + ": unsupported extension (expected .ply or .pcd)");
+  }
+  RequireValidCloud(cloud, "WriteCloud " + Quoted(path), 1);
+  const pcl::PCLPointCloud2 blob = ToBlob(cloud, *format);
+  const bool doubles = !blob.fields.empty() &&
+                       blob.fields.front().datatype == pcl::PCLPointField::FLOAT64;
+  const int precision = doubles ? 17 : 9;  // round-trip digits
+
+  static std::atomic<unsigned> counter{0};
+  std::string temporary_name(1, '.');
+  temporary_name.append(path.filename().string());
+  temporary_name.append(".tmp-");
+  temporary_name.append(std::to_string(::getpid()));
+  temporary_name.push_back('-');
+  temporary_name.append(std::to_string(counter++));
+  const fs::path temporary = path.parent_path() / temporary_name;
+  int status = -1;
+  std::string reason;
+  try {
+    if (*format == Format::kPcd) {
+      pcl::PCDWriter writer;
+      status = binary ? writer.writeBinary(temporary.string(), blob)
+                      : writer.writeASCII(temporary.string(), blob, Eigen::Vector4f::Zero(),
+                                          Eigen::Quaternionf::Identity(), precision);
+    } else {
+      status = WritePly(temporary, blob, binary, precision) ? 0 : -1;
+    }
+  } catch (const std::exception& e) {
+    reason = std::string(" (") + e.what() + ")";
+    status = -1;
+  }
+  std::error_code ec;
+  if (status < 0 || !SyncFile(temporary)) {
+    fs::remove(temporary, ec);
+    throw Error("WriteCloud: cannot write " + Quoted(path) + reason);
+  }
+  fs::rename(temporary, path, ec);
+  if (ec) {
+    const std::string message = ec.message();
+    fs::remove(temporary, ec);
+    throw Error("WriteCloud: cannot replace " + Quoted(path) + " (" + message + ")");
+  }
+}
+
+}  // namespace uwscan::perception

@@ -1,0 +1,328 @@
+#include "perception/icp.hpp"
+
+#include <flann/algorithms/dist.h>
+#include <flann/algorithms/kdtree_single_index.h>
+#include <flann/util/matrix.h>
+#include <flann/util/result_set.h>
+#include <omp.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "perception/svd_alignment.hpp"
+#include "scanner/error.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+constexpr std::ptrdiff_t kBlockSize = 256;  // points per partial sum
+constexpr double kEigenvalueFloor = 1e-10;  // relative: smaller eigenvalues of J^T J dropped
+constexpr int kNoMatch = -1;
+
+int ThreadCount(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
+
+// The nearest point within a radius: a FLANN result set of capacity 1 that starts with the
+// radius as its worst distance, so the tree prunes everything beyond it.
+class NearestWithin : public flann::ResultSet<float> {
+ public:
+  void Reset(float radius_sq) {
+    worst_ = radius_sq;
+    index_ = kNoMatch;
+  }
+  bool full() const override { return true; }
+  void addPoint(float dist, size_t index) override {
+    if (dist < worst_) {
+      worst_ = dist;
+      index_ = static_cast<int>(index);
+    }
+  }
+  float worstDist() const override { return worst_; }
+  int index() const { return index_; }
+
+ private:
+  float worst_ = 0.0f;
+  int index_ = kNoMatch;
+};
+
+// Exact nearest-neighbour search on the target points (relative to the target origin).
+class TargetTree {
+ public:
+  explicit TargetTree(const PointCloud& target)
+      : index_(flann::Matrix<float>(const_cast<float*>(target.points.front().data()), target.size(),
+                                    3),
+               flann::KDTreeSingleIndexParams(10)) {
+    index_.buildIndex();
+  }
+  // Index of the nearest target point within `radius` of p, or kNoMatch. Thread-safe.
+  int Nearest(const Eigen::Vector3d& p, float radius_sq, NearestWithin& result) const {
+    const Eigen::Vector3f query = p.cast<float>();
+    result.Reset(radius_sq);
+    index_.findNeighbors(result, query.data(), exact_);
+    return result.index();
+  }
+
+ private:
+  flann::KDTreeSingleIndex<flann::L2_3D<float>> index_;
+  flann::SearchParams exact_{-1, 0.0f};  // unlimited checks, eps = 0: exact
+};
+
+// -[p]x, so that w x p = MinusSkew(p) w.
+Eigen::Matrix3d MinusSkew(const Eigen::Vector3d& p) {
+  Eigen::Matrix3d m;
+  m << 0.0, p.z(), -p.y(), -p.z(), 0.0, p.x(), p.y(), -p.x(), 0.0;
+  return m;
+}
+
+// Sums of per-pair terms over fixed blocks of points, added in block order, so the rounding
+// does not depend on the thread count.
+struct Sums {
+  Matrix6d JtJ = Matrix6d::Zero();  // upper triangle until Pass() returns
+  Vector6d Jtr = Vector6d::Zero();
+  double squared_residual = 0.0;  // sum of r^2 (the method's residual)
+  double squared_distance = 0.0;  // sum of |p - q|^2
+  std::size_t count = 0;
+
+  void Add(const Sums& other) {
+    JtJ += other.JtJ;
+    Jtr += other.Jtr;
+    squared_residual += other.squared_residual;
+    squared_distance += other.squared_distance;
+    count += other.count;
+  }
+};
+
+// One pass over the source: pairs every moved point p = T_rel s with its nearest target point q
+// within the radius (pairs[i] = target index or kNoMatch) and, with `accumulate`, sums the
+// Gauss-Newton terms with the rotation about `pivot`: rows [(p - c) x n, n] for point-to-plane,
+// [-[p - c]x, I] for point-to-point.
+Sums Pass(const std::vector<Eigen::Vector3d>& source_rel, const PointCloud& target,
+          const TargetTree& tree, const Eigen::Isometry3d& T_rel, double radius,
+          const Eigen::Vector3d& pivot, IcpMethod method, bool accumulate, int threads,
+          std::vector<int>& pairs) {
+  const auto n = static_cast<std::ptrdiff_t>(source_rel.size());
+  const auto radius_sq = static_cast<float>(radius * radius);
+  const std::ptrdiff_t blocks = (n + kBlockSize - 1) / kBlockSize;
+  std::vector<Sums> block_sums(static_cast<std::size_t>(blocks));
+  pairs.resize(source_rel.size());
+#pragma omp parallel num_threads(ThreadCount(threads))
+  {
+    NearestWithin result;
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t block = 0; block < blocks; ++block) {
+      Sums& sums = block_sums[static_cast<std::size_t>(block)];
+      const std::ptrdiff_t end = std::min(n, (block + 1) * kBlockSize);
+      for (std::ptrdiff_t i = block * kBlockSize; i < end; ++i) {
+        const Eigen::Vector3d p = T_rel * source_rel[static_cast<std::size_t>(i)];
+        const int j = tree.Nearest(p, radius_sq, result);
+        pairs[static_cast<std::size_t>(i)] = j;
+        if (j == kNoMatch || !accumulate) continue;
+        const Eigen::Vector3d q = target.points[static_cast<std::size_t>(j)].cast<double>();
+        const Eigen::Vector3d d = p - q;
+        sums.squared_distance += d.squaredNorm();
+        ++sums.count;
+        if (method == IcpMethod::kPointToPlane) {
+          const Eigen::Vector3d normal =
+              target.normals[static_cast<std::size_t>(j)].cast<double>().normalized();
+          Vector6d J;
+          J << (p - pivot).cross(normal), normal;
+          const double r = normal.dot(d);
+          sums.JtJ.selfadjointView<Eigen::Upper>().rankUpdate(J);
+          sums.Jtr += J * r;
+          sums.squared_residual += r * r;
+        } else {
+          Eigen::Matrix<double, 3, 6> J;
+          J << MinusSkew(p - pivot), Eigen::Matrix3d::Identity();
+          sums.JtJ.selfadjointView<Eigen::Upper>().rankUpdate(J.transpose());
+          sums.Jtr += J.transpose() * d;
+          sums.squared_residual += d.squaredNorm();
+        }
+      }
+    }
+  }
+  Sums total;
+  for (const Sums& sums : block_sums) total.Add(sums);
+  total.JtJ.triangularView<Eigen::StrictlyLower>() = total.JtJ.transpose();
+  return total;
+}
+
+// Minimum-norm solution of JtJ x = -Jtr over the eigenvalues above the floor.
+Vector6d SolveTruncated(const Matrix6d& JtJ, const Vector6d& Jtr) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(JtJ);
+  const Vector6d& values = solver.eigenvalues();
+  const double floor = kEigenvalueFloor * values(5);
+  Vector6d x = Vector6d::Zero();
+  if (!(values(5) > 0.0)) return x;
+  for (int k = 0; k < 6; ++k) {
+    if (values(k) <= floor) continue;
+    const Vector6d u = solver.eigenvectors().col(k);
+    x -= (u.dot(Jtr) / values(k)) * u;
+  }
+  return x;
+}
+
+// Rotation by w (rad) about `pivot`, then translation by v.
+Eigen::Isometry3d IncrementAbout(const Eigen::Vector3d& pivot, const Eigen::Vector3d& w,
+                                 const Eigen::Vector3d& v) {
+  Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
+  const double angle = w.norm();
+  if (angle > 0.0) increment.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  increment.translation() = pivot + v - increment.linear() * pivot;
+  return increment;
+}
+
+void RequireRigid(const Eigen::Isometry3d& T) {
+  const Eigen::Matrix3d R = T.linear();
+  if (!T.matrix().allFinite() ||
+      (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+      R.determinant() <= 0.0) {
+    throw Error(
+        "AlignIcp: T_target_source_init must be finite with a rotation (orthonormal, det +1) "
+        "as its linear part");
+  }
+}
+
+}  // namespace
+
+void IcpOptions::Check() const {
+  const auto fail = [](const std::string& field, const std::string& expected) {
+    throw Error("IcpOptions." + field + ": expected " + expected);
+  };
+  if (method != IcpMethod::kPointToPoint && method != IcpMethod::kPointToPlane) {
+    fail("method", "kPointToPoint or kPointToPlane");
+  }
+  if (max_iterations < 1) fail("max_iterations", "> 0, got " + std::to_string(max_iterations));
+  if (max_iterations_per_stage < 1) {
+    fail("max_iterations_per_stage", "> 0, got " + std::to_string(max_iterations_per_stage));
+  }
+  if (max_correspondence_distance_m.empty()) {
+    fail("max_correspondence_distance_m", "at least one distance");
+  }
+  for (std::size_t s = 0; s < max_correspondence_distance_m.size(); ++s) {
+    const double d = max_correspondence_distance_m[s];
+    const std::string field = "max_correspondence_distance_m[" + std::to_string(s) + "]";
+    if (!(std::isfinite(d) && d > 0.0)) fail(field, "a finite distance > 0 m");
+    if (s > 0 && d > max_correspondence_distance_m[s - 1]) {
+      fail(field, "a distance no larger than the previous stage's");
+    }
+  }
+  const auto require_tolerance = [&](const std::string& field, double value) {
+    if (!(std::isfinite(value) && value >= 0.0)) fail(field, "a finite value >= 0");
+  };
+  require_tolerance("rotation_tolerance_rad", rotation_tolerance_rad);
+  require_tolerance("translation_tolerance_m", translation_tolerance_m);
+  require_tolerance("relative_rmse_tolerance", relative_rmse_tolerance);
+  if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
+}
+
+RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
+                            const Eigen::Isometry3d& T_target_source_init,
+                            const IcpOptions& options) {
+  options.Check();
+  RequireValidCloud(source, "AlignIcp: source", 3);
+  RequireValidCloud(target, "AlignIcp: target", 3);
+  if (options.method == IcpMethod::kPointToPlane && !target.has_normals()) {
+    throw Error("AlignIcp: target has no normals; point-to-plane needs one per target point");
+  }
+  RequireRigid(T_target_source_init);
+
+  // Everything below is relative to the target origin: T_rel maps source points relative to
+  // their origin to target points relative to theirs.
+  Eigen::Isometry3d T_rel = Eigen::Translation3d(-target.origin) * T_target_source_init *
+                            Eigen::Translation3d(source.origin);
+  std::vector<Eigen::Vector3d> source_rel(source.size());
+  for (std::size_t i = 0; i < source.size(); ++i) source_rel[i] = source.points[i].cast<double>();
+  Eigen::Vector3d target_centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& q : target.points) target_centroid += q.cast<double>();
+  target_centroid /= static_cast<double>(target.size());
+
+  const TargetTree tree(target);
+  std::vector<int> pairs;
+  RegistrationResult result;
+  bool stopped = false;  // too few pairs or degenerate pairs
+  const std::size_t stages = options.max_correspondence_distance_m.size();
+  const bool point_to_plane = options.method == IcpMethod::kPointToPlane;
+  for (std::size_t stage = 0; stage < stages && !stopped; ++stage) {
+    const double radius = options.max_correspondence_distance_m[stage];
+    bool stage_converged = false;
+    double previous_rmse = std::numeric_limits<double>::quiet_NaN();
+    for (int k = 0;
+         k < options.max_iterations_per_stage && result.iterations < options.max_iterations; ++k) {
+      const Sums sums = Pass(source_rel, target, tree, T_rel, radius, target_centroid,
+                             options.method, point_to_plane, options.threads, pairs);
+      Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
+      double rmse = 0.0;
+      if (point_to_plane) {
+        if (sums.count < 3) {
+          stopped = true;
+          break;
+        }
+        rmse = std::sqrt(sums.squared_residual / static_cast<double>(sums.count));
+        const Vector6d x = SolveTruncated(sums.JtJ, sums.Jtr);
+        increment = IncrementAbout(target_centroid, x.head<3>(), x.tail<3>());
+      } else {
+        std::vector<Eigen::Vector3d> moved, matched;
+        for (std::size_t i = 0; i < source_rel.size(); ++i) {
+          if (pairs[i] == kNoMatch) continue;
+          moved.push_back(T_rel * source_rel[i]);
+          matched.push_back(target.points[static_cast<std::size_t>(pairs[i])].cast<double>());
+        }
+        if (moved.size() < 3) {
+          stopped = true;
+          break;
+        }
+        const SvdAlignment step = AlignSvd(moved, matched);
+        if (step.status != SvdAlignmentStatus::kSuccess) {
+          stopped = true;
+          break;
+        }
+        double squared = 0.0;
+        for (std::size_t i = 0; i < moved.size(); ++i) {
+          squared += (moved[i] - matched[i]).squaredNorm();
+        }
+        rmse = std::sqrt(squared / static_cast<double>(moved.size()));
+        increment = step.T_target_source;
+      }
+      T_rel = increment * T_rel;
+      ++result.iterations;
+
+      const double rotation_step = Eigen::AngleAxisd(increment.linear()).angle();
+      const double translation_step = (increment * target_centroid - target_centroid).norm();
+      const bool small_step = rotation_step < options.rotation_tolerance_rad &&
+                              translation_step < options.translation_tolerance_m;
+      const bool flat_rmse =
+          std::isfinite(previous_rmse) &&
+          std::abs(previous_rmse - rmse) <= options.relative_rmse_tolerance * previous_rmse;
+      previous_rmse = rmse;
+      if (small_step || flat_rmse) {
+        stage_converged = true;
+        break;
+      }
+    }
+    if (stage + 1 == stages) result.converged = stage_converged && !stopped;
+  }
+
+  // Fitness, RMSE and information at the returned transform, with the last stage's distance;
+  // the information's rotation is about the target origin.
+  const Sums final_sums =
+      Pass(source_rel, target, tree, T_rel, options.max_correspondence_distance_m.back(),
+           Eigen::Vector3d::Zero(), options.method, true, options.threads, pairs);
+  result.T_target_source =
+      Eigen::Translation3d(target.origin) * T_rel * Eigen::Translation3d(-source.origin);
+  result.fitness = static_cast<double>(final_sums.count) / static_cast<double>(source.size());
+  result.inlier_rmse =
+      final_sums.count == 0
+          ? 0.0
+          : std::sqrt(final_sums.squared_distance / static_cast<double>(final_sums.count));
+  result.information = final_sums.JtJ;
+  return result;
+}
+
+}  // namespace uwscan::perception

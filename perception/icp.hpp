@@ -1,0 +1,72 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "perception/point_cloud.hpp"
+#include "perception/registration_result.hpp"
+
+namespace uwscan::perception {
+
+enum class IcpMethod {
+  kPointToPoint,  // Besl & McKay 1992: closed-form SVD step on the pairs (AlignSvd)
+  kPointToPlane   // Chen & Medioni 1992: linearised step on n . (p - q); needs target normals
+};
+
+struct IcpOptions {
+  IcpMethod method = IcpMethod::kPointToPoint;
+  int max_iterations = 100;           // iterations over all stages together, > 0
+  int max_iterations_per_stage = 50;  // iterations of one stage of the schedule, > 0
+  // Stages of the schedule, metres: a pair is used only if the target point is within this
+  // distance of the moved source point. Each stage runs until convergence or its cap. Non-empty,
+  // finite, > 0 and non-increasing.
+  std::vector<double> max_correspondence_distance_m = {0.05, 0.02, 0.01};
+  // A stage has converged when an iteration's increment rotates by less than
+  // rotation_tolerance_rad and moves the target centroid by less than translation_tolerance_m,
+  // or when the RMS residual changed by less than relative_rmse_tolerance of its value. All >= 0.
+  double rotation_tolerance_rad = 1e-6;   // radians
+  double translation_tolerance_m = 1e-6;  // metres
+  double relative_rmse_tolerance = 1e-6;  // dimensionless
+  int threads = 0;  // OpenMP threads for the nearest-neighbour search, 0 = OpenMP's default, >= 0
+
+  // Throws uwscan::Error naming the field when a value is out of range.
+  void Check() const;
+};
+
+// Iterative closest point alignment of source onto target, starting at T_target_source_init.
+// Each iteration pairs every moved source point with its nearest target point (a k-d tree on
+// the target, built once; queries in parallel over source points), drops pairs farther apart
+// than the stage's distance and solves for an increment:
+//   point-to-point: the rigid transform minimising sum |p - q|^2 in closed form (AlignSvd);
+//   point-to-plane: one Gauss-Newton step on sum (n_q . (p - q))^2 with the rotation
+//     linearised about the target centroid, solved by the eigen-decomposition of J^T J with
+//     eigenvalues below 1e-10 x the largest dropped, so unconstrained directions (a single
+//     plane) do not move instead of running away; the rotation is then applied exactly.
+// Stages run in order of options.max_correspondence_distance_m.
+//
+// Precision: all geometry in double relative to target.origin; clouds whose origins differ by
+// 1e6 m align as well as nearby ones. Determinism: sums run in fixed blocks of points and are
+// added in a fixed order, so any thread count gives the same bits.
+//
+// Result, evaluated at the returned transform with the last stage's distance:
+//   fitness = fraction of source points with a target point within that distance;
+//   inlier_rmse = RMS of |p - q| over those pairs, metres (point-to-point distance for both
+//     methods);
+//   iterations = iterations over all stages;
+//   converged = the last stage met a tolerance within its cap and options.max_iterations; false
+//     also when an iteration found fewer than 3 pairs (it stops there) or, for point-to-point,
+//     the pairs were collinear (AlignSvd degenerate);
+//   information = sum over those pairs of J^T J with the pose perturbed as
+//     p -> p + w x p + v, p relative to target.origin, ordered [w (rad), v (m)]:
+//     point-to-plane rows [(p x n)^T, n^T]; point-to-point 3 rows per pair [-[p]x, I].
+//     Its near-zero eigenvalues are the directions the pairs do not constrain (3 for a single
+//     plane with point-to-plane: the in-plane translations and the rotation about the normal;
+//     the point-to-point information does not see that sliding, as fixed pairs pin all 6).
+// Throws uwscan::Error when a cloud has fewer than 3 points or a non-finite point or normal,
+// point-to-plane is asked for and the target has no normals, T_target_source_init is not
+// finite or not a rotation plus translation, or the options are invalid.
+RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
+                            const Eigen::Isometry3d& T_target_source_init,
+                            const IcpOptions& options = {});
+
+}  // namespace uwscan::perception

@@ -1,0 +1,48 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "perception/coarse_alignment.hpp"
+#include "perception/icp.hpp"
+#include "perception/point_cloud.hpp"
+#include "perception/registration_result.hpp"
+
+namespace uwscan::perception {
+
+// Coarse-to-fine registration as in seed 000's structure inspection and object pose:
+// voxel downsampling, normals, FPFH at every remaining point, RANSAC over FPFH
+// correspondences with SVD and edge pre-rejection, then point-to-plane ICP.
+struct RegistrationPipelineOptions {
+  double voxel_m = 0.01;           // downsampling leaf, metres
+  double normal_radius_m = 0.025;  // normal neighbourhood, metres
+  double feature_radius_m = 0.05;  // FPFH support, metres
+  // Normals face this point (absolute coordinates); for scans, the sensor.
+  Eigen::Vector3d viewpoint = Eigen::Vector3d::Zero();
+  CoarseAlignmentOptions coarse;
+  IcpOptions icp;
+  int threads = 0;  // OpenMP threads for every stage, 0 = OpenMP's default
+
+  // Parameters scaled to an object of the given bounding-box diagonal: voxel = size / 50,
+  // normals 2.5 voxels, FPFH 5 voxels, RANSAC inliers and ICP 1.5 voxels, then 0.75.
+  static RegistrationPipelineOptions ForObjectSize(double size_m, std::uint64_t seed = 1,
+                                                   int threads = 0);
+  void Check() const;
+};
+
+struct RegistrationPipelineResult {
+  RegistrationResult coarse;  // identity with converged = false when an initial guess was given
+  RegistrationResult fine;
+  std::map<std::string, double> stage_seconds;  // downsample, normals, features, coarse, icp
+};
+
+// Aligns source onto target. With `T_target_source_init` the coarse stage is skipped and ICP
+// starts there. Throws uwscan::Error on invalid clouds (empty, NaN) or options.
+RegistrationPipelineResult RegisterClouds(
+    const PointCloud& source, const PointCloud& target, const RegistrationPipelineOptions& options,
+    const std::optional<Eigen::Isometry3d>& T_target_source_init = std::nullopt);
+
+}  // namespace uwscan::perception
