@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -72,29 +73,43 @@ double FieldValue(const std::uint8_t* point, const pcl::PCLPointField& field) {
     return static_cast<double>(value);
   };
   switch (field.datatype) {
-    case pcl::PCLPointField::INT8: return get(std::int8_t{});
-    case pcl::PCLPointField::UINT8: return get(std::uint8_t{});
-    case pcl::PCLPointField::INT16: return get(std::int16_t{});
-    case pcl::PCLPointField::UINT16: return get(std::uint16_t{});
-    case pcl::PCLPointField::INT32: return get(std::int32_t{});
-    case pcl::PCLPointField::UINT32: return get(std::uint32_t{});
-    case pcl::PCLPointField::FLOAT32: return get(float{});
-    case pcl::PCLPointField::FLOAT64: return get(double{});
-    default: return std::nan("");
+    case pcl::PCLPointField::INT8:
+      return get(std::int8_t{});
+    case pcl::PCLPointField::UINT8:
+      return get(std::uint8_t{});
+    case pcl::PCLPointField::INT16:
+      return get(std::int16_t{});
+    case pcl::PCLPointField::UINT16:
+      return get(std::uint16_t{});
+    case pcl::PCLPointField::INT32:
+      return get(std::int32_t{});
+    case pcl::PCLPointField::UINT32:
+      return get(std::uint32_t{});
+    case pcl::PCLPointField::FLOAT32:
+      return get(float{});
+    case pcl::PCLPointField::FLOAT64:
+      return get(double{});
+    default:
+      return std::nan("");
   }
 }
 
 std::size_t FieldSize(std::uint8_t datatype) {
   switch (datatype) {
     case pcl::PCLPointField::INT8:
-    case pcl::PCLPointField::UINT8: return 1;
+    case pcl::PCLPointField::UINT8:
+      return 1;
     case pcl::PCLPointField::INT16:
-    case pcl::PCLPointField::UINT16: return 2;
+    case pcl::PCLPointField::UINT16:
+      return 2;
     case pcl::PCLPointField::INT32:
     case pcl::PCLPointField::UINT32:
-    case pcl::PCLPointField::FLOAT32: return 4;
-    case pcl::PCLPointField::FLOAT64: return 8;
-    default: return 0;
+    case pcl::PCLPointField::FLOAT32:
+      return 4;
+    case pcl::PCLPointField::FLOAT64:
+      return 8;
+    default:
+      return 0;
   }
 }
 
@@ -231,10 +246,10 @@ pcl::PCLPointCloud2 ToBlob(const PointCloud& cloud, Format format) {
 
 // PLY written directly (PCL 1.13's PLYWriter ignores the ASCII precision, printing 6 digits):
 // one vertex element with the blob's fields, in the host's byte order when binary.
-bool WritePly(const fs::path& path, const pcl::PCLPointCloud2& blob, bool binary, int precision) {
+bool WritePly(const fs::path& path, const pcl::PCLPointCloud2& blob, bool binary) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) return false;
-  const char* format = !binary ? "ascii"
+  const char* format = !binary                                      ? "ascii"
                        : std::endian::native == std::endian::little ? "binary_little_endian"
                                                                     : "binary_big_endian";
   out << "ply\nformat " << format << " 1.0\ncomment uwscan: absolute coordinates in metres\n"
@@ -248,10 +263,11 @@ bool WritePly(const fs::path& path, const pcl::PCLPointCloud2& blob, bool binary
     out.write(reinterpret_cast<const char*>(blob.data.data()),
               static_cast<std::streamsize>(blob.data.size()));
   } else {
-    out.precision(precision);
     for (std::size_t i = 0; i < std::size_t{blob.width} * blob.height; ++i) {
       const std::uint8_t* point = blob.data.data() + i * blob.point_step;
       for (std::size_t f = 0; f < blob.fields.size(); ++f) {
+        // Round-trip digits: 17 for double, 9 for float.
+        out.precision(blob.fields[f].datatype == pcl::PCLPointField::FLOAT64 ? 17 : 9);
         out << (f ? " " : "") << FieldValue(point, blob.fields[f]);
       }
       out << "\n";
@@ -266,8 +282,7 @@ bool WritePly(const fs::path& path, const pcl::PCLPointCloud2& blob, bool binary
 PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   const std::optional<Format> format = FormatOf(path);
   if (!format) {
-    throw Error("ReadCloud: " + Quoted(path) +
-                ": unknown extension (expected .pcd, .ply or .xyz)");
+    throw Error("ReadCloud: " + Quoted(path) + ": unknown extension (expected .pcd, .ply or .xyz)");
   }
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error("ReadCloud: " + Quoted(path) + ": no such file");
@@ -316,8 +331,8 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   std::vector<Eigen::Vector3f> normals;
   points.reserve(raw.points.size());
   for (std::size_t i = 0; i < raw.points.size(); ++i) {
-    const bool finite = raw.points[i].allFinite() &&
-                        (raw.normals.empty() || raw.normals[i].allFinite());
+    const bool finite =
+        raw.points[i].allFinite() && (raw.normals.empty() || raw.normals[i].allFinite());
     if (!finite) continue;
     points.push_back(raw.points[i]);
     if (local.has_normals) normals.push_back(raw.normals[i].cast<float>());
@@ -341,8 +356,8 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
   }
   RequireValidCloud(cloud, "WriteCloud " + Quoted(path), 1);
   const pcl::PCLPointCloud2 blob = ToBlob(cloud, *format);
-  const bool doubles = !blob.fields.empty() &&
-                       blob.fields.front().datatype == pcl::PCLPointField::FLOAT64;
+  const bool doubles =
+      !blob.fields.empty() && blob.fields.front().datatype == pcl::PCLPointField::FLOAT64;
   const int precision = doubles ? 17 : 9;  // round-trip digits
 
   static std::atomic<unsigned> counter{0};
@@ -362,7 +377,7 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
                       : writer.writeASCII(temporary.string(), blob, Eigen::Vector4f::Zero(),
                                           Eigen::Quaternionf::Identity(), precision);
     } else {
-      status = WritePly(temporary, blob, binary, precision) ? 0 : -1;
+      status = WritePly(temporary, blob, binary) ? 0 : -1;
     }
   } catch (const std::exception& e) {
     reason = std::string(" (") + e.what() + ")";

@@ -31,7 +31,8 @@ class CloudIoTest : public ::testing::Test {
     std::mt19937_64 rng(9);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<Eigen::Vector3d> points;
-    for (int i = 0; i < 500; ++i) points.push_back(offset + Eigen::Vector3d(u(rng), u(rng), u(rng)));
+    for (int i = 0; i < 500; ++i)
+      points.push_back(offset + Eigen::Vector3d(u(rng), u(rng), u(rng)));
     PointCloud cloud = MakeCloud(points);
     if (normals) {
       for (int i = 0; i < 500; ++i) {
@@ -137,8 +138,9 @@ TEST_F(CloudIoTest, ErrorsNameTheFile) {
   std::ofstream(all_nan) << "nan 0 0\n0 inf 0\n";
   EXPECT_NE(MessageOf([&] { ReadCloud(all_nan); }).find("2 dropped"), std::string::npos);
   const fs::path text = dir_ / "out.xyz";
-  EXPECT_NE(MessageOf([&] { WriteCloud(text, RandomCloud(Eigen::Vector3d::Zero(), false)); })
-                .find(text.string()),
+  EXPECT_NE(MessageOf([&] {
+              WriteCloud(text, RandomCloud(Eigen::Vector3d::Zero(), false));
+            }).find(text.string()),
             std::string::npos);
 }
 

@@ -54,8 +54,8 @@ RadiusGrid::RadiusGrid(std::span<const Eigen::Vector3f> points, double radius_m)
 
   const std::size_t n = points.size();
   std::vector<Eigen::Array<std::int64_t, 3, 1>> cells(n);
-  Eigen::Array<double, 3, 1> lo = Eigen::Array<double, 3, 1>::Constant(
-      std::numeric_limits<double>::infinity());
+  Eigen::Array<double, 3, 1> lo =
+      Eigen::Array<double, 3, 1>::Constant(std::numeric_limits<double>::infinity());
   Eigen::Array<double, 3, 1> hi = -lo;
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Array<double, 3, 1> c =
@@ -137,8 +137,8 @@ void RadiusGrid::Query(const Eigen::Vector3f& q, std::vector<std::uint32_t>& ind
   indices.clear();
   squared_distances_m2.clear();
   if (index_.empty() || !q.allFinite()) return;
-  const Eigen::Array<double, 3, 1> c = (q.cast<double>().array() * inverse_cell_m_).floor() -
-                                       min_cell_.cast<double>();
+  const Eigen::Array<double, 3, 1> c =
+      (q.cast<double>().array() * inverse_cell_m_).floor() - min_cell_.cast<double>();
   const Eigen::Array<double, 3, 1> n = num_cells_.cast<double>();
   // Outside the occupied block by more than one cell: nothing within the radius.
   if ((c < -1.0).any() || (c > n).any()) return;
@@ -151,10 +151,11 @@ void RadiusGrid::Query(const Eigen::Vector3f& q, std::vector<std::uint32_t>& ind
   const float qx = q.x(), qy = q.y(), qz = q.z();
   for (int x = std::max(ci.x() - 1, 0); x <= std::min(ci.x() + 1, num_cells_.x() - 1); ++x) {
     for (int y = std::max(ci.y() - 1, 0); y <= std::min(ci.y() + 1, num_cells_.y() - 1); ++y) {
-      const std::uint64_t column = (static_cast<std::uint64_t>(x) * ny + static_cast<std::uint64_t>(y)) * nz;
+      const std::uint64_t column =
+          (static_cast<std::uint64_t>(x) * ny + static_cast<std::uint64_t>(y)) * nz;
       std::uint32_t begin = 0, end = 0;
-      CellRange(column + static_cast<std::uint64_t>(z_lo), column + static_cast<std::uint64_t>(z_hi),
-                begin, end);
+      CellRange(column + static_cast<std::uint64_t>(z_lo),
+                column + static_cast<std::uint64_t>(z_hi), begin, end);
       for (std::uint32_t s = begin; s < end; ++s) {
         const float d = SquaredDistance(qx, qy, qz, x_[s], y_[s], z_[s]);
         if (d < radius_sq_) {

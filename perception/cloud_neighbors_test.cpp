@@ -56,9 +56,9 @@ TEST(RadiusGrid, MatchesBruteForceDenseAndSparse) {
       EXPECT_EQ(Sorted(idx, d2), BruteRadius(points, points[i], radius)) << "radius " << radius;
     }
     // Queries off the cloud, including far outside it.
-    for (const Eigen::Vector3f& q : {Eigen::Vector3f(0.5f, -0.3f, 0.01f),
-                                    Eigen::Vector3f(1.05f, 1.02f, 0.0f),
-                                    Eigen::Vector3f(1e30f, 0.0f, 0.0f)}) {
+    for (const Eigen::Vector3f& q :
+         {Eigen::Vector3f(0.5f, -0.3f, 0.01f), Eigen::Vector3f(1.05f, 1.02f, 0.0f),
+          Eigen::Vector3f(1e30f, 0.0f, 0.0f)}) {
       grid.Query(q, idx, d2);
       EXPECT_EQ(Sorted(idx, d2), BruteRadius(points, q, radius));
     }

@@ -11,7 +11,8 @@ namespace uwscan::perception {
 struct ClusteringOptions {
   double tolerance_m = 0.02;  // metres, points closer than this join one cluster; > 0
   std::size_t min_size = 1;   // clusters with fewer points are dropped, >= 1
-  std::size_t max_size = std::numeric_limits<std::size_t>::max();  // larger ones dropped, >= min_size
+  std::size_t max_size =
+      std::numeric_limits<std::size_t>::max();  // larger ones dropped, >= min_size
 
   // Throws uwscan::Error naming the field when it is out of range.
   void Check() const;

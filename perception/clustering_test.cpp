@@ -12,19 +12,20 @@
 namespace uwscan::perception {
 namespace {
 
-void AddSphere(const Eigen::Vector3d& centre, double radius, int n, std::vector<Eigen::Vector3d>* out) {
+void AddSphere(const Eigen::Vector3d& centre, double radius, int n,
+               std::vector<Eigen::Vector3d>* out) {
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < n; ++i) {
     const double z = 1.0 - 2.0 * (i + 0.5) / n;
     const double r = std::sqrt(1.0 - z * z);
-    out->push_back(centre + radius * Eigen::Vector3d(r * std::cos(golden * i),
-                                                     r * std::sin(golden * i), z));
+    out->push_back(centre +
+                   radius * Eigen::Vector3d(r * std::cos(golden * i), r * std::sin(golden * i), z));
   }
 }
 
 TEST(EuclideanClusters, SeparatesTwoSpheres) {
   std::vector<Eigen::Vector3d> points;
-  AddSphere({0, 0, 0}, 0.2, 800, &points);     // spacing about 2.5 cm
+  AddSphere({0, 0, 0}, 0.2, 800, &points);        // spacing about 2.5 cm
   AddSphere({0.6, 0.1, 0}, 0.25, 1500, &points);  // a 16 cm gap between the surfaces
   const PointCloud cloud = MakeCloud(points);
   const auto clusters = EuclideanClusters(cloud, {.tolerance_m = 0.05});

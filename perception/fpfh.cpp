@@ -26,14 +26,15 @@ void RequireFpfhInput(const PointCloud& cloud, std::span<const std::size_t> keyp
                       const std::string& what) {
   RequireValidCloud(cloud, what + ": cloud", 0);
   if (!keypoints.empty() && !cloud.has_normals()) {
-    throw Error(what + ": the cloud has no normals (estimate them first: EstimateNormals, "
-                       "AttachNormals)");
+    throw Error(what +
+                ": the cloud has no normals (estimate them first: EstimateNormals, "
+                "AttachNormals)");
   }
   for (std::size_t i = 0; i < keypoints.size(); ++i) {
     if (keypoints[i] >= cloud.size()) {
       throw Error(what + ": keypoint " + std::to_string(i) + " is index " +
-                  std::to_string(keypoints[i]) + ", the cloud has " +
-                  std::to_string(cloud.size()) + " points");
+                  std::to_string(keypoints[i]) + ", the cloud has " + std::to_string(cloud.size()) +
+                  " points");
     }
   }
 }
@@ -53,14 +54,16 @@ inline bool SwapSourceAndTarget(float angle1, float angle2) {
   return std::acos(a1) > std::acos(a2);
 }
 
-// Bins of the pair feature (Rusu et al. 2009) of points 1 and 2, operation for operation as
-// PCL's computePairFeatures and computePointSPFHSignature (Vector4f with w = 0), so the bins are
-// the same to the bit. False when the pair defines no Darboux frame.
-inline bool PairBins(const Eigen::Vector4f& p1, const Eigen::Vector4f& n1,
-                     const Eigen::Vector4f& p2, const Eigen::Vector4f& n2, int bins[3]) {
+// The angle features (f1, f2, f3) of the pair (Rusu et al. 2009) of points 1 and 2, operation
+// for operation as PCL's computePairFeatures (Vector4f with w = 0), so they agree to the bit.
+// A pair without a Darboux frame (coincident points, or the offset along the source normal)
+// gives (0, 0, 0): PCL's FPFHEstimation ignores computePairFeatures' failure and bins those
+// zeros, and so do we.
+inline Eigen::Vector3f PairFeatures(const Eigen::Vector4f& p1, const Eigen::Vector4f& n1,
+                                    const Eigen::Vector4f& p2, const Eigen::Vector4f& n2) {
   Eigen::Vector4f dp2p1 = p2 - p1;
   const float f4 = dp2p1.norm();
-  if (f4 == 0.0f) return false;
+  if (f4 == 0.0f) return Eigen::Vector3f::Zero();
   Eigen::Vector4f u = n1, n2_copy = n2;
   const float angle1 = u.dot(dp2p1) / f4;
   const float angle2 = n2_copy.dot(dp2p1) / f4;
@@ -76,36 +79,37 @@ inline bool PairBins(const Eigen::Vector4f& p1, const Eigen::Vector4f& n1,
   Eigen::Vector4f v = dp2p1.cross3(u);
   v[3] = 0.0f;
   const float v_norm = v.norm();
-  if (v_norm == 0.0f) return false;
+  if (v_norm == 0.0f) return Eigen::Vector3f::Zero();
   v /= v_norm;
   Eigen::Vector4f w = u.cross3(v);
   w[3] = 0.0f;
-  const float f2 = v.dot(n2_copy);
-  const float f1 = std::atan2(w.dot(n2_copy), u.dot(n2_copy));
-
-  // PCL's binning: in double, with its float 1 / (2 pi).
-  constexpr float kInverseTwoPi = 1.0f / (2.0f * static_cast<float>(std::numbers::pi));
-  const double x[3] = {(static_cast<double>(f1) + std::numbers::pi) *
-                           static_cast<double>(kInverseTwoPi),
-                       (static_cast<double>(f2) + 1.0) * 0.5,
-                       (static_cast<double>(f3) + 1.0) * 0.5};
-  for (int f = 0; f < 3; ++f) {
-    int bin = static_cast<int>(std::floor(kBins * x[f]));
-    bins[f] = bin < 0 ? 0 : (bin >= kBins ? kBins - 1 : bin);
-  }
-  return true;
+  return {std::atan2(w.dot(n2_copy), u.dot(n2_copy)), v.dot(n2_copy), f3};
 }
 
-// The SPFH of point p over its neighbourhood (p itself included), as PCL: each usable pair adds
-// 100 / (neighbours - 1) to one bin of each feature.
-Histogram Spfh(const std::vector<Eigen::Vector4f>& points, const std::vector<Eigen::Vector4f>& normals,
-               std::uint32_t p, const std::vector<std::uint32_t>& neighbours) {
+// PCL's binning of the features: in double, with its float 1 / (2 pi), clamped to the range.
+inline void Bins(const Eigen::Vector3f& f, int bins[3]) {
+  constexpr float kInverseTwoPi = 1.0f / (2.0f * static_cast<float>(std::numbers::pi));
+  const double x[3] = {
+      (static_cast<double>(f[0]) + std::numbers::pi) * static_cast<double>(kInverseTwoPi),
+      (static_cast<double>(f[1]) + 1.0) * 0.5, (static_cast<double>(f[2]) + 1.0) * 0.5};
+  for (int i = 0; i < 3; ++i) {
+    const int bin = static_cast<int>(std::floor(kBins * x[i]));
+    bins[i] = bin < 0 ? 0 : (bin >= kBins ? kBins - 1 : bin);
+  }
+}
+
+// The SPFH of point p over its neighbourhood (p itself included), as PCL: each other neighbour
+// adds 100 / (neighbours - 1) to one bin of each feature.
+Histogram Spfh(const std::vector<Eigen::Vector4f>& points,
+               const std::vector<Eigen::Vector4f>& normals, std::uint32_t p,
+               const std::vector<std::uint32_t>& neighbours) {
   Histogram h{};
   if (neighbours.size() < 2) return h;
   const float increment = 100.0f / static_cast<float>(neighbours.size() - 1);
   int bins[3];
   for (std::uint32_t q : neighbours) {
-    if (q == p || !PairBins(points[p], normals[p], points[q], normals[q], bins)) continue;
+    if (q == p) continue;
+    Bins(PairFeatures(points[p], normals[p], points[q], normals[q]), bins);
     h[static_cast<std::size_t>(bins[0])] += increment;
     h[static_cast<std::size_t>(kBins + bins[1])] += increment;
     h[static_cast<std::size_t>(2 * kBins + bins[2])] += increment;

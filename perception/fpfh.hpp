@@ -32,10 +32,12 @@ struct FpfhOptions {
 // simplified point feature histogram SPFH(p) over its neighbours (three 11-bin histograms of
 // the Darboux-frame angles, each summing to 100), then FPFH(q) = the SPFH of q's neighbours k
 // (q and points coincident with it excluded) weighted by 1 / |q - k|^2 (PCL weights by the
-// squared distance), each 11-bin third renormalised to sum to 100. Bins agree with PCL's to
-// float rounding of the sums.
-// Keypoints whose descriptor is undefined (no neighbour within radius_m, or no usable pair)
-// are dropped: indices and descriptors stay aligned, in keypoint order. The cloud must carry
+// squared distance), each 11-bin third renormalised to sum to 100. As in PCL, a pair without a
+// Darboux frame (coincident points, or the offset along the source normal) counts as angles
+// (0, 0, 0). Bins agree with PCL's to float rounding of the sums.
+// Keypoints whose descriptor is undefined (no neighbour within radius_m other than points
+// coincident with the keypoint) are dropped: indices and descriptors stay aligned, in keypoint
+// order. The cloud must carry
 // unit normals (PointCloud::has_normals) and be finite; keypoints must be valid indices (both
 // throw uwscan::Error otherwise, as does a cloud spanning more than 2^21 radii along an axis).
 // No keypoints or an empty cloud give an empty result.

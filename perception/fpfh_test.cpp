@@ -49,8 +49,8 @@ std::vector<std::size_t> EveryNth(std::size_t size, std::size_t step) {
 }
 
 // PCL's single-threaded FPFHEstimation: the reference.
-std::vector<FpfhDescriptor> PclFpfh(const PointCloud& cloud, const std::vector<std::size_t>& keypoints,
-                                    double radius_m) {
+std::vector<FpfhDescriptor> PclFpfh(const PointCloud& cloud,
+                                    const std::vector<std::size_t>& keypoints, double radius_m) {
   const auto surface = ToPclXYZ(cloud);
   auto input = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   for (std::size_t k : keypoints) input->push_back((*surface)[k]);
@@ -83,6 +83,33 @@ TEST(ComputeFpfh, MatchesPclFpfhEstimationPerBin) {
       }
     }
     EXPECT_LE(worst, 1e-4f) << "radius " << radius;
+  }
+}
+
+TEST(ComputeFpfh, MatchesPclOnExactGeometryWithTiedAngles) {
+  // A noise-free cube sampled on a grid, each face with its exact normal: within a face both
+  // pair angles are exactly 0, the tie that PCL settles with acosf.
+  PointCloud cloud;
+  for (int i = 0; i <= 20; ++i) {
+    for (int j = 0; j <= 20; ++j) {
+      const float a = 0.01f * i, b = 0.01f * j;
+      const Eigen::Vector3f points[6] = {{a, b, 0},    {a, b, 0.2f}, {a, 0, b},
+                                         {a, 0.2f, b}, {0, a, b},    {0.2f, a, b}};
+      const Eigen::Vector3f normals[6] = {-Eigen::Vector3f::UnitZ(), Eigen::Vector3f::UnitZ(),
+                                          -Eigen::Vector3f::UnitY(), Eigen::Vector3f::UnitY(),
+                                          -Eigen::Vector3f::UnitX(), Eigen::Vector3f::UnitX()};
+      for (int f = 0; f < 6; ++f) {
+        cloud.points.push_back(points[f] - Eigen::Vector3f::Constant(0.1f));
+        cloud.normals.push_back(normals[f]);
+      }
+    }
+  }
+  const std::vector<std::size_t> keypoints = EveryNth(cloud.size(), 5);
+  const FpfhFeatures ours = ComputeFpfh(cloud, keypoints, {.radius_m = 0.035});
+  const std::vector<FpfhDescriptor> pcl = PclFpfh(cloud, keypoints, 0.035);
+  ASSERT_EQ(ours.indices.size(), keypoints.size());
+  for (std::size_t k = 0; k < keypoints.size(); ++k) {
+    EXPECT_LE((ours.descriptors[k] - pcl[k]).cwiseAbs().maxCoeff(), 1e-4f) << k;
   }
 }
 
@@ -153,17 +180,25 @@ TEST(ComputeFpfh, EmptyTinyCollinearAndBadInput) {
   const std::vector<std::size_t> first = {0};
   EXPECT_TRUE(ComputeFpfh(one, first, options).indices.empty());
 
-  // Collinear points with normals along the line: no Darboux frame, no descriptor; with
-  // normals across it the descriptors are defined.
+  // Collinear points with normals along the line: no pair has a Darboux frame, and as in PCL
+  // every pair counts as angles (0, 0, 0), the middle bins.
   PointCloud line;
   for (int i = 0; i < 20; ++i) {
     line.points.push_back(Eigen::Vector3f(0.01f * i, 0, 0));
     line.normals.push_back(Eigen::Vector3f::UnitX());
   }
   const std::vector<std::size_t> all = EveryNth(line.size(), 1);
-  EXPECT_TRUE(ComputeFpfh(line, all, options).indices.empty());
-  for (auto& normal : line.normals) normal = Eigen::Vector3f::UnitZ();
-  EXPECT_EQ(ComputeFpfh(line, all, options).indices.size(), line.size());
+  const FpfhFeatures collinear = ComputeFpfh(line, all, options);
+  ASSERT_EQ(collinear.indices.size(), line.size());
+  for (const FpfhDescriptor& d : collinear.descriptors) {
+    EXPECT_FLOAT_EQ(d[5], 100.0f);
+    EXPECT_FLOAT_EQ(d[16], 100.0f);
+    EXPECT_FLOAT_EQ(d[27], 100.0f);
+  }
+  const std::vector<FpfhDescriptor> pcl_collinear = PclFpfh(line, all, options.radius_m);
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    EXPECT_LE((collinear.descriptors[k] - pcl_collinear[k]).cwiseAbs().maxCoeff(), 1e-4f);
+  }
 
   const std::vector<std::size_t> beyond = {cloud.size()};
   EXPECT_THROW(ComputeFpfh(cloud, beyond, options), Error);

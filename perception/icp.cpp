@@ -245,6 +245,7 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
 
   const TargetTree tree(target);
   std::vector<int> pairs;
+  std::vector<Eigen::Vector3d> moved, matched;  // point-to-point pairs, reused
   RegistrationResult result;
   bool stopped = false;  // too few pairs or degenerate pairs
   const std::size_t stages = options.max_correspondence_distance_m.size();
@@ -268,7 +269,8 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
         const Vector6d x = SolveTruncated(sums.JtJ, sums.Jtr);
         increment = IncrementAbout(target_centroid, x.head<3>(), x.tail<3>());
       } else {
-        std::vector<Eigen::Vector3d> moved, matched;
+        moved.clear();
+        matched.clear();
         for (std::size_t i = 0; i < source_rel.size(); ++i) {
           if (pairs[i] == kNoMatch) continue;
           moved.push_back(T_rel * source_rel[i]);

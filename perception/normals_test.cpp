@@ -20,8 +20,8 @@ std::vector<Eigen::Vector3d> Sphere(const Eigen::Vector3d& centre, double radius
   for (int i = 0; i < n; ++i) {
     const double z = 1.0 - 2.0 * (i + 0.5) / n;
     const double r = std::sqrt(1.0 - z * z);
-    points.push_back(centre + radius * Eigen::Vector3d(r * std::cos(golden * i),
-                                                       r * std::sin(golden * i), z));
+    points.push_back(
+        centre + radius * Eigen::Vector3d(r * std::cos(golden * i), r * std::sin(golden * i), z));
   }
   return points;
 }
@@ -52,7 +52,8 @@ TEST(EstimateNormals, SpherePointsRadiallyTowardTheViewpoint) {
   EXPECT_EQ(inward.num_invalid, 0u);
   double worst = 0.0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    worst = std::max(worst, AngleBetween(inward.normals[i].cast<double>(), centre - cloud.Point(i)));
+    worst =
+        std::max(worst, AngleBetween(inward.normals[i].cast<double>(), centre - cloud.Point(i)));
   }
   EXPECT_LT(worst, 1.0 * kDegree);
   // Viewpoint outside, above the sphere: normals face it, so those on the near side point out.
@@ -92,8 +93,8 @@ TEST(EstimateNormals, CurvatureNearZeroOnPlanesAndHigherOnTheEdge) {
     const double to_edge = std::max(p.x(), p.z());  // distance from the edge line (x = z = 0)
     if (to_edge > 0.05) {
       EXPECT_LT(r.curvatures[i], 1e-5f) << p.transpose();
-      const Eigen::Vector3d expected = p.z() < 1e-9 ? Eigen::Vector3d::UnitZ()
-                                                    : Eigen::Vector3d::UnitX();
+      const Eigen::Vector3d expected =
+          p.z() < 1e-9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
       EXPECT_GT(r.normals[i].cast<double>().dot(expected), 0.9999);
     }
     if (to_edge < 1e-9 && p.y() > 0.05 && p.y() < 0.35) {

@@ -35,7 +35,8 @@ OutlierFilterResult RemoveStatisticalOutliers(const PointCloud& cloud,
   }
 
   const KnnIndex index(cloud.points);
-  const int k_search = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(options.k), n - 1)) + 1;
+  const int k_search =
+      static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(options.k), n - 1)) + 1;
   std::vector<double> mean_distance(n);
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
 #pragma omp parallel num_threads(threads)
@@ -58,7 +59,8 @@ OutlierFilterResult RemoveStatisticalOutliers(const PointCloud& cloud,
   for (double d : mean_distance) sum += d;
   result.mean_distance_m = sum / count;
   double sum_sq = 0.0;
-  for (double d : mean_distance) sum_sq += (d - result.mean_distance_m) * (d - result.mean_distance_m);
+  for (double d : mean_distance)
+    sum_sq += (d - result.mean_distance_m) * (d - result.mean_distance_m);
   result.std_distance_m = std::sqrt(sum_sq / (count - 1.0));
   result.threshold_m = result.mean_distance_m + options.std_ratio * result.std_distance_m;
 

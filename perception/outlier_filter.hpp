@@ -8,9 +8,9 @@
 namespace uwscan::perception {
 
 struct OutlierFilterOptions {
-  int k = 20;               // neighbours per point (the point itself not counted), >= 1
-  double std_ratio = 1.0;   // threshold in standard deviations above the mean, finite
-  int threads = 0;          // OpenMP threads, 0 = OpenMP's default; the result does not depend on it
+  int k = 20;              // neighbours per point (the point itself not counted), >= 1
+  double std_ratio = 1.0;  // threshold in standard deviations above the mean, finite
+  int threads = 0;         // OpenMP threads, 0 = OpenMP's default; the result does not depend on it
 
   // Throws uwscan::Error naming the field when it is out of range.
   void Check() const;

@@ -117,9 +117,8 @@ std::optional<Candidate> FindPlane(const PointCloud& cloud, const std::vector<st
     if (best && best->inliers > 0) {
       const double w = static_cast<double>(best->inliers) / static_cast<double>(m);
       const double miss = 1.0 - w * w * w;  // a sample is not all-inlier
-      const double k = miss <= 1e-12 ? 1.0
-                                      : std::ceil(std::log(1.0 - options.probability) /
-                                                  std::log(miss));
+      const double k =
+          miss <= 1e-12 ? 1.0 : std::ceil(std::log(1.0 - options.probability) / std::log(miss));
       needed = static_cast<int>(std::clamp(k, 1.0, static_cast<double>(options.max_iterations)));
     }
   }
@@ -144,8 +143,7 @@ void PlaneRemovalOptions::Check() const {
                 std::to_string(min_fraction));
   }
   if (max_planes < 0) {
-    throw Error("PlaneRemovalOptions.max_planes: expected >= 0, got " +
-                std::to_string(max_planes));
+    throw Error("PlaneRemovalOptions.max_planes: expected >= 0, got " + std::to_string(max_planes));
   }
   if (max_iterations < 1) {
     throw Error("PlaneRemovalOptions.max_iterations: expected >= 1, got " +

@@ -44,8 +44,8 @@ BoxScene MakeBoxScene(const Eigen::Vector3d& offset) {
   for (int i = 0; i <= 15; ++i) {
     for (int j = 0; j <= 15; ++j) {
       const double a = -0.15 + 0.02 * i, b = -0.15 + 0.02 * j, c = 0.02 * j;
-      const Eigen::Vector3d faces[5] = {{a, b, 0.3}, {-0.15, a, c}, {0.15, a, c}, {a, -0.15, c},
-                                        {a, 0.15, c}};
+      const Eigen::Vector3d faces[5] = {
+          {a, b, 0.3}, {-0.15, a, c}, {0.15, a, c}, {a, -0.15, c}, {a, 0.15, c}};
       for (const Eigen::Vector3d& f : faces) {
         scene.box.push_back(points.size());
         points.push_back(offset + f + jitter());
@@ -71,8 +71,9 @@ TEST(RemovePlanes, RemovesFloorAndWallKeepsTheBox) {
   ASSERT_EQ(r.planes.size(), 2u);
   // Floor first (it is larger), then wall; normals up to sign.
   EXPECT_GT(std::abs(r.planes[0].normal.z()), 0.999);
-  EXPECT_NEAR(std::abs(r.planes[0].normal.dot(Eigen::Vector3d(1e5, -2e5, 30.0)) +
-                       r.planes[0].offset_m), 0.0, 0.005);
+  EXPECT_NEAR(
+      std::abs(r.planes[0].normal.dot(Eigen::Vector3d(1e5, -2e5, 30.0)) + r.planes[0].offset_m),
+      0.0, 0.005);
   EXPECT_GT(std::abs(r.planes[1].normal.y()), 0.999);
   EXPECT_GE(r.planes[0].inliers.size(), scene.floor_points * 98 / 100);
   EXPECT_GE(r.planes[1].inliers.size(), scene.wall_points * 98 / 100);

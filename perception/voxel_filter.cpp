@@ -37,8 +37,8 @@ PointCloud VoxelDownsample(const PointCloud& cloud, const VoxelFilterOptions& op
       const double k = std::floor(p[a] / options.leaf_m);
       if (!(std::abs(k) < kMaxKey)) {
         throw Error("VoxelDownsample: leaf_m " + std::to_string(options.leaf_m) +
-                    " m is too small for coordinate " + std::to_string(p[a]) +
-                    " m of point " + std::to_string(i) + " (voxel key overflows 64 bits)");
+                    " m is too small for coordinate " + std::to_string(p[a]) + " m of point " +
+                    std::to_string(i) + " (voxel key overflows 64 bits)");
       }
       entries[i].key[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(k);
     }
