@@ -52,8 +52,8 @@ std::vector<FeatureCorrespondence> MatchFeatures(const FpfhFeatures& source,
 // edge lengths differ between source and target (options.edge_similarity) or that is collinear
 // is dropped before it is solved (AlignSvd) and scored by its number of inlier correspondences
 // (|T s - t| < options.inlier_distance_m). The best hypothesis (most inliers, then the lowest
-// hypothesis index) is refitted on its inliers (AlignSvd, repeated while the inlier count grows,
-// at most 10 times).
+// hypothesis index) is refitted on its inliers (AlignSvd), repeated while the inlier set changes
+// without shrinking, at most 10 times.
 //
 // Determinism: hypothesis i draws its sample from a SplitMix64 stream keyed by (seed, i) and is
 // evaluated independently; hypotheses run in blocks of 512 across threads and the adaptive stop
