@@ -71,16 +71,21 @@ void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOpti
     centroid /= static_cast<double>(surface.points.size());
     std::normal_distribution<double> gauss(0.0, 1.0);
     for (int k = 0; k < o.pairs_per_mesh; ++k) {
-      const Eigen::Vector3d a = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
-      const Eigen::Vector3d axis = a.unitOrthogonal();
-      const Eigen::Vector3d b = Eigen::AngleAxisd(o.view_separation_rad, axis) * a;
-      const double distance = 3.0 * o.mesh_size_m;
       RegistrationPair pair;
       pair.name = std::string(name) + "#" + std::to_string(k);
-      const std::vector<Eigen::Vector3d> target =
-          PartialView(surface, centroid + distance * a, o.noise_sigma_m, rng);
-      std::vector<Eigen::Vector3d> source =
-          PartialView(surface, centroid + distance * b, o.noise_sigma_m, rng);
+      // Viewpoints from which an open mesh shows (almost) no front faces are drawn again.
+      std::vector<Eigen::Vector3d> target, source;
+      for (int attempt = 0; attempt < 50 && (target.size() < 500 || source.size() < 500);
+           ++attempt) {
+        const Eigen::Vector3d a = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        const Eigen::Vector3d b = Eigen::AngleAxisd(o.view_separation_rad, a.unitOrthogonal()) * a;
+        const double distance = 3.0 * o.mesh_size_m;
+        target = PartialView(surface, centroid + distance * a, o.noise_sigma_m, rng);
+        source = PartialView(surface, centroid + distance * b, o.noise_sigma_m, rng);
+      }
+      if (target.size() < 500 || source.size() < 500) {
+        throw Error(std::string("registration pairs: no usable views of mesh '") + name + "'");
+      }
       const Eigen::Isometry3d T_source_target = RandomMotion(rng, o.mesh_size_m);
       for (Eigen::Vector3d& p : source) p = T_source_target * p;
       pair.target = perception::MakeCloud(target);

@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "perception/cloud_neighbors.hpp"
 #include "perception/svd_alignment.hpp"
 #include "scanner/error.hpp"
 
@@ -241,17 +242,30 @@ double RequiredIterations(double inlier_ratio, double confidence) {
   return std::log(1.0 - confidence) / std::log1p(-all_inliers);
 }
 
-Hypothesis Ransac(const Pairs& pairs, const CoarseAlignmentOptions& options, int* drawn) {
+// Keeps the `capacity` best hypotheses (BetterThan order, a total order since indices are
+// unique), so the kept set does not depend on the order hypotheses arrive in.
+void KeepBest(std::vector<Hypothesis>* kept, const Hypothesis& candidate, std::size_t capacity) {
+  if (kept->size() == capacity && !candidate.BetterThan(kept->back())) return;
+  const auto at = std::upper_bound(kept->begin(), kept->end(), candidate,
+                                   [](const Hypothesis& a, const Hypothesis& b) {
+                                     return a.BetterThan(b);
+                                   });
+  kept->insert(at, candidate);
+  if (kept->size() > capacity) kept->pop_back();
+}
+
+// RANSAC; returns the `capacity` best hypotheses, best first.
+std::vector<Hypothesis> Ransac(const Pairs& pairs, const CoarseAlignmentOptions& options,
+                               std::size_t capacity, int* drawn) {
   const std::size_t n = pairs.source.size();
   const double threshold_sq = options.inlier_distance_m * options.inlier_distance_m;
-  Hypothesis best;
+  std::vector<Hypothesis> best;
   std::int64_t begin = 0;
   while (begin < options.max_iterations) {
     const std::int64_t end = std::min<std::int64_t>(begin + kBlockSize, options.max_iterations);
-    Hypothesis block_best;
 #pragma omp parallel num_threads(ThreadCount(options.threads))
     {
-      Hypothesis thread_best;
+      std::vector<Hypothesis> thread_best;
 #pragma omp for schedule(dynamic, 8) nowait
       for (std::int64_t it = begin; it < end; ++it) {
         SampleStream stream(options.seed, static_cast<std::uint64_t>(it));
@@ -272,22 +286,57 @@ Hypothesis Ransac(const Pairs& pairs, const CoarseAlignmentOptions& options, int
         candidate.inliers = CountInliers(pairs, fit.T_target_source, threshold_sq);
         candidate.index = it;
         candidate.T = fit.T_target_source;
-        if (candidate.BetterThan(thread_best)) thread_best = candidate;
+        KeepBest(&thread_best, candidate, capacity);
       }
 #pragma omp critical(uwscan_coarse_alignment_best)
-      if (thread_best.BetterThan(block_best)) block_best = thread_best;
+      for (const Hypothesis& h : thread_best) KeepBest(&best, h, capacity);
     }
-    if (block_best.BetterThan(best)) best = block_best;
     begin = end;
-    if (best.inliers > 0 &&
+    if (!best.empty() && best.front().inliers > 0 &&
         static_cast<double>(begin) >=
-            RequiredIterations(static_cast<double>(best.inliers) / static_cast<double>(n),
+            RequiredIterations(static_cast<double>(best.front().inliers) / static_cast<double>(n),
                                options.confidence)) {
       break;
     }
   }
   *drawn = static_cast<int>(begin);
   return best;
+}
+
+// Source points (relative to the source origin, evenly strided) within `distance` of a target
+// point once moved by T_rel (which maps source-relative to target-relative coordinates).
+int Overlap(const std::vector<Eigen::Vector3d>& source_points, const KnnIndex& target_index,
+            const Eigen::Isometry3d& T_rel, double distance) {
+  std::vector<std::uint32_t> index;
+  std::vector<float> squared;
+  const float limit = static_cast<float>(distance * distance);
+  int count = 0;
+  for (const Eigen::Vector3d& p : source_points) {
+    target_index.Query((T_rel * p).cast<float>(), 1, index, squared);
+    count += !squared.empty() && squared.front() < limit ? 1 : 0;
+  }
+  return count;
+}
+
+// Of the candidates (best by inliers first), the one with the most overlap; ties keep the
+// better-by-inliers one. Evaluated in parallel, chosen in a fixed order: thread-count free.
+Hypothesis MostOverlapping(const std::vector<Hypothesis>& candidates, const PointCloud& source,
+                           const PointCloud& target, const CoarseAlignmentOptions& options) {
+  const std::size_t stride =
+      std::max<std::size_t>(1, source.size() / static_cast<std::size_t>(options.verification_points));
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < source.size(); i += stride) points.push_back(source.points[i].cast<double>());
+  const KnnIndex target_index(target.points);
+  std::vector<int> overlap(candidates.size(), 0);
+#pragma omp parallel for num_threads(ThreadCount(options.threads)) schedule(dynamic, 1)
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    overlap[c] = Overlap(points, target_index, candidates[c].T, options.inlier_distance_m);
+  }
+  std::size_t chosen = 0;
+  for (std::size_t c = 1; c < candidates.size(); ++c) {
+    if (overlap[c] > overlap[chosen]) chosen = c;
+  }
+  return candidates[chosen];
 }
 
 }  // namespace
@@ -311,6 +360,12 @@ void CoarseAlignmentOptions::Check() const {
     fail("min_inlier_fraction", "a value in [0, 1], got " + std::to_string(min_inlier_fraction));
   }
   if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
+  if (verified_hypotheses < 0) {
+    fail("verified_hypotheses", ">= 0, got " + std::to_string(verified_hypotheses));
+  }
+  if (verification_points < 1) {
+    fail("verification_points", "> 0, got " + std::to_string(verification_points));
+  }
 }
 
 std::vector<FeatureCorrespondence> MatchFeatures(const FpfhFeatures& source,
@@ -361,9 +416,13 @@ RegistrationResult AlignCoarse(const PointCloud& source, const FpfhFeatures& sou
   RegistrationResult result;
   if (pairs.source.size() < 3) return result;
   int drawn = 0;
-  const Hypothesis best = Ransac(pairs, options, &drawn);
+  const std::vector<Hypothesis> candidates = Ransac(
+      pairs, options, static_cast<std::size_t>(std::max(1, options.verified_hypotheses)), &drawn);
   result.iterations = drawn;
-  if (best.inliers < 0) return result;
+  if (candidates.empty()) return result;
+  const Hypothesis best = options.verified_hypotheses > 0
+                              ? MostOverlapping(candidates, source, target, options)
+                              : candidates.front();
 
   // Refit on the inliers while that gains inliers. T_rel maps source-relative coordinates to
   // target-relative ones.

@@ -24,6 +24,12 @@ struct CoarseAlignmentOptions {
   double min_inlier_fraction = 0.05;  // fitness needed for converged = true, in [0, 1]
   std::uint64_t seed = 0;             // RANSAC sample stream
   int threads = 0;                    // OpenMP threads, 0 = OpenMP's default, >= 0
+  // The best hypotheses by inlier correspondences are verified on the clouds themselves: the
+  // one that brings most source points within inlier_distance_m of a target point wins (as
+  // PCL's prerejective scores). Repeated structure gives wrong hypotheses many consistent
+  // correspondences; it rarely gives them more overlap. 0 = no verification; >= 0.
+  int verified_hypotheses = 32;
+  int verification_points = 1000;  // source points (evenly strided) the overlap is counted on, > 0
 
   // Throws uwscan::Error naming the field when a value is out of range.
   void Check() const;
@@ -53,7 +59,8 @@ std::vector<FeatureCorrespondence> MatchFeatures(const FpfhFeatures& source,
 // is dropped before it is solved (AlignSvd) and scored by its number of inlier correspondences
 // (|T s - t| < options.inlier_distance_m). The best hypothesis (most inliers, then the lowest
 // hypothesis index) is refitted on its inliers (AlignSvd), repeated while the inlier set changes
-// without shrinking, at most 10 times.
+// without shrinking, at most 10 times. With options.verified_hypotheses > 0 the best of that
+// many (by inliers, then index) is chosen by its overlap of the clouds instead.
 //
 // Determinism: hypothesis i draws its sample from a SplitMix64 stream keyed by (seed, i) and is
 // evaluated independently; hypotheses run in blocks of 512 across threads and the adaptive stop
