@@ -201,3 +201,21 @@ TEST(Cli, RegisterRejectsMissingAndEmptyClouds) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Cli, FeaturesBenchWritesItsJson) {
+  const std::filesystem::path json = TempPath("features.json");
+  const CommandRun run = RunUwscan("bench features --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  for (const char* key : {"uwscan_s", "pcl_s"}) {
+    EXPECT_GT(j["fpfh"][key].get<double>(), 0.0) << key;
+    EXPECT_GT(j["esf"][key].get<double>(), 0.0) << key;
+  }
+  // uwscan's ESF differs from PCL's no more than two samplings of one view differ (x2 margin).
+  EXPECT_LT(j["esf"]["chi2_to_pcl"].get<double>(), 2.0 * j["esf"]["chi2_seed_to_seed"].get<double>());
+  std::filesystem::remove(json);
+}
+
+}  // namespace
