@@ -17,10 +17,12 @@ if ! complete; then
   work=$(mktemp -d)
   trap 'rm -rf "$work"' EXIT
   mkdir -p "$cache/meshes" "$cache/scans"
-  (cd "$work" && apt-get download -qq libcgal-demo python3-pcl >/dev/null 2>&1) || {
+  download() { (cd "$work" && apt-get download -qq libcgal-demo python3-pcl >/dev/null 2>&1); }
+  # A machine whose package lists were never fetched cannot download: refresh them (as root).
+  if ! download && ! { [ "$(id -u)" -eq 0 ] && apt-get update -qq >/dev/null 2>&1 && download; }; then
     echo "fetch_data: apt-get download libcgal-demo python3-pcl failed (run apt-get update?)" >&2
     exit 1
-  }
+  fi
   dpkg-deb -x "$work"/libcgal-demo_*.deb "$work/cgal"
   tar xzf "$work/cgal/usr/share/doc/libcgal-dev/data.tar.gz" -C "$work/cgal"
   for m in "${meshes[@]}"; do
