@@ -34,7 +34,7 @@ RayTrace LaserFan::RayInAir(double fan_tan) const {
 RayTrace LaserFan::RayInWater(double fan_tan) const {
   const RayTrace in_air = RayInAir(fan_tan);
   if (!in_air.ok()) return in_air;
-  return TraceOut(*viewport, in_air.ray);
+  return TraceOut(viewport, in_air.ray);
 }
 
 void GalvoLaser::Check() const {
@@ -61,7 +61,7 @@ LaserFan GalvoLaser::FanAt(double mirror_angle_rad) const {
   fan.spread_dir_C = T_C_L.linear().col(1);
   fan.mirror_normal_C = T_C_M.linear() * normal_M;
   fan.mirror_offset_m = fan.mirror_normal_C.dot(T_C_M.translation()) + rotation_distance_m;
-  fan.viewport = &viewport;
+  fan.viewport = viewport;
   return fan;
 }
 

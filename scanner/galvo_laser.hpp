@@ -16,7 +16,7 @@ struct LaserFan {
   Eigen::Vector3d spread_dir_C;     // y_L
   Eigen::Vector3d mirror_normal_C;  // reflecting normal at this angle
   double mirror_offset_m = 0.0;     // mirror surface: mirror_normal_C . x = mirror_offset_m
-  const FlatViewport* viewport = nullptr;
+  FlatViewport viewport;            // the laser viewport (a copy: the fan stands alone)
 
   // The fan ray after the mirror, starting on the mirror surface.
   RayTrace RayInAir(double fan_tan) const;

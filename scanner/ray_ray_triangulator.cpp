@@ -8,13 +8,19 @@
 namespace uwscan::scanner {
 namespace {
 
+// Longest common perpendicular, per metre of range, accepted as "the rays meet"; converged
+// solves leave ~1e-12 m.
+constexpr double kMaxGapM = 1e-9;
+
 // Signed distance between the lines, times the sine of their angle: zero where the laser
 // ray crosses the camera ray, changing sign as the fan sweeps across it.
 double CrossingFunction(const Eigen::Vector3d& o_s, const Eigen::Vector3d& d_s, const Ray& cam) {
   return (o_s - cam.origin).dot(d_s.cross(cam.direction));
 }
 
-// Closest approach of two lines with unit directions; kParallel below the minimum angle.
+// Closest approach of two lines with unit directions; kParallel below the minimum angle. The
+// lines must actually meet: a common perpendicular longer than round-off (the root search did
+// not converge) is kNoIntersection, never a point.
 TriangulatedPoint MidpointOfCommonPerpendicular(const Ray& cam, const Ray& laser,
                                                 double min_sin2_angle) {
   const Eigen::Vector3d w = cam.origin - laser.origin;
@@ -28,7 +34,11 @@ TriangulatedPoint MidpointOfCommonPerpendicular(const Ray& cam, const Ray& laser
   if (t_cam < 0.0 || t_laser < 0.0) {
     return TriangulatedPoint{Eigen::Vector3d::Zero(), HitStatus::kBehind};
   }
-  return TriangulatedPoint{0.5 * (cam.At(t_cam) + laser.At(t_laser)), HitStatus::kHit};
+  const Eigen::Vector3d on_cam = cam.At(t_cam), on_laser = laser.At(t_laser);
+  if ((on_cam - on_laser).norm() > kMaxGapM * (1.0 + on_cam.norm())) {
+    return TriangulatedPoint{Eigen::Vector3d::Zero(), HitStatus::kNoIntersection};
+  }
+  return TriangulatedPoint{0.5 * (on_cam + on_laser), HitStatus::kHit};
 }
 
 }  // namespace

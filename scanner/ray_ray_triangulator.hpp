@@ -12,17 +12,15 @@ namespace uwscan::scanner {
 // ray is undistorted and refracted out through the camera viewport exactly; the laser ray of
 // fan parameter s = tan(alpha) is reflected by the mirror and refracted through the laser
 // viewport exactly. The root of the signed line-to-line distance in s is bracketed by a
-// binary search over rays precomputed per mirror step, then refined by the Illinois variant
-// of regula falsi with exact traces, to |ds| <= 1e-14. The point is the midpoint of the
-// common perpendicular (its length is ~1e-12 m at convergence).
+// binary search over rays precomputed per mirror step (or the previous peak's interval), then
+// refined by secant steps on exact traces kept inside the bracket (bisection when a step
+// would leave it), to |ds| <= 1e-15. The point is the midpoint of the common perpendicular;
+// a perpendicular longer than 1e-9 m per metre of range (no convergence) is kNoIntersection.
 class RayRayTriangulator final : public Triangulator {
  public:
   // fan_samples: rays per step in the bracketing table (>= 3).
   RayRayTriangulator(const ScannerModel& model, const TriangulationOptions& options = {},
                      int fan_samples = 129);
-  // The fans point into model_: no copies.
-  RayRayTriangulator(const RayRayTriangulator&) = delete;
-  RayRayTriangulator& operator=(const RayRayTriangulator&) = delete;
   TriangulationMethod method() const override { return TriangulationMethod::kRayRay; }
   void TriangulateFrame(int mirror_step, std::span<const Eigen::Vector2d> peaks_px,
                         std::span<TriangulatedPoint> out) const override;
@@ -46,7 +44,7 @@ class RayRayTriangulator final : public Triangulator {
   };
   const StepFan* FanOf(int step) const;
 
-  ScannerModel model_;  // owns the viewport the fans point to
+  ScannerModel model_;
   double min_sin2_angle_;
   std::vector<StepFan> steps_;
 };

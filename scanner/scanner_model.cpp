@@ -14,6 +14,8 @@ extern const char* const kDefaultScannerYaml;
 namespace {
 
 PinholeCamera ReadCamera(const yaml::Context& where, const YAML::Node& node) {
+  yaml::RequireKnownKeys(where, node,
+                         {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px", "distortion"});
   PinholeCamera c;
   c.width_px = yaml::Integer(where, node, "width_px");
   c.height_px = yaml::Integer(where, node, "height_px");
@@ -27,6 +29,8 @@ PinholeCamera ReadCamera(const yaml::Context& where, const YAML::Node& node) {
 }
 
 FlatViewport ReadViewport(const yaml::Context& where, const YAML::Node& node) {
+  yaml::RequireKnownKeys(where, node,
+                         {"normal", "distance_m", "thickness_m", "n_air", "n_glass", "n_water"});
   FlatViewport v;
   v.normal = yaml::Vector3(where, node, "normal");
   if (std::abs(v.normal.norm() - 1.0) > 1e-6) {
@@ -42,6 +46,9 @@ FlatViewport ReadViewport(const yaml::Context& where, const YAML::Node& node) {
 }
 
 GalvoLaser ReadLaser(const yaml::Context& where, const YAML::Node& node) {
+  yaml::RequireKnownKeys(where, node,
+                         {"T_C_L", "T_C_M", "mirror_step_rad", "rotation_distance_m",
+                          "aperture_rad", "step_min", "step_max"});
   GalvoLaser l;
   l.T_C_L = yaml::Pose(where, node, "T_C_L");
   l.T_C_M = yaml::Pose(where, node, "T_C_M");
@@ -79,6 +86,8 @@ ScannerModel ParseScannerModel(const std::string& yaml_text, const std::string& 
   }
   const yaml::Context top{source_name, ""};
   yaml::CheckFormat(top, root);
+  yaml::RequireKnownKeys(top, root,
+                         {"uwscan_format", "camera", "camera_viewport", "laser", "laser_viewport"});
   ScannerModel m;
   m.camera.camera = ReadCamera(yaml::Enter(top, "camera"), yaml::Child(top, root, "camera"));
   m.camera.viewport = ReadViewport(yaml::Enter(top, "camera_viewport"),

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "scanner/error.hpp"
@@ -197,6 +199,28 @@ TEST(ScannerModelTest, LoadingAMissingFileNamesThePath) {
     FAIL() << "loaded a missing file";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace uwscan::scanner
+
+namespace uwscan::scanner {
+namespace {
+
+TEST(ScannerModelUnknownFieldTest, MisspeltFieldIsNamedNotIgnored) {
+  std::ifstream in(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/galvo_default.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = text.find("  n_water: 1.33");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 15, "  nwater: 1.33");
+  try {
+    ParseScannerModel(text, "typo.yaml");
+    FAIL() << "a misspelt field was accepted";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("camera_viewport.nwater"), std::string::npos) << message;
+    EXPECT_NE(message.find("typo.yaml:"), std::string::npos) << message;
   }
 }
 

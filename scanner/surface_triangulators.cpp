@@ -49,6 +49,7 @@ void RayPlaneTriangulator::TriangulateFrame(int mirror_step,
       rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
     }
     TriangulatedPoint& result = out[i];
+    result.p_C.setZero();  // misses carry no point
     if (!rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray)) {
       result.status = HitStatus::kNoIntersection;
       continue;

@@ -10,8 +10,9 @@ namespace uwscan::scanner {
 
 // Options shared by the triangulators.
 struct TriangulationOptions {
-  // Below this angle between the camera ray and the light surface (plane, cone) or the laser
-  // ray (ray-ray) the point is reported kParallel: depth would be unreliable.
+  // Below this angle between the camera ray and the light plane (ray-plane) or the laser ray
+  // (ray-ray) the point is reported kParallel: depth would be unreliable. (Ray-cone reports
+  // only the cone's own degenerate cases; see IntersectRayCone.)
   double min_angle_rad = 0.5 * 3.14159265358979323846 / 180.0;
   void Check() const;
 };

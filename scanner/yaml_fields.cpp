@@ -80,6 +80,7 @@ Eigen::Vector3d Vector3(const Context& where, const YAML::Node& node, const std:
 Eigen::Isometry3d Pose(const Context& where, const YAML::Node& node, const std::string& key) {
   const Context here = Enter(where, key);
   const YAML::Node pose = Child(where, node, key);
+  RequireKnownKeys(here, pose, {"translation_m", "rotation_xyzw"});
   const Eigen::Vector3d t = Vector3(here, pose, "translation_m");
   const Eigen::Vector4d q = Vector(here, pose, "rotation_xyzw", 4);
   if (std::abs(q.norm() - 1.0) > 1e-6) {
@@ -90,6 +91,17 @@ Eigen::Isometry3d Pose(const Context& where, const YAML::Node& node, const std::
   T.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
   T.translation() = t;
   return T;
+}
+
+void RequireKnownKeys(const Context& where, const YAML::Node& node,
+                      std::initializer_list<const char*> known) {
+  if (!node.IsMap()) Fail(where, node, "expected a mapping");
+  for (const auto& entry : node) {
+    const std::string key = entry.first.Scalar();
+    bool found = false;
+    for (const char* k : known) found = found || key == k;
+    if (!found) Fail(Enter(where, key), entry.first, "unknown field (misspelt?)");
+  }
 }
 
 void CheckFormat(const Context& where, const YAML::Node& root) {

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
+#include <initializer_list>
 #include <string>
 
 namespace uwscan::scanner::yaml {
@@ -31,6 +32,11 @@ Eigen::VectorXd Vector(const Context& where, const YAML::Node& node, const std::
 // {translation_m: [x, y, z], rotation_xyzw: [qx, qy, qz, qw]} -> rigid transform. The
 // quaternion must be unit length to 1e-6 (it is then normalised exactly).
 Eigen::Isometry3d Pose(const Context& where, const YAML::Node& node, const std::string& key);
+
+// Throws naming the first key of a mapping that is not among `known`: a misspelt field must not
+// fall back silently to its default.
+void RequireKnownKeys(const Context& where, const YAML::Node& node,
+                      std::initializer_list<const char*> known);
 
 // Checks `uwscan_format: 1` at the root.
 void CheckFormat(const Context& where, const YAML::Node& root);
