@@ -6,6 +6,7 @@
 
 #include "apps/bench_commands.hpp"
 #include "apps/perception_commands.hpp"
+#include "apps/stripe_commands.hpp"
 #include "scanner/error.hpp"
 
 int main(int argc, char** argv) {
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);
   uwscan::app::AddPerceptionBenchCommands(*bench);
+  uwscan::app::AddStripeBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);

@@ -1,5 +1,6 @@
 #include "apps/perception_commands.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -37,6 +38,9 @@ nlohmann::json ResultJson(const perception::RegistrationResult& r) {
 // "tx ty tz qx qy qz qw" (TUM order) -> pose.
 Eigen::Isometry3d ParsePose(const std::vector<double>& v) {
   if (v.size() != 7) throw Error("--init: expected 7 numbers: tx ty tz qx qy qz qw");
+  for (double x : v) {
+    if (!std::isfinite(x)) throw Error("--init: every number must be finite");
+  }
   const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
   if (std::abs(q.norm() - 1.0) > 1e-6) throw Error("--init: the quaternion must be unit length");
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -49,6 +53,7 @@ struct RegisterArgs {
   std::string source, target, json, output;
   std::vector<double> init;
   double voxel_m = 0.0;
+  bool voxel_set = false;
   std::uint64_t seed = 1;
   int threads = 0;
 };
@@ -57,8 +62,12 @@ void RunRegister(const RegisterArgs& a) {
   const perception::PointCloud source = perception::ReadCloud(a.source);
   const perception::PointCloud target = perception::ReadCloud(a.target);
   const double size = perception::BoundingBoxDiagonal(target);
+  if (a.voxel_set && !(a.voxel_m > 0.0)) throw Error("--voxel: must be > 0 metres");
+  if (!a.voxel_set && !(size > 0.0)) {
+    throw Error(a.target + ": the target cloud has no extent (give --voxel)");
+  }
   perception::RegistrationPipelineOptions options =
-      perception::RegistrationPipelineOptions::ForObjectSize(a.voxel_m > 0.0 ? 50.0 * a.voxel_m : size,
+      perception::RegistrationPipelineOptions::ForObjectSize(a.voxel_set ? 50.0 * a.voxel_m : size,
                                                              a.seed, a.threads);
   std::optional<Eigen::Isometry3d> init;
   if (!a.init.empty()) init = ParsePose(a.init);
@@ -79,6 +88,10 @@ void RunRegister(const RegisterArgs& a) {
     if (!init) j["coarse"] = ResultJson(r.coarse);
     j["stage_seconds"] = r.stage_seconds;
     WriteJsonFile(a.json, j);
+  }
+  if (!init && !r.coarse.converged) {
+    throw Error("coarse alignment found no convincing pose (fitness " +
+                std::to_string(r.coarse.fitness) + "); give --init or check the overlap");
   }
   if (!r.fine.converged) throw Error("registration did not converge");
 }
@@ -184,7 +197,8 @@ void AddRegisterCommand(CLI::App& app) {
   cmd->add_option("target", a->target, "cloud to align onto")->required()->check(CLI::ExistingFile);
   cmd->add_option("--init", a->init, "initial T_target_source: tx ty tz qx qy qz qw (skips RANSAC)")
       ->expected(7);
-  cmd->add_option("--voxel", a->voxel_m, "downsampling leaf in metres (default: target size / 50)");
+  cmd->add_option("--voxel", a->voxel_m, "downsampling leaf in metres (default: target size / 50)")
+      ->each([a](const std::string&) { a->voxel_set = true; });
   cmd->add_option("--seed", a->seed, "RANSAC seed");
   cmd->add_option("--threads", a->threads, "threads (0: all)");
   cmd->add_option("-o,--output", a->output, "write the aligned source cloud (PLY/PCD)");

@@ -33,7 +33,7 @@ struct Prepared {
 
 // Both clouds are expressed about the target's origin, as for the other pipelines.
 Prepared Prepare(const perception::PointCloud& cloud, const Eigen::Vector3d& frame_origin,
-                 const PipelineParameters& p, PipelineRun* run) {
+                 const Eigen::Vector3d& viewpoint, const PipelineParameters& p, PipelineRun* run) {
   open3d::geometry::PointCloud full;
   full.points_.reserve(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) full.points_.push_back(cloud.Point(i) - frame_origin);
@@ -45,6 +45,7 @@ Prepared Prepare(const perception::PointCloud& cloud, const Eigen::Vector3d& fra
 
   start = Clock::now();
   out.cloud->EstimateNormals(open3d::geometry::KDTreeSearchParamHybrid(p.normal_radius_m, 30));
+  out.cloud->OrientNormalsTowardsCameraLocation(viewpoint - frame_origin);  // as uwscan's
   run->stage_seconds["normals"] += Since(start);
 
   start = Clock::now();
@@ -61,8 +62,8 @@ bool Open3dAvailable() { return true; }
 PipelineRun RunOpen3dPipeline(const RegistrationPair& pair, const PipelineParameters& p) {
   PipelineRun run;
   const Eigen::Vector3d frame = pair.target.origin;
-  const Prepared source = Prepare(pair.source, frame, p, &run);
-  const Prepared target = Prepare(pair.target, frame, p, &run);
+  const Prepared source = Prepare(pair.source, frame, pair.source_viewpoint, p, &run);
+  const Prepared target = Prepare(pair.target, frame, pair.target_viewpoint, p, &run);
 
   open3d::utility::random::Seed(static_cast<int>(p.seed));
   Clock::time_point start = Clock::now();

@@ -29,7 +29,7 @@ struct Prepared {
 
 // Both clouds are expressed about the target's origin so that PCL's float math stays local.
 Prepared Prepare(const perception::PointCloud& cloud, const Eigen::Vector3d& frame_origin,
-                 const PipelineParameters& p, PipelineRun* run) {
+                 const Eigen::Vector3d& viewpoint, const PipelineParameters& p, PipelineRun* run) {
   auto xyz = perception::ToPclXYZ(cloud);
   const Eigen::Vector3d shift = cloud.origin - frame_origin;
   for (pcl::PointXYZ& q : *xyz) {
@@ -51,6 +51,9 @@ Prepared Prepare(const perception::PointCloud& cloud, const Eigen::Vector3d& fra
   pcl::copyPointCloud(*down, *out.cloud);
   pcl::NormalEstimationOMP<pcl::PointNormal, pcl::PointNormal> normals(p.threads);
   normals.setRadiusSearch(p.normal_radius_m);
+  const Eigen::Vector3d sensor = viewpoint - frame_origin;  // the same viewpoint as uwscan's
+  normals.setViewPoint(static_cast<float>(sensor.x()), static_cast<float>(sensor.y()),
+                       static_cast<float>(sensor.z()));
   normals.setInputCloud(out.cloud);
   normals.compute(*out.cloud);
   run->stage_seconds["normals"] += Since(start);
@@ -70,8 +73,8 @@ Prepared Prepare(const perception::PointCloud& cloud, const Eigen::Vector3d& fra
 PipelineRun RunPclPipeline(const RegistrationPair& pair, const PipelineParameters& p) {
   PipelineRun run;
   const Eigen::Vector3d frame = pair.target.origin;
-  const Prepared source = Prepare(pair.source, frame, p, &run);
-  const Prepared target = Prepare(pair.target, frame, p, &run);
+  const Prepared source = Prepare(pair.source, frame, pair.source_viewpoint, p, &run);
+  const Prepared target = Prepare(pair.target, frame, pair.target_viewpoint, p, &run);
 
   // PCL's RANSAC draws from rand(): seed it so the peer is as repeatable as ours.
   std::srand(static_cast<unsigned>(p.seed));

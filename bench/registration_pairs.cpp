@@ -65,7 +65,9 @@ void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOpti
     scanner::TriangleMesh mesh = scanner::LoadMesh(cache / "meshes" / (std::string(name) + ".off"));
     const double scale = o.mesh_size_m / mesh.BoundingBoxDiagonal();
     for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
+    // Each view gets its own sampling of the surface, as two scans would.
     const scanner::SurfaceSamples surface = scanner::SampleSurface(mesh, o.mesh_samples, rng());
+    const scanner::SurfaceSamples other = scanner::SampleSurface(mesh, o.mesh_samples, rng());
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& p : surface.points) centroid += p;
     centroid /= static_cast<double>(surface.points.size());
@@ -75,19 +77,22 @@ void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOpti
       pair.name = std::string(name) + "#" + std::to_string(k);
       // Viewpoints from which an open mesh shows (almost) no front faces are drawn again.
       std::vector<Eigen::Vector3d> target, source;
+      const double distance = 3.0 * o.mesh_size_m;
       for (int attempt = 0; attempt < 50 && (target.size() < 500 || source.size() < 500);
            ++attempt) {
         const Eigen::Vector3d a = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
         const Eigen::Vector3d b = Eigen::AngleAxisd(o.view_separation_rad, a.unitOrthogonal()) * a;
-        const double distance = 3.0 * o.mesh_size_m;
-        target = PartialView(surface, centroid + distance * a, o.noise_sigma_m, rng);
-        source = PartialView(surface, centroid + distance * b, o.noise_sigma_m, rng);
+        pair.target_viewpoint = centroid + distance * a;
+        pair.source_viewpoint = centroid + distance * b;
+        target = PartialView(surface, pair.target_viewpoint, o.noise_sigma_m, rng);
+        source = PartialView(other, pair.source_viewpoint, o.noise_sigma_m, rng);
       }
       if (target.size() < 500 || source.size() < 500) {
         throw Error(std::string("registration pairs: no usable views of mesh '") + name + "'");
       }
       const Eigen::Isometry3d T_source_target = RandomMotion(rng, o.mesh_size_m);
       for (Eigen::Vector3d& p : source) p = T_source_target * p;
+      pair.source_viewpoint = T_source_target * pair.source_viewpoint;
       pair.target = perception::MakeCloud(target);
       pair.source = perception::MakeCloud(source);
       pair.T_target_source_true = T_source_target.inverse();
@@ -114,6 +119,7 @@ void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng, std:
     const Eigen::Isometry3d T_source_target = RandomMotion(rng, size);
     pair.source = perception::MakeCloud(
         Resampled(points, scan.keep, 1e-3 * size, T_source_target, rng));
+    pair.source_viewpoint = T_source_target * Eigen::Vector3d::Zero();  // the scanner's origin
     pair.T_target_source_true = T_source_target.inverse();
     pair.object_size_m = size;
     pairs->push_back(std::move(pair));

@@ -16,6 +16,8 @@ struct RegistrationPair {
   perception::PointCloud source;
   perception::PointCloud target;
   Eigen::Isometry3d T_target_source_true = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d source_viewpoint = Eigen::Vector3d::Zero();  // sensor, in the source's frame
+  Eigen::Vector3d target_viewpoint = Eigen::Vector3d::Zero();  // sensor, in the target's frame
   double object_size_m = 0.0;  // bounding-box diagonal of the target, for the success test
 };
 
@@ -32,8 +34,9 @@ struct RegistrationPairOptions {
 };
 
 // Pairs from the cached real data (scripts/fetch_data.sh): CGAL meshes sampled into two
-// partial views each (back faces culled, different viewpoints, so the overlap is partial),
-// and the real scans against randomly resampled, noisy copies of themselves. Every source is
+// partial views each (independent surface samplings, back faces culled, different
+// viewpoints, so the overlap is partial), and the real scans against randomly resampled,
+// noisy copies of themselves (full overlap: these test real noise and density, not overlap). Every source is
 // moved by a random rigid motion (any rotation, translation up to the object size).
 // Throws uwscan::Error naming the missing file when the cache is incomplete.
 std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,

@@ -24,8 +24,8 @@ PipelineRun RunUwscanPipeline(const RegistrationPair& pair, const PipelineParame
   perception::RegistrationPipelineOptions o =
       perception::RegistrationPipelineOptions::ForObjectSize(pair.object_size_m, p.seed,
                                                              p.threads);
-  // Normals face the shared frame origin, as the peers' default viewpoint does.
-  o.viewpoint = pair.target.origin;
+  o.source_viewpoint = pair.source_viewpoint;
+  o.target_viewpoint = pair.target_viewpoint;
   const perception::RegistrationPipelineResult result =
       perception::RegisterClouds(pair.source, pair.target, o);
   PipelineRun run;

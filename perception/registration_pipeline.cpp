@@ -22,7 +22,8 @@ struct Prepared {
   FpfhFeatures features;
 };
 
-Prepared Prepare(const PointCloud& cloud, const RegistrationPipelineOptions& o, bool features,
+Prepared Prepare(const PointCloud& cloud, const Eigen::Vector3d& viewpoint,
+                 const RegistrationPipelineOptions& o, bool features,
                  std::map<std::string, double>* seconds) {
   Clock::time_point start = Clock::now();
   VoxelFilterOptions voxel;
@@ -33,7 +34,7 @@ Prepared Prepare(const PointCloud& cloud, const RegistrationPipelineOptions& o, 
   start = Clock::now();
   NormalOptions normal_options;
   normal_options.radius_m = o.normal_radius_m;
-  normal_options.viewpoint = o.viewpoint;
+  normal_options.viewpoint = viewpoint;
   normal_options.threads = o.threads;
   Prepared out;
   out.cloud = AttachNormals(down, EstimateNormals(down, normal_options));
@@ -68,6 +69,7 @@ RegistrationPipelineOptions RegistrationPipelineOptions::ForObjectSize(double si
   o.coarse.max_iterations = 50000;
   o.coarse.seed = seed;
   o.coarse.threads = threads;
+  o.coarse.min_inlier_fraction = 0.01;
   o.icp.method = IcpMethod::kPointToPlane;
   o.icp.max_correspondence_distance_m = {1.5 * o.voxel_m, 0.75 * o.voxel_m};
   o.icp.threads = threads;
@@ -84,28 +86,37 @@ void RegistrationPipelineOptions::Check() const {
   positive(voxel_m, "voxel_m");
   positive(normal_radius_m, "normal_radius_m");
   positive(feature_radius_m, "feature_radius_m");
-  if (!viewpoint.allFinite()) throw Error("registration: field 'viewpoint' must be finite");
+  if (!source_viewpoint.allFinite() || !target_viewpoint.allFinite()) {
+    throw Error("registration: fields 'source_viewpoint' and 'target_viewpoint' must be finite");
+  }
   if (threads < 0) throw Error("registration: field 'threads' must be >= 0");
   coarse.Check();
   icp.Check();
 }
 
 RegistrationPipelineResult RegisterClouds(
-    const PointCloud& source, const PointCloud& target, const RegistrationPipelineOptions& o,
+    const PointCloud& source, const PointCloud& target, const RegistrationPipelineOptions& options,
     const std::optional<Eigen::Isometry3d>& T_target_source_init) {
+  RegistrationPipelineOptions o = options;
+  o.coarse.threads = o.threads;
+  o.icp.threads = o.threads;
   o.Check();
   RequireValidCloud(source, "registration source", 3);
   RequireValidCloud(target, "registration target", 3);
   RegistrationPipelineResult result;
   const bool coarse_needed = !T_target_source_init.has_value();
-  const Prepared s = Prepare(source, o, coarse_needed, &result.stage_seconds);
-  const Prepared t = Prepare(target, o, coarse_needed, &result.stage_seconds);
+  const Prepared s = Prepare(source, o.source_viewpoint, o, coarse_needed, &result.stage_seconds);
+  const Prepared t = Prepare(target, o.target_viewpoint, o, coarse_needed, &result.stage_seconds);
 
   Eigen::Isometry3d start_pose = T_target_source_init.value_or(Eigen::Isometry3d::Identity());
   if (coarse_needed) {
     const Clock::time_point start = Clock::now();
     result.coarse = AlignCoarse(s.cloud.cloud, s.features, t.cloud.cloud, t.features, o.coarse);
     result.stage_seconds["coarse"] += Since(start);
+    if (!result.coarse.converged) {
+      result.fine = result.coarse;  // no convincing start: ICP would only polish a guess
+      return result;
+    }
     start_pose = result.coarse.T_target_source;
   }
   const Clock::time_point start = Clock::now();

@@ -20,14 +20,18 @@ struct RegistrationPipelineOptions {
   double voxel_m = 0.01;           // downsampling leaf, metres
   double normal_radius_m = 0.025;  // normal neighbourhood, metres
   double feature_radius_m = 0.05;  // FPFH support, metres
-  // Normals face this point (absolute coordinates); for scans, the sensor.
-  Eigen::Vector3d viewpoint = Eigen::Vector3d::Zero();
+  // Normals of each cloud face its sensor, given in that cloud's own frame (absolute
+  // coordinates); a scan file usually holds points in the sensor frame, hence the default.
+  Eigen::Vector3d source_viewpoint = Eigen::Vector3d::Zero();
+  Eigen::Vector3d target_viewpoint = Eigen::Vector3d::Zero();
   CoarseAlignmentOptions coarse;
   IcpOptions icp;
-  int threads = 0;  // OpenMP threads for every stage, 0 = OpenMP's default
+  int threads = 0;  // OpenMP threads for every stage (overrides coarse.threads, icp.threads)
 
   // Parameters scaled to an object of the given bounding-box diagonal: voxel = size / 50,
-  // normals 2.5 voxels, FPFH 5 voxels, RANSAC inliers and ICP 1.5 voxels, then 0.75.
+  // normals 2.5 voxels, FPFH 5 voxels, RANSAC inliers and ICP 1.5 voxels, then 0.75; a coarse
+  // result is accepted from 1 % of the keypoints in agreement (features are computed at every
+  // point, so most have no counterpart in a partial view).
   static RegistrationPipelineOptions ForObjectSize(double size_m, std::uint64_t seed = 1,
                                                    int threads = 0);
   void Check() const;
@@ -40,7 +44,9 @@ struct RegistrationPipelineResult {
 };
 
 // Aligns source onto target. With `T_target_source_init` the coarse stage is skipped and ICP
-// starts there. Throws uwscan::Error on invalid clouds (empty, NaN) or options.
+// starts there. When the coarse stage fails (not converged) ICP is not run: `fine` is then the
+// coarse result, converged = false. Throws uwscan::Error on invalid clouds (empty, NaN) or
+// options.
 RegistrationPipelineResult RegisterClouds(
     const PointCloud& source, const PointCloud& target, const RegistrationPipelineOptions& options,
     const std::optional<Eigen::Isometry3d>& T_target_source_init = std::nullopt);

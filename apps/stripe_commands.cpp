@@ -1,0 +1,97 @@
+#include "apps/stripe_commands.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "apps/json_output.hpp"
+#include "apps/progress_bar.hpp"
+#include "bench/stripe_benchmark.hpp"
+#include "scanner/error.hpp"
+
+namespace uwscan::app {
+namespace {
+
+constexpr double kTargetFramesPerS = 2000.0;  // DESIGN.md: on one core, 2048x1088 Mono8
+constexpr double kTargetRmsePx = 0.05;        // DESIGN.md: clean synthetic stripes
+
+struct StripeArgs {
+  int frames = 8;
+  std::uint64_t seed = 1;
+  std::string json_path;
+};
+
+void RunStripe(const StripeArgs& args) {
+  if (!args.json_path.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(args.json_path).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+      throw Error(args.json_path + ": cannot write: folder '" + parent.string() +
+                  "' does not exist");
+    }
+  }
+  bench::StripeBenchOptions options;
+  options.frames = args.frames;
+  options.seed = args.seed;
+  bench::StripeBenchResult result;
+  {
+    ProgressBar bar;
+    result = bench::RunStripeBenchmark(options, bar.Callback());
+  }
+  std::printf(
+      "Stripe detection, %dx%d Mono8, one core; RMSE against the exact centre of clean\n"
+      "stripes (amplitude %.0f, background %.0f); targets >= %.0f frames/s (default "
+      "method), RMSE <= %.2f px\n\n",
+      options.width_px, options.height_px, options.amplitude, options.background, kTargetFramesPerS,
+      kTargetRmsePx);
+  std::printf(
+      "| method | frames/s | RMSE px sigma 1.5 | RMSE px sigma 3 | max err px sigma 1.5 "
+      "| max err px sigma 3 | detected | RMSE target |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---|\n");
+  nlohmann::json methods = nlohmann::json::object();
+  for (const scanner::StripeMethod method : scanner::AllStripeMethods()) {
+    const std::string name = scanner::ToString(method);
+    const bench::StripeMethodFigures& m = result.methods.at(name);
+    const bool meets = m.rmse_px_sigma1_5 <= kTargetRmsePx && m.rmse_px_sigma3 <= kTargetRmsePx;
+    std::printf("| %s%s | %.0f | %.4f | %.4f | %.4f | %.4f | %.4f | %s |\n", name.c_str(),
+                name == result.default_method ? " (default)" : "", m.frames_per_s,
+                m.rmse_px_sigma1_5, m.rmse_px_sigma3, m.max_err_px_sigma1_5, m.max_err_px_sigma3,
+                m.detected_fraction, meets ? "met" : "missed");
+    methods[name] = {{"frames_per_s", m.frames_per_s},
+                     {"rmse_px_sigma1_5", m.rmse_px_sigma1_5},
+                     {"rmse_px_sigma3", m.rmse_px_sigma3},
+                     {"max_err_px_sigma1_5", m.max_err_px_sigma1_5},
+                     {"max_err_px_sigma3", m.max_err_px_sigma3},
+                     {"detected_fraction", m.detected_fraction},
+                     {"meets_rmse_target", meets}};
+  }
+  const double default_fps = result.methods.at(result.default_method).frames_per_s;
+  std::printf("\ndefault method %s: %.0f frames/s (target %.0f: %s)\n",
+              result.default_method.c_str(), default_fps, kTargetFramesPerS,
+              default_fps >= kTargetFramesPerS ? "met" : "missed");
+  if (!args.json_path.empty()) {
+    WriteJsonFile(args.json_path,
+                  {{"default", result.default_method},
+                   {"methods", methods},
+                   {"targets", {{"frames_per_s", kTargetFramesPerS}, {"rmse_px", kTargetRmsePx}}},
+                   {"image",
+                    {{"width_px", options.width_px},
+                     {"height_px", options.height_px},
+                     {"format", "Mono8"}}}});
+  }
+}
+
+}  // namespace
+
+void AddStripeBenchCommand(CLI::App& bench) {
+  auto args = std::make_shared<StripeArgs>();
+  CLI::App* stripe = bench.add_subcommand(
+      "stripe", "stripe detectors: frames/s on 2048x1088 Mono8 and sub-pixel RMSE per method");
+  stripe->add_option("--frames", args->frames, "distinct frames per measurement")
+      ->check(CLI::PositiveNumber);
+  stripe->add_option("--seed", args->seed, "random seed of the rendered stripes");
+  stripe->add_option("--json", args->json_path, "write the figures as JSON");
+  stripe->callback([args] { RunStripe(*args); });
+}
+
+}  // namespace uwscan::app

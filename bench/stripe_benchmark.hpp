@@ -1,0 +1,49 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "bench/progress.hpp"
+#include "scanner/stripe_detector.hpp"
+
+namespace uwscan::bench {
+
+// Speed and accuracy of every stripe detection method. Speed: frames per second on one core
+// over `frames` distinct 2048x1088 Mono8 frames of a mildly noisy stripe (sigma 1.5 px),
+// the fastest of `repeats` passes. Accuracy: RMSE of the detected centre against the renderer's
+// exact centre over every column of `frames` clean Mono8 frames per stripe width (sigma 1.5 and
+// 3 px), each frame with a different smooth curve, so sub-pixel offsets are spread evenly.
+// Every method runs with the same default StripeDetectorOptions except its method.
+struct StripeBenchOptions {
+  int width_px = 2048;
+  int height_px = 1088;
+  int frames = 8;                  // distinct frames per measurement, >= 1
+  double min_seconds = 0.3;        // each speed pass runs at least this long, seconds
+  int repeats = 3;                 // speed passes per method; the fastest is reported, >= 1
+  double amplitude = 200.0;        // stripe height over the background, image units
+  double background = 10.0;        // image units
+  double speed_noise_sigma = 2.0;  // noise of the speed frames, image units
+  std::uint64_t seed = 1;
+
+  void Check() const;
+};
+
+struct StripeMethodFigures {
+  double frames_per_s = 0.0;
+  double rmse_px_sigma1_5 = 0.0;
+  double rmse_px_sigma3 = 0.0;
+  double max_err_px_sigma1_5 = 0.0;
+  double max_err_px_sigma3 = 0.0;
+  double detected_fraction = 0.0;  // columns with a peak over all accuracy frames
+};
+
+struct StripeBenchResult {
+  std::string default_method;                          // ToString(StripeDetectorOptions{}.method)
+  std::map<std::string, StripeMethodFigures> methods;  // keyed by ToString(method)
+};
+
+StripeBenchResult RunStripeBenchmark(const StripeBenchOptions& options,
+                                     const Progress& progress = {});
+
+}  // namespace uwscan::bench
