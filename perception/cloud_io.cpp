@@ -27,7 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kMaxFloat32Coordinate_m = 1000.0;  // ulp 6.1e-5 m: rounding under 31 um
+// Beyond this, coordinates are written as float64: float32 rounding stays under 0.5 um here,
+// below the scanner's accuracy (uwscan keeps geometry in double; files must not undo it).
+constexpr double kMaxFloat32Coordinate_m = 10.0;
 
 enum class Format { kPcd, kPly, kXyz };
 

@@ -26,8 +26,8 @@ struct CloudReadStats {
 PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats = nullptr);
 
 // Writes a cloud to .ply or .pcd (binary, or ascii when `binary` is false) in absolute
-// coordinates: float32 while every coordinate is below 1000 m in magnitude (rounding under
-// 31 um), float64 beyond, so clouds far from the frame origin keep their precision. Normals are
+// coordinates: float32 while every coordinate is below 10 m in magnitude (rounding under
+// 0.5 um), float64 beyond, so clouds far from the frame origin keep their precision. Normals are
 // written when present (PLY nx ny nz, PCD normal_x normal_y normal_z). PCD goes through PCL's
 // PCDWriter; PLY is written by uwscan (PCL 1.13's PLYWriter prints ASCII values to 6 digits).
 // Atomic: the file is written beside the target under a temporary name and renamed over it,
