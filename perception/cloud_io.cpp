@@ -333,11 +333,14 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   std::vector<Eigen::Vector3f> normals;
   points.reserve(raw.points.size());
   for (std::size_t i = 0; i < raw.points.size(); ++i) {
-    const bool finite =
-        raw.points[i].allFinite() && (raw.normals.empty() || raw.normals[i].allFinite());
-    if (!finite) continue;
+    // A normal must be a direction: non-finite or (near) zero-length ones drop their point;
+    // the others are made exactly unit, as PointCloud requires.
+    const bool usable = raw.points[i].allFinite() &&
+                        (raw.normals.empty() ||
+                         (raw.normals[i].allFinite() && raw.normals[i].norm() > 1e-6));
+    if (!usable) continue;
     points.push_back(raw.points[i]);
-    if (local.has_normals) normals.push_back(raw.normals[i].cast<float>());
+    if (local.has_normals) normals.push_back(raw.normals[i].normalized().cast<float>());
   }
   local.num_dropped_non_finite = raw.points.size() - points.size();
   if (points.empty()) {

@@ -10,7 +10,8 @@ namespace uwscan::perception {
 // What ReadCloud found in a file besides the cloud.
 struct CloudReadStats {
   std::size_t num_in_file = 0;             // points (vertices) the file holds
-  std::size_t num_dropped_non_finite = 0;  // dropped: a NaN or infinite coordinate or normal
+  std::size_t num_dropped_non_finite = 0;  // dropped: a NaN or infinite coordinate, or a normal
+                                           // that is not finite or has zero length
   bool has_normals = false;                // normals were read (PCD normal_x.., PLY nx..)
 };
 

@@ -118,6 +118,22 @@ TEST_F(CloudIoTest, ReadsXyzAndDropsNonFinitePoints) {
   EXPECT_EQ(stats.num_dropped_non_finite, 1u);
 }
 
+TEST_F(CloudIoTest, NormalsAreMadeUnitAndZeroNormalsDropTheirPoint) {
+  const fs::path pcd = dir_ / "normals.pcd";
+  std::ofstream(pcd) << "VERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n"
+                        "TYPE F F F F F F\nCOUNT 1 1 1 1 1 1\nWIDTH 3\nHEIGHT 1\n"
+                        "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n"
+                        "1 2 3 2 0 0\n4 5 6 0 0 0\n7 8 9 0 0.5 0.5\n";
+  CloudReadStats stats;
+  const PointCloud cloud = ReadCloud(pcd, &stats);
+  ASSERT_EQ(cloud.size(), 2u);
+  ASSERT_TRUE(cloud.has_normals());
+  EXPECT_EQ(stats.num_dropped_non_finite, 1u);
+  EXPECT_LT((cloud.normals[0] - Eigen::Vector3f(1, 0, 0)).norm(), 1e-6f);
+  EXPECT_NEAR(cloud.normals[1].norm(), 1.0f, 1e-6f);
+  EXPECT_LT((cloud.Point(1) - Eigen::Vector3d(7, 8, 9)).norm(), 1e-6);
+}
+
 TEST_F(CloudIoTest, ErrorsNameTheFile) {
   const fs::path missing = dir_ / "missing.ply";
   EXPECT_NE(MessageOf([&] { ReadCloud(missing); }).find(missing.string()), std::string::npos);
