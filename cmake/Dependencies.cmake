@@ -29,3 +29,9 @@ find_package(Open3D QUIET)
 
 # Meshes (PLY/OFF/STL/OBJ) for scenes and benchmark objects.
 find_package(assimp REQUIRED)
+
+# Ray casting in the simulator (scanner/sim).
+find_package(embree 3 REQUIRED)
+
+# Dive logs (mapping/dive_log).
+find_package(SQLite3 REQUIRED)
