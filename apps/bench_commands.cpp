@@ -150,12 +150,4 @@ void AddBenchCommands(CLI::App& bench) {
   deformation->callback([deformation_json] { RunDeformation(*deformation_json); });
 }
 
-void AddDemoCommand(CLI::App& app) {
-  auto args = std::make_shared<TriangulationArgs>();
-  CLI::App* demo = app.add_subcommand(
-      "demo", "triangulation comparison on the default scanner (the main job, for now)");
-  AddTriangulationOptions(*demo, *args);
-  demo->callback([args] { RunTriangulation(*args); });
-}
-
 }  // namespace uwscan::app

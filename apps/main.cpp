@@ -4,7 +4,11 @@
 #include <cstdio>
 #include <exception>
 
+#include "apps/accuracy_command.hpp"
 #include "apps/bench_commands.hpp"
+#include "apps/demo_command.hpp"
+#include "apps/dive_commands.hpp"
+#include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
 #include "apps/stripe_commands.hpp"
 #include "scanner/error.hpp"
@@ -15,12 +19,16 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   uwscan::app::AddDemoCommand(app);
+  uwscan::app::AddSimulateCommand(app);
+  uwscan::app::AddReconstructCommand(app);
+  uwscan::app::AddMakeObjectCommand(app);
   uwscan::app::AddRegisterCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);
   uwscan::app::AddPerceptionBenchCommands(*bench);
   uwscan::app::AddStripeBenchCommand(*bench);
+  uwscan::app::AddAccuracyBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);

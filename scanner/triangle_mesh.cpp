@@ -6,7 +6,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cstring>
+#include <fstream>
 #include <random>
+#include <string>
+#include <system_error>
 
 #include "scanner/error.hpp"
 
@@ -52,6 +56,66 @@ TriangleMesh LoadMesh(const std::filesystem::path& path) {
     if (!v.allFinite()) throw Error(path.string() + ": the mesh has a non-finite vertex");
   }
   return mesh;
+}
+
+namespace {
+
+// Appends the little-endian bytes of a 4-byte value (PLY binary_little_endian).
+template <typename T>
+void PutLittleEndian(std::string* out, T value) {
+  static_assert(sizeof(T) == 4);
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &value, 4);
+  for (int i = 0; i < 4; ++i) out->push_back(static_cast<char>((bits >> (8 * i)) & 0xffu));
+}
+
+}  // namespace
+
+void WriteMeshPly(const TriangleMesh& mesh, const std::filesystem::path& path) {
+  const std::string name = path.string();
+  if (mesh.triangles.empty()) throw Error(name + ": cannot write a mesh without triangles");
+  const int count = static_cast<int>(mesh.vertices.size());
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    if (!v.allFinite()) throw Error(name + ": cannot write a mesh with a non-finite vertex");
+  }
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    if ((t.array() < 0).any() || (t.array() >= count).any()) {
+      throw Error(name + ": cannot write a mesh whose triangle indexes a missing vertex");
+    }
+  }
+  std::string data = "ply\nformat binary_little_endian 1.0\ncomment written by uwscan\n";
+  data += "element vertex " + std::to_string(count) + "\n";
+  data += "property float x\nproperty float y\nproperty float z\n";
+  data += "element face " + std::to_string(mesh.triangles.size()) + "\n";
+  data += "property list uchar int vertex_indices\nend_header\n";
+  data.reserve(data.size() + 12 * mesh.vertices.size() + 13 * mesh.triangles.size());
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    for (int i = 0; i < 3; ++i) PutLittleEndian(&data, static_cast<float>(v[i]));
+  }
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    data.push_back(3);
+    for (int i = 0; i < 3; ++i) PutLittleEndian(&data, static_cast<std::int32_t>(t[i]));
+  }
+  // Write beside the target, then rename: a rename within a folder replaces it atomically.
+  const std::filesystem::path temporary = name + ".part";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(name + ": cannot write mesh (cannot create " + temporary.string() + ")");
+    out.write(data.data(), static_cast<std::streamsize>(data.size()));
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw Error(name + ": cannot write mesh (write to " + temporary.string() + " failed)");
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw Error(name + ": cannot write mesh: " + error.message());
+  }
 }
 
 SurfaceSamples SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed) {

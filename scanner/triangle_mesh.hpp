@@ -20,6 +20,12 @@ struct TriangleMesh {
 // triangles.
 TriangleMesh LoadMesh(const std::filesystem::path& path);
 
+// Writes binary little-endian PLY (float32 x y z, int32 vertex indices), which LoadMesh and
+// common mesh tools read. Atomic: the file is written next to `path` and renamed over it, so
+// a reader never sees half a mesh. Throws uwscan::Error naming the file when the mesh is
+// empty, has an index out of range or a non-finite vertex, or the file cannot be written.
+void WriteMeshPly(const TriangleMesh& mesh, const std::filesystem::path& path);
+
 // Points drawn uniformly over the surface (triangles picked by area), with the triangles'
 // unit normals. Deterministic for a given seed.
 struct SurfaceSamples {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "scanner/scan_pattern.hpp"
 #include "scanner/sim/effects.hpp"
 #include "scanner/sim/trajectory.hpp"
 #include "scanner/stripe_detector.hpp"
@@ -48,25 +49,10 @@ struct Water {
   double attenuation_per_m = 0.0;  // beam attenuation coefficient c, 1/m
 };
 
-enum class ScannerKind { kGalvo, kMems };
-
-// Galvanometer sweep: one frame per mirror step from step_min to step_max every step_stride.
-struct GalvoScan {
-  int step_min = -100;
-  int step_max = 100;
-  int step_stride = 1;
-  double frame_rate_hz = 339.0;  // seed camera in laser-detection mode
-};
-
-// MEMS scan pattern (seed 001): `lines` lines of `waypoints_per_line` waypoints spread evenly
-// over fov_fraction of the projection functions' field of view; one frame per line.
-struct MemsScan {
-  int lines = 500;
-  int waypoints_per_line = 50;
-  double waypoint_rate_hz = 3500.0;   // DAC update rate of the mirror driver
-  double fov_fraction_x = 1.0;        // (0, 1]
-  double fov_fraction_y = 1.0;        // (0, 1]
-};
+// The scan pattern types live with the scanner (scanner/scan_pattern.hpp): dive logs keep them.
+using ::uwscan::scanner::GalvoScan;
+using ::uwscan::scanner::MemsScan;
+using ::uwscan::scanner::ScannerKind;
 
 struct SceneScanner {
   std::filesystem::path file;  // the scanner YAML the scene names (resolved path)
@@ -84,7 +70,13 @@ struct Scene {
   std::vector<SceneObject> objects;
   Trajectory trajectory;
   SimulationEffects effects;
-  StripeDetectorOptions detector;  // used when image stages are on
+  // Used when image stages are on. Both seed scanners draw roughly vertical stripes: one peak
+  // per image row by default.
+  StripeDetectorOptions detector = [] {
+    StripeDetectorOptions d;
+    d.axis = StripeAxis::kRows;
+    return d;
+  }();
   std::uint64_t seed = 1;          // every random effect draws from it
 };
 

@@ -1,0 +1,157 @@
+#include "apps/dive_commands.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "apps/json_output.hpp"
+#include "apps/progress_bar.hpp"
+#include "mapping/dive_log.hpp"
+#include "mapping/dive_simulation.hpp"
+#include "mapping/reconstruction.hpp"
+#include "perception/cloud_io.hpp"
+#include "perception/point_cloud.hpp"
+#include "scanner/error.hpp"
+#include "scanner/sim/scene.hpp"
+#include "scanner/sim/simulator.hpp"
+
+namespace uwscan::app {
+namespace {
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void RequireWritableFolder(const std::string& path, const char* option) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw Error(std::string(option) + " " + path + ": folder '" + parent.string() +
+                "' does not exist");
+  }
+}
+
+struct SimulateArgs {
+  std::string scene;
+  std::string output;
+  bool images = false;
+  bool force = false;
+  int threads = 0;
+};
+
+void RunSimulate(const SimulateArgs& a) {
+  RequireWritableFolder(a.output, "-o");
+  if (std::filesystem::exists(a.output)) {
+    if (!a.force) throw Error(a.output + ": exists (a dive log is never overwritten; use --force)");
+    std::filesystem::remove(a.output);
+    std::filesystem::remove(a.output + "-wal");
+    std::filesystem::remove(a.output + "-shm");
+  }
+  const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
+  const scanner::sim::Simulator simulator(scene);
+  if (a.images && !scene.effects.AnyImageStage()) {
+    throw Error("--images: scene " + a.scene +
+                " renders no frames (no image effect is on); its dive holds exact peaks");
+  }
+  mapping::DiveSimulationOptions options;
+  options.store_images = a.images;
+  options.threads = a.threads;
+  options.producer = std::string("uwscan simulate ") + UWSCAN_VERSION;
+  mapping::DiveSimulationSummary summary;
+  {
+    ProgressBar bar;
+    summary = mapping::SimulateDive(simulator, ReadText(a.scene), a.output, options,
+                                    [&bar](double f) { bar.Update("simulate", f); });
+  }
+  std::printf("%s: %lld frames (%s scanner, %s), %lld peaks, %lld navigation records%s, %.2f s\n",
+              a.output.c_str(), static_cast<long long>(summary.frames),
+              scanner::ToString(scene.scanner.kind),
+              scene.effects.AnyImageStage() ? "rendered frames, detected stripes" : "exact peaks",
+              static_cast<long long>(summary.peaks),
+              static_cast<long long>(summary.navigation_records),
+              summary.images_stored ? ", images stored" : "", summary.seconds);
+}
+
+struct ReconstructArgs {
+  std::string log;
+  std::string output;
+  std::string method;
+  std::string json;
+  bool ascii = false;
+  bool scanner_frame = false;
+};
+
+void RunReconstruct(const ReconstructArgs& a) {
+  RequireWritableFolder(a.output, "-o");
+  if (!a.json.empty()) RequireWritableFolder(a.json, "--json");
+  mapping::ReconstructionOptions options;
+  if (!a.method.empty()) {
+    options.method = scanner::ParseTriangulationMethod(a.method);
+    if (!options.method) throw Error("--method: unknown '" + a.method + "' (use plane, cone or ray)");
+  }
+  options.use_navigation = !a.scanner_frame;
+  const mapping::DiveLogReader log(a.log);
+  mapping::Reconstruction r;
+  {
+    ProgressBar bar;
+    r = mapping::Reconstruct(log, options, [&bar](double f) { bar.Update("reconstruct", f); });
+  }
+  if (r.points.empty()) throw Error(a.log + ": no frame gave a point; nothing to write");
+  perception::WriteCloud(a.output, perception::MakeCloud(r.points), !a.ascii);
+  const double rate = r.triangulation_seconds > 0.0 ? r.points.size() / r.triangulation_seconds : 0.0;
+  std::printf("%s: %zu points from %lld frames (%lld peaks), %s, %s frame\n", a.output.c_str(),
+              r.points.size(), static_cast<long long>(r.frames), static_cast<long long>(r.peaks),
+              scanner::ToString(r.method), r.world_frame ? "world" : "scanner");
+  std::printf("tables %.3f s, triangulation %.4f s (%.2f M points/s)\n", r.table_seconds,
+              r.triangulation_seconds, rate * 1e-6);
+  nlohmann::json json = {{"points", r.points.size()},
+                         {"frames", r.frames},
+                         {"peaks", r.peaks},
+                         {"method", scanner::ToString(r.method)},
+                         {"world_frame", r.world_frame},
+                         {"table_seconds", r.table_seconds},
+                         {"triangulation_seconds", r.triangulation_seconds}};
+  if (const std::optional<mapping::TruthError> e = mapping::CompareToTruth(r)) {
+    std::printf("error against ground truth (%lld points): mean %.4g mm, std %.4g mm, rms %.4g mm, max %.4g mm\n",
+                static_cast<long long>(e->points), e->mean_m * 1e3, e->std_m * 1e3,
+                e->rms_m * 1e3, e->max_m * 1e3);
+    json["truth_error"] = {{"points", e->points}, {"mean_m", e->mean_m}, {"std_m", e->std_m},
+                           {"rms_m", e->rms_m}, {"max_m", e->max_m}};
+  }
+  if (!a.json.empty()) WriteJsonFile(a.json, json);
+}
+
+}  // namespace
+
+void AddSimulateCommand(CLI::App& app) {
+  auto args = std::make_shared<SimulateArgs>();
+  CLI::App* cmd = app.add_subcommand("simulate", "simulate a scene into a new dive log (SQLite)");
+  cmd->add_option("scene", args->scene, "scene YAML (data/scenes/*.yaml)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "dive log to create (.db)")->required();
+  cmd->add_flag("--images", args->images, "store the rendered frames in the log (image effects on)");
+  cmd->add_flag("--force", args->force, "replace an existing log at the output path");
+  cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([args] { RunSimulate(*args); });
+}
+
+void AddReconstructCommand(CLI::App& app) {
+  auto args = std::make_shared<ReconstructArgs>();
+  CLI::App* cmd = app.add_subcommand("reconstruct", "triangulate a dive log into a point cloud");
+  cmd->add_option("log", args->log, "dive log (.db)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "point cloud to write (.ply, .pcd, .xyz)")->required();
+  cmd->add_option("--method", args->method,
+                  "plane, cone or ray (default: cone for the galvanometer, plane for MEMS)");
+  cmd->add_option("--json", args->json, "also write the figures as JSON");
+  cmd->add_flag("--ascii", args->ascii, "write an ASCII cloud instead of binary");
+  cmd->add_flag("--scanner-frame", args->scanner_frame,
+                "keep points in the camera frame even when the log has navigation");
+  cmd->callback([args] { RunReconstruct(*args); });
+}
+
+}  // namespace uwscan::app

@@ -1,0 +1,151 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+// The dive log: one SQLite file per dive holding the scanner configuration it was taken with,
+// every camera frame (stripe peaks, optionally the image), the vehicle's navigation and, for
+// simulated dives, the ground truth. The file format is documented and versioned in
+// mapping/README.md. SQLite stays inside the .cpp files.
+namespace uwscan::mapping {
+
+// The schema this uwscan writes and the newest it reads.
+inline constexpr int kDiveLogSchemaVersion = 1;
+
+enum class LogPixelFormat : std::uint8_t { kMono8 = 0, kMono16 = 1 };
+
+// A single-channel camera frame: row-major, no padding between rows, Mono16 pixels native-endian
+// uint16_t (the file stores them little-endian). bytes.size() == width * height * bytes/pixel.
+struct LogImage {
+  int width_px = 0;
+  int height_px = 0;
+  LogPixelFormat format = LogPixelFormat::kMono8;
+  std::vector<std::uint8_t> bytes;
+};
+
+struct DiveLogHeader {
+  int schema_version = kDiveLogSchemaVersion;  // filled by the reader; the writer writes its own
+  std::string scanner_kind;                    // "galvo" or "mems"
+  std::string scanner_yaml;  // full scanner configuration (calibration) used to take the dive
+  std::string scan_pattern_yaml;  // how the dive was scanned (scanner/scan_pattern.hpp)
+  std::string scene_yaml;    // scene text when simulated, empty otherwise
+  std::string created_utc;   // ISO 8601 ("2024-05-01T12:34:56Z"), set by the writer
+  std::string producer;      // e.g. "uwscan simulate 0.1.0"
+};
+
+struct FrameRecord {
+  std::int64_t index = 0;  // 0, 1, 2, ... consecutive, assigned by the writer (ignored on append)
+  double time_s = 0.0;     // capture time
+  int command = 0;         // galvo: mirror step; MEMS: line index in the scan pattern
+  int sweep = 0;           // which sweep of the scan pattern
+  std::vector<Eigen::Vector2d> peaks_px;  // stripe peaks (u, v), OpenCV pixel convention
+  std::optional<LogImage> image;
+};
+
+// Only in simulated dives, at most one per frame.
+struct GroundTruthRecord {
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();  // true camera pose at the frame time
+  std::vector<Eigen::Vector3d> points_W;  // true surface point of each peak (same order and size)
+  std::vector<std::int32_t> object_ids;   // scene object each peak lies on (same size)
+};
+
+// What the vehicle believes about its pose, from its own navigation.
+struct NavigationRecord {
+  double time_s = 0.0;
+  Eigen::Isometry3d T_W_V = Eigen::Isometry3d::Identity();
+};
+
+// Writes a new dive log. Every Append* call is one SQLite transaction committed before it
+// returns (WAL journal, synchronous=NORMAL): a process killed at any point leaves a log that
+// opens and holds every frame appended before the call in progress. Not thread-safe: one
+// thread at a time. Every failure throws uwscan::Error naming the file; a rejected record
+// leaves nothing in the log and the next frame gets the index the rejected one would have.
+// Destroying the writer syncs the log and, unless another connection has it open, turns it
+// into one self-contained file (README: "Writing, crashes and power cuts").
+class DiveLogWriter {
+ public:
+  // Creates `path` and commits the header at once. Throws uwscan::Error when the file (or a
+  // stray `-wal` / `-journal` beside it, which SQLite would replay into the new file) already
+  // exists, the header is invalid (scanner_kind not "galvo" or "mems", empty scanner_yaml) or
+  // the file cannot be created. `header.schema_version` and `header.created_utc` are ignored.
+  DiveLogWriter(const std::filesystem::path& path, const DiveLogHeader& header);
+  ~DiveLogWriter();
+  DiveLogWriter(DiveLogWriter&&) noexcept;
+  DiveLogWriter& operator=(DiveLogWriter&&) noexcept;
+  DiveLogWriter(const DiveLogWriter&) = delete;
+  DiveLogWriter& operator=(const DiveLogWriter&) = delete;
+
+  // Appends a frame (and its ground truth when given) in one transaction; returns its index.
+  // Throws before writing anything when time_s or a peak is not finite, the image's byte count
+  // does not match its size and format, or the truth is not finite, not rigid, or its points
+  // or ids are not one per peak.
+  std::int64_t AppendFrame(const FrameRecord& frame, const GroundTruthRecord* truth = nullptr);
+
+  // Appends a navigation sample, committed. Throws on a non-finite time or a non-rigid pose.
+  void AppendNavigation(const NavigationRecord& nav);
+
+  // Stores (or replaces) where the camera sits on the vehicle, committed.
+  void SetVehicleMount(const Eigen::Isometry3d& T_V_C);
+
+  // Frames committed so far.
+  std::int64_t frame_count() const;
+
+  const std::filesystem::path& path() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Reads a dive log, read-only. Works on a log whose writer is still appending (in this or
+// another process: each call sees what was committed when it starts) and on a log whose writer
+// was killed (every committed frame is there). Not thread-safe: one thread at a time.
+class DiveLogReader {
+ public:
+  // Throws uwscan::Error naming the file when it is missing, not a SQLite database, not a dive
+  // log (no `meta` table), of another or a newer schema version, or lacks a table or column.
+  explicit DiveLogReader(const std::filesystem::path& path);
+  ~DiveLogReader();
+  DiveLogReader(DiveLogReader&&) noexcept;
+  DiveLogReader& operator=(DiveLogReader&&) noexcept;
+  DiveLogReader(const DiveLogReader&) = delete;
+  DiveLogReader& operator=(const DiveLogReader&) = delete;
+
+  const DiveLogHeader& header() const;
+
+  // T_V_C when the writer stored it (read at each call).
+  std::optional<Eigen::Isometry3d> vehicle_mount() const;
+
+  // Frames committed at the time of the call.
+  std::int64_t frame_count() const;
+
+  // Throws uwscan::Error naming the index when there is no such frame, and naming the index
+  // and column when a row is corrupt (wrong type, blob size not matching its content).
+  FrameRecord ReadFrame(std::int64_t index) const;
+
+  // The frame's ground truth, nullopt when the frame has none. Throws like ReadFrame.
+  std::optional<GroundTruthRecord> ReadGroundTruth(std::int64_t index) const;
+
+  // Calls `visit` for every frame in index order, with its ground truth when `with_truth` and
+  // the frame has one (else nullptr). One query, one row in memory at a time; the frames are
+  // those committed when the call starts. Throws like ReadFrame, and when an index is missing.
+  void ForEachFrame(const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& visit,
+                    bool with_truth) const;
+
+  // Every navigation sample, in time order (append order among equal times).
+  std::vector<NavigationRecord> ReadNavigation() const;
+
+  const std::filesystem::path& path() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uwscan::mapping

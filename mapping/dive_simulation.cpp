@@ -1,0 +1,107 @@
+#include "mapping/dive_simulation.hpp"
+
+#include <omp.h>
+
+#include <chrono>
+#include <exception>
+#include <vector>
+
+#include "mapping/dive_log.hpp"
+#include "scanner/error.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+constexpr int kFramesPerThreadAndBlock = 4;
+
+LogImage ToLogImage(const scanner::StripeFrame& frame) {
+  LogImage image;
+  image.width_px = frame.width_px;
+  image.height_px = frame.height_px;
+  if (frame.format == scanner::PixelFormat::kMono8) {
+    image.format = LogPixelFormat::kMono8;
+    image.bytes = frame.mono8;
+  } else {
+    image.format = LogPixelFormat::kMono16;
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(frame.mono16.data());
+    image.bytes.assign(bytes, bytes + frame.mono16.size() * sizeof(std::uint16_t));
+  }
+  return image;
+}
+
+}  // namespace
+
+void DiveSimulationOptions::Check() const {
+  if (threads < 0) throw Error("dive simulation: threads must be >= 0");
+  if (!(navigation_rate_hz > 0.0 && navigation_rate_hz <= 1000.0)) {
+    throw Error("dive simulation: navigation_rate_hz must be in (0, 1000] Hz");
+  }
+}
+
+DiveSimulationSummary SimulateDive(const scanner::sim::Simulator& simulator,
+                                   const std::string& scene_yaml,
+                                   const std::filesystem::path& log_path,
+                                   const DiveSimulationOptions& options,
+                                   const std::function<void(double)>& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const scanner::sim::Scene& scene = simulator.scene();
+
+  DiveLogHeader header;
+  header.scanner_kind = scanner::ToString(scene.scanner.kind);
+  header.scanner_yaml = simulator.scanner_yaml();
+  header.scan_pattern_yaml = scanner::ScanPatternToYaml(simulator.scan_pattern());
+  header.scene_yaml = scene_yaml;
+  header.producer = options.producer;
+  DiveLogWriter writer(log_path, header);
+  writer.SetVehicleMount(scene.trajectory.T_V_C);
+
+  DiveSimulationSummary summary;
+  for (const scanner::sim::NavigationSample& nav : simulator.Navigation(options.navigation_rate_hz)) {
+    writer.AppendNavigation(NavigationRecord{nav.time_s, nav.T_W_V});
+    ++summary.navigation_records;
+  }
+
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  const std::int64_t total = simulator.frame_count();
+  const std::int64_t block = static_cast<std::int64_t>(threads) * kFramesPerThreadAndBlock;
+  std::vector<scanner::sim::SimulatedFrame> frames;
+  for (std::int64_t first = 0; first < total; first += block) {
+    const std::int64_t count = std::min(block, total - first);
+    frames.assign(static_cast<size_t>(count), {});
+    std::exception_ptr failure;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (std::int64_t k = 0; k < count; ++k) {
+      try {
+        frames[static_cast<size_t>(k)] = simulator.Frame(first + k);
+      } catch (...) {
+#pragma omp critical(uwscan_dive_simulation_failure)
+        if (!failure) failure = std::current_exception();
+      }
+    }
+    if (failure) std::rethrow_exception(failure);
+    for (const scanner::sim::SimulatedFrame& f : frames) {
+      FrameRecord record;
+      record.time_s = f.time_s;
+      record.command = f.command;
+      record.sweep = f.sweep;
+      record.peaks_px = f.peaks_px;
+      if (options.store_images && f.image) {
+        record.image = ToLogImage(*f.image);
+        summary.images_stored = true;
+      }
+      GroundTruthRecord truth;
+      truth.T_W_C = f.T_W_C;
+      truth.points_W = f.truth_W;
+      truth.object_ids = f.object_ids;
+      writer.AppendFrame(record, &truth);
+      summary.peaks += static_cast<std::int64_t>(f.peaks_px.size());
+      ++summary.frames;
+    }
+    if (progress) progress(static_cast<double>(first + count) / total);
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,222 @@
+#include "scanner/sim/simulator.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "scanner/error.hpp"
+#include "scanner/sim/effective_scanner.hpp"
+#include "scanner/sim/frame_renderer.hpp"
+#include "scanner/sim/light_source.hpp"
+#include "scanner/sim/ray_caster.hpp"
+#include "scanner/sim/stripe_tracer.hpp"
+
+namespace uwscan::scanner::sim {
+namespace {
+
+// Laser rays whose backscatter is drawn per frame, and the spacing of glow samples along each.
+constexpr int kGlowRaysPerFrame = 65;
+constexpr double kGlowSpacingM = 0.02;
+constexpr double kGlowStartM = 0.02;
+constexpr double kGlowMaxRangeM = 3.0;
+// A detected peak takes the truth of the exact crossing of its line within this distance.
+constexpr double kTruthMatchPx = 3.0;
+
+std::uint64_t FrameSeed(std::uint64_t scene_seed, std::int64_t index) {
+  std::seed_seq seq{static_cast<std::uint32_t>(scene_seed), static_cast<std::uint32_t>(scene_seed >> 32),
+                    static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32)};
+  std::uint32_t words[2];
+  seq.generate(words, words + 2);
+  return (static_cast<std::uint64_t>(words[0]) << 32) | words[1];
+}
+
+std::unique_ptr<LightSource> MakeLightSource(const Scene& scene, const std::string& yaml) {
+  const std::string name = scene.scanner.file.string();
+  if (scene.scanner.kind == ScannerKind::kGalvo) {
+    return MakeGalvoLightSource(yaml, name, scene.scanner.galvo);
+  }
+  return MakeMemsLightSource(yaml, name, scene.scanner.mems, scene.effects.mirror_dynamics);
+}
+
+}  // namespace
+
+struct Simulator::Impl {
+  Scene scene;
+  std::string scanner_yaml;
+  std::unique_ptr<LightSource> source;
+  RayCaster caster;
+  StripeTracer tracer;
+
+  explicit Impl(const Scene& s)
+      : scene(s),
+        scanner_yaml(EffectiveScannerYaml(s)),
+        source(MakeLightSource(s, scanner_yaml)),
+        caster(s.objects),
+        tracer(source->camera(), caster,
+               StripeTraceOptions{s.detector.axis, s.effects.occlusion, 25.0}) {}
+
+  double FrameTime(std::int64_t index) const {
+    return scene.trajectory.start_s() + static_cast<double>(index) * source->frame_period_s();
+  }
+
+  std::vector<GlowSample> Glow(const LaserPath& path, const Eigen::Isometry3d& T_W_C) const;
+  void DetectInImage(const std::vector<TracedPeak>& exact, SimulatedFrame* frame) const;
+};
+
+Simulator::Simulator(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) {
+  scene.effects.Check();
+  scene.trajectory.Check();
+  if (scene.scanner.sweeps < 1) throw Error(scene.source + ": scanner.sweeps must be >= 1");
+}
+
+Simulator::~Simulator() = default;
+
+const Scene& Simulator::scene() const { return impl_->scene; }
+const std::string& Simulator::scanner_yaml() const { return impl_->scanner_yaml; }
+double Simulator::frame_period_s() const { return impl_->source->frame_period_s(); }
+
+ScanPattern Simulator::scan_pattern() const {
+  ScanPattern pattern;
+  pattern.kind = impl_->scene.scanner.kind;
+  pattern.galvo = impl_->scene.scanner.galvo;
+  pattern.mems = impl_->scene.scanner.mems;
+  return pattern;
+}
+
+std::int64_t Simulator::frame_count() const {
+  return static_cast<std::int64_t>(impl_->scene.scanner.sweeps) * impl_->source->frames_per_sweep();
+}
+
+std::vector<GlowSample> Simulator::Impl::Glow(const LaserPath& path,
+                                              const Eigen::Isometry3d& T_W_C) const {
+  // Light scattered back by the water along each lit ray, as far as the ray goes, seen by the
+  // camera with the inverse-square falloff of a small source.
+  std::vector<GlowSample> glow;
+  const RefractiveCamera& camera = source->camera();
+  const double c = scene.effects.attenuation ? scene.water.attenuation_per_m : 0.0;
+  const double per_sample = scene.effects.backscatter.level * kGlowSpacingM / kGlowRaysPerFrame;
+  for (int k = 0; k < kGlowRaysPerFrame; ++k) {
+    const double s = path.s_begin + (path.s_end - path.s_begin) * k / (kGlowRaysPerFrame - 1);
+    const RayTrace laser = path.ray_in_water_C(s);
+    if (!laser.ok()) continue;
+    const Ray ray_W{T_W_C * laser.ray.origin, T_W_C.linear() * laser.ray.direction};
+    const std::optional<SurfaceHit> hit = caster.Cast(ray_W);
+    const double end = hit ? hit->distance_m : kGlowMaxRangeM;
+    for (double t = kGlowStartM; t < end; t += kGlowSpacingM) {
+      const Eigen::Vector3d p_C = laser.ray.At(t);
+      const std::optional<Eigen::Vector2d> px = camera.ProjectPointInWater(p_C);
+      if (!px || !camera.camera.InImage(*px)) continue;
+      const double range = std::max(p_C.norm(), 0.05);
+      glow.push_back({*px, per_sample * std::exp(-c * (t + range)) / (range * range)});
+    }
+  }
+  return glow;
+}
+
+void Simulator::Impl::DetectInImage(const std::vector<TracedPeak>& exact,
+                                    SimulatedFrame* frame) const {
+  StripeDetector detector(scene.detector);
+  const StripeDetection detection = detector.Detect(frame->image->view());
+  const bool rows = scene.detector.axis == StripeAxis::kRows;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const StripePeak& peak : detection.peaks) {
+    const Eigen::Vector2d px(peak.u_px, peak.v_px);
+    const double line = rows ? px.y() : px.x();
+    const double along = rows ? px.x() : px.y();
+    // The exact crossing of the same line closest to the detected one is its truth.
+    const TracedPeak* best = nullptr;
+    double best_distance = kTruthMatchPx;
+    for (const TracedPeak& t : exact) {
+      if ((rows ? t.px.y() : t.px.x()) != line) continue;
+      const double distance = std::abs((rows ? t.px.x() : t.px.y()) - along);
+      if (distance <= best_distance) {
+        best_distance = distance;
+        best = &t;
+      }
+    }
+    frame->peaks_px.push_back(px);
+    frame->truth_W.push_back(best ? best->p_W : Eigen::Vector3d::Constant(nan));
+    frame->object_ids.push_back(best ? best->object_index : -1);
+  }
+}
+
+SimulatedFrame Simulator::Frame(std::int64_t index) const {
+  const Impl& m = *impl_;
+  if (index < 0 || index >= frame_count()) {
+    throw Error("simulator: frame " + std::to_string(index) + " out of range [0, " +
+                std::to_string(frame_count()) + ")");
+  }
+  const int per_sweep = m.source->frames_per_sweep();
+  SimulatedFrame frame;
+  frame.index = index;
+  frame.sweep = static_cast<int>(index / per_sweep);
+  const int in_sweep = static_cast<int>(index % per_sweep);
+  frame.command = m.source->CommandOfFrame(in_sweep);
+  frame.time_s = m.FrameTime(index);
+  // Without the motion stage the scanner holds the pose it had when the sweep began.
+  const double pose_time =
+      m.scene.effects.motion ? frame.time_s : m.FrameTime(static_cast<std::int64_t>(frame.sweep) * per_sweep);
+  frame.T_W_C = m.scene.trajectory.T_W_C(pose_time);
+
+  const LaserPath path = m.source->PathOfFrame(in_sweep);
+  const std::vector<TracedPeak> exact = m.tracer.Trace(path, frame.T_W_C);
+  if (!m.scene.effects.AnyImageStage()) {
+    for (const TracedPeak& peak : exact) {
+      frame.peaks_px.push_back(peak.px);
+      frame.truth_W.push_back(peak.p_W);
+      frame.object_ids.push_back(peak.object_index);
+    }
+    return frame;
+  }
+
+  FrameRenderInput input;
+  const PinholeCamera& camera = m.source->camera().camera;
+  input.width_px = camera.width_px;
+  input.height_px = camera.height_px;
+  input.focal_px = 0.5 * (camera.fx_px + camera.fy_px);
+  input.axis = m.scene.detector.axis;
+  input.peaks = exact;
+  input.attenuation_per_m = m.scene.water.attenuation_per_m;
+  if (m.scene.effects.backscatter.on) input.glow = m.Glow(path, frame.T_W_C);
+  frame.image = RenderFrame(input, m.scene.effects, FrameSeed(m.scene.seed, index));
+  m.DetectInImage(exact, &frame);
+  return frame;
+}
+
+std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
+  if (!(rate_hz > 0.0)) throw Error("simulator: navigation rate must be > 0 Hz");
+  const Impl& m = *impl_;
+  const double start = m.FrameTime(0);
+  const double end = m.FrameTime(std::max<std::int64_t>(frame_count() - 1, 0));
+  const double dt = 1.0 / rate_hz;
+  const SimulationEffects::NavigationDrift& drift = m.scene.effects.navigation_drift;
+  std::mt19937_64 rng(FrameSeed(m.scene.seed, -1));
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::Vector3d position_error = Eigen::Vector3d::Zero();
+  double yaw_error = 0.0;
+  std::vector<NavigationSample> samples;
+  for (int k = 0;; ++k) {
+    const double t = start + k * dt;
+    if (t > end + 1e-12 && k > 0) break;
+    NavigationSample sample;
+    sample.time_s = t;
+    sample.T_W_V = m.scene.trajectory.T_W_V(t);
+    if (drift.on) {
+      if (k > 0) {
+        const double sq = std::sqrt(dt);
+        position_error += drift.position_walk_m_per_sqrt_s * sq *
+                          Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+        yaw_error += drift.yaw_walk_rad_per_sqrt_s * sq * normal(rng);
+      }
+      // Heading drift turns the believed pose about the world's down axis (NED z).
+      Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
+      error.linear() = Eigen::AngleAxisd(yaw_error, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      error.translation() = position_error;
+      sample.T_W_V = error * sample.T_W_V;
+    }
+    samples.push_back(sample);
+  }
+  return samples;
+}
+
+}  // namespace uwscan::scanner::sim
