@@ -227,7 +227,7 @@ class AccuracyRun {
         galvo_yaml_(ReadFile(options.galvo_scanner)),
         mems_yaml_(ReadFile(options.mems_scanner)) {}
 
-  GaugeFigures Gauges(bool underwater, const char* stage) {
+  GaugeFigures Gauges(bool underwater, bool realistic, const char* stage) {
     std::vector<double> errors;
     int missed = 0;
     const int total = o_.gauge_positions * static_cast<int>(o_.gauge_lengths_m.size());
@@ -257,7 +257,7 @@ class AccuracyRun {
         std::optional<double> measured;
         if (steps) {
           scene.scanner.galvo = *steps;
-          scene.effects = RealisticEffects(underwater);
+          if (realistic) scene.effects = RealisticEffects(underwater);
           const Simulator simulator(scene);
           measured = MeasureGaugeLength(SimulateAndTriangulate(simulator, cache_.For(simulator), threads_));
         }
@@ -404,8 +404,10 @@ AccuracyBenchResult RunAccuracyBenchmark(const AccuracyBenchOptions& options,
   const auto start = std::chrono::steady_clock::now();
   AccuracyRun run(options, progress);
   AccuracyBenchResult result;
-  result.gauges_air = run.Gauges(false, "gauges in air");
-  result.gauges_water = run.Gauges(true, "gauges in water");
+  result.gauges_air = run.Gauges(false, true, "gauges in air");
+  result.gauges_water = run.Gauges(true, true, "gauges in water");
+  result.gauges_air_exact = run.Gauges(false, false, "gauges in air, exact peaks");
+  result.gauges_water_exact = run.Gauges(true, false, "gauges in water, exact peaks");
   result.plane = run.Planes();
   result.sphere = run.Spheres();
   result.waypoints = run.Waypoints();

@@ -67,6 +67,9 @@ struct WaypointRow {
 struct AccuracyBenchResult {
   GaugeFigures gauges_air;
   GaugeFigures gauges_water;
+  // The same gauges from exact stripe peaks: what the length measurement itself contributes.
+  GaugeFigures gauges_air_exact;
+  GaugeFigures gauges_water_exact;
   std::vector<PlaneRow> plane;
   std::vector<SphereRow> sphere;
   std::vector<WaypointRow> waypoints;

@@ -60,11 +60,12 @@ void AppendSection(StateSpace* s, double omega, double zeta, bool second_order) 
 StateSpace AxisModel(const MirrorDynamicsOptions& o) {
   StateSpace s{Eigen::MatrixXd(0, 0), Eigen::VectorXd(0), 0};
   const double wc = 2.0 * std::numbers::pi * o.lpf_cutoff_hz;
-  // Butterworth: poles on the circle of radius wc at angles pi (2k - 1) / (2 n) from the
-  // negative real axis; each conjugate pair is a section of damping cos(angle), an odd order
-  // adds the real pole.
+  // Butterworth: poles on the circle of radius wc at angles +-pi (n - 2k + 1) / (2 n),
+  // k = 1..n/2, from the negative real axis (n = 2: 45 deg; n = 3: 60 deg and the real pole);
+  // each conjugate pair is a section of damping cos(angle), an odd order adds the real pole.
   for (int k = 1; k <= o.lpf_order / 2; ++k) {
-    AppendSection(&s, wc, std::cos(std::numbers::pi * (2 * k - 1) / (2.0 * o.lpf_order)), true);
+    const double angle = std::numbers::pi * (o.lpf_order - 2 * k + 1) / (2.0 * o.lpf_order);
+    AppendSection(&s, wc, std::cos(angle), true);
   }
   if (o.lpf_order % 2 == 1) AppendSection(&s, wc, 1.0, false);
   AppendSection(&s, 2.0 * std::numbers::pi * o.resonance_hz, o.damping_ratio, true);
@@ -132,6 +133,20 @@ double MirrorAxisDynamics::Advance(double input) {
   return output();
 }
 
+double DriveLagS(const MirrorDynamicsOptions& options) {
+  options.Check();
+  double lag = 2.0 * options.damping_ratio / (2.0 * std::numbers::pi * options.resonance_hz);
+  if (options.lpf_order > 0) {
+    const double wc = 2.0 * std::numbers::pi * options.lpf_cutoff_hz;
+    // Poles p_k = wc exp(i t_k), t_k = pi/2 + pi (2k - 1) / (2n), k = 1..n (left half plane):
+    // -Re(1 / p_k) = -cos(t_k) / wc = sin(pi (2k - 1) / (2n)) / wc; n = 2 gives sqrt(2) / wc.
+    for (int k = 1; k <= options.lpf_order; ++k) {
+      lag += std::sin(std::numbers::pi * (2 * k - 1) / (2.0 * options.lpf_order)) / wc;
+    }
+  }
+  return lag;
+}
+
 TiltPath SimulateLine(const MemsLaser& laser, std::span<const Eigen::Vector2d> waypoint_volts,
                       const MirrorDynamicsOptions& options, bool dynamics) {
   options.Check();
@@ -175,13 +190,16 @@ TiltPath SimulateLine(const MemsLaser& laser, std::span<const Eigen::Vector2d> w
   MirrorAxisDynamics axis_x(options, step_s), axis_y(options, step_s);
   axis_x.Settle(tilts[0].x());
   axis_y.Settle(tilts[0].y());
-  path.samples[0].tilt_rad = Eigen::Vector2d(axis_x.output(), axis_y.output());
-  for (std::size_t i = 1; i < count; ++i) {
+  // The exposure opens `lag` samples after the DAC starts the line (see DriveLagS).
+  const std::size_t lag = static_cast<std::size_t>(std::lround(DriveLagS(options) / step_s));
+  Eigen::Vector2d tilt(axis_x.output(), axis_y.output());
+  if (lag == 0) path.samples[0].tilt_rad = tilt;
+  for (std::size_t i = 1; i < count + lag; ++i) {
     // The step from sample i - 1 to i lies in period j = (i - 1) / per_waypoint, during which
-    // the DAC holds waypoint j + 1.
-    const Eigen::Vector2d& command = tilts[(i - 1) / per_waypoint + 1];
-    path.samples[i].tilt_rad =
-        Eigen::Vector2d(axis_x.Advance(command.x()), axis_y.Advance(command.y()));
+    // the DAC holds waypoint j + 1; after the last waypoint it holds that one.
+    const Eigen::Vector2d& command = tilts[std::min((i - 1) / per_waypoint + 1, m - 1)];
+    tilt = Eigen::Vector2d(axis_x.Advance(command.x()), axis_y.Advance(command.y()));
+    if (i >= lag) path.samples[i - lag].tilt_rad = tilt;
   }
   return path;
 }

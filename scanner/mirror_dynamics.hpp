@@ -22,6 +22,13 @@ namespace uwscan::scanner {
 // on it by t = 0; it then issues waypoint j + 1 at t = j T, so that ideally the mirror reaches
 // waypoint j + 1 at t = (j + 1) T; the exposure closes at t = (m - 1) T, when the next line's
 // waypoint 0 is issued. The line period is thus m T + settle_s.
+//
+// With the dynamics on, the filtered mirror trails its commands by the drive's lag (DriveLagS:
+// the low-frequency group delay of the LPF and the plant, 1.5 ms for the default 150 Hz
+// filter, i.e. five waypoint periods at 3500 Hz). The camera trigger is synchronised with the
+// mirror, not with the DAC: the exposure opens and closes that lag later, while the DAC holds
+// the last waypoint. Lines still follow each other every m T + settle_s (the next line's
+// commands start while the exposure of this one ends), so the lag costs no speed.
 struct MirrorDynamicsOptions {
   double resonance_hz = 1300.0;      // undamped natural frequency of each axis, Hz
   double damping_ratio = 6.5e-3;     // zeta, unitless
@@ -37,6 +44,10 @@ struct MirrorDynamicsOptions {
   // Samples per waypoint period (sample_rate_hz / waypoint_rate_hz).
   int SamplesPerWaypoint() const;
 };
+
+// Low-frequency group delay of the drive, seconds: how long the mirror trails a slow ramp of
+// commands. Butterworth poles p_k give sum_k -Re(1 / p_k); the plant adds 2 zeta / omega0.
+double DriveLagS(const MirrorDynamicsOptions& options);
 
 // Lines per second when every line has `waypoints_per_line` waypoints: 1 / (m T + settle_s).
 double LinesPerSecond(int waypoints_per_line, const MirrorDynamicsOptions& options);

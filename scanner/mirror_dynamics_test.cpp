@@ -130,19 +130,47 @@ TEST(MirrorDynamics, DynamicPathStartsSettledAndIsDeterministic) {
   for (std::size_t i = 0; i < a.samples.size(); ++i) {
     ASSERT_EQ(a.samples[i].tilt_rad, b.samples[i].tilt_rad) << i;
   }
-  EXPECT_LT((a.samples[0].tilt_rad - model.laser.TiltFromVolts(volts[0])).norm(), 1e-17);
   // A line of one repeated waypoint keeps the mirror where it is.
   const std::vector<Eigen::Vector2d> still(5, Eigen::Vector2d(3.0, -1.0));
   for (const TiltSample& s : SimulateLine(model.laser, still, model.dynamics, true).samples) {
-    EXPECT_LT((s.tilt_rad - model.laser.TiltFromVolts(still[0])).norm(), 1e-16);
+    EXPECT_LT((s.tilt_rad - model.laser.TiltFromVolts(still[0])).norm(), 1e-15);
   }
-  // The filtered mirror lags the ideal path but ends near it (within ~5 waypoint periods of
-  // travel: the filter's delay is about sqrt 2 / omega_c = 1.5 ms).
+  // The exposure is shifted by the drive's lag, so the filtered mirror follows the ideal path
+  // closely from the first sample to the last (it trails it only while the ramp starts up).
   const TiltPath ideal = SimulateLine(model.laser, volts, model.dynamics, false);
-  const double lag = (a.samples.back().tilt_rad - ideal.samples.back().tilt_rad).norm();
+  ASSERT_EQ(ideal.samples.size(), a.samples.size());
   const double travel = (ideal.samples.back().tilt_rad - ideal.samples.front().tilt_rad).norm();
-  EXPECT_LT(lag, 0.15 * travel);
-  EXPECT_GT(lag, 0.01 * travel);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.samples.size(); ++i) {
+    worst = std::max(worst, (a.samples[i].tilt_rad - ideal.samples[i].tilt_rad).norm());
+  }
+  std::cout << "[ measured ] dynamic vs ideal path, lag-shifted exposure: worst " << worst / travel * 100
+            << " % of the line\n";
+  EXPECT_LT(worst, 0.03 * travel);
+  EXPECT_LT((a.samples.back().tilt_rad - ideal.samples.back().tilt_rad).norm(), 0.03 * travel);
+}
+
+TEST(MirrorDynamics, DriveLagIsTheLowFrequencyGroupDelay) {
+  MirrorDynamicsOptions o;
+  const double plant = 2.0 * o.damping_ratio / (2.0 * std::numbers::pi * o.resonance_hz);
+  const double wc = 2.0 * std::numbers::pi * o.lpf_cutoff_hz;
+  EXPECT_NEAR(DriveLagS(o), std::sqrt(2.0) / wc + plant, 1e-15);
+  o.lpf_order = 1;
+  EXPECT_NEAR(DriveLagS(o), 1.0 / wc + plant, 1e-15);
+  o.lpf_order = 0;
+  EXPECT_NEAR(DriveLagS(o), plant, 1e-18);
+  // A slow ramp through the drive comes out delayed by exactly that lag.
+  o.lpf_order = 3;
+  const double step = 1.0 / o.sample_rate_hz;
+  MirrorAxisDynamics axis(o, step);
+  axis.Settle(0.0);
+  const double slope = 0.01;  // rad/s
+  double t = 0.0, out = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    t += step;
+    out = axis.Advance(slope * (t - 0.5 * step));  // the held command: the ramp mid-step
+  }
+  EXPECT_NEAR((slope * t - out) / slope, DriveLagS(o), 1e-6);
 }
 
 TEST(MirrorDynamics, LinesPerSecondMatchesTheSeed) {

@@ -130,43 +130,91 @@ std::optional<TracedPeak> StripeTracer::SolveCrossing(const LaserPath& path,
   return std::nullopt;
 }
 
+bool StripeTracer::Continues(const TracedPeak& a, const TracedPeak& b) const {
+  return a.object_index == b.object_index &&
+         (a.px - b.px).cwiseAbs().maxCoeff() <= options_.max_jump_px;
+}
+
+std::optional<TracedPeak> StripeTracer::EdgeSpot(const LaserPath& path,
+                                                 const Eigen::Isometry3d& T_W_C,
+                                                 const TracedPeak& inside, double s_outside) const {
+  // Bisection for the last spot that still continues `inside` towards s_outside: the stripe's
+  // end on that surface (an object's edge, a shadow), to a tiny fraction of the sample step.
+  TracedPeak last = inside;
+  double s_in = inside.s, s_out = s_outside;
+  const double resolution = 1e-12 * (std::abs(path.s_end - path.s_begin) + 1.0);
+  while (std::abs(s_out - s_in) > resolution) {
+    const double mid = 0.5 * (s_in + s_out);
+    if (mid == s_in || mid == s_out) break;
+    const std::optional<TracedPeak> spot = SpotAt(path, T_W_C, mid);
+    if (spot && Continues(last, *spot)) {
+      last = *spot;
+      s_in = mid;
+    } else {
+      s_out = mid;
+    }
+  }
+  if (last.s == inside.s) return std::nullopt;
+  return last;
+}
+
+void StripeTracer::AddCrossings(const LaserPath& path, const Eigen::Isometry3d& T_W_C,
+                                const TracedPeak& a, const TracedPeak& b,
+                                std::vector<TracedPeak>* peaks) const {
+  const int line_count = options_.axis == StripeAxis::kRows ? camera_.camera.height_px
+                                                            : camera_.camera.width_px;
+  const double ca = LineCoordinate(a.px, options_.axis);
+  const double cb = LineCoordinate(b.px, options_.axis);
+  const double lo = std::min(ca, cb);
+  const double hi = std::max(ca, cb);
+  if (lo == hi) return;  // the stripe runs along a line centre: no crossing to solve
+  // Half-open [lo, hi): a line centre falling exactly on a sample is counted once.
+  for (double line = std::max(std::ceil(lo), 0.0); line < hi && line < line_count; ++line) {
+    std::optional<TracedPeak> peak = SolveCrossing(path, T_W_C, a, b, line);
+    if (!peak) continue;
+    // The solve ends within 1e-9 px of the line centre; the peak is put on it exactly.
+    (options_.axis == StripeAxis::kRows ? peak->px.y() : peak->px.x()) = line;
+    peaks->push_back(*peak);
+  }
+}
+
 std::vector<TracedPeak> StripeTracer::Trace(const LaserPath& path,
                                             const Eigen::Isometry3d& T_W_C) const {
   const int n = std::max(path.samples, 2);
   std::vector<std::optional<TracedPeak>> samples(static_cast<size_t>(n));
+  std::vector<double> s_of(static_cast<size_t>(n));
   for (int k = 0; k < n; ++k) {
-    const double s = path.s_begin + (path.s_end - path.s_begin) * k / (n - 1);
-    samples[static_cast<size_t>(k)] = SpotAt(path, T_W_C, s);
+    s_of[static_cast<size_t>(k)] = path.s_begin + (path.s_end - path.s_begin) * k / (n - 1);
+    samples[static_cast<size_t>(k)] = SpotAt(path, T_W_C, s_of[static_cast<size_t>(k)]);
   }
 
-  const int line_count = options_.axis == StripeAxis::kRows ? camera_.camera.height_px
-                                                            : camera_.camera.width_px;
   std::vector<TracedPeak> peaks;
   for (size_t k = 0; k + 1 < samples.size(); ++k) {
     const std::optional<TracedPeak>& a = samples[k];
     const std::optional<TracedPeak>& b = samples[k + 1];
-    if (!a || !b || a->object_index != b->object_index) continue;
-    if ((a->px - b->px).cwiseAbs().maxCoeff() > options_.max_jump_px) continue;
-    const double ca = LineCoordinate(a->px, options_.axis);
-    const double cb = LineCoordinate(b->px, options_.axis);
-    const double lo = std::min(ca, cb);
-    const double hi = std::max(ca, cb);
-    if (lo == hi) continue;  // the stripe runs along a line centre: no crossing to solve
-    // Half-open [lo, hi): a line centre falling exactly on a sample is counted once.
-    for (double line = std::max(std::ceil(lo), 0.0); line < hi && line < line_count; ++line) {
-      std::optional<TracedPeak> peak = SolveCrossing(path, T_W_C, *a, *b, line);
-      if (!peak) continue;
-      // The solve ends within 1e-9 px of the line centre; the peak is put on it exactly.
-      (options_.axis == StripeAxis::kRows ? peak->px.y() : peak->px.x()) = line;
-      peaks.push_back(*peak);
+    if (a && b && Continues(*a, *b)) {
+      AddCrossings(path, T_W_C, *a, *b, &peaks);
+      continue;
+    }
+    // The stripe ends (or jumps to another surface) between the two samples: each side is
+    // followed up to its edge, so that no row near an edge is lost.
+    if (a) {
+      if (const std::optional<TracedPeak> edge = EdgeSpot(path, T_W_C, *a, s_of[k + 1])) {
+        AddCrossings(path, T_W_C, *a, *edge, &peaks);
+      }
+    }
+    if (b) {
+      if (const std::optional<TracedPeak> edge = EdgeSpot(path, T_W_C, *b, s_of[k])) {
+        AddCrossings(path, T_W_C, *edge, *b, &peaks);
+      }
     }
   }
   const StripeAxis axis = options_.axis;
-  std::sort(peaks.begin(), peaks.end(), [axis](const TracedPeak& l, const TracedPeak& r) {
+  const StripeAxis across = axis == StripeAxis::kRows ? StripeAxis::kColumns : StripeAxis::kRows;
+  std::sort(peaks.begin(), peaks.end(), [axis, across](const TracedPeak& l, const TracedPeak& r) {
     const double cl = LineCoordinate(l.px, axis), cr = LineCoordinate(r.px, axis);
     if (cl != cr) return cl < cr;
-    return LineCoordinate(l.px, axis == StripeAxis::kRows ? StripeAxis::kColumns : StripeAxis::kRows) <
-           LineCoordinate(r.px, axis == StripeAxis::kRows ? StripeAxis::kColumns : StripeAxis::kRows);
+    return LineCoordinate(l.px, across) < LineCoordinate(r.px, across);
   });
   return peaks;
 }
