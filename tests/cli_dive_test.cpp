@@ -1,0 +1,139 @@
+// The dive commands end to end: simulate, reconstruct, demo, make-object, bench accuracy.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+struct CommandRun {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+CommandRun RunUwscan(const std::string& arguments) {
+  const std::string command = std::string(UWSCAN_BIN) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::filesystem::path TempPath(const std::string& name) {
+  return std::filesystem::temp_directory_path() /
+         ("uwscan_cli_dive_test_" + std::to_string(getpid()) + "_" + name);
+}
+
+nlohmann::json ReadJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(UWSCAN_SOURCE_DIR) + "/" + relative;
+}
+
+TEST(CliDive, SimulateThenReconstructRecoversTheSceneWithEveryMethod) {
+  const std::filesystem::path log = TempPath("default.db");
+  const CommandRun sim = RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  EXPECT_NE(sim.output.find("201 frames"), std::string::npos) << sim.output;
+
+  // ray-ray is exact, ray-cone within the seed's 0.05 mm, ray-plane off by millimetres.
+  const std::array<std::pair<const char*, double>, 3> bounds = {
+      {{"ray", 1e-6}, {"cone", 5e-5}, {"plane", 1.0}}};
+  for (const auto& [method, max_mean_m] : bounds) {
+    const std::filesystem::path cloud = TempPath(std::string(method) + ".ply");
+    const std::filesystem::path json = TempPath(std::string(method) + ".json");
+    const CommandRun run = RunUwscan("reconstruct " + log.string() + " -o " + cloud.string() +
+                                     " --method " + method + " --json " + json.string());
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json j = ReadJson(json);
+    EXPECT_GT(j["points"].get<int>(), 100000) << method;
+    EXPECT_LT(j["truth_error"]["mean_m"].get<double>(), max_mean_m) << method;
+    EXPECT_GT(std::filesystem::file_size(cloud), 1000000u) << method;
+    std::filesystem::remove(cloud);
+    std::filesystem::remove(json);
+  }
+  // A log is never overwritten by accident.
+  const CommandRun again = RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
+  EXPECT_EQ(again.exit_code, 1);
+  EXPECT_NE(again.output.find("exists"), std::string::npos) << again.output;
+  std::filesystem::remove(log);
+}
+
+TEST(CliDive, MalformedSceneNamesTheFileLineAndField) {
+  const std::filesystem::path dir = TempPath("scenes");
+  std::filesystem::create_directories(dir / "scenes");
+  std::filesystem::copy_file(SourcePath("data/scanners/galvo_default.yaml"), dir / "galvo.yaml");
+  const std::filesystem::path scene = dir / "scenes" / "bad.yaml";
+  std::ofstream(scene) << "uwscan_format: 1\n"
+                          "scanner: {file: ../galvo.yaml}\n"
+                          "objects:\n"
+                          "  - {shape: sphere, radius_m: 0.1, reflectance: 1.5}\n";
+  const CommandRun run = RunUwscan("simulate " + scene.string() + " -o " + (dir / "x.db").string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("bad.yaml:4"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("reflectance"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.db"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliDive, ReconstructRejectsWhatIsNotADiveLog) {
+  const std::filesystem::path junk = TempPath("junk.db");
+  std::ofstream(junk) << "this is not a dive log";
+  const CommandRun run = RunUwscan("reconstruct " + junk.string() + " -o " + TempPath("x.ply").string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find(junk.string()), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(TempPath("x.ply")));
+  std::filesystem::remove(junk);
+}
+
+TEST(CliDive, DemoPrintsEveryMethodAgainstTruth) {
+  const CommandRun run = RunUwscan("demo --scene " + SourcePath("data/scenes/default.yaml"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* method : {"ray_plane", "ray_cone", "ray_ray"}) {
+    EXPECT_NE(run.output.find(method), std::string::npos) << method;
+  }
+}
+
+TEST(CliDive, MakeObjectWritesAReadableMesh) {
+  const std::filesystem::path mesh = TempPath("valve.ply");
+  const CommandRun run = RunUwscan("make-object valve -o " + mesh.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_GT(std::filesystem::file_size(mesh), 1000u);
+  const CommandRun bad = RunUwscan("make-object teapot -o " + mesh.string());
+  EXPECT_NE(bad.exit_code, 0);
+  std::filesystem::remove(mesh);
+}
+
+TEST(CliDive, AccuracyBenchWritesEveryTable) {
+  const std::filesystem::path json = TempPath("accuracy.json");
+  const CommandRun run = RunUwscan("bench accuracy --quick --data " + SourcePath("data") + " --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  for (const char* medium : {"air", "water"}) {
+    EXPECT_GT(j["gauges"][medium]["n"].get<int>(), 0) << medium;
+    // Sub-millimetre gauge lengths with realistic noise (seed: 0.44 mm air, 0.98 mm water).
+    EXPECT_LT(j["gauges"][medium]["mean_err_m"].get<double>(), 1e-3) << medium;
+  }
+  ASSERT_FALSE(j["plane"].empty());
+  EXPECT_LT(j["plane"][0]["rms_m"].get<double>(), 2e-3);
+  ASSERT_FALSE(j["sphere"].empty());
+  EXPECT_LT(std::abs(j["sphere"][0]["radius_err_m"].get<double>()), 2e-3);
+  ASSERT_EQ(j["waypoints"].size(), 2u);
+  // More waypoints per line: slower lines.
+  EXPECT_GT(j["waypoints"][0]["lines_per_s"].get<double>(), j["waypoints"][1]["lines_per_s"].get<double>());
+  std::filesystem::remove(json);
+}
+
+}  // namespace
