@@ -124,7 +124,7 @@ MemsScannerModel ParseMemsScannerModel(const std::string& yaml_text,
   yaml::CheckFormat(top, root);
   yaml::RequireKnownKeys(top, root,
                          {"uwscan_format", "camera", "camera_viewport", "mems", "laser_viewport",
-                          "projection_functions"});
+                          "projection_functions", "calibration"});
   MemsScannerModel m;
   m.camera.camera = yaml::ReadCamera(yaml::Enter(top, "camera"), yaml::Child(top, root, "camera"));
   m.camera.viewport = yaml::ReadViewport(yaml::Enter(top, "camera_viewport"),

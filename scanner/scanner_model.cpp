@@ -45,7 +45,8 @@ ScannerModel ParseScannerModel(const std::string& yaml_text, const std::string& 
   const yaml::Context top{source_name, ""};
   yaml::CheckFormat(top, root);
   yaml::RequireKnownKeys(top, root,
-                         {"uwscan_format", "camera", "camera_viewport", "laser", "laser_viewport"});
+                         {"uwscan_format", "camera", "camera_viewport", "laser", "laser_viewport",
+                          "calibration"});  // calibration: the record of how it was calibrated
   ScannerModel m;
   m.camera.camera = yaml::ReadCamera(yaml::Enter(top, "camera"), yaml::Child(top, root, "camera"));
   m.camera.viewport = yaml::ReadViewport(yaml::Enter(top, "camera_viewport"),
