@@ -86,13 +86,16 @@ Eigen::Isometry3d Pose(const Eigen::Vector3d& t, const Eigen::Matrix3d& r = Eige
 // Builds the triangulation tables once per scanner configuration and scan pattern.
 class TriangulatorCache {
  public:
-  const scanner::Triangulator& For(const Simulator& simulator) {
+  // The triangulator of the simulated scanner, or of `calibration_yaml` when it is given (a
+  // calibration estimated for the same scanner).
+  const scanner::Triangulator& For(const Simulator& simulator, const std::string& calibration_yaml = "") {
     const scanner::ScanPattern pattern = simulator.scan_pattern();
-    const std::string key = simulator.scanner_yaml() + "\n#pattern\n" +
+    const std::string& yaml = calibration_yaml.empty() ? simulator.scanner_yaml() : calibration_yaml;
+    const std::string key = yaml + "\n#pattern\n" +
                             (pattern.kind == scanner::ScannerKind::kMems ? scanner::ScanPatternToYaml(pattern) : "galvo");
     std::unique_ptr<scanner::Triangulator>& slot = cache_[key];
     if (!slot) {
-      slot = scanner::MakeTriangulator(simulator.scanner_yaml(), "bench accuracy scanner", pattern,
+      slot = scanner::MakeTriangulator(yaml, "bench accuracy scanner", pattern,
                                        scanner::DefaultTriangulationMethod(pattern.kind));
     }
     return *slot;
@@ -227,7 +230,8 @@ class AccuracyRun {
         galvo_yaml_(ReadFile(options.galvo_scanner)),
         mems_yaml_(ReadFile(options.mems_scanner)) {}
 
-  GaugeFigures Gauges(bool underwater, bool realistic, const char* stage) {
+  GaugeFigures Gauges(bool underwater, bool realistic, const char* stage,
+                      const std::string& calibration_yaml = "") {
     std::vector<double> errors;
     int missed = 0;
     const int total = o_.gauge_positions * static_cast<int>(o_.gauge_lengths_m.size());
@@ -259,7 +263,8 @@ class AccuracyRun {
           scene.scanner.galvo = *steps;
           if (realistic) scene.effects = RealisticEffects(underwater);
           const Simulator simulator(scene);
-          measured = MeasureGaugeLength(SimulateAndTriangulate(simulator, cache_.For(simulator), threads_));
+          measured = MeasureGaugeLength(
+              SimulateAndTriangulate(simulator, cache_.For(simulator, calibration_yaml), threads_));
         }
         if (measured) {
           errors.push_back(*measured - length);
@@ -396,6 +401,13 @@ void AccuracyBenchOptions::Check() const {
   }
   if (mems_lines < 1) throw Error("bench accuracy: mems_lines must be >= 1");
   if (threads < 0) throw Error("bench accuracy: threads must be >= 0");
+}
+
+GaugeFigures RunGaugeExperiment(const AccuracyBenchOptions& options, bool underwater,
+                                const std::string& calibration_yaml, const Progress& progress) {
+  options.Check();
+  AccuracyRun run(options, progress);
+  return run.Gauges(underwater, true, underwater ? "gauges in water" : "gauges in air", calibration_yaml);
 }
 
 AccuracyBenchResult RunAccuracyBenchmark(const AccuracyBenchOptions& options,

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "bench/progress.hpp"
@@ -75,6 +76,12 @@ struct AccuracyBenchResult {
   std::vector<WaypointRow> waypoints;
   double seconds = 0.0;
 };
+
+// The gauge experiment alone, with realistic effects: the galvanometer scanner is simulated as
+// options.galvo_scanner says and its stripes triangulated with `calibration_yaml` (an estimated
+// calibration of that scanner) or, when empty, with the true scanner.
+GaugeFigures RunGaugeExperiment(const AccuracyBenchOptions& options, bool underwater,
+                                const std::string& calibration_yaml, const Progress& progress = {});
 
 AccuracyBenchResult RunAccuracyBenchmark(const AccuracyBenchOptions& options,
                                          const Progress& progress = {});
