@@ -1,0 +1,123 @@
+#include "scanner/calibration/opencv_camera_import.hpp"
+
+#include <array>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <sstream>
+#include <string>
+#include <system_error>
+
+#include "scanner/error.hpp"
+
+namespace uwscan::scanner::calibration {
+namespace {
+
+// OpenCV's names of distortion coefficients 5 to 13, the ones PinholeCamera has not.
+constexpr std::array<const char*, 9> kUnsupportedTerms = {"k4", "k5", "k6",    "s1",   "s2",
+                                                          "s3", "s4", "tau_x", "tau_y"};
+
+class Reader {
+ public:
+  explicit Reader(const std::filesystem::path& path) : file_(path.string()) {}
+
+  [[noreturn]] void Fail(const std::string& what) const { throw Error(file_ + ": " + what); }
+
+  cv::FileNode Node(const cv::FileStorage& storage, const char* name) const {
+    const cv::FileNode node = storage[name];
+    if (node.empty()) Fail(std::string("missing node '") + name + "'");
+    return node;
+  }
+
+  int Int(const cv::FileStorage& storage, const char* name) const {
+    const cv::FileNode node = Node(storage, name);
+    if (!node.isInt()) Fail(std::string("node '") + name + "' must be an integer");
+    return static_cast<int>(node);
+  }
+
+  cv::Mat Matrix(const cv::FileStorage& storage, const char* name) const {
+    const cv::FileNode node = Node(storage, name);
+    cv::Mat matrix;
+    try {
+      if (node.isMap()) node >> matrix;
+    } catch (const cv::Exception&) {
+      matrix.release();
+    }
+    if (matrix.empty() || matrix.channels() != 1) {
+      Fail(std::string("node '") + name + "' must be an OpenCV matrix (!!opencv-matrix)");
+    }
+    matrix.convertTo(matrix, CV_64F);
+    return matrix;
+  }
+
+ private:
+  std::string file_;
+};
+
+}  // namespace
+
+PinholeCamera ImportOpenCvCalibration(const std::filesystem::path& yaml) {
+  const Reader reader(yaml);
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(yaml, error)) {
+    reader.Fail("no such file (expected an OpenCV calibration YAML)");
+  }
+  cv::FileStorage storage;
+  try {
+    if (!storage.open(yaml.string(), cv::FileStorage::READ)) {
+      reader.Fail("cannot be opened as an OpenCV FileStorage (YAML or XML)");
+    }
+  } catch (const cv::Exception& e) {
+    reader.Fail(std::string("not a readable OpenCV FileStorage file: ") + e.what());
+  }
+
+  PinholeCamera camera;
+  camera.width_px = reader.Int(storage, "image_width");
+  camera.height_px = reader.Int(storage, "image_height");
+
+  const cv::Mat K = reader.Matrix(storage, "camera_matrix");
+  if (K.rows != 3 || K.cols != 3) {
+    reader.Fail("node 'camera_matrix' must be 3x3, got " + std::to_string(K.rows) + "x" +
+                std::to_string(K.cols));
+  }
+  if (K.at<double>(0, 1) != 0.0 || K.at<double>(1, 0) != 0.0 || K.at<double>(2, 0) != 0.0 ||
+      K.at<double>(2, 1) != 0.0 || K.at<double>(2, 2) != 1.0) {
+    reader.Fail("node 'camera_matrix' must be [fx 0 cx; 0 fy cy; 0 0 1] (no skew)");
+  }
+  camera.fx_px = K.at<double>(0, 0);
+  camera.fy_px = K.at<double>(1, 1);
+  camera.cx_px = K.at<double>(0, 2);
+  camera.cy_px = K.at<double>(1, 2);
+
+  const cv::Mat D = reader.Matrix(storage, "distortion_coefficients");
+  const int n = static_cast<int>(D.total());
+  if ((D.rows != 1 && D.cols != 1) || (n != 4 && n != 5 && n != 8 && n != 12 && n != 14)) {
+    reader.Fail(
+        "node 'distortion_coefficients' must be a vector of 4, 5, 8, 12 or 14 values, "
+        "got " +
+        std::to_string(D.rows) + "x" + std::to_string(D.cols));
+  }
+  const auto at = [&D](int k) { return D.at<double>(k); };
+  for (int k = 5; k < n; ++k) {
+    if (at(k) != 0.0) {
+      std::ostringstream message;
+      message << "node 'distortion_coefficients': " << kUnsupportedTerms[k - 5] << " = " << at(k)
+              << " is non-zero; only OpenCV's standard model k1 k2 p1 p2 k3 is "
+              << "supported (not the rational, thin-prism or tilted models): recalibrate "
+              << "without CALIB_RATIONAL_MODEL, CALIB_THIN_PRISM_MODEL or CALIB_TILTED_MODEL";
+      reader.Fail(message.str());
+    }
+  }
+  camera.k1 = at(0);
+  camera.k2 = at(1);
+  camera.p1 = at(2);
+  camera.p2 = at(3);
+  camera.k3 = n >= 5 ? at(4) : 0.0;
+  try {
+    camera.Check();
+  } catch (const Error& e) {
+    reader.Fail(e.what());
+  }
+  return camera;
+}
+
+}  // namespace uwscan::scanner::calibration

@@ -1,0 +1,145 @@
+#include "scanner/calibration/opencv_camera_import.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "scanner/error.hpp"
+
+namespace uwscan::scanner::calibration {
+namespace {
+
+// A fresh directory per test, removed at the end.
+class ImportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("uwscan_import_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // Writes what OpenCV's calibration sample writes (the nodes this import reads, and some it
+  // ignores), with `distortion` as a column vector, the sample's layout.
+  std::filesystem::path Write(const std::string& name, const std::vector<double>& distortion,
+                              double skew = 0.0, bool with_matrix = true) const {
+    const std::filesystem::path path = dir_ / name;
+    cv::FileStorage storage(path.string(), cv::FileStorage::WRITE);
+    storage << "calibration_time"
+            << "Thu 01 Jan 1970 00:00:00 UTC";
+    storage << "nr_of_frames" << 20;
+    storage << "image_width" << 2048;
+    storage << "image_height" << 1088;
+    storage << "flags" << 0;
+    if (with_matrix) {
+      const cv::Mat K =
+          (cv::Mat_<double>(3, 3) << 1751.25, skew, 1022.75, 0.0, 1749.5, 545.125, 0.0, 0.0, 1.0);
+      storage << "camera_matrix" << K;
+    }
+    storage << "distortion_coefficients" << cv::Mat(distortion, true);
+    storage << "avg_reprojection_error" << 0.21;
+    storage.release();
+    return path;
+  }
+
+  std::filesystem::path dir_;
+};
+
+void ExpectErrorMentions(const std::filesystem::path& path, const std::vector<std::string>& parts) {
+  try {
+    ImportOpenCvCalibration(path);
+    ADD_FAILURE() << path << " accepted";
+  } catch (const Error& e) {
+    for (const std::string& part : parts) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
+          << "'" << e.what() << "' does not mention '" << part << "'";
+    }
+  }
+}
+
+TEST_F(ImportTest, RoundTripFiveCoefficients) {
+  const std::filesystem::path path = Write("camera.yaml", {-0.12, 0.08, 0.0005, -0.0003, -0.02});
+  const PinholeCamera camera = ImportOpenCvCalibration(path);
+  EXPECT_EQ(camera.width_px, 2048);
+  EXPECT_EQ(camera.height_px, 1088);
+  EXPECT_EQ(camera.fx_px, 1751.25);
+  EXPECT_EQ(camera.fy_px, 1749.5);
+  EXPECT_EQ(camera.cx_px, 1022.75);
+  EXPECT_EQ(camera.cy_px, 545.125);
+  EXPECT_EQ(camera.k1, -0.12);
+  EXPECT_EQ(camera.k2, 0.08);
+  EXPECT_EQ(camera.p1, 0.0005);
+  EXPECT_EQ(camera.p2, -0.0003);
+  EXPECT_EQ(camera.k3, -0.02);
+}
+
+TEST_F(ImportTest, FourAndEightCoefficientsAndXml) {
+  const PinholeCamera four =
+      ImportOpenCvCalibration(Write("four.yaml", {-0.1, 0.05, 0.001, 0.002}));
+  EXPECT_EQ(four.k1, -0.1);
+  EXPECT_EQ(four.p2, 0.002);
+  EXPECT_EQ(four.k3, 0.0);
+  // Eight values with the rational terms zero: the standard model written in the long form.
+  const PinholeCamera eight =
+      ImportOpenCvCalibration(Write("eight.yaml", {-0.1, 0.05, 0.001, 0.002, 0.01, 0.0, 0.0, 0.0}));
+  EXPECT_EQ(eight.k3, 0.01);
+  const PinholeCamera xml =
+      ImportOpenCvCalibration(Write("camera.xml", {-0.1, 0.05, 0.0, 0.0, 0.01}));
+  EXPECT_EQ(xml.k1, -0.1);
+  EXPECT_EQ(xml.fx_px, 1751.25);
+}
+
+TEST_F(ImportTest, RefusesUnsupportedModels) {
+  ExpectErrorMentions(Write("rational.yaml", {-0.1, 0.05, 0.0, 0.0, 0.01, 0.3, 0.0, 0.0}),
+                      {"rational.yaml", "k4", "non-zero"});
+  std::vector<double> prism(12, 0.0);
+  prism[9] = 1e-4;  // s2
+  ExpectErrorMentions(Write("prism.yaml", prism), {"prism.yaml", "s2"});
+  std::vector<double> tilted(14, 0.0);
+  tilted[13] = 0.01;
+  ExpectErrorMentions(Write("tilted.yaml", tilted), {"tilted.yaml", "tau_y"});
+  ExpectErrorMentions(Write("six.yaml", {0, 0, 0, 0, 0, 0}),
+                      {"six.yaml", "distortion_coefficients", "4, 5, 8, 12 or 14"});
+  ExpectErrorMentions(Write("skew.yaml", {0, 0, 0, 0, 0}, 0.5), {"skew.yaml", "skew"});
+}
+
+TEST_F(ImportTest, MalformedFilesNameTheFileAndTheNode) {
+  ExpectErrorMentions(Write("no_matrix.yaml", {0, 0, 0, 0, 0}, 0.0, false),
+                      {"no_matrix.yaml", "missing node 'camera_matrix'"});
+  ExpectErrorMentions(dir_ / "absent.yaml", {"absent.yaml", "no such file"});
+
+  const std::filesystem::path garbage = dir_ / "garbage.yaml";
+  std::ofstream(garbage) << "%YAML:1.0\n---\nimage_width: [1, 2\n  camera_matrix: {{{\n";
+  ExpectErrorMentions(garbage, {"garbage.yaml"});
+
+  const std::filesystem::path text = dir_ / "text.yaml";
+  std::ofstream(text) << "%YAML:1.0\n---\nimage_width: wide\nimage_height: 1088\n";
+  ExpectErrorMentions(text, {"text.yaml", "'image_width' must be an integer"});
+
+  const std::filesystem::path scalar = dir_ / "scalar.yaml";
+  std::ofstream(scalar) << "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+                           "camera_matrix: 3.0\n";
+  ExpectErrorMentions(scalar, {"scalar.yaml", "'camera_matrix' must be an OpenCV matrix"});
+
+  const std::filesystem::path no_height = dir_ / "no_height.yaml";
+  std::ofstream(no_height) << "%YAML:1.0\n---\nimage_width: 640\n";
+  ExpectErrorMentions(no_height, {"no_height.yaml", "missing node 'image_height'"});
+
+  const std::filesystem::path bad_focal = dir_ / "bad_focal.yaml";
+  {
+    cv::FileStorage storage(bad_focal.string(), cv::FileStorage::WRITE);
+    storage << "image_width" << 640 << "image_height" << 480;
+    storage << "camera_matrix" << (cv::Mat_<double>(3, 3) << 0, 0, 320, 0, 500, 240, 0, 0, 1);
+    storage << "distortion_coefficients" << cv::Mat(std::vector<double>(5, 0.0), true);
+  }
+  ExpectErrorMentions(bad_focal, {"bad_focal.yaml", "fx_px"});
+}
+
+}  // namespace
+}  // namespace uwscan::scanner::calibration
