@@ -11,6 +11,7 @@
 #include "mapping/dive_log.hpp"
 #include "mapping/dive_simulation.hpp"
 #include "mapping/reconstruction.hpp"
+#include "scanner/calibration/dataset_simulation.hpp"
 #include "perception/cloud_io.hpp"
 #include "perception/point_cloud.hpp"
 #include "scanner/error.hpp"
@@ -44,8 +45,33 @@ struct SimulateArgs {
   int threads = 0;
 };
 
+// A calibration scene (a `calibration:` section) simulates a dataset folder, not a dive.
+bool IsCalibrationScene(const std::string& text) {
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind("calibration:", 0) == 0) return true;
+  }
+  return false;
+}
+
+void RunSimulateCalibration(const SimulateArgs& a) {
+  if (a.images) throw Error("--images: a calibration dataset is made of images already");
+  if (std::filesystem::exists(a.output)) {
+    if (!a.force) throw Error(a.output + ": exists (a dataset folder is never overwritten; use --force)");
+    std::filesystem::remove_all(a.output);
+  }
+  {
+    ProgressBar bar;
+    scanner::calibration::SimulateCalibrationDataset(a.scene, a.output,
+                                                     [&bar](double f) { bar.Update("simulate", f); });
+  }
+  std::printf("%s: calibration dataset written (manifest.yaml, images, truth.yaml)\n", a.output.c_str());
+}
+
 void RunSimulate(const SimulateArgs& a) {
   RequireWritableFolder(a.output, "-o");
+  if (IsCalibrationScene(ReadText(a.scene))) return RunSimulateCalibration(a);
   if (std::filesystem::exists(a.output)) {
     if (!a.force) throw Error(a.output + ": exists (a dive log is never overwritten; use --force)");
     std::filesystem::remove(a.output);

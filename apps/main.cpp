@@ -6,6 +6,7 @@
 
 #include "apps/accuracy_command.hpp"
 #include "apps/bench_commands.hpp"
+#include "apps/calibrate_command.hpp"
 #include "apps/demo_command.hpp"
 #include "apps/dive_commands.hpp"
 #include "apps/object_commands.hpp"
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddSimulateCommand(app);
   uwscan::app::AddReconstructCommand(app);
   uwscan::app::AddMakeObjectCommand(app);
+  uwscan::app::AddCalibrateCommand(app);
   uwscan::app::AddRegisterCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);

@@ -18,6 +18,13 @@
 namespace uwscan::scanner::calibration {
 namespace {
 
+// The thickness is held by default (weakly observable); these tests also recover it.
+LaserViewportCalibrationOptions RefineAll() {
+  LaserViewportCalibrationOptions options;
+  options.refine_thickness = true;
+  return options;
+}
+
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Six boards from 0.5 to 1.3 m, each tilted by up to 20 degrees.
@@ -105,7 +112,7 @@ TEST(LaserViewportCalibrationTest, RecoversTheViewportFromExactPoints) {
   const FlatViewport cad = Perturbed(truth.laser.viewport, 0.005, 2.0 * kDeg, 1);
   const auto start = std::chrono::steady_clock::now();
   const LaserViewportCalibrationResult result =
-      CalibrateLaserViewport(WithLaserViewport(truth, cad), points);
+      CalibrateLaserViewport(WithLaserViewport(truth, cad), points, RefineAll());
   Print("exact", result, truth.laser.viewport, Seconds(start));
   EXPECT_GT(points.size(), 1500u);
   EXPECT_TRUE(result.converged);
@@ -133,7 +140,7 @@ TEST(LaserViewportCalibrationTest, NoisyPointsLandWithinTheirStandardDeviations)
   const FlatViewport cad = Perturbed(truth.laser.viewport, 0.002, 1.0 * kDeg, 2);
   const auto start = std::chrono::steady_clock::now();
   const LaserViewportCalibrationResult result =
-      CalibrateLaserViewport(WithLaserViewport(truth, cad), Points(truth, 1e-4, 2));
+      CalibrateLaserViewport(WithLaserViewport(truth, cad), Points(truth, 1e-4, 2), RefineAll());
   Print("0.1 mm noise", result, truth.laser.viewport, Seconds(start));
   EXPECT_TRUE(result.converged);
   EXPECT_LT(Angle(result.viewport.normal, truth.laser.viewport.normal),
@@ -149,12 +156,12 @@ TEST(LaserViewportCalibrationTest, ConvergesFromAPoorStart) {
   const ScannerModel truth = DefaultScannerModel();
   for (double noise_m : {0.0, 1e-4}) {
     const std::vector<LaserCalibrationPoint> points = Points(truth, noise_m, 3);
-    const LaserViewportCalibrationResult from_truth = CalibrateLaserViewport(truth, points);
+    const LaserViewportCalibrationResult from_truth = CalibrateLaserViewport(truth, points, RefineAll());
     for (unsigned seed : {21u, 22u, 23u}) {
       const auto start = std::chrono::steady_clock::now();
       const LaserViewportCalibrationResult from_poor = CalibrateLaserViewport(
           WithLaserViewport(truth, Perturbed(truth.laser.viewport, 0.005, 2.0 * kDeg, seed)),
-          points);
+          points, RefineAll());
       const double seconds = Seconds(start);
       const double normal = Angle(from_poor.viewport.normal, from_truth.viewport.normal);
       const double distance = from_poor.viewport.distance_m - from_truth.viewport.distance_m;
@@ -231,7 +238,7 @@ TEST(LaserViewportCalibrationTest, AbsorbsPartOfTheInAirCalibrationsEmitterError
   const double gap_true_viewport = MaxFanGap(truth.laser, model.laser);
   model.laser.viewport = Perturbed(truth.laser.viewport, 0.005, 2.0 * kDeg, 6);  // the CAD
   const LaserViewportCalibrationResult result =
-      CalibrateLaserViewport(model, Points(truth, 0.0, 7));
+      CalibrateLaserViewport(model, Points(truth, 0.0, 7), RefineAll());
   model.laser.viewport = result.viewport;
   const double gap_calibrated = MaxFanGap(truth.laser, model.laser);
   GalvoLaser result_in_air = in_air_result.laser;

@@ -1,0 +1,10 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace uwscan::app {
+
+// `calibrate STEP DATASET -o CALIB.yaml [--from SCANNER.yaml]`: one calibration step.
+void AddCalibrateCommand(CLI::App& app);
+
+}  // namespace uwscan::app

@@ -1,0 +1,172 @@
+#include "bench/calibration_benchmark.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "bench/accuracy_benchmark.hpp"
+#include "scanner/calibration/calibration_dataset.hpp"
+#include "scanner/calibration/calibration_steps.hpp"
+#include "scanner/calibration/dataset_simulation.hpp"
+#include "scanner/calibration/parameter_lists.hpp"
+#include "scanner/error.hpp"
+#include "scanner/mems_scanner_model.hpp"
+#include "scanner/scanner_model.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+namespace cal = scanner::calibration;
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+std::string ReadText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A scratch folder removed on every way out.
+class ScratchFolder {
+ public:
+  ScratchFolder()
+      : path_(std::filesystem::temp_directory_path() /
+              ("uwscan-bench-calibration-" + std::to_string(::getpid()))) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// The true values of the parameters a step records, by name.
+std::map<std::string, double> TrueValues(const std::string& step, const std::string& truth_yaml) {
+  std::vector<cal::ParameterEstimate> list;
+  if (step == "mems") return {};
+  const scanner::ScannerModel truth = scanner::ParseScannerModel(truth_yaml, "truth");
+  if (step == "intrinsics") list = cal::CameraParameters(truth.camera.camera);
+  if (step == "viewport") list = cal::ViewportParameters("camera_viewport", truth.camera.viewport);
+  if (step == "laser") list = cal::GalvoLaserParameters(truth.laser);
+  if (step == "laser_viewport") list = cal::ViewportParameters("laser_viewport", truth.laser.viewport);
+  std::map<std::string, double> values;
+  for (const cal::ParameterEstimate& p : list) values[p.name] = p.value;
+  return values;
+}
+
+// Largest distance, at 0.8 and 1.5 m deep, between the estimated MEMS beams and the true ones
+// over the calibrated drive range.
+double MemsBeamError(const std::string& estimated_yaml, const std::string& truth_yaml) {
+  const scanner::MemsScannerModel estimated = scanner::ParseMemsScannerModel(estimated_yaml, "estimated");
+  const scanner::MemsScannerModel truth = scanner::ParseMemsScannerModel(truth_yaml, "truth");
+  const scanner::ProjectionFunctions& f = estimated.functions;
+  double worst = 0.0;
+  for (int i = 0; i <= 10; ++i) {
+    for (int j = 0; j <= 10; ++j) {
+      const Eigen::Vector2d volts(f.volts_min.x() + (f.volts_max.x() - f.volts_min.x()) * i / 10.0,
+                                  f.volts_min.y() + (f.volts_max.y() - f.volts_min.y()) * j / 10.0);
+      const scanner::RayTrace e = f.RayInWater_C(volts);
+      const scanner::RayTrace t = truth.laser.RayInWater(volts);
+      if (!e.ok() || !t.ok()) continue;
+      for (const double depth : {0.8, 1.5}) {
+        const Eigen::Vector3d pe = e.ray.At((depth - e.ray.origin.z()) / e.ray.direction.z());
+        const Eigen::Vector3d pt = t.ray.At((depth - t.ray.origin.z()) / t.ray.direction.z());
+        worst = std::max(worst, (pe - pt).norm());
+      }
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+
+void CalibrationBenchOptions::Check() const {
+  if (gauge_positions < 1) throw Error("bench calibration: gauge_positions must be >= 1");
+  if (threads < 0) throw Error("bench calibration: threads must be >= 0");
+  if (!std::filesystem::is_directory(data_dir / "scenes")) {
+    throw Error("bench calibration: " + (data_dir / "scenes").string() + " is not a folder (give --data)");
+  }
+}
+
+CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& options,
+                                               const Progress& progress) {
+  options.Check();
+  const Clock::time_point start = Clock::now();
+  ScratchFolder scratch;
+  CalibrationBenchResult result;
+  std::string galvo_chain;  // the galvanometer calibration as it grows step by step
+  const std::vector<std::string>& steps = cal::CalibrationStepNames();
+  for (size_t k = 0; k < steps.size(); ++k) {
+    const std::string& step = steps[k];
+    StepFigures figures;
+    figures.step = step;
+    const std::filesystem::path folder = scratch.path() / step;
+    const Clock::time_point simulated = Clock::now();
+    cal::SimulateCalibrationDataset(options.data_dir / "scenes" / ("calib_" + step + ".yaml"), folder,
+                                    [&](double f) {
+                                      if (progress) progress("dataset " + step, f);
+                                    });
+    figures.dataset_seconds = Seconds(simulated);
+    const cal::CalibrationDataset dataset = cal::LoadCalibrationDataset(folder);
+    if (!dataset.truth_file || !dataset.scanner_file) {
+      throw Error(folder.string() + ": a simulated dataset must name its truth and its initial scanner");
+    }
+    const std::string truth = cal::LoadDatasetTruth(*dataset.truth_file).scanner_yaml;
+    // The galvanometer steps start from the previous step's output, as a user chains them.
+    const bool chained = step != "mems" && step != "intrinsics" && !galvo_chain.empty();
+    const std::string initial = chained ? galvo_chain : ReadText(*dataset.scanner_file);
+    const cal::CalibrationStepOutcome outcome = cal::RunCalibrationStep(
+        step, dataset, initial, chained ? "the previous step's output" : dataset.scanner_file->string(),
+        [&](double f) {
+          if (progress) progress("calibrate " + step, f);
+        });
+    if (step != "mems") {
+      galvo_chain = outcome.scanner_yaml;
+    }
+    figures.seconds = outcome.record.seconds;
+    figures.residual_rms = outcome.record.residual_rms;
+    figures.residual_unit = outcome.record.residual_unit;
+    const std::map<std::string, double> truth_values = TrueValues(step, truth);
+    for (const cal::ParameterEstimate& p : outcome.record.params) {
+      const auto it = truth_values.find(p.name);
+      figures.params.push_back({p.name, it == truth_values.end() ? std::numeric_limits<double>::quiet_NaN() : it->second,
+                                p.value, p.std});
+    }
+    if (step == "mems") {
+      figures.params.push_back({"beam_error_max_m", 0.0, MemsBeamError(outcome.scanner_yaml, truth), 0.0});
+    }
+    result.steps.push_back(figures);
+  }
+
+  // The seed's gauges under water, triangulated with the chained estimate and with the truth.
+  AccuracyBenchOptions gauges;
+  gauges.galvo_scanner = options.data_dir / "scanners" / "galvo_default.yaml";
+  gauges.mems_scanner = options.data_dir / "scanners" / "mems_default.yaml";
+  gauges.gauge_positions = options.gauge_positions;
+  gauges.seed = options.seed;
+  gauges.threads = options.threads;
+  const GaugeFigures with_truth = RunGaugeExperiment(gauges, true, "", progress);
+  const GaugeFigures with_estimate = RunGaugeExperiment(gauges, true, galvo_chain, progress);
+  result.gauges_true_calibration_mean_err_m = with_truth.mean_err_m;
+  result.gauges_estimated_calibration_mean_err_m = with_estimate.mean_err_m;
+  result.gauges = with_estimate.n;
+  result.seconds = Seconds(start);
+  return result;
+}
+
+}  // namespace uwscan::bench

@@ -1,0 +1,298 @@
+#include "scanner/calibration/calibration_scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "scanner/calibration/calibration_dataset.hpp"
+#include "scanner/calibration/calibration_yaml.hpp"
+#include "scanner/error.hpp"
+#include "scanner/scanner_model.hpp"
+
+namespace uwscan::scanner::calibration {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace calibration_yaml;
+using namespace sim::scene_yaml;
+
+// The scene reader knows every key of a scene, rejects any other, and wants objects. Rather than
+// re-implement it, the `calibration:` section's lines are blanked out of the text (the line
+// count stays, so its messages still point at the user's lines) and a placeholder object is
+// appended after the last line; the parsed scene then drops it.
+std::string SceneTextWithoutCalibration(const std::string& text, const YAML::Node& root,
+                                        const Context& top) {
+  int begin = -1, end = -1;
+  for (const auto& entry : root) {
+    if (entry.first.Scalar() == "calibration") {
+      if (entry.first.Mark().column != 0) {
+        yaml::Fail(yaml::Enter(top, "calibration"), entry.first,
+                   "write a calibration scene in block style, one top-level key per line");
+      }
+      begin = entry.first.Mark().line;
+    }
+  }
+  for (const auto& entry : root) {
+    const int line = entry.first.Mark().line;
+    if (line > begin && (end < 0 || line < end)) end = line;
+  }
+  std::istringstream in(text);
+  std::string result, line;
+  for (int number = 0; std::getline(in, line); ++number) {
+    const bool blank = number >= begin && (end < 0 || number < end);
+    result += (blank ? std::string() : line) + "\n";
+  }
+  return result + "objects: [{shape: plane, size_m: [1, 1]}]\n";
+}
+
+Eigen::Vector2d Pair(const Context& where, const YAML::Node& node, const std::string& key) {
+  const Eigen::VectorXd v = yaml::Vector(where, node, key, 2);
+  return Eigen::Vector2d(v[0], v[1]);
+}
+
+void ReadInitialScanner(const Context& where, const YAML::Node& node, const fs::path& base_dir,
+                        CalibrationScene* cs) {
+  if (node.IsScalar()) {
+    cs->initial_scanner = Resolve(base_dir, node.Scalar());
+  } else {
+    yaml::RequireKnownKeys(where, node, {"file", "true_sections"});
+    cs->initial_scanner = Resolve(base_dir, String(where, node, "file"));
+    if (Has(node, "true_sections")) {
+      const YAML::Node list = node["true_sections"];
+      const Context at = yaml::Enter(where, "true_sections");
+      if (!list.IsSequence()) yaml::Fail(at, list, "expected a list of scanner file sections");
+      const YAML::Node truth =
+          LoadYaml(cs->scene.scanner.yaml_text, cs->scene.scanner.file.string());
+      for (size_t i = 0; i < list.size(); ++i) {
+        const std::string section = list[i].IsScalar() ? list[i].Scalar() : std::string();
+        if (section.empty() || section == "uwscan_format" || !truth[section].IsDefined()) {
+          yaml::Fail(Item(at, i), list[i],
+                     "expected a top-level section of the true scanner file " +
+                         cs->scene.scanner.file.string() + ", got '" + section + "'");
+        }
+        cs->initial_true_sections.push_back(section);
+      }
+    }
+  }
+  if (!fs::is_regular_file(*cs->initial_scanner)) {
+    yaml::Fail(where, node, "initial scanner file not found: " + cs->initial_scanner->string());
+  }
+}
+
+TargetRenderOptions ReadRender(const Context& where, const YAML::Node& node, bool mono16) {
+  yaml::RequireKnownKeys(
+      where, node, {"supersampling", "blur_sigma_px", "white_level", "black_level", "noise_sigma"});
+  TargetRenderOptions r;
+  const double scale = mono16 ? 257.0 : 1.0;  // 8-bit units -> 16-bit
+  r.supersampling = Integer(where, node, "supersampling", 1, r.supersampling);
+  r.blur_sigma_px = Number(where, node, "blur_sigma_px", Range::kNonNegative, r.blur_sigma_px);
+  r.white_level = scale * Number(where, node, "white_level", Range::kPositive, r.white_level);
+  r.black_level = scale * Number(where, node, "black_level", Range::kNonNegative, r.black_level);
+  r.noise_sigma = scale * Number(where, node, "noise_sigma", Range::kNonNegative, r.noise_sigma);
+  r.format = mono16 ? PixelFormat::kMono16 : PixelFormat::kMono8;
+  Checked(where, node, [&] { r.Check(); });
+  return r;
+}
+
+void ReadSection(const Context& where, const YAML::Node& node, const fs::path& base_dir,
+                 CalibrationScene* cs) {
+  yaml::RequireKnownKeys(where, node,
+                         {"step", "pattern", "board_size_m", "board_reflectance", "initial_scanner",
+                          "views", "planes", "distance_m", "max_tilt_rad", "max_roll_rad",
+                          "mirror_steps", "volts_grid", "volts_fraction", "image_scale", "render"});
+  cs->step = String(where, node, "step");
+  const std::vector<std::string>& steps = CalibrationSteps();
+  if (std::find(steps.begin(), steps.end(), cs->step) == steps.end()) {
+    std::string names;
+    for (const std::string& s : steps) names += (names.empty() ? "" : ", ") + s;
+    FailField(where, node, "step", "got '" + cs->step + "', expected one of " + names);
+  }
+  const bool views = cs->step == "intrinsics" || cs->step == "viewport";
+  const bool stripes = cs->step == "laser" || cs->step == "laser_viewport";
+  const bool dots = cs->step == "mems";
+  // A field the step ignores is most likely a mistake (copied from another step's scene).
+  auto only = [&](const char* key, bool used, const char* which) {
+    if (Has(node, key) && !used) {
+      FailField(where, node, key,
+                std::string("not used by a ") + cs->step + " step (only " + which + ")");
+    }
+  };
+  only("views", views, "intrinsics and viewport");
+  only("planes", !views, "laser, laser_viewport and mems");
+  only("mirror_steps", stripes, "laser and laser_viewport");
+  only("volts_grid", dots, "mems");
+  only("volts_fraction", dots, "mems");
+  const bool mems_scanner = cs->scene.scanner.kind == ScannerKind::kMems;
+  if ((stripes && mems_scanner) || (dots && !mems_scanner)) {
+    FailField(where, node, "step",
+              "a " + cs->step + " step needs a " + (stripes ? "galvanometer" : "MEMS") +
+                  " scanner; " + cs->scene.scanner.file.string() + " is a " +
+                  (mems_scanner ? "MEMS" : "galvanometer") + " scanner");
+  }
+
+  cs->pattern = ReadPattern(yaml::Enter(where, "pattern"), yaml::Child(where, node, "pattern"));
+  if (Has(node, "board_size_m")) {
+    cs->board_size_m = Pair(where, node, "board_size_m");
+    Checked(yaml::Enter(where, "board_size_m"), node["board_size_m"],
+            [&] { BoardOf(cs->pattern, cs->board_size_m); });
+  }
+  cs->board_reflectance =
+      Number(where, node, "board_reflectance", Range::kFraction, cs->board_reflectance);
+  if (Has(node, "initial_scanner")) {
+    ReadInitialScanner(yaml::Enter(where, "initial_scanner"), node["initial_scanner"], base_dir,
+                       cs);
+  }
+  cs->views = Integer(where, node, "views", 3, cs->views);
+  cs->planes = Integer(where, node, "planes", 2, cs->planes);
+  if (Has(node, "distance_m")) {
+    cs->distance_m = Pair(where, node, "distance_m");
+    if (!(cs->distance_m.x() > 0.0 && cs->distance_m.y() >= cs->distance_m.x())) {
+      FailField(where, node, "distance_m", "expected [min, max] with 0 < min <= max, metres");
+    }
+  }
+  cs->max_tilt_rad = Number(where, node, "max_tilt_rad", Range::kNonNegative, cs->max_tilt_rad);
+  if (cs->max_tilt_rad > 1.3) FailField(where, node, "max_tilt_rad", "expected <= 1.3 rad");
+  cs->max_roll_rad = Number(where, node, "max_roll_rad", Range::kNonNegative, cs->max_roll_rad);
+  if (cs->max_roll_rad > M_PI) FailField(where, node, "max_roll_rad", "expected <= pi rad");
+  cs->image_scale = Number(where, node, "image_scale", Range::kFraction, cs->image_scale);
+  cs->render = ReadRender(yaml::Enter(where, "render"),
+                          Has(node, "render") ? node["render"] : YAML::Node(YAML::NodeType::Map),
+                          cs->scene.effects.image.format == PixelFormat::kMono16);
+
+  if (stripes) {
+    const Context at = yaml::Enter(where, "mirror_steps");
+    const YAML::Node list = yaml::Child(where, node, "mirror_steps");
+    const GalvoLaser laser =
+        ParseScannerModel(cs->scene.scanner.yaml_text, cs->scene.scanner.file.string()).laser;
+    if (!list.IsSequence()) yaml::Fail(at, list, "expected a list of mirror steps");
+    std::set<int> seen;
+    for (size_t i = 0; i < list.size(); ++i) {
+      int step = 0;
+      if (!list[i].IsScalar() || !YAML::convert<int>::decode(list[i], step)) {
+        yaml::Fail(Item(at, i), list[i], "expected an integer mirror step");
+      }
+      if (step < laser.step_min || step > laser.step_max) {
+        yaml::Fail(Item(at, i), list[i],
+                   "mirror step " + std::to_string(step) + " outside the laser's range [" +
+                       std::to_string(laser.step_min) + ", " + std::to_string(laser.step_max) +
+                       "]");
+      }
+      if (!seen.insert(step).second) {
+        yaml::Fail(Item(at, i), list[i], "mirror step " + std::to_string(step) + " given twice");
+      }
+      cs->mirror_steps.push_back(step);
+    }
+    if (cs->mirror_steps.size() < 2) yaml::Fail(at, list, "expected at least 2 mirror steps");
+  }
+  if (dots) {
+    if (Has(node, "volts_grid")) {
+      const Eigen::VectorXd grid = yaml::Vector(where, node, "volts_grid", 2);
+      if (grid[0] < 1 || grid[1] < 1 || grid[0] != std::floor(grid[0]) ||
+          grid[1] != std::floor(grid[1]) || grid[0] * grid[1] > 100000) {
+        FailField(where, node, "volts_grid", "expected [a, b], whole numbers >= 1");
+      }
+      cs->volts_grid = Eigen::Vector2i(static_cast<int>(grid[0]), static_cast<int>(grid[1]));
+    }
+    cs->volts_fraction =
+        Number(where, node, "volts_fraction", Range::kFraction, cs->volts_fraction);
+  }
+}
+
+}  // namespace
+
+void CalibrationScene::Check() const {
+  auto fail = [&](const std::string& field, const std::string& what) {
+    throw Error(scene.source + ": field 'calibration." + field + "': " + what);
+  };
+  const std::vector<std::string>& steps = CalibrationSteps();
+  if (std::find(steps.begin(), steps.end(), step) == steps.end()) {
+    fail("step", "unknown step '" + step + "'");
+  }
+  const bool stripes = step == "laser" || step == "laser_viewport";
+  const bool mems_scanner = scene.scanner.kind == ScannerKind::kMems;
+  if ((stripes && mems_scanner) || (step == "mems" && !mems_scanner)) {
+    fail("step",
+         "a " + step + " step cannot be simulated with the scanner " + scene.scanner.file.string());
+  }
+  try {
+    pattern.Check();
+  } catch (const Error& e) {
+    fail("pattern", e.what());
+  }
+  try {
+    BoardOf(pattern, board_size_m);
+  } catch (const Error& e) {
+    fail("board_size_m", e.what());
+  }
+  try {
+    render.Check();
+  } catch (const Error& e) {
+    fail("render", e.what());
+  }
+  if (!(board_reflectance > 0.0 && board_reflectance <= 1.0)) {
+    fail("board_reflectance", "expected in (0, 1]");
+  }
+  if (views < 3) fail("views", "expected >= 3");
+  if (planes < 2) fail("planes", "expected >= 2");
+  if (!(distance_m.x() > 0.0 && distance_m.y() >= distance_m.x())) {
+    fail("distance_m", "expected [min, max] with 0 < min <= max, metres");
+  }
+  if (!(max_tilt_rad >= 0.0 && max_tilt_rad <= 1.3)) fail("max_tilt_rad", "expected in [0, 1.3]");
+  if (!(max_roll_rad >= 0.0 && max_roll_rad <= M_PI)) fail("max_roll_rad", "expected in [0, pi]");
+  if (!(image_scale > 0.0 && image_scale <= 1.0)) fail("image_scale", "expected in (0, 1]");
+  if (stripes) {
+    const GalvoLaser laser =
+        ParseScannerModel(scene.scanner.yaml_text, scene.scanner.file.string()).laser;
+    const std::set<int> distinct(mirror_steps.begin(), mirror_steps.end());
+    if (distinct.size() != mirror_steps.size() || distinct.size() < 2) {
+      fail("mirror_steps", "expected at least 2 mirror steps, each once");
+    }
+    if (*distinct.begin() < laser.step_min || *distinct.rbegin() > laser.step_max) {
+      fail("mirror_steps", "outside the laser's range [" + std::to_string(laser.step_min) + ", " +
+                               std::to_string(laser.step_max) + "]");
+    }
+  }
+  if (step == "mems") {
+    if (volts_grid.minCoeff() < 1) fail("volts_grid", "expected [a, b] >= 1");
+    if (!(volts_fraction > 0.0 && volts_fraction <= 1.0)) {
+      fail("volts_fraction", "expected in (0, 1]");
+    }
+  }
+}
+
+CalibrationScene ParseCalibrationScene(const std::string& yaml_text, const std::string& source,
+                                       const fs::path& base_dir) {
+  const YAML::Node root = LoadYaml(yaml_text, source);
+  const Context top{source, ""};
+  yaml::CheckFormat(top, root);
+  if (Has(root, "objects")) {
+    FailField(top, root, "objects",
+              "a calibration scene has no objects: the board, posed by the simulation, is the "
+              "only one");
+  }
+  if (Has(root, "trajectory")) {
+    FailField(top, root, "trajectory",
+              "a calibration scene has no trajectory: the camera stays at the world origin and "
+              "the board moves");
+  }
+  const YAML::Node section = yaml::Child(top, root, "calibration");
+  CalibrationScene cs;
+  cs.scene = sim::ParseScene(SceneTextWithoutCalibration(yaml_text, root, top), source, base_dir);
+  cs.scene.objects.clear();
+  ReadSection(yaml::Enter(top, "calibration"), section, base_dir, &cs);
+  cs.Check();
+  return cs;
+}
+
+CalibrationScene LoadCalibrationScene(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path.string() + ": cannot open calibration scene");
+  std::stringstream text;
+  text << in.rdbuf();
+  const fs::path base = path.parent_path().empty() ? "." : path.parent_path();
+  return ParseCalibrationScene(text.str(), path.string(), base);
+}
+
+}  // namespace uwscan::scanner::calibration
