@@ -7,6 +7,7 @@
 #include "apps/accuracy_command.hpp"
 #include "apps/bench_commands.hpp"
 #include "apps/calibrate_command.hpp"
+#include "apps/calibration_bench_command.hpp"
 #include "apps/demo_command.hpp"
 #include "apps/dive_commands.hpp"
 #include "apps/object_commands.hpp"
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddPerceptionBenchCommands(*bench);
   uwscan::app::AddStripeBenchCommand(*bench);
   uwscan::app::AddAccuracyBenchCommand(*bench);
+  uwscan::app::AddCalibrationBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);

@@ -12,6 +12,7 @@
 #include "bench/accuracy_benchmark.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_steps.hpp"
+#include "scanner/calibration/galvo_laser_calibration.hpp"
 #include "scanner/calibration/dataset_simulation.hpp"
 #include "scanner/calibration/parameter_lists.hpp"
 #include "scanner/error.hpp"
@@ -69,24 +70,53 @@ std::map<std::string, double> TrueValues(const std::string& step, const std::str
   return values;
 }
 
-// Largest distance, at 0.8 and 1.5 m deep, between the estimated MEMS beams and the true ones
-// over the calibrated drive range.
-double MemsBeamError(const std::string& estimated_yaml, const std::string& truth_yaml) {
+// Largest distance, at 0.8 and 1.5 m deep, between the estimated MEMS beams and the true ones,
+// at the voltage pairs the dataset saw on two planes or more (where the functions were fitted;
+// beyond them a polynomial extrapolates).
+double MemsBeamError(const std::string& estimated_yaml, const std::string& truth_yaml,
+                     const cal::CalibrationDataset& dataset) {
   const scanner::MemsScannerModel estimated = scanner::ParseMemsScannerModel(estimated_yaml, "estimated");
   const scanner::MemsScannerModel truth = scanner::ParseMemsScannerModel(truth_yaml, "truth");
-  const scanner::ProjectionFunctions& f = estimated.functions;
+  std::map<std::pair<double, double>, int> planes_of;
+  for (const cal::CalibrationDataset::Plane& plane : dataset.planes) {
+    for (const auto& dot : plane.dots) ++planes_of[{dot.second.x(), dot.second.y()}];
+  }
   double worst = 0.0;
-  for (int i = 0; i <= 10; ++i) {
-    for (int j = 0; j <= 10; ++j) {
-      const Eigen::Vector2d volts(f.volts_min.x() + (f.volts_max.x() - f.volts_min.x()) * i / 10.0,
-                                  f.volts_min.y() + (f.volts_max.y() - f.volts_min.y()) * j / 10.0);
-      const scanner::RayTrace e = f.RayInWater_C(volts);
-      const scanner::RayTrace t = truth.laser.RayInWater(volts);
-      if (!e.ok() || !t.ok()) continue;
-      for (const double depth : {0.8, 1.5}) {
-        const Eigen::Vector3d pe = e.ray.At((depth - e.ray.origin.z()) / e.ray.direction.z());
-        const Eigen::Vector3d pt = t.ray.At((depth - t.ray.origin.z()) / t.ray.direction.z());
-        worst = std::max(worst, (pe - pt).norm());
+  for (const auto& [key, planes] : planes_of) {
+    if (planes < 2) continue;
+    const Eigen::Vector2d volts(key.first, key.second);
+    const scanner::RayTrace e = estimated.functions.RayInWater_C(volts);
+    const scanner::RayTrace t = truth.laser.RayInWater(volts);
+    if (!e.ok() || !t.ok()) continue;
+    for (const double depth : {0.8, 1.5}) {
+      const Eigen::Vector3d pe = e.ray.At((depth - e.ray.origin.z()) / e.ray.direction.z());
+      const Eigen::Vector3d pt = t.ray.At((depth - t.ray.origin.z()) / t.ray.direction.z());
+      worst = std::max(worst, (pe - pt).norm());
+    }
+  }
+  return worst;
+}
+
+// Largest distance from points of the true laser fans (every 20th mirror step, 15 rays each,
+// 0.5-1.5 m deep) to the estimated fans, both in the dataset's medium: what the laser
+// calibration is for, whatever gauge its parameters are expressed in.
+double FanError(const std::string& truth_yaml, const std::string& estimated_yaml,
+                const std::optional<double>& water_index) {
+  const scanner::ScannerModel truth =
+      scanner::ParseScannerModel(cal::ScannerInMedium(truth_yaml, water_index), "truth");
+  const scanner::ScannerModel estimated =
+      scanner::ParseScannerModel(cal::ScannerInMedium(estimated_yaml, water_index), "estimated");
+  double worst = 0.0;
+  const double max_tan = truth.laser.MaxFanTan();
+  for (int step = truth.laser.step_min; step <= truth.laser.step_max; step += 20) {
+    const scanner::LaserFan fan = truth.laser.FanAtStep(step);
+    for (int k = 0; k < 15; ++k) {
+      const scanner::RayTrace ray = fan.RayInWater(-max_tan + 2.0 * max_tan * k / 14.0);
+      if (!ray.ok() || !(ray.ray.direction.z() > 1e-6)) continue;
+      for (const double depth : {0.5, 1.0, 1.5}) {
+        const Eigen::Vector3d p = ray.ray.At((depth - ray.ray.origin.z()) / ray.ray.direction.z());
+        const std::optional<double> d = cal::DistanceToFan(estimated.laser, step, p);
+        if (d) worst = std::max(worst, *d);
       }
     }
   }
@@ -123,15 +153,16 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
                                     });
     figures.dataset_seconds = Seconds(simulated);
     const cal::CalibrationDataset dataset = cal::LoadCalibrationDataset(folder);
-    if (!dataset.truth_file || !dataset.scanner_file) {
-      throw Error(folder.string() + ": a simulated dataset must name its truth and its initial scanner");
-    }
+    if (!dataset.truth_file) throw Error(folder.string() + ": a simulated dataset must name its truth");
     const std::string truth = cal::LoadDatasetTruth(*dataset.truth_file).scanner_yaml;
     // The galvanometer steps start from the previous step's output, as a user chains them.
     const bool chained = step != "mems" && step != "intrinsics" && !galvo_chain.empty();
-    const std::string initial = chained ? galvo_chain : ReadText(*dataset.scanner_file);
+    // Intrinsics need no starting values: they are written into the CAD scanner file.
+    const std::filesystem::path start_file =
+        dataset.scanner_file ? *dataset.scanner_file : options.data_dir / "scanners" / "galvo_cad.yaml";
+    const std::string initial = chained ? galvo_chain : ReadText(start_file);
     const cal::CalibrationStepOutcome outcome = cal::RunCalibrationStep(
-        step, dataset, initial, chained ? "the previous step's output" : dataset.scanner_file->string(),
+        step, dataset, initial, chained ? "the previous step's output" : start_file.string(),
         [&](double f) {
           if (progress) progress("calibrate " + step, f);
         });
@@ -148,7 +179,11 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
                                 p.value, p.std});
     }
     if (step == "mems") {
-      figures.params.push_back({"beam_error_max_m", 0.0, MemsBeamError(outcome.scanner_yaml, truth), 0.0});
+      figures.params.push_back({"beam_error_max_m", 0.0, MemsBeamError(outcome.scanner_yaml, truth, dataset), 0.0});
+    }
+    if (step == "laser" || step == "laser_viewport") {
+      figures.params.push_back(
+          {"fan_error_max_m", 0.0, FanError(truth, outcome.scanner_yaml, dataset.water_refractive_index), 0.0});
     }
     result.steps.push_back(figures);
   }

@@ -98,6 +98,15 @@ std::string WithProjectionFunctions(const std::string& scanner_yaml,
   return Emit(root);
 }
 
+std::string ScannerInMedium(const std::string& scanner_yaml, const std::optional<double>& water_index) {
+  if (!water_index) return scanner_yaml;
+  YAML::Node root = Load(scanner_yaml);
+  for (const char* key : {"camera_viewport", "laser_viewport"}) {
+    if (root[key] && root[key].IsMap()) root[key]["n_water"] = *water_index;
+  }
+  return Emit(root);
+}
+
 std::string WithStepRecord(const std::string& scanner_yaml, StepRecord record) {
   if (record.date_utc.empty()) record.date_utc = NowUtc();
   YAML::Node root = Load(scanner_yaml);

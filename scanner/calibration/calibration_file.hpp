@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,6 +42,11 @@ std::string WithViewport(const std::string& scanner_yaml, const std::string& key
                          const FlatViewport& viewport);
 std::string WithGalvoLaser(const std::string& scanner_yaml, const GalvoLaser& laser);
 std::string WithProjectionFunctions(const std::string& scanner_yaml, const ProjectionFunctions& functions);
+// The scanner as it was when a dataset was taken: every viewport's water side in that medium
+// (1.0: in air). Calibration computes with it and writes its results into the file as given,
+// which keeps the medium the file is meant for. std::nullopt: the text unchanged.
+std::string ScannerInMedium(const std::string& scanner_yaml, const std::optional<double>& water_index);
+
 // Adds (or replaces) the record of record.step in the `calibration:` section.
 std::string WithStepRecord(const std::string& scanner_yaml, StepRecord record);
 

@@ -42,21 +42,6 @@ bool IsMems(const std::string& yaml) {
   }
 }
 
-// The scanner as it was when the dataset was taken: every viewport's water side in the
-// dataset's medium (in air for the in-air steps). Only the computation uses it: the result is
-// written into the scanner file as given, which keeps the medium it is meant for.
-std::string InMedium(const std::string& yaml, const std::optional<double>& water_index) {
-  if (!water_index) return yaml;
-  YAML::Node root = YAML::Load(yaml);
-  for (const char* key : {"camera_viewport", "laser_viewport"}) {
-    if (root[key] && root[key].IsMap()) root[key]["n_water"] = *water_index;
-  }
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << root;
-  return std::string(out.c_str()) + "\n";
-}
-
 RefractiveCamera CameraOf(const std::string& yaml, const std::string& source) {
   return IsMems(yaml) ? ParseMemsScannerModel(yaml, source).camera : ParseScannerModel(yaml, source).camera;
 }
@@ -248,7 +233,8 @@ CalibrationStepOutcome Mems(const std::string& work, const std::string& yaml, co
   rec.residual_unit = "%";
   rec.observations = r.dots;
   for (int i = 0; i < 6; ++i) {
-    const std::string f = "f" + std::to_string(i + 1);
+    std::string f = "f";  // built by += : GCC 12 reports a false -Wrestrict on "f" + string
+    f += std::to_string(i + 1);
     rec.params.push_back({f + ".max_percent_error", r.errors[static_cast<size_t>(i)].max_percent, 0.0});
     rec.params.push_back({f + ".mean_percent_error", r.errors[static_cast<size_t>(i)].mean_percent, 0.0});
     rec.residual_rms = std::max(rec.residual_rms, r.errors[static_cast<size_t>(i)].mean_percent);
@@ -280,7 +266,7 @@ CalibrationStepOutcome RunCalibrationStep(const std::string& step, const Calibra
   }
   const Clock::time_point start = Clock::now();
   const StepRunner run(dataset, progress);
-  const std::string work = InMedium(initial_scanner_yaml, dataset.water_refractive_index);
+  const std::string work = ScannerInMedium(initial_scanner_yaml, dataset.water_refractive_index);
   CalibrationStepOutcome out;
   if (step == "intrinsics") {
     out = Intrinsics(dataset, initial_scanner_yaml, run);
