@@ -8,18 +8,23 @@
 #include <string>
 
 #include "apps/progress_bar.hpp"
+#include "scanner/pinhole_camera.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_steps.hpp"
+#include "scanner/calibration/opencv_camera_import.hpp"
 #include "scanner/error.hpp"
 
 namespace uwscan::app {
 namespace {
+
+using scanner::PinholeCamera;
 
 struct CalibrateArgs {
   std::string step;
   std::string dataset;
   std::string output;
   std::string from;
+  scanner::calibration::CalibrationStepOptions options;
 };
 
 std::string ReadText(const std::filesystem::path& path) {
@@ -50,7 +55,7 @@ void RunCalibrate(const CalibrateArgs& a) {
     ProgressBar bar;
     outcome = scanner::calibration::RunCalibrationStep(
         a.step, dataset, ReadText(initial), initial.string(),
-        [&bar, &a](double f) { bar.Update("calibrate " + a.step, f); });
+        [&bar, &a](double f) { bar.Update("calibrate " + a.step, f); }, a.options);
   }
   scanner::calibration::WriteTextAtomically(a.output, outcome.scanner_yaml);
   std::printf("%s: step %s from %s, started from %s, %.2f s\n", a.output.c_str(), a.step.c_str(),
@@ -62,7 +67,41 @@ void RunCalibrate(const CalibrateArgs& a) {
   }
 }
 
+struct ImportArgs {
+  std::string opencv_yaml;
+  std::string into;
+  std::string output;
+};
+
+void RunImportIntrinsics(const ImportArgs& a) {
+  const PinholeCamera camera = scanner::calibration::ImportOpenCvCalibration(a.opencv_yaml);
+  std::string yaml = scanner::calibration::WithCamera(ReadText(a.into), camera);
+  scanner::calibration::StepRecord record;
+  record.step = "intrinsics";
+  record.dataset = "imported from " + std::filesystem::absolute(a.opencv_yaml).lexically_normal().string();
+  record.residual_unit = "px";
+  record.params = {{"fx_px", camera.fx_px, 0.0}, {"fy_px", camera.fy_px, 0.0},
+                   {"cx_px", camera.cx_px, 0.0}, {"cy_px", camera.cy_px, 0.0}};
+  yaml = scanner::calibration::WithStepRecord(yaml, record);
+  scanner::calibration::WriteTextAtomically(a.output, yaml);
+  std::printf("%s: intrinsics from %s (fx %.3f, fy %.3f, cx %.3f, cy %.3f px; k1 %.6g) into %s\n",
+              a.output.c_str(), a.opencv_yaml.c_str(), camera.fx_px, camera.fy_px, camera.cx_px,
+              camera.cy_px, camera.k1, a.into.c_str());
+}
+
 }  // namespace
+
+void AddImportIntrinsicsCommand(CLI::App& app) {
+  auto args = std::make_shared<ImportArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "import-intrinsics", "put intrinsics from OpenCV's calibration YAML into a scanner file");
+  cmd->add_option("opencv_yaml", args->opencv_yaml, "camera_matrix + distortion_coefficients (OpenCV)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--into", args->into, "scanner file to take everything else from")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "calibration file to write")->required();
+  cmd->callback([args] { RunImportIntrinsics(*args); });
+}
 
 void AddCalibrateCommand(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();
@@ -73,6 +112,12 @@ void AddCalibrateCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--from", args->from,
                   "scanner file to start from (CAD values or an earlier step's output; default: the manifest's)");
+  cmd->add_flag("--refine-thickness", args->options.refine_thickness,
+                "viewport steps: also estimate the viewport thickness (weakly observable)");
+  cmd->add_flag("--refine-water-index", args->options.refine_water_index,
+                "camera viewport: also estimate the water's refractive index");
+  cmd->add_flag("--refine-glass-index", args->options.refine_glass_index,
+                "camera viewport: also estimate the glass's refractive index (weakly observable)");
   cmd->callback([args] { RunCalibrate(*args); });
 }
 

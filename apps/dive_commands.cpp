@@ -108,6 +108,7 @@ struct ReconstructArgs {
   std::string output;
   std::string method;
   std::string json;
+  std::string calibration;
   bool ascii = false;
   bool scanner_frame = false;
 };
@@ -121,6 +122,10 @@ void RunReconstruct(const ReconstructArgs& a) {
     if (!options.method) throw Error("--method: unknown '" + a.method + "' (use plane, cone or ray)");
   }
   options.use_navigation = !a.scanner_frame;
+  if (!a.calibration.empty()) {
+    options.calibration_yaml = ReadText(a.calibration);
+    options.calibration_source = a.calibration;
+  }
   const mapping::DiveLogReader log(a.log);
   mapping::Reconstruction r;
   {
@@ -174,6 +179,9 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_option("--method", args->method,
                   "plane, cone or ray (default: cone for the galvanometer, plane for MEMS)");
   cmd->add_option("--json", args->json, "also write the figures as JSON");
+  cmd->add_option("--calibration", args->calibration,
+                  "calibration file (from `calibrate`) to triangulate with instead of the log's scanner")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--ascii", args->ascii, "write an ASCII cloud instead of binary");
   cmd->add_flag("--scanner-frame", args->scanner_frame,
                 "keep points in the camera frame even when the log has navigation");

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddReconstructCommand(app);
   uwscan::app::AddMakeObjectCommand(app);
   uwscan::app::AddCalibrateCommand(app);
+  uwscan::app::AddImportIntrinsicsCommand(app);
   uwscan::app::AddRegisterCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);

@@ -46,7 +46,9 @@ Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions
 
   const Clock::time_point tables_start = Clock::now();
   const std::unique_ptr<scanner::Triangulator> triangulator = scanner::MakeTriangulator(
-      header.scanner_yaml, source + " (scanner)", pattern, result.method);
+      options.calibration_yaml.empty() ? header.scanner_yaml : options.calibration_yaml,
+      options.calibration_yaml.empty() ? source + " (scanner)" : options.calibration_source, pattern,
+      result.method);
   result.table_seconds = Seconds(tables_start);
 
   const std::optional<scanner::sim::Trajectory> navigation =

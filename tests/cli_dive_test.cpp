@@ -136,4 +136,48 @@ TEST(CliDive, AccuracyBenchWritesEveryTable) {
   std::filesystem::remove(json);
 }
 
+TEST(CliDive, ReconstructUsesTheCalibrationItIsGiven) {
+  const std::filesystem::path log = TempPath("calibrated.db");
+  ASSERT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string()).exit_code, 0);
+  const auto mean_error = [&](const std::string& calibration) {
+    const std::filesystem::path json = TempPath("calibrated.json");
+    const CommandRun run = RunUwscan("reconstruct " + log.string() + " -o " + TempPath("c.ply").string() +
+                                     " --method ray --calibration " + calibration + " --json " + json.string());
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    const double mean = ReadJson(json)["truth_error"]["mean_m"].get<double>();
+    std::filesystem::remove(json);
+    return mean;
+  };
+  // The true scanner file reproduces the log's own result; the CAD one (mm and degrees off)
+  // visibly does not.
+  EXPECT_LT(mean_error(SourcePath("data/scanners/galvo_default.yaml")), 1e-6);
+  EXPECT_GT(mean_error(SourcePath("data/scanners/galvo_cad.yaml")), 1e-4);
+  std::filesystem::remove(log);
+  std::filesystem::remove(TempPath("c.ply"));
+}
+
+TEST(CliDive, ImportIntrinsicsFromOpenCv) {
+  const std::filesystem::path ocv = TempPath("opencv.yaml");
+  std::ofstream(ocv) << "%YAML:1.0\n---\nimage_width: 2048\nimage_height: 1088\n"
+                        "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                        "   data: [ 1700.5, 0., 1020.25, 0., 1701.5, 540.75, 0., 0., 1. ]\n"
+                        "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+                        "   data: [ -0.1, 0.05, 0.001, -0.002, 0.01 ]\n";
+  const std::filesystem::path out = TempPath("imported.yaml");
+  const CommandRun run = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                                   SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("fx_px: 1700.5"), std::string::npos) << text;
+  EXPECT_NE(text.find("intrinsics:"), std::string::npos) << text;
+  std::ofstream(ocv) << "%YAML:1.0\n---\nimage_width: 2048\n";
+  const CommandRun bad = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                                   SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("missing node"), std::string::npos) << bad.output;
+  std::filesystem::remove(ocv);
+  std::filesystem::remove(out);
+}
+
 }  // namespace

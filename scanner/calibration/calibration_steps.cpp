@@ -166,12 +166,17 @@ CalibrationStepOutcome Intrinsics(const CalibrationDataset& d, const std::string
 }
 
 CalibrationStepOutcome Viewport(const CalibrationDataset& d, const std::string& work, const std::string& yaml,
-                                const std::string& source, const StepRunner& run) {
+                                const std::string& source, const StepRunner& run,
+                                const CalibrationStepOptions& options) {
   const RefractiveCamera initial = CameraOf(work, source);
   std::vector<std::string> missing;
   const std::vector<PatternObservation> views = run.ViewObservations(&missing);
+  ViewportCalibrationOptions viewport_options;
+  viewport_options.refine_thickness = options.refine_thickness;
+  viewport_options.refine_water_index = options.refine_water_index;
+  viewport_options.refine_glass_index = options.refine_glass_index;
   const ViewportCalibrationResult r =
-      CalibrateCameraViewport(initial.camera, initial.viewport, d.pattern, views, ViewportCalibrationOptions{});
+      CalibrateCameraViewport(initial.camera, initial.viewport, d.pattern, views, viewport_options);
   CalibrationStepOutcome out;
   out.scanner_yaml = WithViewport(yaml, "camera_viewport", r.viewport);
   StepRecord& rec = out.record;
@@ -180,6 +185,8 @@ CalibrationStepOutcome Viewport(const CalibrationDataset& d, const std::string& 
   rec.residual_max = r.max_px;
   for (const PatternObservation& v : views) rec.observations += static_cast<int>(v.corners_px.size());
   AddViewportParams("camera_viewport", r.viewport, r.normal_std_rad, r.distance_std_m, r.thickness_std_m, &rec);
+  if (options.refine_water_index) rec.params.push_back({"camera_viewport.n_water", r.viewport.n_water, r.n_water_std});
+  if (options.refine_glass_index) rec.params.push_back({"camera_viewport.n_glass", r.viewport.n_glass, r.n_glass_std});
   out.summary.push_back(Format("%.0f views with the pattern, %.0f without; %.0f iterations", views.size(),
                                missing.size(), r.iterations));
   out.summary.push_back(Format("refractive reprojection rms %.3f px; viewport distance %.2f mm, thickness %.2f mm",
@@ -188,7 +195,7 @@ CalibrationStepOutcome Viewport(const CalibrationDataset& d, const std::string& 
 }
 
 CalibrationStepOutcome Laser(const std::string& work, const std::string& yaml, const std::string& source,
-                             const StepRunner& run, bool laser_viewport) {
+                             const StepRunner& run, bool laser_viewport, const CalibrationStepOptions& options) {
   if (IsMems(yaml)) throw Error(source + ": the laser steps calibrate a galvanometer scanner; this one is MEMS");
   const ScannerModel model = ParseScannerModel(work, source);
   const StepRunner::PlaneData planes = run.Planes(model.camera);
@@ -208,7 +215,9 @@ CalibrationStepOutcome Laser(const std::string& work, const std::string& yaml, c
     out.summary.push_back(Format("laser fan residual rms %.4f mm, max %.4f mm; mirror step %.6f rad",
                                  r.residual_rms_m * 1e3, r.residual_max_m * 1e3, r.laser.mirror_step_rad));
   } else {
-    const LaserViewportCalibrationResult r = CalibrateLaserViewport(model, points, LaserViewportCalibrationOptions{});
+    LaserViewportCalibrationOptions viewport_options;
+    viewport_options.refine_thickness = options.refine_thickness;
+    const LaserViewportCalibrationResult r = CalibrateLaserViewport(model, points, viewport_options);
     out.scanner_yaml = WithViewport(yaml, "laser_viewport", r.viewport);
     rec.residual_rms = r.residual_rms_m;
     rec.residual_max = r.residual_max_m;
@@ -256,7 +265,8 @@ const std::vector<std::string>& CalibrationStepNames() {
 CalibrationStepOutcome RunCalibrationStep(const std::string& step, const CalibrationDataset& dataset,
                                           const std::string& initial_scanner_yaml,
                                           const std::string& initial_source,
-                                          const std::function<void(double)>& progress) {
+                                          const std::function<void(double)>& progress,
+                                          const CalibrationStepOptions& options) {
   const std::vector<std::string>& names = CalibrationStepNames();
   if (std::find(names.begin(), names.end(), step) == names.end()) {
     throw Error("calibrate: unknown step '" + step + "' (intrinsics, viewport, laser, laser_viewport, mems)");
@@ -271,9 +281,9 @@ CalibrationStepOutcome RunCalibrationStep(const std::string& step, const Calibra
   if (step == "intrinsics") {
     out = Intrinsics(dataset, initial_scanner_yaml, run);
   } else if (step == "viewport") {
-    out = Viewport(dataset, work, initial_scanner_yaml, initial_source, run);
+    out = Viewport(dataset, work, initial_scanner_yaml, initial_source, run, options);
   } else if (step == "laser" || step == "laser_viewport") {
-    out = Laser(work, initial_scanner_yaml, initial_source, run, step == "laser_viewport");
+    out = Laser(work, initial_scanner_yaml, initial_source, run, step == "laser_viewport", options);
   } else {
     out = Mems(work, initial_scanner_yaml, initial_source, run);
   }

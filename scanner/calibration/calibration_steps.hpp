@@ -12,6 +12,15 @@ namespace uwscan::scanner::calibration {
 // The calibration steps of both seeds, in the order they are run.
 const std::vector<std::string>& CalibrationStepNames();  // intrinsics viewport laser laser_viewport mems
 
+// What a user may ask the viewport steps to estimate beyond their defaults (normal and
+// distance): the thickness (weakly observable, held at the measured value unless asked) and,
+// for the camera viewport, the refractive indices.
+struct CalibrationStepOptions {
+  bool refine_thickness = false;
+  bool refine_water_index = false;  // camera viewport only
+  bool refine_glass_index = false;  // camera viewport only
+};
+
 struct CalibrationStepOutcome {
   std::string scanner_yaml;          // the scanner with this step's values and record
   StepRecord record;
@@ -26,6 +35,7 @@ struct CalibrationStepOutcome {
 CalibrationStepOutcome RunCalibrationStep(const std::string& step, const CalibrationDataset& dataset,
                                           const std::string& initial_scanner_yaml,
                                           const std::string& initial_source,
-                                          const std::function<void(double)>& progress = {});
+                                          const std::function<void(double)>& progress = {},
+                                          const CalibrationStepOptions& options = {});
 
 }  // namespace uwscan::scanner::calibration
