@@ -1,7 +1,5 @@
 #include "apps/demo_command.hpp"
 
-#include <unistd.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +8,7 @@
 #include <vector>
 
 #include "apps/progress_bar.hpp"
+#include "bench/scratch_folder.hpp"
 #include "mapping/dive_log.hpp"
 #include "mapping/dive_simulation.hpp"
 #include "mapping/reconstruction.hpp"
@@ -23,25 +22,6 @@ namespace {
 struct DemoArgs {
   std::string scene = "data/scenes/default.yaml";
   int threads = 0;
-};
-
-// A scratch folder removed on every way out.
-class ScratchFolder {
- public:
-  ScratchFolder()
-      : path_(std::filesystem::temp_directory_path() /
-              ("uwscan-demo-" + std::to_string(::getpid()))) {
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchFolder() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
 };
 
 std::string ReadText(const std::string& path) {
@@ -58,7 +38,7 @@ void RunDemo(const DemoArgs& a) {
   }
   const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
   const scanner::sim::Simulator simulator(scene);
-  ScratchFolder scratch;
+  bench::ScratchFolder scratch("demo");
   const std::filesystem::path log_path = scratch.path() / "dive.db";
   mapping::DiveSimulationOptions options;
   options.threads = a.threads;

@@ -1,7 +1,5 @@
 #include "bench/calibration_benchmark.hpp"
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -10,6 +8,7 @@
 #include <sstream>
 
 #include "bench/accuracy_benchmark.hpp"
+#include "bench/scratch_folder.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_steps.hpp"
 #include "scanner/calibration/galvo_laser_calibration.hpp"
@@ -36,25 +35,6 @@ std::string ReadText(const std::filesystem::path& path) {
   text << in.rdbuf();
   return text.str();
 }
-
-// A scratch folder removed on every way out.
-class ScratchFolder {
- public:
-  ScratchFolder()
-      : path_(std::filesystem::temp_directory_path() /
-              ("uwscan-bench-calibration-" + std::to_string(::getpid()))) {
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchFolder() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
 
 // The true values of the parameters a step records, by name.
 std::map<std::string, double> TrueValues(const std::string& step, const std::string& truth_yaml) {
@@ -137,7 +117,7 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
                                                const Progress& progress) {
   options.Check();
   const Clock::time_point start = Clock::now();
-  ScratchFolder scratch;
+  ScratchFolder scratch("bench-calibration");
   CalibrationBenchResult result;
   std::string galvo_chain;  // the galvanometer calibration as it grows step by step
   const std::vector<std::string>& steps = cal::CalibrationStepNames();

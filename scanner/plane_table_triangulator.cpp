@@ -7,13 +7,6 @@
 #include "scanner/error.hpp"
 
 namespace uwscan::scanner {
-namespace {
-
-// How many peaks ahead the camera-ray table is prefetched (as in RayPlaneTriangulator).
-constexpr std::size_t kPrefetchAhead = 8;
-
-}  // namespace
-
 PlaneTableTriangulator::PlaneTableTriangulator(std::shared_ptr<const CameraRayTable> rays,
                                                std::vector<Plane> planes_C,
                                                const TriangulationOptions& options)
@@ -42,32 +35,8 @@ void PlaneTableTriangulator::TriangulateFrame(int mirror_step,
     }
     return;
   }
-  const Plane& plane = planes_C_[static_cast<std::size_t>(mirror_step)];
-  const Eigen::Vector3d n = plane.normal;
-  const double offset = plane.offset_m;
-  Ray ray;
-  for (std::size_t i = 0; i < peaks_px.size(); ++i) {
-    if (i + kPrefetchAhead < peaks_px.size()) {
-      rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
-    }
-    TriangulatedPoint& result = out[i];
-    result.p_C.setZero();  // misses carry no point
-    if (!rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray)) {
-      result.status = HitStatus::kNoIntersection;
-      continue;
-    }
-    const double denom = n.dot(ray.direction);
-    const double t = (offset - n.dot(ray.origin)) / denom;
-    // Grazing rays: |cos| of the angle to the normal below sin(min_angle) * |d|.
-    if (denom * denom <= min_sin2_angle_ * ray.direction.squaredNorm()) {
-      result.status = HitStatus::kParallel;
-    } else if (t < 0.0) {
-      result.status = HitStatus::kBehind;
-    } else {
-      result.p_C = ray.origin + t * ray.direction;
-      result.status = HitStatus::kHit;
-    }
-  }
+  TriangulatePeaksOnPlane(*rays_, planes_C_[static_cast<std::size_t>(mirror_step)], min_sin2_angle_,
+                          peaks_px, out);
 }
 
 }  // namespace uwscan::scanner

@@ -25,6 +25,37 @@ void TriangulationOptions::Check() const {
   }
 }
 
+void TriangulatePeaksOnPlane(const CameraRayTable& rays, const Plane& plane, double min_sin2_angle,
+                             std::span<const Eigen::Vector2d> peaks_px,
+                             std::span<TriangulatedPoint> out) {
+  assert(out.size() == peaks_px.size());
+  const Eigen::Vector3d n = plane.normal;
+  const double offset = plane.offset_m;
+  Ray ray;
+  for (size_t i = 0; i < peaks_px.size(); ++i) {
+    if (i + kPrefetchAhead < peaks_px.size()) {
+      rays.Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
+    }
+    TriangulatedPoint& result = out[i];
+    result.p_C.setZero();  // misses carry no point
+    if (!rays.Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray)) {
+      result.status = HitStatus::kNoIntersection;
+      continue;
+    }
+    const double denom = n.dot(ray.direction);
+    const double t = (offset - n.dot(ray.origin)) / denom;
+    // Grazing rays: |cos| of the angle to the normal below sin(min_angle) * |d|.
+    if (denom * denom <= min_sin2_angle * ray.direction.squaredNorm()) {
+      result.status = HitStatus::kParallel;
+    } else if (t < 0.0) {
+      result.status = HitStatus::kBehind;
+    } else {
+      result.p_C = ray.origin + t * ray.direction;
+      result.status = HitStatus::kHit;
+    }
+  }
+}
+
 RayPlaneTriangulator::RayPlaneTriangulator(std::shared_ptr<const CameraRayTable> rays,
                                            std::shared_ptr<const LightSurfaceTable> surfaces,
                                            const TriangulationOptions& options)
@@ -41,31 +72,7 @@ void RayPlaneTriangulator::TriangulateFrame(int mirror_step,
   assert(out.size() == peaks_px.size());
   const LightSurfaces* surface = surfaces_->At(mirror_step);
   if (surface == nullptr) return MarkAll(out, HitStatus::kOutsideSurface);
-  const Eigen::Vector3d n = surface->plane.normal;
-  const double offset = surface->plane.offset_m;
-  Ray ray;
-  for (size_t i = 0; i < peaks_px.size(); ++i) {
-    if (i + kPrefetchAhead < peaks_px.size()) {
-      rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
-    }
-    TriangulatedPoint& result = out[i];
-    result.p_C.setZero();  // misses carry no point
-    if (!rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray)) {
-      result.status = HitStatus::kNoIntersection;
-      continue;
-    }
-    const double denom = n.dot(ray.direction);
-    const double t = (offset - n.dot(ray.origin)) / denom;
-    // Grazing rays: |cos| of the angle to the normal below sin(min_angle) * |d|.
-    if (denom * denom <= min_sin2_angle_ * ray.direction.squaredNorm()) {
-      result.status = HitStatus::kParallel;
-    } else if (t < 0.0) {
-      result.status = HitStatus::kBehind;
-    } else {
-      result.p_C = ray.origin + t * ray.direction;
-      result.status = HitStatus::kHit;
-    }
-  }
+  TriangulatePeaksOnPlane(*rays_, surface->plane, min_sin2_angle_, peaks_px, out);
 }
 
 RayConeTriangulator::RayConeTriangulator(std::shared_ptr<const CameraRayTable> rays,

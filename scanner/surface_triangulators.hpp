@@ -17,6 +17,13 @@ struct TriangulationOptions {
   void Check() const;
 };
 
+// The loop shared by every plane-based triangulator: each peak's camera ray (from the table)
+// against one plane; rays within min_sin2_angle of the plane (squared sine of the angle) are
+// kParallel, planes behind the camera kBehind, pixels outside the table kNoIntersection.
+void TriangulatePeaksOnPlane(const CameraRayTable& rays, const Plane& plane, double min_sin2_angle,
+                             std::span<const Eigen::Vector2d> peaks_px,
+                             std::span<TriangulatedPoint> out);
+
 // Camera ray (from the table) against the plane fitted to the step's light surface.
 class RayPlaneTriangulator final : public Triangulator {
  public:

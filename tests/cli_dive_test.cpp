@@ -1,5 +1,7 @@
 // The dive commands end to end: simulate, reconstruct, demo, make-object, bench accuracy.
 #include <gtest/gtest.h>
+
+#include "tests/cli_run.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,21 +14,8 @@
 
 namespace {
 
-struct CommandRun {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
-
-CommandRun RunUwscan(const std::string& arguments) {
-  const std::string command = std::string(UWSCAN_BIN) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::string output;
-  std::array<char, 4096> buffer;
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
+using uwscan::test::CommandRun;
+using uwscan::test::RunUwscan;
 
 std::filesystem::path TempPath(const std::string& name) {
   return std::filesystem::temp_directory_path() /

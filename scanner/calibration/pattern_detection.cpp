@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "scanner/calibration/target_renderer.hpp"
 #include "scanner/error.hpp"
 
 namespace uwscan::scanner::calibration {
@@ -23,41 +24,8 @@ namespace {
 
 constexpr int kMinCharucoCorners = 4;
 
-struct DictionaryName {
-  const char* name;
-  cv::aruco::PREDEFINED_DICTIONARY_NAME id;
-};
-constexpr std::array<DictionaryName, 21> kDictionaries = {{
-    {"DICT_4X4_50", cv::aruco::DICT_4X4_50},
-    {"DICT_4X4_100", cv::aruco::DICT_4X4_100},
-    {"DICT_4X4_250", cv::aruco::DICT_4X4_250},
-    {"DICT_4X4_1000", cv::aruco::DICT_4X4_1000},
-    {"DICT_5X5_50", cv::aruco::DICT_5X5_50},
-    {"DICT_5X5_100", cv::aruco::DICT_5X5_100},
-    {"DICT_5X5_250", cv::aruco::DICT_5X5_250},
-    {"DICT_5X5_1000", cv::aruco::DICT_5X5_1000},
-    {"DICT_6X6_50", cv::aruco::DICT_6X6_50},
-    {"DICT_6X6_100", cv::aruco::DICT_6X6_100},
-    {"DICT_6X6_250", cv::aruco::DICT_6X6_250},
-    {"DICT_6X6_1000", cv::aruco::DICT_6X6_1000},
-    {"DICT_7X7_50", cv::aruco::DICT_7X7_50},
-    {"DICT_7X7_100", cv::aruco::DICT_7X7_100},
-    {"DICT_7X7_250", cv::aruco::DICT_7X7_250},
-    {"DICT_7X7_1000", cv::aruco::DICT_7X7_1000},
-    {"DICT_ARUCO_ORIGINAL", cv::aruco::DICT_ARUCO_ORIGINAL},
-    {"DICT_APRILTAG_16h5", cv::aruco::DICT_APRILTAG_16h5},
-    {"DICT_APRILTAG_25h9", cv::aruco::DICT_APRILTAG_25h9},
-    {"DICT_APRILTAG_36h10", cv::aruco::DICT_APRILTAG_36h10},
-    {"DICT_APRILTAG_36h11", cv::aruco::DICT_APRILTAG_36h11},
-}};
-
 cv::aruco::PREDEFINED_DICTIONARY_NAME DictionaryId(const std::string& name) {
-  for (const DictionaryName& d : kDictionaries) {
-    if (name == d.name) return d.id;
-  }
-  throw Error("pattern: dictionary '" + name +
-              "' is not one of OpenCV's predefined ArUco "
-              "dictionaries (DICT_4X4_50 ... DICT_APRILTAG_36h11)");
+  return static_cast<cv::aruco::PREDEFINED_DICTIONARY_NAME>(ArucoDictionaryId(name));
 }
 
 // The image as 8-bit grey for the detectors, and at full depth (8-bit or float) for the
