@@ -161,7 +161,8 @@ void RunReconstruct(const ReconstructArgs& a) {
 
 void AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
-  CLI::App* cmd = app.add_subcommand("simulate", "simulate a scene into a new dive log (SQLite)");
+  CLI::App* cmd = app.add_subcommand(
+      "simulate", "simulate a scene into a new dive log (SQLite), or a calibration scene into a dataset folder");
   cmd->add_option("scene", args->scene, "scene YAML (data/scenes/*.yaml)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output, "dive log to create (.db)")->required();
   cmd->add_flag("--images", args->images, "store the rendered frames in the log (image effects on)");
