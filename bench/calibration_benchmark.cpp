@@ -120,7 +120,7 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
   ScratchFolder scratch("bench-calibration");
   CalibrationBenchResult result;
   std::string galvo_chain;  // the galvanometer calibration as it grows step by step
-  const std::vector<std::string>& steps = cal::CalibrationStepNames();
+  const std::vector<std::string>& steps = cal::CalibrationSteps();
   for (size_t k = 0; k < steps.size(); ++k) {
     const std::string& step = steps[k];
     StepFigures figures;

@@ -257,17 +257,12 @@ CalibrationStepOutcome Mems(const std::string& work, const std::string& yaml, co
 
 }  // namespace
 
-const std::vector<std::string>& CalibrationStepNames() {
-  static const std::vector<std::string> names = {"intrinsics", "viewport", "laser", "laser_viewport", "mems"};
-  return names;
-}
-
 CalibrationStepOutcome RunCalibrationStep(const std::string& step, const CalibrationDataset& dataset,
                                           const std::string& initial_scanner_yaml,
                                           const std::string& initial_source,
                                           const std::function<void(double)>& progress,
                                           const CalibrationStepOptions& options) {
-  const std::vector<std::string>& names = CalibrationStepNames();
+  const std::vector<std::string>& names = CalibrationSteps();
   if (std::find(names.begin(), names.end(), step) == names.end()) {
     throw Error("calibrate: unknown step '" + step + "' (intrinsics, viewport, laser, laser_viewport, mems)");
   }

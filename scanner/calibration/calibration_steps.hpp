@@ -9,9 +9,6 @@
 
 namespace uwscan::scanner::calibration {
 
-// The calibration steps of both seeds, in the order they are run.
-const std::vector<std::string>& CalibrationStepNames();  // intrinsics viewport laser laser_viewport mems
-
 // What a user may ask the viewport steps to estimate beyond their defaults (normal and
 // distance): the thickness (weakly observable, held at the measured value unless asked) and,
 // for the camera viewport, the refractive indices.
