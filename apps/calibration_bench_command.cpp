@@ -60,7 +60,7 @@ void RunCalibrationBench(const CalibrationBenchArgs& a) {
           std::isfinite(error) && p.std > 0.0 ? std::to_string(error / p.std).substr(0, 6) : "-";
       std::printf("| %s | %.9g | %.9g | %.3g | %s |\n", p.name.c_str(), p.truth, p.estimated, p.std,
                   ratio.c_str());
-      params[p.name] = {{"true", NumberOrNull(p.truth)}, {"estimated", p.estimated}, {"std", p.std}};
+      params[p.name] = {{"true", NumberOrNull(p.truth)}, {"estimated", NumberOrNull(p.estimated)}, {"std", p.std}};
     }
     std::printf("\n");
     steps[step.step] = {{"params", params},

@@ -11,6 +11,7 @@
 #include "mapping/dive_log.hpp"
 #include "mapping/dive_simulation.hpp"
 #include "mapping/reconstruction.hpp"
+#include "scanner/calibration/calibration_scene.hpp"
 #include "scanner/calibration/dataset_simulation.hpp"
 #include "perception/cloud_io.hpp"
 #include "perception/point_cloud.hpp"
@@ -59,6 +60,11 @@ void RunSimulateCalibration(const SimulateArgs& a) {
   if (a.images) throw Error("--images: a calibration dataset is made of images already");
   if (std::filesystem::exists(a.output)) {
     if (!a.force) throw Error(a.output + ": exists (a dataset folder is never overwritten; use --force)");
+    // --force replaces a dataset, never an arbitrary folder.
+    if (!std::filesystem::is_regular_file(std::filesystem::path(a.output) / "manifest.yaml")) {
+      throw Error(a.output + ": exists and is not a calibration dataset (no manifest.yaml); not replaced");
+    }
+    scanner::calibration::LoadCalibrationScene(a.scene);  // a bad scene fails before anything is removed
     std::filesystem::remove_all(a.output);
   }
   {
@@ -72,17 +78,21 @@ void RunSimulateCalibration(const SimulateArgs& a) {
 void RunSimulate(const SimulateArgs& a) {
   RequireWritableFolder(a.output, "-o");
   if (IsCalibrationScene(ReadText(a.scene))) return RunSimulateCalibration(a);
-  if (std::filesystem::exists(a.output)) {
-    if (!a.force) throw Error(a.output + ": exists (a dive log is never overwritten; use --force)");
-    std::filesystem::remove(a.output);
-    std::filesystem::remove(a.output + "-wal");
-    std::filesystem::remove(a.output + "-shm");
+  if (std::filesystem::exists(a.output) && !a.force) {
+    throw Error(a.output + ": exists (a dive log is never overwritten; use --force)");
   }
+  // Everything is checked before --force removes the old log.
   const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
   const scanner::sim::Simulator simulator(scene);
   if (a.images && !scene.effects.AnyImageStage()) {
     throw Error("--images: scene " + a.scene +
                 " renders no frames (no image effect is on); its dive holds exact peaks");
+  }
+  if (std::filesystem::exists(a.output)) {
+    if (!std::filesystem::is_regular_file(a.output)) throw Error(a.output + ": exists and is not a file; not replaced");
+    std::filesystem::remove(a.output);
+    std::filesystem::remove(a.output + "-wal");
+    std::filesystem::remove(a.output + "-shm");
   }
   mapping::DiveSimulationOptions options;
   options.store_images = a.images;

@@ -96,7 +96,8 @@ double FanError(const std::string& truth_yaml, const std::string& estimated_yaml
       for (const double depth : {0.5, 1.0, 1.5}) {
         const Eigen::Vector3d p = ray.ray.At((depth - ray.ray.origin.z()) / ray.ray.direction.z());
         const std::optional<double> d = cal::DistanceToFan(estimated.laser, step, p);
-        if (d) worst = std::max(worst, *d);
+        // A true point the estimated fan cannot reach at all is as wrong as can be.
+        worst = d ? std::max(worst, *d) : std::numeric_limits<double>::infinity();
       }
     }
   }

@@ -169,4 +169,26 @@ TEST(CliDive, ImportIntrinsicsFromOpenCv) {
   std::filesystem::remove(out);
 }
 
+TEST(CliDive, ForceReplacesOnlyWhatItShouldAndOnlyAfterChecking) {
+  // A log is not removed when the new scene fails to load.
+  const std::filesystem::path log = TempPath("keep.db");
+  std::ofstream(log) << "precious";
+  const std::filesystem::path bad = TempPath("bad_scene.yaml");
+  std::ofstream(bad) << "uwscan_format: 1\nscanner: {file: /nonexistent.yaml}\nobjects: []\n";
+  const CommandRun run = RunUwscan("simulate " + bad.string() + " -o " + log.string() + " --force");
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_EQ(std::filesystem::file_size(log), 8u);
+  // --force never replaces a folder that is not a calibration dataset.
+  const std::filesystem::path folder = TempPath("not_a_dataset");
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "notes.txt") << "keep me";
+  const CommandRun dataset = RunUwscan("simulate " + SourcePath("data/scenes/calib_intrinsics.yaml") + " -o " +
+                                       folder.string() + " --force");
+  EXPECT_EQ(dataset.exit_code, 1) << dataset.output;
+  EXPECT_TRUE(std::filesystem::exists(folder / "notes.txt"));
+  std::filesystem::remove_all(folder);
+  std::filesystem::remove(log);
+  std::filesystem::remove(bad);
+}
+
 }  // namespace

@@ -46,6 +46,16 @@ RefractiveCamera CameraOf(const std::string& yaml, const std::string& source) {
   return IsMems(yaml) ? ParseMemsScannerModel(yaml, source).camera : ParseScannerModel(yaml, source).camera;
 }
 
+// A viewport estimated in the dataset's medium, written back with the refractive indices of the
+// file it goes into (the medium it is meant for), except those the step estimated.
+FlatViewport KeepIndices(FlatViewport estimated, const FlatViewport& file, bool water_estimated,
+                         bool glass_estimated) {
+  estimated.n_air = file.n_air;
+  if (!water_estimated) estimated.n_water = file.n_water;
+  if (!glass_estimated) estimated.n_glass = file.n_glass;
+  return estimated;
+}
+
 // The board plane of a pose: z_O = 0 in the camera frame, offset >= 0.
 Plane BoardPlane(const Eigen::Isometry3d& T_C_O) {
   Plane plane;
@@ -178,7 +188,9 @@ CalibrationStepOutcome Viewport(const CalibrationDataset& d, const std::string& 
   const ViewportCalibrationResult r =
       CalibrateCameraViewport(initial.camera, initial.viewport, d.pattern, views, viewport_options);
   CalibrationStepOutcome out;
-  out.scanner_yaml = WithViewport(yaml, "camera_viewport", r.viewport);
+  out.scanner_yaml = WithViewport(yaml, "camera_viewport",
+                                  KeepIndices(r.viewport, CameraOf(yaml, source).viewport,
+                                              options.refine_water_index, options.refine_glass_index));
   StepRecord& rec = out.record;
   rec.residual_unit = "px";
   rec.residual_rms = r.rms_px;
@@ -218,7 +230,9 @@ CalibrationStepOutcome Laser(const std::string& work, const std::string& yaml, c
     LaserViewportCalibrationOptions viewport_options;
     viewport_options.refine_thickness = options.refine_thickness;
     const LaserViewportCalibrationResult r = CalibrateLaserViewport(model, points, viewport_options);
-    out.scanner_yaml = WithViewport(yaml, "laser_viewport", r.viewport);
+    out.scanner_yaml = WithViewport(
+        yaml, "laser_viewport",
+        KeepIndices(r.viewport, ParseScannerModel(yaml, source).laser.viewport, false, false));
     rec.residual_rms = r.residual_rms_m;
     rec.residual_max = r.residual_max_m;
     AddViewportParams("laser_viewport", r.viewport, r.normal_std_rad, r.distance_std_m, r.thickness_std_m, &rec);

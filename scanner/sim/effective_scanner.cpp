@@ -18,6 +18,7 @@ void AdjustViewports(YAML::Node node, const Scene& scene) {
   if (!node.IsMap()) return;
   for (auto entry : node) {
     const std::string key = entry.first.as<std::string>();
+    if (key == "calibration") continue;  // a calibration file's records are history, not optics
     YAML::Node value = entry.second;
     if (EndsWith(key, "viewport") && value.IsMap()) {
       if (scene.effects.refraction) {

@@ -17,6 +17,7 @@ constexpr int kMinPathSamples = 513;
 
 MirrorDynamicsOptions DynamicsOfScan(const MemsScannerModel& model, const MemsScan& scan) {
   // The scan pattern sets the DAC's waypoint rate; the mirror and its filter are the scanner's.
+  scan.Check();  // a bad scene value is reported as the scene's, not as a mirror field
   MirrorDynamicsOptions dynamics = model.dynamics;
   dynamics.waypoint_rate_hz = scan.waypoint_rate_hz;
   dynamics.Check();

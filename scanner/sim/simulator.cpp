@@ -58,6 +58,15 @@ struct Simulator::Impl {
   double FrameTime(std::int64_t index) const {
     return scene.trajectory.start_s() + static_cast<double>(index) * source->frame_period_s();
   }
+  // The time whose pose a frame at `time_s` is simulated with: its own, or without the motion
+  // stage the start of its sweep (the scanner holds still during a sweep).
+  double PoseTime(double time_s) const {
+    if (scene.effects.motion) return time_s;
+    const double sweep_s = source->frames_per_sweep() * source->frame_period_s();
+    const double start = scene.trajectory.start_s();
+    const double sweep = std::floor((time_s - start) / sweep_s + 1e-9);
+    return start + std::max(sweep, 0.0) * sweep_s;
+  }
 
   std::vector<GlowSample> Glow(const LaserPath& path, const Eigen::Isometry3d& T_W_C) const;
   void DetectInImage(const std::vector<TracedPeak>& exact, SimulatedFrame* frame) const;
@@ -154,9 +163,8 @@ SimulatedFrame Simulator::Frame(std::int64_t index) const {
   frame.command = m.source->CommandOfFrame(in_sweep);
   frame.time_s = m.FrameTime(index);
   // Without the motion stage the scanner holds the pose it had when the sweep began.
-  const double pose_time =
-      m.scene.effects.motion ? frame.time_s : m.FrameTime(static_cast<std::int64_t>(frame.sweep) * per_sweep);
-  frame.T_W_C = m.scene.trajectory.T_W_C(pose_time);
+  frame.T_W_C = m.scene.trajectory.T_W_C(
+      m.scene.effects.motion ? frame.time_s : m.FrameTime(static_cast<std::int64_t>(frame.sweep) * per_sweep));
 
   const LaserPath path = m.source->PathOfFrame(in_sweep);
   const std::vector<TracedPeak> exact = m.tracer.Trace(path, frame.T_W_C);
@@ -195,12 +203,16 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
   Eigen::Vector3d position_error = Eigen::Vector3d::Zero();
   double yaw_error = 0.0;
   std::vector<NavigationSample> samples;
+  const Eigen::Vector3d start_position = m.scene.trajectory.T_W_V(start).translation();
+  // One sample at or past the last frame, so that every frame time is bracketed.
   for (int k = 0;; ++k) {
     const double t = start + k * dt;
-    if (t > end + 1e-12 && k > 0) break;
+    if (k > 0 && t - dt >= end) break;
     NavigationSample sample;
     sample.time_s = t;
-    sample.T_W_V = m.scene.trajectory.T_W_V(t);
+    // The navigation reports the pose the frames were simulated with (held during a sweep
+    // without the motion stage), so that reconstruction places them where they were taken.
+    sample.T_W_V = m.scene.trajectory.T_W_V(m.PoseTime(t));
     if (drift.on) {
       if (k > 0) {
         const double sq = std::sqrt(dt);
@@ -208,10 +220,11 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
                           Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
         yaw_error += drift.yaw_walk_rad_per_sqrt_s * sq * normal(rng);
       }
-      // Heading drift turns the believed pose about the world's down axis (NED z).
+      // Heading drift turns the believed path about the world's down axis (NED z) through the
+      // dive's start, as dead reckoning does; the position walk adds to it.
       Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
       error.linear() = Eigen::AngleAxisd(yaw_error, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      error.translation() = position_error;
+      error.translation() = start_position + position_error - error.linear() * start_position;
       sample.T_W_V = error * sample.T_W_V;
     }
     samples.push_back(sample);

@@ -271,6 +271,35 @@ TEST(Simulator, NavigationDriftIsASeededRandomWalkAwayFromTheTruth) {
   EXPECT_GT(drift, 0.0);
 }
 
+TEST(Simulator, NoRowCarriesTheSameSpotTwice) {
+  // The sphere's rim is seen at grazing angles, where the stripe's image jumps between samples.
+  const Simulator simulator(GalvoScene());
+  for (std::int64_t i = 0; i < simulator.frame_count(); ++i) {
+    const SimulatedFrame frame = simulator.Frame(i);
+    for (size_t k = 1; k < frame.peaks_px.size(); ++k) {
+      const Eigen::Vector2d& p = frame.peaks_px[k - 1];
+      const Eigen::Vector2d& q = frame.peaks_px[k];
+      EXPECT_FALSE(p.y() == q.y() && std::abs(p.x() - q.x()) < 1e-3) << "frame " << i << " row " << q.y();
+    }
+  }
+}
+
+TEST(Simulator, WithoutMotionTheNavigationHoldsThePoseOfEachSweep) {
+  Scene scene = GalvoScene();
+  scene.scanner.sweeps = 3;
+  scene.trajectory.poses = {{0.0, At(0, 0, 0)}, {1.0, At(0.5, 0, 0)}};
+  const Simulator simulator(scene);
+  const std::vector<NavigationSample> nav = simulator.Navigation(200.0);
+  const double sweep_s = 21 * simulator.frame_period_s();
+  ASSERT_GT(nav.back().time_s, 2.9 * sweep_s);  // the last sample brackets the last frame
+  for (const NavigationSample& n : nav) {
+    const int sweep = static_cast<int>(std::floor(n.time_s / sweep_s + 1e-9));
+    if (sweep > 2) continue;  // the sample past the last frame
+    const SimulatedFrame first = simulator.Frame(sweep * 21);
+    EXPECT_TRUE(n.T_W_V.isApprox(first.T_W_C, 1e-12)) << n.time_s;
+  }
+}
+
 TEST(Simulator, FrameOutOfRangeIsAnError) {
   const Simulator simulator(GalvoScene());
   EXPECT_THROW(simulator.Frame(-1), Error);

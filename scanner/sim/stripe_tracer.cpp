@@ -9,6 +9,9 @@ namespace {
 // A crossing is accepted when the spot's image lies this close to the line centre.
 constexpr double kCrossingTolerancePx = 1e-9;
 constexpr int kMaxCrossingIterations = 80;
+// Halvings of a sample interval when following the stripe: 2^-40 of a sample step is far below
+// a pixel, so an edge is found to well within its row.
+constexpr int kMaxFollowDepth = 40;
 
 double LineCoordinate(const Eigen::Vector2d& px, StripeAxis axis) {
   return axis == StripeAxis::kRows ? px.y() : px.x();
@@ -135,27 +138,21 @@ bool StripeTracer::Continues(const TracedPeak& a, const TracedPeak& b) const {
          (a.px - b.px).cwiseAbs().maxCoeff() <= options_.max_jump_px;
 }
 
-std::optional<TracedPeak> StripeTracer::EdgeSpot(const LaserPath& path,
-                                                 const Eigen::Isometry3d& T_W_C,
-                                                 const TracedPeak& inside, double s_outside) const {
-  // Bisection for the last spot that still continues `inside` towards s_outside: the stripe's
-  // end on that surface (an object's edge, a shadow), to a tiny fraction of the sample step.
-  TracedPeak last = inside;
-  double s_in = inside.s, s_out = s_outside;
-  const double resolution = 1e-12 * (std::abs(path.s_end - path.s_begin) + 1.0);
-  while (std::abs(s_out - s_in) > resolution) {
-    const double mid = 0.5 * (s_in + s_out);
-    if (mid == s_in || mid == s_out) break;
-    const std::optional<TracedPeak> spot = SpotAt(path, T_W_C, mid);
-    if (spot && Continues(last, *spot)) {
-      last = *spot;
-      s_in = mid;
-    } else {
-      s_out = mid;
-    }
-  }
-  if (last.s == inside.s) return std::nullopt;
-  return last;
+void StripeTracer::Follow(const LaserPath& path, const Eigen::Isometry3d& T_W_C, double s_a,
+                          const std::optional<TracedPeak>& a, double s_b,
+                          const std::optional<TracedPeak>& b, int depth,
+                          std::vector<TracedPeak>* peaks) const {
+  if (!a && !b) return;  // no surface at either end: nothing lit in between at this resolution
+  if (a && b && Continues(*a, *b)) return AddCrossings(path, T_W_C, *a, *b, peaks);
+  // The ends do not continue each other: the stripe ends, changes surface, or its image moves
+  // fast over one surface seen obliquely. Halving the interval until each part is continuous
+  // follows the fast image row by row, and at a true cut homes in on the edge, so that no row
+  // near an edge is lost and none is counted twice.
+  if (depth >= kMaxFollowDepth) return;
+  const double s_mid = 0.5 * (s_a + s_b);
+  const std::optional<TracedPeak> mid = SpotAt(path, T_W_C, s_mid);
+  Follow(path, T_W_C, s_a, a, s_mid, mid, depth + 1, peaks);
+  Follow(path, T_W_C, s_mid, mid, s_b, b, depth + 1, peaks);
 }
 
 void StripeTracer::AddCrossings(const LaserPath& path, const Eigen::Isometry3d& T_W_C,
@@ -190,24 +187,7 @@ std::vector<TracedPeak> StripeTracer::Trace(const LaserPath& path,
 
   std::vector<TracedPeak> peaks;
   for (size_t k = 0; k + 1 < samples.size(); ++k) {
-    const std::optional<TracedPeak>& a = samples[k];
-    const std::optional<TracedPeak>& b = samples[k + 1];
-    if (a && b && Continues(*a, *b)) {
-      AddCrossings(path, T_W_C, *a, *b, &peaks);
-      continue;
-    }
-    // The stripe ends (or jumps to another surface) between the two samples: each side is
-    // followed up to its edge, so that no row near an edge is lost.
-    if (a) {
-      if (const std::optional<TracedPeak> edge = EdgeSpot(path, T_W_C, *a, s_of[k + 1])) {
-        AddCrossings(path, T_W_C, *a, *edge, &peaks);
-      }
-    }
-    if (b) {
-      if (const std::optional<TracedPeak> edge = EdgeSpot(path, T_W_C, *b, s_of[k])) {
-        AddCrossings(path, T_W_C, *edge, *b, &peaks);
-      }
-    }
+    Follow(path, T_W_C, s_of[k], samples[k], s_of[k + 1], samples[k + 1], 0, &peaks);
   }
   const StripeAxis axis = options_.axis;
   const StripeAxis across = axis == StripeAxis::kRows ? StripeAxis::kColumns : StripeAxis::kRows;

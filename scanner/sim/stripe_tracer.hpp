@@ -43,7 +43,8 @@ struct TracedPeak {
 
 // Finds every crossing of the stripe's image with a row (or column) centre: the path is sampled,
 // where two neighbouring samples do not continue each other (a miss, another surface, a jump)
-// each side is followed by bisection up to its edge, and each crossing between two spots on
+// the interval is halved until every part is continuous or ends at an edge, and each crossing
+// between two spots on
 // the same surface is solved for by a safeguarded
 // secant search on s to 1e-9 px, each evaluation an exact ray cast and an exact projection
 // through the camera viewport. Deterministic; safe to call from several threads.
@@ -63,8 +64,9 @@ class StripeTracer {
   bool Visible(const TracedPeak& spot, const Eigen::Vector3d& laser_origin_W,
                const Eigen::Isometry3d& T_W_C) const;
   bool Continues(const TracedPeak& a, const TracedPeak& b) const;
-  std::optional<TracedPeak> EdgeSpot(const LaserPath& path, const Eigen::Isometry3d& T_W_C,
-                                     const TracedPeak& inside, double s_outside) const;
+  void Follow(const LaserPath& path, const Eigen::Isometry3d& T_W_C, double s_a,
+              const std::optional<TracedPeak>& a, double s_b, const std::optional<TracedPeak>& b,
+              int depth, std::vector<TracedPeak>* peaks) const;
   void AddCrossings(const LaserPath& path, const Eigen::Isometry3d& T_W_C, const TracedPeak& a,
                     const TracedPeak& b, std::vector<TracedPeak>* peaks) const;
   std::optional<TracedPeak> SolveCrossing(const LaserPath& path, const Eigen::Isometry3d& T_W_C,
