@@ -18,35 +18,6 @@ namespace fs = std::filesystem;
 using namespace calibration_yaml;
 using namespace sim::scene_yaml;
 
-// The scene reader knows every key of a scene, rejects any other, and wants objects. Rather than
-// re-implement it, the `calibration:` section's lines are blanked out of the text (the line
-// count stays, so its messages still point at the user's lines) and a placeholder object is
-// appended after the last line; the parsed scene then drops it.
-std::string SceneTextWithoutCalibration(const std::string& text, const YAML::Node& root,
-                                        const Context& top) {
-  int begin = -1, end = -1;
-  for (const auto& entry : root) {
-    if (entry.first.Scalar() == "calibration") {
-      if (entry.first.Mark().column != 0) {
-        yaml::Fail(yaml::Enter(top, "calibration"), entry.first,
-                   "write a calibration scene in block style, one top-level key per line");
-      }
-      begin = entry.first.Mark().line;
-    }
-  }
-  for (const auto& entry : root) {
-    const int line = entry.first.Mark().line;
-    if (line > begin && (end < 0 || line < end)) end = line;
-  }
-  std::istringstream in(text);
-  std::string result, line;
-  for (int number = 0; std::getline(in, line); ++number) {
-    const bool blank = number >= begin && (end < 0 || number < end);
-    result += (blank ? std::string() : line) + "\n";
-  }
-  return result + "objects: [{shape: plane, size_m: [1, 1]}]\n";
-}
-
 Eigen::Vector2d Pair(const Context& where, const YAML::Node& node, const std::string& key) {
   const Eigen::VectorXd v = yaml::Vector(where, node, key, 2);
   return Eigen::Vector2d(v[0], v[1]);
@@ -279,8 +250,7 @@ CalibrationScene ParseCalibrationScene(const std::string& yaml_text, const std::
   }
   const YAML::Node section = yaml::Child(top, root, "calibration");
   CalibrationScene cs;
-  cs.scene = sim::ParseScene(SceneTextWithoutCalibration(yaml_text, root, top), source, base_dir);
-  cs.scene.objects.clear();
+  cs.scene = sim::ParseScene(yaml_text, source, base_dir, sim::SceneKind::kCalibration);
   ReadSection(yaml::Enter(top, "calibration"), section, base_dir, &cs);
   cs.Check();
   return cs;

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "scanner/calibration/jet_geometry.hpp"
 #include "scanner/error.hpp"
 #include "scanner/light_plane.hpp"
 #include "scanner/refraction.hpp"
@@ -22,17 +23,11 @@
 namespace uwscan::scanner::calibration {
 namespace {
 
-template <typename T>
-using Vec3 = Eigen::Matrix<T, 3, 1>;
+using jet::Value;
+using jet::Vec3;
 template <typename T>
 using Mat3 = Eigen::Matrix<T, 3, 3>;
 using Jet1 = ceres::Jet<double, 1>;
-
-double Value(double x) { return x; }
-template <int N>
-double Value(const ceres::Jet<double, N>& x) {
-  return x.a;
-}
 
 // ---------------------------------------------------------------------------------------------
 // The fan of one mirror step, in a form that can carry Ceres Jets (derivatives).
@@ -70,24 +65,15 @@ StepFan<double> FanOfLaser(const GalvoLaser& laser, int step) {
 template <typename T>
 bool TraceFanRay(const StepFan<T>& fan, const FlatViewport& v, const T& s, Vec3<T>& origin,
                  Vec3<T>& direction) {
-  using std::sqrt;
   const Vec3<T> d = (fan.central + s * fan.spread).normalized();
   const T denom = fan.mirror_normal.dot(d);
   if (!(std::abs(Value(denom)) > 1e-15)) return false;
   const T t_mirror = (fan.mirror_offset - fan.mirror_normal.dot(fan.origin)) / denom;
   const Vec3<T> q = fan.origin + t_mirror * d;
   const Vec3<T> r = d - T(2.0) * d.dot(fan.mirror_normal) * fan.mirror_normal;
-  const Vec3<T> n = v.normal.cast<T>();
-  const T cos_air = n.dot(r);
-  if (!(Value(cos_air) > 1e-15)) return false;
-  const T t_face = (T(v.distance_m) - n.dot(q)) / cos_air;
-  const Vec3<T> along_faces = r - cos_air * n;
-  const T sin2_air = along_faces.squaredNorm();
-  const double eta_glass = v.n_air / v.n_glass, eta_water = v.n_air / v.n_water;
-  const T cos_glass = sqrt(T(1.0) - eta_glass * eta_glass * sin2_air);
-  const T cos_water = sqrt(T(1.0) - eta_water * eta_water * sin2_air);
-  origin = q + t_face * r + v.thickness_m * ((eta_glass / cos_glass) * along_faces + n);
-  direction = eta_water * along_faces + cos_water * n;
+  if (!(Value(v.normal.cast<T>().dot(r)) > 1e-15)) return false;
+  jet::TraceOutT(jet::Slab<T>{v.normal.cast<T>(), T(v.distance_m), T(v.thickness_m)}, v, q, r,
+                 origin, direction);
   return true;
 }
 

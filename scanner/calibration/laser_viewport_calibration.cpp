@@ -9,49 +9,19 @@
 #include <optional>
 #include <string>
 
+#include "scanner/calibration/jet_geometry.hpp"
 #include "scanner/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
 
-template <typename T>
-using Vec3 = Eigen::Matrix<T, 3, 1>;
+using jet::Slab;
+using jet::TraceOutT;
+using jet::Value;
+using jet::Vec3;
 using Jet1 = ceres::Jet<double, 1>;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-double Value(double x) { return x; }
-template <int N>
-double Value(const ceres::Jet<double, N>& x) {
-  return x.a;
-}
-
-// A viewport whose geometry may carry Jets; the refractive indices are known.
-template <typename T>
-struct Slab {
-  Vec3<T> normal;
-  T distance_m;
-  T thickness_m;
-};
-
-// TraceOut's closed form (air -> glass -> water through parallel faces), for Jets.
-template <typename T>
-void TraceOutT(const Slab<T>& slab, const FlatViewport& indices, const Vec3<T>& origin,
-               const Vec3<T>& direction, Vec3<T>& out_origin, Vec3<T>& out_direction) {
-  using std::sqrt;
-  const Vec3<T>& n = slab.normal;
-  const T cos_air = n.dot(direction);
-  const T t = (slab.distance_m - n.dot(origin)) / cos_air;
-  const Vec3<T> along_faces = direction - cos_air * n;
-  const T sin2_air = along_faces.squaredNorm();
-  const double eta_glass = indices.n_air / indices.n_glass;
-  const double eta_water = indices.n_air / indices.n_water;
-  const T cos_glass = sqrt(T(1.0) - eta_glass * eta_glass * sin2_air);
-  const T cos_water = sqrt(T(1.0) - eta_water * eta_water * sin2_air);
-  out_origin =
-      origin + t * direction + slab.thickness_m * ((eta_glass / cos_glass) * along_faces + n);
-  out_direction = eta_water * along_faces + cos_water * n;
-}
 
 // Signed distance between the camera line and a laser line, times the sine of their angle:
 // zero where the fan ray crosses the camera ray (as in RayRayTriangulator).

@@ -331,14 +331,20 @@ const char* ToString(ObjectShape shape) {
 }
 
 Scene ParseScene(const std::string& yaml_text, const std::string& source_name,
-                 const std::filesystem::path& base_dir) {
+                 const std::filesystem::path& base_dir, SceneKind kind) {
   // Const: yaml-cpp's non-const operator[] would add the keys it looks up.
   const YAML::Node root = LoadYaml(yaml_text, source_name);
   const Context top{source_name, ""};
   yaml::CheckFormat(top, root);
-  yaml::RequireKnownKeys(top, root,
-                         {"uwscan_format", "seed", "water", "scanner", "trajectory", "effects",
-                          "detector", "objects"});
+  if (kind == SceneKind::kDive) {
+    yaml::RequireKnownKeys(top, root,
+                           {"uwscan_format", "seed", "water", "scanner", "trajectory", "effects",
+                            "detector", "objects"});
+  } else {
+    yaml::RequireKnownKeys(top, root,
+                           {"uwscan_format", "seed", "water", "scanner", "effects", "detector",
+                            "calibration"});
+  }
   Scene scene;
   scene.source = source_name;
   if (Has(root, "seed")) scene.seed = ReadSeed(top, root);
@@ -355,8 +361,10 @@ Scene ParseScene(const std::string& yaml_text, const std::string& source_name,
   if (Has(root, "detector")) {
     scene.detector = ReadDetector(yaml::Enter(top, "detector"), root["detector"]);
   }
-  scene.objects =
-      ReadSceneObjects(yaml::Enter(top, "objects"), yaml::Child(top, root, "objects"), base_dir);
+  if (kind == SceneKind::kDive) {
+    scene.objects =
+        ReadSceneObjects(yaml::Enter(top, "objects"), yaml::Child(top, root, "objects"), base_dir);
+  }
   return scene;
 }
 

@@ -80,10 +80,17 @@ struct Scene {
   std::uint64_t seed = 1;          // every random effect draws from it
 };
 
+// A dive scene has objects (and may have a trajectory); a calibration scene has a
+// `calibration:` section instead (read by scanner/calibration/calibration_scene), its board
+// being the one object and the camera staying at the origin.
+enum class SceneKind { kDive, kCalibration };
+
 // Reads a scene (format in data/README.md). Relative paths (scanner file, meshes) are
-// resolved against base_dir. Throws uwscan::Error naming source:line and the field.
+// resolved against base_dir. Throws uwscan::Error naming source:line and the field. For
+// kCalibration the parts shared with dive scenes are read and the `calibration:` section is
+// left to its own reader; objects stay empty and the trajectory static.
 Scene ParseScene(const std::string& yaml_text, const std::string& source_name,
-                 const std::filesystem::path& base_dir);
+                 const std::filesystem::path& base_dir, SceneKind kind = SceneKind::kDive);
 Scene LoadScene(const std::filesystem::path& path);
 
 }  // namespace uwscan::scanner::sim

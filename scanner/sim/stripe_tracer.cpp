@@ -47,19 +47,12 @@ StripeTracer::StripeTracer(const RefractiveCamera& camera, const RayCaster& cast
       max_normalised_radius2_(MaxNormalisedRadius2(camera.camera)) {}
 
 bool StripeTracer::Visible(const TracedPeak& spot, const Eigen::Vector3d& laser_origin_W,
-                           const Eigen::Isometry3d& T_W_C) const {
-  // The camera's ray to the spot leaves the viewport at `exit`: recompute it in {C}.
-  const Eigen::Vector3d p_C = T_W_C.inverse() * spot.p_W;
-  const DirectionResult in_air = DirectionThroughViewport(camera_.viewport, Eigen::Vector3d::Zero(), p_C);
-  if (!in_air.ok()) return false;
-  const RayTrace out = TraceOut(camera_.viewport, Ray{Eigen::Vector3d::Zero(), in_air.direction});
-  if (!out.ok()) return false;
-  const Eigen::Vector3d exit_W = T_W_C * out.ray.origin;
+                           const Eigen::Vector3d& camera_exit_W) const {
   // A back face: the laser lights one side of the surface, the camera looks at the other.
   const double laser_side = spot.normal_W.dot(laser_origin_W - spot.p_W);
-  const double camera_side = spot.normal_W.dot(exit_W - spot.p_W);
+  const double camera_side = spot.normal_W.dot(camera_exit_W - spot.p_W);
   if (laser_side * camera_side <= 0.0) return false;
-  return !caster_.Blocked(spot.p_W, exit_W);
+  return !caster_.Blocked(spot.p_W, camera_exit_W);
 }
 
 std::optional<TracedPeak> StripeTracer::SpotAt(const LaserPath& path,
@@ -93,7 +86,10 @@ std::optional<TracedPeak> StripeTracer::SpotAt(const LaserPath& path,
   spot.cos_incidence = std::abs(hit->normal_W.dot(ray_W.direction.normalized()));
   spot.z_C_m = p_C.z();
   spot.s = s;
-  if (options_.occlusion && !Visible(spot, ray_W.origin, T_W_C)) return std::nullopt;
+  // The camera's ray to the spot leaves its viewport at to_camera's origin.
+  if (options_.occlusion && !Visible(spot, ray_W.origin, T_W_C * to_camera.ray.origin)) {
+    return std::nullopt;
+  }
   return spot;
 }
 

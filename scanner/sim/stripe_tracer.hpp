@@ -62,7 +62,7 @@ class StripeTracer {
 
  private:
   bool Visible(const TracedPeak& spot, const Eigen::Vector3d& laser_origin_W,
-               const Eigen::Isometry3d& T_W_C) const;
+               const Eigen::Vector3d& camera_exit_W) const;
   bool Continues(const TracedPeak& a, const TracedPeak& b) const;
   void Follow(const LaserPath& path, const Eigen::Isometry3d& T_W_C, double s_a,
               const std::optional<TracedPeak>& a, double s_b, const std::optional<TracedPeak>& b,
