@@ -8,7 +8,7 @@
 #include "apps/json_output.hpp"
 #include "apps/progress_bar.hpp"
 #include "bench/accuracy_benchmark.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::app {
 namespace {

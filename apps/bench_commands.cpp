@@ -10,8 +10,8 @@
 #include "apps/progress_bar.hpp"
 #include "bench/deformation_experiment.hpp"
 #include "bench/triangulation_benchmark.hpp"
-#include "scanner/error.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::app {
 namespace {

@@ -8,11 +8,11 @@
 #include <string>
 
 #include "apps/progress_bar.hpp"
-#include "scanner/pinhole_camera.hpp"
+#include "scanner/optics/pinhole_camera.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_steps.hpp"
 #include "scanner/calibration/opencv_camera_import.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::app {
 namespace {

@@ -9,7 +9,7 @@
 #include "apps/json_output.hpp"
 #include "apps/progress_bar.hpp"
 #include "bench/calibration_benchmark.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::app {
 namespace {

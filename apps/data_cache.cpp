@@ -2,7 +2,7 @@
 
 #include <cstdlib>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::app {
 

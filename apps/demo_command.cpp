@@ -12,7 +12,7 @@
 #include "mapping/dive_log.hpp"
 #include "mapping/dive_simulation.hpp"
 #include "mapping/reconstruction.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 

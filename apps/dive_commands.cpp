@@ -15,7 +15,7 @@
 #include "scanner/calibration/dataset_simulation.hpp"
 #include "perception/cloud_io.hpp"
 #include "perception/point_cloud.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 

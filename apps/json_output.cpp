@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::app {
 

@@ -13,7 +13,7 @@
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
 #include "apps/stripe_commands.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"uwscan: underwater laser scanner perception toolkit"};

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
-#include "scanner/triangle_mesh.hpp"
+#include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::app {
 namespace {

@@ -14,7 +14,7 @@
 #include "bench/registration_benchmark.hpp"
 #include "perception/cloud_io.hpp"
 #include "perception/registration_pipeline.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::app {
 namespace {

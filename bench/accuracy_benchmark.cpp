@@ -15,11 +15,11 @@
 #include <string>
 
 #include "perception/sphere_fit.hpp"
-#include "scanner/error.hpp"
-#include "scanner/light_plane.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/simulator.hpp"
-#include "scanner/triangulator_factory.hpp"
+#include "scanner/triangulation/triangulator_factory.hpp"
 
 namespace uwscan::bench {
 namespace {

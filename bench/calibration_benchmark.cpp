@@ -14,9 +14,9 @@
 #include "scanner/calibration/galvo_laser_calibration.hpp"
 #include "scanner/calibration/dataset_simulation.hpp"
 #include "scanner/calibration/parameter_lists.hpp"
-#include "scanner/error.hpp"
-#include "scanner/mems_scanner_model.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::bench {
 namespace {

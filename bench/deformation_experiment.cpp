@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "scanner/error.hpp"
-#include "scanner/flat_viewport.hpp"
-#include "scanner/light_plane.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/optics/flat_viewport.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 
 namespace uwscan::bench {
 namespace {

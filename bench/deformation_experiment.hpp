@@ -3,7 +3,7 @@
 #include <vector>
 
 #include "bench/progress.hpp"
-#include "scanner/cone_fit.hpp"
+#include "scanner/triangulation/cone_fit.hpp"
 
 namespace uwscan::bench {
 

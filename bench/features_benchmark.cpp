@@ -8,7 +8,7 @@
 #include "perception/fpfh.hpp"
 #include "perception/normals.hpp"
 #include "perception/voxel_filter.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::bench {
 namespace {

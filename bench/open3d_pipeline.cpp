@@ -12,7 +12,7 @@
 #include <chrono>
 #endif
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::bench {
 

@@ -3,7 +3,7 @@
 #include <functional>
 
 #include "bench/registration_pipelines.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::bench {
 

@@ -5,8 +5,8 @@
 #include <random>
 
 #include "perception/cloud_io.hpp"
-#include "scanner/error.hpp"
-#include "scanner/triangle_mesh.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::bench {
 namespace {

@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "scanner/error.hpp"
-#include "scanner/stripe_render.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/stripe/stripe_render.hpp"
 
 namespace uwscan::bench {
 namespace {

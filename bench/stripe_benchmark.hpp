@@ -5,7 +5,7 @@
 #include <string>
 
 #include "bench/progress.hpp"
-#include "scanner/stripe_detector.hpp"
+#include "scanner/stripe/stripe_detector.hpp"
 
 namespace uwscan::bench {
 

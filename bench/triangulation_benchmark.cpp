@@ -9,9 +9,9 @@
 #include <random>
 #include <vector>
 
-#include "scanner/error.hpp"
-#include "scanner/ray_ray_triangulator.hpp"
-#include "scanner/surface_triangulators.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/triangulation/ray_ray_triangulator.hpp"
+#include "scanner/triangulation/surface_triangulators.hpp"
 
 namespace uwscan::bench {
 namespace {

@@ -5,9 +5,9 @@
 #include <string>
 
 #include "bench/progress.hpp"
-#include "scanner/light_surface_table.hpp"
-#include "scanner/scanner_model.hpp"
-#include "scanner/triangulator.hpp"
+#include "scanner/triangulation/light_surface_table.hpp"
+#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/triangulation/triangulator.hpp"
 
 namespace uwscan::bench {
 

@@ -14,7 +14,7 @@
 #include <utility>
 
 #include "mapping/sqlite_db.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
 namespace {

@@ -33,7 +33,7 @@ struct DiveLogHeader {
   int schema_version = kDiveLogSchemaVersion;  // filled by the reader; the writer writes its own
   std::string scanner_kind;                    // "galvo" or "mems"
   std::string scanner_yaml;  // full scanner configuration (calibration) used to take the dive
-  std::string scan_pattern_yaml;  // how the dive was scanned (scanner/scan_pattern.hpp)
+  std::string scan_pattern_yaml;  // how the dive was scanned (scanner/lasers/scan_pattern.hpp)
   std::string scene_yaml;    // scene text when simulated, empty otherwise
   std::string created_utc;   // ISO 8601 ("2024-05-01T12:34:56Z"), set by the writer
   std::string producer;      // e.g. "uwscan simulate 0.1.0"

@@ -16,7 +16,7 @@
 #include <random>
 #include <string>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
 namespace {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "mapping/dive_log.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
 namespace {

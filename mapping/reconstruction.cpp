@@ -4,10 +4,10 @@
 #include <cmath>
 #include <limits>
 
-#include "scanner/error.hpp"
-#include "scanner/scan_pattern.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/sim/trajectory.hpp"
-#include "scanner/triangulator_factory.hpp"
+#include "scanner/triangulation/triangulator_factory.hpp"
 
 namespace uwscan::mapping {
 namespace {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "mapping/dive_log.hpp"
-#include "scanner/triangulator.hpp"
+#include "scanner/triangulation/triangulator.hpp"
 
 namespace uwscan::mapping {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::mapping::sqlite {
 

@@ -20,7 +20,7 @@
 #include <system_error>
 #include <vector>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

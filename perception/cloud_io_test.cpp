@@ -10,7 +10,7 @@
 #include <random>
 #include <string>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

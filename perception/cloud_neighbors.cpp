@@ -9,7 +9,7 @@
 #include <string>
 #include <utility>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -7,7 +7,7 @@
 #include <random>
 #include <utility>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

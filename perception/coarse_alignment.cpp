@@ -13,7 +13,7 @@
 
 #include "perception/cloud_neighbors.hpp"
 #include "perception/svd_alignment.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -16,7 +16,7 @@
 #include <set>
 
 #include "perception/esf.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 

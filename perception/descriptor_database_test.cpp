@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "perception/esf.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "perception/pcl_conversion.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "perception/normals.hpp"
 #include "perception/pcl_conversion.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

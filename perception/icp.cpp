@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "perception/svd_alignment.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "perception/point_cloud.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "perception/normals.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "perception/cloud_neighbors.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 

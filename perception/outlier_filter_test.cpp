@@ -7,7 +7,7 @@
 #include <limits>
 #include <random>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -1,6 +1,6 @@
 #include "perception/pcl_conversion.hpp"
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 

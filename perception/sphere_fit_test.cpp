@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

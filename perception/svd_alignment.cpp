@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <string>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "scanner/calibration/calibration_yaml.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -7,7 +7,7 @@
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <system_error>
 
-#include "scanner/error.hpp"
-#include "scanner/mems_scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -6,10 +6,10 @@
 #include <utility>
 #include <vector>
 
-#include "scanner/flat_viewport.hpp"
-#include "scanner/galvo_laser.hpp"
-#include "scanner/pinhole_camera.hpp"
-#include "scanner/projection_functions.hpp"
+#include "scanner/optics/flat_viewport.hpp"
+#include "scanner/lasers/galvo_laser.hpp"
+#include "scanner/optics/pinhole_camera.hpp"
+#include "scanner/lasers/projection_functions.hpp"
 
 namespace uwscan::scanner::calibration {
 

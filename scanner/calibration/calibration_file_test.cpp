@@ -5,9 +5,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "scanner/error.hpp"
-#include "scanner/mems_scanner_model.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

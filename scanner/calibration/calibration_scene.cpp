@@ -8,8 +8,8 @@
 
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_yaml.hpp"
-#include "scanner/error.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

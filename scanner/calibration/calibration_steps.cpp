@@ -19,9 +19,9 @@
 #include "scanner/calibration/pattern_pose.hpp"
 #include "scanner/calibration/stripe_extraction.hpp"
 #include "scanner/calibration/viewport_calibration.hpp"
-#include "scanner/error.hpp"
-#include "scanner/mems_scanner_model.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

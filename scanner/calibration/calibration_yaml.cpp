@@ -3,7 +3,7 @@
 #include <charconv>
 #include <cmath>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration::calibration_yaml {
 

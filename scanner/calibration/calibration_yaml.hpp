@@ -1,7 +1,7 @@
 #pragma once
 
 // YAML pieces shared by the calibration files (dataset manifest, truth file, calibration scene),
-// on top of scanner/yaml_fields.hpp and scanner/sim/scene_fields.hpp: every failure names
+// on top of scanner/common/yaml_fields.hpp and scanner/sim/scene_fields.hpp: every failure names
 // "file:line: field 'a.b': ...". Included only by the .cpp files that read or write them.
 
 #include <yaml-cpp/yaml.h>
@@ -11,7 +11,7 @@
 
 #include "scanner/calibration/observations.hpp"
 #include "scanner/sim/scene_fields.hpp"
-#include "scanner/yaml_fields.hpp"
+#include "scanner/common/yaml_fields.hpp"
 
 namespace uwscan::scanner::calibration::calibration_yaml {
 

@@ -12,9 +12,9 @@
 
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_yaml.hpp"
-#include "scanner/error.hpp"
-#include "scanner/mems_scanner_model.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 #include "scanner/sim/effective_scanner.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/simulator.hpp"

@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -16,9 +16,9 @@
 #include <string>
 
 #include "scanner/calibration/jet_geometry.hpp"
-#include "scanner/error.hpp"
-#include "scanner/light_plane.hpp"
-#include "scanner/refraction.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/triangulation/light_plane.hpp"
+#include "scanner/optics/refraction.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "scanner/calibration/laser_points.hpp"
-#include "scanner/galvo_laser.hpp"
+#include "scanner/lasers/galvo_laser.hpp"
 
 namespace uwscan::scanner::calibration {
 

@@ -10,9 +10,9 @@
 #include <random>
 #include <vector>
 
-#include "scanner/error.hpp"
-#include "scanner/light_plane.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/triangulation/light_plane.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "scanner/calibration/pattern_pose.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

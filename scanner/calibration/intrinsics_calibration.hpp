@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/pinhole_camera.hpp"
+#include "scanner/optics/pinhole_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 

@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
-#include "scanner/flat_viewport.hpp"
+#include "scanner/optics/flat_viewport.hpp"
 
 namespace uwscan::scanner::calibration::jet {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 

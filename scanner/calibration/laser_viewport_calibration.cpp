@@ -10,7 +10,7 @@
 #include <string>
 
 #include "scanner/calibration/jet_geometry.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -3,8 +3,8 @@
 #include <vector>
 
 #include "scanner/calibration/laser_points.hpp"
-#include "scanner/flat_viewport.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/optics/flat_viewport.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "scanner/calibration/galvo_laser_calibration.hpp"
-#include "scanner/error.hpp"
-#include "scanner/light_plane.hpp"
-#include "scanner/ray_ray_triangulator.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/triangulation/light_plane.hpp"
+#include "scanner/triangulation/ray_ray_triangulator.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -6,7 +6,7 @@
 #include <map>
 #include <string>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

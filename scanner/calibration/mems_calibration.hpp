@@ -5,9 +5,9 @@
 #include <vector>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/light_plane.hpp"
-#include "scanner/projection_functions.hpp"
-#include "scanner/refractive_camera.hpp"
+#include "scanner/triangulation/light_plane.hpp"
+#include "scanner/lasers/projection_functions.hpp"
+#include "scanner/optics/refractive_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 

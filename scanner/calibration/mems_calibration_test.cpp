@@ -5,8 +5,8 @@
 #include <iostream>
 #include <random>
 
-#include "scanner/error.hpp"
-#include "scanner/mems_scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 

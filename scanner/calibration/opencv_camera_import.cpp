@@ -7,7 +7,7 @@
 #include <string>
 #include <system_error>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

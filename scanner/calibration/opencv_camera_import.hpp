@@ -2,7 +2,7 @@
 
 #include <filesystem>
 
-#include "scanner/pinhole_camera.hpp"
+#include "scanner/optics/pinhole_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 

@@ -6,8 +6,8 @@
 #include "scanner/calibration/calibration_file.hpp"
 #include "scanner/calibration/galvo_laser_calibration.hpp"
 #include "scanner/calibration/intrinsics_calibration.hpp"
-#include "scanner/flat_viewport.hpp"
-#include "scanner/pinhole_camera.hpp"
+#include "scanner/optics/flat_viewport.hpp"
+#include "scanner/optics/pinhole_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "scanner/calibration/target_renderer.hpp"
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

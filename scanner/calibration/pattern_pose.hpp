@@ -5,9 +5,9 @@
 #include <vector>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/flat_viewport.hpp"
-#include "scanner/pinhole_camera.hpp"
-#include "scanner/refractive_camera.hpp"
+#include "scanner/optics/flat_viewport.hpp"
+#include "scanner/optics/pinhole_camera.hpp"
+#include "scanner/optics/refractive_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 

@@ -16,8 +16,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "scanner/error.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

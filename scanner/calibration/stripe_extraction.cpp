@@ -2,7 +2,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::calibration {
 

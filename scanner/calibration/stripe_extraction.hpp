@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/stripe_detector.hpp"
+#include "scanner/stripe/stripe_detector.hpp"
 
 namespace uwscan::scanner::calibration {
 

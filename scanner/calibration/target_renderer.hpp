@@ -5,9 +5,9 @@
 #include <string>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/camera_ray_table.hpp"
-#include "scanner/refractive_camera.hpp"
-#include "scanner/stripe_render.hpp"
+#include "scanner/optics/camera_ray_table.hpp"
+#include "scanner/optics/refractive_camera.hpp"
+#include "scanner/stripe/stripe_render.hpp"
 
 namespace uwscan::scanner::calibration {
 

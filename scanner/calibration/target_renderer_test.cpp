@@ -10,8 +10,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "scanner/error.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

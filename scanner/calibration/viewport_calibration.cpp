@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "scanner/calibration/pattern_pose.hpp"
-#include "scanner/error.hpp"
-#include "scanner/refractive_camera.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/optics/refractive_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

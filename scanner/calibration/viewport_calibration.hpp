@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/flat_viewport.hpp"
-#include "scanner/pinhole_camera.hpp"
+#include "scanner/optics/flat_viewport.hpp"
+#include "scanner/optics/pinhole_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 

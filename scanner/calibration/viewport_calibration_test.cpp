@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "scanner/error.hpp"
-#include "scanner/refractive_camera.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/optics/refractive_camera.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

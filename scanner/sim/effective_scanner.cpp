@@ -2,7 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <string>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {

@@ -1,6 +1,6 @@
 #pragma once
 
-#include "scanner/stripe_image.hpp"
+#include "scanner/stripe/stripe_image.hpp"
 
 namespace uwscan::scanner::sim {
 

@@ -5,7 +5,7 @@
 
 #include "scanner/sim/effects.hpp"
 #include "scanner/sim/stripe_tracer.hpp"
-#include "scanner/stripe_render.hpp"
+#include "scanner/stripe/stripe_render.hpp"
 
 namespace uwscan::scanner::sim {
 

@@ -1,6 +1,6 @@
 #include <memory>
 
-#include "scanner/scanner_model.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 #include "scanner/sim/light_source.hpp"
 
 namespace uwscan::scanner::sim {

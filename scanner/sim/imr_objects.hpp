@@ -18,7 +18,7 @@
 
 #include <Eigen/Core>
 
-#include "scanner/triangle_mesh.hpp"
+#include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::scanner::sim {
 

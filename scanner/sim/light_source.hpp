@@ -3,8 +3,8 @@
 #include <memory>
 #include <string>
 
-#include "scanner/refractive_camera.hpp"
-#include "scanner/scan_pattern.hpp"
+#include "scanner/optics/refractive_camera.hpp"
+#include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/sim/stripe_tracer.hpp"
 
 namespace uwscan::scanner::sim {

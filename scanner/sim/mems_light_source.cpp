@@ -3,10 +3,10 @@
 #include <memory>
 #include <vector>
 
-#include "scanner/error.hpp"
-#include "scanner/mems_scan_pattern.hpp"
-#include "scanner/mems_scanner_model.hpp"
-#include "scanner/mirror_dynamics.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scan_pattern.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
+#include "scanner/lasers/mirror_dynamics.hpp"
 #include "scanner/sim/light_source.hpp"
 
 namespace uwscan::scanner::sim {

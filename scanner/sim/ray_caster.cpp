@@ -11,7 +11,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {

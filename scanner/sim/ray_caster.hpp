@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "scanner/ray.hpp"
+#include "scanner/optics/ray.hpp"
 #include "scanner/sim/scene.hpp"
 
 namespace uwscan::scanner::sim {

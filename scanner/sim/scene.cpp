@@ -5,11 +5,11 @@
 #include <optional>
 #include <sstream>
 
-#include "scanner/error.hpp"
-#include "scanner/scanner_model.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_model.hpp"
 #include "scanner/sim/scene_fields.hpp"
 #include "scanner/sim/scene_objects.hpp"
-#include "scanner/yaml_fields.hpp"
+#include "scanner/common/yaml_fields.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {

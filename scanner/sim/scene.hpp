@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "scanner/scan_pattern.hpp"
+#include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/sim/effects.hpp"
 #include "scanner/sim/trajectory.hpp"
-#include "scanner/stripe_detector.hpp"
-#include "scanner/triangle_mesh.hpp"
+#include "scanner/stripe/stripe_detector.hpp"
+#include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::scanner::sim {
 
@@ -49,7 +49,7 @@ struct Water {
   double attenuation_per_m = 0.0;  // beam attenuation coefficient c, 1/m
 };
 
-// The scan pattern types live with the scanner (scanner/scan_pattern.hpp): dive logs keep them.
+// The scan pattern types live with the scanner (scanner/lasers/scan_pattern.hpp): dive logs keep them.
 using ::uwscan::scanner::GalvoScan;
 using ::uwscan::scanner::MemsScan;
 using ::uwscan::scanner::ScannerKind;

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::sim::scene_yaml {
 

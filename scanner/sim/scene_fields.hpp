@@ -1,6 +1,6 @@
 #pragma once
 
-// Typed, range-checked fields of scene files, on top of scanner/yaml_fields.hpp: every failure
+// Typed, range-checked fields of scene files, on top of scanner/common/yaml_fields.hpp: every failure
 // names "file:line: field 'a.b': ...". Included only by the scene readers.
 
 #include <yaml-cpp/yaml.h>
@@ -11,7 +11,7 @@
 #include <optional>
 #include <string>
 
-#include "scanner/yaml_fields.hpp"
+#include "scanner/common/yaml_fields.hpp"
 
 namespace uwscan::scanner::sim::scene_yaml {
 

@@ -2,7 +2,7 @@
 
 #include <map>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/scene_fields.hpp"
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "scanner/sim/scene.hpp"
-#include "scanner/yaml_fields.hpp"
+#include "scanner/common/yaml_fields.hpp"
 
 namespace uwscan::scanner::sim {
 

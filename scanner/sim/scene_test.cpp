@@ -9,7 +9,7 @@
 #include <numbers>
 #include <string>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
 namespace uwscan::scanner::sim {

@@ -4,7 +4,7 @@
 #include <limits>
 #include <random>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/sim/effective_scanner.hpp"
 #include "scanner/sim/frame_renderer.hpp"
 #include "scanner/sim/light_source.hpp"

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "scanner/scan_pattern.hpp"
+#include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/sim/scene.hpp"
-#include "scanner/stripe_render.hpp"
+#include "scanner/stripe/stripe_render.hpp"
 
 namespace uwscan::scanner::sim {
 

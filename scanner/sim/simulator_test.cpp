@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <sstream>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
-#include "scanner/triangulator_factory.hpp"
+#include "scanner/triangulation/triangulator_factory.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {

@@ -4,10 +4,10 @@
 #include <functional>
 #include <vector>
 
-#include "scanner/flat_viewport.hpp"
-#include "scanner/refractive_camera.hpp"
+#include "scanner/optics/flat_viewport.hpp"
+#include "scanner/optics/refractive_camera.hpp"
 #include "scanner/sim/ray_caster.hpp"
-#include "scanner/stripe_detector.hpp"
+#include "scanner/stripe/stripe_detector.hpp"
 
 namespace uwscan::scanner::sim {
 

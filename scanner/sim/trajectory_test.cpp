@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "scanner/error.hpp"
+#include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {

@@ -1,0 +1,157 @@
+#include "scanner/common/triangle_mesh.hpp"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+#include <system_error>
+
+#include "scanner/common/error.hpp"
+
+namespace uwscan::scanner {
+
+double TriangleMesh::BoundingBoxDiagonal() const {
+  if (vertices.empty()) return 0.0;
+  Eigen::Vector3d lo = vertices.front(), hi = vertices.front();
+  for (const Eigen::Vector3d& v : vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  return (hi - lo).norm();
+}
+
+TriangleMesh LoadMesh(const std::filesystem::path& path) {
+  if (!std::filesystem::is_regular_file(path)) throw Error(path.string() + ": no such mesh file");
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(
+      path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_DropNormals | aiProcess_FindDegenerates);
+  if (scene == nullptr) {
+    throw Error(path.string() + ": cannot read mesh: " + importer.GetErrorString());
+  }
+  TriangleMesh mesh;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* part = scene->mMeshes[m];
+    const int base = static_cast<int>(mesh.vertices.size());
+    for (unsigned v = 0; v < part->mNumVertices; ++v) {
+      const aiVector3D& p = part->mVertices[v];
+      mesh.vertices.emplace_back(p.x, p.y, p.z);
+    }
+    for (unsigned f = 0; f < part->mNumFaces; ++f) {
+      const aiFace& face = part->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines left by the triangulation
+      mesh.triangles.emplace_back(base + static_cast<int>(face.mIndices[0]),
+                                  base + static_cast<int>(face.mIndices[1]),
+                                  base + static_cast<int>(face.mIndices[2]));
+    }
+  }
+  if (mesh.triangles.empty()) throw Error(path.string() + ": the mesh has no triangles");
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    if (!v.allFinite()) throw Error(path.string() + ": the mesh has a non-finite vertex");
+  }
+  return mesh;
+}
+
+namespace {
+
+// Appends the little-endian bytes of a 4-byte value (PLY binary_little_endian).
+template <typename T>
+void PutLittleEndian(std::string* out, T value) {
+  static_assert(sizeof(T) == 4);
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &value, 4);
+  for (int i = 0; i < 4; ++i) out->push_back(static_cast<char>((bits >> (8 * i)) & 0xffu));
+}
+
+}  // namespace
+
+void WriteMeshPly(const TriangleMesh& mesh, const std::filesystem::path& path) {
+  const std::string name = path.string();
+  if (mesh.triangles.empty()) throw Error(name + ": cannot write a mesh without triangles");
+  const int count = static_cast<int>(mesh.vertices.size());
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    if (!v.allFinite()) throw Error(name + ": cannot write a mesh with a non-finite vertex");
+  }
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    if ((t.array() < 0).any() || (t.array() >= count).any()) {
+      throw Error(name + ": cannot write a mesh whose triangle indexes a missing vertex");
+    }
+  }
+  std::string data = "ply\nformat binary_little_endian 1.0\ncomment written by uwscan\n";
+  data += "element vertex " + std::to_string(count) + "\n";
+  data += "property float x\nproperty float y\nproperty float z\n";
+  data += "element face " + std::to_string(mesh.triangles.size()) + "\n";
+  data += "property list uchar int vertex_indices\nend_header\n";
+  data.reserve(data.size() + 12 * mesh.vertices.size() + 13 * mesh.triangles.size());
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    for (int i = 0; i < 3; ++i) PutLittleEndian(&data, static_cast<float>(v[i]));
+  }
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    data.push_back(3);
+    for (int i = 0; i < 3; ++i) PutLittleEndian(&data, static_cast<std::int32_t>(t[i]));
+  }
+  // Write beside the target, then rename: a rename within a folder replaces it atomically.
+  const std::filesystem::path temporary = name + ".part";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(name + ": cannot write mesh (cannot create " + temporary.string() + ")");
+    out.write(data.data(), static_cast<std::streamsize>(data.size()));
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw Error(name + ": cannot write mesh (write to " + temporary.string() + " failed)");
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw Error(name + ": cannot write mesh: " + error.message());
+  }
+}
+
+SurfaceSamples SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed) {
+  if (count < 0) throw Error("SampleSurface: count must be >= 0");
+  std::vector<double> cumulative_area;
+  cumulative_area.reserve(mesh.triangles.size());
+  double total = 0.0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d& a = mesh.vertices[t[0]];
+    total += 0.5 * (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).norm();
+    cumulative_area.push_back(total);
+  }
+  if (!(total > 0.0)) throw Error("SampleSurface: the mesh has no area");
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  SurfaceSamples samples;
+  samples.points.reserve(count);
+  samples.normals.reserve(count);
+  for (int i = 0; i < count; ++i) {
+    const double pick = unit(rng) * total;
+    const size_t k = std::min<size_t>(
+        std::lower_bound(cumulative_area.begin(), cumulative_area.end(), pick) -
+            cumulative_area.begin(),
+        mesh.triangles.size() - 1);
+    const Eigen::Vector3i& t = mesh.triangles[k];
+    const Eigen::Vector3d &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]],
+                          &c = mesh.vertices[t[2]];
+    // Uniform on the triangle: fold the unit square onto it.
+    double u = unit(rng), v = unit(rng);
+    if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+    samples.points.push_back(a + u * (b - a) + v * (c - a));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    samples.normals.push_back(n.norm() > 0.0 ? Eigen::Vector3d(n.normalized())
+                                             : Eigen::Vector3d::UnitZ());
+  }
+  return samples;
+}
+
+}  // namespace uwscan::scanner

@@ -1,0 +1,444 @@
+#include "scanner/stripe/stripe_detector.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <vector>
+
+namespace uwscan::scanner {
+namespace {
+
+constexpr std::array<StripeMethod, 6> kAllMethods = {
+    StripeMethod::kMaximum,  StripeMethod::kCentreOfMass, StripeMethod::kGaussian,
+    StripeMethod::kParabola, StripeMethod::kBlaisRioux,   StripeMethod::kSteger};
+
+// Buffers of the column scan, reused from frame to frame.
+template <typename Pixel>
+struct ColumnScratch {
+  std::vector<Pixel> max, second, in_band;
+  std::vector<std::uint16_t> arg;
+  std::vector<int> first_event, event_column, cursor;
+
+  void Resize(int width) {
+    max.resize(width);
+    second.resize(width);
+    in_band.resize(width);
+    arg.resize(width);
+  }
+};
+
+// What the refinement of one line needs from the options, so that the per-line code sees only
+// scalars and the Steger kernel.
+struct RefineParams {
+  StripeMethod method;
+  int half_window;                    // window_px / 2
+  int support;                        // pixels needed each side of the brightest one
+  std::span<const double> steger_d1;  // k = -R..R
+};
+
+// Where a slope-like response s(k) (positive before the peak, negative after) falls through zero
+// within kCrossingReach samples of 0, linearly interpolated; std::nullopt if it does not.
+constexpr int kCrossingReach = 2;
+
+template <typename Slope>
+std::optional<double> ZeroCrossingNear(const Slope& s) {
+  const double s0 = s(0);
+  if (s0 > 0.0) {
+    double previous = s0;
+    for (int k = 1; k <= kCrossingReach; ++k) {
+      const double next = s(k);
+      if (next <= 0.0) return k - 1 + previous / (previous - next);
+      previous = next;
+    }
+    return std::nullopt;
+  }
+  double next = s0;
+  for (int k = -1; k >= -kCrossingReach; --k) {
+    const double previous = s(k);
+    if (previous > 0.0) return k + previous / (previous - next);
+    next = previous;
+  }
+  return std::nullopt;
+}
+
+// The refinement of one line. at(i) is the line's sample i in [0, n); i0 its brightest sample
+// (the first of equal maxima). Returns the sub-pixel offset from i0, or std::nullopt.
+template <typename Get>
+std::optional<double> RefineLine(const RefineParams& rp, const Get& at, int n, int i0,
+                                 double saturation) {
+  const auto p = [&](int k) { return at(i0 + k); };
+  const double top = p(0);
+  const int available_left = i0;
+  const int available_right = n - 1 - i0;
+
+  // The run of samples equal to the top (i0 is its first).
+  int run_end = 0;
+  while (run_end < available_right && p(run_end + 1) == top) ++run_end;
+  if (rp.method == StripeMethod::kMaximum) return 0.5 * run_end;
+
+  if (top >= saturation || run_end >= 2) {
+    // Flat top: midpoint of the half-level crossings, searched within half_window of the run.
+    const int left = std::min(available_left, rp.half_window);
+    const int right = std::min(available_right, run_end + rp.half_window);
+    double low = top;
+    for (int k = -left; k <= right; ++k) low = std::min(low, p(k));
+    const double level = 0.5 * (top + low);
+    if (!(level < top)) return std::nullopt;
+    int a = -1;
+    while (a >= -left && p(a) > level) --a;
+    int b = run_end + 1;
+    while (b <= right && p(b) > level) ++b;
+    if (a < -left || b > right) return std::nullopt;
+    const double left_x = a + (level - p(a)) / (p(a + 1) - p(a));
+    const double right_x = b - 1 + (p(b - 1) - level) / (p(b - 1) - p(b));
+    return 0.5 * (left_x + right_x);
+  }
+
+  if (available_left < rp.support || available_right < rp.support) {
+    if (rp.method != StripeMethod::kCentreOfMass || available_left < 1 || available_right < 1) {
+      return std::nullopt;
+    }
+  }
+
+  switch (rp.method) {
+    case StripeMethod::kMaximum:
+      return 0.0;
+    case StripeMethod::kCentreOfMass: {
+      const int h = std::min({rp.half_window, available_left, available_right});
+      double low = top;
+      for (int k = -h; k <= h; ++k) low = std::min(low, p(k));
+      double sum_w = 0.0, sum_kw = 0.0;
+      for (int k = -h; k <= h; ++k) {
+        const double w = p(k) - low;
+        sum_w += w;
+        sum_kw += k * w;
+      }
+      return sum_w > 0.0 ? sum_kw / sum_w : 0.0;
+    }
+    case StripeMethod::kGaussian: {
+      const int h = std::min({rp.half_window, available_left, available_right});
+      double low = top;
+      for (int k = -h; k <= h; ++k) low = std::min(low, p(k));
+      // Half an intensity level keeps the logarithm finite where a neighbour is at background.
+      const double a = std::log(std::max(p(-1) - low, 0.5));
+      const double b = std::log(std::max(top - low, 0.5));
+      const double c = std::log(std::max(p(1) - low, 0.5));
+      const double curvature = a - 2.0 * b + c;
+      if (!(curvature < 0.0)) return std::nullopt;
+      return 0.5 * (a - c) / curvature;
+    }
+    case StripeMethod::kParabola: {
+      const double curvature = p(-1) - 2.0 * top + p(1);
+      if (!(curvature < 0.0)) return std::nullopt;
+      return 0.5 * (p(-1) - p(1)) / curvature;
+    }
+    case StripeMethod::kBlaisRioux: {
+      // Blais & Rioux's filter g(k) = I(k-2) + I(k-1) - I(k+1) - I(k+2), negated here so that,
+      // like a slope, it is positive on the rising side; the centre is its zero crossing.
+      const auto g = [&](int k) { return p(k + 1) + p(k + 2) - p(k - 1) - p(k - 2); };
+      return ZeroCrossingNear(g);
+    }
+    case StripeMethod::kSteger: {
+      // First derivative of the Gaussian-smoothed profile: positive rising, negative after.
+      const int r = static_cast<int>(rp.steger_d1.size() / 2);
+      const auto d = [&](int k) {
+        double sum = 0.0;
+        for (int j = -r; j <= r; ++j) sum += p(k + j) * rp.steger_d1[j + r];
+        return sum;
+      };
+      return ZeroCrossingNear(d);
+    }
+  }
+  return std::nullopt;
+}
+
+// One row of the second pass: second[u] = max(second[u], row[u]) where row[u] is a local maximum
+// of its column outside the band.
+template <typename Pixel>
+void SecondPeakRow(const Pixel* __restrict above, const Pixel* __restrict row,
+                   const Pixel* __restrict below, const Pixel* __restrict in_band, int width,
+                   Pixel* __restrict second) {
+  for (int u = 0; u < width; ++u) {
+    const Pixel c = row[u];
+    const bool peak = (c > above[u]) & (c >= below[u]) & (in_band[u] == 0);
+    const Pixel value = peak ? c : Pixel{0};
+    second[u] = std::max(second[u], value);
+  }
+}
+
+// Second pass of the column scan: each column's highest interior local maximum (brighter than
+// the row above, at least as bright as the row below: a flat top counts once) farther than
+// `separation` rows from the column's brightest pixel arg[u]. The band |v - arg[u]| <=
+// separation is kept as a per-column flag of the pixels' width, toggled at the rows where the
+// band starts and ends (bucketed by row beforehand), so the inner loop stays at that width.
+template <typename Pixel>
+void SecondPeaks(const StripeImage& image, const std::uint16_t* __restrict arg, int separation,
+                 ColumnScratch<Pixel>& scratch) {
+  const int width = image.width_px;
+  const int height = image.height_px;
+  std::vector<int>& first_event = scratch.first_event;  // events of row v: [first[v], first[v+1])
+  std::vector<int>& event_column = scratch.event_column;
+  first_event.assign(height + 1, 0);
+  event_column.resize(2 * width);
+  const auto for_each_event = [&](auto&& visit) {
+    for (int u = 0; u < width; ++u) {
+      visit(std::max(0, arg[u] - separation), u);
+      if (arg[u] + separation + 1 < height) visit(arg[u] + separation + 1, u);
+    }
+  };
+  for_each_event([&](int v, int) { ++first_event[v + 1]; });
+  for (int v = 0; v < height; ++v) first_event[v + 1] += first_event[v];
+  scratch.cursor.assign(first_event.begin(), first_event.end() - 1);
+  for_each_event([&](int v, int u) { event_column[scratch.cursor[v]++] = u; });
+
+  Pixel* __restrict in_band = scratch.in_band.data();
+  Pixel* __restrict second = scratch.second.data();
+  std::fill(in_band, in_band + width, Pixel{0});
+  std::fill(second, second + width, Pixel{0});
+  for (int v = 0; v + 1 < height; ++v) {
+    for (int e = first_event[v]; e < first_event[v + 1]; ++e) {
+      in_band[event_column[e]] ^= static_cast<Pixel>(~Pixel{0});
+    }
+    if (v == 0) continue;
+    SecondPeakRow(image.Row<Pixel>(v - 1), image.Row<Pixel>(v), image.Row<Pixel>(v + 1), in_band,
+                  width, second);
+  }
+}
+
+// First pass of the column scan: each column's brightest value and the first row reaching it.
+template <typename Pixel>
+void ColumnMaxima(const StripeImage& image, Pixel* __restrict max, std::uint16_t* __restrict arg) {
+  const int width = image.width_px;
+  std::fill(max, max + width, Pixel{0});
+  std::fill(arg, arg + width, std::uint16_t{0});
+  for (int v = 0; v < image.height_px; ++v) {
+    const Pixel* __restrict row = image.Row<Pixel>(v);
+    const std::uint16_t vv = static_cast<std::uint16_t>(v);
+    for (int u = 0; u < width; ++u) {
+      const Pixel c = row[u];
+      const bool brighter = c > max[u];
+      max[u] = brighter ? c : max[u];
+      arg[u] = brighter ? vv : arg[u];
+    }
+  }
+}
+
+}  // namespace
+
+struct StripeDetector::Scratch {
+  ColumnScratch<std::uint8_t> mono8;
+  ColumnScratch<std::uint16_t> mono16;
+};
+
+StripeDetector::~StripeDetector() = default;
+StripeDetector::StripeDetector(StripeDetector&&) noexcept = default;
+StripeDetector& StripeDetector::operator=(StripeDetector&&) noexcept = default;
+
+const char* ToString(StripeMethod method) {
+  switch (method) {
+    case StripeMethod::kMaximum:
+      return "maximum";
+    case StripeMethod::kCentreOfMass:
+      return "centre_of_mass";
+    case StripeMethod::kGaussian:
+      return "gaussian";
+    case StripeMethod::kParabola:
+      return "parabola";
+    case StripeMethod::kBlaisRioux:
+      return "blais_rioux";
+    case StripeMethod::kSteger:
+      return "steger";
+  }
+  return "unknown";
+}
+
+std::optional<StripeMethod> StripeMethodFromString(std::string_view name) {
+  for (StripeMethod m : kAllMethods) {
+    if (name == ToString(m)) return m;
+  }
+  return std::nullopt;
+}
+
+std::span<const StripeMethod> AllStripeMethods() { return kAllMethods; }
+
+void StripeDetectorOptions::Check() const {
+  if (static_cast<int>(method) > static_cast<int>(StripeMethod::kSteger)) {
+    throw Error("stripe detector: method: unknown value " + std::to_string(int(method)));
+  }
+  if (axis != StripeAxis::kColumns && axis != StripeAxis::kRows) {
+    throw Error("stripe detector: axis: expected columns or rows");
+  }
+  if (threshold < 1 || threshold > 65535) {
+    throw Error("stripe detector: threshold: " + std::to_string(threshold) +
+                ", expected 1..65535 image units");
+  }
+  if (window_px < 3 || window_px % 2 == 0 || window_px > 255) {
+    throw Error("stripe detector: window_px: " + std::to_string(window_px) +
+                ", expected an odd width in 3..255 px");
+  }
+  if (!(max_second_peak_ratio > 0.0 && max_second_peak_ratio <= 1.0)) {
+    throw Error("stripe detector: max_second_peak_ratio: " + std::to_string(max_second_peak_ratio) +
+                ", expected in (0, 1] (1 disables multiple-peak rejection)");
+  }
+  if (min_separation_px < 1) {
+    throw Error("stripe detector: min_separation_px: " + std::to_string(min_separation_px) +
+                ", expected >= 1 px");
+  }
+  if (!(steger_sigma_px >= 0.5 && steger_sigma_px <= 10.0)) {
+    throw Error("stripe detector: steger_sigma_px: " + std::to_string(steger_sigma_px) +
+                ", expected in [0.5, 10] px");
+  }
+}
+
+StripeDetector::StripeDetector(const StripeDetectorOptions& options)
+    : options_(options), scratch_(std::make_unique<Scratch>()) {
+  options_.Check();
+  // Steger's kernel integrates the Gaussian derivative over each pixel:
+  // d1[j] = G(j - 1/2) - G(j + 1/2), so that sum_j I(k + j) d1[j] is the smoothed slope at k.
+  const double s = options_.steger_sigma_px;
+  steger_radius_ = static_cast<int>(std::ceil(3.0 * s));
+  const auto gauss = [s](double x) {
+    return std::exp(-0.5 * x * x / (s * s)) / (s * 2.5066282746310002);
+  };
+  steger_d1_.resize(2 * steger_radius_ + 1);
+  for (int j = -steger_radius_; j <= steger_radius_; ++j) {
+    steger_d1_[j + steger_radius_] = gauss(j - 0.5) - gauss(j + 0.5);
+  }
+  switch (options_.method) {
+    case StripeMethod::kMaximum:
+      support_radius_ = 0;
+      break;
+    case StripeMethod::kCentreOfMass:
+    case StripeMethod::kGaussian:
+    case StripeMethod::kParabola:
+      support_radius_ = 1;
+      break;
+    case StripeMethod::kBlaisRioux:
+      support_radius_ = 2 + kCrossingReach;
+      break;
+    case StripeMethod::kSteger:
+      support_radius_ = steger_radius_ + kCrossingReach;
+      break;
+  }
+}
+
+std::optional<double> StripeDetector::RefinePeak(std::span<const double> profile, int peak_index,
+                                                 double saturation) const {
+  if (peak_index < 0 || peak_index >= std::ssize(profile)) {
+    throw Error("stripe detector: peak_index " + std::to_string(peak_index) +
+                " outside the profile of " + std::to_string(profile.size()) + " samples");
+  }
+  const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
+  return RefineLine(
+      rp, [&](int i) { return profile[i]; }, static_cast<int>(profile.size()), peak_index,
+      saturation);
+}
+
+template <typename Pixel>
+void StripeDetector::DetectColumns(const StripeImage& image, StripeDetection* result) {
+  const int width = image.width_px;
+  const int height = image.height_px;
+  ColumnScratch<Pixel>* scratch;
+  if constexpr (sizeof(Pixel) == 1) {
+    scratch = &scratch_->mono8;
+  } else {
+    scratch = &scratch_->mono16;
+  }
+  scratch->Resize(width);
+  const std::uint16_t* arg = scratch->arg.data();
+  ColumnMaxima<Pixel>(image, scratch->max.data(), scratch->arg.data());
+  const bool reject_multiple = options_.max_second_peak_ratio < 1.0;
+  if (reject_multiple) SecondPeaks<Pixel>(image, arg, options_.min_separation_px, *scratch);
+
+  const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
+  const double saturation = MaxPixelValue(image.format);
+  const Pixel* __restrict max = scratch->max.data();
+  const Pixel* __restrict second = scratch->second.data();
+  for (int u = 0; u < width; ++u) {
+    const double top = max[u];
+    if (top < options_.threshold) {
+      ++result->below_threshold;
+      continue;
+    }
+    if (reject_multiple && second[u] >= options_.threshold &&
+        second[u] > options_.max_second_peak_ratio * top) {
+      ++result->multiple_peaks;
+      continue;
+    }
+    const Pixel* column = image.Row<Pixel>(0) + u;
+    const std::ptrdiff_t step = image.stride_bytes / static_cast<std::ptrdiff_t>(sizeof(Pixel));
+    const auto at = [column, step](int v) { return static_cast<double>(column[v * step]); };
+    const int v0 = arg[u];
+    const std::optional<double> offset = RefineLine(rp, at, height, v0, saturation);
+    if (!offset) {
+      ++result->unrefined;
+      continue;
+    }
+    result->peaks.push_back({static_cast<double>(u), v0 + *offset, top});
+  }
+}
+
+template <typename Pixel>
+void StripeDetector::DetectRows(const StripeImage& image, StripeDetection* result) {
+  const int width = image.width_px;
+  const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
+  const double saturation = MaxPixelValue(image.format);
+  const bool reject_multiple = options_.max_second_peak_ratio < 1.0;
+  for (int v = 0; v < image.height_px; ++v) {
+    const Pixel* row = image.Row<Pixel>(v);
+    const int u0 = static_cast<int>(std::max_element(row, row + width) - row);
+    const double top = row[u0];
+    if (top < options_.threshold) {
+      ++result->below_threshold;
+      continue;
+    }
+    if (reject_multiple) {
+      Pixel second = 0;
+      for (int u = 1; u + 1 < width; ++u) {
+        if (row[u] > row[u - 1] && row[u] >= row[u + 1] &&
+            std::abs(u - u0) > options_.min_separation_px) {
+          second = std::max(second, row[u]);
+        }
+      }
+      if (second >= options_.threshold && second > options_.max_second_peak_ratio * top) {
+        ++result->multiple_peaks;
+        continue;
+      }
+    }
+    const auto at = [row](int u) { return static_cast<double>(row[u]); };
+    const std::optional<double> offset = RefineLine(rp, at, width, u0, saturation);
+    if (!offset) {
+      ++result->unrefined;
+      continue;
+    }
+    result->peaks.push_back({u0 + *offset, static_cast<double>(v), top});
+  }
+}
+
+void StripeDetector::Detect(const StripeImage& image, StripeDetection* result) {
+  image.Check();
+  const bool columns = options_.axis == StripeAxis::kColumns;
+  if (columns && image.height_px > 65535) {
+    throw Error("stripe detector: image of " + std::to_string(image.height_px) +
+                " rows, expected at most 65535 for per-column detection");
+  }
+  result->peaks.clear();
+  result->lines = columns ? image.width_px : image.height_px;
+  result->below_threshold = result->multiple_peaks = result->unrefined = 0;
+  const bool mono8 = image.format == PixelFormat::kMono8;
+  if (columns) {
+    mono8 ? DetectColumns<std::uint8_t>(image, result)
+          : DetectColumns<std::uint16_t>(image, result);
+  } else {
+    mono8 ? DetectRows<std::uint8_t>(image, result) : DetectRows<std::uint16_t>(image, result);
+  }
+}
+
+StripeDetection StripeDetector::Detect(const StripeImage& image) {
+  StripeDetection result;
+  Detect(image, &result);
+  return result;
+}
+
+}  // namespace uwscan::scanner

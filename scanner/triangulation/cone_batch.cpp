@@ -1,0 +1,101 @@
+#include "scanner/triangulation/cone_batch.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace uwscan::scanner {
+namespace {
+
+constexpr std::size_t kN = RayBlock::kSize;
+
+// Lane-wise select; compiles to a blend.
+inline double Select(bool condition, double a, double b) { return condition ? a : b; }
+
+// Statuses carried as doubles inside the vector loop (one lane type keeps it vectorisable).
+constexpr double kHit = static_cast<double>(HitStatus::kHit);
+constexpr double kParallel = static_cast<double>(HitStatus::kParallel);
+constexpr double kBehind = static_cast<double>(HitStatus::kBehind);
+constexpr double kOutsideSurface = static_cast<double>(HitStatus::kOutsideSurface);
+constexpr double kNoIntersection = static_cast<double>(HitStatus::kNoIntersection);
+
+}  // namespace
+
+// Each loop below runs over the lanes of the block; every lane follows exactly the arithmetic
+// of the per-ray IntersectRayCone, with its early returns turned into masks.
+__attribute__((target_clones("avx2", "default"))) void IntersectRayConeBlock(
+    const PreparedCone& cone, const RayBlock& rays, HitBlock* hits) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const Eigen::Matrix3d& S = cone.S_C;
+  const double bb = cone.b * cone.b, abs_b = std::abs(cone.b);
+  const double s00 = S(0, 0), s01 = S(0, 1), s02 = S(0, 2), s10 = S(1, 0), s11 = S(1, 1),
+               s12 = S(1, 2), s20 = S(2, 0), s21 = S(2, 1), s22 = S(2, 2);
+  const double c0 = cone.s_origin.x(), c1 = cone.s_origin.y(), c2 = cone.s_origin.z();
+  const double b = cone.b, h_min = cone.h_min_m, cos_min = cone.cos_beta_min,
+               cos_max = cone.cos_beta_max, coefficient_tol = cone.coefficient_tol,
+               origin_size = cone.origin_size;
+
+#pragma omp simd
+  for (std::size_t i = 0; i < kN; ++i) {
+    // Ray in cone coordinates s = S x + s_origin.
+    const double ox = s00 * rays.ox[i] + s01 * rays.oy[i] + s02 * rays.oz[i] + c0;
+    const double oy = s10 * rays.ox[i] + s11 * rays.oy[i] + s12 * rays.oz[i] + c1;
+    const double oz = s20 * rays.ox[i] + s21 * rays.oy[i] + s22 * rays.oz[i] + c2;
+    const double dx = s00 * rays.dx[i] + s01 * rays.dy[i] + s02 * rays.dz[i];
+    const double dy = s10 * rays.dx[i] + s11 * rays.dy[i] + s12 * rays.dz[i];
+    const double dz = s20 * rays.dx[i] + s21 * rays.dy[i] + s22 * rays.dz[i];
+
+    const double g2 = (dz - dx) * (dz + dx);
+    const double g1 = oz * dz - ox * dx;
+    const double g0 = (oz - ox) * (oz + ox);
+    const double qa_raw = dy * dy - bb * g2;
+    const double qb = oy * dy - bb * g1;
+    const double qc = oy * oy - bb * g0;
+
+    const double o_size = std::abs(ox) + std::abs(oy) + std::abs(oz) + origin_size;
+    const double d_size = std::abs(dx) + std::abs(dy) + std::abs(dz);
+    const double tol = coefficient_tol * d_size;
+    const bool qa_zero = std::abs(qa_raw) <= tol * d_size;
+    const bool parallel = qa_zero & (std::abs(qb) <= tol * o_size);
+    const double qa = Select(qa_zero, 0.0, qa_raw);
+
+    const double mx = oy * dz - oz * dy;
+    const double my = oz * dx - ox * dz;
+    const double mz = ox * dy - oy * dx;
+    const double disc_over_bb = (mx - mz) * (mx + mz) + bb * my * my;
+    const bool no_intersection = !(disc_over_bb >= 0.0) & (bb != 0.0);
+    const double sqrt_disc = abs_b * std::sqrt(disc_over_bb > 0.0 ? disc_over_bb : 0.0);
+    const double q = -(qb + std::copysign(sqrt_disc, qb));
+    const double t1 = q / qa;
+    const double t2 = qc / q;
+
+    const double apex_tol = detail::kConeApexTol * o_size * d_size;
+    const bool through_apex = mx * mx + my * my + mz * mz <= apex_tol * apex_tol;
+    const double t_near = t2 < t1 ? t2 : t1;
+    const double t_far = t2 > t1 ? t2 : t1;
+    const double un = ox + t_near * dx, yn = oy + t_near * dy, zn = oz + t_near * dz;
+    const bool lit_near = (t_near >= 0.0) & (t_near < kInf) & (zn > h_min) & (yn * b >= 0.0) &
+                          (un >= cos_max * zn) & (un <= cos_min * zn);
+    const double uf = ox + t_far * dx, yf = oy + t_far * dy, zf = oz + t_far * dz;
+    const bool lit_far = (t_far >= 0.0) & (t_far < kInf) & (zf > h_min) & (yf * b >= 0.0) &
+                         (uf >= cos_max * zf) & (uf <= cos_min * zf);
+    const bool ahead = ((t1 >= 0.0) & (t1 < kInf)) | ((t2 >= 0.0) & (t2 < kInf));
+
+    const bool candidate = !(parallel | no_intersection | through_apex);
+    const bool hit_near = candidate & lit_near;
+    const bool hit_far = candidate & !lit_near & lit_far;
+    const bool hit = hit_near | hit_far;
+    const double t = Select(hit_near, t_near, Select(hit_far, t_far, 0.0));
+    // Status in the per-ray function's order of tests, as a lane-wise select chain.
+    double status = Select(ahead, kOutsideSurface, kBehind);
+    status = Select(hit, kHit, status);
+    status = Select(no_intersection, kNoIntersection, status);
+    status = Select(parallel, kParallel, status);
+    hits->status[i] = static_cast<double>(status);
+    hits->t[i] = t;
+    hits->x[i] = Select(hit, rays.ox[i] + t * rays.dx[i], 0.0);
+    hits->y[i] = Select(hit, rays.oy[i] + t * rays.dy[i], 0.0);
+    hits->z[i] = Select(hit, rays.oz[i] + t * rays.dz[i], 0.0);
+  }
+}
+
+}  // namespace uwscan::scanner

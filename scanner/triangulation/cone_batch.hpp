@@ -1,0 +1,33 @@
+#pragma once
+
+#include <cstddef>
+
+#include "scanner/triangulation/light_cone.hpp"
+
+namespace uwscan::scanner {
+
+// A block of rays in structure-of-arrays form: the layout the batched intersection needs so
+// that the compiler can process several rays per instruction.
+struct RayBlock {
+  static constexpr std::size_t kSize = 16;
+  double ox[kSize], oy[kSize], oz[kSize];  // origins, camera frame {C}
+  double dx[kSize], dy[kSize], dz[kSize];  // directions (any length)
+};
+
+// Hits of a block: status, ray parameter and point in {C}.
+struct HitBlock {
+  double status[RayBlock::kSize];  // a HitStatus value, kept as double for the vector lanes
+  HitStatus Status(std::size_t lane) const { return static_cast<HitStatus>(status[lane]); }
+  double t[RayBlock::kSize];
+  double x[RayBlock::kSize], y[RayBlock::kSize], z[RayBlock::kSize];
+};
+
+// IntersectRayCone (light_cone.hpp) for every ray of a block, the same method,
+// tests and statuses, written without branches over structure-of-arrays data so that it runs
+// several rays per vector instruction (AVX2 where the CPU has it, chosen at run time; results
+// do not depend on which: the same IEEE operations in the same order, no fused multiply-add).
+// Misses get t = 0 and the point (0, 0, 0). Every lane must hold a finite ray (fill unused
+// lanes with any). Agreement with the per-ray function is checked in cone_batch_test.
+void IntersectRayConeBlock(const PreparedCone& cone, const RayBlock& rays, HitBlock* hits);
+
+}  // namespace uwscan::scanner

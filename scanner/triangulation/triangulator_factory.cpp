@@ -1,0 +1,66 @@
+#include "scanner/triangulation/triangulator_factory.hpp"
+
+#include "scanner/optics/camera_ray_table.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/mems_scan_pattern.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
+#include "scanner/triangulation/plane_table_triangulator.hpp"
+#include "scanner/triangulation/ray_ray_triangulator.hpp"
+#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/triangulation/surface_triangulators.hpp"
+
+namespace uwscan::scanner {
+namespace {
+
+std::unique_ptr<Triangulator> MakeGalvoTriangulator(const std::string& scanner_yaml,
+                                                    const std::string& source_name,
+                                                    TriangulationMethod method) {
+  const ScannerModel model = ParseScannerModel(scanner_yaml, source_name);
+  if (method == TriangulationMethod::kRayRay) return std::make_unique<RayRayTriangulator>(model);
+  auto rays = std::make_shared<const CameraRayTable>(model.camera);
+  auto surfaces = std::make_shared<const LightSurfaceTable>(model.laser, LightSurfaceTableOptions{});
+  if (method == TriangulationMethod::kRayPlane) {
+    return std::make_unique<RayPlaneTriangulator>(rays, surfaces);
+  }
+  return std::make_unique<RayConeTriangulator>(rays, surfaces);
+}
+
+std::unique_ptr<Triangulator> MakeMemsTriangulator(const std::string& scanner_yaml,
+                                                   const std::string& source_name,
+                                                   const MemsScan& scan, TriangulationMethod method) {
+  if (method != TriangulationMethod::kRayPlane) {
+    throw Error(source_name + ": the MEMS scanner triangulates with the planes of its lines only "
+                "(seed 001); method '" + std::string(ToString(method)) + "' needs a galvanometer scanner");
+  }
+  const MemsScannerModel model = ParseMemsScannerModel(scanner_yaml, source_name);
+  MemsScanPatternOptions pattern;
+  pattern.lines = scan.lines;
+  pattern.waypoints_per_line = scan.waypoints_per_line;
+  pattern.fov_fraction_x = scan.fov_fraction_x;
+  pattern.fov_fraction_y = scan.fov_fraction_y;
+  std::vector<Plane> planes;
+  for (const MemsLine& line : DesignMemsScanPattern(model.functions, pattern)) {
+    planes.push_back(line.plane_C);
+  }
+  return std::make_unique<PlaneTableTriangulator>(std::make_shared<const CameraRayTable>(model.camera),
+                                                  std::move(planes));
+}
+
+}  // namespace
+
+TriangulationMethod DefaultTriangulationMethod(ScannerKind kind) {
+  return kind == ScannerKind::kGalvo ? TriangulationMethod::kRayCone : TriangulationMethod::kRayPlane;
+}
+
+std::unique_ptr<Triangulator> MakeTriangulator(const std::string& scanner_yaml,
+                                               const std::string& source_name,
+                                               const ScanPattern& pattern,
+                                               TriangulationMethod method) {
+  pattern.Check();
+  if (pattern.kind == ScannerKind::kGalvo) {
+    return MakeGalvoTriangulator(scanner_yaml, source_name, method);
+  }
+  return MakeMemsTriangulator(scanner_yaml, source_name, pattern.mems, method);
+}
+
+}  // namespace uwscan::scanner
