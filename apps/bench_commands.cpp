@@ -11,7 +11,8 @@
 #include "bench/deformation_experiment.hpp"
 #include "bench/triangulation_benchmark.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::app {
 namespace {
@@ -33,8 +34,13 @@ void CheckOutputPath(const std::string& path) {
   }
 }
 
-scanner::ScannerModel LoadModel(const std::string& path) {
-  return path.empty() ? scanner::DefaultScannerModel() : scanner::LoadScannerModel(path);
+scanner::GalvoScannerModel LoadModel(const std::string& path) {
+  if (path.empty()) return scanner::DefaultGalvoScannerModel();
+  const scanner::Scanner loaded = scanner::LoadScanner(path);
+  if (loaded.kind() != scanner::ScannerKind::kGalvo) {
+    throw Error(path + ": a MEMS scanner; this benchmark triangulates a galvanometer scanner");
+  }
+  return loaded.galvo();
 }
 
 nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
@@ -92,7 +98,7 @@ void RunTriangulation(const TriangulationArgs& args) {
   bench::TriangulationBenchOptions options;
   options.points = args.points;
   options.seed = args.seed;
-  const scanner::ScannerModel model = LoadModel(args.scanner_path);
+  const scanner::GalvoScannerModel model = LoadModel(args.scanner_path);
   bench::TriangulationBenchResult result;
   {
     ProgressBar bar;

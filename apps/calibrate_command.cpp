@@ -2,9 +2,7 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include "apps/progress_bar.hpp"
@@ -13,6 +11,7 @@
 #include "scanner/calibration/calibration_steps.hpp"
 #include "scanner/calibration/opencv_camera_import.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::app {
 namespace {
@@ -26,14 +25,6 @@ struct CalibrateArgs {
   std::string from;
   scanner::calibration::CalibrationStepOptions options;
 };
-
-std::string ReadText(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 void RunCalibrate(const CalibrateArgs& a) {
   const std::filesystem::path parent = std::filesystem::path(a.output).parent_path();
@@ -54,15 +45,15 @@ void RunCalibrate(const CalibrateArgs& a) {
   {
     ProgressBar bar;
     outcome = scanner::calibration::RunCalibrationStep(
-        a.step, dataset, ReadText(initial), initial.string(),
+        a.step, dataset, scanner::LoadScanner(initial), initial.string(),
         [&bar, &a](double f) { bar.Update("calibrate " + a.step, f); }, a.options);
   }
-  scanner::calibration::WriteTextAtomically(a.output, outcome.scanner_yaml);
+  scanner::calibration::WriteTextAtomically(a.output, scanner::ScannerToYaml(outcome.scanner));
   std::printf("%s: step %s from %s, started from %s, %.2f s\n", a.output.c_str(), a.step.c_str(),
               a.dataset.c_str(), initial.string().c_str(), outcome.record.seconds);
   for (const std::string& line : outcome.summary) std::printf("  %s\n", line.c_str());
   std::printf("\n| parameter | value | std |\n|---|---:|---:|\n");
-  for (const scanner::calibration::ParameterEstimate& p : outcome.record.params) {
+  for (const scanner::ParameterEstimate& p : outcome.record.params) {
     std::printf("| %s | %.9g | %.3g |\n", p.name.c_str(), p.value, p.std);
   }
 }
@@ -75,15 +66,17 @@ struct ImportArgs {
 
 void RunImportIntrinsics(const ImportArgs& a) {
   const PinholeCamera camera = scanner::calibration::ImportOpenCvCalibration(a.opencv_yaml);
-  std::string yaml = scanner::calibration::WithCamera(ReadText(a.into), camera);
-  scanner::calibration::StepRecord record;
+  scanner::Scanner calibrated = scanner::LoadScanner(a.into);
+  calibrated.camera().camera = camera;
+  scanner::StepRecord record;
   record.step = "intrinsics";
   record.dataset = "imported from " + std::filesystem::absolute(a.opencv_yaml).lexically_normal().string();
   record.residual_unit = "px";
   record.params = {{"fx_px", camera.fx_px, 0.0}, {"fy_px", camera.fy_px, 0.0},
                    {"cx_px", camera.cx_px, 0.0}, {"cy_px", camera.cy_px, 0.0}};
-  yaml = scanner::calibration::WithStepRecord(yaml, record);
-  scanner::calibration::WriteTextAtomically(a.output, yaml);
+  record.date_utc = scanner::calibration::NowUtc();
+  scanner::SetStepRecord(&calibrated, record);
+  scanner::calibration::WriteTextAtomically(a.output, scanner::ScannerToYaml(calibrated));
   std::printf("%s: intrinsics from %s (fx %.3f, fy %.3f, cx %.3f, cy %.3f px; k1 %.6g) into %s\n",
               a.output.c_str(), a.opencv_yaml.c_str(), camera.fx_px, camera.fy_px, camera.cx_px,
               camera.cy_px, camera.k1, a.into.c_str());

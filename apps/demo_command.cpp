@@ -50,13 +50,13 @@ void RunDemo(const DemoArgs& a) {
                                     [&bar](double f) { bar.Update("simulate", f); });
   }
   std::printf("Scene %s: %s scanner, %zu objects, %lld frames, %lld stripe peaks (%s), simulated in %.2f s\n\n",
-              a.scene.c_str(), scanner::ToString(scene.scanner.kind), scene.objects.size(),
+              a.scene.c_str(), scanner::ToString(scene.scanner.model.kind()), scene.objects.size(),
               static_cast<long long>(summary.frames), static_cast<long long>(summary.peaks),
               scene.effects.AnyImageStage() ? "detected in rendered frames" : "exact",
               summary.seconds);
 
   std::vector<scanner::TriangulationMethod> methods = {scanner::TriangulationMethod::kRayPlane};
-  if (scene.scanner.kind == scanner::ScannerKind::kGalvo) {
+  if (scene.scanner.model.kind() == scanner::ScannerKind::kGalvo) {
     methods.push_back(scanner::TriangulationMethod::kRayCone);
     methods.push_back(scanner::TriangulationMethod::kRayRay);
   }

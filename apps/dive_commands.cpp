@@ -16,6 +16,7 @@
 #include "perception/cloud_io.hpp"
 #include "perception/point_cloud.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 
@@ -106,7 +107,7 @@ void RunSimulate(const SimulateArgs& a) {
   }
   std::printf("%s: %lld frames (%s scanner, %s), %lld peaks, %lld navigation records%s, %.2f s\n",
               a.output.c_str(), static_cast<long long>(summary.frames),
-              scanner::ToString(scene.scanner.kind),
+              scanner::ToString(scene.scanner.model.kind()),
               scene.effects.AnyImageStage() ? "rendered frames, detected stripes" : "exact peaks",
               static_cast<long long>(summary.peaks),
               static_cast<long long>(summary.navigation_records),
@@ -133,8 +134,7 @@ void RunReconstruct(const ReconstructArgs& a) {
   }
   options.use_navigation = !a.scanner_frame;
   if (!a.calibration.empty()) {
-    options.calibration_yaml = ReadText(a.calibration);
-    options.calibration_source = a.calibration;
+    options.calibration = scanner::LoadScanner(a.calibration);
   }
   const mapping::DiveLogReader log(a.log);
   mapping::Reconstruction r;

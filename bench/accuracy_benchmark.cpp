@@ -8,14 +8,13 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <fstream>
 #include <map>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include "perception/sphere_fit.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 #include "scanner/triangulation/light_plane.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/simulator.hpp"
@@ -36,14 +35,6 @@ constexpr double kWaterIndex = 1.33;
 constexpr double kRunBreakM = 0.003;
 constexpr int kMinRunPoints = 8;
 
-std::string ReadFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot read the scanner file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // The image stages a real dive has. Under water the beam is also attenuated and scattered back.
 SimulationEffects RealisticEffects(bool underwater) {
   SimulationEffects e;
@@ -59,16 +50,14 @@ SimulationEffects RealisticEffects(bool underwater) {
   return e;
 }
 
-Scene BaseScene(const std::filesystem::path& scanner_path, const std::string& scanner_yaml,
-                scanner::ScannerKind kind, double water_index, double attenuation_per_m,
-                std::uint64_t seed) {
+Scene BaseScene(const std::filesystem::path& scanner_path, const scanner::Scanner& model,
+                double water_index, double attenuation_per_m, std::uint64_t seed) {
   Scene scene;
   scene.source = "bench accuracy";
   scene.water.refractive_index = water_index;
   scene.water.attenuation_per_m = attenuation_per_m;
   scene.scanner.file = scanner_path;
-  scene.scanner.yaml_text = scanner_yaml;
-  scene.scanner.kind = kind;
+  scene.scanner.model = model;
   scene.trajectory.poses.push_back({0.0, Eigen::Isometry3d::Identity()});
   scene.detector.axis = scanner::StripeAxis::kRows;
   scene.detector.threshold = 30;
@@ -86,17 +75,17 @@ Eigen::Isometry3d Pose(const Eigen::Vector3d& t, const Eigen::Matrix3d& r = Eige
 // Builds the triangulation tables once per scanner configuration and scan pattern.
 class TriangulatorCache {
  public:
-  // The triangulator of the simulated scanner, or of `calibration_yaml` when it is given (a
+  // The triangulator of the simulated scanner, or of `calibration` when it is given (a
   // calibration estimated for the same scanner).
-  const scanner::Triangulator& For(const Simulator& simulator, const std::string& calibration_yaml = "") {
+  const scanner::Triangulator& For(const Simulator& simulator, const scanner::Scanner* calibration = nullptr) {
     const scanner::ScanPattern pattern = simulator.scan_pattern();
-    const std::string& yaml = calibration_yaml.empty() ? simulator.scanner_yaml() : calibration_yaml;
-    const std::string key = yaml + "\n#pattern\n" +
+    const scanner::Scanner& used = calibration ? *calibration : simulator.scanner();
+    // Keyed by the scanner's file text: two equal scanners share one set of tables.
+    const std::string key = scanner::ScannerToYaml(used) + "\n#pattern\n" +
                             (pattern.kind == scanner::ScannerKind::kMems ? scanner::ScanPatternToYaml(pattern) : "galvo");
     std::unique_ptr<scanner::Triangulator>& slot = cache_[key];
     if (!slot) {
-      slot = scanner::MakeTriangulator(yaml, "bench accuracy scanner", pattern,
-                                       scanner::DefaultTriangulationMethod(pattern.kind));
+      slot = scanner::MakeTriangulator(used, pattern, scanner::DefaultTriangulationMethod(pattern.kind));
     }
     return *slot;
   }
@@ -227,11 +216,11 @@ class AccuracyRun {
       : o_(options),
         progress_(progress),
         threads_(options.threads > 0 ? options.threads : omp_get_max_threads()),
-        galvo_yaml_(ReadFile(options.galvo_scanner)),
-        mems_yaml_(ReadFile(options.mems_scanner)) {}
+        galvo_(scanner::LoadScanner(options.galvo_scanner)),
+        mems_(scanner::LoadScanner(options.mems_scanner)) {}
 
   GaugeFigures Gauges(bool underwater, bool realistic, const char* stage,
-                      const std::string& calibration_yaml = "") {
+                      const scanner::Scanner* calibration = nullptr) {
     std::vector<double> errors;
     int missed = 0;
     const int total = o_.gauge_positions * static_cast<int>(o_.gauge_lengths_m.size());
@@ -244,7 +233,7 @@ class AccuracyRun {
       const Eigen::Matrix3d yaw =
           Eigen::AngleAxisd(0.35 * std::sin(0.9 * i + 0.3), Eigen::Vector3d::UnitY()).toRotationMatrix();
       for (double length : o_.gauge_lengths_m) {
-        Scene scene = BaseScene(o_.galvo_scanner, galvo_yaml_, scanner::ScannerKind::kGalvo,
+        Scene scene = BaseScene(o_.galvo_scanner, galvo_,
                                 underwater ? kWaterIndex : kAirIndex,
                                 underwater ? o_.water_attenuation_per_m : 0.0,
                                 o_.seed + static_cast<std::uint64_t>(1000 * i) +
@@ -264,7 +253,7 @@ class AccuracyRun {
           if (realistic) scene.effects = RealisticEffects(underwater);
           const Simulator simulator(scene);
           measured = MeasureGaugeLength(
-              SimulateAndTriangulate(simulator, cache_.For(simulator, calibration_yaml), threads_));
+              SimulateAndTriangulate(simulator, cache_.For(simulator, calibration), threads_));
         }
         if (measured) {
           errors.push_back(*measured - length);
@@ -278,7 +267,7 @@ class AccuracyRun {
   }
 
   Scene MemsScene(int waypoints, std::uint64_t seed, bool realistic) const {
-    Scene scene = BaseScene(o_.mems_scanner, mems_yaml_, scanner::ScannerKind::kMems, kWaterIndex,
+    Scene scene = BaseScene(o_.mems_scanner, mems_, kWaterIndex,
                             o_.water_attenuation_per_m, seed);
     scene.scanner.mems.lines = o_.mems_lines;
     scene.scanner.mems.waypoints_per_line = waypoints;
@@ -375,8 +364,8 @@ class AccuracyRun {
   const AccuracyBenchOptions& o_;
   const Progress& progress_;
   int threads_;
-  std::string galvo_yaml_;
-  std::string mems_yaml_;
+  scanner::Scanner galvo_;
+  scanner::Scanner mems_;
   TriangulatorCache cache_;
 };
 
@@ -404,10 +393,11 @@ void AccuracyBenchOptions::Check() const {
 }
 
 GaugeFigures RunGaugeExperiment(const AccuracyBenchOptions& options, bool underwater,
-                                const std::string& calibration_yaml, const Progress& progress) {
+                                const std::optional<scanner::Scanner>& calibration, const Progress& progress) {
   options.Check();
   AccuracyRun run(options, progress);
-  return run.Gauges(underwater, true, underwater ? "gauges in water" : "gauges in air", calibration_yaml);
+  return run.Gauges(underwater, true, underwater ? "gauges in water" : "gauges in air",
+                    calibration ? &*calibration : nullptr);
 }
 
 AccuracyBenchResult RunAccuracyBenchmark(const AccuracyBenchOptions& options,

@@ -2,10 +2,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bench/progress.hpp"
+#include "scanner/lasers/scanner.hpp"
 
 namespace uwscan::bench {
 
@@ -78,10 +80,11 @@ struct AccuracyBenchResult {
 };
 
 // The gauge experiment alone, with realistic effects: the galvanometer scanner is simulated as
-// options.galvo_scanner says and its stripes triangulated with `calibration_yaml` (an estimated
-// calibration of that scanner) or, when empty, with the true scanner.
+// options.galvo_scanner says and its stripes triangulated with `calibration` (an estimated
+// calibration of that scanner) or, when std::nullopt, with the true scanner.
 GaugeFigures RunGaugeExperiment(const AccuracyBenchOptions& options, bool underwater,
-                                const std::string& calibration_yaml, const Progress& progress = {});
+                                const std::optional<scanner::Scanner>& calibration,
+                                const Progress& progress = {});
 
 AccuracyBenchResult RunAccuracyBenchmark(const AccuracyBenchOptions& options,
                                          const Progress& progress = {});

@@ -2,10 +2,8 @@
 
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <map>
-#include <sstream>
 
 #include "bench/accuracy_benchmark.hpp"
 #include "bench/scratch_folder.hpp"
@@ -15,8 +13,7 @@
 #include "scanner/calibration/dataset_simulation.hpp"
 #include "scanner/calibration/parameter_lists.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/mems_scanner_model.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::bench {
 namespace {
@@ -28,35 +25,27 @@ double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-std::string ReadText(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // The true values of the parameters a step records, by name.
-std::map<std::string, double> TrueValues(const std::string& step, const std::string& truth_yaml) {
-  std::vector<cal::ParameterEstimate> list;
+std::map<std::string, double> TrueValues(const std::string& step, const scanner::Scanner& true_scanner) {
+  std::vector<scanner::ParameterEstimate> list;
   if (step == "mems") return {};
-  const scanner::ScannerModel truth = scanner::ParseScannerModel(truth_yaml, "truth");
+  const scanner::GalvoScannerModel& truth = true_scanner.galvo();
   if (step == "intrinsics") list = cal::CameraParameters(truth.camera.camera);
   if (step == "viewport") list = cal::ViewportParameters("camera_viewport", truth.camera.viewport);
   if (step == "laser") list = cal::GalvoLaserParameters(truth.laser);
   if (step == "laser_viewport") list = cal::ViewportParameters("laser_viewport", truth.laser.viewport);
   std::map<std::string, double> values;
-  for (const cal::ParameterEstimate& p : list) values[p.name] = p.value;
+  for (const scanner::ParameterEstimate& p : list) values[p.name] = p.value;
   return values;
 }
 
 // Largest distance, at 0.8 and 1.5 m deep, between the estimated MEMS beams and the true ones,
 // at the voltage pairs the dataset saw on two planes or more (where the functions were fitted;
 // beyond them a polynomial extrapolates).
-double MemsBeamError(const std::string& estimated_yaml, const std::string& truth_yaml,
+double MemsBeamError(const scanner::Scanner& estimated_scanner, const scanner::Scanner& true_scanner,
                      const cal::CalibrationDataset& dataset) {
-  const scanner::MemsScannerModel estimated = scanner::ParseMemsScannerModel(estimated_yaml, "estimated");
-  const scanner::MemsScannerModel truth = scanner::ParseMemsScannerModel(truth_yaml, "truth");
+  const scanner::MemsScannerModel& estimated = estimated_scanner.mems();
+  const scanner::MemsScannerModel& truth = true_scanner.mems();
   std::map<std::pair<double, double>, int> planes_of;
   for (const cal::CalibrationDataset::Plane& plane : dataset.planes) {
     for (const auto& dot : plane.dots) ++planes_of[{dot.second.x(), dot.second.y()}];
@@ -80,12 +69,10 @@ double MemsBeamError(const std::string& estimated_yaml, const std::string& truth
 // Largest distance from points of the true laser fans (every 20th mirror step, 15 rays each,
 // 0.5-1.5 m deep) to the estimated fans, both in the dataset's medium: what the laser
 // calibration is for, whatever gauge its parameters are expressed in.
-double FanError(const std::string& truth_yaml, const std::string& estimated_yaml,
+double FanError(const scanner::Scanner& true_scanner, const scanner::Scanner& estimated_scanner,
                 const std::optional<double>& water_index) {
-  const scanner::ScannerModel truth =
-      scanner::ParseScannerModel(cal::ScannerInMedium(truth_yaml, water_index), "truth");
-  const scanner::ScannerModel estimated =
-      scanner::ParseScannerModel(cal::ScannerInMedium(estimated_yaml, water_index), "estimated");
+  const scanner::GalvoScannerModel truth = cal::ScannerInMedium(true_scanner, water_index).galvo();
+  const scanner::GalvoScannerModel estimated = cal::ScannerInMedium(estimated_scanner, water_index).galvo();
   double worst = 0.0;
   const double max_tan = truth.laser.MaxFanTan();
   for (int step = truth.laser.step_min; step <= truth.laser.step_max; step += 20) {
@@ -120,7 +107,7 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
   const Clock::time_point start = Clock::now();
   ScratchFolder scratch("bench-calibration");
   CalibrationBenchResult result;
-  std::string galvo_chain;  // the galvanometer calibration as it grows step by step
+  std::optional<scanner::Scanner> galvo_chain;  // the galvanometer calibration as it grows step by step
   const std::vector<std::string>& steps = cal::CalibrationSteps();
   for (size_t k = 0; k < steps.size(); ++k) {
     const std::string& step = steps[k];
@@ -135,36 +122,36 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
     figures.dataset_seconds = Seconds(simulated);
     const cal::CalibrationDataset dataset = cal::LoadCalibrationDataset(folder);
     if (!dataset.truth_file) throw Error(folder.string() + ": a simulated dataset must name its truth");
-    const std::string truth = cal::LoadDatasetTruth(*dataset.truth_file).scanner_yaml;
+    const scanner::Scanner truth = cal::LoadDatasetTruth(*dataset.truth_file).scanner;
     // The galvanometer steps start from the previous step's output, as a user chains them.
-    const bool chained = step != "mems" && step != "intrinsics" && !galvo_chain.empty();
+    const bool chained = step != "mems" && step != "intrinsics" && galvo_chain.has_value();
     // Intrinsics need no starting values: they are written into the CAD scanner file.
     const std::filesystem::path start_file =
         dataset.scanner_file ? *dataset.scanner_file : options.data_dir / "scanners" / "galvo_cad.yaml";
-    const std::string initial = chained ? galvo_chain : ReadText(start_file);
+    const scanner::Scanner initial = chained ? *galvo_chain : scanner::LoadScanner(start_file);
     const cal::CalibrationStepOutcome outcome = cal::RunCalibrationStep(
         step, dataset, initial, chained ? "the previous step's output" : start_file.string(),
         [&](double f) {
           if (progress) progress("calibrate " + step, f);
         });
     if (step != "mems") {
-      galvo_chain = outcome.scanner_yaml;
+      galvo_chain = outcome.scanner;
     }
     figures.seconds = outcome.record.seconds;
     figures.residual_rms = outcome.record.residual_rms;
     figures.residual_unit = outcome.record.residual_unit;
     const std::map<std::string, double> truth_values = TrueValues(step, truth);
-    for (const cal::ParameterEstimate& p : outcome.record.params) {
+    for (const scanner::ParameterEstimate& p : outcome.record.params) {
       const auto it = truth_values.find(p.name);
       figures.params.push_back({p.name, it == truth_values.end() ? std::numeric_limits<double>::quiet_NaN() : it->second,
                                 p.value, p.std});
     }
     if (step == "mems") {
-      figures.params.push_back({"beam_error_max_m", 0.0, MemsBeamError(outcome.scanner_yaml, truth, dataset), 0.0});
+      figures.params.push_back({"beam_error_max_m", 0.0, MemsBeamError(outcome.scanner, truth, dataset), 0.0});
     }
     if (step == "laser" || step == "laser_viewport") {
       figures.params.push_back(
-          {"fan_error_max_m", 0.0, FanError(truth, outcome.scanner_yaml, dataset.water_refractive_index), 0.0});
+          {"fan_error_max_m", 0.0, FanError(truth, outcome.scanner, dataset.water_refractive_index), 0.0});
     }
     result.steps.push_back(figures);
   }
@@ -176,7 +163,7 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
   gauges.gauge_positions = options.gauge_positions;
   gauges.seed = options.seed;
   gauges.threads = options.threads;
-  const GaugeFigures with_truth = RunGaugeExperiment(gauges, true, "", progress);
+  const GaugeFigures with_truth = RunGaugeExperiment(gauges, true, std::nullopt, progress);
   const GaugeFigures with_estimate = RunGaugeExperiment(gauges, true, galvo_chain, progress);
   result.gauges_true_calibration_mean_err_m = with_truth.mean_err_m;
   result.gauges_estimated_calibration_mean_err_m = with_estimate.mean_err_m;

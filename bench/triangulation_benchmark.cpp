@@ -50,7 +50,7 @@ void SortLikeADetector(Frame* frame) {
 // (depth a random sinusoid of the fan angle, its mean anywhere in the depth range), so the
 // stripe crosses the image with one peak per fan sample. Points the camera cannot see are
 // dropped; the frame's peaks are then sorted like a detector's output.
-std::vector<Frame> MakeFrames(const scanner::ScannerModel& model,
+std::vector<Frame> MakeFrames(const scanner::GalvoScannerModel& model,
                               const TriangulationBenchOptions& o, const Progress& progress) {
   std::mt19937_64 rng(o.seed);
   const scanner::GalvoLaser& laser = model.laser;
@@ -144,7 +144,7 @@ void TriangulationBenchOptions::Check() const {
   surfaces.Check();
 }
 
-TriangulationBenchResult RunTriangulationBenchmark(const scanner::ScannerModel& model,
+TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerModel& model,
                                                    const TriangulationBenchOptions& o,
                                                    const Progress& progress) {
   o.Check();

@@ -6,7 +6,7 @@
 
 #include "bench/progress.hpp"
 #include "scanner/triangulation/light_surface_table.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/triangulation/triangulator.hpp"
 
 namespace uwscan::bench {
@@ -46,7 +46,7 @@ struct TriangulationBenchResult {
   std::map<std::string, MethodFigures> methods;  // keyed by ToString(method)
 };
 
-TriangulationBenchResult RunTriangulationBenchmark(const scanner::ScannerModel& model,
+TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerModel& model,
                                                    const TriangulationBenchOptions& options,
                                                    const Progress& progress = {});
 

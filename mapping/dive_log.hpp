@@ -9,6 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/lasers/scanner.hpp"
+
 // The dive log: one SQLite file per dive holding the scanner configuration it was taken with,
 // every camera frame (stripe peaks, optionally the image), the vehicle's navigation and, for
 // simulated dives, the ground truth. The file format is documented and versioned in
@@ -31,10 +34,9 @@ struct LogImage {
 
 struct DiveLogHeader {
   int schema_version = kDiveLogSchemaVersion;  // filled by the reader; the writer writes its own
-  std::string scanner_kind;                    // "galvo" or "mems"
-  std::string scanner_yaml;  // full scanner configuration (calibration) used to take the dive
-  std::string scan_pattern_yaml;  // how the dive was scanned (scanner/lasers/scan_pattern.hpp)
-  std::string scene_yaml;    // scene text when simulated, empty otherwise
+  scanner::Scanner scanner;          // the scanner (its calibration) the dive was taken with
+  scanner::ScanPattern scan_pattern;  // how the dive was scanned
+  std::string scene_yaml;  // scene text when simulated, empty otherwise (a record, not read back)
   std::string created_utc;   // ISO 8601 ("2024-05-01T12:34:56Z"), set by the writer
   std::string producer;      // e.g. "uwscan simulate 0.1.0"
 };
@@ -72,7 +74,8 @@ class DiveLogWriter {
  public:
   // Creates `path` and commits the header at once. Throws uwscan::Error when the file (or a
   // stray `-wal` / `-journal` beside it, which SQLite would replay into the new file) already
-  // exists, the header is invalid (scanner_kind not "galvo" or "mems", empty scanner_yaml) or
+  // exists, the header is invalid (scanner or scan pattern fail their checks, or are of two
+  // kinds) or
   // the file cannot be created. `header.schema_version` and `header.created_utc` are ignored.
   DiveLogWriter(const std::filesystem::path& path, const DiveLogHeader& header);
   ~DiveLogWriter();

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -27,9 +28,14 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 DiveLogHeader TestHeader() {
   DiveLogHeader header;
-  header.scanner_kind = "galvo";
-  header.scanner_yaml = "uwscan_format: 1\ncamera:\n  fx_px: 2400.5\n# ümlaut, tab\there\n";
-  header.scan_pattern_yaml = "uwscan_format: 1\nkind: galvo\n";
+  header.scanner = scanner::DefaultScanner(scanner::ScannerKind::kGalvo);
+  header.scanner.camera().camera.fx_px = 2400.5;
+  scanner::StepRecord record;
+  record.step = "intrinsics";
+  record.dataset = "/data/ümlaut, tab\there";  // text of any kind goes through
+  header.scanner.calibration.push_back(record);
+  header.scan_pattern.kind = scanner::ScannerKind::kGalvo;
+  header.scan_pattern.galvo.step_stride = 5;
   header.scene_yaml = "objects:\n  - shape: sphere\n";
   header.producer = "uwscan dive_log_test";
   return header;
@@ -231,9 +237,10 @@ TEST_F(DiveLogTest, RoundTripsHeaderFramesTruthAndNavigation) {
 
   const DiveLogReader reader(path);
   EXPECT_EQ(reader.header().schema_version, kDiveLogSchemaVersion);
-  EXPECT_EQ(reader.header().scanner_kind, header.scanner_kind);
-  EXPECT_EQ(reader.header().scanner_yaml, header.scanner_yaml);
-  EXPECT_EQ(reader.header().scan_pattern_yaml, header.scan_pattern_yaml);
+  EXPECT_EQ(scanner::ScannerToYaml(reader.header().scanner), scanner::ScannerToYaml(header.scanner));
+  EXPECT_EQ(reader.header().scanner.calibration.at(0).dataset, "/data/ümlaut, tab\there");
+  EXPECT_EQ(reader.header().scan_pattern.kind, scanner::ScannerKind::kGalvo);
+  EXPECT_EQ(reader.header().scan_pattern.galvo.step_stride, 5);
   EXPECT_EQ(reader.header().scene_yaml, header.scene_yaml);
   EXPECT_EQ(reader.header().producer, header.producer);
   EXPECT_TRUE(IsIso8601Utc(reader.header().created_utc)) << reader.header().created_utc;
@@ -349,12 +356,12 @@ TEST_F(DiveLogTest, RefusesToOverwriteAnything) {
 
 TEST_F(DiveLogTest, RefusesAnInvalidHeader) {
   DiveLogHeader header = TestHeader();
-  header.scanner_kind = "lidar";
-  EXPECT_NE(MessageOf([&] { DiveLogWriter(dir_ / "a.uwlog", header); }).find("scanner_kind"),
+  header.scan_pattern.kind = scanner::ScannerKind::kMems;  // the scanner is a galvanometer
+  EXPECT_NE(MessageOf([&] { DiveLogWriter(dir_ / "a.uwlog", header); }).find("header.scan_pattern"),
             std::string::npos);
   header = TestHeader();
-  header.scanner_yaml.clear();
-  EXPECT_NE(MessageOf([&] { DiveLogWriter(dir_ / "b.uwlog", header); }).find("scanner_yaml"),
+  header.scanner.camera().camera.fx_px = -1.0;
+  EXPECT_NE(MessageOf([&] { DiveLogWriter(dir_ / "b.uwlog", header); }).find("invalid header"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(dir_ / "a.uwlog"));
   EXPECT_FALSE(fs::exists(dir_ / "b.uwlog"));

@@ -48,9 +48,8 @@ DiveSimulationSummary SimulateDive(const scanner::sim::Simulator& simulator,
   const scanner::sim::Scene& scene = simulator.scene();
 
   DiveLogHeader header;
-  header.scanner_kind = scanner::ToString(scene.scanner.kind);
-  header.scanner_yaml = simulator.scanner_yaml();
-  header.scan_pattern_yaml = scanner::ScanPatternToYaml(simulator.scan_pattern());
+  header.scanner = simulator.scanner();
+  header.scan_pattern = simulator.scan_pattern();
   header.scene_yaml = scene_yaml;
   header.producer = options.producer;
   DiveLogWriter writer(log_path, header);

@@ -38,17 +38,13 @@ std::optional<scanner::sim::Trajectory> NavigationTrajectory(const DiveLogReader
 Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions& options,
                            const std::function<void(double)>& progress) {
   const DiveLogHeader& header = log.header();
-  const std::string source = log.path().string();
-  const scanner::ScanPattern pattern =
-      scanner::ParseScanPattern(header.scan_pattern_yaml, source + " (scan pattern)");
+  const scanner::ScanPattern& pattern = header.scan_pattern;
   Reconstruction result;
   result.method = options.method.value_or(scanner::DefaultTriangulationMethod(pattern.kind));
 
   const Clock::time_point tables_start = Clock::now();
-  const std::unique_ptr<scanner::Triangulator> triangulator = scanner::MakeTriangulator(
-      options.calibration_yaml.empty() ? header.scanner_yaml : options.calibration_yaml,
-      options.calibration_yaml.empty() ? source + " (scanner)" : options.calibration_source, pattern,
-      result.method);
+  const std::unique_ptr<scanner::Triangulator> triangulator =
+      scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern, result.method);
   result.table_seconds = Seconds(tables_start);
 
   const std::optional<scanner::sim::Trajectory> navigation =

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mapping/dive_log.hpp"
+#include "scanner/lasers/scanner.hpp"
 #include "scanner/triangulation/triangulator.hpp"
 
 namespace uwscan::mapping {
@@ -18,10 +19,9 @@ struct ReconstructionOptions {
   // Put points in the world frame using the log's navigation when it has some; otherwise (or
   // when false) every point stays in the camera frame {C} of the scanner.
   bool use_navigation = true;
-  // A calibration file (scanner YAML) to triangulate with instead of the scanner configuration
-  // the log was recorded with; empty: the log's own.
-  std::string calibration_yaml;
-  std::string calibration_source;  // its name, for messages
+  // A calibration to triangulate with instead of the scanner the log was recorded with;
+  // std::nullopt: the log's own.
+  std::optional<scanner::Scanner> calibration;
 };
 
 // A dive's point cloud, point by point with the frame it came from, and the truth of each point

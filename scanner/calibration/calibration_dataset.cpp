@@ -12,6 +12,7 @@
 
 #include "scanner/calibration/calibration_yaml.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -461,7 +462,7 @@ DatasetTruth LoadDatasetTruth(const fs::path& path) {
     FailField(top, root, "dataset", "got '" + kind + "', expected calibration_truth");
   }
   DatasetTruth truth;
-  truth.scanner_yaml = String(top, root, "scanner");
+  truth.scanner = ParseScanner(String(top, root, "scanner"), path.string() + " (scanner)");
   truth.T_C_O_views = ReadPoses(top, root, "T_C_O_views");
   truth.T_C_O_planes = ReadPoses(top, root, "T_C_O_planes");
   return truth;
@@ -472,7 +473,7 @@ void WriteDatasetTruth(const fs::path& path, const DatasetTruth& truth) {
   out << YAML::BeginMap;
   out << YAML::Key << "uwscan_format" << YAML::Value << 1;
   out << YAML::Key << "dataset" << YAML::Value << "calibration_truth";
-  out << YAML::Key << "scanner" << YAML::Value << YAML::Literal << truth.scanner_yaml;
+  out << YAML::Key << "scanner" << YAML::Value << YAML::Literal << ScannerToYaml(truth.scanner);
   for (const auto& [key, poses] : {std::pair{"T_C_O_views", &truth.T_C_O_views},
                                    std::pair{"T_C_O_planes", &truth.T_C_O_planes}}) {
     out << YAML::Key << key << YAML::Value << YAML::BeginSeq;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scanner/calibration/observations.hpp"
+#include "scanner/lasers/scanner.hpp"
 
 namespace uwscan::scanner::calibration {
 
@@ -71,16 +72,16 @@ CalibrationDataset LoadCalibrationDataset(const std::filesystem::path& folder);
 // the scanner and truth files are written relative to the folder when they lie inside it.
 void WriteCalibrationManifest(const CalibrationDataset& dataset);
 
-// What a simulated dataset was made from: the true scanner (the simulator's effective scanner
-// YAML: water index, refraction and distortion as simulated) and the true board poses, one per
+// What a simulated dataset was made from: the true scanner (the simulator's effective scanner:
+// water index, refraction and distortion as simulated) and the true board poses, one per
 // view or plane, in the order of the manifest.
 struct DatasetTruth {
-  std::string scanner_yaml;
+  Scanner scanner;
   std::vector<Eigen::Isometry3d> T_C_O_views;
   std::vector<Eigen::Isometry3d> T_C_O_planes;
 };
 
-// truth.yaml: {uwscan_format: 1, dataset: calibration_truth, scanner: |- <YAML text>,
+// truth.yaml: {uwscan_format: 1, dataset: calibration_truth, scanner: |- <scanner file text>,
 // T_C_O_views: [poses], T_C_O_planes: [poses]}; poses as in scanner files, written with
 // round-trip precision. Both throw uwscan::Error naming the file (and line, field).
 DatasetTruth LoadDatasetTruth(const std::filesystem::path& path);

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -141,7 +142,8 @@ TEST(CalibrationDataset, MemsDotsKeepTheirVoltsExactly) {
 TEST(CalibrationDataset, TruthRoundTripsToTheSameDoubles) {
   const fs::path folder = TestFolder("truth");
   DatasetTruth truth;
-  truth.scanner_yaml = "# a scanner\nuwscan_format: 1\ncamera: {width_px: 4}\n";
+  truth.scanner = DefaultScanner(ScannerKind::kMems);
+  truth.scanner.camera().camera.fx_px = 1750.0 + 1.0 / 3.0;
   for (int i = 0; i < 3; ++i) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() =
@@ -152,7 +154,7 @@ TEST(CalibrationDataset, TruthRoundTripsToTheSameDoubles) {
   truth.T_C_O_planes.push_back(truth.T_C_O_views[1]);
   WriteDatasetTruth(folder / "truth.yaml", truth);
   const DatasetTruth read = LoadDatasetTruth(folder / "truth.yaml");
-  EXPECT_EQ(read.scanner_yaml, truth.scanner_yaml);
+  EXPECT_EQ(ScannerToYaml(read.scanner), ScannerToYaml(truth.scanner));
   ASSERT_EQ(read.T_C_O_views.size(), 3u);
   ASSERT_EQ(read.T_C_O_planes.size(), 1u);
   for (int i = 0; i < 3; ++i) {

@@ -9,7 +9,7 @@
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_yaml.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -34,11 +34,10 @@ void ReadInitialScanner(const Context& where, const YAML::Node& node, const fs::
       const YAML::Node list = node["true_sections"];
       const Context at = yaml::Enter(where, "true_sections");
       if (!list.IsSequence()) yaml::Fail(at, list, "expected a list of scanner file sections");
-      const YAML::Node truth =
-          LoadYaml(cs->scene.scanner.yaml_text, cs->scene.scanner.file.string());
+      const std::vector<std::string> sections = ScannerSections(cs->scene.scanner.model.kind());
       for (size_t i = 0; i < list.size(); ++i) {
         const std::string section = list[i].IsScalar() ? list[i].Scalar() : std::string();
-        if (section.empty() || section == "uwscan_format" || !truth[section].IsDefined()) {
+        if (std::find(sections.begin(), sections.end(), section) == sections.end()) {
           yaml::Fail(Item(at, i), list[i],
                      "expected a top-level section of the true scanner file " +
                          cs->scene.scanner.file.string() + ", got '" + section + "'");
@@ -95,7 +94,7 @@ void ReadSection(const Context& where, const YAML::Node& node, const fs::path& b
   only("mirror_steps", stripes, "laser and laser_viewport");
   only("volts_grid", dots, "mems");
   only("volts_fraction", dots, "mems");
-  const bool mems_scanner = cs->scene.scanner.kind == ScannerKind::kMems;
+  const bool mems_scanner = cs->scene.scanner.model.kind() == ScannerKind::kMems;
   if ((stripes && mems_scanner) || (dots && !mems_scanner)) {
     FailField(where, node, "step",
               "a " + cs->step + " step needs a " + (stripes ? "galvanometer" : "MEMS") +
@@ -135,8 +134,7 @@ void ReadSection(const Context& where, const YAML::Node& node, const fs::path& b
   if (stripes) {
     const Context at = yaml::Enter(where, "mirror_steps");
     const YAML::Node list = yaml::Child(where, node, "mirror_steps");
-    const GalvoLaser laser =
-        ParseScannerModel(cs->scene.scanner.yaml_text, cs->scene.scanner.file.string()).laser;
+    const GalvoLaser& laser = cs->scene.scanner.model.galvo().laser;
     if (!list.IsSequence()) yaml::Fail(at, list, "expected a list of mirror steps");
     std::set<int> seen;
     for (size_t i = 0; i < list.size(); ++i) {
@@ -182,7 +180,7 @@ void CalibrationScene::Check() const {
     fail("step", "unknown step '" + step + "'");
   }
   const bool stripes = step == "laser" || step == "laser_viewport";
-  const bool mems_scanner = scene.scanner.kind == ScannerKind::kMems;
+  const bool mems_scanner = scene.scanner.model.kind() == ScannerKind::kMems;
   if ((stripes && mems_scanner) || (step == "mems" && !mems_scanner)) {
     fail("step",
          "a " + step + " step cannot be simulated with the scanner " + scene.scanner.file.string());
@@ -214,8 +212,7 @@ void CalibrationScene::Check() const {
   if (!(max_roll_rad >= 0.0 && max_roll_rad <= M_PI)) fail("max_roll_rad", "expected in [0, pi]");
   if (!(image_scale > 0.0 && image_scale <= 1.0)) fail("image_scale", "expected in (0, 1]");
   if (stripes) {
-    const GalvoLaser laser =
-        ParseScannerModel(scene.scanner.yaml_text, scene.scanner.file.string()).laser;
+    const GalvoLaser& laser = scene.scanner.model.galvo().laser;
     const std::set<int> distinct(mirror_steps.begin(), mirror_steps.end());
     if (distinct.size() != mirror_steps.size() || distinct.size() < 2) {
       fail("mirror_steps", "expected at least 2 mirror steps, each once");

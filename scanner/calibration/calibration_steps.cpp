@@ -1,7 +1,5 @@
 #include "scanner/calibration/calibration_steps.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,8 +18,6 @@
 #include "scanner/calibration/stripe_extraction.hpp"
 #include "scanner/calibration/viewport_calibration.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/mems_scanner_model.hpp"
-#include "scanner/lasers/scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -32,18 +28,6 @@ std::string Format(const char* format, double a, double b = 0.0, double c = 0.0)
   char text[256];
   std::snprintf(text, sizeof(text), format, a, b, c);
   return text;
-}
-
-bool IsMems(const std::string& yaml) {
-  try {
-    return static_cast<bool>(YAML::Load(yaml)["mems"]);
-  } catch (const YAML::Exception&) {
-    return false;  // the parser below reports the problem with its line
-  }
-}
-
-RefractiveCamera CameraOf(const std::string& yaml, const std::string& source) {
-  return IsMems(yaml) ? ParseMemsScannerModel(yaml, source).camera : ParseScannerModel(yaml, source).camera;
 }
 
 // A viewport estimated in the dataset's medium, written back with the refractive indices of the
@@ -153,12 +137,13 @@ class StepRunner {
   const std::function<void(double)>& progress_;
 };
 
-CalibrationStepOutcome Intrinsics(const CalibrationDataset& d, const std::string& yaml, const StepRunner& run) {
+CalibrationStepOutcome Intrinsics(const CalibrationDataset& d, const Scanner& initial, const StepRunner& run) {
   std::vector<std::string> missing;
   const std::vector<PatternObservation> views = run.ViewObservations(&missing);
   const IntrinsicsResult r = CalibrateIntrinsics(d.pattern, views, d.width_px, d.height_px, IntrinsicsOptions{});
   CalibrationStepOutcome out;
-  out.scanner_yaml = WithCamera(yaml, r.camera);
+  out.scanner = initial;
+  out.scanner.camera().camera = r.camera;
   StepRecord& rec = out.record;
   rec.residual_unit = "px";
   rec.residual_rms = r.rms_px;
@@ -175,10 +160,9 @@ CalibrationStepOutcome Intrinsics(const CalibrationDataset& d, const std::string
   return out;
 }
 
-CalibrationStepOutcome Viewport(const CalibrationDataset& d, const std::string& work, const std::string& yaml,
-                                const std::string& source, const StepRunner& run,
-                                const CalibrationStepOptions& options) {
-  const RefractiveCamera initial = CameraOf(work, source);
+CalibrationStepOutcome Viewport(const CalibrationDataset& d, const Scanner& work, const Scanner& initial,
+                                const StepRunner& run, const CalibrationStepOptions& options) {
+  const RefractiveCamera& camera = work.camera();
   std::vector<std::string> missing;
   const std::vector<PatternObservation> views = run.ViewObservations(&missing);
   ViewportCalibrationOptions viewport_options;
@@ -186,11 +170,11 @@ CalibrationStepOutcome Viewport(const CalibrationDataset& d, const std::string& 
   viewport_options.refine_water_index = options.refine_water_index;
   viewport_options.refine_glass_index = options.refine_glass_index;
   const ViewportCalibrationResult r =
-      CalibrateCameraViewport(initial.camera, initial.viewport, d.pattern, views, viewport_options);
+      CalibrateCameraViewport(camera.camera, camera.viewport, d.pattern, views, viewport_options);
   CalibrationStepOutcome out;
-  out.scanner_yaml = WithViewport(yaml, "camera_viewport",
-                                  KeepIndices(r.viewport, CameraOf(yaml, source).viewport,
-                                              options.refine_water_index, options.refine_glass_index));
+  out.scanner = initial;
+  out.scanner.camera().viewport = KeepIndices(r.viewport, initial.camera().viewport, options.refine_water_index,
+                                              options.refine_glass_index);
   StepRecord& rec = out.record;
   rec.residual_unit = "px";
   rec.residual_rms = r.rms_px;
@@ -206,19 +190,26 @@ CalibrationStepOutcome Viewport(const CalibrationDataset& d, const std::string& 
   return out;
 }
 
-CalibrationStepOutcome Laser(const std::string& work, const std::string& yaml, const std::string& source,
+CalibrationStepOutcome Laser(const Scanner& work, const Scanner& initial, const std::string& source,
                              const StepRunner& run, bool laser_viewport, const CalibrationStepOptions& options) {
-  if (IsMems(yaml)) throw Error(source + ": the laser steps calibrate a galvanometer scanner; this one is MEMS");
-  const ScannerModel model = ParseScannerModel(work, source);
+  if (work.kind() == ScannerKind::kMems) {
+    throw Error(source + ": the laser steps calibrate a galvanometer scanner; this one is MEMS");
+  }
+  const GalvoScannerModel& model = work.galvo();
   const StepRunner::PlaneData planes = run.Planes(model.camera);
   const std::vector<LaserCalibrationPoint> points = LaserCalibrationPoints(model.camera, planes.planes, planes.stripes);
   CalibrationStepOutcome out;
+  out.scanner = initial;
   StepRecord& rec = out.record;
   rec.residual_unit = "m";
   rec.observations = static_cast<int>(points.size());
   if (!laser_viewport) {
     const GalvoLaserCalibrationResult r = CalibrateGalvoLaser(points, model.laser, GalvoLaserCalibrationOptions{});
-    out.scanner_yaml = WithGalvoLaser(yaml, r.laser);
+    GalvoLaser& laser = out.scanner.galvo().laser;
+    laser.T_C_L = r.laser.T_C_L;
+    laser.T_C_M = r.laser.T_C_M;
+    laser.mirror_step_rad = r.laser.mirror_step_rad;
+    laser.rotation_distance_m = r.laser.rotation_distance_m;
     rec.residual_rms = r.residual_rms_m;
     rec.residual_max = r.residual_max_m;
     rec.params = GalvoLaserParameters(r.laser, &r.std_devs);
@@ -230,9 +221,7 @@ CalibrationStepOutcome Laser(const std::string& work, const std::string& yaml, c
     LaserViewportCalibrationOptions viewport_options;
     viewport_options.refine_thickness = options.refine_thickness;
     const LaserViewportCalibrationResult r = CalibrateLaserViewport(model, points, viewport_options);
-    out.scanner_yaml = WithViewport(
-        yaml, "laser_viewport",
-        KeepIndices(r.viewport, ParseScannerModel(yaml, source).laser.viewport, false, false));
+    out.scanner.laser_viewport() = KeepIndices(r.viewport, initial.laser_viewport(), false, false);
     rec.residual_rms = r.residual_rms_m;
     rec.residual_max = r.residual_max_m;
     AddViewportParams("laser_viewport", r.viewport, r.normal_std_rad, r.distance_std_m, r.thickness_std_m, &rec);
@@ -244,14 +233,17 @@ CalibrationStepOutcome Laser(const std::string& work, const std::string& yaml, c
   return out;
 }
 
-CalibrationStepOutcome Mems(const std::string& work, const std::string& yaml, const std::string& source,
+CalibrationStepOutcome Mems(const Scanner& work, const Scanner& initial, const std::string& source,
                             const StepRunner& run) {
-  if (!IsMems(yaml)) throw Error(source + ": the mems step calibrates a MEMS scanner; this one is a galvanometer");
-  const MemsScannerModel model = ParseMemsScannerModel(work, source);
-  const StepRunner::PlaneData planes = run.Planes(model.camera);
-  const MemsCalibrationResult r = CalibrateMemsProjection(model.camera, planes.planes, planes.dots);
+  if (work.kind() != ScannerKind::kMems) {
+    throw Error(source + ": the mems step calibrates a MEMS scanner; this one is a galvanometer");
+  }
+  const StepRunner::PlaneData planes = run.Planes(work.camera());
+  const MemsCalibrationResult r = CalibrateMemsProjection(work.camera(), planes.planes, planes.dots);
   CalibrationStepOutcome out;
-  out.scanner_yaml = WithProjectionFunctions(yaml, r.functions);
+  out.scanner = initial;
+  out.scanner.mems().functions = r.functions;
+  out.scanner.mems().functions_from_file = true;
   StepRecord& rec = out.record;
   rec.residual_unit = "%";
   rec.observations = r.dots;
@@ -272,8 +264,7 @@ CalibrationStepOutcome Mems(const std::string& work, const std::string& yaml, co
 }  // namespace
 
 CalibrationStepOutcome RunCalibrationStep(const std::string& step, const CalibrationDataset& dataset,
-                                          const std::string& initial_scanner_yaml,
-                                          const std::string& initial_source,
+                                          const Scanner& initial, const std::string& initial_source,
                                           const std::function<void(double)>& progress,
                                           const CalibrationStepOptions& options) {
   const std::vector<std::string>& names = CalibrationSteps();
@@ -285,21 +276,22 @@ CalibrationStepOutcome RunCalibrationStep(const std::string& step, const Calibra
   }
   const Clock::time_point start = Clock::now();
   const StepRunner run(dataset, progress);
-  const std::string work = ScannerInMedium(initial_scanner_yaml, dataset.water_refractive_index);
+  const Scanner work = ScannerInMedium(initial, dataset.water_refractive_index);
   CalibrationStepOutcome out;
   if (step == "intrinsics") {
-    out = Intrinsics(dataset, initial_scanner_yaml, run);
+    out = Intrinsics(dataset, initial, run);
   } else if (step == "viewport") {
-    out = Viewport(dataset, work, initial_scanner_yaml, initial_source, run, options);
+    out = Viewport(dataset, work, initial, run, options);
   } else if (step == "laser" || step == "laser_viewport") {
-    out = Laser(work, initial_scanner_yaml, initial_source, run, step == "laser_viewport", options);
+    out = Laser(work, initial, initial_source, run, step == "laser_viewport", options);
   } else {
-    out = Mems(work, initial_scanner_yaml, initial_source, run);
+    out = Mems(work, initial, initial_source, run);
   }
   out.record.step = step;
   out.record.dataset = std::filesystem::absolute(dataset.folder).lexically_normal().string();
   out.record.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  out.scanner_yaml = WithStepRecord(out.scanner_yaml, out.record);
+  out.record.date_utc = NowUtc();
+  SetStepRecord(&out.scanner, out.record);
   return out;
 }
 

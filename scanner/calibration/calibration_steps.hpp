@@ -19,19 +19,18 @@ struct CalibrationStepOptions {
 };
 
 struct CalibrationStepOutcome {
-  std::string scanner_yaml;          // the scanner with this step's values and record
+  Scanner scanner;                   // the scanner with this step's values and record
   StepRecord record;
   std::vector<std::string> summary;  // a few lines for the user (the app prints them)
 };
 
 // Runs one step on a dataset: extracts the observations from its images (pattern corners,
 // board poses, stripe peaks, dots), estimates the step's parameters starting from
-// `initial_scanner_yaml` (CAD values, or the output of the earlier steps) and returns the
-// updated scanner file text with the step's record. Throws uwscan::Error naming the image or
+// `initial` (CAD values, or the output of the earlier steps; `initial_source` names it in
+// messages) and returns the updated scanner with the step's record. Throws uwscan::Error naming the image or
 // the problem: a dataset of another step, no pattern found in any image, too few usable views.
 CalibrationStepOutcome RunCalibrationStep(const std::string& step, const CalibrationDataset& dataset,
-                                          const std::string& initial_scanner_yaml,
-                                          const std::string& initial_source,
+                                          const Scanner& initial, const std::string& initial_source,
                                           const std::function<void(double)>& progress = {},
                                           const CalibrationStepOptions& options = {});
 

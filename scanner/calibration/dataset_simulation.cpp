@@ -8,13 +8,11 @@
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
-#include <sstream>
 
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_yaml.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/mems_scanner_model.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/effective_scanner.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/simulator.hpp"
@@ -23,7 +21,6 @@ namespace uwscan::scanner::calibration {
 namespace {
 
 namespace fs = std::filesystem;
-using calibration_yaml::LoadYaml;
 
 constexpr int kMaxPoseDraws = 5000;
 // Pose acceptance: the pattern's outline this far inside the image (fraction of its width),
@@ -45,64 +42,42 @@ std::uint64_t Seed(std::uint64_t seed, std::uint64_t a, std::uint64_t b = 0) {
   return SplitMix(SplitMix(seed ^ SplitMix(a + 1)) ^ (b + 0x5851F42D4C957F2Dull));
 }
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path.string() + ": cannot read");
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-std::string Emit(const YAML::Node& root, const std::string& header) {
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << root;
-  return header + out.c_str() + "\n";
-}
-
 // The scanner with its camera shrunk by `scale`: pixel grid and intrinsics together, so the
 // field of view and the distortion (in normalised coordinates) stay; pixel edges keep their
 // places, hence c' = (c + 1/2) s - 1/2.
-std::string ScaleCamera(const std::string& text, double scale, const std::string& source) {
-  YAML::Node root = LoadYaml(text, source);
-  try {
-    YAML::Node camera = root["camera"];
-    const int w = camera["width_px"].as<int>(), h = camera["height_px"].as<int>();
-    const int w2 = std::max(1, static_cast<int>(std::lround(w * scale)));
-    const int h2 = std::max(1, static_cast<int>(std::lround(h * scale)));
-    const double sx = static_cast<double>(w2) / w, sy = static_cast<double>(h2) / h;
-    camera["width_px"] = w2;
-    camera["height_px"] = h2;
-    camera["fx_px"] = camera["fx_px"].as<double>() * sx;
-    camera["fy_px"] = camera["fy_px"].as<double>() * sy;
-    camera["cx_px"] = (camera["cx_px"].as<double>() + 0.5) * sx - 0.5;
-    camera["cy_px"] = (camera["cy_px"].as<double>() + 0.5) * sy - 0.5;
-  } catch (const YAML::Exception& e) {
-    throw Error(source + ": cannot scale its camera section (image_scale): " + e.what());
-  }
-  return Emit(root, "# " + source + " with its camera scaled by image_scale " +
-                        calibration_yaml::Shortest(scale) + "\n");
+void ScaleCamera(double scale, Scanner* scanner) {
+  PinholeCamera& camera = scanner->camera().camera;
+  const int w = camera.width_px, h = camera.height_px;
+  const int w2 = std::max(1, static_cast<int>(std::lround(w * scale)));
+  const int h2 = std::max(1, static_cast<int>(std::lround(h * scale)));
+  const double sx = static_cast<double>(w2) / w, sy = static_cast<double>(h2) / h;
+  camera.width_px = w2;
+  camera.height_px = h2;
+  camera.fx_px *= sx;
+  camera.fy_px *= sy;
+  camera.cx_px = (camera.cx_px + 0.5) * sx - 0.5;
+  camera.cy_px = (camera.cy_px + 0.5) * sy - 0.5;
 }
 
 // The initial scanner the manifest names: the scene's file, with the sections earlier steps
 // would have calibrated taken from the true scanner, and the camera scaled like the truth's.
 std::string InitialScannerText(const CalibrationScene& cs) {
-  const std::string source = cs.initial_scanner->string();
-  std::string text = ReadText(*cs.initial_scanner);
+  Scanner initial = LoadScanner(*cs.initial_scanner);
+  std::string comment = "Initial scanner for a " + cs.step + " calibration: " +
+                        cs.initial_scanner->filename().string();
   if (!cs.initial_true_sections.empty()) {
-    YAML::Node initial = LoadYaml(text, source);
-    const YAML::Node truth = LoadYaml(cs.scene.scanner.yaml_text, cs.scene.scanner.file.string());
     std::string names;
     for (const std::string& section : cs.initial_true_sections) {
-      initial[section] = truth[section];
+      CopySection(cs.scene.scanner.model, section, &initial);
       names += (names.empty() ? "" : ", ") + section;
     }
-    text = Emit(initial, "# Initial scanner for a " + cs.step +
-                             " calibration: " + cs.initial_scanner->filename().string() + " with " +
-                             names + " from the true scanner " +
-                             cs.scene.scanner.file.filename().string() + "\n");
+    comment += " with " + names + " from the true scanner " + cs.scene.scanner.file.filename().string();
   }
-  return cs.image_scale == 1.0 ? text : ScaleCamera(text, cs.image_scale, source);
+  if (cs.image_scale != 1.0) {
+    ScaleCamera(cs.image_scale, &initial);
+    comment += ", its camera scaled by image_scale " + calibration_yaml::Shortest(cs.image_scale);
+  }
+  return ScannerToYaml(initial, comment);
 }
 
 void PrepareFolder(const fs::path& folder) {
@@ -166,9 +141,9 @@ std::optional<BoardHit> HitBoard(const Ray& ray, const Eigen::Isometry3d& T_C_O,
 // Everything the pose draws and the images need about the scene.
 struct Setup {
   const CalibrationScene& cs;
-  std::string truth_yaml;  // effective scanner (scaled)
+  Scanner truth;  // effective scanner (scaled)
   RefractiveCamera camera;
-  std::optional<ScannerModel> galvo;
+  std::optional<GalvoScannerModel> galvo;
   std::optional<MemsScannerModel> mems;
   BoardGeometry board;
   sim::Scene scene;  // the scene with the scaled scanner
@@ -364,18 +339,13 @@ void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_
                                 const std::function<void(double)>& progress) {
   cs.Check();
   Setup s{cs, {}, {}, {}, {}, BoardOf(cs.pattern, cs.board_size_m), cs.scene};
-  if (cs.image_scale != 1.0) {
-    s.scene.scanner.yaml_text =
-        ScaleCamera(cs.scene.scanner.yaml_text, cs.image_scale, cs.scene.scanner.file.string());
-  }
-  s.truth_yaml = sim::EffectiveScannerYaml(s.scene);
-  const std::string truth_name = "true scanner of " + cs.scene.source;
-  if (cs.scene.scanner.kind == ScannerKind::kGalvo) {
-    s.galvo = ParseScannerModel(s.truth_yaml, truth_name);
-    s.camera = s.galvo->camera;
+  if (cs.image_scale != 1.0) ScaleCamera(cs.image_scale, &s.scene.scanner.model);
+  s.truth = sim::EffectiveScanner(s.scene);
+  s.camera = s.truth.camera();
+  if (s.truth.kind() == ScannerKind::kGalvo) {
+    s.galvo = s.truth.galvo();
   } else {
-    s.mems = ParseMemsScannerModel(s.truth_yaml, truth_name);
-    s.camera = s.mems->camera;
+    s.mems = s.truth.mems();
   }
   PrepareFolder(out_folder);
 
@@ -400,7 +370,7 @@ void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_
   dataset.width_px = s.camera.camera.width_px;
   dataset.height_px = s.camera.camera.height_px;
   DatasetTruth truth;
-  truth.scanner_yaml = s.truth_yaml;
+  truth.scanner = s.truth;
   const TargetRenderer renderer(s.camera);
   TargetRenderOptions render = cs.render;
   render.board_size_m = s.board.size_m;

@@ -15,9 +15,10 @@
 #include "scanner/calibration/stripe_extraction.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/mems_scanner_model.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/simulator.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -58,11 +59,7 @@ CalibrationScene Scene(const std::string& scanner, const std::string& head,
   return ParseCalibrationScene(text, "test.yaml", kSource / "data/scenes");
 }
 
-RefractiveCamera TruthCamera(const DatasetTruth& truth) {
-  return truth.scanner_yaml.find("\nmems:") != std::string::npos
-             ? ParseMemsScannerModel(truth.scanner_yaml, "truth").camera
-             : ParseScannerModel(truth.scanner_yaml, "truth").camera;
-}
+RefractiveCamera TruthCamera(const DatasetTruth& truth) { return truth.scanner.camera(); }
 
 // Pattern corners found in an image with OpenCV, in uwscan's pixel convention, by corner id.
 std::map<int, Eigen::Vector2d> DetectCorners(const fs::path& image_file, const PatternSpec& spec,
@@ -159,7 +156,7 @@ TEST(DatasetSimulation, IntrinsicsViewsInAirMatchTheirTruth) {
   ASSERT_EQ(truth.T_C_O_views.size(), 4u);
   EXPECT_TRUE(truth.T_C_O_planes.empty());
   // In air, without the viewport: its glass takes the air's index.
-  const ScannerModel model = ParseScannerModel(truth.scanner_yaml, "truth");
+  const GalvoScannerModel model = truth.scanner.galvo();
   EXPECT_EQ(model.camera.viewport.n_glass, 1.0);
   EXPECT_EQ(model.camera.camera.width_px, 1024);
   EXPECT_DOUBLE_EQ(model.camera.camera.fx_px, 875.0);
@@ -185,8 +182,8 @@ TEST(DatasetSimulation, ViewportCharucoUnderWaterWithItsInitialScanner) {
   // The initial scanner: the true (scaled) camera, the CAD viewport.
   ASSERT_TRUE(d.scanner_file.has_value());
   EXPECT_EQ(d.scanner_file->filename(), "initial_scanner.yaml");
-  const ScannerModel initial = LoadScannerModel(*d.scanner_file);
-  const ScannerModel real = ParseScannerModel(truth.scanner_yaml, "truth");
+  const GalvoScannerModel initial = LoadScanner(*d.scanner_file).galvo();
+  const GalvoScannerModel real = truth.scanner.galvo();
   EXPECT_EQ(initial.camera.camera.width_px, 1024);
   EXPECT_EQ(initial.camera.camera.fx_px, real.camera.camera.fx_px);
   EXPECT_EQ(initial.camera.camera.k1, real.camera.camera.k1);
@@ -208,7 +205,7 @@ void CheckStripes(const CalibrationScene& scene, const fs::path& out) {
     exact.source = "exact";
     exact.water = scene.scene.water;
     exact.scanner.file = "truth.yaml";
-    exact.scanner.yaml_text = truth.scanner_yaml;
+    exact.scanner.model = truth.scanner;
     exact.scanner.galvo.step_min = -100;
     exact.scanner.galvo.step_max = 100;
     exact.trajectory.poses = {sim::TrajectoryPose{}};
@@ -265,9 +262,11 @@ TEST(DatasetSimulation, LaserStripesInAirLieWhereTheTrueLaserFalls) {
   SimulateCalibrationDataset(scene, out);
   CheckStripes(scene, out);
   // Without true_sections the initial scanner is the CAD file, only its camera scaled.
-  const ScannerModel initial = LoadScannerModel(out / "initial_scanner.yaml");
-  const ScannerModel cad = LoadScannerModel(kSource / "data/scanners/galvo_cad.yaml");
-  EXPECT_EQ(initial.laser.T_C_L.matrix(), cad.laser.T_C_L.matrix());
+  const GalvoScannerModel initial = LoadScanner(out / "initial_scanner.yaml").galvo();
+  const GalvoScannerModel cad = LoadScanner(kSource / "data/scanners/galvo_cad.yaml").galvo();
+  // A pose goes through its quaternion in the file: the same to the last bit or two.
+  EXPECT_LT((initial.laser.T_C_L.matrix() - cad.laser.T_C_L.matrix()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(initial.laser.mirror_step_rad, cad.laser.mirror_step_rad);
   EXPECT_EQ(initial.camera.camera.width_px, 1024);
 }
 
@@ -301,7 +300,7 @@ TEST(DatasetSimulation, MemsDotsSitOnTheTrueBeam) {
   const CalibrationDataset d = LoadCalibrationDataset(out);
   const DatasetTruth truth = LoadDatasetTruth(*d.truth_file);
   CheckPatternImages(d, truth);
-  const MemsScannerModel model = ParseMemsScannerModel(truth.scanner_yaml, "truth");
+  const MemsScannerModel model = truth.scanner.mems();
   for (size_t p = 0; p < d.planes.size(); ++p) {
     EXPECT_GE(d.planes[p].dots.size(), 5u);
     EXPECT_LE(d.planes[p].dots.size(), 20u);
@@ -332,7 +331,7 @@ TEST(DatasetSimulation, MemsDotsSitOnTheTrueBeam) {
     }
   }
   // The initial scanner reads as a MEMS scanner with the true camera and the CAD laser box.
-  const MemsScannerModel initial = LoadMemsScannerModel(*d.scanner_file);
+  const MemsScannerModel initial = LoadScanner(*d.scanner_file).mems();
   EXPECT_EQ(initial.camera.camera.fx_px, model.camera.camera.fx_px);
   EXPECT_GT((initial.laser.emitter_origin_C - model.laser.emitter_origin_C).norm(), 1e-3);
 }

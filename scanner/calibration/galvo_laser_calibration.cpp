@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "scanner/calibration/galvo_laser_simplified.hpp"
 #include "scanner/calibration/jet_geometry.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/triangulation/light_plane.hpp"
@@ -23,6 +24,12 @@
 namespace uwscan::scanner::calibration {
 namespace {
 
+using galvo_simplified::EmitterFromEdgeRays;
+using galvo_simplified::GroupBySteps;
+using galvo_simplified::InAir;
+using galvo_simplified::PointsByStep;
+using galvo_simplified::Simplified;
+using galvo_simplified::SimplifiedModel;
 using jet::Value;
 using jet::Vec3;
 template <typename T>
@@ -302,243 +309,6 @@ GalvoLaserStdDevs StdDevs(const std::vector<LaserCalibrationPoint>& points,
   s.mirror_step_rad = sd(blocks[4], 1, 0);
   s.rotation_distance_m = sd(blocks[5], 1, 0);
   return s;
-}
-
-// ---------------------------------------------------------------------------------------------
-// The simplified model.
-
-using PointsByStep = std::map<int, std::vector<const LaserCalibrationPoint*>>;
-
-// A 3-D line (unit direction) fitted through points: centroid and principal direction.
-Ray FitLine(const std::vector<Eigen::Vector3d>& points) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points) centroid += p;
-  centroid /= static_cast<double>(points.size());
-  Eigen::MatrixX3d centred(static_cast<Eigen::Index>(points.size()), 3);
-  for (size_t k = 0; k < points.size(); ++k) {
-    centred.row(static_cast<Eigen::Index>(k)) = (points[k] - centroid).transpose();
-  }
-  const Eigen::JacobiSVD<Eigen::MatrixX3d> svd(centred, Eigen::ComputeFullV);
-  return Ray{centroid, svd.matrixV().col(0)};
-}
-
-// The seed's estimate of the emitter: on every projection plane a stripe that reaches the
-// fan's edges ends on the two edge rays, so each step's stripe ends, over the planes, lie on
-// two lines; traced back in through the viewport and reflected on the mirror plane they pass
-// through the emitter. Their point closest to all of them on pi_l (z_L = n_l, offset_l) is
-// the emitter. A stripe cut short (by the image, or the board's border) ends elsewhere: then
-// the angle between its step's two lines is not the aperture, and that step is not used.
-// std::nullopt when no step qualifies or the lines do not meet (rms gap above 2 mm).
-std::optional<Eigen::Vector3d> EmitterFromEdgeRays(const PointsByStep& by_step,
-                                                   const GalvoLaser& laser, double offset_l) {
-  const Eigen::Vector3d x_L = laser.T_C_L.linear().col(0), y_L = laser.T_C_L.linear().col(1);
-  const Eigen::Vector3d n_l = laser.T_C_L.linear().col(2);
-  std::vector<Ray> lines;
-  for (const auto& [step, points] : by_step) {
-    const LaserFan fan = laser.FanAtStep(step);
-    const Eigen::Vector3d spread = Reflect(y_L, fan.mirror_normal_C);
-    std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> ends;  // per plane: low, high
-    std::map<int, int> count;
-    for (const LaserCalibrationPoint* point : points) {
-      auto [it, inserted] = ends.try_emplace(point->plane, point->p_C, point->p_C);
-      if (!inserted) {
-        if (spread.dot(point->p_C) < spread.dot(it->second.first)) it->second.first = point->p_C;
-        if (spread.dot(point->p_C) > spread.dot(it->second.second)) it->second.second = point->p_C;
-      }
-      ++count[point->plane];
-    }
-    std::vector<Eigen::Vector3d> low, high;
-    for (const auto& [plane, end] : ends) {
-      if (count[plane] < 2) continue;
-      low.push_back(end.first);
-      high.push_back(end.second);
-    }
-    if (low.size() < 2) continue;
-    std::array<Ray, 2> edge = {FitLine(low), FitLine(high)};
-    for (Ray& ray : edge) {  // pointed back at the mirror, from the far side of the viewport
-      if (ray.direction.dot(ray.origin - laser.T_C_M.translation()) > 0.0) {
-        ray.direction = -ray.direction;
-      }
-    }
-    const double angle = std::acos(std::clamp(edge[0].direction.dot(edge[1].direction), -1.0, 1.0));
-    if (std::abs(angle - laser.aperture_rad) > 0.035) continue;  // 2 degrees: a cut stripe
-    for (const Ray& ray : edge) {
-      const RayTrace inside = TraceIn(laser.viewport, ray);
-      if (!inside.ok()) continue;
-      const Eigen::Vector3d& q = inside.ray.origin;
-      lines.push_back(
-          Ray{q - 2.0 * (fan.mirror_normal_C.dot(q) - fan.mirror_offset_m) * fan.mirror_normal_C,
-              Reflect(inside.ray.direction, fan.mirror_normal_C)});
-    }
-  }
-  if (lines.size() < 2) return std::nullopt;
-  // Least squares over the plane's two coordinates: sum |P_k (e0 + B z - q_k)|^2.
-  const Eigen::Vector3d e0 =
-      laser.T_C_L.translation() - (n_l.dot(laser.T_C_L.translation()) - offset_l) * n_l;
-  Eigen::Matrix<double, 3, 2> B;
-  B << x_L, y_L;
-  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d b = Eigen::Vector2d::Zero();
-  for (const Ray& line : lines) {
-    const Eigen::Matrix3d P =
-        Eigen::Matrix3d::Identity() - line.direction * line.direction.transpose();
-    A += B.transpose() * P * B;
-    b += B.transpose() * P * (line.origin - e0);
-  }
-  const Eigen::Vector3d emitter = e0 + B * A.colPivHouseholderQr().solve(b);
-  double sum_sq = 0.0;
-  for (const Ray& line : lines) {
-    const Eigen::Vector3d gap = emitter - line.origin;
-    sum_sq += (gap - gap.dot(line.direction) * line.direction).squaredNorm();
-  }
-  if (!emitter.allFinite() || std::sqrt(sum_sq / static_cast<double>(lines.size())) > 2e-3) {
-    return std::nullopt;
-  }
-  return emitter;
-}
-
-PointsByStep GroupBySteps(const std::vector<LaserCalibrationPoint>& points) {
-  PointsByStep by_step;
-  for (const LaserCalibrationPoint& point : points) by_step[point.mirror_step].push_back(&point);
-  return by_step;
-}
-
-// The lasers are traced in air here: the water side of the viewport is air.
-GalvoLaser InAir(GalvoLaser laser) {
-  laser.viewport.n_water = laser.viewport.n_air;
-  return laser;
-}
-
-struct Simplified {
-  GalvoLaser laser;
-  bool emitter_from_edge_rays = false;
-};
-
-Simplified SimplifiedModel(const PointsByStep& by_step, const GalvoLaser& initial) {
-  constexpr const char* kWho = "SimplifiedGalvoLaser";
-  if (by_step.size() < 3) {
-    throw Error(std::string(kWho) + ": points of " + std::to_string(by_step.size()) +
-                " mirror steps; at least 3 are needed");
-  }
-  const Eigen::Matrix3d R_L_cad = initial.T_C_L.linear(), R_M_cad = initial.T_C_M.linear();
-
-  // One plane per step, its normal oriented as the CAD's reflected laser-plane normal.
-  std::vector<int> steps;
-  std::vector<Plane> planes;
-  for (const auto& [step, step_points] : by_step) {
-    std::vector<Eigen::Vector3d> xyz;
-    for (const LaserCalibrationPoint* point : step_points) xyz.push_back(point->p_C);
-    Plane plane;
-    try {
-      plane = FitPlane(xyz).plane;
-    } catch (const Error& e) {
-      throw Error(std::string(kWho) + ": mirror step " + std::to_string(step) + ": " + e.what() +
-                  " (a step needs stripes on two projection planes or more)");
-    }
-    const Eigen::Vector3d cad_normal =
-        Reflect(R_L_cad.col(2), initial.FanAtStep(step).mirror_normal_C);
-    if (plane.normal.dot(cad_normal) < 0.0) plane = Plane{-plane.normal, -plane.offset_m};
-    steps.push_back(step);
-    planes.push_back(plane);
-  }
-  const size_t n = planes.size();
-
-  // The reflected normals turn about the axis a by twice the mirror angle: they lie on a circle
-  // of the unit sphere, a . n_j = cos(cone angle), i.e. on a plane whose normal is a. On a short
-  // arc that circle's curvature cannot tell a tilted cone from a great circle; then the plane is
-  // taken through the origin (the laser plane contains the axis direction, as designs intend).
-  std::vector<Eigen::Vector3d> normals(n);
-  for (size_t j = 0; j < n; ++j) normals[j] = planes[j].normal;
-  Eigen::Vector3d axis;
-  const double arc = std::acos(std::clamp(normals.front().dot(normals.back()), -1.0, 1.0));
-  if (arc >= 0.35) {
-    axis = FitPlane(normals).plane.normal;
-  } else {
-    Eigen::MatrixX3d stacked(static_cast<Eigen::Index>(n), 3);
-    for (size_t j = 0; j < n; ++j)
-      stacked.row(static_cast<Eigen::Index>(j)) = normals[j].transpose();
-    axis = Eigen::JacobiSVD<Eigen::MatrixX3d>(stacked, Eigen::ComputeFullV).matrixV().col(2);
-  }
-  if (axis.dot(R_M_cad.col(1)) < 0.0) axis = -axis;
-
-  // Their angle about the axis grows by 2 rho_s per step: rho_s from a line fit.
-  const Eigen::Vector3d e1 = (normals.front() - normals.front().dot(axis) * axis).normalized();
-  const Eigen::Vector3d e2 = axis.cross(e1);
-  std::vector<double> psi(n);
-  double mean_step = 0.0, mean_psi = 0.0;
-  for (size_t j = 0; j < n; ++j) {
-    psi[j] = std::atan2(normals[j].dot(e2), normals[j].dot(e1));
-    if (j > 0) psi[j] = psi[j - 1] + std::remainder(psi[j] - psi[j - 1], 2.0 * std::numbers::pi);
-    mean_step += steps[j] / static_cast<double>(n);
-    mean_psi += psi[j] / static_cast<double>(n);
-  }
-  double s_xy = 0.0, s_xx = 0.0;
-  for (size_t j = 0; j < n; ++j) {
-    s_xy += (steps[j] - mean_step) * (psi[j] - mean_psi);
-    s_xx += (steps[j] - mean_step) * (steps[j] - mean_step);
-  }
-  const double rho = 0.5 * s_xy / s_xx;
-  if (!(std::abs(rho) > 1e-9 && std::abs(rho) < 0.1)) {
-    std::ostringstream message;
-    message << kWho << ": the step planes turn by " << 2.0 * rho
-            << " rad per step; expected a mirror step in (1e-9, 0.1) rad";
-    throw Error(message.str());
-  }
-
-  // With delta = 0 every step plane passes through the axis' point X where it meets pi_l:
-  // n_j . X = d_j, with n_j . a the same for all j. Unknowns: X across the axis and that
-  // constant times X's position along it (well conditioned even when the constant is 0).
-  Eigen::MatrixX3d A(static_cast<Eigen::Index>(n), 3);
-  Eigen::VectorXd b(static_cast<Eigen::Index>(n));
-  for (size_t j = 0; j < n; ++j) {
-    A.row(static_cast<Eigen::Index>(j)) << normals[j].dot(e1), normals[j].dot(e2), 1.0;
-    b(static_cast<Eigen::Index>(j)) = planes[j].offset_m;
-  }
-  const Eigen::Vector3d solution = A.colPivHouseholderQr().solve(b);
-  const Eigen::Vector3d across = solution(0) * e1 + solution(1) * e2;
-
-  GalvoLaser laser = initial;
-  laser.mirror_step_rad = rho;
-  laser.rotation_distance_m = 0.0;
-  // Mirror origin: the point of the axis nearest the CAD's (along the axis is a gauge); zero
-  // angle: the CAD's normal at angle 0 turned about the axis (see the header).
-  const Eigen::Vector3d t_M = across + (initial.T_C_M.translation() - across).dot(axis) * axis;
-  const Eigen::Vector3d m0 = (R_M_cad.col(2) - R_M_cad.col(2).dot(axis) * axis).normalized();
-  Eigen::Matrix3d R_M;
-  R_M << axis.cross(m0), axis, m0;
-  laser.T_C_M.linear() = R_M;
-  laser.T_C_M.translation() = t_M;
-
-  // The laser plane: each step plane reflected back on its mirror plane, averaged.
-  Eigen::Vector3d n_sum = Eigen::Vector3d::Zero();
-  double offset_l = 0.0;
-  for (size_t j = 0; j < n; ++j) {
-    const LaserFan fan = laser.FanAtStep(steps[j]);
-    const Eigen::Vector3d& m = fan.mirror_normal_C;
-    n_sum += Reflect(planes[j].normal, m);
-    offset_l += (planes[j].offset_m - 2.0 * planes[j].normal.dot(m) * fan.mirror_offset_m) /
-                static_cast<double>(n);
-  }
-  Eigen::Vector3d n_l = n_sum.normalized();
-  if (n_l.dot(R_L_cad.col(2)) < 0.0) n_l = -n_l, offset_l = -offset_l;
-
-  // Laser rotation (seed): z_L = n_l, y_L along pi_l ^ pi_s_0 (s_0: the mirror at angle 0),
-  // x_L = y_L x z_L (the seed's matrix, written right-handed).
-  Eigen::Vector3d y_L = n_l.cross(m0);
-  if (!(y_L.norm() > 1e-6)) {
-    throw Error(std::string(kWho) + ": the laser plane is parallel to the mirror");
-  }
-  y_L.normalize();
-  if (y_L.dot(R_L_cad.col(1)) < 0.0) y_L = -y_L;
-  Eigen::Matrix3d R_L;
-  R_L << y_L.cross(n_l), y_L, n_l;
-  laser.T_C_L.linear() = R_L;
-  const Eigen::Vector3d o_cad = initial.T_C_L.translation();
-  laser.T_C_L.translation() = o_cad - (n_l.dot(o_cad) - offset_l) * n_l;
-  const std::optional<Eigen::Vector3d> emitter = EmitterFromEdgeRays(by_step, laser, offset_l);
-  if (emitter) laser.T_C_L.translation() = *emitter;
-  laser.Check();
-  return Simplified{laser, emitter.has_value()};
 }
 
 // The refinement, on a laser traced in air.

@@ -12,7 +12,7 @@
 
 #include "scanner/common/error.hpp"
 #include "scanner/triangulation/light_plane.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -21,13 +21,13 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 
 // The default scanner's laser in air: its viewport still shifts the rays, without bending them.
 GalvoLaser TrueLaserInAir() {
-  GalvoLaser laser = DefaultScannerModel().laser;
+  GalvoLaser laser = DefaultGalvoScannerModel().laser;
   laser.viewport.n_water = 1.0;
   return laser;
 }
 
 GalvoLaser UnderWater(GalvoLaser laser) {
-  laser.viewport.n_water = DefaultScannerModel().laser.viewport.n_water;
+  laser.viewport.n_water = DefaultGalvoScannerModel().laser.viewport.n_water;
   return laser;
 }
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -100,7 +100,7 @@ void ExpectWithinStd(const PinholeCamera& truth, const IntrinsicsResult& r, doub
 }
 
 TEST(CalibrateIntrinsics, RecoversTheDefaultCamera) {
-  const PinholeCamera truth = DefaultScannerModel().camera.camera;
+  const PinholeCamera truth = DefaultGalvoScannerModel().camera.camera;
   const PatternSpec spec = TestPattern();
   std::vector<Eigen::Isometry3d> poses;
   const std::vector<PatternObservation> views = MakeViews(truth, spec, 15, 0.2, 21, &poses);
@@ -129,7 +129,7 @@ TEST(CalibrateIntrinsics, RecoversTheDefaultCamera) {
 }
 
 TEST(CalibrateIntrinsics, ExactCornersExactIntrinsics) {
-  const PinholeCamera truth = DefaultScannerModel().camera.camera;
+  const PinholeCamera truth = DefaultGalvoScannerModel().camera.camera;
   const PatternSpec spec = TestPattern();
   const std::vector<PatternObservation> views = MakeViews(truth, spec, 15, 0.0, 22);
   const IntrinsicsResult r = CalibrateIntrinsics(spec, views, truth.width_px, truth.height_px);
@@ -142,7 +142,7 @@ TEST(CalibrateIntrinsics, ExactCornersExactIntrinsics) {
 }
 
 TEST(CalibrateIntrinsics, RejectsACorruptedView) {
-  const PinholeCamera truth = DefaultScannerModel().camera.camera;
+  const PinholeCamera truth = DefaultGalvoScannerModel().camera.camera;
   const PatternSpec spec = TestPattern();
   std::vector<PatternObservation> views = MakeViews(truth, spec, 15, 0.2, 21);
   // View 6: the last two rows shifted 4 px sideways (a uniform shift would only move the pose).
@@ -163,7 +163,7 @@ TEST(CalibrateIntrinsics, RejectsACorruptedView) {
 }
 
 TEST(CalibrateIntrinsics, FixK3) {
-  const PinholeCamera truth = DefaultScannerModel().camera.camera;
+  const PinholeCamera truth = DefaultGalvoScannerModel().camera.camera;
   const PatternSpec spec = TestPattern();
   const std::vector<PatternObservation> views = MakeViews(truth, spec, 15, 0.2, 23);
   IntrinsicsOptions options;
@@ -175,7 +175,7 @@ TEST(CalibrateIntrinsics, FixK3) {
 }
 
 TEST(CalibrateIntrinsics, TooFewViewsAndBadInput) {
-  const PinholeCamera truth = DefaultScannerModel().camera.camera;
+  const PinholeCamera truth = DefaultGalvoScannerModel().camera.camera;
   const PatternSpec spec = TestPattern();
   std::vector<PatternObservation> views = MakeViews(truth, spec, 4, 0.2, 24);
   // One view with only 3 corners: unusable, leaving 3 of 4.

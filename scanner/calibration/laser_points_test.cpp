@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -23,7 +23,7 @@ struct Stripes {
   std::vector<std::vector<Eigen::Vector3d>> true_points;  // per plane, in peak order
 };
 
-Stripes Observe(const ScannerModel& scanner, const std::vector<Plane>& planes) {
+Stripes Observe(const GalvoScannerModel& scanner, const std::vector<Plane>& planes) {
   Stripes stripes;
   for (const Plane& plane : planes) {
     stripes.per_plane.emplace_back();
@@ -47,7 +47,7 @@ Stripes Observe(const ScannerModel& scanner, const std::vector<Plane>& planes) {
 }
 
 TEST(LaserPointsTest, LiftsEveryPeakOntoItsPlane) {
-  const ScannerModel scanner = DefaultScannerModel();
+  const GalvoScannerModel scanner = DefaultGalvoScannerModel();
   const Eigen::Vector3d n1 =
       Eigen::AngleAxisd(12.0 * kDeg, Eigen::Vector3d::UnitY()) * Eigen::Vector3d::UnitZ();
   const std::vector<Plane> planes = {Plane{Eigen::Vector3d::UnitZ(), 0.7},
@@ -73,7 +73,7 @@ TEST(LaserPointsTest, LiftsEveryPeakOntoItsPlane) {
 }
 
 TEST(LaserPointsTest, SkipsPeaksWhoseRayMissesThePlane) {
-  const ScannerModel scanner = DefaultScannerModel();
+  const GalvoScannerModel scanner = DefaultGalvoScannerModel();
   StripeObservation stripe{"", 5, {Eigen::Vector2d(900.0, 500.0), Eigen::Vector2d(1100.0, 300.0)}};
   // A plane behind the camera, and the plane x = 0, which both rays leave behind them: each
   // starts on the viewport on its own side of it and heads further out.
@@ -85,7 +85,7 @@ TEST(LaserPointsTest, SkipsPeaksWhoseRayMissesThePlane) {
 }
 
 TEST(LaserPointsTest, RejectsMismatchedOrNonFiniteInput) {
-  const ScannerModel scanner = DefaultScannerModel();
+  const GalvoScannerModel scanner = DefaultGalvoScannerModel();
   const std::vector<Plane> planes = {Plane{Eigen::Vector3d::UnitZ(), 1.0}};
   EXPECT_THROW(LaserCalibrationPoints(scanner.camera, planes, {}), Error);
   StripeObservation bad{"img.png", 0, {Eigen::Vector2d(std::nan(""), 1.0)}};

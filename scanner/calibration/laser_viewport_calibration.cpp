@@ -203,7 +203,7 @@ void LaserViewportCalibrationOptions::Check() const {
 }
 
 LaserViewportCalibrationResult CalibrateLaserViewport(
-    const ScannerModel& model, const std::vector<LaserCalibrationPoint>& points,
+    const GalvoScannerModel& model, const std::vector<LaserCalibrationPoint>& points,
     const LaserViewportCalibrationOptions& options) {
   options.Check();
   model.Check();

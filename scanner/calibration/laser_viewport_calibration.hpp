@@ -4,7 +4,7 @@
 
 #include "scanner/calibration/laser_points.hpp"
 #include "scanner/optics/flat_viewport.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 
@@ -53,7 +53,7 @@ struct LaserViewportCalibrationResult {
 // Throws uwscan::Error on an invalid model or options, a point whose mirror step is outside
 // the laser's range, or fewer usable points than unknowns.
 LaserViewportCalibrationResult CalibrateLaserViewport(
-    const ScannerModel& model, const std::vector<LaserCalibrationPoint>& points_in_water,
+    const GalvoScannerModel& model, const std::vector<LaserCalibrationPoint>& points_in_water,
     const LaserViewportCalibrationOptions& options = {});
 
 }  // namespace uwscan::scanner::calibration

@@ -44,7 +44,7 @@ std::vector<Plane> ProjectionPlanes() {
 // What the camera sees of 8 mirror steps' stripes on every board (~50 peaks per stripe), each
 // point moved by isotropic Gaussian noise and its pixel re-projected, so that the calibration
 // point stays on its pixel's camera ray (as LaserCalibrationPoints makes it).
-std::vector<LaserCalibrationPoint> Points(const ScannerModel& scanner, double noise_m,
+std::vector<LaserCalibrationPoint> Points(const GalvoScannerModel& scanner, double noise_m,
                                           unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
@@ -81,7 +81,7 @@ FlatViewport Perturbed(FlatViewport v, double position_m, double angle_rad, unsi
   return v;
 }
 
-ScannerModel WithLaserViewport(ScannerModel model, const FlatViewport& viewport) {
+GalvoScannerModel WithLaserViewport(GalvoScannerModel model, const FlatViewport& viewport) {
   model.laser.viewport = viewport;
   return model;
 }
@@ -107,7 +107,7 @@ void Print(const char* what, const LaserViewportCalibrationResult& r, const Flat
 
 // (a) Exact points, started from a CAD 5 mm / 2 degrees off: the truth, to rounding.
 TEST(LaserViewportCalibrationTest, RecoversTheViewportFromExactPoints) {
-  const ScannerModel truth = DefaultScannerModel();
+  const GalvoScannerModel truth = DefaultGalvoScannerModel();
   const std::vector<LaserCalibrationPoint> points = Points(truth, 0.0, 1);
   const FlatViewport cad = Perturbed(truth.laser.viewport, 0.005, 2.0 * kDeg, 1);
   const auto start = std::chrono::steady_clock::now();
@@ -136,7 +136,7 @@ TEST(LaserViewportCalibrationTest, RecoversTheViewportFromExactPoints) {
 
 // (b) 0.1 mm of noise: within 4 standard deviations.
 TEST(LaserViewportCalibrationTest, NoisyPointsLandWithinTheirStandardDeviations) {
-  const ScannerModel truth = DefaultScannerModel();
+  const GalvoScannerModel truth = DefaultGalvoScannerModel();
   const FlatViewport cad = Perturbed(truth.laser.viewport, 0.002, 1.0 * kDeg, 2);
   const auto start = std::chrono::steady_clock::now();
   const LaserViewportCalibrationResult result =
@@ -153,7 +153,7 @@ TEST(LaserViewportCalibrationTest, NoisyPointsLandWithinTheirStandardDeviations)
 
 // (c) Started 5 mm / 2 degrees from the truth: the same answer as started from the truth.
 TEST(LaserViewportCalibrationTest, ConvergesFromAPoorStart) {
-  const ScannerModel truth = DefaultScannerModel();
+  const GalvoScannerModel truth = DefaultGalvoScannerModel();
   for (double noise_m : {0.0, 1e-4}) {
     const std::vector<LaserCalibrationPoint> points = Points(truth, noise_m, 3);
     const LaserViewportCalibrationResult from_truth = CalibrateLaserViewport(truth, points, RefineAll());
@@ -179,7 +179,7 @@ TEST(LaserViewportCalibrationTest, ConvergesFromAPoorStart) {
 }
 
 TEST(LaserViewportCalibrationTest, HeldThicknessStaysPut) {
-  const ScannerModel truth = DefaultScannerModel();
+  const GalvoScannerModel truth = DefaultGalvoScannerModel();
   FlatViewport cad = Perturbed(truth.laser.viewport, 0.003, 1.0 * kDeg, 4);
   cad.thickness_m = truth.laser.viewport.thickness_m;
   LaserViewportCalibrationOptions options;
@@ -193,7 +193,7 @@ TEST(LaserViewportCalibrationTest, HeldThicknessStaysPut) {
 }
 
 TEST(LaserViewportCalibrationTest, RejectsBadInput) {
-  const ScannerModel truth = DefaultScannerModel();
+  const GalvoScannerModel truth = DefaultGalvoScannerModel();
   std::vector<LaserCalibrationPoint> points = Points(truth, 0.0, 5);
   LaserViewportCalibrationOptions options;
   options.max_iterations = 0;
@@ -225,15 +225,15 @@ double MaxFanGap(const GalvoLaser& a, const GalvoLaser& b) {
 // image, so the emitter stays at the CAD's, here 2 mm off in its plane), then the viewport
 // under water, which absorbs part of what that emitter error does to the in-water fans.
 TEST(LaserViewportCalibrationTest, AbsorbsPartOfTheInAirCalibrationsEmitterError) {
-  const ScannerModel truth = DefaultScannerModel();
-  ScannerModel in_air = truth;
+  const GalvoScannerModel truth = DefaultGalvoScannerModel();
+  GalvoScannerModel in_air = truth;
   in_air.laser.viewport.n_water = in_air.camera.viewport.n_water = 1.0;
   GalvoLaser cad = truth.laser;
   cad.T_C_L.translation() += Eigen::Vector3d(0.002, 0.0, 0.0);  // along the central ray
   const GalvoLaserCalibrationResult in_air_result =
       CalibrateGalvoLaser(Points(in_air, 0.0, 6), cad);
   ASSERT_FALSE(in_air_result.emitter_from_edge_rays);
-  ScannerModel model = truth;
+  GalvoScannerModel model = truth;
   model.laser = in_air_result.laser;
   const double gap_true_viewport = MaxFanGap(truth.laser, model.laser);
   model.laser.viewport = Perturbed(truth.laser.viewport, 0.005, 2.0 * kDeg, 6);  // the CAD

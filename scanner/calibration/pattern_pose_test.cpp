@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -27,7 +27,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // The default scanner's camera and viewport, with the viewport tilted by ~1.4 degrees so that
 // nothing relies on the normal being the optical axis.
 RefractiveCamera TestCamera() {
-  RefractiveCamera camera = DefaultScannerModel().camera;
+  RefractiveCamera camera = DefaultGalvoScannerModel().camera;
   camera.viewport.normal = Eigen::Vector3d(0.02, -0.015, 1.0).normalized();
   return camera;
 }

@@ -11,16 +11,16 @@
 #include <opencv2/imgproc.hpp>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
 
-RefractiveCamera WaterCamera() { return DefaultScannerModel().camera; }
+RefractiveCamera WaterCamera() { return DefaultGalvoScannerModel().camera; }
 
 // The same camera in air with the viewport index-matched: rays go straight through.
 RefractiveCamera AirCamera() {
-  RefractiveCamera camera = DefaultScannerModel().camera;
+  RefractiveCamera camera = DefaultGalvoScannerModel().camera;
   camera.viewport.n_glass = 1.0;
   camera.viewport.n_water = 1.0;
   return camera;

@@ -16,7 +16,7 @@
 
 #include "scanner/common/error.hpp"
 #include "scanner/optics/refractive_camera.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -27,7 +27,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // centre, n_water 1.33) with the normal tilted by ~1.4 degrees, a realistic mounting error
 // that keeps the problem generic (a normal exactly on the optical axis is a special case).
 RefractiveCamera TrueCamera() {
-  RefractiveCamera camera = DefaultScannerModel().camera;
+  RefractiveCamera camera = DefaultGalvoScannerModel().camera;
   camera.viewport.normal = Eigen::Vector3d(0.02, -0.015, 1.0).normalized();
   camera.viewport.n_water = 1.33;
   return camera;

@@ -59,6 +59,12 @@ int Integer(const Context& where, const YAML::Node& node, const std::string& key
   return value;
 }
 
+std::string Text(const Context& where, const YAML::Node& node, const std::string& key) {
+  const YAML::Node child = Child(where, node, key);
+  if (!child.IsScalar()) Fail(Enter(where, key), child, "expected text");
+  return child.Scalar();
+}
+
 Eigen::VectorXd Vector(const Context& where, const YAML::Node& node, const std::string& key,
                        int size) {
   const Context here = Enter(where, key);

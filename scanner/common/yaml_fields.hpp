@@ -26,6 +26,8 @@ double Number(const Context& where, const YAML::Node& node, const std::string& k
 double NumberOr(const Context& where, const YAML::Node& node, const std::string& key,
                 double fallback);
 int Integer(const Context& where, const YAML::Node& node, const std::string& key);
+// A scalar read as text (numbers included, as written).
+std::string Text(const Context& where, const YAML::Node& node, const std::string& key);
 Eigen::Vector3d Vector3(const Context& where, const YAML::Node& node, const std::string& key);
 Eigen::VectorXd Vector(const Context& where, const YAML::Node& node, const std::string& key,
                        int size);

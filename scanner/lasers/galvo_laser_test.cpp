@@ -12,14 +12,14 @@
 
 #include "scanner/common/error.hpp"
 #include "scanner/optics/refraction.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-GalvoLaser DefaultLaser() { return DefaultScannerModel().laser; }
+GalvoLaser DefaultLaser() { return DefaultGalvoScannerModel().laser; }
 
 double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b));

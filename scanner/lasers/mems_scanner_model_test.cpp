@@ -8,7 +8,8 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -38,9 +39,16 @@ std::string Edited(std::string text, const std::string& from, const std::string&
   return text.replace(at, from.size(), to);
 }
 
+// The default scanner's file with its fitted functions written out, as a calibration writes them.
+std::string TextWithFunctions() {
+  Scanner scanner = DefaultScanner(ScannerKind::kMems);
+  scanner.mems().functions_from_file = true;
+  return ScannerToYaml(scanner);
+}
+
 std::string ParseError(const std::string& text) {
   try {
-    ParseMemsScannerModel(text, kSource);
+    ParseScanner(text, kSource).mems();
   } catch (const Error& e) {
     return e.what();
   }
@@ -50,14 +58,14 @@ std::string ParseError(const std::string& text) {
 
 TEST(MemsScannerModel, DefaultFileIsTheCompiledInDefault) {
   const MemsScannerModel compiled = DefaultMemsScannerModel();
-  const MemsScannerModel loaded = LoadMemsScannerModel(
-      std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scanners/mems_default.yaml");
+  const MemsScannerModel loaded = LoadScanner(
+      std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scanners/mems_default.yaml").mems();
   EXPECT_NO_THROW(compiled.Check());
   EXPECT_EQ(compiled.laser.emitter_origin_C, loaded.laser.emitter_origin_C);
   EXPECT_EQ(compiled.laser.T_C_M.matrix(), loaded.laser.T_C_M.matrix());
   EXPECT_EQ(compiled.functions.f3.coefficients(), loaded.functions.f3.coefficients());
   // The camera is the galvanometer default's.
-  const ScannerModel galvo = DefaultScannerModel();
+  const GalvoScannerModel galvo = DefaultGalvoScannerModel();
   EXPECT_EQ(compiled.camera.camera.fx_px, galvo.camera.camera.fx_px);
   EXPECT_EQ(compiled.camera.viewport.distance_m, galvo.camera.viewport.distance_m);
   // Dynamics as in the file, and without projection_functions the ideal calibration.
@@ -68,8 +76,8 @@ TEST(MemsScannerModel, DefaultFileIsTheCompiledInDefault) {
 
 TEST(MemsScannerModel, ProjectionFunctionsRoundTripExactly) {
   const MemsScannerModel model = DefaultMemsScannerModel();
-  const std::string text = DefaultText() + ProjectionFunctionsToYaml(model.functions);
-  const MemsScannerModel read = ParseMemsScannerModel(text, kSource);
+  const MemsScannerModel read = ParseScanner(TextWithFunctions(), kSource).mems();
+  EXPECT_TRUE(read.functions_from_file);
   const Polynomial2d* a[6] = {&model.functions.f1, &model.functions.f2, &model.functions.f3,
                               &model.functions.f4, &model.functions.f5, &model.functions.f6};
   const Polynomial2d* b[6] = {&read.functions.f1, &read.functions.f2, &read.functions.f3,
@@ -131,8 +139,7 @@ TEST(MemsScannerModel, ErrorsNameTheLineAndTheField) {
 }
 
 TEST(MemsScannerModel, ProjectionFunctionErrorsNameTheField) {
-  const MemsScannerModel model = DefaultMemsScannerModel();
-  const std::string text = DefaultText() + ProjectionFunctionsToYaml(model.functions);
+  const std::string text = TextWithFunctions();
   // f3 with a coefficient too few.
   const std::size_t f3 = text.find("  f3:");
   const std::size_t list = text.find("coefficients: [", f3);

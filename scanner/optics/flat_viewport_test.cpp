@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -21,7 +21,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // The camera viewport of the default scanner, its normal tilted by `tilt_deg` about an axis
 // in the x-y plane at `axis_deg` from x.
 FlatViewport TiltedViewport(double tilt_deg, double axis_deg = 90.0) {
-  FlatViewport v = DefaultScannerModel().camera.viewport;
+  FlatViewport v = DefaultGalvoScannerModel().camera.viewport;
   const Eigen::Vector3d axis(std::cos(axis_deg * kDeg), std::sin(axis_deg * kDeg), 0.0);
   v.normal = Eigen::AngleAxisd(tilt_deg * kDeg, axis) * Eigen::Vector3d::UnitZ();
   return v;
@@ -45,8 +45,8 @@ double DistanceToLine(const Eigen::Vector3d& p, const Ray& line) {
 }
 
 TEST(FlatViewportTest, DefaultViewportsPassCheck) {
-  EXPECT_NO_THROW(DefaultScannerModel().camera.viewport.Check());
-  EXPECT_NO_THROW(DefaultScannerModel().laser.viewport.Check());
+  EXPECT_NO_THROW(DefaultGalvoScannerModel().camera.viewport.Check());
+  EXPECT_NO_THROW(DefaultGalvoScannerModel().laser.viewport.Check());
   FlatViewport v = TiltedViewport(0.0);
   v.normal = Eigen::Vector3d(0.0, 0.0, 2.0);
   EXPECT_THROW(v.Check(), Error);
@@ -152,7 +152,7 @@ TEST(FlatViewportTest, DirectionThroughViewportInvertsTraceOut) {
                      "camera viewport tilted " + std::to_string(tilt_deg)});
   }
   // The laser viewport of the default scanner (toed in by 15 deg), seen from the mirror.
-  const ScannerModel scanner = DefaultScannerModel();
+  const GalvoScannerModel scanner = DefaultGalvoScannerModel();
   cases.push_back({scanner.laser.viewport, scanner.laser.T_C_M.translation(), "laser viewport"});
   FlatViewport thick = TiltedViewport(25.0, 0.0);
   thick.thickness_m = 0.08;

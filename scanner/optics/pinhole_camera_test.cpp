@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner {
 namespace {
 
-PinholeCamera DefaultCamera() { return DefaultScannerModel().camera.camera; }
+PinholeCamera DefaultCamera() { return DefaultGalvoScannerModel().camera.camera; }
 
 // A wide-angle camera with much stronger barrel distortion than the default one, still
 // invertible over its whole image.

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -56,7 +56,7 @@ double MaxRoundTripErrorPx(const RefractiveCamera& camera) {
 
 // Measured: max round-trip error 9.3e-13 px over the whole image (default scanner camera).
 TEST(RefractiveCameraTest, RoundTripOverWholeImageDefaultCamera) {
-  const RefractiveCamera camera = DefaultScannerModel().camera;
+  const RefractiveCamera camera = DefaultGalvoScannerModel().camera;
   ASSERT_NO_THROW(camera.Check());
   const double max_error_px = MaxRoundTripErrorPx(camera);
   std::cout << "[ measured ] default camera: max pixel round-trip error " << max_error_px
@@ -65,7 +65,7 @@ TEST(RefractiveCameraTest, RoundTripOverWholeImageDefaultCamera) {
 
 // Measured: max round-trip error 1.4e-12 px over the whole image (viewport tilted 20 deg).
 TEST(RefractiveCameraTest, RoundTripOverWholeImageViewportTilted20Deg) {
-  RefractiveCamera camera = DefaultScannerModel().camera;
+  RefractiveCamera camera = DefaultGalvoScannerModel().camera;
   camera.viewport.normal =
       Eigen::AngleAxisd(20.0 * kDeg, Eigen::Vector3d(0.6, 0.8, 0.0)) * Eigen::Vector3d::UnitZ();
   ASSERT_NO_THROW(camera.Check());
@@ -75,14 +75,14 @@ TEST(RefractiveCameraTest, RoundTripOverWholeImageViewportTilted20Deg) {
 }
 
 TEST(RefractiveCameraTest, PointsNotInFrontOfTheViewportDoNotProject) {
-  const RefractiveCamera camera = DefaultScannerModel().camera;
+  const RefractiveCamera camera = DefaultGalvoScannerModel().camera;
   EXPECT_FALSE(camera.ProjectPointInWater({0.1, 0.0, 0.02}).has_value());   // in the housing
   EXPECT_FALSE(camera.ProjectPointInWater({0.1, 0.0, 0.035}).has_value());  // in the glass
   EXPECT_FALSE(camera.ProjectPointInWater({0.1, 0.0, -1.0}).has_value());   // behind
 }
 
 TEST(RefractiveCameraTest, CheckRequiresTheCameraCentreInsideTheHousing) {
-  RefractiveCamera camera = DefaultScannerModel().camera;
+  RefractiveCamera camera = DefaultGalvoScannerModel().camera;
   camera.viewport.distance_m = -0.01;
   EXPECT_THROW(camera.Check(), Error);
 }

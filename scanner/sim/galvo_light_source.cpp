@@ -1,6 +1,6 @@
 #include <memory>
 
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/sim/light_source.hpp"
 
 namespace uwscan::scanner::sim {
@@ -8,7 +8,7 @@ namespace {
 
 class GalvoLightSource final : public LightSource {
  public:
-  GalvoLightSource(ScannerModel model, const GalvoScan& scan) : model_(std::move(model)), scan_(scan) {
+  GalvoLightSource(GalvoScannerModel model, const GalvoScan& scan) : model_(std::move(model)), scan_(scan) {
     scan_.Check();
   }
   const RefractiveCamera& camera() const override { return model_.camera; }
@@ -28,16 +28,14 @@ class GalvoLightSource final : public LightSource {
   }
 
  private:
-  ScannerModel model_;
+  GalvoScannerModel model_;
   GalvoScan scan_;
 };
 
 }  // namespace
 
-std::unique_ptr<LightSource> MakeGalvoLightSource(const std::string& scanner_yaml,
-                                                  const std::string& source_name,
-                                                  const GalvoScan& scan) {
-  return std::make_unique<GalvoLightSource>(ParseScannerModel(scanner_yaml, source_name), scan);
+std::unique_ptr<LightSource> MakeGalvoLightSource(const GalvoScannerModel& model, const GalvoScan& scan) {
+  return std::make_unique<GalvoLightSource>(model, scan);
 }
 
 }  // namespace uwscan::scanner::sim

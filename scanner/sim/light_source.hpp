@@ -1,9 +1,10 @@
 #pragma once
 
 #include <memory>
-#include <string>
 
 #include "scanner/optics/refractive_camera.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/sim/stripe_tracer.hpp"
 
@@ -22,16 +23,13 @@ class LightSource {
   virtual LaserPath PathOfFrame(int frame_in_sweep) const = 0;
 };
 
-// The galvanometer scanner of `scanner_yaml` (seed 000) swept as `scan` says.
-std::unique_ptr<LightSource> MakeGalvoLightSource(const std::string& scanner_yaml,
-                                                  const std::string& source_name,
-                                                  const GalvoScan& scan);
+// The galvanometer scanner `model` (seed 000) swept as `scan` says.
+std::unique_ptr<LightSource> MakeGalvoLightSource(const GalvoScannerModel& model, const GalvoScan& scan);
 
-// The MEMS scanner of `scanner_yaml` (seed 001) drawing the scan pattern `scan`, its mirror
+// The MEMS scanner `model` (seed 001) drawing the scan pattern `scan`, its mirror
 // following the ideal path between waypoints or, with `mirror_dynamics`, its filtered and
 // resonant response.
-std::unique_ptr<LightSource> MakeMemsLightSource(const std::string& scanner_yaml,
-                                                 const std::string& source_name,
-                                                 const MemsScan& scan, bool mirror_dynamics);
+std::unique_ptr<LightSource> MakeMemsLightSource(const MemsScannerModel& model, const MemsScan& scan,
+                                                 bool mirror_dynamics);
 
 }  // namespace uwscan::scanner::sim

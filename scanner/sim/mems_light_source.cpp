@@ -84,11 +84,9 @@ class MemsLightSource final : public LightSource {
 
 }  // namespace
 
-std::unique_ptr<LightSource> MakeMemsLightSource(const std::string& scanner_yaml,
-                                                 const std::string& source_name,
-                                                 const MemsScan& scan, bool mirror_dynamics) {
-  return std::make_unique<MemsLightSource>(ParseMemsScannerModel(scanner_yaml, source_name), scan,
-                                           mirror_dynamics);
+std::unique_ptr<LightSource> MakeMemsLightSource(const MemsScannerModel& model, const MemsScan& scan,
+                                                 bool mirror_dynamics) {
+  return std::make_unique<MemsLightSource>(model, scan, mirror_dynamics);
 }
 
 }  // namespace uwscan::scanner::sim

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/scene_fields.hpp"
 #include "scanner/sim/scene_objects.hpp"
 #include "scanner/common/yaml_fields.hpp"
@@ -87,30 +87,16 @@ SceneScanner ReadScanner(const Context& where, const YAML::Node& node,
   s.file = Resolve(base_dir, String(where, node, "file"));
   const std::optional<std::string> text = ReadText(s.file);
   if (!text) FailField(where, node, "file", "cannot read scanner file '" + s.file.string() + "'");
-  s.yaml_text = *text;
-  YAML::Node parsed;
-  try {
-    parsed = YAML::Load(s.yaml_text);
-  } catch (const YAML::Exception& e) {
-    FailField(where, node, "file",
-              "scanner file '" + s.file.string() + "' is not valid YAML (line " +
-                  std::to_string(e.mark.line + 1) + ": " + e.msg + ")");
-  }
-  const YAML::Node& root = parsed;
-  if (!root.IsMap()) {
-    FailField(where, node, "file", "scanner file '" + s.file.string() + "' is not a YAML mapping");
-  }
-  s.kind = root["mems"].IsDefined() ? ScannerKind::kMems : ScannerKind::kGalvo;
-  if (s.kind == ScannerKind::kGalvo) {
+  // Read in full now: a broken scanner file should stop the scene, naming its own line.
+  s.model = ParseScanner(*text, s.file.string());
+  if (s.model.kind() == ScannerKind::kGalvo) {
     if (Has(node, "mems")) {
       FailField(where, node, "mems",
                 "the scanner file has no top-level 'mems:', so it is a galvanometer scanner: "
                 "give scanner.galvo instead");
     }
-    // Read in full now: a broken scanner file should stop the scene, naming its own line.
-    const ScannerModel model = ParseScannerModel(s.yaml_text, s.file.string());
     const YAML::Node galvo = Has(node, "galvo") ? node["galvo"] : YAML::Node(YAML::NodeType::Map);
-    s.galvo = ReadGalvo(yaml::Enter(where, "galvo"), galvo, model.laser);
+    s.galvo = ReadGalvo(yaml::Enter(where, "galvo"), galvo, s.model.galvo().laser);
   } else {
     if (Has(node, "galvo")) {
       FailField(where, node, "galvo",

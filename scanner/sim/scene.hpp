@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/lasers/scanner.hpp"
 #include "scanner/sim/effects.hpp"
 #include "scanner/sim/trajectory.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
@@ -55,9 +56,8 @@ using ::uwscan::scanner::MemsScan;
 using ::uwscan::scanner::ScannerKind;
 
 struct SceneScanner {
-  std::filesystem::path file;  // the scanner YAML the scene names (resolved path)
-  std::string yaml_text;       // its contents, kept so the dive log can store them
-  ScannerKind kind = ScannerKind::kGalvo;  // kMems when the file has a `mems:` section
+  std::filesystem::path file;  // the scanner file the scene names (resolved path), for messages
+  Scanner model;               // read from it when the scene is read
   GalvoScan galvo;
   MemsScan mems;
   int sweeps = 1;  // sweeps simulated; with a moving trajectory, sweep after sweep

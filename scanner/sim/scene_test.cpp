@@ -11,6 +11,7 @@
 
 #include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {
@@ -49,11 +50,11 @@ TEST(SceneParse, MinimalSceneTakesDefaults) {
   EXPECT_EQ(s.source, "scene.yaml");
   EXPECT_EQ(s.seed, 1u);
   EXPECT_EQ(s.water.refractive_index, 1.33);
-  EXPECT_EQ(s.scanner.kind, ScannerKind::kGalvo);
+  EXPECT_EQ(s.scanner.model.kind(), ScannerKind::kGalvo);
   EXPECT_EQ(s.scanner.galvo.step_min, -100);  // the laser's range
   EXPECT_EQ(s.scanner.galvo.step_max, 100);
   EXPECT_EQ(s.scanner.sweeps, 1);
-  EXPECT_NE(s.scanner.yaml_text.find("laser_viewport:"), std::string::npos);
+  EXPECT_EQ(s.scanner.model.laser_viewport().thickness_m, DefaultGalvoScannerModel().laser.viewport.thickness_m);
   ASSERT_EQ(s.trajectory.poses.size(), 1u);
   EXPECT_TRUE(s.trajectory.T_W_C(0.0).isApprox(Eigen::Isometry3d::Identity()));
   ASSERT_EQ(s.objects.size(), 1u);
@@ -248,13 +249,13 @@ TEST(SceneParse, MissingScannerFileNamesFieldAndPath) {
 }
 
 TEST(SceneParse, MemsScannerFromTheFile) {
-  // Only the top-level `mems:` key decides the kind; the MEMS scanner's own reader checks the
-  // rest of the file.
+  // The top-level `mems:` key decides the kind; the whole file is read with the scene.
   const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "uwscan_scene_mems";
   std::filesystem::create_directories(dir);
   {
     std::ofstream out(dir / "mems.yaml");
-    out << "uwscan_format: 1\nmems: {}\n";
+    std::ifstream in(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/mems_default.yaml");
+    out << in.rdbuf();
   }
   const std::string body = std::string(kPlaneObject);
   const Scene s = ParseScene(
@@ -262,7 +263,7 @@ TEST(SceneParse, MemsScannerFromTheFile) {
       "fov_fraction: [0.5, 1]}\n" +
           body,
       "scene.yaml", dir);
-  EXPECT_EQ(s.scanner.kind, ScannerKind::kMems);
+  EXPECT_EQ(s.scanner.model.kind(), ScannerKind::kMems);
   EXPECT_EQ(s.scanner.mems.lines, 20);
   EXPECT_EQ(s.scanner.mems.waypoints_per_line, 30);
   EXPECT_EQ(s.scanner.mems.fov_fraction_x, 0.5);

@@ -30,27 +30,24 @@ std::uint64_t FrameSeed(std::uint64_t scene_seed, std::int64_t index) {
   return (static_cast<std::uint64_t>(words[0]) << 32) | words[1];
 }
 
-std::unique_ptr<LightSource> MakeLightSource(const Scene& scene, const std::string& yaml) {
-  const std::string name = scene.scanner.file.string();
-  if (scene.scanner.kind == ScannerKind::kGalvo) {
-    return MakeGalvoLightSource(yaml, name, scene.scanner.galvo);
-  }
-  return MakeMemsLightSource(yaml, name, scene.scanner.mems, scene.effects.mirror_dynamics);
+std::unique_ptr<LightSource> MakeLightSource(const Scene& scene, const Scanner& scanner) {
+  if (scanner.kind() == ScannerKind::kGalvo) return MakeGalvoLightSource(scanner.galvo(), scene.scanner.galvo);
+  return MakeMemsLightSource(scanner.mems(), scene.scanner.mems, scene.effects.mirror_dynamics);
 }
 
 }  // namespace
 
 struct Simulator::Impl {
   Scene scene;
-  std::string scanner_yaml;
+  Scanner scanner;
   std::unique_ptr<LightSource> source;
   RayCaster caster;
   StripeTracer tracer;
 
   explicit Impl(const Scene& s)
       : scene(s),
-        scanner_yaml(EffectiveScannerYaml(s)),
-        source(MakeLightSource(s, scanner_yaml)),
+        scanner(EffectiveScanner(s)),
+        source(MakeLightSource(s, scanner)),
         caster(s.objects),
         tracer(source->camera(), caster,
                StripeTraceOptions{s.detector.axis, s.effects.occlusion, 25.0}) {}
@@ -81,12 +78,12 @@ Simulator::Simulator(const Scene& scene) : impl_(std::make_unique<Impl>(scene)) 
 Simulator::~Simulator() = default;
 
 const Scene& Simulator::scene() const { return impl_->scene; }
-const std::string& Simulator::scanner_yaml() const { return impl_->scanner_yaml; }
+const Scanner& Simulator::scanner() const { return impl_->scanner; }
 double Simulator::frame_period_s() const { return impl_->source->frame_period_s(); }
 
 ScanPattern Simulator::scan_pattern() const {
   ScanPattern pattern;
-  pattern.kind = impl_->scene.scanner.kind;
+  pattern.kind = impl_->scanner.kind();
   pattern.galvo = impl_->scene.scanner.galvo;
   pattern.mems = impl_->scene.scanner.mems;
   return pattern;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/lasers/scanner.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/stripe/stripe_render.hpp"
 
@@ -53,9 +54,9 @@ class Simulator {
   std::vector<NavigationSample> Navigation(double rate_hz) const;
 
   const Scene& scene() const;
-  // The scanner configuration the dive was simulated with (see EffectiveScannerYaml) and the
-  // scan pattern: together, what reconstruction needs.
-  const std::string& scanner_yaml() const;
+  // The scanner the dive was simulated with (see EffectiveScanner) and the scan pattern:
+  // together, what reconstruction needs.
+  const Scanner& scanner() const;
   ScanPattern scan_pattern() const;
   double frame_period_s() const;
 

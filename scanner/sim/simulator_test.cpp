@@ -9,17 +9,10 @@
 #include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/triangulation/triangulator_factory.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {
-
-std::string ReadSourceFile(const std::string& relative) {
-  const std::string path = std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/" + relative;
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 Eigen::Isometry3d At(double x, double y, double z) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -33,8 +26,7 @@ Scene GalvoScene() {
   Scene scene;
   scene.source = "test scene";
   scene.scanner.file = "data/scanners/galvo_default.yaml";
-  scene.scanner.yaml_text = ReadSourceFile("data/scanners/galvo_default.yaml");
-  scene.scanner.kind = ScannerKind::kGalvo;
+  scene.scanner.model = LoadScanner(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/galvo_default.yaml");
   scene.scanner.galvo.step_stride = 10;
   scene.trajectory.poses.push_back({0.0, Eigen::Isometry3d::Identity()});
   scene.detector.axis = StripeAxis::kRows;
@@ -68,7 +60,7 @@ struct Recovery {
 
 Recovery Reconstruct(const Simulator& simulator, TriangulationMethod method) {
   const std::unique_ptr<Triangulator> triangulator =
-      MakeTriangulator(simulator.scanner_yaml(), "test", simulator.scan_pattern(), method);
+      MakeTriangulator(simulator.scanner(), simulator.scan_pattern(), method);
   Recovery r;
   for (std::int64_t i = 0; i < simulator.frame_count(); ++i) {
     const SimulatedFrame frame = simulator.Frame(i);
@@ -311,8 +303,7 @@ Scene MemsScene(int waypoints_per_line) {
   Scene scene;
   scene.source = "test MEMS scene";
   scene.scanner.file = "data/scanners/mems_default.yaml";
-  scene.scanner.yaml_text = ReadSourceFile("data/scanners/mems_default.yaml");
-  scene.scanner.kind = ScannerKind::kMems;
+  scene.scanner.model = LoadScanner(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/mems_default.yaml");
   scene.scanner.mems.lines = 12;
   scene.scanner.mems.waypoints_per_line = waypoints_per_line;
   scene.trajectory.poses.push_back({0.0, Eigen::Isometry3d::Identity()});
@@ -333,8 +324,7 @@ TEST(SimulatorMems, LinesBecomePlanesInWaterToTheDesignsPrecision) {
   // Seed 001: the pre-curved lines are planes in water up to the pattern's planarity (tens of
   // micrometres here) and the fitted projection functions' error.
   EXPECT_LT(r.max_error_m, 3e-4);
-  EXPECT_THROW(MakeTriangulator(simulator.scanner_yaml(), "test", simulator.scan_pattern(),
-                                TriangulationMethod::kRayRay),
+  EXPECT_THROW(MakeTriangulator(simulator.scanner(), simulator.scan_pattern(), TriangulationMethod::kRayRay),
                Error);
 }
 

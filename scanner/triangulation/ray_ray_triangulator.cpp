@@ -43,7 +43,7 @@ TriangulatedPoint MidpointOfCommonPerpendicular(const Ray& cam, const Ray& laser
 
 }  // namespace
 
-RayRayTriangulator::RayRayTriangulator(const ScannerModel& model,
+RayRayTriangulator::RayRayTriangulator(const GalvoScannerModel& model,
                                        const TriangulationOptions& options, int fan_samples)
     : model_(model) {
   model_.Check();

@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/triangulation/surface_triangulators.hpp"
 #include "scanner/triangulation/triangulator.hpp"
 
@@ -19,7 +19,7 @@ namespace uwscan::scanner {
 class RayRayTriangulator final : public Triangulator {
  public:
   // fan_samples: rays per step in the bracketing table (>= 3).
-  RayRayTriangulator(const ScannerModel& model, const TriangulationOptions& options = {},
+  RayRayTriangulator(const GalvoScannerModel& model, const TriangulationOptions& options = {},
                      int fan_samples = 129);
   TriangulationMethod method() const override { return TriangulationMethod::kRayRay; }
   void TriangulateFrame(int mirror_step, std::span<const Eigen::Vector2d> peaks_px,
@@ -44,7 +44,7 @@ class RayRayTriangulator final : public Triangulator {
   };
   const StepFan* FanOf(int step) const;
 
-  ScannerModel model_;
+  GalvoScannerModel model_;
   double min_sin2_angle_;
   std::vector<StepFan> steps_;
 };

@@ -15,7 +15,7 @@ namespace uwscan::scanner {
 namespace {
 
 // An exact point of the laser fan at a given camera depth.
-std::optional<Eigen::Vector3d> FanPoint(const ScannerModel& model, int step, double fan_angle_rad,
+std::optional<Eigen::Vector3d> FanPoint(const GalvoScannerModel& model, int step, double fan_angle_rad,
                                         double depth_m) {
   const RayTrace ray = model.laser.FanAtStep(step).RayInWater(std::tan(fan_angle_rad));
   if (!ray.ok() || ray.ray.direction.z() <= 0.0) return std::nullopt;
@@ -23,7 +23,7 @@ std::optional<Eigen::Vector3d> FanPoint(const ScannerModel& model, int step, dou
 }
 
 // The exact camera ray in water through a point, whether or not it falls inside the image.
-Ray ExactCameraRay(const ScannerModel& model, const Eigen::Vector3d& p_C) {
+Ray ExactCameraRay(const GalvoScannerModel& model, const Eigen::Vector3d& p_C) {
   const DirectionResult dir =
       DirectionThroughViewport(model.camera.viewport, Eigen::Vector3d::Zero(), p_C);
   EXPECT_TRUE(dir.ok());
@@ -35,7 +35,7 @@ Ray ExactCameraRay(const ScannerModel& model, const Eigen::Vector3d& p_C) {
 class TriangulationTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    model_ = std::make_unique<ScannerModel>(DefaultScannerModel());
+    model_ = std::make_unique<GalvoScannerModel>(DefaultGalvoScannerModel());
     rays_ = std::make_shared<const CameraRayTable>(model_->camera, 4);
     surfaces_ = std::make_shared<const LightSurfaceTable>(model_->laser, LightSurfaceTableOptions{});
   }
@@ -60,11 +60,11 @@ class TriangulationTest : public ::testing::Test {
     ASSERT_EQ(std::ssize(*px), count);
   }
 
-  static std::unique_ptr<ScannerModel> model_;
+  static std::unique_ptr<GalvoScannerModel> model_;
   static std::shared_ptr<const CameraRayTable> rays_;
   static std::shared_ptr<const LightSurfaceTable> surfaces_;
 };
-std::unique_ptr<ScannerModel> TriangulationTest::model_;
+std::unique_ptr<GalvoScannerModel> TriangulationTest::model_;
 std::shared_ptr<const CameraRayTable> TriangulationTest::rays_;
 std::shared_ptr<const LightSurfaceTable> TriangulationTest::surfaces_;
 

@@ -3,19 +3,15 @@
 #include "scanner/optics/camera_ray_table.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/mems_scan_pattern.hpp"
-#include "scanner/lasers/mems_scanner_model.hpp"
 #include "scanner/triangulation/plane_table_triangulator.hpp"
 #include "scanner/triangulation/ray_ray_triangulator.hpp"
-#include "scanner/lasers/scanner_model.hpp"
 #include "scanner/triangulation/surface_triangulators.hpp"
 
 namespace uwscan::scanner {
 namespace {
 
-std::unique_ptr<Triangulator> MakeGalvoTriangulator(const std::string& scanner_yaml,
-                                                    const std::string& source_name,
+std::unique_ptr<Triangulator> MakeGalvoTriangulator(const GalvoScannerModel& model,
                                                     TriangulationMethod method) {
-  const ScannerModel model = ParseScannerModel(scanner_yaml, source_name);
   if (method == TriangulationMethod::kRayRay) return std::make_unique<RayRayTriangulator>(model);
   auto rays = std::make_shared<const CameraRayTable>(model.camera);
   auto surfaces = std::make_shared<const LightSurfaceTable>(model.laser, LightSurfaceTableOptions{});
@@ -25,14 +21,12 @@ std::unique_ptr<Triangulator> MakeGalvoTriangulator(const std::string& scanner_y
   return std::make_unique<RayConeTriangulator>(rays, surfaces);
 }
 
-std::unique_ptr<Triangulator> MakeMemsTriangulator(const std::string& scanner_yaml,
-                                                   const std::string& source_name,
-                                                   const MemsScan& scan, TriangulationMethod method) {
+std::unique_ptr<Triangulator> MakeMemsTriangulator(const MemsScannerModel& model, const MemsScan& scan,
+                                                   TriangulationMethod method) {
   if (method != TriangulationMethod::kRayPlane) {
-    throw Error(source_name + ": the MEMS scanner triangulates with the planes of its lines only "
-                "(seed 001); method '" + std::string(ToString(method)) + "' needs a galvanometer scanner");
+    throw Error("the MEMS scanner triangulates with the planes of its lines only (seed 001); method '" +
+                std::string(ToString(method)) + "' needs a galvanometer scanner");
   }
-  const MemsScannerModel model = ParseMemsScannerModel(scanner_yaml, source_name);
   MemsScanPatternOptions pattern;
   pattern.lines = scan.lines;
   pattern.waypoints_per_line = scan.waypoints_per_line;
@@ -52,15 +46,15 @@ TriangulationMethod DefaultTriangulationMethod(ScannerKind kind) {
   return kind == ScannerKind::kGalvo ? TriangulationMethod::kRayCone : TriangulationMethod::kRayPlane;
 }
 
-std::unique_ptr<Triangulator> MakeTriangulator(const std::string& scanner_yaml,
-                                               const std::string& source_name,
-                                               const ScanPattern& pattern,
+std::unique_ptr<Triangulator> MakeTriangulator(const Scanner& scanner, const ScanPattern& pattern,
                                                TriangulationMethod method) {
   pattern.Check();
-  if (pattern.kind == ScannerKind::kGalvo) {
-    return MakeGalvoTriangulator(scanner_yaml, source_name, method);
+  if (pattern.kind != scanner.kind()) {
+    throw Error(std::string("the scan pattern is for a ") + ToString(pattern.kind) + " scanner, the scanner is " +
+                ToString(scanner.kind()));
   }
-  return MakeMemsTriangulator(scanner_yaml, source_name, pattern.mems, method);
+  if (pattern.kind == ScannerKind::kGalvo) return MakeGalvoTriangulator(scanner.galvo(), method);
+  return MakeMemsTriangulator(scanner.mems(), pattern.mems, method);
 }
 
 }  // namespace uwscan::scanner

@@ -4,17 +4,15 @@
 #include <string>
 
 #include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/lasers/scanner.hpp"
 #include "scanner/triangulation/triangulator.hpp"
 
 namespace uwscan::scanner {
 
-// Builds the triangulator of `method` for a scanner configuration (galvanometer or MEMS YAML)
-// and its scan pattern, with every per-calibration table (camera rays, a plane and a cone per
+// Builds the triangulator of `method` for a scanner (galvanometer or MEMS) and its scan pattern, with every per-calibration table (camera rays, a plane and a cone per
 // mirror step, a plane per MEMS line) computed here, once. The MEMS scanner triangulates with
 // the planes of its lines only (seed 001); other methods are an error naming the method.
-std::unique_ptr<Triangulator> MakeTriangulator(const std::string& scanner_yaml,
-                                               const std::string& source_name,
-                                               const ScanPattern& pattern,
+std::unique_ptr<Triangulator> MakeTriangulator(const Scanner& scanner, const ScanPattern& pattern,
                                                TriangulationMethod method);
 
 // The method used when none is asked for: ray-cone for the galvanometer scanner (exact to

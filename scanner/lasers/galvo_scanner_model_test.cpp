@@ -1,4 +1,4 @@
-#include "scanner/lasers/scanner_model.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -66,7 +67,7 @@ std::string Edited(const std::string& from, const std::string& to) {
 // The message of the uwscan::Error that parsing `text` throws ("" and a failure if none).
 std::string ParseError(const std::string& text) {
   try {
-    ParseScannerModel(text, kSource);
+    ParseScanner(text, kSource).galvo();
   } catch (const Error& e) {
     return e.what();
   } catch (const std::exception& e) {
@@ -86,9 +87,9 @@ void ExpectNamesLineAndField(const std::string& message, int line, const std::st
       << "expected field '" << field << "' in: " << message;
 }
 
-TEST(ScannerModelTest, DefaultScannerLoadsAndChecks) {
-  ScannerModel model;
-  ASSERT_NO_THROW(model = DefaultScannerModel());
+TEST(GalvoScannerModelTest, DefaultScannerLoadsAndChecks) {
+  GalvoScannerModel model;
+  ASSERT_NO_THROW(model = DefaultGalvoScannerModel());
   EXPECT_NO_THROW(model.Check());
   EXPECT_EQ(model.camera.camera.width_px, 2048);
   EXPECT_EQ(model.camera.camera.height_px, 1088);
@@ -101,9 +102,9 @@ TEST(ScannerModelTest, DefaultScannerLoadsAndChecks) {
   EXPECT_NEAR(model.laser.viewport.normal.norm(), 1.0, 1e-15);
 }
 
-TEST(ScannerModelTest, ValidTextParsesToTheDefaultScanner) {
-  const ScannerModel parsed = ParseScannerModel(kValidYaml, kSource);
-  const ScannerModel expected = DefaultScannerModel();
+TEST(GalvoScannerModelTest, ValidTextParsesToTheDefaultScanner) {
+  const GalvoScannerModel parsed = ParseScanner(kValidYaml, kSource).galvo();
+  const GalvoScannerModel expected = DefaultGalvoScannerModel();
   EXPECT_DOUBLE_EQ(parsed.camera.camera.cy_px, expected.camera.camera.cy_px);
   EXPECT_TRUE(parsed.laser.T_C_M.isApprox(expected.laser.T_C_M, 1e-15));
   EXPECT_TRUE(parsed.laser.viewport.normal.isApprox(expected.laser.viewport.normal, 1e-15));
@@ -111,7 +112,7 @@ TEST(ScannerModelTest, ValidTextParsesToTheDefaultScanner) {
   EXPECT_DOUBLE_EQ(parsed.camera.viewport.n_water, FlatViewport{}.n_water);
 }
 
-TEST(ScannerModelTest, MissingFieldIsNamed) {
+TEST(GalvoScannerModelTest, MissingFieldIsNamed) {
   const std::string text = Edited("  fx_px: 1750.0\n", "");
   const std::string message = ParseError(text);
   EXPECT_NE(message.find("missing"), std::string::npos) << message;
@@ -119,14 +120,14 @@ TEST(ScannerModelTest, MissingFieldIsNamed) {
   ExpectNamesLineAndField(message, LineOf(text, "width_px"), "camera.fx_px");
 }
 
-TEST(ScannerModelTest, NonNumericValueIsNamedWithItsLine) {
+TEST(GalvoScannerModelTest, NonNumericValueIsNamedWithItsLine) {
   const std::string text = Edited("fx_px: 1750.0", "fx_px: \"abc\"");
   const std::string message = ParseError(text);
   ExpectNamesLineAndField(message, LineOf(text, "fx_px"), "camera.fx_px");
   EXPECT_NE(message.find("abc"), std::string::npos) << message;
 }
 
-TEST(ScannerModelTest, WrongLengthDistortionIsNamedWithItsLine) {
+TEST(GalvoScannerModelTest, WrongLengthDistortionIsNamedWithItsLine) {
   const std::string text =
       Edited("[-0.12, 0.08, 0.0005, -0.0003, -0.02]", "[-0.12, 0.08, 0.0, 0.0]");
   const std::string message = ParseError(text);
@@ -134,14 +135,14 @@ TEST(ScannerModelTest, WrongLengthDistortionIsNamedWithItsLine) {
   EXPECT_NE(message.find("5"), std::string::npos) << message;
 }
 
-TEST(ScannerModelTest, UnsupportedFormatVersionIsNamedWithItsLine) {
+TEST(GalvoScannerModelTest, UnsupportedFormatVersionIsNamedWithItsLine) {
   const std::string text = Edited("uwscan_format: 1", "uwscan_format: 2");
   const std::string message = ParseError(text);
   ExpectNamesLineAndField(message, 1, "uwscan_format");
   EXPECT_NE(message.find("2"), std::string::npos) << message;
 }
 
-TEST(ScannerModelTest, NonUnitQuaternionIsNamedWithItsLine) {
+TEST(GalvoScannerModelTest, NonUnitQuaternionIsNamedWithItsLine) {
   const std::string text =
       Edited("rotation_xyzw: [0.0, 1.0, 0.0, 0.0]", "rotation_xyzw: [0.0, 1.0, 0.0, 0.1]");
   const std::string message = ParseError(text);
@@ -149,7 +150,7 @@ TEST(ScannerModelTest, NonUnitQuaternionIsNamedWithItsLine) {
                           "laser.T_C_L.rotation_xyzw");
 }
 
-TEST(ScannerModelTest, NonUnitViewportNormalIsNamedWithItsLine) {
+TEST(GalvoScannerModelTest, NonUnitViewportNormalIsNamedWithItsLine) {
   const std::string text = Edited("normal: [0.0, 0.0, 1.0]", "normal: [0.0, 0.0, 1.1]");
   const std::string message = ParseError(text);
   ExpectNamesLineAndField(message, LineOf(text, "normal: [0.0, 0.0, 1.1]"),
@@ -164,7 +165,7 @@ TEST(ScannerModelTest, NonUnitViewportNormalIsNamedWithItsLine) {
                           "laser_viewport.normal");
 }
 
-TEST(ScannerModelTest, NonYamlGarbageNamesTheLine) {
+TEST(GalvoScannerModelTest, NonYamlGarbageNamesTheLine) {
   const std::string text = Edited("  fy_px: 1750.0\n", "  fy_px: [1750.0\n  ]]: {\n");
   const std::string message = ParseError(text);
   EXPECT_NE(message.find(kSource), std::string::npos) << message;
@@ -183,7 +184,7 @@ TEST(ScannerModelTest, NonYamlGarbageNamesTheLine) {
   EXPECT_NE(ParseError("just a sentence, not a mapping").find("top level"), std::string::npos);
 }
 
-TEST(ScannerModelTest, CheckFailureNamesTheSection) {
+TEST(GalvoScannerModelTest, CheckFailureNamesTheSection) {
   const std::string text = Edited("aperture_rad: 0.9599310885968813", "aperture_rad: 0.0");
   const std::string message = ParseError(text);
   EXPECT_NE(message.find(kSource), std::string::npos) << message;
@@ -191,11 +192,11 @@ TEST(ScannerModelTest, CheckFailureNamesTheSection) {
   EXPECT_NE(message.find("aperture_rad"), std::string::npos) << message;
 }
 
-TEST(ScannerModelTest, LoadingAMissingFileNamesThePath) {
+TEST(GalvoScannerModelTest, LoadingAMissingFileNamesThePath) {
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() / "uwscan_no_such_dir" / "no_such_scanner.yaml";
   try {
-    LoadScannerModel(path);
+    LoadScanner(path).galvo();
     FAIL() << "loaded a missing file";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
@@ -215,7 +216,7 @@ TEST(ScannerModelUnknownFieldTest, MisspeltFieldIsNamedNotIgnored) {
   ASSERT_NE(at, std::string::npos);
   text.replace(at, 15, "  nwater: 1.33");
   try {
-    ParseScannerModel(text, "typo.yaml");
+    ParseScanner(text, "typo.yaml").galvo();
     FAIL() << "a misspelt field was accepted";
   } catch (const Error& e) {
     const std::string message = e.what();
