@@ -36,10 +36,15 @@ struct StripeMethodFigures {
   double max_err_px_sigma1_5 = 0.0;
   double max_err_px_sigma3 = 0.0;
   double detected_fraction = 0.0;  // columns with a peak over all accuracy frames
+  double fraction_of_limit = 0.0;  // frames_per_s / StripeBenchResult::limit_frames_per_s
 };
 
 struct StripeBenchResult {
   std::string default_method;                          // ToString(StripeDetectorOptions{}.method)
+  // The floor of any per-column detector, measured on the same frames in the same run: one
+  // pass reading every pixel in row order (the detectors' memory order) that keeps each
+  // column's running maximum, and nothing else.
+  double limit_frames_per_s = 0.0;
   std::map<std::string, StripeMethodFigures> methods;  // keyed by ToString(method)
 };
 

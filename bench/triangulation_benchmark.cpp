@@ -90,23 +90,52 @@ std::vector<Frame> MakeFrames(const scanner::GalvoScannerModel& model,
   return frames;
 }
 
-// Triangulates every frame `repeats` times; returns the fastest pass's time spent in
-// TriangulateFrame only (the fastest pass is the one least disturbed by the shared machine).
-double RunMethod(const scanner::Triangulator& method, const std::vector<Frame>& frames,
-                 int repeats, std::vector<std::vector<scanner::TriangulatedPoint>>* results,
-                 const Progress& progress) {
+// Runs `triangulate_frame(frame, out)` over every frame `repeats` times; returns the fastest
+// pass's time spent in it only (the fastest pass is the one least disturbed by the shared
+// machine).
+template <typename TriangulateFrame>
+double TimePasses(const std::vector<Frame>& frames, int repeats,
+                  std::vector<std::vector<scanner::TriangulatedPoint>>* results, const std::string& what,
+                  const Progress& progress, TriangulateFrame&& triangulate_frame) {
   results->resize(frames.size());
   for (size_t f = 0; f < frames.size(); ++f) (*results)[f].resize(frames[f].peaks_px.size());
   double best = std::numeric_limits<double>::infinity();
   for (int pass = 0; pass < repeats; ++pass) {
     const Clock::time_point start = Clock::now();
-    for (size_t f = 0; f < frames.size(); ++f) {
-      method.TriangulateFrame(frames[f].step, frames[f].peaks_px, (*results)[f]);
-    }
+    for (size_t f = 0; f < frames.size(); ++f) triangulate_frame(frames[f], (*results)[f]);
     best = std::min(best, SecondsSince(start));
-    if (progress) progress(ToString(method.method()), (pass + 1.0) / repeats);
+    if (progress) progress(what, (pass + 1.0) / repeats);
   }
   return best;
+}
+
+double RunMethod(const scanner::Triangulator& method, const std::vector<Frame>& frames, int repeats,
+                 std::vector<std::vector<scanner::TriangulatedPoint>>* results, const Progress& progress) {
+  return TimePasses(frames, repeats, results, ToString(method.method()), progress,
+                    [&](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
+                      method.TriangulateFrame(frame.step, frame.peaks_px, out);
+                    });
+}
+
+// The floor of any table method over the same pixels: each peak's camera ray looked up in the
+// table (prefetched ahead, as the methods do) and one multiply-add per coordinate, o + s d,
+// with a per-frame s standing for the surface. No intersection, no tests.
+double RunLimit(const scanner::CameraRayTable& rays, const std::vector<Frame>& frames, int repeats,
+                std::vector<std::vector<scanner::TriangulatedPoint>>* results, const Progress& progress) {
+  return TimePasses(frames, repeats, results, "limit", progress,
+                    [&](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
+                      const std::vector<Eigen::Vector2d>& px = frame.peaks_px;
+                      const double s = 1.0 + 1e-3 * frame.step;
+                      scanner::Ray ray;
+                      for (size_t i = 0; i < px.size(); ++i) {
+                        if (i + scanner::CameraRayTable::kPrefetchAhead < px.size()) {
+                          rays.Prefetch(px[i + scanner::CameraRayTable::kPrefetchAhead].x(), px[i + scanner::CameraRayTable::kPrefetchAhead].y());
+                        }
+                        const bool in = rays.Lookup(px[i].x(), px[i].y(), &ray);
+                        out[i].p_C = ray.origin + s * ray.direction;
+                        out[i].status = in ? scanner::HitStatus::kHit : scanner::HitStatus::kNoIntersection;
+                      }
+                    });
 }
 
 // Mean, standard deviation and maximum of |method - reference| over points both produced.
@@ -182,8 +211,12 @@ TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerMo
     figures.seconds = RunMethod(*method, frames, o.repeats, &approximate, progress);
     CompareTo(approximate, exact, &figures);
   }
+  std::vector<std::vector<scanner::TriangulatedPoint>> limit_points;
+  result.limit_seconds = RunLimit(*rays, frames, o.repeats, &limit_points, progress);
+  result.limit_points_per_s = result.points / result.limit_seconds;
   for (auto& [name, figures] : result.methods) {
     figures.points_per_s = figures.seconds > 0.0 ? result.points / figures.seconds : 0.0;
+    figures.fraction_of_limit = figures.points_per_s / result.limit_points_per_s;
   }
   return result;
 }

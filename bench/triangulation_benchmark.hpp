@@ -37,6 +37,7 @@ struct MethodFigures {
   double mean_err_m = 0.0;
   double std_err_m = 0.0;
   double max_err_m = 0.0;
+  double fraction_of_limit = 0.0;  // points_per_s / TriangulationBenchResult::limit_points_per_s
 };
 
 struct TriangulationBenchResult {
@@ -44,6 +45,10 @@ struct TriangulationBenchResult {
   double setup_s = 0.0;              // tables: camera rays, plane and cone fits per step
   double exact_vs_truth_max_m = 0.0;  // ray-ray against the generating points
   std::map<std::string, MethodFigures> methods;  // keyed by ToString(method)
+  // The floor of any table method on the same pixels in the same run: per peak the camera-ray
+  // table lookup (prefetched) and one multiply-add per coordinate.
+  double limit_seconds = 0.0;
+  double limit_points_per_s = 0.0;
 };
 
 TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerModel& model,

@@ -85,6 +85,35 @@ TEST(Cli, TriangulationBenchWritesItsJson) {
             10 * j["methods"]["ray_cone"]["mean_err_m"].get<double>());
   EXPECT_LT(j["exact_vs_truth_max_m"].get<double>(), 1e-9);
   EXPECT_EQ(j["points"].get<int>(), 20000);
+  // Each speed beside the limit of the same work measured in the same run.
+  const double limit = j.at("limit").at("points_per_s").get<double>();
+  EXPECT_GT(limit, 0.0);
+  for (const char* method : {"ray_plane", "ray_cone", "ray_ray"}) {
+    const nlohmann::json& m = j["methods"][method];
+    EXPECT_NEAR(m.at("fraction_of_limit").get<double>(), m["points_per_s"].get<double>() / limit, 1e-9)
+        << method;
+  }
+  EXPECT_FALSE(j.at("cpu").get<std::string>().empty());
+  std::filesystem::remove(json);
+}
+
+TEST(Cli, StripeBenchReportsEachMethodBesideItsLimit) {
+  const std::filesystem::path json = TempPath("stripe.json");
+  const CommandRun run = RunUwscan("bench stripe --frames 2 --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("| limit:"), std::string::npos) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  const double limit = j.at("limit").at("frames_per_s").get<double>();
+  EXPECT_GT(limit, 0.0);
+  ASSERT_EQ(j.at("methods").size(), 6u);
+  for (const auto& [name, m] : j["methods"].items()) {
+    EXPECT_NEAR(m.at("fraction_of_limit").get<double>(), m["frames_per_s"].get<double>() / limit, 1e-9)
+        << name;
+    // Accuracy holds whatever the machine: every centre-finding method within 0.05 px.
+    if (name != "maximum") {
+      EXPECT_LT(m["rmse_px_sigma1_5"].get<double>(), 0.05) << name;
+    }
+  }
   std::filesystem::remove(json);
 }
 

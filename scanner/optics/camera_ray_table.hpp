@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <vector>
 
 #include "scanner/optics/ray.hpp"
@@ -47,6 +48,9 @@ class CameraRayTable {
   // Hints the cache to fetch the nodes a later Lookup of this pixel reads. Stripe peaks come
   // one per image row, so consecutive lookups land in different table rows and would each wait
   // on memory; prefetching a few peaks ahead hides that latency. Safe for any pixel.
+  // How many peaks ahead callers prefetch: far enough to cover a memory fetch, near enough that
+  // the lines are still in cache when the lookup comes.
+  static constexpr std::size_t kPrefetchAhead = 8;
   void Prefetch(double u_px, double v_px) const {
     const double fu = (u_px + 0.5) * inverse_grid_;
     const double fv = (v_px + 0.5) * inverse_grid_;

@@ -30,4 +30,10 @@ struct HitBlock {
 // lanes with any). Agreement with the per-ray function is checked in cone_batch_test.
 void IntersectRayConeBlock(const PreparedCone& cone, const RayBlock& rays, HitBlock* hits);
 
+// Marks kParallel every hit of the block whose ray meets the cone at an angle whose squared
+// sine is at most min_sin2_angle: the angle between the ray and the cone's tangent plane at the
+// crossing, the same test ray-plane makes against its plane. Other lanes are left as they are.
+void RejectGrazingHits(const PreparedCone& cone, const RayBlock& rays, double min_sin2_angle,
+                       HitBlock* hits);
+
 }  // namespace uwscan::scanner

@@ -10,8 +10,7 @@
 namespace uwscan::scanner {
 namespace {
 
-// How many peaks ahead the camera-ray table is prefetched (about one memory latency of work).
-constexpr size_t kPrefetchAhead = 8;
+constexpr size_t kPrefetchAhead = CameraRayTable::kPrefetchAhead;
 
 void MarkAll(std::span<TriangulatedPoint> out, HitStatus status) {
   for (TriangulatedPoint& p : out) p = TriangulatedPoint{Eigen::Vector3d::Zero(), status};
@@ -76,8 +75,12 @@ void RayPlaneTriangulator::TriangulateFrame(int mirror_step,
 }
 
 RayConeTriangulator::RayConeTriangulator(std::shared_ptr<const CameraRayTable> rays,
-                                         std::shared_ptr<const LightSurfaceTable> surfaces)
-    : rays_(std::move(rays)), surfaces_(std::move(surfaces)) {
+                                         std::shared_ptr<const LightSurfaceTable> surfaces,
+                                         const TriangulationOptions& options)
+    : rays_(std::move(rays)),
+      surfaces_(std::move(surfaces)),
+      min_sin2_angle_(std::pow(std::sin(options.min_angle_rad), 2)) {
+  options.Check();
   if (!rays_ || !surfaces_) throw Error("ray-cone triangulator: missing tables");
 }
 
@@ -108,10 +111,12 @@ void RayConeTriangulator::TriangulateFrame(int mirror_step,
       rays.dz[lane] = ray.direction.z();
     }
     IntersectRayConeBlock(cone, rays, &hits);
+    RejectGrazingHits(cone, rays, min_sin2_angle_, &hits);
     for (size_t lane = 0; lane < count; ++lane) {
       TriangulatedPoint& result = out[start + lane];
       result.status = in_image[lane] ? hits.Status(lane) : HitStatus::kNoIntersection;
-      result.p_C = Eigen::Vector3d(hits.x[lane], hits.y[lane], hits.z[lane]);
+      result.p_C = result.ok() ? Eigen::Vector3d(hits.x[lane], hits.y[lane], hits.z[lane])
+                               : Eigen::Vector3d::Zero();  // misses carry no point
     }
   }
 }

@@ -10,9 +10,9 @@ namespace uwscan::scanner {
 
 // Options shared by the triangulators.
 struct TriangulationOptions {
-  // Below this angle between the camera ray and the light plane (ray-plane) or the laser ray
-  // (ray-ray) the point is reported kParallel: depth would be unreliable. (Ray-cone reports
-  // only the cone's own degenerate cases; see IntersectRayCone.)
+  // Below this angle between the camera ray and the light surface (ray-plane: the plane;
+  // ray-cone: the cone's tangent plane at the crossing) or the laser ray (ray-ray) the point is
+  // reported kParallel: its depth would be unreliable.
   double min_angle_rad = 0.5 * 3.14159265358979323846 / 180.0;
   void Check() const;
 };
@@ -41,11 +41,12 @@ class RayPlaneTriangulator final : public Triangulator {
 };
 
 // Camera ray (from the table) against the elliptic cone fitted to the step's light surface,
-// in closed form.
+// in closed form; crossings within the minimum angle of the cone are kParallel.
 class RayConeTriangulator final : public Triangulator {
  public:
   RayConeTriangulator(std::shared_ptr<const CameraRayTable> rays,
-                      std::shared_ptr<const LightSurfaceTable> surfaces);
+                      std::shared_ptr<const LightSurfaceTable> surfaces,
+                      const TriangulationOptions& options = {});
   TriangulationMethod method() const override { return TriangulationMethod::kRayCone; }
   void TriangulateFrame(int mirror_step, std::span<const Eigen::Vector2d> peaks_px,
                         std::span<TriangulatedPoint> out) const override;
@@ -53,6 +54,7 @@ class RayConeTriangulator final : public Triangulator {
  private:
   std::shared_ptr<const CameraRayTable> rays_;
   std::shared_ptr<const LightSurfaceTable> surfaces_;
+  double min_sin2_angle_;
 };
 
 }  // namespace uwscan::scanner

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "scanner/triangulation/light_cone.hpp"
 #include "scanner/triangulation/ray_ray_triangulator.hpp"
 #include "scanner/triangulation/surface_triangulators.hpp"
 
@@ -178,17 +179,61 @@ TEST_F(TriangulationTest, PixelsOutsideTheImageAreMisses) {
   }
 }
 
-TEST_F(TriangulationTest, GrazingCameraRayAgainstThePlaneIsParallel) {
-  // With a minimum angle larger than any real geometry every point is too grazing to trust.
+TEST_F(TriangulationTest, EveryMethodAppliesTheMinimumAngleAlike) {
+  // With a minimum angle larger than any real geometry every point is too grazing to trust, for
+  // every method: none of them may return a point.
   TriangulationOptions options;
   options.min_angle_rad = 0.99;  // 57 degrees
   const RayPlaneTriangulator ray_plane(rays_, surfaces_, options);
+  const RayConeTriangulator ray_cone(rays_, surfaces_, options);
+  const RayRayTriangulator ray_ray(*model_, options);
   std::vector<Eigen::Vector2d> px;
   std::vector<Eigen::Vector3d> truth;
   MakeFrame(40, 20, 11, &px, &truth);
+  for (const Triangulator* t : {static_cast<const Triangulator*>(&ray_plane),
+                                static_cast<const Triangulator*>(&ray_cone),
+                                static_cast<const Triangulator*>(&ray_ray)}) {
+    std::vector<TriangulatedPoint> out(px.size());
+    t->TriangulateFrame(40, px, out);
+    for (const TriangulatedPoint& p : out) {
+      EXPECT_EQ(p.status, HitStatus::kParallel) << ToString(t->method());
+      EXPECT_EQ(p.p_C, Eigen::Vector3d::Zero()) << ToString(t->method());
+    }
+  }
+  // With the default minimum (0.5 degrees) the same frame triangulates with every method.
+  const RayConeTriangulator cone_default(rays_, surfaces_);
   std::vector<TriangulatedPoint> out(px.size());
-  ray_plane.TriangulateFrame(40, px, out);
-  for (const TriangulatedPoint& p : out) EXPECT_EQ(p.status, HitStatus::kParallel);
+  cone_default.TriangulateFrame(40, px, out);
+  for (const TriangulatedPoint& p : out) EXPECT_TRUE(p.ok()) << ToString(p.status);
+}
+
+TEST_F(TriangulationTest, RayConeRejectsACrossingJustBelowTheMinimumAngle) {
+  // The angle between each camera ray and the cone at its crossing, from the exact cone normal
+  // (finite differences of the ray-cone point over the pixel would be the same to first order):
+  // a minimum angle just above it rejects the point, just below keeps it.
+  std::vector<Eigen::Vector2d> px;
+  std::vector<Eigen::Vector3d> truth;
+  MakeFrame(-60, 5, 12, &px, &truth);
+  const PreparedCone cone = PrepareCone(surfaces_->At(-60)->cone);
+  for (size_t i = 0; i < px.size(); ++i) {
+    Ray ray;
+    ASSERT_TRUE(rays_->Lookup(px[i].x(), px[i].y(), &ray));
+    const RayHit hit = IntersectRayCone(ray, cone);
+    ASSERT_TRUE(hit.ok());
+    // Normal of F(s) = y^2 - b^2 (z^2 - u^2) at the hit, in {C}.
+    const Eigen::Vector3d s = cone.S_C * hit.point + cone.s_origin;
+    const Eigen::Vector3d grad_s(cone.b * cone.b * s.x(), s.y(), -cone.b * cone.b * s.z());
+    const Eigen::Vector3d normal_C = cone.S_C.transpose() * grad_s;
+    const double angle = std::asin(std::abs(normal_C.normalized().dot(ray.direction.normalized())));
+    for (const double factor : {0.999, 1.001}) {
+      TriangulationOptions options;
+      options.min_angle_rad = angle * factor;
+      const RayConeTriangulator ray_cone(rays_, surfaces_, options);
+      std::vector<TriangulatedPoint> out(1);
+      ray_cone.TriangulateFrame(-60, std::span(&px[i], 1), out);
+      EXPECT_EQ(out[0].ok(), factor < 1.0) << "point " << i << " at " << angle << " rad";
+    }
+  }
 }
 
 TEST_F(TriangulationTest, NearlyParallelCameraAndLaserRaysAreReported) {
