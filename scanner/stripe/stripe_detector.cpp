@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <vector>
 
 namespace uwscan::scanner {
@@ -13,18 +14,34 @@ constexpr std::array<StripeMethod, 6> kAllMethods = {
     StripeMethod::kMaximum,  StripeMethod::kCentreOfMass, StripeMethod::kGaussian,
     StripeMethod::kParabola, StripeMethod::kBlaisRioux,   StripeMethod::kSteger};
 
+// Rows per block of the column scan. The one pass over the frame keeps each column's maximum
+// per block (for 2048x1088 Mono8, 68 blocks: 139 KB, in cache); the few blocks that can hold
+// a column's peak or a second peak are then read again, and only in that column.
+constexpr int kBlockRows = 16;
+constexpr std::uint16_t kNoBlock = 0xFFFF;
+
 // Buffers of the column scan, reused from frame to frame.
 template <typename Pixel>
 struct ColumnScratch {
-  std::vector<Pixel> max, second, in_band;
+  std::vector<Pixel> block_max;          // [block * width + u]
+  std::vector<std::uint8_t> block_arg;   // first row in the block reaching block_max, from its start
+  std::vector<Pixel> max;
+  std::vector<std::uint16_t> first_block;  // first block reaching max[u]
   std::vector<std::uint16_t> arg;
-  std::vector<int> first_event, event_column, cursor;
+  // Second-peak candidates: the lowest value that could reject column u, and the first and
+  // last block whose maximum reaches it (kNoBlock: none).
+  std::vector<Pixel> cut;
+  std::vector<std::uint16_t> first_candidate, last_candidate;
 
-  void Resize(int width) {
+  void Resize(int width, int blocks) {
+    block_max.resize(static_cast<std::size_t>(width) * blocks);
+    block_arg.resize(static_cast<std::size_t>(width) * blocks);
     max.resize(width);
-    second.resize(width);
-    in_band.resize(width);
+    first_block.resize(width);
     arg.resize(width);
+    cut.resize(width);
+    first_candidate.resize(width);
+    last_candidate.resize(width);
   }
 };
 
@@ -153,75 +170,102 @@ std::optional<double> RefineLine(const RefineParams& rp, const Get& at, int n, i
   return std::nullopt;
 }
 
-// One row of the second pass: second[u] = max(second[u], row[u]) where row[u] is a local maximum
-// of its column outside the band.
+// The one pass over the frame, in row order: each column's maximum over each block of
+// kBlockRows rows and the first row of the block reaching it (found again over the block's rows
+// while they are still in cache: cheaper than reading them back column by column later), then
+// each column's maximum and the first block reaching it, hence arg: the first row of the column
+// with its brightest value.
 template <typename Pixel>
-void SecondPeakRow(const Pixel* __restrict above, const Pixel* __restrict row,
-                   const Pixel* __restrict below, const Pixel* __restrict in_band, int width,
-                   Pixel* __restrict second) {
-  for (int u = 0; u < width; ++u) {
-    const Pixel c = row[u];
-    const bool peak = (c > above[u]) & (c >= below[u]) & (in_band[u] == 0);
-    const Pixel value = peak ? c : Pixel{0};
-    second[u] = std::max(second[u], value);
-  }
-}
-
-// Second pass of the column scan: each column's highest interior local maximum (brighter than
-// the row above, at least as bright as the row below: a flat top counts once) farther than
-// `separation` rows from the column's brightest pixel arg[u]. The band |v - arg[u]| <=
-// separation is kept as a per-column flag of the pixels' width, toggled at the rows where the
-// band starts and ends (bucketed by row beforehand), so the inner loop stays at that width.
-template <typename Pixel>
-void SecondPeaks(const StripeImage& image, const std::uint16_t* __restrict arg, int separation,
-                 ColumnScratch<Pixel>& scratch) {
+void ColumnMaxima(const StripeImage& image, ColumnScratch<Pixel>& scratch) {
   const int width = image.width_px;
   const int height = image.height_px;
-  std::vector<int>& first_event = scratch.first_event;  // events of row v: [first[v], first[v+1])
-  std::vector<int>& event_column = scratch.event_column;
-  first_event.assign(height + 1, 0);
-  event_column.resize(2 * width);
-  const auto for_each_event = [&](auto&& visit) {
+  const int blocks = (height + kBlockRows - 1) / kBlockRows;
+  for (int b = 0; b < blocks; ++b) {
+    Pixel* __restrict out = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
+    const int v_end = std::min(height, (b + 1) * kBlockRows);
+    const Pixel* __restrict first = image.Row<Pixel>(b * kBlockRows);
+    std::copy(first, first + width, out);
+    for (int v = b * kBlockRows + 1; v < v_end; ++v) {
+      const Pixel* __restrict row = image.Row<Pixel>(v);
+      for (int u = 0; u < width; ++u) out[u] = std::max(out[u], row[u]);
+    }
+    // Rows from last to first, so the first row reaching the maximum is the one kept.
+    std::uint8_t* __restrict at = scratch.block_arg.data() + static_cast<std::size_t>(b) * width;
+    for (int v = v_end - 1; v >= b * kBlockRows; --v) {
+      const Pixel* __restrict row = image.Row<Pixel>(v);
+      const std::uint8_t k = static_cast<std::uint8_t>(v - b * kBlockRows);
+      for (int u = 0; u < width; ++u) at[u] = row[u] == out[u] ? k : at[u];
+    }
+  }
+  Pixel* __restrict max = scratch.max.data();
+  std::uint16_t* __restrict first_block = scratch.first_block.data();
+  std::fill(max, max + width, Pixel{0});
+  std::fill(first_block, first_block + width, std::uint16_t{0});
+  for (int b = 0; b < blocks; ++b) {
+    const Pixel* __restrict block = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
+    const std::uint16_t bb = static_cast<std::uint16_t>(b);
     for (int u = 0; u < width; ++u) {
-      visit(std::max(0, arg[u] - separation), u);
-      if (arg[u] + separation + 1 < height) visit(arg[u] + separation + 1, u);
+      const bool brighter = block[u] > max[u];
+      max[u] = brighter ? block[u] : max[u];
+      first_block[u] = brighter ? bb : first_block[u];
     }
-  };
-  for_each_event([&](int v, int) { ++first_event[v + 1]; });
-  for (int v = 0; v < height; ++v) first_event[v + 1] += first_event[v];
-  scratch.cursor.assign(first_event.begin(), first_event.end() - 1);
-  for_each_event([&](int v, int u) { event_column[scratch.cursor[v]++] = u; });
-
-  Pixel* __restrict in_band = scratch.in_band.data();
-  Pixel* __restrict second = scratch.second.data();
-  std::fill(in_band, in_band + width, Pixel{0});
-  std::fill(second, second + width, Pixel{0});
-  for (int v = 0; v + 1 < height; ++v) {
-    for (int e = first_event[v]; e < first_event[v + 1]; ++e) {
-      in_band[event_column[e]] ^= static_cast<Pixel>(~Pixel{0});
-    }
-    if (v == 0) continue;
-    SecondPeakRow(image.Row<Pixel>(v - 1), image.Row<Pixel>(v), image.Row<Pixel>(v + 1), in_band,
-                  width, second);
+  }
+  for (int u = 0; u < width; ++u) {
+    const std::size_t b = first_block[u];
+    scratch.arg[u] = static_cast<std::uint16_t>(b * kBlockRows + scratch.block_arg[b * width + u]);
   }
 }
 
-// First pass of the column scan: each column's brightest value and the first row reaching it.
+// For every column, the blocks that could hold a value rejecting it as a line with two peaks
+// (at least `threshold` and above ratio * max[u]): one vectorisable pass over the block maxima,
+// so that the per-column check below reads only those blocks.
 template <typename Pixel>
-void ColumnMaxima(const StripeImage& image, Pixel* __restrict max, std::uint16_t* __restrict arg) {
-  const int width = image.width_px;
-  std::fill(max, max + width, Pixel{0});
-  std::fill(arg, arg + width, std::uint16_t{0});
-  for (int v = 0; v < image.height_px; ++v) {
-    const Pixel* __restrict row = image.Row<Pixel>(v);
-    const std::uint16_t vv = static_cast<std::uint16_t>(v);
+void SecondPeakCandidates(int width, int blocks, int threshold, double ratio, ColumnScratch<Pixel>& scratch) {
+  constexpr double kTop = static_cast<double>(std::numeric_limits<Pixel>::max());
+  for (int u = 0; u < width; ++u) {
+    // Integer values c with c >= threshold and c > ratio * top: c >= floor(ratio * top) + 1.
+    const double lowest = std::max<double>(threshold, std::floor(ratio * scratch.max[u]) + 1.0);
+    scratch.cut[u] = static_cast<Pixel>(std::min(lowest, kTop));
+  }
+  std::uint16_t* __restrict first = scratch.first_candidate.data();
+  std::uint16_t* __restrict last = scratch.last_candidate.data();
+  const Pixel* __restrict cut = scratch.cut.data();
+  std::fill(first, first + width, kNoBlock);
+  std::fill(last, last + width, kNoBlock);
+  for (int b = blocks - 1; b >= 0; --b) {  // backwards: the first candidate is written last
+    const Pixel* __restrict block = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
+    const std::uint16_t bb = static_cast<std::uint16_t>(b);
     for (int u = 0; u < width; ++u) {
-      const Pixel c = row[u];
-      const bool brighter = c > max[u];
-      max[u] = brighter ? c : max[u];
-      arg[u] = brighter ? vv : arg[u];
+      const bool candidate = block[u] >= cut[u];
+      first[u] = candidate ? bb : first[u];
+      last[u] = (candidate & (last[u] == kNoBlock)) ? bb : last[u];
     }
   }
+}
+
+// Whether column u holds a second peak that rejects it: an interior local maximum (brighter
+// than the row above, at least as bright as the row below: a flat top counts once) farther than
+// `separation` rows from the brightest pixel arg, at least `threshold` and above ratio * top.
+// Only the candidate blocks are read.
+template <typename Pixel>
+bool HasSecondPeak(const StripeImage& image, const ColumnScratch<Pixel>& scratch, int u, int separation,
+                   double threshold, double ratio) {
+  const int first = scratch.first_candidate[u];
+  if (first == kNoBlock) return false;
+  const int last = scratch.last_candidate[u];
+  const int height = image.height_px;
+  const double top = scratch.max[u];
+  const int arg = scratch.arg[u];
+  const auto matters = [&](double c) { return c >= threshold && c > ratio * top; };
+  const Pixel* column = image.Row<Pixel>(0) + u;
+  const std::ptrdiff_t step = image.stride_bytes / static_cast<std::ptrdiff_t>(sizeof(Pixel));
+  const int v_end = std::min(height - 1, (last + 1) * kBlockRows);
+  for (int v = std::max(1, first * kBlockRows); v < v_end; ++v) {
+    if (std::abs(v - arg) <= separation) continue;
+    const Pixel c = column[v * step];
+    if (c > column[(v - 1) * step] && c >= column[(v + 1) * step] && matters(c)) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -345,24 +389,26 @@ void StripeDetector::DetectColumns(const StripeImage& image, StripeDetection* re
   } else {
     scratch = &scratch_->mono16;
   }
-  scratch->Resize(width);
+  scratch->Resize(width, (height + kBlockRows - 1) / kBlockRows);
+  ColumnMaxima<Pixel>(image, *scratch);
   const std::uint16_t* arg = scratch->arg.data();
-  ColumnMaxima<Pixel>(image, scratch->max.data(), scratch->arg.data());
   const bool reject_multiple = options_.max_second_peak_ratio < 1.0;
-  if (reject_multiple) SecondPeaks<Pixel>(image, arg, options_.min_separation_px, *scratch);
+  if (reject_multiple) {
+    SecondPeakCandidates(width, (height + kBlockRows - 1) / kBlockRows, options_.threshold,
+                         options_.max_second_peak_ratio, *scratch);
+  }
 
   const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
   const double saturation = MaxPixelValue(image.format);
   const Pixel* __restrict max = scratch->max.data();
-  const Pixel* __restrict second = scratch->second.data();
   for (int u = 0; u < width; ++u) {
     const double top = max[u];
     if (top < options_.threshold) {
       ++result->below_threshold;
       continue;
     }
-    if (reject_multiple && second[u] >= options_.threshold &&
-        second[u] > options_.max_second_peak_ratio * top) {
+    if (reject_multiple && HasSecondPeak(image, *scratch, u, options_.min_separation_px, options_.threshold,
+                                         options_.max_second_peak_ratio)) {
       ++result->multiple_peaks;
       continue;
     }
