@@ -21,4 +21,15 @@ std::filesystem::path DataCache() {
   return cache;
 }
 
+std::filesystem::path TableCache() {
+  const auto env = [](const char* name) -> const char* {
+    const char* value = std::getenv(name);
+    return value != nullptr && *value != '\0' ? value : nullptr;
+  };
+  if (const char* dir = env("UWSCAN_TABLE_CACHE")) return dir;
+  if (const char* xdg = env("XDG_CACHE_HOME")) return std::filesystem::path(xdg) / "uwscan" / "tables";
+  if (const char* home = env("HOME")) return std::filesystem::path(home) / ".cache" / "uwscan" / "tables";
+  return {};
+}
+
 }  // namespace uwscan::app

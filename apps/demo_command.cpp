@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/data_cache.hpp"
 #include "apps/progress_bar.hpp"
 #include "bench/scratch_folder.hpp"
 #include "mapping/dive_log.hpp"
@@ -66,6 +67,7 @@ void RunDemo(const DemoArgs& a) {
   for (const scanner::TriangulationMethod method : methods) {
     mapping::ReconstructionOptions ro;
     ro.method = method;
+    ro.table_cache = TableCache();
     const mapping::Reconstruction r = mapping::Reconstruct(log, ro);
     const std::optional<mapping::TruthError> e = mapping::CompareToTruth(r);
     if (!e) throw Error("demo: the simulated log has no ground truth");

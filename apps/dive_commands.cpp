@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 
+#include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
 #include "apps/progress_bar.hpp"
 #include "mapping/dive_log.hpp"
@@ -122,6 +123,7 @@ struct ReconstructArgs {
   std::string calibration;
   bool ascii = false;
   bool scanner_frame = false;
+  bool no_table_cache = false;
 };
 
 void RunReconstruct(const ReconstructArgs& a) {
@@ -133,6 +135,7 @@ void RunReconstruct(const ReconstructArgs& a) {
     if (!options.method) throw Error("--method: unknown '" + a.method + "' (use plane, cone or ray)");
   }
   options.use_navigation = !a.scanner_frame;
+  if (!a.no_table_cache) options.table_cache = TableCache();
   if (!a.calibration.empty()) {
     options.calibration = scanner::LoadScanner(a.calibration);
   }
@@ -196,6 +199,9 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_flag("--ascii", args->ascii, "write an ASCII cloud instead of binary");
   cmd->add_flag("--scanner-frame", args->scanner_frame,
                 "keep points in the camera frame even when the log has navigation");
+  cmd->add_flag("--no-table-cache", args->no_table_cache,
+                "fit the cone table again instead of reusing the one kept for this calibration "
+                "($UWSCAN_TABLE_CACHE, else ~/.cache/uwscan/tables)");
   cmd->callback([args] { RunReconstruct(*args); });
 }
 

@@ -44,7 +44,8 @@ Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions
 
   const Clock::time_point tables_start = Clock::now();
   const std::unique_ptr<scanner::Triangulator> triangulator =
-      scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern, result.method);
+      scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern, result.method,
+                                scanner::TriangulatorBuildOptions{options.table_cache});
   result.table_seconds = Seconds(tables_start);
 
   const std::optional<scanner::sim::Trajectory> navigation =

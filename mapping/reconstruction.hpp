@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -22,6 +23,8 @@ struct ReconstructionOptions {
   // A calibration to triangulate with instead of the scanner the log was recorded with;
   // std::nullopt: the log's own.
   std::optional<scanner::Scanner> calibration;
+  // Folder keeping per-calibration tables between runs; empty: computed every time.
+  std::filesystem::path table_cache;
 };
 
 // A dive's point cloud, point by point with the frame it came from, and the truth of each point

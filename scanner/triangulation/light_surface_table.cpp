@@ -3,6 +3,7 @@
 #include <cmath>
 #include <exception>
 #include <string>
+#include <utility>
 
 #include "scanner/common/error.hpp"
 
@@ -48,7 +49,7 @@ FanSamples SampleFan(const LaserFan& fan, double max_fan_tan,
 
 LightSurfaceTable::LightSurfaceTable(const GalvoLaser& laser,
                                      const LightSurfaceTableOptions& options)
-    : step_min_(laser.step_min), step_max_(laser.step_max) {
+    : step_min_(laser.step_min), step_max_(laser.step_max), has_cones_(options.fit_cones) {
   laser.Check();
   options.Check();
   const int count = step_max_ - step_min_ + 1;
@@ -60,16 +61,30 @@ LightSurfaceTable::LightSurfaceTable(const GalvoLaser& laser,
     try {
       const FanSamples samples = SampleFan(laser.FanAtStep(step_min_ + i), max_fan_tan, options);
       const PlaneFit plane = FitPlane(samples.points_C);
-      const ConeFit cone = FitCone(samples.points_C, samples.propagation_dir_C,
-                                   samples.apex_hint_C, options.cone);
-      surfaces_[static_cast<size_t>(i)] =
-          LightSurfaces{plane.plane, cone.cone, plane.rms_m, cone.rms_m, cone.converged};
+      LightSurfaces& surfaces = surfaces_[static_cast<size_t>(i)];
+      surfaces.plane = plane.plane;
+      surfaces.plane_rms_m = plane.rms_m;
+      if (options.fit_cones) {
+        const ConeFit cone = FitCone(samples.points_C, samples.propagation_dir_C,
+                                     samples.apex_hint_C, options.cone);
+        surfaces.cone = cone.cone;
+        surfaces.cone_rms_m = cone.rms_m;
+        surfaces.cone_converged = cone.converged;
+      }
     } catch (...) {
 #pragma omp critical
       if (!failure) failure = std::current_exception();
     }
   }
   if (failure) std::rethrow_exception(failure);
+}
+
+LightSurfaceTable::LightSurfaceTable(int step_min, std::vector<LightSurfaces> surfaces, bool has_cones)
+    : step_min_(step_min),
+      step_max_(step_min + static_cast<int>(surfaces.size()) - 1),
+      surfaces_(std::move(surfaces)),
+      has_cones_(has_cones) {
+  if (surfaces_.empty()) throw Error("light surface table: no mirror steps");
 }
 
 }  // namespace uwscan::scanner

@@ -16,12 +16,14 @@ struct LightSurfaceTableOptions {
   double depth_max_m = 1.6;  // ... and of the farthest
   int rays_per_fan = 35;     // seed: 35 model rays
   int points_per_ray = 5;    // seed: 5 points per ray
+  bool fit_cones = true;     // false: planes only (all ray-plane needs; the cone fits are ~all the cost)
   ConeFitOptions cone;
 
   void Check() const;
 };
 
-// The plane and the elliptic cone fitted to one mirror step's light surface in water.
+// The plane and the elliptic cone fitted to one mirror step's light surface in water (the cone
+// left default, cone_converged false, when the table fits no cones).
 struct LightSurfaces {
   Plane plane;
   EllipticCone cone;
@@ -45,6 +47,8 @@ FanSamples SampleFan(const LaserFan& fan, double max_fan_tan,
 class LightSurfaceTable {
  public:
   LightSurfaceTable(const GalvoLaser& laser, const LightSurfaceTableOptions& options);
+  // A table computed before (light_surface_cache.hpp): surfaces[i] is step step_min + i.
+  LightSurfaceTable(int step_min, std::vector<LightSurfaces> surfaces, bool has_cones);
 
   // nullptr when the step lies outside the laser's command range.
   const LightSurfaces* At(int step) const {
@@ -53,11 +57,14 @@ class LightSurfaceTable {
   }
   int step_min() const { return step_min_; }
   int step_max() const { return step_max_; }
+  bool has_cones() const { return has_cones_; }
+  const std::vector<LightSurfaces>& surfaces() const { return surfaces_; }
 
  private:
   int step_min_;
   int step_max_;
   std::vector<LightSurfaces> surfaces_;
+  bool has_cones_ = true;
 };
 
 }  // namespace uwscan::scanner

@@ -81,6 +81,9 @@ RayConeTriangulator::RayConeTriangulator(std::shared_ptr<const CameraRayTable> r
       surfaces_(std::move(surfaces)),
       min_sin2_angle_(std::pow(std::sin(options.min_angle_rad), 2)) {
   options.Check();
+  if (surfaces_ && !surfaces_->has_cones()) {
+    throw Error("ray-cone triangulator: the light surface table was built without cones");
+  }
   if (!rays_ || !surfaces_) throw Error("ray-cone triangulator: missing tables");
 }
 

@@ -3,6 +3,7 @@
 #include "scanner/optics/camera_ray_table.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/mems_scan_pattern.hpp"
+#include "scanner/triangulation/light_surface_cache.hpp"
 #include "scanner/triangulation/plane_table_triangulator.hpp"
 #include "scanner/triangulation/ray_ray_triangulator.hpp"
 #include "scanner/triangulation/surface_triangulators.hpp"
@@ -10,14 +11,18 @@
 namespace uwscan::scanner {
 namespace {
 
-std::unique_ptr<Triangulator> MakeGalvoTriangulator(const GalvoScannerModel& model,
-                                                    TriangulationMethod method) {
+std::unique_ptr<Triangulator> MakeGalvoTriangulator(const GalvoScannerModel& model, TriangulationMethod method,
+                                                    const TriangulatorBuildOptions& options) {
   if (method == TriangulationMethod::kRayRay) return std::make_unique<RayRayTriangulator>(model);
   auto rays = std::make_shared<const CameraRayTable>(model.camera);
-  auto surfaces = std::make_shared<const LightSurfaceTable>(model.laser, LightSurfaceTableOptions{});
+  LightSurfaceTableOptions table;
   if (method == TriangulationMethod::kRayPlane) {
-    return std::make_unique<RayPlaneTriangulator>(rays, surfaces);
+    table.fit_cones = false;
+    return std::make_unique<RayPlaneTriangulator>(rays, std::make_shared<const LightSurfaceTable>(model.laser, table));
   }
+  std::shared_ptr<const LightSurfaceTable> surfaces =
+      options.table_cache.empty() ? std::make_shared<const LightSurfaceTable>(model.laser, table)
+                                  : LoadOrBuildLightSurfaceTable(model.laser, table, options.table_cache).table;
   return std::make_unique<RayConeTriangulator>(rays, surfaces);
 }
 
@@ -47,13 +52,13 @@ TriangulationMethod DefaultTriangulationMethod(ScannerKind kind) {
 }
 
 std::unique_ptr<Triangulator> MakeTriangulator(const Scanner& scanner, const ScanPattern& pattern,
-                                               TriangulationMethod method) {
+                                               TriangulationMethod method, const TriangulatorBuildOptions& options) {
   pattern.Check();
   if (pattern.kind != scanner.kind()) {
     throw Error(std::string("the scan pattern is for a ") + ToString(pattern.kind) + " scanner, the scanner is " +
                 ToString(scanner.kind()));
   }
-  if (pattern.kind == ScannerKind::kGalvo) return MakeGalvoTriangulator(scanner.galvo(), method);
+  if (pattern.kind == ScannerKind::kGalvo) return MakeGalvoTriangulator(scanner.galvo(), method, options);
   return MakeMemsTriangulator(scanner.mems(), pattern.mems, method);
 }
 
