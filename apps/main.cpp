@@ -10,8 +10,10 @@
 #include "apps/calibration_bench_command.hpp"
 #include "apps/demo_command.hpp"
 #include "apps/dive_commands.hpp"
+#include "apps/kernels_command.hpp"
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
+#include "apps/simulation_bench_command.hpp"
 #include "apps/stripe_commands.hpp"
 #include "scanner/common/error.hpp"
 
@@ -34,6 +36,8 @@ int main(int argc, char** argv) {
   uwscan::app::AddStripeBenchCommand(*bench);
   uwscan::app::AddAccuracyBenchCommand(*bench);
   uwscan::app::AddCalibrationBenchCommand(*bench);
+  uwscan::app::AddSimulationBenchCommand(*bench);
+  uwscan::app::AddKernelsCommand(*bench);
 
   try {
     app.parse(argc, argv);

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -103,6 +104,29 @@ TEST(CliDive, MakeObjectWritesAReadableMesh) {
   const CommandRun bad = RunUwscan("make-object teapot -o " + mesh.string());
   EXPECT_NE(bad.exit_code, 0);
   std::filesystem::remove(mesh);
+}
+
+TEST(CliDive, SimulationBenchTimesEveryEffectAndOffStagesChangeNothing) {
+  const std::filesystem::path json = TempPath("simulation.json");
+  const CommandRun run = RunUwscan("bench simulation --frames 2 --data " + SourcePath("data") + " --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json rows = ReadJson(json).at("rows");
+  std::map<std::string, nlohmann::json> galvo, mems;
+  for (const nlohmann::json& row : rows) {
+    (row["scene"] == "galvo" ? galvo : mems)[row["effect"].get<std::string>()] = row;
+    EXPECT_GT(row["ms_per_frame"].get<double>(), 0.0);
+  }
+  for (const char* effect : {"none", "refraction", "lens_distortion", "occlusion", "motion", "navigation_drift",
+                             "image", "beam", "sensor_noise", "speckle", "attenuation", "backscatter", "ambient",
+                             "off_with_parameters", "all"}) {
+    EXPECT_TRUE(galvo.contains(effect)) << effect;
+    EXPECT_TRUE(mems.contains(effect)) << effect;
+  }
+  EXPECT_TRUE(mems.contains("mirror_dynamics"));
+  // Stages left off with changed parameters produce exactly the all-off frames.
+  EXPECT_EQ(galvo["off_with_parameters"]["peaks"], galvo["none"]["peaks"]);
+  EXPECT_EQ(mems["off_with_parameters"]["peaks"], mems["none"]["peaks"]);
+  std::filesystem::remove(json);
 }
 
 TEST(CliDive, AccuracyBenchWritesEveryTable) {

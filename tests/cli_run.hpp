@@ -13,8 +13,9 @@ struct CommandRun {
   std::string output;  // stdout and stderr
 };
 
-inline CommandRun RunUwscan(const std::string& arguments) {
-  const std::string command = std::string(UWSCAN_BIN) + " " + arguments + " 2>&1";
+// Any shell command line, stdout and stderr captured.
+inline CommandRun RunCommand(const std::string& command_line) {
+  const std::string command = command_line + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return {-1, "popen failed"};
   std::string output;
@@ -22,6 +23,10 @@ inline CommandRun RunUwscan(const std::string& arguments) {
   while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
   const int status = pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+inline CommandRun RunUwscan(const std::string& arguments) {
+  return RunCommand(std::string(UWSCAN_BIN) + " " + arguments);
 }
 
 }  // namespace uwscan::test

@@ -16,6 +16,7 @@
 
 namespace {
 
+using uwscan::test::RunCommand;
 using uwscan::test::CommandRun;
 using uwscan::test::RunUwscan;
 
@@ -94,6 +95,27 @@ TEST(Cli, TriangulationBenchWritesItsJson) {
         << method;
   }
   EXPECT_FALSE(j.at("cpu").get<std::string>().empty());
+  std::filesystem::remove(json);
+}
+
+TEST(Cli, KernelInstructionCountsComeFromCallgrind) {
+  const CommandRun kernels = RunUwscan("bench kernels --frames 1 --points 3000");
+  ASSERT_EQ(kernels.exit_code, 0) << kernels.output;
+  EXPECT_NE(kernels.output.find("ray_cone: 3000 points, 3000 triangulated"), std::string::npos) << kernels.output;
+  const std::filesystem::path json = TempPath("instructions.json");
+  const CommandRun run = RunCommand(std::string(UWSCAN_SOURCE_DIR) + "/bench/instructions.sh " + UWSCAN_BIN +
+                                    " --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  // Fixed work, counted: exact ray-ray costs several times ray-cone, ray-cone more than ray-plane,
+  // and a frame of 2.2 M pixels at least one instruction per 16-pixel vector.
+  const double plane = j.at("ray_plane_instructions_per_point").get<double>();
+  const double cone = j.at("ray_cone_instructions_per_point").get<double>();
+  const double ray = j.at("ray_ray_instructions_per_point").get<double>();
+  EXPECT_GT(plane, 10.0);
+  EXPECT_GT(cone, plane);
+  EXPECT_GT(ray, 3.0 * cone);
+  EXPECT_GT(j.at("stripe_instructions_per_frame").get<double>(), 2048.0 * 1088.0 / 16.0);
   std::filesystem::remove(json);
 }
 
