@@ -4,6 +4,7 @@
 #include <chrono>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <utility>
 
 #include "scanner/common/error.hpp"
@@ -57,24 +58,39 @@ SimulationEffects OffWithParameters() {
   return e;
 }
 
-EffectCost Time(const Scene& base, const SimulationEffects& effects, const SimulationBenchOptions& o) {
-  Scene scene = base;
-  scene.effects = effects;
-  const scanner::sim::Simulator simulator(scene);
-  const std::int64_t count = simulator.frame_count();
+// Times every row's frames in round-robin passes (row 1, row 2, ..., then again), so that a
+// drift of the shared machine's speed does not favour the rows measured first or last; each row
+// keeps its fastest pass.
+std::vector<EffectCost> TimeRows(const Scene& base, const std::vector<std::pair<std::string, SimulationEffects>>& rows,
+                                 const SimulationBenchOptions& o, const std::function<void(double)>& done) {
+  std::vector<std::unique_ptr<scanner::sim::Simulator>> simulators;
+  for (const auto& row : rows) {
+    Scene scene = base;
+    scene.effects = row.second;
+    simulators.push_back(std::make_unique<scanner::sim::Simulator>(scene));
+  }
+  const std::int64_t count = simulators.front()->frame_count();
   std::vector<std::int64_t> indices;
   for (int k = 0; k < o.frames; ++k) indices.push_back(count * k / o.frames);
-  EffectCost cost;
-  double best = std::numeric_limits<double>::infinity();
-  for (int pass = 0; pass < o.repeats; ++pass) {
-    std::int64_t peaks = 0;
-    const Clock::time_point start = Clock::now();
-    for (const std::int64_t i : indices) peaks += std::ssize(simulator.Frame(i).peaks_px);
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
-    cost.peaks = peaks;
+  std::vector<EffectCost> costs(rows.size());
+  std::vector<double> best(rows.size(), std::numeric_limits<double>::infinity());
+  for (int pass = 0; pass <= o.repeats; ++pass) {  // pass 0 warms up (caches, lazy set-up)
+    for (size_t r = 0; r < rows.size(); ++r) {
+      std::int64_t peaks = 0;
+      const Clock::time_point start = Clock::now();
+      for (const std::int64_t i : indices) peaks += std::ssize(simulators[r]->Frame(i).peaks_px);
+      const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      if (pass > 0) best[r] = std::min(best[r], seconds);
+      costs[r].peaks = peaks;
+      done((pass * rows.size() + r + 1.0) / ((o.repeats + 1.0) * rows.size()));
+    }
   }
-  cost.ms_per_frame = 1e3 * best / static_cast<double>(indices.size());
-  return cost;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    costs[r].effect = rows[r].first;
+    costs[r].ms_per_frame = 1e3 * best[r] / static_cast<double>(indices.size());
+    costs[r].ratio_to_none = best[r] / best[0];
+  }
+  return costs;
 }
 
 }  // namespace
@@ -101,14 +117,10 @@ SimulationBenchResult RunSimulationBenchmark(const SimulationBenchOptions& o, co
     }
     rows.emplace_back("off_with_parameters", OffWithParameters());
     rows.emplace_back("all", all);
-    double none_ms = 0.0;
-    for (size_t r = 0; r < rows.size(); ++r) {
-      if (progress) progress(std::string("simulation ") + name, static_cast<double>(r) / rows.size());
-      EffectCost cost = Time(scene, rows[r].second, o);
+    for (EffectCost& cost : TimeRows(scene, rows, o, [&](double f) {
+           if (progress) progress(std::string("simulation ") + name, f);
+         })) {
       cost.scene = name;
-      cost.effect = rows[r].first;
-      if (r == 0) none_ms = cost.ms_per_frame;
-      cost.ratio_to_none = cost.ms_per_frame / none_ms;
       result.rows.push_back(cost);
     }
     if (progress) progress(std::string("simulation ") + name, 1.0);
