@@ -17,6 +17,7 @@
 
 #include "perception/esf.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/fnv1a.hpp"
 
 namespace uwscan::perception {
 
@@ -43,15 +44,6 @@ constexpr std::size_t kChecksumBytes = 8;
 std::mutex& FlannRandMutex() {
   static std::mutex mutex;
   return mutex;
-}
-
-std::uint64_t Fnv1a64(const char* data, std::size_t size) {
-  std::uint64_t h = 14695981039346656037ull;
-  for (std::size_t i = 0; i < size; ++i) {
-    h ^= static_cast<unsigned char>(data[i]);
-    h *= 1099511628211ull;
-  }
-  return h;
 }
 
 // Little-endian encoding, independent of the host's byte order.

@@ -12,6 +12,8 @@
 #include <system_error>
 #include <vector>
 
+#include "scanner/common/fnv1a.hpp"
+
 namespace uwscan::scanner {
 namespace {
 
@@ -72,15 +74,6 @@ class Reader {
   bool ok_ = true;
 };
 
-std::uint64_t Fnv1a(const char* data, std::size_t size) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (std::size_t i = 0; i < size; ++i) {
-    h ^= static_cast<unsigned char>(data[i]);
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 // Everything the table depends on, as bits.
 std::vector<char> Inputs(const GalvoLaser& laser, const LightSurfaceTableOptions& o) {
   Bytes b;
@@ -135,7 +128,7 @@ std::vector<char> Serialize(const std::vector<char>& inputs, const LightSurfaceT
   b.Put(static_cast<std::uint64_t>(table.surfaces().size()));
   for (const LightSurfaces& s : table.surfaces()) PutSurfaces(s, &b);
   b.Put(table.has_cones());
-  b.Put(Fnv1a(b.data().data(), b.data().size()));
+  b.Put(Fnv1a64(b.data().data(), b.data().size()));
   return std::move(b.data());
 }
 
@@ -148,7 +141,7 @@ std::shared_ptr<const LightSurfaceTable> Deserialize(const std::vector<char>& da
   }
   std::uint64_t stored = 0;
   std::memcpy(&stored, data.data() + data.size() - kChecksum, kChecksum);
-  if (stored != Fnv1a(data.data(), data.size() - kChecksum)) return nullptr;
+  if (stored != Fnv1a64(data.data(), data.size() - kChecksum)) return nullptr;
   Reader r(data, sizeof(kMagic));
   const std::uint64_t input_size = r.Get<std::uint64_t>();
   if (!r.ok() || input_size != inputs.size() || r.at() + input_size > data.size() ||
@@ -200,7 +193,7 @@ CachedTable LoadOrBuildLightSurfaceTable(const GalvoLaser& laser, const LightSur
   const std::vector<char> inputs = Inputs(laser, options);
   char name[64];
   std::snprintf(name, sizeof(name), "light_surfaces_%016llx.bin",
-                static_cast<unsigned long long>(Fnv1a(inputs.data(), inputs.size())));
+                static_cast<unsigned long long>(Fnv1a64(inputs.data(), inputs.size())));
   const std::filesystem::path path = folder / name;
   if (const std::optional<std::vector<char>> data = ReadFile(path)) {
     if (std::shared_ptr<const LightSurfaceTable> table = Deserialize(*data, inputs)) return {table, true};
