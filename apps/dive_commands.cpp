@@ -201,7 +201,7 @@ void AddReconstructCommand(CLI::App& app) {
                 "keep points in the camera frame even when the log has navigation");
   cmd->add_flag("--no-table-cache", args->no_table_cache,
                 "fit the cone table again instead of reusing the one kept for this calibration "
-                "($UWSCAN_TABLE_CACHE, else ~/.cache/uwscan/tables)");
+                "($UWSCAN_TABLE_CACHE, else $XDG_CACHE_HOME/uwscan/tables, else ~/.cache/uwscan/tables)");
   cmd->callback([args] { RunReconstruct(*args); });
 }
 

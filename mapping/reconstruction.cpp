@@ -43,9 +43,14 @@ Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions
   result.method = options.method.value_or(scanner::DefaultTriangulationMethod(pattern.kind));
 
   const Clock::time_point tables_start = Clock::now();
-  const std::unique_ptr<scanner::Triangulator> triangulator =
-      scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern, result.method,
-                                scanner::TriangulatorBuildOptions{options.table_cache});
+  std::unique_ptr<scanner::Triangulator> triangulator;
+  try {
+    triangulator = scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern,
+                                             result.method, scanner::TriangulatorBuildOptions{options.table_cache});
+  } catch (const Error& e) {
+    throw Error(log.path().string() + (options.calibration ? " with the calibration given" : "") + ": " +
+                e.what());
+  }
   result.table_seconds = Seconds(tables_start);
 
   const std::optional<scanner::sim::Trajectory> navigation =

@@ -37,7 +37,10 @@ void ReadInitialScanner(const Context& where, const YAML::Node& node, const fs::
       const std::vector<std::string> sections = ScannerSections(cs->scene.scanner.model.kind());
       for (size_t i = 0; i < list.size(); ++i) {
         const std::string section = list[i].IsScalar() ? list[i].Scalar() : std::string();
-        if (std::find(sections.begin(), sections.end(), section) == sections.end()) {
+        // Fitted projection functions are not a section of the file: the truth gives none.
+        const bool fitted_functions = section == "projection_functions" &&
+                                      !cs->scene.scanner.model.mems().functions_from_file;
+        if (std::find(sections.begin(), sections.end(), section) == sections.end() || fitted_functions) {
           yaml::Fail(Item(at, i), list[i],
                      "expected a top-level section of the true scanner file " +
                          cs->scene.scanner.file.string() + ", got '" + section + "'");

@@ -68,7 +68,12 @@ std::string InitialScannerText(const CalibrationScene& cs) {
   if (!cs.initial_true_sections.empty()) {
     std::string names;
     for (const std::string& section : cs.initial_true_sections) {
-      CopySection(cs.scene.scanner.model, section, &initial);
+      try {
+        CopySection(cs.scene.scanner.model, section, &initial);
+      } catch (const Error& e) {
+        throw Error(cs.initial_scanner->string() + ": true section from " + cs.scene.scanner.file.string() +
+                    ": " + e.what());
+      }
       names += (names.empty() ? "" : ", ") + section;
     }
     comment += " with " + names + " from the true scanner " + cs.scene.scanner.file.filename().string();

@@ -74,6 +74,10 @@ void CopySection(const Scanner& from, const std::string& section, Scanner* to) {
     to->mems().dynamics = from.mems().dynamics;
     to->laser_viewport() = viewport;
   } else {
+    if (!from.mems().functions_from_file) {
+      throw Error("'projection_functions': the scanner they would come from has none of its own "
+                  "(its functions are fitted to its laser)");
+    }
     to->mems().functions = from.mems().functions;
     to->mems().functions_from_file = from.mems().functions_from_file;
   }

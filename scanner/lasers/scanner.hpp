@@ -40,7 +40,8 @@ struct Scanner {
 std::vector<std::string> ScannerSections(ScannerKind kind);
 
 // Replaces `section` (one of ScannerSections) of *to with that of `from`, a scanner of the same
-// kind. Throws uwscan::Error naming the section when it is not one of them or the kinds differ.
+// kind. Throws uwscan::Error naming the section when it is not one of them, the kinds differ, or
+// `from` has no projection functions of its own (only ones fitted to its laser) to give.
 void CopySection(const Scanner& from, const std::string& section, Scanner* to);
 
 // After a MEMS scanner's laser or laser viewport changed: projection functions that were fitted

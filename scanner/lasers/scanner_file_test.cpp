@@ -112,6 +112,13 @@ TEST(ScannerFile, CopySectionTakesOneSectionOnly) {
   EXPECT_EQ(to.laser_viewport().distance_m, 0.123);
   EXPECT_THROW(CopySection(from, "mems", &to), Error);
   EXPECT_THROW(CopySection(from, "uwscan_format", &to), Error);
+  // A MEMS scanner whose functions are only fitted to its laser has none to give.
+  Scanner mems_to = DefaultScanner(ScannerKind::kMems);
+  Scanner mems_from = mems_to;
+  EXPECT_THROW(CopySection(mems_from, "projection_functions", &mems_to), Error);
+  mems_from.mems().functions_from_file = true;
+  CopySection(mems_from, "projection_functions", &mems_to);
+  EXPECT_TRUE(mems_to.mems().functions_from_file);
 }
 
 TEST(ScannerFile, ChangedMemsLaserRefitsOnlyFittedFunctions) {

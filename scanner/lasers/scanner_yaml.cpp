@@ -232,7 +232,8 @@ std::vector<StepRecord> ReadStepRecords(const Context& where, const YAML::Node& 
   std::vector<StepRecord> records;
   for (const auto& entry : node) {
     StepRecord r;
-    r.step = entry.first.as<std::string>();
+    if (!entry.first.IsScalar()) Fail(where, entry.first, "expected a step name as key");
+    r.step = entry.first.Scalar();
     const Context at = Enter(where, r.step);
     const YAML::Node n = entry.second;
     RequireKnownKeys(at, n,
@@ -249,7 +250,8 @@ std::vector<StepRecord> ReadStepRecords(const Context& where, const YAML::Node& 
     const YAML::Node params = Child(at, n, "params");
     if (!params.IsMap()) Fail(params_at, params, "expected a mapping of parameters");
     for (const auto& p : params) {
-      const std::string name = p.first.as<std::string>();
+      if (!p.first.IsScalar()) Fail(params_at, p.first, "expected a parameter name as key");
+      const std::string name = p.first.Scalar();
       const Context p_at = Enter(params_at, name);
       RequireKnownKeys(p_at, p.second, {"value", "std"});
       r.params.push_back({name, Number(p_at, p.second, "value"), Number(p_at, p.second, "std")});

@@ -15,8 +15,9 @@ constexpr std::array<StripeMethod, 6> kAllMethods = {
     StripeMethod::kParabola, StripeMethod::kBlaisRioux,   StripeMethod::kSteger};
 
 // Rows per block of the column scan. The one pass over the frame keeps each column's maximum
-// per block (for 2048x1088 Mono8, 68 blocks: 139 KB, in cache); the few blocks that can hold
-// a column's peak or a second peak are then read again, and only in that column.
+// per block and the row of the block reaching it first (for 2048x1088 Mono8, 68 blocks: 2 x 139
+// KB, in cache); the few blocks that can hold a second peak are then read again, only in that
+// column.
 constexpr int kBlockRows = 16;
 constexpr std::uint16_t kNoBlock = 0xFFFF;
 

@@ -52,7 +52,7 @@ struct StripeDetectorOptions {
   int window_px = 11;
   // Multiple-peak rejection: a line is dropped when its highest local maximum farther than
   // min_separation_px from the brightest pixel is >= threshold and > max_second_peak_ratio
-  // times the brightest pixel. 1 disables it (and its second pass over the image). In (0, 1].
+  // times the brightest pixel. 1 disables it (and its search for second peaks). In (0, 1].
   double max_second_peak_ratio = 0.5;
   int min_separation_px = 8;  // pixels, >= 1
   // Steger: standard deviation of the Gaussian whose derivatives are convolved, pixels,
@@ -84,10 +84,12 @@ struct StripeDetection {
 
 // Finds at most one stripe peak per image column (or row) of Mono8 and Mono16 frames.
 //
-// For kColumns the frame is read row by row, keeping each column's running maximum and the
-// row where it was first reached (a loop over a contiguous row that the compiler vectorises);
-// with multiple-peak rejection on, a second such pass finds each column's highest local
-// maximum outside min_separation_px of its brightest pixel. Only then is each column's profile
+// For kColumns the frame is read once, row by row, keeping each column's maximum over every
+// block of 16 rows and the first row of the block reaching it (loops over contiguous rows that
+// the compiler vectorises); hence each column's maximum and the first row reaching it. With
+// multiple-peak rejection on, only the blocks whose maximum could reject a column are read
+// again, in that column, for a local maximum outside min_separation_px of its brightest pixel.
+// Only then is each column's profile
 // read around its maximum and refined to sub-pixel by the configured method. kRows reads each
 // row directly. Nothing is allocated per pixel; buffers are reused from frame to frame.
 //

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include "scanner/common/fnv1a.hpp"
@@ -18,6 +19,10 @@ namespace uwscan::scanner {
 namespace {
 
 constexpr char kMagic[8] = {'U', 'W', 'L', 'S', 'T', 'A', 'B', '1'};
+// Part of every key: bump it whenever the code that samples or fits the light surfaces
+// (SampleFan, FitPlane, FitCone, the laser and refraction models) changes its results, so that
+// tables fitted by older code are not served.
+constexpr std::int32_t kFittingVersion = 1;
 
 // Bytes appended as they are in memory: the cache is a file of this machine, not an exchange
 // format, so native doubles (every bit) are what it compares and returns.
@@ -77,6 +82,7 @@ class Reader {
 // Everything the table depends on, as bits.
 std::vector<char> Inputs(const GalvoLaser& laser, const LightSurfaceTableOptions& o) {
   Bytes b;
+  b.Put(kFittingVersion);
   b.Put(laser.T_C_L);
   b.Put(laser.T_C_M);
   b.Put(laser.mirror_step_rad);
@@ -170,7 +176,9 @@ std::optional<std::vector<char>> ReadFile(const std::filesystem::path& path) {
 void WriteFileAtomically(const std::filesystem::path& path, const std::vector<char>& data) {
   std::error_code ec;
   std::filesystem::create_directories(path.parent_path(), ec);
-  const std::filesystem::path temp = path.string() + ".part" + std::to_string(::getpid());
+  // Unique per process and thread, so that writers of the same table never share a temp file.
+  const std::filesystem::path temp = path.string() + ".part" + std::to_string(::getpid()) + "_" +
+                                     std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id()));
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     if (!out) return;

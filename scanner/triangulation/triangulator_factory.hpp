@@ -10,15 +10,16 @@
 
 namespace uwscan::scanner {
 
-// Builds the triangulator of `method` for a scanner (galvanometer or MEMS) and its scan pattern, with every per-calibration table (camera rays, a plane and a cone per
-// mirror step, a plane per MEMS line) computed here, once. The MEMS scanner triangulates with
-// the planes of its lines only (seed 001); other methods are an error naming the method.
 struct TriangulatorBuildOptions {
   // Folder where the galvanometer's cone table is kept between runs (light_surface_cache.hpp);
   // empty: fitted every time. Ray-plane fits planes only, which takes milliseconds.
   std::filesystem::path table_cache;
 };
 
+// Builds the triangulator of `method` for a scanner (galvanometer or MEMS) and its scan
+// pattern, with every per-calibration table (camera rays, a plane and a cone per mirror step,
+// a plane per MEMS line) computed here, once. The MEMS scanner triangulates with the planes of
+// its lines only (seed 001); other methods are an error naming the method.
 std::unique_ptr<Triangulator> MakeTriangulator(const Scanner& scanner, const ScanPattern& pattern,
                                                TriangulationMethod method,
                                                const TriangulatorBuildOptions& options = {});
