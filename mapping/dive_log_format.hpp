@@ -11,8 +11,8 @@
 
 namespace uwscan::mapping::dive_log_format {
 
-// The schema of version 1, documented in mapping/README.md. A later version may add tables and
-// columns; a reader refuses versions it does not know.
+// The schema of version 2, documented in mapping/README.md (version 1 lacks navigation_noise).
+// A later version may add tables and columns; a reader refuses versions it does not know.
 inline constexpr const char* kSchemaSql = R"sql(
 CREATE TABLE meta (key TEXT PRIMARY KEY NOT NULL, value NOT NULL);
 CREATE TABLE header (
@@ -36,6 +36,11 @@ CREATE TABLE navigation (
   T_W_V_tx REAL NOT NULL, T_W_V_ty REAL NOT NULL, T_W_V_tz REAL NOT NULL,
   T_W_V_qx REAL NOT NULL, T_W_V_qy REAL NOT NULL, T_W_V_qz REAL NOT NULL,
   T_W_V_qw REAL NOT NULL);
+CREATE TABLE navigation_noise (
+  id INTEGER PRIMARY KEY CHECK (id = 1),
+  position_walk_m_per_sqrt_s REAL NOT NULL, heading_walk_rad_per_sqrt_s REAL NOT NULL,
+  speed_scale_sigma REAL NOT NULL, heading_bias_sigma_rad REAL NOT NULL,
+  depth_sigma_m REAL NOT NULL, roll_pitch_sigma_rad REAL NOT NULL);
 )sql";
 
 // "UWDL": lets `file` and other tools tell a dive log from any other SQLite database.

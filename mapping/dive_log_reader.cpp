@@ -79,7 +79,7 @@ struct DiveLogReader::Impl {
   Statement Prepare(const std::string& sql, unsigned flags = SQLITE_PREPARE_PERSISTENT) const {
     return sqlite::Prepare(
         db.get(), sql, flags, name,
-        "does not match schema version " + std::to_string(kDiveLogSchemaVersion));
+        "does not match schema version " + std::to_string(header.schema_version));
   }
 
   // The names of the file's tables. The first read of the file: where a file that is not
@@ -112,9 +112,11 @@ struct DiveLogReader::Impl {
     if (rc == SQLITE_DONE) throw Error(name + ": table meta has no schema_version");
     if (rc != SQLITE_ROW) sqlite::Fail(name, "cannot read the schema version", db.get());
     header.schema_version = Row(meta.get(), name, "table meta, key schema_version").Int(0);
-    if (header.schema_version != kDiveLogSchemaVersion) {
+    if (header.schema_version < kOldestDiveLogSchemaVersion ||
+        header.schema_version > kDiveLogSchemaVersion) {
       throw Error(name + " has schema version " + std::to_string(header.schema_version) +
-                  ", this uwscan reads " + std::to_string(kDiveLogSchemaVersion));
+                  ", this uwscan reads " + std::to_string(kOldestDiveLogSchemaVersion) + " to " +
+                  std::to_string(kDiveLogSchemaVersion));
     }
   }
 
@@ -142,6 +144,31 @@ struct DiveLogReader::Impl {
     rc = sqlite3_step(head.get());
     if (rc == SQLITE_ROW) throw Error(name + ": table header has more than one row");
     if (rc != SQLITE_DONE) sqlite::Fail(name, "cannot read the header", db.get());
+  }
+
+  // Version 2 on: the navigation's noise model, when the writer had one.
+  void ReadNavigationNoise() {
+    Statement select = Prepare(
+        "SELECT position_walk_m_per_sqrt_s, heading_walk_rad_per_sqrt_s, speed_scale_sigma, "
+        "heading_bias_sigma_rad, depth_sigma_m, roll_pitch_sigma_rad FROM navigation_noise",
+        0);
+    const int rc = sqlite3_step(select.get());
+    if (rc == SQLITE_DONE) return;
+    if (rc != SQLITE_ROW) sqlite::Fail(name, "cannot read the navigation noise", db.get());
+    const Row row(select.get(), name, "table navigation_noise");
+    NavigationNoise noise;
+    noise.position_walk_m_per_sqrt_s = row.Real(0);
+    noise.heading_walk_rad_per_sqrt_s = row.Real(1);
+    noise.speed_scale_sigma = row.Real(2);
+    noise.heading_bias_sigma_rad = row.Real(3);
+    noise.depth_sigma_m = row.Real(4);
+    noise.roll_pitch_sigma_rad = row.Real(5);
+    try {
+      noise.Check();
+    } catch (const Error& e) {
+      throw Error(name + ": table navigation_noise: " + e.what());
+    }
+    header.navigation_noise = noise;
   }
 
   [[noreturn]] void NoSuchFrame(std::int64_t index, std::int64_t count) const {
@@ -174,7 +201,12 @@ DiveLogReader::DiveLogReader(const std::filesystem::path& path) : impl_(std::mak
                   " has meta, header, frames, ground_truth and navigation)");
     }
   }
+  if (r.header.schema_version >= 2 && !tables.contains("navigation_noise")) {
+    throw Error(r.name + " has no table 'navigation_noise' (schema version " +
+                std::to_string(r.header.schema_version) + " has it)");
+  }
   r.ReadHeader();
+  if (r.header.schema_version >= 2) r.ReadNavigationNoise();
 
   r.frame_by_index =
       r.Prepare(std::string("SELECT ") + kFrameColumns + " FROM frames f WHERE f.frame_index = ?");

@@ -148,7 +148,22 @@ struct DiveLogWriter::Impl {
                           SQLITE_UTF8);
     }
     sqlite::StepDone(handle, head.get(), name, "cannot write the header");
+    if (header.navigation_noise) WriteNavigationNoise(*header.navigation_noise);
     sqlite::Exec(handle, "COMMIT", name, "cannot commit the header");
+  }
+
+  void WriteNavigationNoise(const NavigationNoise& noise) {
+    Statement insert = Prepare(
+        "INSERT INTO navigation_noise (id, position_walk_m_per_sqrt_s, heading_walk_rad_per_sqrt_s, "
+        "speed_scale_sigma, heading_bias_sigma_rad, depth_sigma_m, roll_pitch_sigma_rad) "
+        "VALUES (1, ?, ?, ?, ?, ?, ?)");
+    int column = 1;
+    for (double value : {noise.position_walk_m_per_sqrt_s, noise.heading_walk_rad_per_sqrt_s,
+                         noise.speed_scale_sigma, noise.heading_bias_sigma_rad, noise.depth_sigma_m,
+                         noise.roll_pitch_sigma_rad}) {
+      sqlite3_bind_double(insert.get(), column++, value);
+    }
+    sqlite::StepDone(db.get(), insert.get(), name, "cannot write the navigation noise");
   }
 };
 
@@ -162,6 +177,13 @@ DiveLogWriter::DiveLogWriter(const std::filesystem::path& path, const DiveLogHea
     header.scan_pattern.Check();
   } catch (const Error& e) {
     throw Error(w.name + ": invalid header: " + e.what());
+  }
+  if (header.navigation_noise) {
+    try {
+      header.navigation_noise->Check();
+    } catch (const Error& e) {
+      throw Error(w.name + ": invalid header: " + e.what());
+    }
   }
   if (header.scan_pattern.kind != header.scanner.kind()) {
     throw Error(w.name + ": header.scan_pattern is for a " + scanner::ToString(header.scan_pattern.kind) +

@@ -52,6 +52,18 @@ DiveSimulationSummary SimulateDive(const scanner::sim::Simulator& simulator,
   header.scan_pattern = simulator.scan_pattern();
   header.scene_yaml = scene_yaml;
   header.producer = options.producer;
+  // The navigation's noise as the scene made it: zero when it reports the truth.
+  const scanner::sim::SimulationEffects::NavigationDrift& drift = scene.effects.navigation_drift;
+  NavigationNoise noise;
+  if (drift.on) {
+    noise.position_walk_m_per_sqrt_s = drift.position_walk_m_per_sqrt_s;
+    noise.heading_walk_rad_per_sqrt_s = drift.yaw_walk_rad_per_sqrt_s;
+    noise.speed_scale_sigma = drift.speed_scale_sigma;
+    noise.heading_bias_sigma_rad = drift.heading_bias_sigma_rad;
+    noise.depth_sigma_m = drift.depth_sigma_m;
+    noise.roll_pitch_sigma_rad = drift.roll_pitch_sigma_rad;
+  }
+  header.navigation_noise = noise;
   DiveLogWriter writer(log_path, header);
   writer.SetVehicleMount(scene.trajectory.T_V_C);
 

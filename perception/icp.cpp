@@ -168,6 +168,28 @@ Vector6d SolveTruncated(const Matrix6d& JtJ, const Vector6d& Jtr) {
   return x;
 }
 
+// The step with a prior: minimises |J x + r|^2 / sigma^2 + (e + x)^T L (e + x), where
+// e = [w, v] is the current pose's perturbation from the prior's (offset = current * prior^-1,
+// its rotation vector and translation) and L the prior's information.
+Vector6d SolveWithPrior(const Sums& sums, const IcpPrior& prior, const Eigen::Isometry3d& offset) {
+  const double weight = 1.0 / (prior.point_sigma_m * prior.point_sigma_m);
+  Vector6d e;
+  const Eigen::AngleAxisd rotation(offset.linear());
+  e << rotation.angle() * rotation.axis(), offset.translation();
+  const Matrix6d H = weight * sums.JtJ + prior.information;
+  const Vector6d g = weight * sums.Jtr + prior.information * e;
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(H);
+  const Vector6d& values = solver.eigenvalues();
+  Vector6d x = Vector6d::Zero();
+  if (!(values(5) > 0.0)) return x;
+  for (int k = 0; k < 6; ++k) {
+    if (values(k) <= kEigenvalueFloor * values(5)) continue;  // neither points nor prior: stay
+    const Vector6d u = solver.eigenvectors().col(k);
+    x -= (u.dot(g) / values(k)) * u;
+  }
+  return x;
+}
+
 // Rotation by w (rad) about `pivot`, then translation by v.
 Eigen::Isometry3d IncrementAbout(const Eigen::Vector3d& pivot, const Eigen::Vector3d& w,
                                  const Eigen::Vector3d& v) {
@@ -220,6 +242,18 @@ void IcpOptions::Check() const {
   require_tolerance("translation_tolerance_m", translation_tolerance_m);
   require_tolerance("relative_rmse_tolerance", relative_rmse_tolerance);
   if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
+  if (prior) {
+    if (method != IcpMethod::kPointToPlane) fail("prior", "point-to-plane (method kPointToPlane)");
+    if (!(std::isfinite(prior->point_sigma_m) && prior->point_sigma_m > 0.0)) {
+      fail("prior.point_sigma_m", "a finite value > 0 m");
+    }
+    const Matrix6d& info = prior->information;
+    if (!info.allFinite() || !info.isApprox(info.transpose(), 1e-9) ||
+        Eigen::SelfAdjointEigenSolver<Matrix6d>(info).eigenvalues().minCoeff() <
+            -1e-9 * info.cwiseAbs().maxCoeff()) {
+      fail("prior.information", "a finite, symmetric, positive semi-definite 6x6 matrix");
+    }
+  }
 }
 
 RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
@@ -243,6 +277,16 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
   for (const Eigen::Vector3f& q : target.points) target_centroid += q.cast<double>();
   target_centroid /= static_cast<double>(target.size());
 
+  // With a prior the linearisation is about the target origin, where the prior's information
+  // is expressed; without one about the centroid, which conditions the step best.
+  const std::optional<IcpPrior>& prior = options.prior;
+  const Eigen::Vector3d pivot = prior ? Eigen::Vector3d::Zero() : target_centroid;
+  const Eigen::Isometry3d prior_rel =
+      prior ? Eigen::Translation3d(-target.origin) * prior->T_target_source *
+                  Eigen::Translation3d(source.origin)
+            : Eigen::Isometry3d::Identity();
+  if (prior) RequireRigid(prior->T_target_source);
+
   const TargetTree tree(target);
   std::vector<int> pairs;
   std::vector<Eigen::Vector3d> moved, matched;  // point-to-point pairs, reused
@@ -256,18 +300,20 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
     double previous_rmse = std::numeric_limits<double>::quiet_NaN();
     for (int k = 0;
          k < options.max_iterations_per_stage && result.iterations < options.max_iterations; ++k) {
-      const Sums sums = Pass(source_rel, target, tree, T_rel, radius, target_centroid,
+      const Sums sums = Pass(source_rel, target, tree, T_rel, radius, pivot,
                              options.method, point_to_plane, options.threads, pairs);
       Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
       double rmse = 0.0;
       if (point_to_plane) {
         if (sums.count < 3) {
+          if (prior) T_rel = prior_rel;  // nothing to match: the prior is the answer
           stopped = true;
           break;
         }
         rmse = std::sqrt(sums.squared_residual / static_cast<double>(sums.count));
-        const Vector6d x = SolveTruncated(sums.JtJ, sums.Jtr);
-        increment = IncrementAbout(target_centroid, x.head<3>(), x.tail<3>());
+        const Vector6d x = prior ? SolveWithPrior(sums, *prior, T_rel * prior_rel.inverse())
+                                 : SolveTruncated(sums.JtJ, sums.Jtr);
+        increment = IncrementAbout(pivot, x.head<3>(), x.tail<3>());
       } else {
         moved.clear();
         matched.clear();

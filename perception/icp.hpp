@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <optional>
 #include <vector>
 
 #include "perception/point_cloud.hpp"
@@ -11,6 +12,19 @@ namespace uwscan::perception {
 enum class IcpMethod {
   kPointToPoint,  // Besl & McKay 1992: closed-form SVD step on the pairs (AlignSvd)
   kPointToPlane   // Chen & Medioni 1992: linearised step on n . (p - q); needs target normals
+};
+
+// A prior on the pose, in information form (e.g. the navigation's estimate of a motion), for
+// point-to-plane: each step then minimises
+//   sum_i r_i^2 / point_sigma_m^2 + e^T information e,
+// e = [w (rad), v (m)], the left perturbation taking T_target_source to the current pose:
+// a rotation by w about the target cloud's origin, then a translation by v. Directions the
+// points do not constrain (a flat seabed, a single pipe) then follow the prior instead of
+// staying wherever the start put them.
+struct IcpPrior {
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();  // symmetric PSD
+  double point_sigma_m = 0.001;  // std of one point-to-plane residual, metres, > 0
 };
 
 struct IcpOptions {
@@ -28,6 +42,8 @@ struct IcpOptions {
   double translation_tolerance_m = 1e-6;  // metres
   double relative_rmse_tolerance = 1e-6;  // dimensionless
   int threads = 0;  // OpenMP threads for the nearest-neighbour search, 0 = OpenMP's default, >= 0
+  // Point-to-plane only; with a prior, rotations are linearised about the target origin.
+  std::optional<IcpPrior> prior;
 
   // Throws uwscan::Error naming the field when a value is out of range.
   void Check() const;

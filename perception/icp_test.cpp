@@ -318,6 +318,43 @@ TEST(IcpSinglePlane, InformationShowsTheThreeUnconstrainedDirections) {
   }
 }
 
+TEST(IcpSinglePlane, APriorDecidesTheDirectionsThePlaneLeavesFree) {
+  // A plane z = 0.4 m (in the target frame, origin 0); the source is the same plane lifted by
+  // 5 mm and slid. The prior says: slid by (0.02, -0.01) m and turned 0.01 rad about z, and
+  // also (wrongly) lifted by 1 cm; the points must win along the normal, the prior elsewhere.
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> uniform(-0.3, 0.3);
+  PointCloud target;
+  for (int i = 0; i < 3000; ++i) {
+    target.points.emplace_back(float(uniform(rng)), float(uniform(rng)), 0.4f);
+    target.normals.emplace_back(0.0f, 0.0f, 1.0f);
+  }
+  PointCloud source = target;
+  source.normals.clear();
+  source.origin = Eigen::Vector3d(0.0, 0.0, 0.005);
+  IcpPrior prior;
+  prior.T_target_source = Eigen::Translation3d(0.02, -0.01, 0.01) *
+                          Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ());
+  prior.information = Eigen::Matrix<double, 6, 6>::Identity() * 1e4;  // 1 cm, 0.01 rad
+  prior.point_sigma_m = 0.0005;
+  IcpOptions options = Options(IcpMethod::kPointToPlane);
+  options.prior = prior;
+  const RegistrationResult result = AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
+  EXPECT_TRUE(result.converged);
+  const Eigen::Isometry3d& T = result.T_target_source;
+  EXPECT_NEAR(T.translation().x(), 0.02, 1e-6);   // free: the prior's
+  EXPECT_NEAR(T.translation().y(), -0.01, 1e-6);  // free: the prior's
+  EXPECT_NEAR(Eigen::AngleAxisd(T.linear()).angle(), 0.01, 1e-6);
+  // Along the normal 3000 points at 0.5 mm outweigh a 1 cm prior: the surfaces meet.
+  EXPECT_NEAR((T * Eigen::Vector3d(0.0, 0.0, 0.405)).z(), 0.4, 2e-5);
+
+  options.method = IcpMethod::kPointToPoint;
+  EXPECT_THROW(options.Check(), Error);
+  options.method = IcpMethod::kPointToPlane;
+  options.prior->information(0, 1) = 1.0;  // not symmetric
+  EXPECT_THROW(options.Check(), Error);
+}
+
 TEST(IcpBadInput, EmptyOnePointAndNaNCloudsThrow) {
   const PointCloud good = BumpySurface(100, 13);
   PointCloud empty;

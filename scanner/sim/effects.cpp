@@ -32,6 +32,17 @@ void SimulationEffects::Check() const {
   Require(NonNegative(navigation_drift.yaw_walk_rad_per_sqrt_s),
           "navigation_drift.yaw_walk_rad_per_sqrt_s", navigation_drift.yaw_walk_rad_per_sqrt_s,
           ">= 0 rad/sqrt(s)");
+  Require(NonNegative(navigation_drift.speed_scale_sigma) && navigation_drift.speed_scale_sigma < 0.5,
+          "navigation_drift.speed_scale_sigma", navigation_drift.speed_scale_sigma, "in [0, 0.5)");
+  Require(NonNegative(navigation_drift.heading_bias_sigma_rad),
+          "navigation_drift.heading_bias_sigma_rad", navigation_drift.heading_bias_sigma_rad,
+          ">= 0 rad");
+  Require(NonNegative(navigation_drift.depth_sigma_m), "navigation_drift.depth_sigma_m",
+          navigation_drift.depth_sigma_m, ">= 0 m");
+  Require(NonNegative(navigation_drift.roll_pitch_sigma_rad),
+          "navigation_drift.roll_pitch_sigma_rad", navigation_drift.roll_pitch_sigma_rad,
+          ">= 0 rad");
+  Require(NonNegative(peak_noise.sigma_px), "peak_noise.sigma_px", peak_noise.sigma_px, ">= 0 px");
   if (image.format != PixelFormat::kMono8 && image.format != PixelFormat::kMono16) {
     throw Error("simulation effects: image.format: expected mono8 or mono16");
   }

@@ -16,12 +16,27 @@ struct SimulationEffects {
   bool mirror_dynamics = false; // MEMS: low-pass filter + resonant mirror between waypoints
   bool motion = false;          // the vehicle moves during a sweep: each frame at its own pose
 
-  // Navigation the vehicle believes in: the true trajectory plus a random walk.
+  // Navigation the vehicle believes in, as a vehicle has it: depth (pressure sensor) and roll /
+  // pitch (AHRS) absolute with white noise; x, y and heading by dead reckoning (DVL velocity
+  // turned by the heading and integrated), which drifts: a random walk of position and heading,
+  // a speed scale error and a heading bias (both drawn once per dive from the seed).
   struct NavigationDrift {
     bool on = false;
-    double position_walk_m_per_sqrt_s = 0.002;  // random-walk density of x, y, z
+    double position_walk_m_per_sqrt_s = 0.002;  // random-walk density of x and y
     double yaw_walk_rad_per_sqrt_s = 0.0005;    // random-walk density of the heading
+    double speed_scale_sigma = 0.0;             // std of the DVL's speed scale error (0.01 = 1 %)
+    double heading_bias_sigma_rad = 0.0;        // std of the constant heading bias
+    double depth_sigma_m = 0.0;                 // white noise of the pressure depth
+    double roll_pitch_sigma_rad = 0.0;          // white noise of the AHRS roll and pitch
   } navigation_drift;
+
+  // Exact peaks moved along their image line by Gaussian noise, for long dives where rendering
+  // every frame would cost too much: the detector's error without the image. Ignored when an
+  // image stage is on (the rendered frame then carries its own noise).
+  struct PeakNoise {
+    bool on = false;
+    double sigma_px = 0.1;  // std of the sub-pixel position along the line
+  } peak_noise;
 
   // --- Image: how the stripe looks (any of these on => frames are rendered) ---------------
   struct Image {

@@ -155,7 +155,7 @@ bool ReadStage(const Context& where, const YAML::Node& node, const std::string& 
 SimulationEffects ReadEffects(const Context& where, const YAML::Node& node) {
   yaml::RequireKnownKeys(where, node,
                          {"refraction", "lens_distortion", "occlusion", "mirror_dynamics", "motion",
-                          "navigation_drift", "image", "beam", "sensor_noise", "speckle",
+                          "navigation_drift", "peak_noise", "image", "beam", "sensor_noise", "speckle",
                           "attenuation", "backscatter", "ambient"});
   SimulationEffects e;
   auto flag = [&](const char* key, bool* value) {
@@ -170,15 +170,26 @@ SimulationEffects ReadEffects(const Context& where, const YAML::Node& node) {
 
   auto& drift = e.navigation_drift;
   drift.on = ReadStage(where, node, "navigation_drift",
-                       {"on", "position_walk_m_per_sqrt_s", "yaw_walk_rad_per_sqrt_s"},
+                       {"on", "position_walk_m_per_sqrt_s", "yaw_walk_rad_per_sqrt_s",
+                        "speed_scale_sigma", "heading_bias_sigma_rad", "depth_sigma_m",
+                        "roll_pitch_sigma_rad"},
                        [&](const Context& at, const YAML::Node& n) {
-                         drift.position_walk_m_per_sqrt_s =
-                             Number(at, n, "position_walk_m_per_sqrt_s", Range::kNonNegative,
-                                    drift.position_walk_m_per_sqrt_s);
-                         drift.yaw_walk_rad_per_sqrt_s =
-                             Number(at, n, "yaw_walk_rad_per_sqrt_s", Range::kNonNegative,
-                                    drift.yaw_walk_rad_per_sqrt_s);
+                         const auto read = [&](const char* key, double* value) {
+                           *value = Number(at, n, key, Range::kNonNegative, *value);
+                         };
+                         read("position_walk_m_per_sqrt_s", &drift.position_walk_m_per_sqrt_s);
+                         read("yaw_walk_rad_per_sqrt_s", &drift.yaw_walk_rad_per_sqrt_s);
+                         read("speed_scale_sigma", &drift.speed_scale_sigma);
+                         read("heading_bias_sigma_rad", &drift.heading_bias_sigma_rad);
+                         read("depth_sigma_m", &drift.depth_sigma_m);
+                         read("roll_pitch_sigma_rad", &drift.roll_pitch_sigma_rad);
                        });
+  auto& peak_noise = e.peak_noise;
+  peak_noise.on = ReadStage(where, node, "peak_noise", {"on", "sigma_px"},
+                            [&](const Context& at, const YAML::Node& n) {
+                              peak_noise.sigma_px =
+                                  Number(at, n, "sigma_px", Range::kNonNegative, peak_noise.sigma_px);
+                            });
   auto& image = e.image;
   image.on = ReadStage(
       where, node, "image", {"on", "format", "peak_level", "blur_sigma_px"},

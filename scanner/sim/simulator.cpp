@@ -21,6 +21,8 @@ constexpr double kGlowStartM = 0.02;
 constexpr double kGlowMaxRangeM = 3.0;
 // A detected peak takes the truth of the exact crossing of its line within this distance.
 constexpr double kTruthMatchPx = 3.0;
+// Separates the random stream of the peak noise from the rendered frames' (same frame seeds).
+constexpr std::uint64_t kPeakNoiseStream = 0x9e3779b97f4a7c15ULL;
 
 std::uint64_t FrameSeed(std::uint64_t scene_seed, std::int64_t index) {
   std::seed_seq seq{static_cast<std::uint32_t>(scene_seed), static_cast<std::uint32_t>(scene_seed >> 32),
@@ -166,8 +168,14 @@ SimulatedFrame Simulator::Frame(std::int64_t index) const {
   const LaserPath path = m.source->PathOfFrame(in_sweep);
   const std::vector<TracedPeak> exact = m.tracer.Trace(path, frame.T_W_C);
   if (!m.scene.effects.AnyImageStage()) {
+    const SimulationEffects::PeakNoise& noise = m.scene.effects.peak_noise;
+    std::mt19937_64 rng(FrameSeed(m.scene.seed ^ kPeakNoiseStream, index));
+    std::normal_distribution<double> along(0.0, noise.sigma_px);
+    const int along_axis = m.scene.detector.axis == StripeAxis::kRows ? 0 : 1;
     for (const TracedPeak& peak : exact) {
-      frame.peaks_px.push_back(peak.px);
+      Eigen::Vector2d px = peak.px;
+      if (noise.on) px[along_axis] += along(rng);
+      frame.peaks_px.push_back(px);
       frame.truth_W.push_back(peak.p_W);
       frame.object_ids.push_back(peak.object_index);
     }
@@ -197,10 +205,13 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
   const SimulationEffects::NavigationDrift& drift = m.scene.effects.navigation_drift;
   std::mt19937_64 rng(FrameSeed(m.scene.seed, -1));
   std::normal_distribution<double> normal(0.0, 1.0);
-  Eigen::Vector3d position_error = Eigen::Vector3d::Zero();
-  double yaw_error = 0.0;
+  // Drawn once per dive: the DVL's speed scale error and the compass's heading bias.
+  const double speed_scale = 1.0 + (drift.on ? drift.speed_scale_sigma * normal(rng) : 0.0);
+  const double heading_bias = drift.on ? drift.heading_bias_sigma_rad * normal(rng) : 0.0;
+  double heading_walk = 0.0;
+  Eigen::Vector2d believed_xy = Eigen::Vector2d::Zero();
+  Eigen::Vector3d previous_true = Eigen::Vector3d::Zero();
   std::vector<NavigationSample> samples;
-  const Eigen::Vector3d start_position = m.scene.trajectory.T_W_V(start).translation();
   // One sample at or past the last frame, so that every frame time is bracketed.
   for (int k = 0;; ++k) {
     const double t = start + k * dt;
@@ -209,20 +220,38 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
     sample.time_s = t;
     // The navigation reports the pose the frames were simulated with (held during a sweep
     // without the motion stage), so that reconstruction places them where they were taken.
-    sample.T_W_V = m.scene.trajectory.T_W_V(m.PoseTime(t));
+    const Eigen::Isometry3d truth = m.scene.trajectory.T_W_V(m.PoseTime(t));
+    sample.T_W_V = truth;
     if (drift.on) {
-      if (k > 0) {
-        const double sq = std::sqrt(dt);
-        position_error += drift.position_walk_m_per_sqrt_s * sq *
-                          Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-        yaw_error += drift.yaw_walk_rad_per_sqrt_s * sq * normal(rng);
+      const double sq = std::sqrt(dt);
+      if (k == 0) {
+        believed_xy = truth.translation().head<2>();  // dead reckoning starts from a known fix
+      } else {
+        heading_walk += drift.yaw_walk_rad_per_sqrt_s * sq * normal(rng);
       }
-      // Heading drift turns the believed path about the world's down axis (NED z) through the
-      // dive's start, as dead reckoning does; the position walk adds to it.
-      Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
-      error.linear() = Eigen::AngleAxisd(yaw_error, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      error.translation() = start_position + position_error - error.linear() * start_position;
-      sample.T_W_V = error * sample.T_W_V;
+      // Dead reckoning: the true horizontal displacement as the DVL measures it (scaled),
+      // turned by the heading error, plus the random walk of the position.
+      const double heading_error = heading_bias + heading_walk;
+      const Eigen::Rotation2Dd turn(heading_error);
+      if (k > 0) {
+        const Eigen::Vector2d moved = (truth.translation() - previous_true).head<2>();
+        believed_xy += speed_scale * (turn * moved) +
+                       drift.position_walk_m_per_sqrt_s * sq * Eigen::Vector2d(normal(rng), normal(rng));
+      }
+      previous_true = truth.translation();
+      // Absolute sensors: depth from pressure, roll and pitch from gravity (noise about the
+      // vehicle's own x and y axes), heading with its error about the world's down axis.
+      const double depth_noise = drift.depth_sigma_m * normal(rng);
+      const Eigen::Vector3d tilt_noise(drift.roll_pitch_sigma_rad * normal(rng),
+                                       drift.roll_pitch_sigma_rad * normal(rng), 0.0);
+      const double tilt_angle = tilt_noise.norm();
+      const Eigen::Matrix3d tilt =
+          tilt_angle > 0.0 ? Eigen::AngleAxisd(tilt_angle, tilt_noise / tilt_angle).toRotationMatrix()
+                           : Eigen::Matrix3d::Identity();
+      sample.T_W_V.linear() =
+          Eigen::AngleAxisd(heading_error, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+          truth.linear() * tilt;
+      sample.T_W_V.translation() << believed_xy, truth.translation().z() + depth_noise;
     }
     samples.push_back(sample);
   }
