@@ -11,6 +11,7 @@
 #include "apps/demo_command.hpp"
 #include "apps/dive_commands.hpp"
 #include "apps/kernels_command.hpp"
+#include "apps/map_command.hpp"
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddCalibrateCommand(app);
   uwscan::app::AddImportIntrinsicsCommand(app);
   uwscan::app::AddRegisterCommand(app);
+  uwscan::app::AddMapCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);

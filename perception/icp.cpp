@@ -369,6 +369,10 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
       final_sums.count == 0
           ? 0.0
           : std::sqrt(final_sums.squared_distance / static_cast<double>(final_sums.count));
+  if (point_to_plane && final_sums.count > 0) {
+    result.inlier_plane_rmse =
+        std::sqrt(final_sums.squared_residual / static_cast<double>(final_sums.count));
+  }
   result.information = final_sums.JtJ;
   return result;
 }

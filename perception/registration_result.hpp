@@ -9,6 +9,9 @@ struct RegistrationResult {
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
   double fitness = 0.0;      // fraction of source points with a target point within range
   double inlier_rmse = 0.0;  // metres, over those inliers
+  // Point-to-plane ICP: RMS of n . (p - q) over the inliers, metres (the residual the
+  // information is built from); 0 for other methods.
+  double inlier_plane_rmse = 0.0;
   int iterations = 0;
   bool converged = false;
   // 6x6 information (inverse covariance up to the noise scale) of the pose, ordered

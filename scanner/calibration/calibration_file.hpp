@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "scanner/common/atomic_file.hpp"  // WriteTextAtomically, used with these files
 #include "scanner/lasers/scanner.hpp"
 
 namespace uwscan::scanner::calibration {
@@ -20,9 +21,5 @@ Scanner ScannerInMedium(Scanner scanner, const std::optional<double>& water_inde
 
 // The current time as ISO 8601 UTC ("2024-05-01T12:34:56Z"), for StepRecord::date_utc.
 std::string NowUtc();
-
-// Writes text to path through a temporary file and a rename: a failure leaves any earlier
-// file untouched. Throws uwscan::Error naming the path.
-void WriteTextAtomically(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace uwscan::scanner::calibration

@@ -19,7 +19,8 @@ struct SimulationEffects {
   // Navigation the vehicle believes in, as a vehicle has it: depth (pressure sensor) and roll /
   // pitch (AHRS) absolute with white noise; x, y and heading by dead reckoning (DVL velocity
   // turned by the heading and integrated), which drifts: a random walk of position and heading,
-  // a speed scale error and a heading bias (both drawn once per dive from the seed).
+  // a speed scale error and a heading bias, the DVL's misalignment, which turns the measured
+  // velocity but not the reported heading (both drawn once per dive from the seed).
   struct NavigationDrift {
     bool on = false;
     double position_walk_m_per_sqrt_s = 0.002;  // random-walk density of x and y

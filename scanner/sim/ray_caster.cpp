@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -88,6 +89,51 @@ std::optional<double> SphereDistance(const Geometry& g, const QueryContext& q) {
   if (InRange(t0, q)) return t0;
   if (InRange(t1, q)) return t1;
   return std::nullopt;
+}
+
+// Distance from p to the closest point of segment [a, b].
+double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double s = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (p - (a + s * ab)).norm();
+}
+
+// Distance from p to triangle `prim`: to its plane when p projects inside it, else to the
+// nearest edge.
+double PointTriangleDistance(const Geometry& g, unsigned prim, const Eigen::Vector3d& p) {
+  const Eigen::Vector3i& t = g.triangles[prim];
+  const Eigen::Vector3d& a = g.vertices_W[t[0]];
+  const Eigen::Vector3d& b = g.vertices_W[t[1]];
+  const Eigen::Vector3d& c = g.vertices_W[t[2]];
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double n2 = n.squaredNorm();
+  if (n2 > 0.0) {
+    // Inside when p lies on the inner side of all three edges (seen along the normal).
+    const bool inside = n.dot((b - a).cross(p - a)) >= 0.0 && n.dot((c - b).cross(p - b)) >= 0.0 &&
+                        n.dot((a - c).cross(p - c)) >= 0.0;
+    if (inside) return std::abs(n.dot(p - a)) / std::sqrt(n2);
+  }
+  return std::min({SegmentDistance(p, a, b), SegmentDistance(p, b, c), SegmentDistance(p, c, a)});
+}
+
+// What a point query carries through Embree: the point in double and the best distance so far.
+struct ClosestQuery {
+  const std::vector<std::unique_ptr<Geometry>>* geometries = nullptr;
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
+  double best_m = std::numeric_limits<double>::infinity();
+  float pad = 0.0f;  // added to the float search radius so rounding never culls the closest
+};
+
+bool ClosestCallback(RTCPointQueryFunctionArguments* args) {
+  auto& query = *static_cast<ClosestQuery*>(args->userPtr);
+  const Geometry& g = *(*query.geometries)[args->geomID];
+  const double d = g.sphere ? std::abs((query.p_W - g.centre_W).norm() - g.radius_m)
+                            : PointTriangleDistance(g, args->primID, query.p_W);
+  if (!(d < query.best_m)) return false;
+  query.best_m = d;
+  args->query->radius = static_cast<float>(d) + query.pad;
+  return true;  // the search radius shrank
 }
 
 // Embree's candidate triangles are accepted only when their exact distance is in range.
@@ -297,6 +343,29 @@ RayCaster::RayCaster(const std::vector<SceneObject>& objects) : impl_(std::make_
 RayCaster::~RayCaster() = default;
 RayCaster::RayCaster(RayCaster&&) noexcept = default;
 RayCaster& RayCaster::operator=(RayCaster&&) noexcept = default;
+
+std::optional<double> RayCaster::DistanceToSurface(const Eigen::Vector3d& p_W, double max_m) const {
+  const Impl& m = *impl_;
+  if (!p_W.allFinite() || !(max_m > 0.0)) {
+    throw Error("ray caster: DistanceToSurface: expected a finite point and max_m > 0");
+  }
+  ClosestQuery closest;
+  closest.geometries = &m.geometries;
+  closest.p_W = p_W;
+  const Eigen::Vector3d p_E = p_W - m.origin_E_W;
+  closest.pad = static_cast<float>(1e-6 * (1.0 + p_E.norm() + max_m));
+  RTCPointQuery query;
+  query.x = static_cast<float>(p_E.x());
+  query.y = static_cast<float>(p_E.y());
+  query.z = static_cast<float>(p_E.z());
+  query.time = 0.0f;
+  query.radius = static_cast<float>(max_m) + closest.pad;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(m.scene, &query, &context, ClosestCallback, &closest);
+  if (!(closest.best_m <= max_m)) return std::nullopt;
+  return closest.best_m;
+}
 
 int RayCaster::object_count() const { return static_cast<int>(impl_->geometries.size()); }
 

@@ -55,6 +55,11 @@ class RayCaster {
   bool Blocked(const Eigen::Vector3d& from_W, const Eigen::Vector3d& to_W,
                double eps_m = 1e-6) const;
 
+  // Distance from p_W to the nearest surface of the scene (triangles and spheres, exact in
+  // double), when one lies within max_m; std::nullopt otherwise. Thread-safe like Cast. Throws
+  // uwscan::Error when p_W is not finite or max_m is not > 0.
+  std::optional<double> DistanceToSurface(const Eigen::Vector3d& p_W, double max_m) const;
+
   int object_count() const;
 
  private:

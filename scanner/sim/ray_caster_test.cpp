@@ -197,6 +197,44 @@ TEST(RayCaster, BoxFacesAndNormals) {
   EXPECT_GT(hits, 50);
 }
 
+// Distance from p to an axis-aligned box of half-size h centred at the origin (exact formula).
+double BoxDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& h) {
+  const Eigen::Vector3d q = p.cwiseAbs() - h;
+  const double outside = q.cwiseMax(0.0).norm();
+  const double inside = std::min(q.maxCoeff(), 0.0);
+  return outside > 0.0 ? outside : -inside;
+}
+
+TEST(RayCaster, DistanceToSurfaceMatchesExactFormulas) {
+  const Eigen::Vector3d size(0.2, 0.3, 0.4);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, 1.0, -0.4).normalized()).matrix();
+  const Eigen::Isometry3d T_W_O = Pose({0.1, 0.05, 1.2}, R);
+  const Eigen::Vector3d centre(-0.6, 0.2, 1.0);
+  const RayCaster caster({MeshObject("box", ObjectShape::kBox, MakeBox(size), T_W_O, 0.5),
+                          Sphere(centre, 0.15)});
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int found = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3d p(u(rng), u(rng), 1.1 + 0.5 * u(rng));
+    const double box = BoxDistance(T_W_O.inverse() * p, 0.5 * size);
+    const double sphere = std::abs((p - centre).norm() - 0.15);
+    const double expected = std::min(box, sphere);
+    const std::optional<double> d = caster.DistanceToSurface(p, 0.3);
+    if (expected <= 0.3 - 1e-9) {
+      ASSERT_TRUE(d.has_value()) << "point " << i;
+      EXPECT_NEAR(*d, expected, 1e-12);
+      ++found;
+    } else if (expected > 0.3 + 1e-9) {
+      EXPECT_FALSE(d.has_value()) << "point " << i;
+    }
+  }
+  EXPECT_GT(found, 100);
+  EXPECT_THROW(caster.DistanceToSurface(Eigen::Vector3d::Constant(NAN), 1.0), Error);
+  EXPECT_THROW(caster.DistanceToSurface(Eigen::Vector3d::Zero(), 0.0), Error);
+}
+
 TEST(RayCaster, CylinderMeshWithinTheChordError) {
   const double r = 0.1, chord = 1e-4;
   const RayCaster caster({MeshObject("cylinder", ObjectShape::kCylinder,

@@ -240,7 +240,8 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
       }
       previous_true = truth.translation();
       // Absolute sensors: depth from pressure, roll and pitch from gravity (noise about the
-      // vehicle's own x and y axes), heading with its error about the world's down axis.
+      // vehicle's own x and y axes), heading with its drift about the world's down axis (the
+      // bias is the DVL's misalignment: it turns the measured velocity, not the heading).
       const double depth_noise = drift.depth_sigma_m * normal(rng);
       const Eigen::Vector3d tilt_noise(drift.roll_pitch_sigma_rad * normal(rng),
                                        drift.roll_pitch_sigma_rad * normal(rng), 0.0);
@@ -249,7 +250,7 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
           tilt_angle > 0.0 ? Eigen::AngleAxisd(tilt_angle, tilt_noise / tilt_angle).toRotationMatrix()
                            : Eigen::Matrix3d::Identity();
       sample.T_W_V.linear() =
-          Eigen::AngleAxisd(heading_error, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+          Eigen::AngleAxisd(heading_walk, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
           truth.linear() * tilt;
       sample.T_W_V.translation() << believed_xy, truth.translation().z() + depth_noise;
     }

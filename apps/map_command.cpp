@@ -1,0 +1,169 @@
+#include "apps/map_command.hpp"
+
+#include <omp.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "apps/data_cache.hpp"
+#include "apps/json_output.hpp"
+#include "apps/progress_bar.hpp"
+#include "mapping/dive_mapping.hpp"
+#include "mapping/map_report.hpp"
+#include "perception/cloud_io.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::app {
+namespace {
+
+struct MapArgs {
+  std::string log;
+  std::string output;
+  std::string trajectory;
+  std::string dead_reckoning;
+  std::string truth;
+  std::string json;
+  double voxel_m = 0.005;
+  int sweeps_per_submap = 4;
+  int threads = 0;
+};
+
+nlohmann::json TumRows(const std::vector<mapping::TimedPose>& poses) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const mapping::TimedPose& p : poses) {
+    const Eigen::Quaterniond q(p.T_W_V.linear());
+    const Eigen::Vector3d& t = p.T_W_V.translation();
+    rows.push_back({p.time_s, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()});
+  }
+  return rows;
+}
+
+template <typename T>
+nlohmann::json Optional(const std::optional<T>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+// The map report (format in mapping/README.md, "uwscan map"): what the viewer reads.
+nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& log, const std::string& map) {
+  const mapping::MapSummary s = mapping::Summarise(m);
+  nlohmann::json report = {{"uwscan_format", 1}, {"kind", "map_report"}, {"log", log}};
+  const std::filesystem::path map_path(map);
+  report["map"] = map_path.is_absolute() ? map : std::filesystem::absolute(map_path).string();
+  report["trajectories"] = {{"slam", TumRows(m.slam)}, {"dead_reckoning", TumRows(m.dead_reckoning)}};
+  if (!m.truth.empty()) report["trajectories"]["truth"] = TumRows(m.truth);
+  nlohmann::json covariance = nlohmann::json::array(), deviation = nlohmann::json::array();
+  for (std::size_t i = 0; i < m.covariances.size(); ++i) {
+    nlohmann::json row = {m.slam[i].time_s};
+    for (int r = 0; r < 6; ++r) {
+      for (int c = 0; c < 6; ++c) row.push_back(m.covariances[i](r, c));
+    }
+    covariance.push_back(row);
+    const Eigen::Matrix<double, 6, 1> std = mapping::PoseStd(m.covariances[i]);
+    deviation.push_back({m.slam[i].time_s, std(0), std(1), std(2), std(3), std(4), std(5)});
+  }
+  report["pose_covariance"] = covariance;  // [t, 36 values of [rotation (rad), position (m)] row-major]
+  report["pose_std"] = deviation;          // [t, x, y, z (m), roll, pitch, yaw (rad)]
+  nlohmann::json loops = nlohmann::json::array();
+  for (const mapping::LoopClosure& l : m.loops) {
+    loops.push_back({{"from_submap", l.from}, {"to_submap", l.to}, {"accepted", l.accepted},
+                     {"reason", l.reason}, {"fitness", l.fitness}, {"chi2", l.chi2}});
+  }
+  report["loops"] = loops;
+  report["figures"] = {{"submaps", m.submaps},
+                       {"map_points", m.map.size()},
+                       {"dive_duration_s", m.dive_duration_s},
+                       {"seconds", m.seconds},
+                       {"real_time_factor", s.real_time_factor},
+                       {"registrations", m.stats.registrations},
+                       {"registrations_left_to_navigation", m.stats.registrations_failed},
+                       {"loops_accepted", s.loops_accepted},
+                       {"loops_rejected", s.loops_rejected},
+                       {"loops_false", Optional(s.loops_false)},
+                       {"navigation_noise_assumed", m.navigation_noise_assumed},
+                       {"ate_slam_m", Optional(s.ate_slam_m)},
+                       {"ate_dead_reckoning_m", Optional(s.ate_dead_reckoning_m)},
+                       {"rpe_slam_per_m", Optional(s.rpe_slam_per_m)},
+                       {"rpe_dead_reckoning_per_m", Optional(s.rpe_dead_reckoning_per_m)},
+                       {"nees_mean", Optional(s.nees_mean)}};
+  return report;
+}
+
+// Every output is checked before any work: a missing folder, or an output that is the input.
+void RequireOutput(const std::string& path, const char* option, const std::string& log) {
+  if (path.empty()) return;
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw Error(std::string(option) + " " + path + ": folder '" + parent.string() + "' does not exist");
+  }
+  std::error_code ec;
+  if (std::filesystem::equivalent(path, log, ec)) {
+    throw Error(std::string(option) + " " + path + ": is the dive log itself");
+  }
+}
+
+void RunMap(const MapArgs& a) {
+  for (const auto& [path, option] : {std::pair{a.output, "-o"}, {a.trajectory, "--trajectory"},
+                                     {a.dead_reckoning, "--dead-reckoning"}, {a.truth, "--truth"},
+                                     {a.json, "--json"}}) {
+    RequireOutput(path, option, a.log);
+  }
+  if (a.threads > 0) omp_set_num_threads(a.threads);
+  mapping::DiveMappingOptions options;
+  options.map_voxel_m = a.voxel_m;
+  options.mapper.sweeps_per_submap = a.sweeps_per_submap;
+  options.mapper.threads = a.threads;
+  options.table_cache = TableCache();
+  const mapping::DiveLogReader log(a.log);
+  mapping::DiveMapping m;
+  {
+    ProgressBar bar;
+    m = mapping::MapDive(log, options, [&bar](double f) { bar.Update("map", f); });
+  }
+  perception::WriteCloud(a.output, m.map);
+  if (!a.trajectory.empty()) mapping::WriteTum(a.trajectory, m.slam);
+  if (!a.dead_reckoning.empty()) mapping::WriteTum(a.dead_reckoning, m.dead_reckoning);
+  if (!a.truth.empty()) {
+    if (m.truth.empty()) throw Error("--truth " + a.truth + ": the log holds no ground truth (not simulated)");
+    mapping::WriteTum(a.truth, m.truth);
+  }
+  const mapping::MapSummary s = mapping::Summarise(m);
+  std::printf("%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
+              a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
+  std::printf("registrations %d (%d left to navigation), loops accepted %d, rejected %d\n",
+              m.stats.registrations, m.stats.registrations_failed, s.loops_accepted, s.loops_rejected);
+  if (m.navigation_noise_assumed) {
+    std::printf("navigation noise: not recorded in the log (schema 1), a typical AUV's assumed\n");
+  }
+  if (s.ate_slam_m) {
+    std::printf("against the truth: ATE dead reckoning %.4f m, SLAM %.4f m", *s.ate_dead_reckoning_m, *s.ate_slam_m);
+    if (s.nees_mean) std::printf(", NEES %.2f (6 for a consistent covariance)", *s.nees_mean);
+    std::printf("\n");
+  }
+  if (!a.json.empty()) WriteJsonFile(a.json, MapReportJson(m, a.log, a.output));
+}
+
+}  // namespace
+
+void AddMapCommand(CLI::App& app) {
+  auto args = std::make_shared<MapArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "map", "scan-matching SLAM over a dive log: map, trajectories, per-pose uncertainty, loop closures");
+  cmd->add_option("log", args->log, "dive log (.db)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "map to write (.ply, .pcd, .xyz), voxelised")->required();
+  cmd->add_option("--trajectory", args->trajectory, "SLAM trajectory to write (TUM: t tx ty tz qx qy qz qw)");
+  cmd->add_option("--dead-reckoning", args->dead_reckoning, "the navigation at the same times (TUM)");
+  cmd->add_option("--truth", args->truth, "the true trajectory at the same times (TUM; simulated logs)");
+  cmd->add_option("--json", args->json,
+                  "report: trajectories, per-pose covariance and standard deviations, loops, figures");
+  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")->check(CLI::PositiveNumber);
+  cmd->add_option("--sweeps-per-submap", args->sweeps_per_submap, "sweeps grouped into one submap")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->threads, "threads (0: all cores); the output does not depend on it")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([args] { RunMap(*args); });
+}
+
+}  // namespace uwscan::app

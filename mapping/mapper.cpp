@@ -1,0 +1,434 @@
+#include "mapping/mapper.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <numeric>
+
+#include "mapping/navigation_buffer.hpp"
+#include "mapping/navigation_uncertainty.hpp"
+#include "perception/icp.hpp"
+#include "perception/voxel_filter.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/triangulation/triangulator_factory.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// Frames waiting for navigation beyond this many mean the navigation has stopped.
+constexpr std::size_t kMaxWaitingFrames = 20000;
+// The start fix: where the dive's dead reckoning starts is known to this much.
+constexpr double kStartSigma_m = 0.001;
+constexpr double kStartSigma_rad = 0.001;
+
+// Appends `cloud` (points and normals) moved by T to `out`, whose origin is 0.
+void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isometry3d& T, perception::PointCloud* out) {
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    out->points.push_back((T * cloud.Point(i)).cast<float>());
+    if (cloud.has_normals()) out->normals.push_back(R * cloud.normals[i]);
+  }
+}
+
+// Information along world axes [w_W, t_W] holding only heading, x and y: the start fix.
+Matrix6d StartInformation() {
+  Matrix6d info = Matrix6d::Zero();
+  info(2, 2) = 1.0 / (kStartSigma_rad * kStartSigma_rad);
+  info(3, 3) = info(4, 4) = 1.0 / (kStartSigma_m * kStartSigma_m);
+  return info;
+}
+
+// Covariance of the position of `to` seen from `from`'s frame, from the [w, v] covariance of
+// T_from_to: the rotation moves it by w x t.
+Eigen::Matrix3d PositionCovariance(const Matrix6d& covariance, const Eigen::Vector3d& t) {
+  Eigen::Matrix<double, 3, 6> J;
+  Eigen::Matrix3d minus_skew;
+  minus_skew << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;
+  J << minus_skew, Eigen::Matrix3d::Identity();
+  return J * covariance * J.transpose();
+}
+
+double LargestStd(const Eigen::Matrix3d& covariance) {
+  return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
+}
+
+}  // namespace
+
+void MapperOptions::Check() const {
+  const auto fail = [](const std::string& field, const std::string& expected) {
+    throw Error("MapperOptions." + field + ": expected " + expected);
+  };
+  clouds.Check();
+  if (sweeps_per_submap < 1) fail("sweeps_per_submap", "> 0");
+  if (local_map_submaps < 1) fail("local_map_submaps", "> 0");
+  if (!(point_sigma_floor_m > 0.0)) fail("point_sigma_floor_m", "> 0 m");
+  if (!(min_fitness >= 0.0 && min_fitness <= 1.0)) fail("min_fitness", "in [0, 1]");
+  if (!(loop_min_fitness >= 0.0 && loop_min_fitness <= 1.0)) fail("loop_min_fitness", "in [0, 1]");
+  if (loop_min_index_gap <= local_map_submaps) fail("loop_min_index_gap", "> local_map_submaps");
+  if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
+  if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
+  if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
+  if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
+  if (!(loop_chi2_gate > 0.0)) fail("loop_chi2_gate", "> 0");
+  if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
+  if (threads < 0) fail("threads", ">= 0");
+  perception::IcpOptions icp;
+  icp.max_correspondence_distance_m = icp_distances_m;
+  icp.Check();
+  icp.max_correspondence_distance_m = loop_icp_distances_m;
+  icp.Check();
+}
+
+struct Mapper::Impl {
+  MapperOptions options;
+  Eigen::Isometry3d T_V_C;
+  NavigationUncertainty uncertainty;
+  std::unique_ptr<scanner::Triangulator> triangulator;
+  NavigationBuffer navigation;
+  std::deque<FrameRecord> waiting;
+  bool finished = false;
+
+  // The submap being filled: points in the navigation's world frame, and its frames.
+  std::vector<Eigen::Vector3d> points_W;
+  std::vector<std::pair<std::int64_t, double>> frames;  // index, time
+  int first_sweep = 0;
+  std::vector<scanner::TriangulatedPoint> triangulated;
+
+  std::vector<Submap> submaps;                 // node i of the graph is submaps[i]
+  std::vector<Matrix6d> increment_covariance;  // of T_{i-1,i} in frame i-1 (0 for i = 0)
+  PoseGraph graph;
+  std::vector<LoopClosure> loops;
+  MapperStats stats;
+  int since_solve = 0;
+
+  Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
+      : options(o), T_V_C(mount), uncertainty(noise) {}
+
+  void Drain(bool hold_at_ends);
+  void Place(const FrameRecord& frame, bool hold_at_ends);
+  void CloseSubmap();
+  void AddToGraph(Submap submap);
+  perception::RegistrationResult Register(const Submap& source, const perception::PointCloud& target,
+                                          const Eigen::Isometry3d& T_init, const Matrix6d& prior_covariance,
+                                          const std::vector<double>& distances) const;
+  Matrix6d RegistrationInformation(const perception::RegistrationResult& r) const;
+  Matrix6d ChainCovariance(int from, int to) const;
+  void TryLoopClosures(int k);
+  void Solve();
+};
+
+void Mapper::Impl::Drain(bool hold_at_ends) {
+  while (!waiting.empty()) {
+    const double t = waiting.front().time_s;
+    if (!hold_at_ends && !(navigation.Covers(t) || (!navigation.empty() && t < navigation.first_time_s()))) {
+      break;
+    }
+    Place(waiting.front(), hold_at_ends);
+    waiting.pop_front();
+  }
+}
+
+void Mapper::Impl::Place(const FrameRecord& frame, bool hold_at_ends) {
+  (void)hold_at_ends;
+  if (!frames.empty() && frame.sweep >= first_sweep + options.sweeps_per_submap) CloseSubmap();
+  if (frames.empty()) first_sweep = frame.sweep;
+  const Clock::time_point start = Clock::now();
+  triangulated.resize(frame.peaks_px.size());
+  triangulator->TriangulateFrame(frame.command, frame.peaks_px, triangulated);
+  // Held at the first or last sample outside the navigation's span.
+  const double t = std::clamp(frame.time_s, navigation.first_time_s(), navigation.last_time_s());
+  const Eigen::Isometry3d T_W_C = navigation.T_W_V(t) * T_V_C;
+  for (const scanner::TriangulatedPoint& p : triangulated) {
+    if (!p.ok()) continue;
+    points_W.push_back(T_W_C * p.p_C);
+    ++stats.points;
+  }
+  frames.emplace_back(frame.index, frame.time_s);
+  ++stats.frames;
+  stats.triangulation_s += Since(start);
+}
+
+void Mapper::Impl::CloseSubmap() {
+  if (frames.empty()) return;
+  const Clock::time_point start = Clock::now();
+  Submap submap;
+  const auto& anchor = frames[frames.size() / 2];
+  submap.anchor_frame = anchor.first;
+  submap.anchor_time_s = anchor.second;
+  submap.first_frame = frames.front().first;
+  submap.last_frame = frames.back().first;
+  submap.start_s = frames.front().second;
+  submap.end_s = frames.back().second;
+  const double t = std::clamp(anchor.second, navigation.first_time_s(), navigation.last_time_s());
+  submap.T_W_V_nav = navigation.T_W_V(t);
+  const Eigen::Isometry3d T_V_W = submap.T_W_V_nav.inverse();
+  std::vector<Eigen::Vector3d> points_V;
+  points_V.reserve(points_W.size());
+  for (const Eigen::Vector3d& p : points_W) points_V.push_back(T_V_W * p);
+  SubmapCloudOptions cloud_options = options.clouds;
+  cloud_options.viewpoint_V = T_V_C.translation();
+  cloud_options.threads = options.threads;
+  BuildSubmapClouds(points_V, cloud_options, &submap);
+  const double last_time = frames.back().second;
+  points_W.clear();
+  frames.clear();
+  navigation.DropBefore(last_time);
+  stats.submap_s += Since(start);
+  // A submap that saw nothing (open water) adds no node: odometry bridges it.
+  if (submap.cloud.empty() || submap.sparse.size() < 10) return;
+  AddToGraph(std::move(submap));
+}
+
+perception::RegistrationResult Mapper::Impl::Register(const Submap& source, const perception::PointCloud& target,
+                                                      const Eigen::Isometry3d& T_init,
+                                                      const Matrix6d& prior_covariance,
+                                                      const std::vector<double>& distances) const {
+  perception::IcpOptions icp;
+  icp.method = perception::IcpMethod::kPointToPlane;
+  icp.max_correspondence_distance_m = distances;
+  icp.max_iterations = 120;
+  icp.max_iterations_per_stage = 30;
+  // Converged once a step moves less than a hundredth of the finest voxel.
+  icp.translation_tolerance_m = 0.01 * options.clouds.map_voxel_m;
+  icp.rotation_tolerance_rad = 1e-5;
+  icp.relative_rmse_tolerance = 1e-6;
+  icp.threads = options.threads;
+  perception::IcpPrior prior;
+  prior.T_target_source = T_init;
+  prior.information = prior_covariance.inverse();
+  prior.information = 0.5 * (prior.information + prior.information.transpose());
+  prior.point_sigma_m = 2.0 * options.point_sigma_floor_m;
+  icp.prior = prior;
+  return perception::AlignIcp(source.sparse, target, T_init, icp);
+}
+
+Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r) const {
+  const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
+  return r.information / (sigma * sigma);
+}
+
+Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
+  Matrix6d covariance = Matrix6d::Zero();
+  const Eigen::Isometry3d T_from_W = graph.pose(from).inverse();
+  for (int i = from + 1; i <= to; ++i) {
+    const Matrix6d ad = Adjoint(T_from_W * graph.pose(i - 1));
+    covariance += ad * increment_covariance[static_cast<size_t>(i)] * ad.transpose();
+  }
+  return covariance;
+}
+
+void Mapper::Impl::AddToGraph(Submap submap) {
+  const int k = static_cast<int>(submaps.size());
+  submap.index = k;
+  const NavigationNoise& noise = uncertainty.noise();
+  Eigen::Isometry3d initial = submap.T_W_V_nav;
+  Matrix6d increment_cov = Matrix6d::Zero();
+  std::optional<RelativePoseEdge> registration;
+  if (k > 0) {
+    const Submap& previous = submaps.back();
+    const Eigen::Isometry3d T_nav = previous.T_W_V_nav.inverse() * submap.T_W_V_nav;
+    const double dt = submap.anchor_time_s - previous.anchor_time_s;
+    increment_cov = uncertainty.IncrementCovariance(previous.T_W_V_nav, submap.T_W_V_nav, dt);
+    initial = graph.pose(k - 1) * T_nav;
+
+    const Clock::time_point start = Clock::now();
+    perception::PointCloud local;
+    const Eigen::Isometry3d T_prev_W = graph.pose(k - 1).inverse();
+    for (int j = std::max(0, k - options.local_map_submaps); j < k; ++j) {
+      AppendMoved(submaps[static_cast<size_t>(j)].cloud, T_prev_W * graph.pose(j), &local);
+    }
+    const perception::RegistrationResult r =
+        Register(submap, local, T_nav, increment_cov, options.icp_distances_m);
+    stats.registration_s += Since(start);
+    const Matrix6d nav_information = increment_cov.inverse();
+    if (r.fitness >= options.min_fitness) {
+      const Matrix6d information = RegistrationInformation(r);
+      registration = RelativePoseEdge{k - 1, k, r.T_target_source, information, false, 3.0};
+      initial = graph.pose(k - 1) * r.T_target_source;
+      increment_cov = (nav_information + information).inverse();
+      ++stats.registrations;
+    } else {
+      ++stats.registrations_failed;
+    }
+  }
+  const int node = graph.AddNode(initial);
+  if (k == 0) {
+    graph.AddPrior({node, submap.T_W_V_nav, StartInformation()});
+  } else {
+    const Submap& previous = submaps.back();
+    const double dt = submap.anchor_time_s - previous.anchor_time_s;
+    graph.AddEdge({k - 1, k, previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
+                   uncertainty.OdometryInformation(previous.T_W_V_nav, submap.T_W_V_nav, dt), false, 3.0});
+    if (registration) graph.AddEdge(*registration);
+  }
+  graph.AddDepth({node, submap.T_W_V_nav.translation().z(), noise.depth_sigma_m});
+  graph.AddGravity({node, submap.T_W_V_nav.linear().transpose() * Eigen::Vector3d::UnitZ(), noise.roll_pitch_sigma_rad});
+  submaps.push_back(std::move(submap));
+  increment_covariance.push_back(0.5 * (increment_cov + increment_cov.transpose()));
+
+  const std::size_t loops_before = std::count_if(loops.begin(), loops.end(), [](const LoopClosure& l) { return l.accepted; });
+  TryLoopClosures(k);
+  const std::size_t loops_after = std::count_if(loops.begin(), loops.end(), [](const LoopClosure& l) { return l.accepted; });
+  if (loops_after > loops_before || ++since_solve >= options.solve_every_submaps) Solve();
+}
+
+void Mapper::Impl::TryLoopClosures(int k) {
+  if (options.max_loop_candidates == 0) return;
+  const Clock::time_point start = Clock::now();
+  const Submap& current = submaps[static_cast<size_t>(k)];
+  const Eigen::Vector3d centre_k = graph.pose(k) * current.centroid_V;
+  struct Candidate {
+    int j;
+    double distance;
+    Matrix6d covariance;
+  };
+  std::vector<Candidate> candidates;
+  for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
+    const Submap& old = submaps[static_cast<size_t>(j)];
+    const double distance = (graph.pose(j) * old.centroid_V - centre_k).norm();
+    const double overlap = 0.5 * (old.radius_m + current.radius_m);
+    if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
+    const Matrix6d covariance = ChainCovariance(j, k);
+    const Eigen::Vector3d t = (graph.pose(j).inverse() * graph.pose(k)).translation();
+    const double sigma = LargestStd(PositionCovariance(covariance, t));
+    if (distance - overlap > options.gate_sigmas * sigma) continue;
+    candidates.push_back({j, distance, covariance});
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+  if (candidates.size() > static_cast<size_t>(options.max_loop_candidates)) {
+    candidates.resize(static_cast<size_t>(options.max_loop_candidates));
+  }
+  for (const Candidate& c : candidates) {
+    const int j = c.j;
+    perception::PointCloud target;
+    for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
+      AppendMoved(submaps[static_cast<size_t>(i)].cloud, graph.pose(j).inverse() * graph.pose(i), &target);
+    }
+    const Eigen::Isometry3d T_pred = graph.pose(j).inverse() * graph.pose(k);
+    const Eigen::Vector3d t = T_pred.translation();
+    // The first stage reaches as far as the prediction may be off.
+    std::vector<double> distances = options.loop_icp_distances_m;
+    const double reach = options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, t));
+    if (reach > distances.front()) distances.insert(distances.begin(), reach);
+    const perception::RegistrationResult r = Register(current, target, T_pred, c.covariance, distances);
+
+    LoopClosure loop;
+    loop.from = j;
+    loop.to = k;
+    loop.fitness = r.fitness;
+    loop.T_from_to = r.T_target_source;
+    const Matrix6d information = RegistrationInformation(r);
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(information);
+    if (r.fitness < options.loop_min_fitness) {
+      loop.reason = "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
+    } else if (!(eigen.eigenvalues()(0) > 0.0)) {
+      loop.reason = "degenerate: the scans leave a direction unconstrained";
+    } else {
+      const Matrix6d cov = information.inverse();
+      const double sigma_m = LargestStd(cov.bottomRightCorner<3, 3>());
+      const double sigma_rad = LargestStd(cov.topLeftCorner<3, 3>());
+      const Vector6d innovation = PoseError(r.T_target_source, T_pred);
+      loop.chi2 = innovation.dot((c.covariance + cov).ldlt().solve(innovation));
+      if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
+        loop.reason = "degenerate: registration std " + std::to_string(sigma_m) + " m, " +
+                      std::to_string(sigma_rad) + " rad";
+      } else if (!(loop.chi2 <= options.loop_chi2_gate)) {
+        loop.reason = "inconsistent with the prediction: chi2 " + std::to_string(loop.chi2);
+      } else {
+        loop.accepted = true;
+        graph.AddEdge({j, k, r.T_target_source, information, true, 3.0});
+      }
+    }
+    loops.push_back(loop);
+  }
+  stats.loop_s += Since(start);
+}
+
+void Mapper::Impl::Solve() {
+  const Clock::time_point start = Clock::now();
+  graph.Solve(PoseGraphOptions{});
+  since_solve = 0;
+  stats.graph_s += Since(start);
+}
+
+Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern, const Eigen::Isometry3d& T_V_C,
+               const NavigationNoise& noise, const MapperOptions& options,
+               const std::filesystem::path& table_cache)
+    : impl_(std::make_unique<Impl>(options, T_V_C, noise)) {
+  options.Check();
+  impl_->triangulator = scanner::MakeTriangulator(scanner, pattern, scanner::DefaultTriangulationMethod(pattern.kind),
+                                                  scanner::TriangulatorBuildOptions{table_cache});
+}
+
+Mapper::~Mapper() = default;
+
+void Mapper::AddNavigation(const NavigationRecord& record) {
+  if (impl_->finished) throw Error("mapper: navigation added after Finish");
+  impl_->navigation.Add(record);
+  impl_->Drain(false);
+}
+
+void Mapper::AddFrame(const FrameRecord& frame) {
+  Impl& m = *impl_;
+  if (m.finished) throw Error("mapper: frame added after Finish");
+  if (!m.waiting.empty() && frame.time_s < m.waiting.back().time_s) {
+    throw Error("mapper: frame " + std::to_string(frame.index) + " is older than the one before it");
+  }
+  if (m.waiting.size() >= kMaxWaitingFrames) {
+    throw Error("mapper: " + std::to_string(m.waiting.size()) +
+                " frames wait for navigation that does not come (last sample at " +
+                (m.navigation.empty() ? std::string("none") : std::to_string(m.navigation.last_time_s()) + " s") + ")");
+  }
+  FrameRecord copy;
+  copy.index = frame.index;
+  copy.time_s = frame.time_s;
+  copy.command = frame.command;
+  copy.sweep = frame.sweep;
+  copy.peaks_px = frame.peaks_px;  // the image is not needed once the peaks are found
+  m.waiting.push_back(std::move(copy));
+  m.Drain(false);
+}
+
+void Mapper::Finish() {
+  Impl& m = *impl_;
+  if (m.finished) return;
+  if (m.navigation.empty()) throw Error("mapper: no navigation: frames cannot be placed");
+  m.Drain(true);
+  m.CloseSubmap();
+  m.finished = true;
+  if (!m.submaps.empty()) m.Solve();
+}
+
+int Mapper::submap_count() const { return static_cast<int>(impl_->submaps.size()); }
+const Submap& Mapper::submap(int index) const { return impl_->submaps.at(static_cast<size_t>(index)); }
+Eigen::Isometry3d Mapper::pose(int index) const { return impl_->graph.pose(index); }
+const std::vector<LoopClosure>& Mapper::loops() const { return impl_->loops; }
+const MapperStats& Mapper::stats() const { return impl_->stats; }
+
+std::optional<std::vector<Matrix6d>> Mapper::Covariances() const {
+  return impl_->graph.Covariances();
+}
+
+perception::PointCloud Mapper::Map(double voxel_m, bool with_navigation) const {
+  const Impl& m = *impl_;
+  perception::PointCloud all;
+  if (m.submaps.empty()) return all;
+  const auto placed = [&](int i) { return with_navigation ? m.submaps[static_cast<size_t>(i)].T_W_V_nav : pose(i); };
+  all.origin = placed(0).translation();
+  const Eigen::Isometry3d T_origin = Eigen::Translation3d(-all.origin) * Eigen::Isometry3d::Identity();
+  for (int i = 0; i < submap_count(); ++i) {
+    perception::PointCloud cloud = m.submaps[static_cast<size_t>(i)].cloud;
+    cloud.normals.clear();
+    AppendMoved(cloud, T_origin * placed(i), &all);
+  }
+  return perception::VoxelDownsample(all, {voxel_m});
+}
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,111 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mapping/dive_log.hpp"
+#include "mapping/pose_graph.hpp"
+#include "mapping/submap.hpp"
+#include "perception/point_cloud.hpp"
+#include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/lasers/scanner.hpp"
+#include "scanner/triangulation/triangulator.hpp"
+
+// Scan-matching SLAM, frame by frame: the front end that `uwscan map` replays a log through and
+// that online inspection feeds live (mapping/README.md, "Scan-matching SLAM").
+namespace uwscan::mapping {
+
+struct MapperOptions {
+  int sweeps_per_submap = 4;            // sweeps grouped into one submap, > 0
+  SubmapCloudOptions clouds;            // voxel sizes, normals
+  int local_map_submaps = 3;            // previous submaps the new one is registered to, > 0
+  // ICP stages (metres, non-increasing) for consecutive submaps and for loop closures.
+  std::vector<double> icp_distances_m = {0.04, 0.02, 0.01};
+  std::vector<double> loop_icp_distances_m = {0.10, 0.04, 0.02, 0.01};
+  double point_sigma_floor_m = 0.0003;  // a point-to-plane residual is never trusted beyond this
+  double min_fitness = 0.3;             // registration edge kept only above this fitness
+  // Loop closures: candidates at least this many submaps back, whose overlap is plausible
+  // within gate_sigmas of the relative uncertainty; at most max_loop_candidates tried per
+  // submap. Accepted only if the registration's fitness, its own uncertainty (every direction
+  // constrained) and its consistency with the prediction (chi-square, 6 dof) all agree.
+  int loop_min_index_gap = 6;
+  int max_loop_candidates = 2;
+  double gate_sigmas = 3.0;
+  double loop_min_fitness = 0.4;
+  double loop_max_sigma_m = 0.01;     // registration std along any direction
+  double loop_max_sigma_rad = 0.005;  // registration std about any axis
+  double loop_chi2_gate = 22.46;      // 6 dof, 99.9 %
+  int solve_every_submaps = 10;       // whole-graph solve also without a loop closure, > 0
+  int threads = 0;                    // OpenMP threads of ICP and normals, 0 = default
+  void Check() const;
+};
+
+struct LoopClosure {
+  int from = 0;  // the earlier submap
+  int to = 0;    // the new one
+  bool accepted = false;
+  std::string reason;  // why it was rejected ("" when accepted)
+  double fitness = 0.0;
+  double chi2 = 0.0;   // of the registration against the prediction
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
+};
+
+struct MapperStats {
+  std::int64_t frames = 0;
+  std::int64_t points = 0;
+  int registrations = 0;         // consecutive submaps registered (fitness above the floor)
+  int registrations_failed = 0;  // left to odometry alone
+  double triangulation_s = 0.0;
+  double submap_s = 0.0;  // voxels and normals
+  double registration_s = 0.0;
+  double loop_s = 0.0;
+  double graph_s = 0.0;
+};
+
+// Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until
+// the navigation covers their time, then triangulated and placed with the navigation
+// interpolated at their own time; every `sweeps_per_submap` sweeps close a submap, which is
+// registered (point-to-plane ICP with the navigation increment as start and prior) to the last
+// few submaps, added to the graph with its odometry and registration edges and its depth and
+// roll/pitch priors, and checked for loop closures against older submaps. The graph is
+// re-solved when a loop closes (and every few submaps). Memory: the voxelised submaps and the
+// graph, not the frames. Deterministic: the same inputs give the same bits for any thread count.
+class Mapper {
+ public:
+  // T_V_C: the camera on the vehicle. Throws uwscan::Error on invalid options.
+  Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern, const Eigen::Isometry3d& T_V_C,
+         const NavigationNoise& noise, const MapperOptions& options,
+         const std::filesystem::path& table_cache = {});
+  ~Mapper();
+  Mapper(const Mapper&) = delete;
+  Mapper& operator=(const Mapper&) = delete;
+
+  // Feed in time order (navigation may run ahead of frames; frames wait for it).
+  void AddNavigation(const NavigationRecord& record);
+  void AddFrame(const FrameRecord& frame);
+  // Processes every frame still waiting (past the last navigation sample: held at it), closes
+  // the last submap and solves the whole graph. Nothing may be added afterwards.
+  void Finish();
+
+  int submap_count() const;
+  const Submap& submap(int index) const;
+  Eigen::Isometry3d pose(int index) const;  // current estimate of T_W_V at the submap's anchor
+  const std::vector<LoopClosure>& loops() const;
+  const MapperStats& stats() const;
+  // Per-submap marginal covariances ([rotation, position] in the world, pose_graph.hpp).
+  std::optional<std::vector<Matrix6d>> Covariances() const;
+  // Every submap's cloud placed with the current estimates (or the navigation), voxelised at
+  // `voxel_m`, origin at the first submap's position.
+  perception::PointCloud Map(double voxel_m, bool with_navigation = false) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uwscan::mapping

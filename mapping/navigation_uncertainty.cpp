@@ -1,0 +1,88 @@
+#include "mapping/navigation_uncertainty.hpp"
+
+#include <algorithm>
+
+namespace uwscan::mapping {
+namespace {
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+// A covariance expressed along the world's axes, re-expressed in frame a (both blocks rotate).
+Matrix6d WorldAxesToFrame(const Matrix6d& in_world_axes, const Eigen::Matrix3d& R_W_a) {
+  Matrix6d B = Matrix6d::Zero();
+  B.topLeftCorner<3, 3>() = R_W_a.transpose();
+  B.bottomRightCorner<3, 3>() = R_W_a.transpose();
+  return B * in_world_axes * B.transpose();
+}
+
+}  // namespace
+
+Matrix6d Adjoint(const Eigen::Isometry3d& T) {
+  Matrix6d ad = Matrix6d::Zero();
+  const Eigen::Matrix3d& R = T.linear();
+  ad.topLeftCorner<3, 3>() = R;
+  ad.bottomLeftCorner<3, 3>() = Skew(T.translation()) * R;
+  ad.bottomRightCorner<3, 3>() = R;
+  return ad;
+}
+
+NavigationUncertainty::NavigationUncertainty(const NavigationNoise& noise) : noise_(noise) {
+  noise_.Check();
+  noise_.position_walk_m_per_sqrt_s = std::max(noise_.position_walk_m_per_sqrt_s, kFloorWalk_m_per_sqrt_s);
+  noise_.heading_walk_rad_per_sqrt_s =
+      std::max(noise_.heading_walk_rad_per_sqrt_s, kFloorHeadingWalk_rad_per_sqrt_s);
+  noise_.speed_scale_sigma = std::max(noise_.speed_scale_sigma, kFloorScale);
+  noise_.heading_bias_sigma_rad = std::max(noise_.heading_bias_sigma_rad, kFloorHeadingBias_rad);
+  noise_.depth_sigma_m = std::max(noise_.depth_sigma_m, kFloorDepth_m);
+  noise_.roll_pitch_sigma_rad = std::max(noise_.roll_pitch_sigma_rad, kFloorRollPitch_rad);
+}
+
+Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W_a,
+                                                    const Eigen::Isometry3d& T_W_b, double dt_s) const {
+  const double dt = std::max(dt_s, 0.0);
+  const Eigen::Vector2d moved = (T_W_b.translation() - T_W_a.translation()).head<2>();
+  const double distance = moved.norm();
+  Matrix6d world = Matrix6d::Zero();
+  const double tilt = 2.0 * noise_.roll_pitch_sigma_rad * noise_.roll_pitch_sigma_rad;
+  world(0, 0) = tilt;
+  world(1, 1) = tilt;
+  world(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * dt;
+  Eigen::Matrix2d xy = Eigen::Matrix2d::Identity() *
+                       (noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * dt);
+  if (distance > 0.0) {
+    const Eigen::Vector2d along = moved / distance;
+    const Eigen::Vector2d across(-along.y(), along.x());
+    const double scale = noise_.speed_scale_sigma * distance;
+    const double bias = noise_.heading_bias_sigma_rad * distance;
+    xy += scale * scale * along * along.transpose() + bias * bias * across * across.transpose();
+  }
+  world.block<2, 2>(3, 3) = xy;
+  world(5, 5) = 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m;
+  return WorldAxesToFrame(world, T_W_a.linear());
+}
+
+Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a,
+                                                    const Eigen::Isometry3d& T_W_b, double dt_s) const {
+  // Heading, x and y (world axes 2, 3, 4) inverted together; the other three carry nothing.
+  const Matrix6d world_cov = WorldAxesToFrame(IncrementCovariance(T_W_a, T_W_b, dt_s),
+                                              T_W_a.linear().transpose());
+  const int kept[3] = {2, 3, 4};
+  Eigen::Matrix3d sub;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) sub(r, c) = world_cov(kept[r], kept[c]);
+  }
+  const Eigen::Matrix3d sub_info = sub.inverse();
+  Matrix6d world_info = Matrix6d::Zero();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) world_info(kept[r], kept[c]) = sub_info(r, c);
+  }
+  // Information transforms with the inverse of the covariance's map: e_W = B^-1 e_a, B
+  // orthogonal, so the same rotation applies.
+  return WorldAxesToFrame(world_info, T_W_a.linear());
+}
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,51 @@
+#include "mapping/submap.hpp"
+
+#include <algorithm>
+
+#include "perception/normals.hpp"
+#include "perception/voxel_filter.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::mapping {
+
+void SubmapCloudOptions::Check() const {
+  if (!(map_voxel_m > 0.0)) throw Error("SubmapCloudOptions.map_voxel_m: expected > 0 m");
+  if (!(registration_voxel_m > 0.0)) throw Error("SubmapCloudOptions.registration_voxel_m: expected > 0 m");
+  if (normal_neighbours < 3) throw Error("SubmapCloudOptions.normal_neighbours: expected >= 3");
+  if (threads < 0) throw Error("SubmapCloudOptions.threads: expected >= 0");
+}
+
+void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const SubmapCloudOptions& options,
+                       Submap* submap) {
+  options.Check();
+  submap->cloud = {};
+  submap->sparse = {};
+  // Origin 0 in {V_k}: the registration's information is then about the submap's anchor.
+  perception::PointCloud raw;
+  raw.points.reserve(points_V.size());
+  for (const Eigen::Vector3d& p : points_V) raw.points.push_back(p.cast<float>());
+  if (raw.size() < 10) return;
+
+  const perception::PointCloud voxels = perception::VoxelDownsample(raw, {options.map_voxel_m});
+  perception::NormalOptions normal_options;
+  normal_options.k = options.normal_neighbours;
+  normal_options.viewpoint = options.viewpoint_V;
+  normal_options.threads = options.threads;
+  perception::CloudWithNormals with_normals =
+      perception::AttachNormals(voxels, perception::EstimateNormals(voxels, normal_options));
+  if (with_normals.cloud.size() < 10) return;
+  submap->cloud = std::move(with_normals.cloud);
+  submap->sparse = perception::VoxelDownsample(raw, {options.registration_voxel_m});
+
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < submap->cloud.size(); ++i) centroid += submap->cloud.Point(i);
+  centroid /= static_cast<double>(submap->cloud.size());
+  double radius = 0.0;
+  for (std::size_t i = 0; i < submap->cloud.size(); ++i) {
+    radius = std::max(radius, (submap->cloud.Point(i) - centroid).norm());
+  }
+  submap->centroid_V = centroid;
+  submap->radius_m = radius;
+}
+
+}  // namespace uwscan::mapping
