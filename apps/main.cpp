@@ -15,6 +15,7 @@
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
+#include "apps/slam_bench_command.hpp"
 #include "apps/stripe_commands.hpp"
 #include "scanner/common/error.hpp"
 
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddCalibrationBenchCommand(*bench);
   uwscan::app::AddSimulationBenchCommand(*bench);
   uwscan::app::AddKernelsCommand(*bench);
+  uwscan::app::AddSlamBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);

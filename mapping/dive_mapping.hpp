@@ -18,6 +18,7 @@ struct DiveMappingOptions {
   MapperOptions mapper;
   double map_voxel_m = 0.005;  // the output map's voxel, > 0
   std::filesystem::path table_cache;  // triangulation tables kept between runs ("" = none)
+  bool keep_submaps = false;          // fill DiveMapping::submap_clouds
   void Check() const;
 };
 
@@ -32,6 +33,9 @@ struct DiveMapping {
   std::vector<LoopClosure> loops;
   perception::PointCloud map;             // voxelised, world frame (SLAM poses)
   perception::PointCloud map_dead_reckoning;  // the same submaps placed by the navigation
+  // Each submap's cloud in its own frame (normals attached), for peers that take the same
+  // submaps; filled only when DiveMappingOptions::keep_submaps.
+  std::vector<perception::PointCloud> submap_clouds;
   MapperStats stats;
   bool navigation_noise_assumed = false;  // the log did not record it (schema 1)
   double dive_duration_s = 0.0;

@@ -2,6 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -73,6 +75,7 @@ void MapperOptions::Check() const {
   if (loop_min_index_gap <= local_map_submaps) fail("loop_min_index_gap", "> local_map_submaps");
   if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
   if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
+  if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0)) fail("loop_overlap_ratio", "in (0, 1]");
   if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
   if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
   if (!(loop_chi2_gate > 0.0)) fail("loop_chi2_gate", "> 0");
@@ -117,7 +120,7 @@ struct Mapper::Impl {
   perception::RegistrationResult Register(const Submap& source, const perception::PointCloud& target,
                                           const Eigen::Isometry3d& T_init, const Matrix6d& prior_covariance,
                                           const std::vector<double>& distances) const;
-  Matrix6d RegistrationInformation(const perception::RegistrationResult& r) const;
+  Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& a, const Submap& b) const;
   Matrix6d ChainCovariance(int from, int to) const;
   void TryLoopClosures(int k);
   void Solve();
@@ -167,6 +170,11 @@ void Mapper::Impl::CloseSubmap() {
   submap.end_s = frames.back().second;
   const double t = std::clamp(anchor.second, navigation.first_time_s(), navigation.last_time_s());
   submap.T_W_V_nav = navigation.T_W_V(t);
+  const auto clamped = [&](double time) {
+    return navigation.T_W_V(std::clamp(time, navigation.first_time_s(), navigation.last_time_s()));
+  };
+  submap.T_W_V_start = clamped(submap.start_s);
+  submap.T_W_V_end = clamped(submap.end_s);
   const Eigen::Isometry3d T_V_W = submap.T_W_V_nav.inverse();
   std::vector<Eigen::Vector3d> points_V;
   points_V.reserve(points_W.size());
@@ -195,9 +203,11 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
   icp.max_iterations = 120;
   icp.max_iterations_per_stage = 30;
   // Converged once a step moves less than a hundredth of the finest voxel.
-  icp.translation_tolerance_m = 0.01 * options.clouds.map_voxel_m;
-  icp.rotation_tolerance_rad = 1e-5;
-  icp.relative_rmse_tolerance = 1e-6;
+  // Converged once a step moves the data less than a twentieth of the finest voxel: finer
+  // steps are the pairing flickering between neighbours, not progress.
+  icp.translation_tolerance_m = 0.05 * options.clouds.map_voxel_m;
+  icp.rotation_tolerance_rad = 2e-5;
+  icp.relative_rmse_tolerance = 1e-4;
   icp.threads = options.threads;
   perception::IcpPrior prior;
   prior.T_target_source = T_init;
@@ -208,9 +218,14 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
   return perception::AlignIcp(source.sparse, target, T_init, icp);
 }
 
-Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r) const {
+Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& a,
+                                               const Submap& b) const {
   const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
-  return r.information / (sigma * sigma);
+  // Both submaps may be bent by the navigation that placed their frames.
+  const Matrix6d distortion =
+      uncertainty.SubmapDistortionCovariance(a.T_W_V_start, a.T_W_V_end, a.end_s - a.start_s) +
+      uncertainty.SubmapDistortionCovariance(b.T_W_V_start, b.T_W_V_end, b.end_s - b.start_s);
+  return InformationOfSum(r.information / (sigma * sigma), distortion);
 }
 
 Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
@@ -247,8 +262,15 @@ void Mapper::Impl::AddToGraph(Submap submap) {
         Register(submap, local, T_nav, increment_cov, options.icp_distances_m);
     stats.registration_s += Since(start);
     const Matrix6d nav_information = increment_cov.inverse();
+    if (std::getenv("UWSCAN_DEBUG_MAPPER")) {
+      const Eigen::Isometry3d d = T_nav.inverse() * r.T_target_source;
+      std::fprintf(stderr, "reg %d fit %.3f rmse %.5f it %d conv %d  nav->icp dt [%.4f %.4f %.4f] rot %.5f\n", k, r.fitness,
+                   r.inlier_plane_rmse, r.iterations, int(r.converged), d.translation().x(), d.translation().y(),
+                   d.translation().z(), Eigen::AngleAxisd(d.linear()).angle());
+      std::fprintf(stderr, "   T_icp t [%.4f %.4f %.4f]\n", r.T_target_source.translation().x(), r.T_target_source.translation().y(), r.T_target_source.translation().z());
+    }
     if (r.fitness >= options.min_fitness) {
-      const Matrix6d information = RegistrationInformation(r);
+      const Matrix6d information = RegistrationInformation(r, previous, submap);
       registration = RelativePoseEdge{k - 1, k, r.T_target_source, information, false, 3.0};
       initial = graph.pose(k - 1) * r.T_target_source;
       increment_cov = (nav_information + information).inverse();
@@ -292,11 +314,12 @@ void Mapper::Impl::TryLoopClosures(int k) {
   for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
     const Submap& old = submaps[static_cast<size_t>(j)];
     const double distance = (graph.pose(j) * old.centroid_V - centre_k).norm();
-    const double overlap = 0.5 * (old.radius_m + current.radius_m);
+    const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
     if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
     const Matrix6d covariance = ChainCovariance(j, k);
     const Eigen::Vector3d t = (graph.pose(j).inverse() * graph.pose(k)).translation();
     const double sigma = LargestStd(PositionCovariance(covariance, t));
+    if (std::getenv("UWSCAN_DEBUG_MAPPER")) std::fprintf(stderr, "cand %d-%d d %.3f overlap %.3f sigma %.4f\n", j, k, distance, overlap, sigma);
     if (distance - overlap > options.gate_sigmas * sigma) continue;
     candidates.push_back({j, distance, covariance});
   }
@@ -324,18 +347,22 @@ void Mapper::Impl::TryLoopClosures(int k) {
     loop.to = k;
     loop.fitness = r.fitness;
     loop.T_from_to = r.T_target_source;
-    const Matrix6d information = RegistrationInformation(r);
-    const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(information);
+    const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
+    const Matrix6d points_information = r.information / (sigma * sigma);
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(points_information);
+    const Matrix6d information = RegistrationInformation(r, submaps[static_cast<size_t>(j)], current);
     if (r.fitness < options.loop_min_fitness) {
       loop.reason = "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
     } else if (!(eigen.eigenvalues()(0) > 0.0)) {
       loop.reason = "degenerate: the scans leave a direction unconstrained";
     } else {
-      const Matrix6d cov = information.inverse();
-      const double sigma_m = LargestStd(cov.bottomRightCorner<3, 3>());
-      const double sigma_rad = LargestStd(cov.topLeftCorner<3, 3>());
+      // The geometry alone must pin every direction; the consistency test also allows for
+      // the submaps' bending.
+      const Matrix6d points_cov = points_information.inverse();
+      const double sigma_m = LargestStd(points_cov.bottomRightCorner<3, 3>());
+      const double sigma_rad = LargestStd(points_cov.topLeftCorner<3, 3>());
       const Vector6d innovation = PoseError(r.T_target_source, T_pred);
-      loop.chi2 = innovation.dot((c.covariance + cov).ldlt().solve(innovation));
+      loop.chi2 = innovation.dot((c.covariance + information.inverse()).ldlt().solve(innovation));
       if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
         loop.reason = "degenerate: registration std " + std::to_string(sigma_m) + " m, " +
                       std::to_string(sigma_rad) + " rad";
@@ -346,6 +373,7 @@ void Mapper::Impl::TryLoopClosures(int k) {
         graph.AddEdge({j, k, r.T_target_source, information, true, 3.0});
       }
     }
+    if (std::getenv("UWSCAN_DEBUG_MAPPER")) std::fprintf(stderr, "loop %d-%d fit %.3f chi2 %.2f %s\n", j, k, loop.fitness, loop.chi2, loop.reason.c_str());
     loops.push_back(loop);
   }
   stats.loop_s += Since(start);

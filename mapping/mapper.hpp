@@ -36,7 +36,10 @@ struct MapperOptions {
   int loop_min_index_gap = 6;
   int max_loop_candidates = 2;
   double gate_sigmas = 3.0;
-  double loop_min_fitness = 0.4;
+  // Two submaps overlap enough to match when their centres are closer than this fraction of
+  // the sum of their radii (1 = they just touch).
+  double loop_overlap_ratio = 0.6;
+  double loop_min_fitness = 0.15;
   double loop_max_sigma_m = 0.01;     // registration std along any direction
   double loop_max_sigma_rad = 0.005;  // registration std about any axis
   double loop_chi2_gate = 22.46;      // 6 dof, 99.9 %

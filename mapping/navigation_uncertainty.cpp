@@ -5,6 +5,9 @@
 namespace uwscan::mapping {
 namespace {
 
+// A submap shorter than this is taken as this long when its tilt error is bounded.
+constexpr double kMinSubmapLength_m = 0.1;
+
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
@@ -63,6 +66,23 @@ Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W
   world.block<2, 2>(3, 3) = xy;
   world(5, 5) = 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m;
   return WorldAxesToFrame(world, T_W_a.linear());
+}
+
+Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_a,
+                                                           const Eigen::Isometry3d& T_W_b, double span_s) const {
+  Matrix6d covariance = IncrementCovariance(T_W_a, T_W_b, span_s);
+  const double length = std::max((T_W_b.translation() - T_W_a.translation()).norm(), kMinSubmapLength_m);
+  const double tilt = 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m / (length * length);
+  Matrix6d world = Matrix6d::Zero();
+  world(0, 0) = world(1, 1) = tilt;
+  return covariance + WorldAxesToFrame(world, T_W_a.linear());
+}
+
+Matrix6d InformationOfSum(const Matrix6d& information_a, const Matrix6d& covariance_b) {
+  const Matrix6d information_b = covariance_b.inverse();
+  const Matrix6d inner = (information_a + information_b).inverse();
+  const Matrix6d sum = information_a - information_a * inner * information_a;
+  return 0.5 * (sum + sum.transpose());
 }
 
 Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a,

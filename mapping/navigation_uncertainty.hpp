@@ -24,6 +24,14 @@ class NavigationUncertainty {
   Matrix6d IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
                                double dt_s) const;
 
+  // How much the navigation may have bent a submap whose frames it placed while the vehicle
+  // went from a to b (span_s): the dead-reckoning covariance over that span, plus the tilt a
+  // change of depth error across the submap's length would give (depth errors are not white).
+  // Added to a registration's own covariance: scan matching cannot be more certain than the
+  // shapes it matches are rigid. In a's frame.
+  Matrix6d SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
+                                      double span_s) const;
+
   // Information of the same motion in x, y and heading only, zero in depth, roll and pitch:
   // the odometry edge of the graph, where absolute priors hold those three.
   Matrix6d OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
@@ -40,6 +48,10 @@ inline constexpr double kFloorScale = 1e-4;
 inline constexpr double kFloorHeadingBias_rad = 1e-5;
 inline constexpr double kFloorDepth_m = 1e-4;
 inline constexpr double kFloorRollPitch_rad = 1e-5;
+
+// The information of (Sigma_a + Sigma_b) from the information a (possibly singular) and the
+// covariance b (full rank), by Woodbury: L_a - L_a (L_a + Sigma_b^-1)^-1 L_a.
+Matrix6d InformationOfSum(const Matrix6d& information_a, const Matrix6d& covariance_b);
 
 // Ad(T) for the [w, v] left-perturbation convention: T exp(e) T^-1 = exp(Ad(T) e).
 Matrix6d Adjoint(const Eigen::Isometry3d& T);

@@ -58,7 +58,12 @@ struct PriorCost {
   bool operator()(const T* q_raw, const T* p_raw, T* residual_raw) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q(q_raw);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_raw);
-    const Eigen::Matrix<T, 6, 1> e = LeftError<T>(Eigen::Quaternion<T>(q), p, q_meas, t_meas);
+    // Rotation error as for the edges; the position error is the position's own (not about
+    // the world origin, which would tie it to the rotation through the vehicle's distance).
+    Eigen::Quaternion<T> q_delta = Eigen::Quaternion<T>(q) * q_meas.conjugate().cast<T>();
+    if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
+    Eigen::Matrix<T, 6, 1> e;
+    e << T(2) * q_delta.vec(), p - t_meas.cast<T>();
     Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
     residual = sqrt_information.cast<T>() * e;
     return true;

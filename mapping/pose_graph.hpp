@@ -39,8 +39,8 @@ struct GravityPrior {
   Eigen::Vector3d down_in_V = Eigen::Vector3d::UnitZ();  // unit
   double sigma_rad = 0.0;                                 // > 0
 };
-// A full pose prior, e.g. the fix the dive starts from; same error convention as the edges
-// with `from` = the world.
+// A full pose prior, e.g. the fix the dive starts from. Error [w, p - p_prior]: the rotation
+// vector of R R_prior^T and the position error, both along the world's axes.
 struct PosePrior {
   int node = 0;
   Eigen::Isometry3d T_W_V = Eigen::Isometry3d::Identity();

@@ -27,8 +27,10 @@ struct SimulationEffects {
     double yaw_walk_rad_per_sqrt_s = 0.0005;    // random-walk density of the heading
     double speed_scale_sigma = 0.0;             // std of the DVL's speed scale error (0.01 = 1 %)
     double heading_bias_sigma_rad = 0.0;        // std of the constant heading bias
-    double depth_sigma_m = 0.0;                 // white noise of the pressure depth
-    double roll_pitch_sigma_rad = 0.0;          // white noise of the AHRS roll and pitch
+    // Errors of the filtered absolute sensors: std of a slowly wandering error (correlation
+    // time 5 s), not a jump per sample.
+    double depth_sigma_m = 0.0;                 // pressure depth
+    double roll_pitch_sigma_rad = 0.0;          // AHRS roll and pitch
   } navigation_drift;
 
   // Exact peaks moved along their image line by Gaussian noise, for long dives where rendering

@@ -21,6 +21,8 @@ constexpr double kGlowStartM = 0.02;
 constexpr double kGlowMaxRangeM = 3.0;
 // A detected peak takes the truth of the exact crossing of its line within this distance.
 constexpr double kTruthMatchPx = 3.0;
+// Correlation time of the navigation's depth and roll/pitch errors, seconds.
+constexpr double kAbsoluteErrorCorrelation_s = 5.0;
 // Separates the random stream of the peak noise from the rendered frames' (same frame seeds).
 constexpr std::uint64_t kPeakNoiseStream = 0x9e3779b97f4a7c15ULL;
 
@@ -209,6 +211,8 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
   const double speed_scale = 1.0 + (drift.on ? drift.speed_scale_sigma * normal(rng) : 0.0);
   const double heading_bias = drift.on ? drift.heading_bias_sigma_rad * normal(rng) : 0.0;
   double heading_walk = 0.0;
+  double depth_error = 0.0;
+  Eigen::Vector2d tilt_error = Eigen::Vector2d::Zero();
   Eigen::Vector2d believed_xy = Eigen::Vector2d::Zero();
   Eigen::Vector3d previous_true = Eigen::Vector3d::Zero();
   std::vector<NavigationSample> samples;
@@ -239,12 +243,19 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
                        drift.position_walk_m_per_sqrt_s * sq * Eigen::Vector2d(normal(rng), normal(rng));
       }
       previous_true = truth.translation();
-      // Absolute sensors: depth from pressure, roll and pitch from gravity (noise about the
+      // Absolute sensors: depth from pressure, roll and pitch from gravity (errors about the
       // vehicle's own x and y axes), heading with its drift about the world's down axis (the
-      // bias is the DVL's misalignment: it turns the measured velocity, not the heading).
-      const double depth_noise = drift.depth_sigma_m * normal(rng);
-      const Eigen::Vector3d tilt_noise(drift.roll_pitch_sigma_rad * normal(rng),
-                                       drift.roll_pitch_sigma_rad * normal(rng), 0.0);
+      // bias is the DVL's misalignment: it turns the measured velocity, not the heading). The
+      // navigation filter smooths its sensors: their errors wander (first-order Gauss-Markov,
+      // std as given, correlation time kAbsoluteErrorCorrelation_s) rather than jump per sample.
+      const double keep = k == 0 ? 0.0 : std::exp(-dt / kAbsoluteErrorCorrelation_s);
+      const double fresh = std::sqrt(1.0 - keep * keep);
+      depth_error = keep * depth_error + fresh * drift.depth_sigma_m * normal(rng);
+      for (int axis = 0; axis < 2; ++axis) {
+        tilt_error[axis] = keep * tilt_error[axis] + fresh * drift.roll_pitch_sigma_rad * normal(rng);
+      }
+      const double depth_noise = depth_error;
+      const Eigen::Vector3d tilt_noise(tilt_error[0], tilt_error[1], 0.0);
       const double tilt_angle = tilt_noise.norm();
       const Eigen::Matrix3d tilt =
           tilt_angle > 0.0 ? Eigen::AngleAxisd(tilt_angle, tilt_noise / tilt_angle).toRotationMatrix()

@@ -1,0 +1,139 @@
+#include "bench/slam_benchmark.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "bench/scratch_folder.hpp"
+#include "mapping/dive_simulation.hpp"
+#include "mapping/map_report.hpp"
+#include "perception/voxel_filter.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/sim/ray_caster.hpp"
+#include "scanner/sim/scene.hpp"
+#include "scanner/sim/simulator.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+// Map points further than this from every true surface count at this distance (outliers).
+constexpr double kSurfaceSearch_m = 0.5;
+
+std::string ReadText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+SurfaceDistance DistanceToScene(const perception::PointCloud& map, const scanner::sim::RayCaster& caster, int threads) {
+  std::vector<double> distances(map.size());
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(map.size()); ++i) {
+    const std::optional<double> d = caster.DistanceToSurface(map.Point(static_cast<size_t>(i)), kSurfaceSearch_m);
+    distances[static_cast<size_t>(i)] = d.value_or(kSurfaceSearch_m);
+  }
+  SurfaceDistance out;
+  out.points = distances.size();
+  if (distances.empty()) return out;
+  double sum = 0.0, sum2 = 0.0;
+  for (double d : distances) {
+    sum += d;
+    sum2 += d * d;
+  }
+  out.mean_m = sum / static_cast<double>(distances.size());
+  out.rms_m = std::sqrt(sum2 / static_cast<double>(distances.size()));
+  const std::size_t k = static_cast<std::size_t>(0.95 * static_cast<double>(distances.size() - 1));
+  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(k), distances.end());
+  out.p95_m = distances[k];
+  return out;
+}
+
+// The submaps placed at `poses` (one per submap), voxelised like the SLAM map.
+perception::PointCloud PlaceSubmaps(const mapping::DiveMapping& m, const std::vector<mapping::TimedPose>& poses,
+                                    double voxel_m) {
+  perception::PointCloud all;
+  all.origin = poses.front().T_W_V.translation();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Eigen::Isometry3d T = Eigen::Translation3d(-all.origin) * poses[i].T_W_V;
+    for (std::size_t p = 0; p < m.submap_clouds[i].size(); ++p) {
+      all.points.push_back((T * m.submap_clouds[i].Point(p)).cast<float>());
+    }
+  }
+  return perception::VoxelDownsample(all, {voxel_m});
+}
+
+}  // namespace
+
+void SlamBenchOptions::Check() const {
+  if (scenes.empty()) throw Error("bench slam: no scene");
+  if (threads < 1) throw Error("bench slam: threads must be > 0");
+}
+
+std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Progress& progress) {
+  options.Check();
+  ScratchFolder scratch("bench-slam");
+  std::vector<DiveFigures> dives;
+  for (const std::filesystem::path& scene_path : options.scenes) {
+    DiveFigures f;
+    f.name = scene_path.stem().string();
+    const scanner::sim::Scene scene = scanner::sim::LoadScene(scene_path);
+    const std::filesystem::path log_path = scratch.path() / (f.name + ".db");
+    {
+      const scanner::sim::Simulator simulator(scene);
+      mapping::DiveSimulationOptions sim_options;
+      sim_options.threads = options.threads;
+      sim_options.producer = "uwscan bench slam";
+      const mapping::DiveSimulationSummary summary = mapping::SimulateDive(
+          simulator, ReadText(scene_path), log_path, sim_options,
+          [&](double fraction) { if (progress) progress("simulate " + f.name, fraction); });
+      f.simulate_seconds = summary.seconds;
+    }
+    mapping::DiveMappingOptions map_options;
+    map_options.mapper.threads = options.threads;
+    map_options.table_cache = options.table_cache;
+    map_options.keep_submaps = true;
+    omp_set_num_threads(options.threads);
+    const mapping::DiveLogReader log(log_path);
+    const mapping::DiveMapping m = mapping::MapDive(
+        log, map_options, [&](double fraction) { if (progress) progress("map " + f.name, fraction); });
+    if (m.truth.empty()) throw Error(f.name + ": the simulated log has no truth");
+    const mapping::MapSummary s = mapping::Summarise(m);
+    f.duration_s = m.dive_duration_s;
+    f.submaps = m.submaps;
+    f.loops_accepted = s.loops_accepted;
+    f.loops_rejected = s.loops_rejected;
+    f.loops_false = s.loops_false.value_or(0);
+    f.nees_mean = s.nees_mean;
+    f.real_time_factor = s.real_time_factor;
+
+    const scanner::sim::RayCaster caster(scene.objects);
+    if (progress) progress("surface distances " + f.name, 0.0);
+    f.dead_reckoning.ate_m = *s.ate_dead_reckoning_m;
+    f.dead_reckoning.rpe_per_m = s.rpe_dead_reckoning_per_m;
+    f.dead_reckoning.map = DistanceToScene(m.map_dead_reckoning, caster, options.threads);
+    f.slam.ate_m = *s.ate_slam_m;
+    f.slam.rpe_per_m = s.rpe_slam_per_m;
+    f.slam.map = DistanceToScene(m.map, caster, options.threads);
+    f.slam.seconds = m.seconds;
+    if (options.run_open3d && Open3dMultiwayAvailable()) {
+      if (progress) progress("open3d " + f.name, 0.0);
+      TrajectoryFigures o;
+      const std::vector<mapping::TimedPose> poses = Open3dMultiway(m, options.threads, &o.seconds);
+      o.ate_m = mapping::AbsoluteTrajectoryError(poses, m.truth);
+      o.rpe_per_m = mapping::RelativeErrorPerMetre(poses, m.truth);
+      o.map = DistanceToScene(PlaceSubmaps(m, poses, map_options.map_voxel_m), caster, options.threads);
+      f.open3d = o;
+    }
+    if (progress) progress("surface distances " + f.name, 1.0);
+    dives.push_back(f);
+  }
+  return dives;
+}
+
+}  // namespace uwscan::bench

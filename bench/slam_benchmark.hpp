@@ -1,0 +1,59 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bench/progress.hpp"
+#include "mapping/dive_mapping.hpp"
+
+namespace uwscan::bench {
+
+// Scan-matching SLAM against dead reckoning and against Open3D's multiway registration on the
+// same submaps, on simulated inspection dives, in one run.
+struct SlamBenchOptions {
+  std::vector<std::filesystem::path> scenes;  // dive scenes (data/scenes/inspection_*.yaml)
+  int threads = 2;
+  bool run_open3d = true;
+  std::filesystem::path table_cache;
+  void Check() const;
+};
+
+// Distance of a map's points to the scene's true surfaces.
+struct SurfaceDistance {
+  double mean_m = 0.0;
+  double rms_m = 0.0;
+  double p95_m = 0.0;
+  std::size_t points = 0;
+};
+
+struct TrajectoryFigures {
+  double ate_m = 0.0;
+  std::optional<double> rpe_per_m;
+  SurfaceDistance map;
+  double seconds = 0.0;
+};
+
+struct DiveFigures {
+  std::string name;
+  double duration_s = 0.0;
+  int submaps = 0;
+  TrajectoryFigures dead_reckoning, slam;
+  std::optional<TrajectoryFigures> open3d;
+  int loops_accepted = 0, loops_rejected = 0, loops_false = 0;
+  std::optional<double> nees_mean;
+  double real_time_factor = 0.0;
+  double simulate_seconds = 0.0;
+};
+
+std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Progress& progress = {});
+
+// Open3D's multiway registration (pairwise point-to-plane ICP between consecutive submaps and
+// between submaps whose navigated positions overlap, then GlobalOptimization with its line
+// process) on the submaps of `mapping`, started from the dead reckoning: the submap poses it
+// finds. Throws when Open3D is not built in.
+std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& mapping, int threads, double* seconds);
+bool Open3dMultiwayAvailable();
+
+}  // namespace uwscan::bench
