@@ -56,20 +56,28 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
   if (!m.truth.empty()) report["trajectories"]["truth"] = TumRows(m.truth);
   nlohmann::json covariance = nlohmann::json::array(), deviation = nlohmann::json::array();
   for (std::size_t i = 0; i < m.covariances.size(); ++i) {
+    // Reordered to (x, y, z, roll, pitch, yaw): position first, as the report documents.
+    const Eigen::Matrix<double, 6, 6>& c = m.covariances[i];
+    Eigen::Matrix<double, 6, 6> ordered;
+    ordered << c.bottomRightCorner<3, 3>(), c.bottomLeftCorner<3, 3>(), c.topRightCorner<3, 3>(),
+        c.topLeftCorner<3, 3>();
     nlohmann::json row = {m.slam[i].time_s};
     for (int r = 0; r < 6; ++r) {
-      for (int c = 0; c < 6; ++c) row.push_back(m.covariances[i](r, c));
+      for (int k = 0; k < 6; ++k) row.push_back(ordered(r, k));
     }
     covariance.push_back(row);
     const Eigen::Matrix<double, 6, 1> std = mapping::PoseStd(m.covariances[i]);
     deviation.push_back({m.slam[i].time_s, std(0), std(1), std(2), std(3), std(4), std(5)});
   }
-  report["pose_covariance"] = covariance;  // [t, 36 values of [rotation (rad), position (m)] row-major]
+  report["pose_covariance"] = covariance;  // [t, 36 values, (x, y, z (m), roll, pitch, yaw (rad)) row-major]
   report["pose_std"] = deviation;          // [t, x, y, z (m), roll, pitch, yaw (rad)]
   nlohmann::json loops = nlohmann::json::array();
   for (const mapping::LoopClosure& l : m.loops) {
+    const Eigen::Quaterniond q(l.T_from_to.linear());
+    const Eigen::Vector3d& t = l.T_from_to.translation();
     loops.push_back({{"from_submap", l.from}, {"to_submap", l.to}, {"accepted", l.accepted},
-                     {"reason", l.reason}, {"fitness", l.fitness}, {"chi2", l.chi2}});
+                     {"reason", l.reason}, {"fitness", l.fitness}, {"chi2", l.chi2},
+                     {"T_from_to", {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}}});
   }
   report["loops"] = loops;
   report["figures"] = {{"submaps", m.submaps},
@@ -134,6 +142,8 @@ void RunMap(const MapArgs& a) {
               a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
   std::printf("registrations %d (%d left to navigation), loops accepted %d, rejected %d\n",
               m.stats.registrations, m.stats.registrations_failed, s.loops_accepted, s.loops_rejected);
+  std::printf("time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, graph %.2f s\n",
+              m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s, m.stats.graph_s);
   if (m.navigation_noise_assumed) {
     std::printf("navigation noise: not recorded in the log (schema 1), a typical AUV's assumed\n");
   }

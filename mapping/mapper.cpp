@@ -2,8 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -60,6 +58,55 @@ double LargestStd(const Eigen::Matrix3d& covariance) {
   return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
 }
 
+// How evenly the pairs of a registration pin the six directions: the smallest over the largest
+// eigenvalue of its information, with the rotation taken about the source's centroid (in the
+// target frame) and scaled by the source's RMS radius, so that both are displacements of the
+// data. 0: a direction is free (a plane, a long pipe); 1: all six equally constrained.
+// The map taking [w, v] about the target origin to the normalised coordinates of Conditioning:
+// normalised = N^T information N.
+Matrix6d Normaliser(const perception::PointCloud& source, const Eigen::Isometry3d& T_target_source) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < source.size(); ++i) centroid += T_target_source * source.Point(i);
+  centroid /= static_cast<double>(source.size());
+  double radius2 = 0.0;
+  for (std::size_t i = 0; i < source.size(); ++i) {
+    radius2 += (T_target_source * source.Point(i) - centroid).squaredNorm();
+  }
+  const double radius = std::sqrt(radius2 / static_cast<double>(source.size()));
+  // [w, v_origin] = A [w, v_centroid]: a rotation about the centroid moves the origin by -w x c.
+  Matrix6d A = Matrix6d::Identity();
+  Eigen::Matrix3d skew;
+  skew << 0.0, -centroid.z(), centroid.y(), centroid.z(), 0.0, -centroid.x(), -centroid.y(), centroid.x(), 0.0;
+  A.bottomLeftCorner<3, 3>() = skew;
+  Matrix6d S = Matrix6d::Identity();
+  S.topLeftCorner<3, 3>() /= std::max(radius, 1e-3);
+  return A * S;
+}
+
+double Conditioning(const Matrix6d& information, const perception::PointCloud& source,
+                    const Eigen::Isometry3d& T_target_source) {
+  const Matrix6d N = Normaliser(source, T_target_source);
+  const Vector6d values = Eigen::SelfAdjointEigenSolver<Matrix6d>(N.transpose() * information * N).eigenvalues();
+  return values(5) > 0.0 ? std::max(0.0, values(0)) / values(5) : 0.0;
+}
+
+// The information with its weakly constrained directions (normalised eigenvalue below `ratio`
+// of the largest) removed: along a pipe or over a flat seabed the pairs still sum to something,
+// but ICP's answer there is the noise's, not the scene's; the navigation decides those.
+Matrix6d WithoutWeakDirections(const Matrix6d& information, const perception::PointCloud& source,
+                               const Eigen::Isometry3d& T_target_source, double ratio) {
+  const Matrix6d N = Normaliser(source, T_target_source);
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(N.transpose() * information * N);
+  Vector6d values = eigen.eigenvalues();
+  for (int k = 0; k < 6; ++k) {
+    if (!(values(k) >= ratio * values(5))) values(k) = 0.0;
+  }
+  const Matrix6d N_inverse = N.inverse();
+  const Matrix6d kept = N_inverse.transpose() * eigen.eigenvectors() * values.asDiagonal() *
+                        eigen.eigenvectors().transpose() * N_inverse;
+  return 0.5 * (kept + kept.transpose());
+}
+
 }  // namespace
 
 void MapperOptions::Check() const {
@@ -72,6 +119,7 @@ void MapperOptions::Check() const {
   if (!(point_sigma_floor_m > 0.0)) fail("point_sigma_floor_m", "> 0 m");
   if (!(min_fitness >= 0.0 && min_fitness <= 1.0)) fail("min_fitness", "in [0, 1]");
   if (!(loop_min_fitness >= 0.0 && loop_min_fitness <= 1.0)) fail("loop_min_fitness", "in [0, 1]");
+  if (!(loop_min_conditioning >= 0.0 && loop_min_conditioning < 1.0)) fail("loop_min_conditioning", "in [0, 1)");
   if (loop_min_index_gap <= local_map_submaps) fail("loop_min_index_gap", "> local_map_submaps");
   if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
   if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
@@ -80,6 +128,7 @@ void MapperOptions::Check() const {
   if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
   if (!(loop_chi2_gate > 0.0)) fail("loop_chi2_gate", "> 0");
   if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
+  if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
   if (threads < 0) fail("threads", ">= 0");
   perception::IcpOptions icp;
   icp.max_correspondence_distance_m = icp_distances_m;
@@ -114,7 +163,7 @@ struct Mapper::Impl {
       : options(o), T_V_C(mount), uncertainty(noise) {}
 
   void Drain(bool hold_at_ends);
-  void Place(const FrameRecord& frame, bool hold_at_ends);
+  void Place(const FrameRecord& frame);
   void CloseSubmap();
   void AddToGraph(Submap submap);
   perception::RegistrationResult Register(const Submap& source, const perception::PointCloud& target,
@@ -132,13 +181,12 @@ void Mapper::Impl::Drain(bool hold_at_ends) {
     if (!hold_at_ends && !(navigation.Covers(t) || (!navigation.empty() && t < navigation.first_time_s()))) {
       break;
     }
-    Place(waiting.front(), hold_at_ends);
+    Place(waiting.front());
     waiting.pop_front();
   }
 }
 
-void Mapper::Impl::Place(const FrameRecord& frame, bool hold_at_ends) {
-  (void)hold_at_ends;
+void Mapper::Impl::Place(const FrameRecord& frame) {
   if (!frames.empty() && frame.sweep >= first_sweep + options.sweeps_per_submap) CloseSubmap();
   if (frames.empty()) first_sweep = frame.sweep;
   const Clock::time_point start = Clock::now();
@@ -221,11 +269,13 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
 Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& a,
                                                const Submap& b) const {
   const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
+  const Matrix6d points = WithoutWeakDirections(r.information / (sigma * sigma), b.sparse, r.T_target_source,
+                                                options.weak_direction_ratio);
   // Both submaps may be bent by the navigation that placed their frames.
   const Matrix6d distortion =
       uncertainty.SubmapDistortionCovariance(a.T_W_V_start, a.T_W_V_end, a.end_s - a.start_s) +
       uncertainty.SubmapDistortionCovariance(b.T_W_V_start, b.T_W_V_end, b.end_s - b.start_s);
-  return InformationOfSum(r.information / (sigma * sigma), distortion);
+  return InformationOfSum(points, distortion);
 }
 
 Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
@@ -262,13 +312,6 @@ void Mapper::Impl::AddToGraph(Submap submap) {
         Register(submap, local, T_nav, increment_cov, options.icp_distances_m);
     stats.registration_s += Since(start);
     const Matrix6d nav_information = increment_cov.inverse();
-    if (std::getenv("UWSCAN_DEBUG_MAPPER")) {
-      const Eigen::Isometry3d d = T_nav.inverse() * r.T_target_source;
-      std::fprintf(stderr, "reg %d fit %.3f rmse %.5f it %d conv %d  nav->icp dt [%.4f %.4f %.4f] rot %.5f\n", k, r.fitness,
-                   r.inlier_plane_rmse, r.iterations, int(r.converged), d.translation().x(), d.translation().y(),
-                   d.translation().z(), Eigen::AngleAxisd(d.linear()).angle());
-      std::fprintf(stderr, "   T_icp t [%.4f %.4f %.4f]\n", r.T_target_source.translation().x(), r.T_target_source.translation().y(), r.T_target_source.translation().z());
-    }
     if (r.fitness >= options.min_fitness) {
       const Matrix6d information = RegistrationInformation(r, previous, submap);
       registration = RelativePoseEdge{k - 1, k, r.T_target_source, information, false, 3.0};
@@ -319,7 +362,6 @@ void Mapper::Impl::TryLoopClosures(int k) {
     const Matrix6d covariance = ChainCovariance(j, k);
     const Eigen::Vector3d t = (graph.pose(j).inverse() * graph.pose(k)).translation();
     const double sigma = LargestStd(PositionCovariance(covariance, t));
-    if (std::getenv("UWSCAN_DEBUG_MAPPER")) std::fprintf(stderr, "cand %d-%d d %.3f overlap %.3f sigma %.4f\n", j, k, distance, overlap, sigma);
     if (distance - overlap > options.gate_sigmas * sigma) continue;
     candidates.push_back({j, distance, covariance});
   }
@@ -350,11 +392,14 @@ void Mapper::Impl::TryLoopClosures(int k) {
     const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
     const Matrix6d points_information = r.information / (sigma * sigma);
     const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(points_information);
+    const double conditioning = Conditioning(r.information, current.sparse, r.T_target_source);
+    loop.conditioning = conditioning;
     const Matrix6d information = RegistrationInformation(r, submaps[static_cast<size_t>(j)], current);
     if (r.fitness < options.loop_min_fitness) {
       loop.reason = "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
-    } else if (!(eigen.eigenvalues()(0) > 0.0)) {
-      loop.reason = "degenerate: the scans leave a direction unconstrained";
+    } else if (!(eigen.eigenvalues()(0) > 0.0) || conditioning < options.loop_min_conditioning) {
+      loop.reason = "degenerate: the scans barely constrain a direction (conditioning " +
+                    std::to_string(conditioning) + ")";
     } else {
       // The geometry alone must pin every direction; the consistency test also allows for
       // the submaps' bending.
@@ -373,7 +418,6 @@ void Mapper::Impl::TryLoopClosures(int k) {
         graph.AddEdge({j, k, r.T_target_source, information, true, 3.0});
       }
     }
-    if (std::getenv("UWSCAN_DEBUG_MAPPER")) std::fprintf(stderr, "loop %d-%d fit %.3f chi2 %.2f %s\n", j, k, loop.fitness, loop.chi2, loop.reason.c_str());
     loops.push_back(loop);
   }
   stats.loop_s += Since(start);

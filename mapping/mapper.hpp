@@ -39,11 +39,17 @@ struct MapperOptions {
   // Two submaps overlap enough to match when their centres are closer than this fraction of
   // the sum of their radii (1 = they just touch).
   double loop_overlap_ratio = 0.6;
-  double loop_min_fitness = 0.15;
+  double loop_min_fitness = 0.5;
+  // A loop's pairs must pin every direction: smallest / largest eigenvalue of the information,
+  // rotations scaled by the data's radius (a long pipe on a flat seabed stays below it).
+  double loop_min_conditioning = 0.02;
   double loop_max_sigma_m = 0.01;     // registration std along any direction
   double loop_max_sigma_rad = 0.005;  // registration std about any axis
   double loop_chi2_gate = 22.46;      // 6 dof, 99.9 %
-  int solve_every_submaps = 10;       // whole-graph solve also without a loop closure, > 0
+  int solve_every_submaps = 1;        // whole-graph solve also without a loop closure, > 0
+  // Registration directions whose normalised information is below this fraction of the
+  // strongest are left to the navigation (Conditioning in mapper.cpp).
+  double weak_direction_ratio = 0.02;
   int threads = 0;                    // OpenMP threads of ICP and normals, 0 = default
   void Check() const;
 };
@@ -55,6 +61,7 @@ struct LoopClosure {
   std::string reason;  // why it was rejected ("" when accepted)
   double fitness = 0.0;
   double chi2 = 0.0;   // of the registration against the prediction
+  double conditioning = 0.0;  // smallest / largest normalised eigenvalue of its information
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
 };
 

@@ -1,0 +1,219 @@
+#include "mapping/dive_mapping.hpp"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <string>
+
+#include "mapping/dive_log_test_support.hpp"
+#include "mapping/dive_simulation.hpp"
+#include "mapping/map_report.hpp"
+#include "mapping/navigation_uncertainty.hpp"
+#include "scanner/sim/scene.hpp"
+#include "scanner/sim/simulator.hpp"
+
+namespace uwscan::mapping::test {
+namespace {
+
+scanner::sim::Scene ShortScene() {
+  return scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_short.yaml");
+}
+
+class DiveMappingTest : public DiveLogTest {
+ protected:
+  fs::path Simulate(const scanner::sim::Scene& scene, const char* name) {
+    const fs::path path = dir_ / name;
+    const scanner::sim::Simulator simulator(scene);
+    DiveSimulationOptions options;
+    options.threads = 2;
+    SimulateDive(simulator, "", path, options);
+    return path;
+  }
+  DiveMapping Map(const fs::path& path, int threads = 2) {
+    DiveMappingOptions options;
+    options.mapper.threads = threads;
+    options.table_cache = dir_ / "tables";
+    return MapDive(DiveLogReader(path), options);
+  }
+};
+
+void ExpectSameBits(const DiveMapping& a, const DiveMapping& b) {
+  ASSERT_EQ(a.slam.size(), b.slam.size());
+  for (std::size_t i = 0; i < a.slam.size(); ++i) ExpectSamePose(a.slam[i].T_W_V, b.slam[i].T_W_V);
+  ASSERT_EQ(a.map.size(), b.map.size());
+  for (std::size_t i = 0; i < a.map.size(); ++i) {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(std::bit_cast<std::uint32_t>(a.map.points[i][k]),
+                                          std::bit_cast<std::uint32_t>(b.map.points[i][k]));
+  }
+  ASSERT_EQ(a.loops.size(), b.loops.size());
+}
+
+TEST_F(DiveMappingTest, WithoutDriftTheMapLiesOnTheTruth) {
+  scanner::sim::Scene scene = ShortScene();
+  scene.effects.navigation_drift.on = false;
+  scene.effects.peak_noise.on = false;
+  const DiveMapping m = Map(Simulate(scene, "exact.db"));
+  ASSERT_GT(m.submaps, 5);
+  ASSERT_EQ(m.truth.size(), m.slam.size());
+  EXPECT_LT(AbsoluteTrajectoryError(m.slam, m.truth), 5e-4);
+  EXPECT_LT(AbsoluteTrajectoryError(m.dead_reckoning, m.truth), 1e-9);
+  EXPECT_GT(m.map.size(), 10000u);
+}
+
+TEST_F(DiveMappingTest, SameBitsForOneAndTwoThreadsAndOnlineOrOffline) {
+  const fs::path log = Simulate(ShortScene(), "drift.db");
+  const DiveMapping one = Map(log, 1), two = Map(log, 2);
+  ExpectSameBits(one, two);
+
+  // Online: the same log fed as a live vehicle would, navigation far ahead of the frames.
+  const DiveLogReader reader(log);
+  MapperOptions options;
+  options.threads = 2;
+  Mapper mapper(reader.header().scanner, reader.header().scan_pattern, *reader.vehicle_mount(),
+                *reader.header().navigation_noise, options, dir_ / "tables");
+  for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
+  reader.ForEachFrame([&](const FrameRecord& frame, const GroundTruthRecord*) { mapper.AddFrame(frame); }, false);
+  mapper.Finish();
+  ASSERT_EQ(mapper.submap_count(), two.submaps);
+  for (int i = 0; i < mapper.submap_count(); ++i) ExpectSamePose(two.slam[static_cast<size_t>(i)].T_W_V, mapper.pose(i));
+}
+
+TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
+  const DiveMapping m = Map(Simulate(ShortScene(), "drift.db"));
+  const MapSummary s = Summarise(m);
+  ASSERT_TRUE(s.nees_mean.has_value());
+  EXPECT_GT(*s.nees_mean, 0.5 * 6.0);
+  EXPECT_LT(*s.nees_mean, 3.0 * 6.0);
+  EXPECT_EQ(s.loops_false.value_or(-1), 0);
+  for (const Matrix6d& c : m.covariances) EXPECT_GT(PoseStd(c).head<2>().minCoeff(), 0.0);
+}
+
+TEST_F(DiveMappingTest, AlongASinglePipeTheMapFollowsTheNavigation) {
+  // Out along the pipe only: scan matching sees a pipe on a plane, free along the pipe (x).
+  scanner::sim::Scene scene =
+      scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_pipe.yaml");
+  scene.scanner.sweeps = 40;
+  const DiveMapping m = Map(Simulate(scene, "pipe.db"));
+  ASSERT_EQ(m.truth.size(), m.slam.size());
+  for (std::size_t i = 0; i < m.slam.size(); ++i) {
+    const double slam_x = std::abs(m.slam[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
+    const double dr_x = std::abs(m.dead_reckoning[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
+    EXPECT_LT(slam_x, dr_x + 0.01) << "submap " << i;
+  }
+  EXPECT_LE(AbsoluteTrajectoryError(m.slam, m.truth), AbsoluteTrajectoryError(m.dead_reckoning, m.truth) + 0.005);
+}
+
+TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {
+  // A recorder that died mid-sweep: every navigation sample, the frames up to the crash.
+  const scanner::sim::Simulator simulator(ShortScene());
+  const fs::path path = dir_ / "cut.db";
+  const std::int64_t kept = simulator.frame_count() / 2 + 7;
+  {
+    DiveLogHeader header;
+    header.scanner = simulator.scanner();
+    header.scan_pattern = simulator.scan_pattern();
+    header.navigation_noise = NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005};
+    DiveLogWriter writer(path, header);
+    writer.SetVehicleMount(simulator.scene().trajectory.T_V_C);
+    for (const scanner::sim::NavigationSample& n : simulator.Navigation(20.0)) writer.AppendNavigation({n.time_s, n.T_W_V});
+    for (std::int64_t i = 0; i < kept; ++i) {
+      const scanner::sim::SimulatedFrame f = simulator.Frame(i);
+      FrameRecord record;
+      record.time_s = f.time_s;
+      record.command = f.command;
+      record.sweep = f.sweep;
+      record.peaks_px = f.peaks_px;
+      writer.AppendFrame(record);
+    }
+  }
+  const DiveMapping m = Map(path);
+  EXPECT_TRUE(m.truth.empty());
+  ASSERT_GT(m.submaps, 2);
+  EXPECT_NEAR(m.dive_duration_s, static_cast<double>(kept - 1) * simulator.frame_period_s(), 1e-9);
+  EXPECT_GT(m.slam.back().time_s, m.dive_duration_s - 2.0);
+}
+
+TEST_F(DiveMappingTest, UnusableLogsGiveAClearError) {
+  const fs::path empty_nav = dir_ / "no_nav.db";
+  {
+    DiveLogWriter writer(empty_nav, TestHeader());
+    for (int i = 0; i < 3; ++i) writer.AppendFrame(TestFrame(i, 10));
+  }
+  EXPECT_NE(MessageOf([&] { Map(empty_nav); }).find("has no navigation"), std::string::npos);
+
+  const fs::path one = dir_ / "one.db";
+  {
+    DiveLogWriter writer(one, TestHeader());
+    writer.AppendFrame(TestFrame(0, 10));
+    writer.AppendNavigation({0.0, Eigen::Isometry3d::Identity()});
+  }
+  EXPECT_NE(MessageOf([&] { Map(one); }).find("has 1 frame"), std::string::npos);
+
+  RawExec(one, "UPDATE meta SET value = 3 WHERE key = 'schema_version'");
+  EXPECT_NE(MessageOf([&] { Map(one); }).find("schema version 3, this uwscan reads 1 to 2"), std::string::npos);
+}
+
+TEST_F(DiveMappingTest, VersionOneLogsOpenAndMapWithAnAssumedNoise) {
+  scanner::sim::Scene scene = ShortScene();
+  scene.scanner.sweeps = 12;
+  const fs::path path = Simulate(scene, "v1.db");
+  EXPECT_TRUE(DiveLogReader(path).header().navigation_noise.has_value());
+  RawExec(path, "DROP TABLE navigation_noise; UPDATE meta SET value = 1 WHERE key = 'schema_version'");
+  const DiveLogReader reader(path);
+  EXPECT_EQ(reader.header().schema_version, 1);
+  EXPECT_FALSE(reader.header().navigation_noise.has_value());
+  const DiveMapping m = Map(path);
+  EXPECT_TRUE(m.navigation_noise_assumed);
+  EXPECT_GT(m.submaps, 1);
+}
+
+TEST(PoseGraph, ACovarianceIsTheInverseOfItsOnlyPrior) {
+  PoseGraph graph;
+  const Eigen::Isometry3d T = TestPose(3);
+  graph.AddNode(T);
+  Matrix6d information = Matrix6d::Zero();
+  information.diagonal() << 1e4, 4e4, 9e4, 1e2, 4e2, 9e2;  // 0.01, 0.005, 0.0033 rad; 0.1, 0.05, 0.033 m
+  information(0, 3) = information(3, 0) = 50.0;
+  graph.AddPrior({0, T, information});
+  graph.Solve({});
+  const std::optional<std::vector<Matrix6d>> covariance = graph.Covariances();
+  ASSERT_TRUE(covariance.has_value());
+  EXPECT_LT(((*covariance)[0] - information.inverse()).norm(), 1e-9 * information.inverse().norm());
+}
+
+TEST(PoseGraph, RecoversAChainFromExactEdgesAndAPrior) {
+  PoseGraph graph;
+  std::vector<Eigen::Isometry3d> truth;
+  for (int i = 0; i < 5; ++i) truth.push_back(TestPose(10 + static_cast<std::uint64_t>(i)));
+  for (int i = 0; i < 5; ++i) graph.AddNode(i == 0 ? truth[0] : TestPose(100 + static_cast<std::uint64_t>(i)));
+  graph.AddPrior({0, truth[0], Matrix6d::Identity() * 1e6});
+  for (int i = 0; i + 1 < 5; ++i) {
+    graph.AddEdge({i, i + 1, truth[static_cast<size_t>(i)].inverse() * truth[static_cast<size_t>(i) + 1],
+                   Matrix6d::Identity() * 1e4, false, 3.0});
+  }
+  EXPECT_TRUE(graph.Solve({}).converged);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_LT(PoseError(graph.pose(i), truth[static_cast<size_t>(i)]).norm(), 1e-7) << "node " << i;
+  }
+}
+
+TEST(NavigationUncertainty, OdometryLeavesDepthRollAndPitchToThePriors) {
+  const NavigationUncertainty model(NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005});
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
+  a.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  b.translation() = Eigen::Vector3d(0.5, 0.1, 0.0);
+  const Matrix6d info = model.OdometryInformation(a, b, 2.0);
+  // In a's frame the world's down axis is still z (a turns about it): z, roll and pitch free.
+  Vector6d down = Vector6d::Zero();
+  down(5) = 1.0;
+  EXPECT_NEAR(down.dot(info * down), 0.0, 1e-9);
+  Vector6d roll = Vector6d::Zero();
+  roll(0) = 1.0;
+  EXPECT_NEAR(roll.dot(info * roll), 0.0, 1e-9);
+  Vector6d yaw = Vector6d::Zero();
+  yaw(2) = 1.0;
+  EXPECT_GT(yaw.dot(info * yaw), 1e5);
+}
+
+}  // namespace
+}  // namespace uwscan::mapping::test
