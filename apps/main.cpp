@@ -15,6 +15,7 @@
 #include "apps/perception_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
 #include "apps/stripe_commands.hpp"
+#include "apps/view_command.hpp"
 #include "scanner/common/error.hpp"
 
 int main(int argc, char** argv) {
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddCalibrateCommand(app);
   uwscan::app::AddImportIntrinsicsCommand(app);
   uwscan::app::AddRegisterCommand(app);
+  uwscan::app::AddViewCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);

@@ -27,7 +27,7 @@ PictureInfo SaveScreenshot(const Scene& scene, const RenderOptions& options,
   internal::VtkScene vtk = internal::BuildVtkScene(scene, options);
   vtkSmartPointer<vtkRenderWindow> window = internal::MakeRenderWindow(options, /*offscreen=*/true);
   window->AddRenderer(vtk.renderer);
-  internal::ApplyCameraPreset(*vtk.renderer, options.camera, options.up);
+  internal::ApplyCameraPreset(*vtk.renderer, options.camera, options.up, vtk.fit_bounds);
   window->Render();
   internal::WriteWindowPng(*window, png_path);
 

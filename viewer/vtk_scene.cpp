@@ -21,6 +21,7 @@
 #include <vtkWindowToImageFilter.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cstdio>
 #include <system_error>
 
@@ -33,6 +34,8 @@ namespace {
 constexpr double kTrajectoryLineWidthPx = 3.0;
 constexpr double kEllipsoidOpacity = 0.35;
 constexpr int kColourBarEntries = 256;
+constexpr double kTrajectoryPointSizePx = 6.0;  // a vehicle that holds still is still seen
+constexpr double kFitMargin = 0.9;              // of the tightest fit
 
 void SetColour(vtkProperty& property, const Rgb& c) {
   property.SetColor(c.r / 255.0, c.g / 255.0, c.b / 255.0);
@@ -63,51 +66,6 @@ void AddCloud(const CloudLayer& layer, int layer_index, std::size_t stride, std:
   out.renderer->AddActor(drawn.actor);
   out.points_drawn += colours.size();
   out.clouds.push_back(std::move(drawn));
-}
-
-void AddMesh(const MeshLayer& layer, const Rgb& colour, VtkScene& out) {
-  auto points = FloatPoints(layer.mesh.vertices.size());
-  for (std::size_t i = 0; i < layer.mesh.vertices.size(); ++i) {
-    const Eigen::Vector3d p = layer.T_W_M * layer.mesh.vertices[i] - out.anchor_W;
-    points->SetPoint(static_cast<vtkIdType>(i), p.x(), p.y(), p.z());
-  }
-  vtkNew<vtkCellArray> triangles;
-  for (const Eigen::Vector3i& t : layer.mesh.triangles) {
-    const vtkIdType ids[3] = {t[0], t[1], t[2]};
-    triangles->InsertNextCell(3, ids);
-  }
-  vtkNew<vtkPolyData> data;
-  data->SetPoints(points);
-  data->SetPolys(triangles);
-  vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputData(data);
-  vtkNew<vtkActor> actor;
-  actor->SetMapper(mapper);
-  SetColour(*actor->GetProperty(), colour);
-  out.renderer->AddActor(actor);
-}
-
-void AddTrajectory(const TrajectoryLayer& layer, const Rgb& colour, VtkScene& out) {
-  if (layer.positions_W.empty()) return;
-  auto points = FloatPoints(layer.positions_W.size());
-  vtkNew<vtkCellArray> line;
-  line->InsertNextCell(static_cast<vtkIdType>(layer.positions_W.size()));
-  for (std::size_t i = 0; i < layer.positions_W.size(); ++i) {
-    const Eigen::Vector3d p = layer.positions_W[i] - out.anchor_W;
-    points->SetPoint(static_cast<vtkIdType>(i), p.x(), p.y(), p.z());
-    line->InsertCellPoint(static_cast<vtkIdType>(i));
-  }
-  vtkNew<vtkPolyData> data;
-  data->SetPoints(points);
-  data->SetLines(line);
-  vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputData(data);
-  vtkNew<vtkActor> actor;
-  actor->SetMapper(mapper);
-  SetColour(*actor->GetProperty(), colour);
-  actor->GetProperty()->SetLineWidth(kTrajectoryLineWidthPx);
-  actor->GetProperty()->LightingOff();  // the line keeps its exact colour
-  out.renderer->AddActor(actor);
 }
 
 // A unit sphere stretched along the covariance's principal axes to `sigmas` deviations.
@@ -146,6 +104,58 @@ std::string BarTitle(ColourMode mode) {
 }
 
 }  // namespace
+
+vtkSmartPointer<vtkActor> MeshActor(const MeshLayer& layer, const Rgb& colour, const Eigen::Vector3d& anchor_W) {
+  auto points = FloatPoints(layer.mesh.vertices.size());
+  for (std::size_t i = 0; i < layer.mesh.vertices.size(); ++i) {
+    const Eigen::Vector3d p = layer.T_W_M * layer.mesh.vertices[i] - anchor_W;
+    points->SetPoint(static_cast<vtkIdType>(i), p.x(), p.y(), p.z());
+  }
+  vtkNew<vtkCellArray> triangles;
+  for (const Eigen::Vector3i& t : layer.mesh.triangles) {
+    const vtkIdType ids[3] = {t[0], t[1], t[2]};
+    triangles->InsertNextCell(3, ids);
+  }
+  vtkNew<vtkPolyData> data;
+  data->SetPoints(points);
+  data->SetPolys(triangles);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(data);
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  SetColour(*actor->GetProperty(), colour);
+  return actor;
+}
+
+vtkSmartPointer<vtkActor> TrajectoryActor(const TrajectoryLayer& layer, const Rgb& colour,
+                                          const Eigen::Vector3d& anchor_W) {
+  auto points = FloatPoints(layer.positions_W.size());
+  vtkNew<vtkCellArray> line, vertices;
+  line->InsertNextCell(static_cast<vtkIdType>(layer.positions_W.size()));
+  for (std::size_t i = 0; i < layer.positions_W.size(); ++i) {
+    const Eigen::Vector3d p = layer.positions_W[i] - anchor_W;
+    points->SetPoint(static_cast<vtkIdType>(i), p.x(), p.y(), p.z());
+    line->InsertCellPoint(static_cast<vtkIdType>(i));
+  }
+  // The first and last positions as dots: where the path starts and where the vehicle is.
+  vertices->InsertNextCell(1);
+  vertices->InsertCellPoint(0);
+  vertices->InsertNextCell(1);
+  vertices->InsertCellPoint(static_cast<vtkIdType>(layer.positions_W.size() - 1));
+  vtkNew<vtkPolyData> data;
+  data->SetPoints(points);
+  data->SetLines(line);
+  data->SetVerts(vertices);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(data);
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  SetColour(*actor->GetProperty(), colour);
+  actor->GetProperty()->SetLineWidth(kTrajectoryLineWidthPx);
+  actor->GetProperty()->SetPointSize(kTrajectoryPointSizePx);
+  actor->GetProperty()->LightingOff();  // the line keeps its exact colour
+  return actor;
+}
 
 vtkSmartPointer<vtkPolyData> PointPolyData(const Eigen::Vector3d& origin_render,
                                            const std::vector<Eigen::Vector3f>& offsets,
@@ -238,11 +248,19 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
   }
   // Meshes and trajectories continue the categorical colours after the clouds', so no two
   // things of one scene share a colour when clouds are coloured by file.
+  std::vector<vtkActor*> fitted;
+  for (const DrawnCloud& cloud : out.clouds) fitted.push_back(cloud.actor);
   int next_colour = static_cast<int>(scene.clouds.size());
-  for (const MeshLayer& mesh : scene.meshes) AddMesh(mesh, CategoricalColour(next_colour++), out);
+  for (const MeshLayer& mesh : scene.meshes) {
+    vtkSmartPointer<vtkActor> actor = MeshActor(mesh, CategoricalColour(next_colour++), out.anchor_W);
+    out.renderer->AddActor(actor);
+    fitted.push_back(actor);
+  }
+  out.fit_bounds = UnionBounds(fitted);
   for (const TrajectoryLayer& trajectory : scene.trajectories) {
-    AddTrajectory(trajectory, trajectory.colour.value_or(CategoricalColour(next_colour)), out);
+    const Rgb colour = trajectory.colour.value_or(CategoricalColour(next_colour));
     ++next_colour;
+    if (!trajectory.positions_W.empty()) out.renderer->AddActor(TrajectoryActor(trajectory, colour, out.anchor_W));
   }
   if (!scene.ellipsoids.empty()) {
     vtkNew<vtkSphereSource> sphere;
@@ -261,7 +279,25 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
   return out;
 }
 
-void ApplyCameraPreset(vtkRenderer& renderer, CameraPreset preset, const Eigen::Vector3d& up_in) {
+std::optional<std::array<double, 6>> UnionBounds(const std::vector<vtkActor*>& actors) {
+  std::optional<std::array<double, 6>> all;
+  for (vtkActor* actor : actors) {
+    const double* b = actor->GetBounds();
+    if (b == nullptr || !(b[0] <= b[1])) continue;
+    if (!all) {
+      all = std::array<double, 6>{b[0], b[1], b[2], b[3], b[4], b[5]};
+      continue;
+    }
+    for (int a = 0; a < 3; ++a) {
+      (*all)[2 * a] = std::min((*all)[2 * a], b[2 * a]);
+      (*all)[2 * a + 1] = std::max((*all)[2 * a + 1], b[2 * a + 1]);
+    }
+  }
+  return all;
+}
+
+void ApplyCameraPreset(vtkRenderer& renderer, CameraPreset preset, const Eigen::Vector3d& up_in,
+                       const std::optional<std::array<double, 6>>& bounds) {
   const Eigen::Vector3d up = up_in.normalized();
   // A horizontal reference direction: x, unless x is (nearly) vertical.
   Eigen::Vector3d north = Eigen::Vector3d::UnitX() - up * up.x();
@@ -285,7 +321,16 @@ void ApplyCameraPreset(vtkRenderer& renderer, CameraPreset preset, const Eigen::
   camera->SetFocalPoint(0.0, 0.0, 0.0);
   camera->SetPosition(towards_camera.x(), towards_camera.y(), towards_camera.z());
   camera->SetViewUp(view_up.x(), view_up.y(), view_up.z());
-  renderer.ResetCamera();  // keeps the direction, fits every visible prop
+  // Keeps the direction; fits the visible props' projected box rather than their bounding
+  // sphere, so the scene fills the picture. Needs the renderer in its window.
+  if (bounds) {
+    renderer.ResetCamera(bounds->data());
+    renderer.ResetCameraScreenSpace(bounds->data());
+  } else {
+    renderer.ResetCamera();
+    renderer.ResetCameraScreenSpace();
+  }
+  camera->Zoom(kFitMargin);
   renderer.ResetCameraClippingRange();
 }
 

@@ -10,6 +10,7 @@
 #include <vtkSmartPointer.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -38,6 +39,9 @@ struct VtkScene {
   std::optional<ScalarRange> range;  // the colour map's range, continuous modes with points
   std::size_t points_drawn = 0;
   std::size_t points_total = 0;
+  // What the camera presets fit: the clouds and meshes when there are any (a vehicle's path
+  // a metre above its scan must not shrink the scan), else everything.
+  std::optional<std::array<double, 6>> fit_bounds;
 };
 
 // Every layer of `scene` as actors in a new renderer (background, colour bar, EDL as the
@@ -49,14 +53,22 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options);
 vtkSmartPointer<vtkPolyData> PointPolyData(const Eigen::Vector3d& origin_render,
                                            const std::vector<Eigen::Vector3f>& offsets,
                                            std::size_t stride, const std::vector<Rgb>& colours);
+// A trajectory's line (unlit, exact colour) and a mesh placed in the world, in render
+// coordinates (world minus anchor_W).
+vtkSmartPointer<vtkActor> TrajectoryActor(const TrajectoryLayer& layer, const Rgb& colour,
+                                          const Eigen::Vector3d& anchor_W);
+vtkSmartPointer<vtkActor> MeshActor(const MeshLayer& layer, const Rgb& colour, const Eigen::Vector3d& anchor_W);
 // An unlit point actor (vtkPointGaussianMapper drawing plain points): exact colours.
 vtkSmartPointer<vtkActor> PointActor(vtkPolyData* points, double point_size_px);
 // The scalar bar of the continuous colour map over `range`.
 vtkSmartPointer<vtkScalarBarActor> ColourBar(const ScalarRange& range, const std::string& title);
 void EnableEyeDomeLighting(vtkRenderer& renderer);
 
-// Places the camera for a preset around everything visible in `renderer`.
-void ApplyCameraPreset(vtkRenderer& renderer, CameraPreset preset, const Eigen::Vector3d& up);
+// Places the camera for a preset around `bounds` (render coordinates), or everything visible.
+void ApplyCameraPreset(vtkRenderer& renderer, CameraPreset preset, const Eigen::Vector3d& up,
+                       const std::optional<std::array<double, 6>>& bounds = std::nullopt);
+// The union of the actors' bounds; nullopt when none has any.
+std::optional<std::array<double, 6>> UnionBounds(const std::vector<vtkActor*>& actors);
 
 // A render window of the options' size, no multisampling (the same input gives the same
 // pixels), offscreen when asked. Call RequireDisplay() first.
