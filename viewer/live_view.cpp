@@ -183,7 +183,7 @@ class LiveScene {
     status_->SetDisplayPosition(10, options.render.height_px - 30);
     status_->SetInput("waiting for data");
     pick_ = internal::CornerText(bg);
-    pick_->SetInput(kLiveKeys);
+    pick_->SetInput(options.offscreen ? "" : kLiveKeys);  // no key hints in a picture
     renderer_->AddViewProp(status_);
     renderer_->AddViewProp(pick_);
     window_.AddRenderer(renderer_);
