@@ -13,6 +13,7 @@
 #include "apps/kernels_command.hpp"
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
+#include "apps/plot_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
 #include "apps/stripe_commands.hpp"
 #include "apps/view_command.hpp"
@@ -31,6 +32,8 @@ int main(int argc, char** argv) {
   uwscan::app::AddImportIntrinsicsCommand(app);
   uwscan::app::AddRegisterCommand(app);
   uwscan::app::AddViewCommand(app);
+  uwscan::app::AddPlotCommand(app);
+  uwscan::app::AddReportCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddCalibrationBenchCommand(*bench);
   uwscan::app::AddSimulationBenchCommand(*bench);
   uwscan::app::AddKernelsCommand(*bench);
+  uwscan::app::AddViewerBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);
