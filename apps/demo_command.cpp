@@ -16,6 +16,9 @@
 #include "scanner/common/error.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
+#include "viewer/display.hpp"
+#include "viewer/scene_files.hpp"
+#include "viewer/screenshot.hpp"
 
 namespace uwscan::app {
 namespace {
@@ -23,7 +26,21 @@ namespace {
 struct DemoArgs {
   std::string scene = "data/scenes/default.yaml";
   int threads = 0;
+  std::string screenshot;  // PNG of the reconstructed scene coloured by error; empty: none
 };
+
+// The reconstructed scene (the scanner's default method), coloured by each point's error.
+void WriteDemoScreenshot(const std::filesystem::path& log, const std::string& png) {
+  viewer::Scene scene;
+  mapping::ReconstructionOptions options;
+  options.table_cache = TableCache();
+  viewer::AddDiveLog(log, options, scene);
+  viewer::RenderOptions render;
+  render.colour = viewer::ColourMode::kError;
+  const viewer::PictureInfo info = viewer::SaveScreenshot(scene, render, png);
+  std::printf("\n%s: the reconstructed scene, %zu points coloured by error against truth (%.3g .. %.3g mm)\n",
+              png.c_str(), info.points_drawn, info.range->lo * 1e3, info.range->hi * 1e3);
+}
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -37,6 +54,7 @@ void RunDemo(const DemoArgs& a) {
   if (!std::filesystem::is_regular_file(a.scene)) {
     throw Error("--scene " + a.scene + ": no such file (run from the repository root, or give --scene)");
   }
+  if (!a.screenshot.empty()) viewer::RequireDisplay();  // before the run, not after it
   const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
   const scanner::sim::Simulator simulator(scene);
   bench::ScratchFolder scratch("demo");
@@ -79,6 +97,7 @@ void RunDemo(const DemoArgs& a) {
   std::printf("\nErrors are distances from each reconstructed point to the true surface point of its\n"
               "stripe peak. Ray-plane ignores the refraction of the laser plane into a cone; ray-cone\n"
               "fits that cone per mirror step; ray-ray solves the exact refracted rays.\n");
+  if (!a.screenshot.empty()) WriteDemoScreenshot(log_path, a.screenshot);
 }
 
 }  // namespace
@@ -90,6 +109,8 @@ void AddDemoCommand(CLI::App& app) {
   cmd->add_option("--scene", args->scene, "scene YAML (default data/scenes/default.yaml)");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--screenshot", args->screenshot,
+                  "also write a PNG of the reconstructed scene coloured by error (needs an X display)");
   cmd->callback([args] { RunDemo(*args); });
 }
 

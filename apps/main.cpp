@@ -14,9 +14,11 @@
 #include "apps/map_command.hpp"
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
+#include "apps/plot_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
 #include "apps/slam_bench_command.hpp"
 #include "apps/stripe_commands.hpp"
+#include "apps/view_command.hpp"
 #include "scanner/common/error.hpp"
 
 int main(int argc, char** argv) {
@@ -32,6 +34,9 @@ int main(int argc, char** argv) {
   uwscan::app::AddImportIntrinsicsCommand(app);
   uwscan::app::AddRegisterCommand(app);
   uwscan::app::AddMapCommand(app);
+  uwscan::app::AddViewCommand(app);
+  uwscan::app::AddPlotCommand(app);
+  uwscan::app::AddReportCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);
@@ -42,6 +47,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddSimulationBenchCommand(*bench);
   uwscan::app::AddKernelsCommand(*bench);
   uwscan::app::AddSlamBenchCommand(*bench);
+  uwscan::app::AddViewerBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);

@@ -35,3 +35,13 @@ find_package(embree 3 REQUIRED)
 
 # Dive logs (mapping/dive_log).
 find_package(SQLite3 REQUIRED)
+
+# The viewer (viewer/), the one module that links VTK: component targets only, never
+# ${VTK_LIBRARIES} (DESIGN.md, "Known traps"). X11 checks that a display answers before VTK
+# opens one: VTK 9.1 on Debian 12 renders only through X and aborts the process without it.
+find_package(VTK 9.1 REQUIRED COMPONENTS
+  CommonCore CommonDataModel CommonColor FiltersCore FiltersSources IOImage
+  RenderingCore RenderingOpenGL2 RenderingAnnotation RenderingFreeType
+  InteractionStyle ChartsCore RenderingContext2D RenderingContextOpenGL2 ViewsContext2D)
+find_package(X11 REQUIRED)
+find_package(Threads REQUIRED)

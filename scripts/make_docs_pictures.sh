@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Regenerates the README's pictures in docs/ with the program itself (run from anywhere; needs a
+# build: ./run build). Without an X display it runs under Xvfb (cmake/run_with_display.sh).
+#   scripts/make_docs_pictures.sh [UWSCAN_BINARY]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+UWSCAN=${1:-build/bin/uwscan}
+[ -x "$UWSCAN" ] || { echo "make_docs_pictures: no $UWSCAN (./run build first)" >&2; exit 1; }
+if [ -z "${UWSCAN_DOCS_UNDER_DISPLAY:-}" ]; then
+  export UWSCAN_DOCS_UNDER_DISPLAY=1
+  exec cmake/run_with_display.sh "$0" "$UWSCAN"
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+mkdir -p docs
+
+# The demo scene, reconstructed with the galvanometer's default ray-cone, coloured by error.
+"$UWSCAN" simulate data/scenes/default.yaml -o "$work/dive.db" >/dev/null
+"$UWSCAN" view "$work/dive.db" --colour error --screenshot docs/demo_error.png --size 1280x800
+"$UWSCAN" view "$work/dive.db" --edl --point-size 3 --camera top --screenshot docs/demo_edl_top.png --size 1280x800
+
+# Trade-offs: triangulation methods and stripe detectors, accuracy against time.
+"$UWSCAN" bench triangulation --points 1000000 --json "$work/triangulation.json" >/dev/null
+"$UWSCAN" plot "$work/triangulation.json" -o docs/triangulation_tradeoff.png
+"$UWSCAN" bench stripe --json "$work/stripe.json" >/dev/null
+"$UWSCAN" plot "$work/stripe.json" -o docs/stripe_tradeoff.png
+echo "make_docs_pictures: docs/*.png written"

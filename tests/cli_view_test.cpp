@@ -1,0 +1,175 @@
+// The viewer's commands end to end: view --screenshot, --follow, map reports, plot, and the
+// one-line error without a display. CTest runs this under Xvfb (cmake/run_with_display.sh).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "tests/cli_run.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using uwscan::test::CommandRun;
+using uwscan::test::RunCommand;
+using uwscan::test::RunUwscan;
+
+fs::path TempPath(const std::string& name) {
+  return fs::temp_directory_path() / ("uwscan_cli_view_test_" + std::to_string(getpid()) + "_" + name);
+}
+
+std::string SourcePath(const std::string& relative) { return std::string(UWSCAN_SOURCE_DIR) + "/" + relative; }
+
+std::string Bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A PNG's width and height from its IHDR chunk.
+std::pair<int, int> PngSize(const fs::path& path) {
+  const std::string b = Bytes(path);
+  if (b.size() < 24 || b.compare(1, 3, "PNG") != 0) return {0, 0};
+  auto be32 = [&b](std::size_t at) {
+    return (int(static_cast<unsigned char>(b[at])) << 24) | (int(static_cast<unsigned char>(b[at + 1])) << 16) |
+           (int(static_cast<unsigned char>(b[at + 2])) << 8) | int(static_cast<unsigned char>(b[at + 3]));
+  };
+  return {be32(16), be32(20)};
+}
+
+fs::path CubeCloud() {
+  const fs::path path = TempPath("cube.xyz");
+  std::ofstream out(path);
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      for (int k = 0; k < 6; ++k) out << 0.1 * i << " " << 0.1 * j << " " << 0.1 * k << "\n";
+    }
+  }
+  return path;
+}
+
+int CountLines(const std::string& text) {
+  int lines = 0;
+  for (const char c : text) lines += c == '\n';
+  return lines;
+}
+
+TEST(CliView, WithoutADisplayEveryRenderingCommandFailsWithOneLine) {
+  const fs::path cloud = CubeCloud();
+  for (const std::string& args : {"view " + cloud.string() + " --screenshot " + TempPath("x.png").string(),
+                                  "view " + cloud.string(), std::string("bench viewer --points 1000"),
+                                  "plot " + SourcePath("viewer/testdata/stripe_bench.json") + " -o " + TempPath("p.png").string()}) {
+    const CommandRun run = RunCommand("env -u DISPLAY " + std::string(UWSCAN_BIN) + " " + args);
+    EXPECT_EQ(run.exit_code, 1) << args << "\n" << run.output;
+    EXPECT_EQ(CountLines(run.output), 1) << run.output;
+    EXPECT_NE(run.output.find("uwscan: error: no X display"), std::string::npos) << run.output;
+  }
+  EXPECT_FALSE(fs::exists(TempPath("x.png")));
+  fs::remove(cloud);
+}
+
+TEST(CliView, ScreenshotOfACloudHasTheAskedSizeAndIsTheSameTwice) {
+  const fs::path cloud = CubeCloud(), a = TempPath("a.png"), b = TempPath("b.png");
+  for (const fs::path& png : {a, b}) {
+    const CommandRun run = RunUwscan("view " + cloud.string() + " --screenshot " + png.string() +
+                                     " --size 400x300 --camera side --edl --point-size 4");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("216 of 216 points drawn"), std::string::npos) << run.output;
+  }
+  EXPECT_EQ(PngSize(a), std::make_pair(400, 300));
+  EXPECT_EQ(Bytes(a), Bytes(b));
+  // A point budget draws every k-th point.
+  const CommandRun budget = RunUwscan("view " + cloud.string() + " --screenshot " + a.string() + " --max-points 100");
+  ASSERT_EQ(budget.exit_code, 0) << budget.output;
+  EXPECT_NE(budget.output.find("72 of 216 points drawn"), std::string::npos) << budget.output;
+  for (const fs::path& p : {cloud, a, b}) fs::remove(p);
+}
+
+TEST(CliView, BadInputGivesOneLineNamingIt) {
+  const fs::path unknown = TempPath("notes.doc");
+  std::ofstream(unknown) << "x";
+  const CommandRun run = RunUwscan("view " + unknown.string() + " --screenshot " + TempPath("u.png").string());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(CountLines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find(unknown.string()), std::string::npos) << run.output;
+  const fs::path cloud = CubeCloud();
+  const CommandRun error = RunUwscan("view " + cloud.string() + " --colour error --screenshot " + TempPath("e.png").string());
+  EXPECT_EQ(error.exit_code, 1);
+  EXPECT_NE(error.output.find("no ground truth"), std::string::npos) << error.output;
+  fs::remove(unknown);
+  fs::remove(cloud);
+}
+
+// A hand-made map report in the format `uwscan map --json` writes: its map, three trajectories
+// and uncertainty ellipsoids.
+TEST(CliView, MapReportIsDrawnWithItsMapTrajectoriesAndEllipsoids) {
+  const fs::path dir = TempPath("map");
+  fs::create_directories(dir);
+  fs::copy_file(CubeCloud(), dir / "map.xyz", fs::copy_options::overwrite_existing);
+  std::ostringstream slam, dead, covariance;
+  for (int i = 0; i < 20; ++i) {
+    const char* comma = i ? "," : "";
+    slam << comma << "[" << i << "," << 0.03 * i << ",0.25,-1,0,0,0,1]";
+    dead << comma << "[" << i << "," << 0.03 * i << "," << 0.25 + 0.01 * i << ",-1,0,0,0,1]";
+    covariance << comma << "[" << i;
+    for (int k = 0; k < 36; ++k) covariance << "," << (k % 7 == 0 ? 1e-4 * (i + 1) : 0.0);
+    covariance << "]";
+  }
+  const fs::path report = dir / "report.json";
+  std::ofstream(report) << R"({"uwscan_format": 1, "kind": "map_report", "log": "dive.db", "map": "map.xyz",
+    "trajectories": {"slam": [)" << slam.str() << R"(], "dead_reckoning": [)" << dead.str() << R"(]},
+    "pose_covariance": [)" << covariance.str() << R"(],
+    "loops": [{"from_submap": 0, "to_submap": 3, "accepted": true, "reason": "ok"}]})";
+  const fs::path png = dir / "map.png";
+  const CommandRun run = RunUwscan("view " + report.string() + " --screenshot " + png.string() + " --ellipsoid-every 5");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::exists(png));
+  // A broken report names the field.
+  std::ofstream(dir / "bad.json") << R"({"uwscan_format": 1, "kind": "map_report", "trajectories": {"slam": [[0, 1, 2]]}})";
+  const CommandRun bad = RunUwscan("view " + (dir / "bad.json").string() + " --screenshot " + png.string());
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.output.find("trajectories.slam[0]"), std::string::npos) << bad.output;
+  fs::remove_all(dir);
+}
+
+// `view --follow` started before the log exists shows every frame `simulate` then writes.
+TEST(CliView, FollowPicksUpADiveWrittenAfterItStarted) {
+  const fs::path log = TempPath("follow.db"), png = TempPath("follow.png"), out = TempPath("follow.txt");
+  fs::remove(log);
+  std::thread viewer([&] {
+    const CommandRun run = RunUwscan("view " + log.string() + " --follow --frames 201 --timeout 120 --colour error --screenshot " +
+                                     png.string());
+    std::ofstream(out) << run.exit_code << "\n" << run.output;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const CommandRun sim = RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
+  viewer.join();
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const std::string result = Bytes(out);
+  EXPECT_EQ(result.rfind("0\n", 0), 0u) << result;
+  EXPECT_NE(result.find("followed 201 frames, 206699 points"), std::string::npos) << result;
+  EXPECT_TRUE(fs::exists(png));
+  for (const fs::path& p : {log, png, out}) fs::remove(p);
+}
+
+TEST(CliView, PlotDrawsABenchJsonAndRefusesOtherJson) {
+  const fs::path png = TempPath("stripe.png");
+  const CommandRun run = RunUwscan("plot " + SourcePath("viewer/testdata/stripe_bench.json") + " -o " + png.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("stripe bench plotted"), std::string::npos);
+  EXPECT_EQ(PngSize(png), std::make_pair(760, 560));
+  const fs::path other = TempPath("other.json");
+  std::ofstream(other) << R"({"hello": 1})";
+  const CommandRun bad = RunUwscan("plot " + other.string() + " -o " + png.string());
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.output.find("not the JSON of a bench"), std::string::npos) << bad.output;
+  fs::remove(png);
+  fs::remove(other);
+}
+
+}  // namespace
