@@ -29,9 +29,13 @@ TEST_F(DiveLogTest, ReaderNamesTheFileAndWhatIsWrong) {
   expect(other, "not a uwscan dive log");
 
   const fs::path newer = WriteLog("newer.uwlog", 2, 3);
-  RawExec(newer, "UPDATE meta SET value = 2 WHERE key = 'schema_version'");
+  RawExec(newer, "UPDATE meta SET value = 3 WHERE key = 'schema_version'");
   const std::string message = MessageOf([&] { DiveLogReader reader(newer); });
-  EXPECT_EQ(message, "dive log '" + newer.string() + "' has schema version 2, this uwscan reads 1");
+  EXPECT_EQ(message, "dive log '" + newer.string() + "' has schema version 3, this uwscan reads 1 to 2");
+
+  const fs::path no_noise = WriteLog("no_noise.uwlog", 2, 3);
+  RawExec(no_noise, "DROP TABLE navigation_noise");
+  expect(no_noise, "no table 'navigation_noise'");
 
   const fs::path no_nav = WriteLog("no_nav.uwlog", 2, 3);
   RawExec(no_nav, "DROP TABLE navigation");
