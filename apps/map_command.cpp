@@ -2,7 +2,6 @@
 
 #include <omp.h>
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>

@@ -11,7 +11,7 @@
 #include "bench/scratch_folder.hpp"
 #include "mapping/dive_simulation.hpp"
 #include "mapping/map_report.hpp"
-#include "perception/voxel_filter.hpp"
+#include "mapping/submap.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
@@ -52,20 +52,6 @@ SurfaceDistance DistanceToScene(const perception::PointCloud& map, const scanner
   std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(k), distances.end());
   out.p95_m = distances[k];
   return out;
-}
-
-// The submaps placed at `poses` (one per submap), voxelised like the SLAM map.
-perception::PointCloud PlaceSubmaps(const mapping::DiveMapping& m, const std::vector<mapping::TimedPose>& poses,
-                                    double voxel_m) {
-  perception::PointCloud all;
-  all.origin = poses.front().T_W_V.translation();
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    const Eigen::Isometry3d T = Eigen::Translation3d(-all.origin) * poses[i].T_W_V;
-    for (std::size_t p = 0; p < m.submap_clouds[i].size(); ++p) {
-      all.points.push_back((T * m.submap_clouds[i].Point(p)).cast<float>());
-    }
-  }
-  return perception::VoxelDownsample(all, {voxel_m});
 }
 
 }  // namespace
@@ -127,7 +113,13 @@ std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Pro
       const std::vector<mapping::TimedPose> poses = Open3dMultiway(m, options.threads, &o.seconds);
       o.ate_m = mapping::AbsoluteTrajectoryError(poses, m.truth);
       o.rpe_per_m = mapping::RelativeErrorPerMetre(poses, m.truth);
-      o.map = DistanceToScene(PlaceSubmaps(m, poses, map_options.map_voxel_m), caster, options.threads);
+      std::vector<const perception::PointCloud*> clouds;
+      std::vector<Eigen::Isometry3d> placed;
+      for (std::size_t i = 0; i < poses.size(); ++i) {
+        clouds.push_back(&m.submap_clouds[i]);
+        placed.push_back(poses[i].T_W_V);
+      }
+      o.map = DistanceToScene(mapping::MergeClouds(clouds, placed, map_options.map_voxel_m), caster, options.threads);
       f.open3d = o;
     }
     if (progress) progress("surface distances " + f.name, 1.0);

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
-#include <numeric>
 
 #include "mapping/navigation_buffer.hpp"
 #include "mapping/navigation_uncertainty.hpp"
@@ -489,18 +488,14 @@ std::optional<std::vector<Matrix6d>> Mapper::Covariances() const {
 }
 
 perception::PointCloud Mapper::Map(double voxel_m, bool with_navigation) const {
-  const Impl& m = *impl_;
-  perception::PointCloud all;
-  if (m.submaps.empty()) return all;
-  const auto placed = [&](int i) { return with_navigation ? m.submaps[static_cast<size_t>(i)].T_W_V_nav : pose(i); };
-  all.origin = placed(0).translation();
-  const Eigen::Isometry3d T_origin = Eigen::Translation3d(-all.origin) * Eigen::Isometry3d::Identity();
+  std::vector<const perception::PointCloud*> clouds;
+  std::vector<Eigen::Isometry3d> poses;
   for (int i = 0; i < submap_count(); ++i) {
-    perception::PointCloud cloud = m.submaps[static_cast<size_t>(i)].cloud;
-    cloud.normals.clear();
-    AppendMoved(cloud, T_origin * placed(i), &all);
+    const Submap& s = impl_->submaps[static_cast<size_t>(i)];
+    clouds.push_back(&s.cloud);
+    poses.push_back(with_navigation ? s.T_W_V_nav : pose(i));
   }
-  return perception::VoxelDownsample(all, {voxel_m});
+  return MergeClouds(clouds, poses, voxel_m);
 }
 
 }  // namespace uwscan::mapping

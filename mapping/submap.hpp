@@ -42,4 +42,9 @@ struct SubmapCloudOptions {
 void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const SubmapCloudOptions& options,
                        Submap* submap);
 
+// The clouds placed in the world by their poses (T_W_cloud, one per cloud) and voxelised at
+// voxel_m into one cloud, its origin at the first pose's position (normals dropped).
+perception::PointCloud MergeClouds(const std::vector<const perception::PointCloud*>& clouds,
+                                   const std::vector<Eigen::Isometry3d>& T_W_cloud, double voxel_m);
+
 }  // namespace uwscan::mapping
