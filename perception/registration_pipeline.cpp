@@ -72,6 +72,13 @@ RegistrationPipelineOptions RegistrationPipelineOptions::ForObjectSize(double si
   o.coarse.min_inlier_fraction = 0.01;
   o.icp.method = IcpMethod::kPointToPlane;
   o.icp.max_correspondence_distance_m = {1.5 * o.voxel_m, 0.75 * o.voxel_m};
+  // Converged means the pose stopped changing at the scale of the data: a step below 1 % of a
+  // voxel at the object's edge. With noisy partial views ICP otherwise ends its iterations
+  // oscillating by micrometres around the answer, short of tolerances of 1e-6, and says it
+  // did not converge although the pose is as good as the data allows.
+  o.icp.translation_tolerance_m = 0.01 * o.voxel_m;
+  o.icp.rotation_tolerance_rad = o.icp.translation_tolerance_m / (0.5 * size_m);
+  o.icp.relative_rmse_tolerance = 1e-4;
   o.icp.threads = threads;
   o.threads = threads;
   return o;
