@@ -14,6 +14,7 @@
 #include "apps/map_command.hpp"
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
+#include "apps/recognition_commands.hpp"
 #include "apps/plot_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
 #include "apps/slam_bench_command.hpp"
@@ -33,6 +34,8 @@ int main(int argc, char** argv) {
   uwscan::app::AddCalibrateCommand(app);
   uwscan::app::AddImportIntrinsicsCommand(app);
   uwscan::app::AddRegisterCommand(app);
+  uwscan::app::AddBuildDbCommand(app);
+  uwscan::app::AddRecognizeCommand(app);
   uwscan::app::AddMapCommand(app);
   uwscan::app::AddViewCommand(app);
   uwscan::app::AddPlotCommand(app);

@@ -1,0 +1,152 @@
+#include "perception/object_database_builder.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "perception/cloud_neighbors.hpp"
+#include "perception/voxel_filter.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+constexpr int kMinViewPoints = 50;
+
+std::uint64_t Mix(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t z = a * 0x9E3779B97F4A7C15ull + b + 0x632BE59BD9B4E019ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// Voxelised surface samples with the mesh's outward normals (of the nearest sample).
+PointCloud ModelCloud(const scanner::TriangleMesh& mesh, double voxel_m, std::uint64_t seed) {
+  double area = 0.0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(t[0])];
+    area += 0.5 * (mesh.vertices[static_cast<std::size_t>(t[1])] - a)
+                      .cross(mesh.vertices[static_cast<std::size_t>(t[2])] - a)
+                      .norm();
+  }
+  const int count = static_cast<int>(std::clamp(16.0 * area / (voxel_m * voxel_m), 2000.0, 400000.0));
+  const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, count, seed);
+  const PointCloud dense = MakeCloud(samples.points);
+  PointCloud model = VoxelDownsample(dense, VoxelFilterOptions{voxel_m});
+  const KnnIndex index(dense.points);
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared;
+  model.normals.resize(model.size());
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    index.Query(model.points[i] + (model.origin - dense.origin).cast<float>(), 1, nearest, squared);
+    model.normals[i] = samples.normals[nearest[0]].cast<float>();
+  }
+  return model;
+}
+
+double Diameter(const PointCloud& cloud) {
+  double best = 0.0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (std::size_t j = i + 1; j < cloud.size(); ++j) {
+      best = std::max(best, static_cast<double>((cloud.points[i] - cloud.points[j]).squaredNorm()));
+    }
+  }
+  return std::sqrt(best);
+}
+
+}  // namespace
+
+void DatabaseBuildOptions::Check() const {
+  if (views < 1) throw Error("build-db: views must be >= 1");
+  if (standoffs_m.empty()) throw Error("build-db: at least one stand-off is needed");
+  for (double d : standoffs_m) {
+    if (!(d > 0.0) || !std::isfinite(d)) throw Error("build-db: stand-offs must be finite and > 0");
+  }
+  if (!(parameters.voxel_m > 0.0) || !(parameters.normal_radius_m > parameters.voxel_m) ||
+      !(parameters.feature_radius_m > parameters.normal_radius_m)) {
+    throw Error("build-db: needs 0 < voxel < normal radius < feature radius");
+  }
+  if (threads < 0) throw Error("build-db: threads must be >= 0");
+}
+
+EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t seed) {
+  EsfOptions options;
+  options.seed = seed;
+  return ComputeEsf(VoxelDownsample(cloud, VoxelFilterOptions{voxel_m}), options);
+}
+
+Eigen::Isometry3d ViewPose(int index, int count, const Eigen::Vector3d& centre_O, double standoff_m) {
+  const Eigen::Vector3d direction = scanner::sim::SphereDirections(count)[static_cast<std::size_t>(index)];
+  const Eigen::Vector3d up =
+      std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  return scanner::sim::LookAt(centre_O + standoff_m * direction, centre_O, up);
+}
+
+ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
+                                   const scanner::sim::VirtualScanner& scanner,
+                                   const DatabaseBuildOptions& options,
+                                   const std::function<void(double)>& progress) {
+  options.Check();
+  std::set<std::string> ids;
+  for (const ObjectSource& o : objects) {
+    if (o.id.empty()) throw Error("build-db: an object has an empty id");
+    if (!ids.insert(o.id).second) throw Error("build-db: two objects are called '" + o.id + "'");
+  }
+  ObjectDatabase db;
+  db.parameters = options.parameters;
+  const ObjectDatabaseParameters& p = options.parameters;
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const ObjectSource& source = objects[k];
+    ObjectModel model;
+    model.id = source.id;
+    model.source = source.source;
+    model.grasps = source.grasps;
+    model.model = ModelCloud(source.mesh, p.voxel_m, Mix(options.seed, k));
+    model.diameter_m = Diameter(model.model);
+    std::vector<std::size_t> all(model.model.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+    model.features = ComputeFpfh(model.model, all, FpfhOptions{p.feature_radius_m, threads});
+    model.symmetries_declared = source.symmetries.has_value();
+    model.symmetries = source.symmetries ? *source.symmetries : DetectSymmetries(source.mesh);
+
+    scanner::sim::SceneObject object;
+    object.name = source.id;
+    object.shape = scanner::sim::ObjectShape::kMesh;
+    object.mesh = source.mesh;
+    const std::vector<scanner::sim::SceneObject> scene = {object};
+    Eigen::Vector3d centre = model.model.origin;
+    std::vector<std::optional<ObjectView>> views(static_cast<std::size_t>(options.views));
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int v = 0; v < options.views; ++v) {
+      const double standoff = options.standoffs_m[static_cast<std::size_t>(v) % options.standoffs_m.size()];
+      const Eigen::Isometry3d T_O_C = ViewPose(v, options.views, centre, standoff);
+      const std::uint64_t seed = Mix(Mix(options.seed, k), static_cast<std::uint64_t>(v));
+      const scanner::sim::VirtualScan scan = scanner.Scan(scene, T_O_C, seed);
+      if (scan.points_C.size() < kMinViewPoints) continue;
+      const PointCloud cloud = MakeCloud(scan.points_C);
+      const EsfResult esf = VoxelisedEsf(cloud, p.voxel_m, seed);
+      if (!esf.ok) continue;
+      ObjectView view;
+      view.T_O_C = T_O_C;
+      view.esf = esf.histogram;
+      view.points = static_cast<int>(VoxelDownsample(cloud, VoxelFilterOptions{p.voxel_m}).size());
+      if (view.points < kMinViewPoints) continue;
+      views[static_cast<std::size_t>(v)] = view;
+    }
+    for (const std::optional<ObjectView>& v : views) {
+      if (v) model.views.push_back(*v);
+    }
+    if (model.views.empty()) {
+      throw Error("build-db: no view of '" + source.id + "' holds " + std::to_string(kMinViewPoints) +
+                  " points (is it far smaller or larger than the scanner's field of view?)");
+    }
+    db.objects.push_back(std::move(model));
+    if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(objects.size()));
+  }
+  return db;
+}
+
+}  // namespace uwscan::perception

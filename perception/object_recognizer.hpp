@@ -1,0 +1,90 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "perception/object_database.hpp"
+#include "perception/point_cloud.hpp"
+
+namespace uwscan::perception {
+
+struct RecognitionOptions {
+  double plane_distance_m = 0.01;      // seabed / wall inliers, metres
+  double plane_min_fraction = 0.15;    // a plane is removed while it holds this share of the scan
+  double cluster_tolerance_m = 0.015;  // points closer than this belong to one segment, metres
+  int min_segment_points = 150;        // voxelised points; smaller segments are ignored
+  int top_views = 20;                  // nearest views by chi-square considered
+  int max_candidates = 3;              // objects among them whose pose is estimated
+  // "unknown" when the nearest view is farther than this (chi-square, histograms summing to 1)
+  double max_chi_square = 0.9;
+  // Verification: at least this share of the segment within 1.5 voxels of the posed model...
+  double min_fitness = 0.85;
+  // ...and at most this share of the model surface facing the sensor (within the segment's
+  // extent along the view) left without a scan point within 2 voxels.
+  double max_missing = 0.45;
+  // A pose direction is free when its information is below this fraction of the largest.
+  double free_direction_ratio = 0.02;
+  std::uint64_t seed = 1;
+  int threads = 0;  // OpenMP threads, 0 = OpenMP's default; the answer does not depend on it
+  void Check() const;  // throws uwscan::Error naming the field
+};
+
+// A direction the pose leaves undetermined.
+struct FreeDirection {
+  std::string kind;           // "symmetry" (of the object) or "unconstrained" (by the data)
+  std::string motion;         // "rotation" or "translation"
+  Eigen::Vector3d axis_S = Eigen::Vector3d::UnitZ();   // unit, scan frame
+  Eigen::Vector3d point_S = Eigen::Vector3d::Zero();   // a point on a rotation axis, scan frame
+  int order = 0;              // symmetry: 0 continuous, N-fold; unconstrained: 0
+};
+
+// One object considered for a segment.
+struct RecognitionCandidate {
+  std::string object_id;
+  double chi_square = 0.0;  // to its nearest view
+  int view = -1;            // that view's index in the object's views
+  double fitness = 0.0;     // share of the segment on the posed model
+  double missing = 1.0;     // share of the expected visible model surface not seen
+  double rmse_m = 0.0;      // point-to-plane RMS of the final ICP
+  double score = 0.0;       // fitness x (1 - missing); the best verified one wins
+  bool verified = false;
+  Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();
+};
+
+struct RecognizedObject {
+  std::string object_id;  // "unknown" when nothing matched well enough
+  double score = 0.0;
+  double chi_square = 0.0;
+  double margin = 0.0;  // chi-square of the best other object's nearest view minus this one's
+  Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();  // pose in the scan frame
+  // Covariance of the pose over [w (rad), v (m)] in the object frame: the object moved by
+  // x -> x + w x (x - c) + v, c the model's centroid; from the ICP's information and
+  // point-to-plane residual. Free directions carry none (0 there).
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::vector<FreeDirection> free_directions;
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> grasps_S;  // name, T_S_G
+  std::vector<RecognitionCandidate> candidates;  // every object considered, best first
+  std::vector<std::size_t> segment;              // indices into the input scan
+  Eigen::Vector3d centroid_S = Eigen::Vector3d::Zero();
+};
+
+struct RecognitionResult {
+  std::vector<RecognizedObject> objects;  // one per segment, largest segment first
+  std::size_t plane_points = 0;           // removed as planes
+  std::map<std::string, double> stage_seconds;  // preprocess, segment, describe, match, pose, verify
+};
+
+// Plane removal, Euclidean segments, ESF against every view by chi-square, then for the best
+// few objects a pose by FPFH + RANSAC (correspondences restricted to the model surface the
+// matched view saw) and point-to-plane ICP of the segment onto the whole model, verified by fit
+// and by model surface that should have been seen. The scan is in the sensor's frame (the
+// sensor at its origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
+// invalid scan (NaN) or options.
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
+                                   const RecognitionOptions& options = {});
+
+}  // namespace uwscan::perception
