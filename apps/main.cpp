@@ -14,6 +14,7 @@
 #include "apps/map_command.hpp"
 #include "apps/object_commands.hpp"
 #include "apps/perception_commands.hpp"
+#include "apps/recognition_bench_command.hpp"
 #include "apps/recognition_commands.hpp"
 #include "apps/plot_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddSimulationBenchCommand(*bench);
   uwscan::app::AddKernelsCommand(*bench);
   uwscan::app::AddSlamBenchCommand(*bench);
+  uwscan::app::AddRecognitionBenchCommand(*bench);
   uwscan::app::AddViewerBenchCommand(*bench);
 
   try {

@@ -1,7 +1,7 @@
 # Every find_package of the project lives here; targets link imported targets only.
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(Ceres REQUIRED)
-find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs calib3d aruco)
+find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs calib3d aruco surface_matching)
 find_package(yaml-cpp REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)

@@ -1,0 +1,314 @@
+#include "bench/recognition_benchmark.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <random>
+
+#include "bench/recognition_peers.hpp"
+#include "perception/normals.hpp"
+#include "perception/object_database_builder.hpp"
+#include "perception/object_recognizer.hpp"
+#include "perception/voxel_filter.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/imr_objects.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+namespace sim = scanner::sim;
+using perception::ObjectDatabase;
+using perception::ObjectModel;
+using perception::PointCloud;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr const char* kForeignMeshes[] = {"bunny00", "rotor", "turbine", "anchor", "joint"};
+constexpr int kMinVisiblePoints = 300;  // an object with fewer scan points is not scored
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// The pose resting an object on the seabed (z = 0, up +z): its y_O up (valve stems), its z_O
+// axis horizontal at `yaw_rad`, at (x, y), lowest vertex on the seabed.
+Eigen::Isometry3d RestingPose(const scanner::TriangleMesh& mesh, double yaw_rad, double x, double y) {
+  Eigen::Matrix3d lay;
+  lay << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // x_O -> x, y_O -> z, z_O -> -y
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() * lay;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& v : mesh.vertices) lowest = std::min(lowest, (T.linear() * v).z());
+  T.translation() = Eigen::Vector3d(x, y, -lowest);
+  return T;
+}
+
+sim::SceneObject Object(const std::string& name, const scanner::TriangleMesh& mesh,
+                        const Eigen::Isometry3d& T_W_O) {
+  sim::SceneObject o;
+  o.name = name;
+  o.shape = sim::ObjectShape::kMesh;
+  o.mesh = mesh;
+  o.T_W_O = T_W_O;
+  o.reflectance = 0.5;
+  return o;
+}
+
+struct Scene {
+  std::vector<sim::SceneObject> objects;  // [0] seabed, then catalogue objects, then foreign
+  std::vector<std::string> classes;       // per object: catalogue id, "foreign" or "" (seabed)
+  Eigen::Isometry3d T_W_C;
+};
+
+Scene MakeScene(int index, const std::vector<perception::ObjectSource>& catalogue,
+                const std::vector<scanner::TriangleMesh>& foreign, std::uint64_t seed) {
+  std::mt19937_64 rng(seed * 7919 + static_cast<std::uint64_t>(index));
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Scene scene;
+  sim::SceneObject seabed;
+  seabed.name = "seabed";
+  seabed.shape = sim::ObjectShape::kPlane;
+  seabed.mesh = sim::MakeRectangle(4.0, 4.0);
+  seabed.reflectance = 0.3;
+  scene.objects.push_back(seabed);
+  scene.classes.push_back("");
+  // The target, in turn through the catalogue; a second catalogue object in half the scenes,
+  // touching the first in a third of those; a foreign mesh nearby.
+  const std::size_t first = static_cast<std::size_t>(index) % catalogue.size();
+  std::vector<std::pair<std::size_t, Eigen::Vector2d>> placed = {{first, {0.0, 0.0}}};
+  if (unit(rng) < 0.5) {
+    const std::size_t second = (first + 1 + static_cast<std::size_t>(unit(rng) * (catalogue.size() - 1))) % catalogue.size();
+    const double touching = unit(rng) < 0.33;
+    const double gap = 0.5 * (catalogue[first].mesh.BoundingBoxDiagonal() +
+                              catalogue[second].mesh.BoundingBoxDiagonal()) * (touching ? 0.55 : 1.0);
+    const double angle = 2.0 * std::numbers::pi * unit(rng);
+    placed.push_back({second, gap * Eigen::Vector2d(std::cos(angle), std::sin(angle))});
+  }
+  for (const auto& [k, xy] : placed) {
+    scene.objects.push_back(Object(catalogue[k].id, catalogue[k].mesh,
+                                   RestingPose(catalogue[k].mesh, 2.0 * std::numbers::pi * unit(rng), xy.x(), xy.y())));
+    scene.classes.push_back(catalogue[k].id);
+  }
+  if (!foreign.empty()) {
+    const scanner::TriangleMesh& mesh = foreign[static_cast<std::size_t>(index) % foreign.size()];
+    const double angle = 2.0 * std::numbers::pi * unit(rng);
+    const double distance = 0.25 + 0.5 * catalogue[first].mesh.BoundingBoxDiagonal();
+    scene.objects.push_back(Object("foreign", mesh,
+                                   RestingPose(mesh, 2.0 * std::numbers::pi * unit(rng),
+                                               distance * std::cos(angle), distance * std::sin(angle))));
+    scene.classes.push_back("foreign");
+  }
+  // The camera 0.5-1.5 m from the target, 35-90 degrees above the seabed.
+  const double range = 0.5 + unit(rng);
+  const double elevation = (35.0 + 55.0 * unit(rng)) * kDeg;
+  const double azimuth = 2.0 * std::numbers::pi * unit(rng);
+  const Eigen::Vector3d target = scene.objects[1].T_W_O.translation();
+  const Eigen::Vector3d eye =
+      target + range * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                                       std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+  const Eigen::Vector3d up = std::abs(std::sin(elevation)) > 0.99 ? Eigen::Vector3d::UnitX()
+                                                                  : Eigen::Vector3d::UnitZ();
+  scene.T_W_C = sim::LookAt(eye, target, up);
+  return scene;
+}
+
+// The database's models as the peers take them, with the views scanned again for their points.
+std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
+                                    const std::vector<perception::ObjectSource>& catalogue,
+                                    const sim::VirtualScanner& scanner, std::uint64_t seed, int threads) {
+  std::vector<PeerObject> peers(db.objects.size());
+  for (std::size_t k = 0; k < db.objects.size(); ++k) {
+    peers[k].id = db.objects[k].id;
+    peers[k].model = db.objects[k].model;
+    const std::vector<sim::SceneObject> scene = {
+        Object(catalogue[k].id, catalogue[k].mesh, Eigen::Isometry3d::Identity())};
+    std::vector<std::optional<PeerView>> views(db.objects[k].views.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int v = 0; v < static_cast<int>(views.size()); ++v) {
+      const Eigen::Isometry3d T_O_C = db.objects[k].views[static_cast<std::size_t>(v)].T_O_C;
+      const sim::VirtualScan scan = scanner.Scan(scene, T_O_C, seed + static_cast<std::uint64_t>(v));
+      const PointCloud cloud = perception::VoxelDownsample(
+          perception::MakeCloud(scan.points_C), perception::VoxelFilterOptions{db.parameters.voxel_m});
+      perception::EsfResult esf;
+#pragma omp critical(pcl_esf)
+      esf = perception::ComputePclEsf(cloud);  // PCL's ESF uses the global rand()
+      if (!esf.ok) continue;
+      PeerView view{esf.histogram, T_O_C, Eigen::Vector3d::Zero()};
+      for (std::size_t i = 0; i < cloud.size(); ++i) view.centroid_C += cloud.Point(i);
+      view.centroid_C /= static_cast<double>(cloud.size());
+      views[static_cast<std::size_t>(v)] = view;
+    }
+    for (const auto& v : views) {
+      if (v) peers[k].views.push_back(*v);
+    }
+  }
+  return peers;
+}
+
+// Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame.
+void Score(const std::string& truth, const std::string& answer,
+           const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
+           const ObjectDatabase& db, PipelineFigures& figures) {
+  figures.confusion[truth][answer] += 1;
+  if (truth == "foreign") {
+    ++figures.foreign;
+    if (answer == "unknown") ++figures.foreign_unknown;
+    return;
+  }
+  ++figures.objects;
+  if (answer != truth || !T_S_O) return;
+  ++figures.recognised;
+  const ObjectModel& model = *std::find_if(db.objects.begin(), db.objects.end(),
+                                           [&](const ObjectModel& o) { return o.id == truth; });
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < model.model.size(); i += 4) points.push_back(model.model.Point(i));
+  const std::vector<Eigen::Isometry3d> symmetries = perception::SymmetryTransforms(model.symmetries);
+  const perception::SymmetricPoseError e =
+      perception::PoseErrorModuloSymmetry(*T_S_O, T_S_O_true, points, symmetries);
+  figures.rotation_errors_rad.push_back(e.rotation_rad);
+  figures.translation_errors_m.push_back(e.translation_m);
+  if (e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005) ++figures.pose_success;
+  if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
+  if (model.grasps.empty()) return;
+  const Eigen::Isometry3d T_true = T_S_O_true * symmetries[e.symmetry];
+  double worst_position = 0.0, worst_angle = 0.0;
+  for (const perception::GraspFrame& g : model.grasps) {
+    const Eigen::Isometry3d est = *T_S_O * g.T_O_G, truth_g = T_true * g.T_O_G;
+    worst_position = std::max(worst_position, (est.translation() - truth_g.translation()).norm());
+    const double c = std::clamp(est.linear().col(2).dot(truth_g.linear().col(2)), -1.0, 1.0);
+    worst_angle = std::max(worst_angle, std::acos(c));
+  }
+  figures.grasp_position_errors_m.push_back(worst_position);
+  figures.grasp_angle_errors_rad.push_back(worst_angle);
+  if (worst_position <= 0.005 && worst_angle <= 3.0 * kDeg) ++figures.grasp_success;
+}
+
+}  // namespace
+
+void RecognitionBenchOptions::Check() const {
+  if (scans < 1 || views < 1 || galvo_stride < 1 || threads < 1) {
+    throw Error("bench recognition: scans, views, stride and threads must be >= 1");
+  }
+}
+
+RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& options,
+                                           const Progress& progress) {
+  options.Check();
+  RecognitionBenchResult result;
+  result.scans = options.scans;
+  std::vector<perception::ObjectSource> catalogue;
+  for (const std::string& name : perception::CatalogueNames()) {
+    catalogue.push_back(perception::CatalogueObject(name));
+  }
+  std::vector<scanner::TriangleMesh> foreign;
+  for (const char* name : kForeignMeshes) {
+    scanner::TriangleMesh mesh =
+        scanner::LoadMesh(options.data_cache / "meshes" / (std::string(name) + ".off"));
+    const double scale = 0.25 / mesh.BoundingBoxDiagonal();
+    for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
+    foreign.push_back(std::move(mesh));
+  }
+
+  sim::VirtualScannerOptions db_scan;
+  db_scan.pattern.kind = scanner::ScannerKind::kGalvo;
+  db_scan.pattern.galvo.step_stride = options.galvo_stride;
+  db_scan.table_cache = options.table_cache;
+  const scanner::Scanner galvo = scanner::DefaultScanner(scanner::ScannerKind::kGalvo);
+  const sim::VirtualScanner db_scanner(galvo, db_scan);
+  auto start = std::chrono::steady_clock::now();
+  perception::DatabaseBuildOptions build;
+  build.views = options.views;
+  build.seed = options.seed;
+  build.threads = options.threads;
+  const ObjectDatabase db = perception::BuildObjectDatabase(
+      catalogue, db_scanner, build,
+      [&](double f) { if (progress) progress("object database", f); });
+  result.database_seconds = Seconds(start);
+
+  sim::VirtualScannerOptions scene_scan = db_scan;
+  if (options.images) {
+    sim::SimulationEffects& e = scene_scan.effects;
+    e.peak_noise.on = false;
+    e.image.on = e.beam.on = e.sensor_noise.on = e.speckle.on = e.backscatter.on = e.ambient.on = true;
+    e.attenuation = true;
+  }
+  sim::Water water;
+  water.attenuation_per_m = 0.2;
+  scene_scan.water = water;
+  const sim::VirtualScanner scene_scanner(galvo, scene_scan);
+
+  std::optional<PclEsfPeer> pcl_peer;
+  std::optional<PpfPeer> ppf_peer;
+  if (options.run_peers) {
+    std::vector<PeerObject> peers = PeerObjects(db, catalogue, db_scanner, options.seed, options.threads);
+    ppf_peer.emplace(peers);
+    result.ppf_training_seconds = ppf_peer->training_seconds();
+    pcl_peer.emplace(std::move(peers));
+  }
+
+  perception::RecognitionOptions recognition;
+  recognition.seed = options.seed;
+  recognition.threads = options.threads;
+  for (int s = 0; s < options.scans; ++s) {
+    const Scene scene = MakeScene(s, catalogue, foreign, options.seed);
+    start = std::chrono::steady_clock::now();
+    const sim::VirtualScan scan = scene_scanner.Scan(scene.objects, scene.T_W_C, options.seed + 1000 + s);
+    result.simulation_seconds += Seconds(start);
+    if (scan.points_C.empty()) continue;
+    const PointCloud cloud = perception::MakeCloud(scan.points_C);
+
+    start = std::chrono::steady_clock::now();
+    const perception::RecognitionResult answer = perception::RecognizeObjects(cloud, db, recognition);
+    result.pipelines["uwscan"].seconds += Seconds(start);
+    for (const auto& [stage, seconds] : answer.stage_seconds) result.uwscan_stage_seconds[stage] += seconds;
+
+    // Each object of the scene with enough points, and the segment holding most of them.
+    for (std::size_t o = 1; o < scene.objects.size(); ++o) {
+      int visible = 0;
+      for (std::int32_t id : scan.object_index) visible += id == static_cast<int>(o);
+      if (visible < kMinVisiblePoints) continue;
+      int best_segment = -1, best_count = 0;
+      for (std::size_t k = 0; k < answer.objects.size(); ++k) {
+        int count = 0;
+        for (std::size_t i : answer.objects[k].segment) count += scan.object_index[i] == static_cast<int>(o);
+        if (count > best_count) best_count = count, best_segment = static_cast<int>(k);
+      }
+      const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
+      const std::string& truth = scene.classes[o];
+      if (best_segment < 0) {
+        Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
+        if (options.run_peers) {
+          Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
+          Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["opencv_ppf"]);
+        }
+        continue;
+      }
+      const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
+      Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"]);
+      if (!options.run_peers) continue;
+      const PointCloud segment = perception::VoxelDownsample(
+          perception::Subset(cloud, ours.segment), perception::VoxelFilterOptions{db.parameters.voxel_m});
+      start = std::chrono::steady_clock::now();
+      const PeerAnswer pcl = pcl_peer->Recognize(segment);
+      result.pipelines["pcl_esf"].seconds += Seconds(start);
+      Score(truth, pcl.id, pcl.T_S_O, T_S_O_true, db, result.pipelines["pcl_esf"]);
+      start = std::chrono::steady_clock::now();
+      perception::NormalOptions normals;
+      normals.radius_m = db.parameters.normal_radius_m;
+      normals.threads = options.threads;
+      const perception::CloudWithNormals with_normals =
+          perception::AttachNormals(segment, perception::EstimateNormals(segment, normals));
+      const PeerAnswer ppf = ppf_peer->Recognize(with_normals.cloud);
+      result.pipelines["opencv_ppf"].seconds += Seconds(start);
+      Score(truth, ppf.id, ppf.T_S_O, T_S_O_true, db, result.pipelines["opencv_ppf"]);
+    }
+    if (progress) progress("scans", static_cast<double>(s + 1) / options.scans);
+  }
+  return result;
+}
+
+}  // namespace uwscan::bench

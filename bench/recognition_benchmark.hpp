@@ -1,0 +1,57 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bench/progress.hpp"
+
+namespace uwscan::bench {
+
+// Object recognition for grasping on simulated scans: the six procedural IMR objects in a
+// database made by the virtual scanner, scenes of one or two of them on a seabed with a
+// foreign mesh beside them (sometimes touching), each scanned once by the galvanometer scanner
+// from 0.5-1.5 m, under water, with the image stages on. uwscan's recogniser and two peers
+// on the same segments.
+struct RecognitionBenchOptions {
+  int scans = 100;                 // scenes, each scanned once, >= 1
+  int views = 24;                  // database views per object, >= 1
+  bool images = true;              // render and detect frames (else exact peaks + 0.1 px noise)
+  int galvo_stride = 2;            // mirror steps per frame, >= 1 (2: 101 frames per sweep)
+  std::uint64_t seed = 1;
+  int threads = 2;
+  bool run_peers = true;
+  std::filesystem::path data_cache;   // foreign meshes (scripts/fetch_data.sh)
+  std::filesystem::path table_cache;  // cone table kept between runs
+  void Check() const;
+};
+
+struct PipelineFigures {
+  int objects = 0;              // catalogue objects in the scans (the rate's denominator)
+  int recognised = 0;           // with the right id
+  int pose_success = 0;         // of those: within 5 mm and 2 degrees modulo symmetry
+  int mssd_success = 0;         // of those: MSSD below 0.1 x diameter
+  int grasp_success = 0;        // of those: grasp within 5 mm and 3 degrees
+  int foreign = 0, foreign_unknown = 0;  // foreign meshes, and those called "unknown"
+  double seconds = 0.0;         // recognition of every scan (segmentation included for uwscan)
+  std::vector<double> rotation_errors_rad, translation_errors_m, grasp_position_errors_m,
+      grasp_angle_errors_rad;
+  // true class (or "foreign") -> answer -> count
+  std::map<std::string, std::map<std::string, int>> confusion;
+};
+
+struct RecognitionBenchResult {
+  int scans = 0;
+  double database_seconds = 0.0;
+  double simulation_seconds = 0.0;
+  std::map<std::string, PipelineFigures> pipelines;  // uwscan, pcl_esf, opencv_ppf
+  std::map<std::string, double> uwscan_stage_seconds;  // summed over scans
+  double ppf_training_seconds = 0.0;
+};
+
+RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& options,
+                                           const Progress& progress = {});
+
+}  // namespace uwscan::bench
