@@ -53,27 +53,31 @@ Eigen::Isometry3d GetPose(ByteReader& in, const char* field) {
   return T;
 }
 
+// A cloud with or without normals (a flag byte says which).
 void PutCloud(ByteWriter& out, const PointCloud& cloud) {
   PutVector(out, cloud.origin);
+  out.Put<std::uint8_t>(cloud.has_normals() ? 1 : 0);
   out.Put<std::uint64_t>(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     for (int k = 0; k < 3; ++k) out.Put<float>(cloud.points[i][k]);
+    if (!cloud.has_normals()) continue;
     for (int k = 0; k < 3; ++k) out.Put<float>(cloud.normals[i][k]);
   }
 }
 
 PointCloud GetCloud(ByteReader& in) {
   PointCloud cloud;
-  cloud.origin = GetVector(in, "model origin");
-  const std::size_t n = in.GetCount("model points", 24);
+  cloud.origin = GetVector(in, "cloud origin");
+  const bool normals = in.Get<std::uint8_t>("cloud normals flag") != 0;
+  const std::size_t n = in.GetCount("cloud points", normals ? 24 : 12);
   cloud.points.resize(n);
-  cloud.normals.resize(n);
+  if (normals) cloud.normals.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) cloud.points[i][k] = in.Get<float>("model point");
-    for (int k = 0; k < 3; ++k) cloud.normals[i][k] = in.Get<float>("model normal");
-    if (!cloud.points[i].allFinite() || !cloud.normals[i].allFinite()) {
-      in.Fail("a model point or normal is not finite");
-    }
+    for (int k = 0; k < 3; ++k) cloud.points[i][k] = in.Get<float>("cloud point");
+    if (!cloud.points[i].allFinite()) in.Fail("a cloud point is not finite");
+    if (!normals) continue;
+    for (int k = 0; k < 3; ++k) cloud.normals[i][k] = in.Get<float>("cloud normal");
+    if (!cloud.normals[i].allFinite()) in.Fail("a normal is not finite");
   }
   return cloud;
 }
@@ -105,6 +109,7 @@ void PutObject(ByteWriter& out, const ObjectModel& o) {
     PutPose(out, v.T_O_C);
     out.Put<std::int32_t>(v.points);
     for (int k = 0; k < 640; ++k) out.Put<float>(v.esf[k]);
+    PutCloud(out, v.cloud);
   }
 }
 
@@ -116,6 +121,7 @@ ObjectModel GetObject(ByteReader& in) {
   o.diameter_m = GetFinite(in, "diameter");
   if (!(o.diameter_m > 0.0)) in.Fail("object '" + o.id + "' has no positive diameter");
   o.model = GetCloud(in);
+  if (!o.model.has_normals() || o.model.empty()) in.Fail("object '" + o.id + "' has no model normals");
   const std::size_t features = in.GetCount("features", 8 + 33 * 4);
   for (std::size_t i = 0; i < features; ++i) {
     const std::uint64_t index = in.Get<std::uint64_t>("feature index");
@@ -152,6 +158,7 @@ ObjectModel GetObject(ByteReader& in) {
     v.points = in.Get<std::int32_t>("view points");
     for (int k = 0; k < 640; ++k) v.esf[k] = in.Get<float>("view ESF");
     if (!v.esf.allFinite() || (v.esf.array() < 0.0f).any()) in.Fail("a view's ESF is invalid");
+    v.cloud = GetCloud(in);
     o.views.push_back(v);
   }
   return o;

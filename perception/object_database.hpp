@@ -24,6 +24,10 @@ struct ObjectView {
   Eigen::Isometry3d T_O_C = Eigen::Isometry3d::Identity();  // the camera in the object frame
   EsfDescriptor esf = EsfDescriptor::Zero();  // of the view's voxelised points
   int points = 0;                             // voxelised points of the view
+  // The view's voxelised points in its camera frame: what the pose's coarse stage matches a
+  // segment against (a partial scan like the segment, unlike the whole model, whose thin walls
+  // and inner bores give FPFH neighbourhoods no scan sees).
+  PointCloud cloud;
 };
 
 // What recognition needs of one object: the model surface with normals and FPFH for its pose,

@@ -132,7 +132,8 @@ ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
       ObjectView view;
       view.T_O_C = T_O_C;
       view.esf = esf.histogram;
-      view.points = static_cast<int>(VoxelDownsample(cloud, VoxelFilterOptions{p.voxel_m}).size());
+      view.cloud = VoxelDownsample(cloud, VoxelFilterOptions{p.voxel_m});
+      view.points = static_cast<int>(view.cloud.size());
       if (view.points < kMinViewPoints) continue;
       views[static_cast<std::size_t>(v)] = view;
     }

@@ -49,32 +49,68 @@ std::vector<std::pair<double, int>> NearestViews(const EsfDescriptor& esf, const
   return nearest;
 }
 
-// The model's features on the surface a camera at eye_O sees (normals facing it).
-FpfhFeatures FeaturesFacing(const ObjectModel& o, const Eigen::Vector3d& eye_O) {
-  FpfhFeatures facing;
-  for (std::size_t i = 0; i < o.features.indices.size(); ++i) {
-    const std::size_t p = o.features.indices[i];
-    const Eigen::Vector3d x = o.model.Point(p);
-    if (o.model.normals[p].cast<double>().dot(eye_O - x) > 0.0) {
-      facing.indices.push_back(p);
-      facing.descriptors.push_back(o.features.descriptors[i]);
-    }
-  }
-  return facing;
+// The view's points with normals (facing its camera at the origin) and FPFH at every one.
+struct ViewFeatures {
+  PointCloud cloud;
+  FpfhFeatures features;
+};
+ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads) {
+  NormalOptions normals;
+  normals.radius_m = p.normal_radius_m;
+  normals.threads = threads;
+  ViewFeatures v;
+  v.cloud = AttachNormals(view.cloud, EstimateNormals(view.cloud, normals)).cloud;
+  std::vector<std::size_t> all(v.cloud.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  v.features = ComputeFpfh(v.cloud, all, FpfhOptions{p.feature_radius_m, threads});
+  return v;
 }
 
-// Share of the model surface that faces the sensor squarely (within the segment's reach) and
-// has no segment point within `radius_m`.
+// Share of the model surface the sensor should have seen that has no segment point within
+// `radius_m`. Seen: facing the sensor (not grazing) and nearest to it along its line of sight
+// (a depth buffer over direction bins about one voxel wide at the object), so parts the
+// object hides from itself are not expected.
 double MissingShare(const ObjectModel& o, const PointCloud& segment_O, const Eigen::Vector3d& sensor_O,
                     double radius_m) {
+  const double range = (o.model.origin - sensor_O).norm();
+  const double bin_rad = std::max(radius_m / std::max(range, 1e-3), 1e-4);
+  // The sweep may cover only part of the object: only directions within the segment's angular
+  // window (one bin of margin) are expected.
+  auto angles = [&](const Eigen::Vector3d& ray) {
+    return Eigen::Vector2d(std::atan2(ray.y(), ray.x()), std::asin(ray.z() / ray.norm()));
+  };
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e9), hi = Eigen::Vector2d::Constant(-1e9);
+  for (std::size_t i = 0; i < segment_O.size(); ++i) {
+    const Eigen::Vector2d a = angles(segment_O.Point(i) - sensor_O);
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(a);
+  }
+  lo.array() -= bin_rad;
+  hi.array() += bin_rad;
+  std::map<std::pair<long, long>, double> nearest_depth;
+  std::vector<std::size_t> facing;
+  std::vector<std::pair<long, long>> bins;
+  for (std::size_t i = 0; i < o.model.size(); ++i) {
+    const Eigen::Vector3d x = o.model.Point(i);
+    const Eigen::Vector3d ray = x - sensor_O;
+    const double depth = ray.norm();
+    if (o.model.normals[i].cast<double>().dot(-ray / depth) < 0.3) continue;  // grazing or back
+    const Eigen::Vector2d a = angles(ray);
+    if ((a.array() < lo.array()).any() || (a.array() > hi.array()).any()) continue;  // not swept
+    const std::pair<long, long> bin{std::lround(std::atan2(ray.y(), ray.x()) / bin_rad),
+                                    std::lround(std::asin(ray.z() / depth) / bin_rad)};
+    auto [it, inserted] = nearest_depth.emplace(bin, depth);
+    if (!inserted) it->second = std::min(it->second, depth);
+    facing.push_back(i);
+    bins.push_back(bin);
+  }
   const KnnIndex index(segment_O.points);
   std::vector<std::uint32_t> nearest;
   std::vector<float> squared;
   std::size_t expected = 0, missing = 0;
-  for (std::size_t i = 0; i < o.model.size(); ++i) {
-    const Eigen::Vector3d x = o.model.Point(i);
-    const Eigen::Vector3d to_sensor = (sensor_O - x).normalized();
-    if (o.model.normals[i].cast<double>().dot(to_sensor) < 0.5) continue;  // grazing or hidden
+  for (std::size_t k = 0; k < facing.size(); ++k) {
+    const Eigen::Vector3d x = o.model.Point(facing[k]);
+    if ((x - sensor_O).norm() > nearest_depth[bins[k]] + radius_m) continue;  // hidden
     ++expected;
     index.Query((x - segment_O.origin).cast<float>(), 1, nearest, squared);
     if (nearest.empty() || squared[0] > radius_m * radius_m) ++missing;
@@ -224,16 +260,17 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
       candidate.object_id = model.id;
       candidate.chi_square = nearest[candidates[k]].first;
       candidate.view = nearest[candidates[k]].second;
-      const Eigen::Vector3d eye_O =
-          model.views[static_cast<std::size_t>(candidate.view)].T_O_C.translation();
+      const ObjectView& view = model.views[static_cast<std::size_t>(candidate.view)];
+      const ViewFeatures described = DescribeView(view, p, options.threads);
       CoarseAlignmentOptions coarse;
       coarse.inlier_distance_m = 2.0 * p.voxel_m;
       coarse.max_iterations = 20000;
       coarse.min_inlier_fraction = 0.02;
       coarse.seed = options.seed;
       coarse.threads = options.threads;
-      const RegistrationResult rough = AlignCoarse(with_normals.cloud, segment_features, model.model,
-                                                   FeaturesFacing(model, eye_O), coarse);
+      // The segment onto the view it resembles, which places it on the model.
+      const RegistrationResult rough = AlignCoarse(with_normals.cloud, segment_features,
+                                                   described.cloud, described.features, coarse);
       if (rough.converged) {
         IcpOptions icp;
         icp.method = IcpMethod::kPointToPlane;
@@ -242,7 +279,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
         icp.rotation_tolerance_rad = icp.translation_tolerance_m / (0.5 * model.diameter_m);
         icp.relative_rmse_tolerance = 1e-4;
         icp.threads = options.threads;
-        fine[k] = AlignIcp(with_normals.cloud, model.model, rough.T_target_source, icp);
+        fine[k] = AlignIcp(with_normals.cloud, model.model, view.T_O_C * rough.T_target_source, icp);
         const Eigen::Isometry3d T_O_S = fine[k].T_target_source;
         candidate.T_S_O = T_O_S.inverse();
         candidate.fitness = fine[k].fitness;

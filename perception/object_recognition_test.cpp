@@ -1,0 +1,169 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "perception/object_catalogue.hpp"
+#include "perception/object_database.hpp"
+#include "perception/object_database_builder.hpp"
+#include "perception/object_recognizer.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/imr_objects.hpp"
+#include "scanner/sim/virtual_scanner.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+namespace sim = scanner::sim;
+
+const sim::VirtualScanner& Scanner() {
+  static const sim::VirtualScanner scanner = [] {
+    sim::VirtualScannerOptions options;
+    options.pattern.galvo.step_stride = 2;
+    return sim::VirtualScanner(scanner::DefaultScanner(scanner::ScannerKind::kGalvo), options);
+  }();
+  return scanner;
+}
+
+ObjectDatabase Build(const std::vector<std::string>& names, int threads) {
+  std::vector<ObjectSource> sources;
+  for (const std::string& name : names) sources.push_back(CatalogueObject(name));
+  DatabaseBuildOptions options;
+  options.views = 16;
+  options.threads = threads;
+  return BuildObjectDatabase(sources, Scanner(), options);
+}
+
+const ObjectDatabase& PipeFlangeValveDb() {
+  static const ObjectDatabase db = Build({"pipe", "flange", "valve_wheel"}, 2);
+  return db;
+}
+
+sim::SceneObject Placed(const scanner::TriangleMesh& mesh, const Eigen::Isometry3d& T_W_O) {
+  sim::SceneObject o;
+  o.name = "object";
+  o.shape = sim::ObjectShape::kMesh;
+  o.mesh = mesh;
+  o.T_W_O = T_W_O;
+  return o;
+}
+
+// An object lying on a seabed (z = 0, up +z, its y_O up and z_O along y), scanned from `eye`.
+struct Scan {
+  PointCloud cloud;
+  Eigen::Isometry3d T_S_O;
+};
+Scan ScanOnSeabed(const scanner::TriangleMesh& mesh, const Eigen::Vector3d& eye, std::uint64_t seed) {
+  sim::SceneObject seabed;
+  seabed.name = "seabed";
+  seabed.shape = sim::ObjectShape::kPlane;
+  seabed.mesh = sim::MakeRectangle(4.0, 4.0);
+  Eigen::Isometry3d T_W_O = Eigen::Isometry3d::Identity();
+  T_W_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  double lowest = 1e9;
+  for (const Eigen::Vector3d& v : mesh.vertices) lowest = std::min(lowest, (T_W_O.linear() * v).z());
+  T_W_O.translation() = Eigen::Vector3d(0.0, 0.0, -lowest);
+  const Eigen::Isometry3d T_W_C =
+      sim::LookAt(eye, T_W_O.translation(), Eigen::Vector3d::UnitZ());
+  const sim::VirtualScan scan = Scanner().Scan({seabed, Placed(mesh, T_W_O)}, T_W_C, seed);
+  return {MakeCloud(scan.points_C), T_W_C.inverse() * T_W_O};
+}
+
+// The segment whose centroid lies nearest the object's true position.
+const RecognizedObject* Nearest(const RecognitionResult& r, const Scan& scan) {
+  const RecognizedObject* best = nullptr;
+  for (const RecognizedObject& o : r.objects) {
+    if (best == nullptr || (o.centroid_S - scan.T_S_O.translation()).norm() <
+                               (best->centroid_S - scan.T_S_O.translation()).norm()) {
+      best = &o;
+    }
+  }
+  return best;
+}
+
+TEST(ObjectRecognition, SameDatabaseAndAnswerForOneAndTwoThreads) {
+  const ObjectDatabase one = Build({"elbow", "tee"}, 1);
+  const ObjectDatabase two = Build({"elbow", "tee"}, 2);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  one.Save(dir / "uwscan_db_1.db");
+  two.Save(dir / "uwscan_db_2.db");
+  auto bytes = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes(dir / "uwscan_db_1.db"), bytes(dir / "uwscan_db_2.db"));
+
+  const Scan scan = ScanOnSeabed(CatalogueObject("tee").mesh, Eigen::Vector3d(-0.3, 0.6, 0.8), 5);
+  RecognitionOptions options;
+  options.threads = 1;
+  const RecognitionResult a = RecognizeObjects(scan.cloud, one, options);
+  options.threads = 2;
+  const RecognitionResult b = RecognizeObjects(scan.cloud, one, options);
+  const RecognitionResult c = RecognizeObjects(scan.cloud, ObjectDatabase::Load(dir / "uwscan_db_2.db"), options);
+  ASSERT_EQ(a.objects.size(), b.objects.size());
+  ASSERT_EQ(a.objects.size(), c.objects.size());
+  for (std::size_t i = 0; i < a.objects.size(); ++i) {
+    EXPECT_EQ(a.objects[i].object_id, b.objects[i].object_id);
+    EXPECT_EQ(a.objects[i].object_id, c.objects[i].object_id);
+    EXPECT_TRUE(a.objects[i].T_S_O.matrix() == b.objects[i].T_S_O.matrix());
+    EXPECT_TRUE(a.objects[i].T_S_O.matrix() == c.objects[i].T_S_O.matrix());
+  }
+}
+
+TEST(ObjectRecognition, AnObjectNotInTheDatabaseIsUnknown) {
+  const Scan elbow = ScanOnSeabed(CatalogueObject("elbow").mesh, Eigen::Vector3d(0.5, 0.2, 0.6), 4);
+  const RecognitionResult r = RecognizeObjects(elbow.cloud, PipeFlangeValveDb());
+  ASSERT_NE(Nearest(r, elbow), nullptr);
+  EXPECT_EQ(Nearest(r, elbow)->object_id, "unknown");
+}
+
+TEST(ObjectDatabaseFile, TruncatedForeignAndNewerFilesGiveOneLineErrors) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const std::filesystem::path good = dir / "uwscan_db_good.db";
+  PipeFlangeValveDb().Save(good);
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes(std::istreambuf_iterator<char>(in), {});
+  auto write = [&](const std::string& name, const std::string& content) {
+    std::ofstream(dir / name, std::ios::binary) << content;
+    return dir / name;
+  };
+  auto message = [](const std::filesystem::path& p) {
+    try {
+      ObjectDatabase::Load(p);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string newer = bytes;
+  newer[9] = 2;
+  const std::string truncated = message(write("uwscan_db_cut.db", bytes.substr(0, bytes.size() / 2)));
+  const std::string foreign = message(write("uwscan_db_foreign.db", "ply\nformat ascii 1.0\n"));
+  const std::string version = message(write("uwscan_db_newer.db", newer));
+  EXPECT_NE(truncated.find("truncated"), std::string::npos) << truncated;
+  EXPECT_NE(foreign.find("not an object database"), std::string::npos) << foreign;
+  EXPECT_NE(version.find("newer"), std::string::npos) << version;
+  for (const std::string& m : {truncated, foreign, version}) {
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+  EXPECT_NO_THROW(ObjectDatabase::Load(good));
+}
+
+TEST(ObjectSymmetry, FoundFromTheMesh) {
+  const std::vector<SymmetryAxis> pipe = DetectSymmetries(CatalogueObject("pipe").mesh);
+  ASSERT_FALSE(pipe.empty());
+  EXPECT_TRUE(pipe[0].continuous());
+  EXPECT_GT(std::abs(pipe[0].axis_O.z()), 0.999);
+  const std::vector<SymmetryAxis> elbow = DetectSymmetries(CatalogueObject("elbow").mesh);
+  ASSERT_EQ(elbow.size(), 1u);
+  EXPECT_EQ(elbow[0].order, 2);
+}
+
+}  // namespace
+}  // namespace uwscan::perception
