@@ -367,6 +367,7 @@ std::optional<AcquiredFrame> FrameSource::Next(std::chrono::milliseconds timeout
     AcquiredFrame frame;
     frame.sequence = m.sequence++;
     frame.frame_id = id;
+    frame.frame_number = step.frame_number;
     frame.lost_before = step.lost_before;
     frame.session = m.session;
     frame.camera_timestamp_ns = arv_buffer_get_timestamp(buffer);

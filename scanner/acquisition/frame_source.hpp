@@ -76,6 +76,7 @@ struct PayloadDescription {
 struct AcquiredFrame {
   std::int64_t sequence = 0;        // frames handed out by this source, 0 first
   std::uint16_t frame_id = 0;       // the camera's 16-bit GigE Vision block id
+  std::int64_t frame_number = 0;    // unwrapped frame id within the session, 0 first
   std::int64_t lost_before = 0;     // frames the camera sent that never came, just before this
   int session = 0;                  // how many times the camera was reopened before this frame
   std::uint64_t camera_timestamp_ns = 0;  // the camera's clock
