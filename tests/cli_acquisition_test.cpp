@@ -246,7 +246,8 @@ TEST(CliAcquisition, ACameraThatDiesIsReopenedAndTheGapReported) {
   Background acquire({"acquire", "--camera", "127.0.0.1", "-o", log.string(), "--seconds", "5", "--scene", scene,
                       "--watchdog-s", "0.5", "--json", json.string()},
                      TempPath("gap_acquire.log"));
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  ASSERT_TRUE(acquire.WaitFor("profile mode", 20.0)) << acquire.Output();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
   camera->Signal(SIGKILL);
   camera->Wait();
   const std::int64_t before = uwscan::mapping::DiveLogReader(log).frame_count();
@@ -258,9 +259,8 @@ TEST(CliAcquisition, ACameraThatDiesIsReopenedAndTheGapReported) {
   ASSERT_EQ(j["gaps"].size(), 1u) << acquire.Output();
   const double silent = j["gaps"][0]["silent_after_s"].get<double>();
   const double resumed = j["gaps"][0]["resumed_at_s"].get<double>();
-  EXPECT_GT(silent, 1.0);
-  EXPECT_LT(silent, 2.0);
-  EXPECT_GT(resumed, silent + 0.8);
+  EXPECT_GT(silent, 0.5);  // frames for about a second, then nothing
+  EXPECT_GT(resumed, silent + 0.9) << "the camera was away for a second at least";
   EXPECT_NE(acquire.Output().find("camera silent after"), std::string::npos) << acquire.Output();
   const uwscan::mapping::DiveLogReader reader(log);
   EXPECT_EQ(reader.frame_count(), j["frames"].get<std::int64_t>());
