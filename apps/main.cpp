@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "apps/accuracy_command.hpp"
+#include "apps/acquisition_bench_command.hpp"
 #include "apps/acquisition_commands.hpp"
 #include "apps/bench_commands.hpp"
 #include "apps/calibrate_command.hpp"
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddKernelsCommand(*bench);
   uwscan::app::AddSlamBenchCommand(*bench);
   uwscan::app::AddViewerBenchCommand(*bench);
+  uwscan::app::AddAcquisitionBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);
