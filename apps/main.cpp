@@ -5,6 +5,8 @@
 #include <exception>
 
 #include "apps/accuracy_command.hpp"
+#include "apps/acquisition_bench_command.hpp"
+#include "apps/acquisition_commands.hpp"
 #include "apps/bench_commands.hpp"
 #include "apps/calibrate_command.hpp"
 #include "apps/calibration_bench_command.hpp"
@@ -41,6 +43,8 @@ int main(int argc, char** argv) {
   uwscan::app::AddViewCommand(app);
   uwscan::app::AddPlotCommand(app);
   uwscan::app::AddReportCommand(app);
+  uwscan::app::AddFakeCameraCommand(app);
+  uwscan::app::AddAcquireCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);
@@ -53,6 +57,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddSlamBenchCommand(*bench);
   uwscan::app::AddRecognitionBenchCommand(*bench);
   uwscan::app::AddViewerBenchCommand(*bench);
+  uwscan::app::AddAcquisitionBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);

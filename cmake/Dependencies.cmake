@@ -45,3 +45,7 @@ find_package(VTK 9.1 REQUIRED COMPONENTS
   InteractionStyle ChartsCore RenderingContext2D RenderingContextOpenGL2 ViewsContext2D)
 find_package(X11 REQUIRED)
 find_package(Threads REQUIRED)
+
+# GenICam cameras (scanner/acquisition, the one part that links Aravis): Debian's aravis-0.8.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(Aravis REQUIRED IMPORTED_TARGET aravis-0.8)

@@ -1,0 +1,197 @@
+#include "apps/acquisition_bench_command.hpp"
+
+#include <sched.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "apps/json_output.hpp"
+#include "scanner/acquisition/fake_camera.hpp"
+#include "scanner/acquisition/frame_source.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/sim/scene.hpp"
+#include "scanner/sim/simulator.hpp"
+#include "scanner/stripe/stripe_detector.hpp"
+
+namespace uwscan::app {
+namespace {
+
+namespace acq = scanner::acquisition;
+
+struct AcquisitionBenchArgs {
+  std::string json;
+  double seconds = 4.0;
+  std::string profile_scene = "data/scenes/default.yaml";
+  std::string image_scene = "data/scenes/camera_image.yaml";
+};
+
+struct StreamFigures {
+  double requested_fps = 0.0;
+  double frames_per_s = 0.0;
+  double mb_per_s = 0.0;
+  std::int64_t frames = 0;
+  std::int64_t lost_frames = 0;
+  double latency_s = 0.0;  // median, capture (camera clock) to peaks on the host
+};
+
+std::uint64_t RealTimeNs() {
+  timespec t{};
+  clock_gettime(CLOCK_REALTIME, &t);
+  return static_cast<std::uint64_t>(t.tv_sec) * 1000000000ull + static_cast<std::uint64_t>(t.tv_nsec);
+}
+
+// Streams `seconds` from the fake camera on 127.0.0.1 and decodes (profile) or detects (image)
+// every frame, as `acquire` does, without the disk.
+StreamFigures Stream(const scanner::sim::Simulator& simulator, acq::FakeCameraMode mode, double fps,
+                     double seconds) {
+  acq::FakeCameraOptions options;
+  options.mode = mode;
+  options.frame_rate_hz = fps;
+  acq::FakeCamera camera(simulator, options);
+  acq::CameraSettings settings;
+  settings.buffers = 256;
+  acq::FrameSource source(settings);
+  scanner::StripeDetector detector(simulator.scene().detector);
+  std::vector<double> latencies;
+  source.Start();
+  while (source.ElapsedSeconds() < seconds) {
+    std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
+    if (!frame) continue;
+    std::size_t peaks = 0;
+    if (source.payload().profile) {
+      if (auto d = acq::DecodeProfile(source.payload().profile_layout, frame->payload)) peaks = d->peaks_px.size();
+    } else if (auto d = acq::DecodeImage(source.payload().image_layout, frame->payload)) {
+      peaks = detector.Detect(d->image).peaks.size();
+    }
+    if (peaks > 0) latencies.push_back((static_cast<double>(RealTimeNs()) - static_cast<double>(frame->camera_timestamp_ns)) * 1e-9);
+  }
+  const double elapsed = source.ElapsedSeconds();
+  source.Stop();
+  const acq::FrameSourceStatistics s = source.statistics();
+  StreamFigures f;
+  f.requested_fps = camera.frame_rate_hz();
+  f.frames = s.frames;
+  f.frames_per_s = s.frames / elapsed;
+  f.mb_per_s = s.bytes / elapsed * 1e-6;
+  f.lost_frames = s.lost_frames;
+  if (!latencies.empty()) {
+    std::nth_element(latencies.begin(), latencies.begin() + latencies.size() / 2, latencies.end());
+    f.latency_s = latencies[latencies.size() / 2];
+  }
+  return f;
+}
+
+// Aravis's own arv-camera-test-0.8 on the same fake camera: its mean frames/s after the first
+// second (it prints one rate a second).
+double PeerFramesPerSecond(const scanner::sim::Simulator& simulator, acq::FakeCameraMode mode, double fps,
+                           double seconds) {
+  acq::FakeCameraOptions options;
+  options.mode = mode;
+  options.frame_rate_hz = fps;
+  acq::FakeCamera camera(simulator, options);
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%.0f", camera.frame_rate_hz());
+  const std::string command = "timeout -s INT " + std::to_string(static_cast<int>(std::ceil(seconds)) + 1) +
+                              " arv-camera-test-0.8 -n 127.0.0.1 -f " + rate + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) throw Error("bench acquisition: cannot run arv-camera-test-0.8 (package aravis-tools)");
+  std::string output;
+  char buffer[4096];
+  while (std::size_t n = fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, n);
+  pclose(pipe);
+  const std::regex line(R"((\d+) frames/s)");
+  std::vector<double> rates;
+  for (auto it = std::sregex_iterator(output.begin(), output.end(), line); it != std::sregex_iterator(); ++it) {
+    rates.push_back(std::stod((*it)[1].str()));
+  }
+  if (rates.size() < 2) throw Error("bench acquisition: arv-camera-test-0.8 reported no frame rate:\n" + output);
+  double sum = 0.0;
+  for (std::size_t i = 1; i < rates.size(); ++i) sum += rates[i];
+  return sum / static_cast<double>(rates.size() - 1);
+}
+
+nlohmann::json ToJson(const StreamFigures& f) {
+  return {{"requested_frames_per_s", f.requested_fps}, {"frames_per_s", f.frames_per_s}, {"mb_per_s", f.mb_per_s},
+          {"frames", f.frames}, {"lost_frames", f.lost_frames}, {"latency_s", f.latency_s}};
+}
+
+void Print(const char* name, const StreamFigures& f) {
+  std::printf("%-16s asked %6.0f frames/s: got %7.1f frames/s, %7.2f MB/s, %lld lost of %lld, latency %.2f ms\n",
+              name, f.requested_fps, f.frames_per_s, f.mb_per_s, static_cast<long long>(f.lost_frames),
+              static_cast<long long>(f.frames + f.lost_frames), f.latency_s * 1e3);
+}
+
+void RunAcquisitionBench(const AcquisitionBenchArgs& a) {
+  if (!(a.seconds >= 2.0 && a.seconds <= 600.0)) throw Error("--seconds must be in [2, 600]");
+  // A private network namespace (root only): nothing leaves the machine and nothing else on
+  // this host's loopback competes. Must come before any thread is started.
+  bool private_network = false;
+  if (unshare(CLONE_NEWNET) == 0) {
+    private_network = std::system("ip link set lo up") == 0;
+    if (!private_network) throw Error("bench acquisition: cannot bring lo up in the private network namespace");
+  }
+  std::printf("bench acquisition: %s, %.0f s per run\n",
+              private_network ? "private network namespace (lo only)" : "this host's loopback (not root: no private namespace)",
+              a.seconds);
+  const scanner::sim::Scene profile_scene = scanner::sim::LoadScene(a.profile_scene);
+  const scanner::sim::Simulator profile_sim(profile_scene);
+  const scanner::sim::Scene image_scene = scanner::sim::LoadScene(a.image_scene);
+  const scanner::sim::Simulator image_sim(image_scene);
+
+  const StreamFigures profile = Stream(profile_sim, acq::FakeCameraMode::kProfile, 339.0, a.seconds);
+  Print("profile", profile);
+  const StreamFigures ceiling = Stream(profile_sim, acq::FakeCameraMode::kProfile, 1000.0, a.seconds);
+  Print("profile ceiling", ceiling);
+  const StreamFigures image = Stream(image_sim, acq::FakeCameraMode::kImage, 60.0, a.seconds);
+  Print("image 2048x1088", image);
+  const StreamFigures image_ceiling = Stream(image_sim, acq::FakeCameraMode::kImage, 1000.0, a.seconds);
+  Print("image ceiling", image_ceiling);
+  const double peer_profile = PeerFramesPerSecond(profile_sim, acq::FakeCameraMode::kProfile, 1000.0, a.seconds);
+  const double peer_image = PeerFramesPerSecond(image_sim, acq::FakeCameraMode::kImage, 1000.0, a.seconds);
+  std::printf("peer arv-camera-test-0.8 at the ceilings: profile %.1f frames/s (uwscan %.2fx), image %.1f frames/s "
+              "(uwscan %.2fx)\n",
+              peer_profile, ceiling.frames_per_s / peer_profile, peer_image, image_ceiling.frames_per_s / peer_image);
+  std::printf("latency: capture (camera clock) to peaks on the host, median; not to the map (`inspect` is not built)\n");
+  if (!a.json.empty()) {
+    nlohmann::json profile_json = ToJson(profile);
+    profile_json["ceiling"] = ToJson(ceiling);
+    nlohmann::json image_json = ToJson(image);
+    image_json["ceiling"] = ToJson(image_ceiling);
+    WriteJsonFile(a.json, {{"profile", profile_json},
+                           {"image", image_json},
+                           {"peer", {{"tool", "arv-camera-test-0.8"},
+                                     {"profile_frames_per_s", peer_profile},
+                                     {"image_frames_per_s", peer_image},
+                                     {"profile_ratio", ceiling.frames_per_s / peer_profile},
+                                     {"image_ratio", image_ceiling.frames_per_s / peer_image}}},
+                           {"latency_measured_to", "peaks on the host (decoded profile or detected image)"},
+                           {"private_network_namespace", private_network},
+                           {"seconds_per_run", a.seconds}});
+  }
+}
+
+}  // namespace
+
+void AddAcquisitionBenchCommand(CLI::App& bench) {
+  auto args = std::make_shared<AcquisitionBenchArgs>();
+  CLI::App* cmd = bench.add_subcommand(
+      "acquisition", "frames/s, MB/s, lost frames and latency from the GigE Vision fake camera on loopback, "
+                     "profile and image mode, with arv-camera-test-0.8 as the peer");
+  cmd->add_option("--json", args->json, "write the figures as JSON");
+  cmd->add_option("--seconds", args->seconds, "seconds per run")->capture_default_str();
+  cmd->add_option("--profile-scene", args->profile_scene, "scene served in profile mode")
+      ->capture_default_str()->check(CLI::ExistingFile);
+  cmd->add_option("--image-scene", args->image_scene, "scene served in image mode (renders frames)")
+      ->capture_default_str()->check(CLI::ExistingFile);
+  cmd->callback([args] { RunAcquisitionBench(*args); });
+}
+
+}  // namespace uwscan::app
