@@ -1,4 +1,5 @@
 #include "apps/acquisition_commands.hpp"
+#include "apps/text_file.hpp"
 
 #include <signal.h>
 #include <unistd.h>
@@ -42,14 +43,6 @@ void InstallStopHandlers() {
   sigaction(SIGTERM, &action, nullptr);
 }
 bool StopRequested() { return g_stop_signal.load() != 0; }
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // --------------------------------------------------------------------------------------------
 struct FakeCameraArgs {

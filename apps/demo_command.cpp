@@ -9,6 +9,7 @@
 
 #include "apps/data_cache.hpp"
 #include "apps/progress_bar.hpp"
+#include "apps/text_file.hpp"
 #include "bench/scratch_folder.hpp"
 #include "mapping/dive_log.hpp"
 #include "mapping/dive_simulation.hpp"
@@ -40,14 +41,6 @@ void WriteDemoScreenshot(const std::filesystem::path& log, const std::string& pn
   const viewer::PictureInfo info = viewer::SaveScreenshot(scene, render, png);
   std::printf("\n%s: the reconstructed scene, %zu points coloured by error against truth (%.3g .. %.3g mm)\n",
               png.c_str(), info.points_drawn, info.range->lo * 1e3, info.range->hi * 1e3);
-}
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 void RunDemo(const DemoArgs& a) {

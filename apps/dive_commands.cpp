@@ -9,6 +9,7 @@
 #include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
 #include "apps/progress_bar.hpp"
+#include "apps/text_file.hpp"
 #include "mapping/dive_log.hpp"
 #include "mapping/dive_simulation.hpp"
 #include "mapping/reconstruction.hpp"
@@ -23,14 +24,6 @@
 
 namespace uwscan::app {
 namespace {
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 void RequireWritableFolder(const std::string& path, const char* option) {
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();

@@ -114,11 +114,10 @@ std::vector<SymmetryAxis> DetectSymmetries(const scanner::TriangleMesh& mesh,
       if (axis.order == 0) continue;
     }
     axis.point_O = centroid;
-    // A continuous axis makes every perpendicular N-fold axis redundant with the other found.
+    // Redundant axes (a pipe's two perpendicular 2-fold flips) are kept: SymmetryTransforms
+    // then lists some poses twice, which costs time, not correctness.
     found.push_back(axis);
   }
-  // Two continuous axes only happen for a sphere-like surface: keep them, SymmetryTransforms
-  // then covers the rotations about both.
   return found;
 }
 
