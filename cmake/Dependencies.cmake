@@ -33,8 +33,10 @@ find_package(assimp REQUIRED)
 # Ray casting in the simulator (scanner/sim).
 find_package(embree 3 REQUIRED)
 
-# Dive logs (mapping/dive_log).
+# Dive logs (mapping/dive_log), with a checksum per column of every row (xxHash's XXH3).
 find_package(SQLite3 REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(xxhash REQUIRED IMPORTED_TARGET libxxhash)
 
 # The viewer (viewer/), the one module that links VTK: component targets only, never
 # ${VTK_LIBRARIES} (DESIGN.md, "Known traps"). X11 checks that a display answers before VTK

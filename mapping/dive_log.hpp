@@ -19,7 +19,7 @@
 namespace uwscan::mapping {
 
 // The schema this uwscan writes and the newest it reads; it also reads every older one.
-inline constexpr int kDiveLogSchemaVersion = 2;
+inline constexpr int kDiveLogSchemaVersion = 3;
 inline constexpr int kOldestDiveLogSchemaVersion = 1;
 
 enum class LogPixelFormat : std::uint8_t { kMono8 = 0, kMono16 = 1 };
@@ -124,6 +124,26 @@ class DiveLogWriter {
   std::unique_ptr<Impl> impl_;
 };
 
+// A damaged row that DiveLogReader::Check found.
+struct DiveLogDamage {
+  std::string table;      // "frames" (a frame or its ground truth), "navigation", "header", "file"
+  std::int64_t row = -1;  // the frame index or the navigation sample's nav_id; -1: not a row
+  std::string message;    // what the reader said, naming the file, the row and the column
+};
+
+// What DiveLogReader::Check found in a whole log.
+struct DiveLogCheck {
+  int schema_version = 0;
+  bool checksummed = false;            // schema version 3 on: every value verified
+  std::vector<std::string> integrity;  // SQLite's quick_check findings (empty: none)
+  std::int64_t frames = 0;             // rows of the frames table, and how many are intact
+  std::int64_t frames_intact = 0;      // (with their ground truth, when they have one)
+  std::int64_t navigation = 0;
+  std::int64_t navigation_intact = 0;
+  std::vector<DiveLogDamage> damage;
+  bool ok() const { return integrity.empty() && damage.empty(); }
+};
+
 // Reads a dive log, read-only. Works on a log whose writer is still appending (in this or
 // another process: each call sees what was committed when it starts) and on a log whose writer
 // was killed (every committed frame is there). Not thread-safe: one thread at a time.
@@ -161,6 +181,13 @@ class DiveLogReader {
 
   // Every navigation sample, in time order (append order among equal times).
   std::vector<NavigationRecord> ReadNavigation() const;
+
+  // Reads every row of the log, going on past damaged ones, and runs SQLite's quick_check:
+  // `frame` is called for each intact frame in index order (with its ground truth, or nullptr),
+  // `navigation` for each intact sample in nav_id order; either may be empty. A frame whose
+  // ground truth is damaged counts as damaged. Throws only when the file cannot be read at all.
+  DiveLogCheck Check(const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
+                     const std::function<void(const NavigationRecord&)>& navigation) const;
 
   const std::filesystem::path& path() const;
 

@@ -29,9 +29,11 @@ TEST_F(DiveLogTest, ReaderNamesTheFileAndWhatIsWrong) {
   expect(other, "not a uwscan dive log");
 
   const fs::path newer = WriteLog("newer.uwlog", 2, 3);
-  RawExec(newer, "UPDATE meta SET value = 3 WHERE key = 'schema_version'");
+  const int next = kDiveLogSchemaVersion + 1;
+  RawExec(newer, "UPDATE meta SET value = " + std::to_string(next) + " WHERE key = 'schema_version'");
   const std::string message = MessageOf([&] { DiveLogReader reader(newer); });
-  EXPECT_EQ(message, "dive log '" + newer.string() + "' has schema version 3, this uwscan reads 1 to 2");
+  EXPECT_EQ(message, "dive log '" + newer.string() + "' has schema version " + std::to_string(next) +
+                         ", this uwscan reads 1 to " + std::to_string(kDiveLogSchemaVersion));
 
   const fs::path no_noise = WriteLog("no_noise.uwlog", 2, 3);
   RawExec(no_noise, "DROP TABLE navigation_noise");

@@ -18,19 +18,29 @@ using sqlite::ResetOnExit;
 using sqlite::Row;
 using sqlite::Statement;
 
-// Selected by every frame query and decoded by DecodeFrame, in this order.
-constexpr const char* kFrameColumns =
-    "f.frame_index, f.time_s, f.command, f.sweep, f.peaks_px, f.image_width_px, "
-    "f.image_height_px, f.image_format, f.image";
-constexpr int kNumFrameColumns = 9;
-// Selected by ground truth queries and decoded by DecodeTruth, in this order.
-constexpr const char* kTruthColumns =
-    "g.frame_index IS NOT NULL, g.T_W_C_tx, g.T_W_C_ty, g.T_W_C_tz, g.T_W_C_qx, g.T_W_C_qy, "
-    "g.T_W_C_qz, g.T_W_C_qw, g.points_W, g.object_ids";
+// A table's checksums column, or NULL in a log older than the checksums.
+std::string Checksums(const char* table, bool checksummed) {
+  return checksummed ? std::string(table) + ".checksums" : std::string("NULL");
+}
+
+// Selected by every frame query and decoded by DecodeFrame, in this order: the columns the
+// checksums cover (dive_log_format.hpp), then the checksums.
+std::string FrameColumns(bool checksummed) {
+  return "f.frame_index, f.time_s, f.command, f.sweep, f.peaks_px, f.image_width_px, "
+         "f.image_height_px, f.image_format, f.image, " + Checksums("f", checksummed);
+}
+constexpr int kNumFrameColumns = 10;
+// Selected by ground truth queries and decoded by DecodeTruth, in this order (frame_index is
+// NULL when the frame has no ground truth).
+std::string TruthColumns(bool checksummed) {
+  return "g.frame_index, g.T_W_C_tx, g.T_W_C_ty, g.T_W_C_tz, g.T_W_C_qx, g.T_W_C_qy, "
+         "g.T_W_C_qz, g.T_W_C_qw, g.points_W, g.object_ids, " + Checksums("g", checksummed);
+}
 
 
-// kFrameColumns from column 0; the row's context names the frame.
-FrameRecord DecodeFrame(const Row& row, std::int64_t index) {
+// FrameColumns from column 0; the row's context names the frame.
+FrameRecord DecodeFrame(const Row& row, std::int64_t index, bool checksummed) {
+  if (checksummed) row.VerifyChecksums(0, kNumFrameColumns - 1, kNumFrameColumns - 1);
   FrameRecord frame;
   frame.index = index;
   frame.time_s = row.Real(1);
@@ -56,9 +66,11 @@ FrameRecord DecodeFrame(const Row& row, std::int64_t index) {
   return frame;
 }
 
-// kTruthColumns from column `first`; nullopt when the frame has no ground truth.
-std::optional<GroundTruthRecord> DecodeTruth(const Row& row, int first, std::size_t num_peaks) {
-  if (row.Integer(first) == 0) return std::nullopt;
+// TruthColumns from column `first`; nullopt when the frame has no ground truth.
+std::optional<GroundTruthRecord> DecodeTruth(const Row& row, int first, std::size_t num_peaks,
+                                             bool checksummed) {
+  if (row.IsNull(first)) return std::nullopt;
+  if (checksummed) row.VerifyChecksums(first, 10, first + 10);
   GroundTruthRecord truth;
   truth.T_W_C = row.Pose(first + 1);
   truth.points_W = row.Items<Eigen::Vector3d, double>(first + 8, std::int64_t(num_peaks));
@@ -74,6 +86,15 @@ struct DiveLogReader::Impl {
   sqlite::Db db;
   DiveLogHeader header;
   Statement frame_by_index, truth_by_index, last_index, mount, navigation;
+
+  bool checksummed() const { return header.schema_version >= kFirstChecksummedVersion; }
+
+  // The header's columns in the order of kHeaderChecksumColumns, then the checksums.
+  Statement SelectHeader() const {
+    return Prepare(std::string("SELECT ") + kHeaderChecksumColumns + ", " +
+                       Checksums("header", checksummed()) + " FROM header",
+                   0);
+  }
 
   // Prepared at open, so that a table or column missing from the file shows there.
   Statement Prepare(const std::string& sql, unsigned flags = SQLITE_PREPARE_PERSISTENT) const {
@@ -121,14 +142,12 @@ struct DiveLogReader::Impl {
   }
 
   void ReadHeader() {
-    Statement head = Prepare(
-        "SELECT scanner_kind, scanner_yaml, scan_pattern_yaml, scene_yaml, created_utc, producer "
-        "FROM header",
-        0);
+    Statement head = SelectHeader();
     int rc = sqlite3_step(head.get());
     if (rc == SQLITE_DONE) throw Error(name + ": table header is empty");
     if (rc != SQLITE_ROW) sqlite::Fail(name, "cannot read the header", db.get());
     const Row row(head.get(), name, "table header");
+    if (checksummed()) row.VerifyChecksums(0, kNumHeaderChecksumColumns, kNumHeaderChecksumColumns);
     // Parsed here, once: the rest of uwscan takes the scanner and the pattern as values.
     const std::string kind = row.Text(0);
     header.scanner = scanner::ParseScanner(row.Text(1), name + ", header.scanner_yaml");
@@ -148,14 +167,15 @@ struct DiveLogReader::Impl {
 
   // Version 2 on: the navigation's noise model, when the writer had one.
   void ReadNavigationNoise() {
-    Statement select = Prepare(
-        "SELECT position_walk_m_per_sqrt_s, heading_walk_rad_per_sqrt_s, speed_scale_sigma, "
-        "heading_bias_sigma_rad, depth_sigma_m, roll_pitch_sigma_rad FROM navigation_noise",
-        0);
+    Statement select = Prepare(std::string("SELECT ") + kNoiseChecksumColumns + ", " +
+                                   Checksums("navigation_noise", checksummed()) +
+                                   " FROM navigation_noise",
+                               0);
     const int rc = sqlite3_step(select.get());
     if (rc == SQLITE_DONE) return;
     if (rc != SQLITE_ROW) sqlite::Fail(name, "cannot read the navigation noise", db.get());
     const Row row(select.get(), name, "table navigation_noise");
+    if (checksummed()) row.VerifyChecksums(0, kNumNoiseChecksumColumns, kNumNoiseChecksumColumns);
     NavigationNoise noise;
     noise.position_walk_m_per_sqrt_s = row.Real(0);
     noise.heading_walk_rad_per_sqrt_s = row.Real(1);
@@ -208,19 +228,19 @@ DiveLogReader::DiveLogReader(const std::filesystem::path& path) : impl_(std::mak
   r.ReadHeader();
   if (r.header.schema_version >= 2) r.ReadNavigationNoise();
 
-  r.frame_by_index =
-      r.Prepare(std::string("SELECT ") + kFrameColumns + " FROM frames f WHERE f.frame_index = ?");
+  const bool checksummed = r.checksummed();
+  r.frame_by_index = r.Prepare("SELECT " + FrameColumns(checksummed) +
+                               " FROM frames f WHERE f.frame_index = ?");
   // length() reads a blob's size from the record header, without reading the blob.
-  r.truth_by_index = r.Prepare(std::string("SELECT length(f.peaks_px), ") + kTruthColumns +
+  r.truth_by_index = r.Prepare("SELECT length(f.peaks_px), " + TruthColumns(checksummed) +
                                " FROM frames f LEFT JOIN ground_truth g"
                                " ON g.frame_index = f.frame_index WHERE f.frame_index = ?");
   // The largest primary key is found without a scan; indices run from 0 without gaps.
   r.last_index = r.Prepare("SELECT max(frame_index) FROM frames");
-  r.mount = r.Prepare(
-      "SELECT T_V_C_tx, T_V_C_ty, T_V_C_tz, T_V_C_qx, T_V_C_qy, T_V_C_qz, T_V_C_qw FROM header");
+  r.mount = r.SelectHeader();
   r.navigation = r.Prepare(
       "SELECT nav_id, time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, T_W_V_qz, "
-      "T_W_V_qw FROM navigation ORDER BY time_s, nav_id");
+      "T_W_V_qw, " + Checksums("navigation", checksummed) + " FROM navigation ORDER BY time_s, nav_id");
 }
 
 DiveLogReader::~DiveLogReader() = default;
@@ -236,8 +256,10 @@ std::optional<Eigen::Isometry3d> DiveLogReader::vehicle_mount() const {
   if (sqlite3_step(s) != SQLITE_ROW)
     sqlite::Fail(r.name, "cannot read the vehicle mount", r.db.get());
   const Row row(s, r.name, "table header");
-  for (int i = 0; i < 7; ++i) {
-    if (!row.IsNull(i)) return row.Pose(0);
+  if (r.checksummed()) row.VerifyChecksums(0, kNumHeaderChecksumColumns, kNumHeaderChecksumColumns);
+  constexpr int kMount = 6;  // T_V_C_tx in kHeaderChecksumColumns
+  for (int i = kMount; i < kMount + 7; ++i) {
+    if (!row.IsNull(i)) return row.Pose(kMount);
   }
   return std::nullopt;
 }
@@ -258,7 +280,7 @@ FrameRecord DiveLogReader::ReadFrame(std::int64_t index) const {
     ResetOnExit reset(s);
     sqlite3_bind_int64(s, 1, index);
     const int rc = sqlite3_step(s);
-    if (rc == SQLITE_ROW) return DecodeFrame(Row(s, r.name, FrameName(index)), index);
+    if (rc == SQLITE_ROW) return DecodeFrame(Row(s, r.name, FrameName(index)), index, r.checksummed());
     if (rc != SQLITE_DONE) sqlite::Fail(r.name, "cannot read " + FrameName(index), r.db.get());
   }
   r.NoSuchFrame(index, frame_count());
@@ -277,7 +299,7 @@ std::optional<GroundTruthRecord> DiveLogReader::ReadGroundTruth(std::int64_t ind
       if (peak_bytes % std::int64_t{sizeof(Eigen::Vector2d)} != 0) {
         row.Corrupt(0, "is " + std::to_string(peak_bytes) + ", not a multiple of 16");
       }
-      return DecodeTruth(row, 1, std::size_t(peak_bytes) / sizeof(Eigen::Vector2d));
+      return DecodeTruth(row, 1, std::size_t(peak_bytes) / sizeof(Eigen::Vector2d), r.checksummed());
     }
     if (rc != SQLITE_DONE) {
       sqlite::Fail(r.name, "cannot read the ground truth of " + FrameName(index), r.db.get());
@@ -291,11 +313,12 @@ void DiveLogReader::ForEachFrame(
     bool with_truth) const {
   const Impl& r = *impl_;
   // A statement of its own, so that `visit` may call any reader method, this one included.
+  const bool checksummed = r.checksummed();
   const std::string sql =
-      with_truth ? std::string("SELECT ") + kFrameColumns + ", " + kTruthColumns +
+      with_truth ? "SELECT " + FrameColumns(checksummed) + ", " + TruthColumns(checksummed) +
                        " FROM frames f LEFT JOIN ground_truth g USING (frame_index)"
                        " ORDER BY f.frame_index"
-                 : std::string("SELECT ") + kFrameColumns + " FROM frames f ORDER BY f.frame_index";
+                 : "SELECT " + FrameColumns(checksummed) + " FROM frames f ORDER BY f.frame_index";
   const Statement statement = r.Prepare(sql, 0);
   sqlite3_stmt* s = statement.get();
   std::int64_t expected = 0;
@@ -307,10 +330,10 @@ void DiveLogReader::ForEachFrame(
       throw Error(r.name + ": " + FrameName(expected) + " is missing (the next is " +
                   std::to_string(index) + ")");
     }
-    const FrameRecord frame = DecodeFrame(row, index);
+    const FrameRecord frame = DecodeFrame(row, index, checksummed);
     if (with_truth) {
       const std::optional<GroundTruthRecord> truth =
-          DecodeTruth(row, kNumFrameColumns, frame.peaks_px.size());
+          DecodeTruth(row, kNumFrameColumns, frame.peaks_px.size(), checksummed);
       visit(frame, truth ? &*truth : nullptr);
     } else {
       visit(frame, nullptr);
@@ -328,10 +351,113 @@ std::vector<NavigationRecord> DiveLogReader::ReadNavigation() const {
   int rc;
   while ((rc = sqlite3_step(s)) == SQLITE_ROW) {
     const Row row(s, r.name, "navigation sample " + std::to_string(sqlite3_column_int64(s, 0)));
+    if (r.checksummed()) row.VerifyChecksums(1, 8, 9);
     samples.push_back({row.Real(1), row.Pose(2)});
   }
   if (rc != SQLITE_DONE) sqlite::Fail(r.name, "cannot read the navigation", r.db.get());
   return samples;
+}
+
+namespace {
+
+// Runs a read-only statement, handing each row's column 0 as an integer to `row`; returns
+// SQLite's message when stepping fails half-way ("" when it ends cleanly).
+std::string ForEachInteger(sqlite3* db, const std::string& sql, const std::function<void(std::int64_t)>& row) {
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) return sqlite3_errmsg(db);
+  const Statement statement(raw);
+  int rc;
+  while ((rc = sqlite3_step(raw)) == SQLITE_ROW) row(sqlite3_column_int64(raw, 0));
+  return rc == SQLITE_DONE ? std::string() : std::string(sqlite3_errmsg(db));
+}
+
+}  // namespace
+
+DiveLogCheck DiveLogReader::Check(
+    const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
+    const std::function<void(const NavigationRecord&)>& navigation) const {
+  const Impl& r = *impl_;
+  DiveLogCheck check;
+  check.schema_version = r.header.schema_version;
+  check.checksummed = r.checksummed();
+
+  // SQLite's own check of the file's structure (pages, b-trees), without the index cross-checks.
+  {
+    sqlite3_stmt* raw = nullptr;
+    if (sqlite3_prepare_v2(r.db.get(), "PRAGMA quick_check(20)", -1, &raw, nullptr) != SQLITE_OK) {
+      check.integrity.push_back(sqlite3_errmsg(r.db.get()));
+    }
+    const Statement statement(raw);
+    int rc = SQLITE_DONE;
+    while (raw && (rc = sqlite3_step(raw)) == SQLITE_ROW) {
+      const auto* text = reinterpret_cast<const char*>(sqlite3_column_text(raw, 0));
+      const std::string line = text ? text : "?";
+      if (line != "ok") check.integrity.push_back(line);
+    }
+    if (raw && rc != SQLITE_DONE) check.integrity.push_back(sqlite3_errmsg(r.db.get()));
+  }
+  auto damaged = [&](const std::string& table, std::int64_t row, const std::string& message) {
+    check.damage.push_back({table, row, message});
+  };
+
+  try {
+    vehicle_mount();
+  } catch (const Error& e) {
+    damaged("header", -1, e.what());
+  }
+
+  // Frames one by one through the primary key, so that a damaged page costs only its rows.
+  std::vector<std::int64_t> indices;
+  const std::string listing =
+      ForEachInteger(r.db.get(), "SELECT frame_index FROM frames ORDER BY frame_index",
+                     [&](std::int64_t index) { indices.push_back(index); });
+  if (!listing.empty()) {
+    damaged("file", -1, r.name + ": cannot list the frames past " + std::to_string(indices.size()) +
+                            " (" + listing + ")");
+  }
+  check.frames = static_cast<std::int64_t>(indices.size());
+  std::int64_t expected = 0;
+  for (std::int64_t index : indices) {
+    for (; expected < index; ++expected) {
+      damaged("frames", expected, r.name + ": " + FrameName(expected) + " is missing");
+    }
+    expected = index + 1;
+    try {
+      const FrameRecord record = ReadFrame(index);
+      const std::optional<GroundTruthRecord> truth = ReadGroundTruth(index);
+      ++check.frames_intact;
+      if (frame) frame(record, truth ? &*truth : nullptr);
+    } catch (const Error& e) {
+      damaged("frames", index, e.what());
+    }
+  }
+
+  // Navigation: row by row, in the order it was appended.
+  const bool checksummed = r.checksummed();
+  const Statement statement = r.Prepare(
+      "SELECT nav_id, time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, T_W_V_qz, "
+      "T_W_V_qw, " + Checksums("navigation", checksummed) + " FROM navigation ORDER BY nav_id", 0);
+  sqlite3_stmt* s = statement.get();
+  int rc;
+  while ((rc = sqlite3_step(s)) == SQLITE_ROW) {
+    ++check.navigation;
+    const std::int64_t nav_id = sqlite3_column_int64(s, 0);
+    try {
+      const Row row(s, r.name, "navigation sample " + std::to_string(nav_id));
+      if (checksummed) row.VerifyChecksums(1, 8, 9);
+      const NavigationRecord record{row.Real(1), row.Pose(2)};
+      ++check.navigation_intact;
+      if (navigation) navigation(record);
+    } catch (const Error& e) {
+      damaged("navigation", nav_id, e.what());
+    }
+  }
+  if (rc != SQLITE_DONE) {
+    damaged("file", -1, r.name + ": cannot read the navigation past " +
+                            std::to_string(check.navigation) + " samples (" +
+                            sqlite3_errmsg(r.db.get()) + ")");
+  }
+  return check;
 }
 
 const std::filesystem::path& DiveLogReader::path() const { return impl_->path; }

@@ -12,6 +12,7 @@
 
 #include "mapping/dive_log.hpp"
 #include "mapping/dive_log_format.hpp"
+#include "mapping/row_checksums.hpp"
 #include "mapping/sqlite_db.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/scanner_file.hpp"
@@ -76,7 +77,9 @@ struct DiveLogWriter::Impl {
   sqlite::Db db;
   Statement begin, commit, rollback, insert_frame, insert_truth, insert_navigation, update_mount;
   std::int64_t frame_count = 0;
-  std::vector<std::uint8_t> scratch[4];  // byte-swapped blobs on big-endian hosts only
+  std::vector<std::uint8_t> scratch[4];
+  // The header's text columns, kept for the checksums of a vehicle mount stored later.
+  std::vector<std::string> header_texts;  // byte-swapped blobs on big-endian hosts only
 
   // A finished log goes back to a rollback journal, which checkpoints (syncing everything)
   // and removes the WAL: it is then one self-contained file that read-only connections open
@@ -135,34 +138,48 @@ struct DiveLogWriter::Impl {
     sqlite::StepDone(handle, meta.get(), name, "cannot write the schema version");
     Statement head = Prepare(
         "INSERT INTO header (id, scanner_kind, scanner_yaml, scan_pattern_yaml, scene_yaml, "
-        "created_utc, producer) VALUES (1, ?, ?, ?, ?, ?, ?)");
-    const std::string created_utc = UtcNow();
-    const std::string kind = scanner::ToString(header.scanner.kind());
-    const std::string scanner_yaml = scanner::ScannerToYaml(header.scanner);
-    const std::string pattern_yaml = scanner::ScanPatternToYaml(header.scan_pattern);
+        "created_utc, producer, checksums) VALUES (1, ?, ?, ?, ?, ?, ?, ?)");
+    header_texts = {scanner::ToString(header.scanner.kind()), scanner::ScannerToYaml(header.scanner),
+                    scanner::ScanPatternToYaml(header.scan_pattern), header.scene_yaml, UtcNow(),
+                    header.producer};
     int column = 1;
-    for (const std::string* text :
-         {&kind, &scanner_yaml, &pattern_yaml, &header.scene_yaml, &created_utc, &header.producer}) {
+    for (const std::string& text : header_texts) {
       // Unbound (too long) text would stay NULL and fail the NOT NULL constraint.
-      sqlite3_bind_text64(head.get(), column++, text->data(), text->size(), SQLITE_STATIC,
-                          SQLITE_UTF8);
+      sqlite3_bind_text64(head.get(), column++, text.data(), text.size(), SQLITE_STATIC, SQLITE_UTF8);
     }
+    const RowChecksums checksums = HeaderChecksums(nullptr);
+    sqlite::BindBlob(head.get(), column, checksums.blob().data(), checksums.blob().size());
     sqlite::StepDone(handle, head.get(), name, "cannot write the header");
     if (header.navigation_noise) WriteNavigationNoise(*header.navigation_noise);
     sqlite::Exec(handle, "COMMIT", name, "cannot commit the header");
   }
 
+  // kHeaderChecksumColumns: the texts, then the vehicle mount (NULL until stored).
+  RowChecksums HeaderChecksums(const Eigen::Isometry3d* T_V_C) const {
+    RowChecksums checksums;
+    for (const std::string& text : header_texts) checksums.Text(text);
+    if (T_V_C) {
+      for (double value : sqlite::PoseColumns(*T_V_C)) checksums.Number(value);
+    } else {
+      for (int i = 0; i < 7; ++i) checksums.Null();
+    }
+    return checksums;
+  }
+
   void WriteNavigationNoise(const NavigationNoise& noise) {
     Statement insert = Prepare(
         "INSERT INTO navigation_noise (id, position_walk_m_per_sqrt_s, heading_walk_rad_per_sqrt_s, "
-        "speed_scale_sigma, heading_bias_sigma_rad, depth_sigma_m, roll_pitch_sigma_rad) "
-        "VALUES (1, ?, ?, ?, ?, ?, ?)");
+        "speed_scale_sigma, heading_bias_sigma_rad, depth_sigma_m, roll_pitch_sigma_rad, checksums) "
+        "VALUES (1, ?, ?, ?, ?, ?, ?, ?)");
     int column = 1;
+    RowChecksums checksums;
     for (double value : {noise.position_walk_m_per_sqrt_s, noise.heading_walk_rad_per_sqrt_s,
                          noise.speed_scale_sigma, noise.heading_bias_sigma_rad, noise.depth_sigma_m,
                          noise.roll_pitch_sigma_rad}) {
       sqlite3_bind_double(insert.get(), column++, value);
+      checksums.Number(value);
     }
+    sqlite::BindBlob(insert.get(), column, checksums.blob().data(), checksums.blob().size());
     sqlite::StepDone(db.get(), insert.get(), name, "cannot write the navigation noise");
   }
 };
@@ -237,17 +254,17 @@ DiveLogWriter::DiveLogWriter(const std::filesystem::path& path, const DiveLogHea
     w.rollback = w.Prepare("ROLLBACK");
     w.insert_frame = w.Prepare(
         "INSERT INTO frames (frame_index, time_s, command, sweep, peaks_px, image_width_px, "
-        "image_height_px, image_format, image) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "image_height_px, image_format, image, checksums) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     w.insert_truth = w.Prepare(
         "INSERT INTO ground_truth (frame_index, T_W_C_tx, T_W_C_ty, T_W_C_tz, T_W_C_qx, "
-        "T_W_C_qy, T_W_C_qz, T_W_C_qw, points_W, object_ids) "
-        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "T_W_C_qy, T_W_C_qz, T_W_C_qw, points_W, object_ids, checksums) "
+        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     w.insert_navigation = w.Prepare(
         "INSERT INTO navigation (time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, "
-        "T_W_V_qz, T_W_V_qw) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
+        "T_W_V_qz, T_W_V_qw, checksums) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
     w.update_mount = w.Prepare(
         "UPDATE header SET T_V_C_tx = ?, T_V_C_ty = ?, T_V_C_tz = ?, T_V_C_qx = ?, "
-        "T_V_C_qy = ?, T_V_C_qz = ?, T_V_C_qw = ?");
+        "T_V_C_qy = ?, T_V_C_qz = ?, T_V_C_qw = ?, checksums = ?");
   } catch (...) {
     // The file is ours (created exclusively above): leave nothing half-made behind.
     impl_.reset();
@@ -316,19 +333,30 @@ std::int64_t DiveLogWriter::AppendFrame(const FrameRecord& frame, const GroundTr
     };
     sqlite3_stmt* s = w.insert_frame.get();
     ResetOnExit reset(s);
+    // The checksums follow the columns' order (dive_log_format.hpp).
+    RowChecksums checksums;
     bind(sqlite3_bind_int64(s, 1, index));
     bind(sqlite3_bind_double(s, 2, frame.time_s));
     bind(sqlite3_bind_int(s, 3, frame.command));
     bind(sqlite3_bind_int(s, 4, frame.sweep));
+    for (double value : {double(index), frame.time_s, double(frame.command), double(frame.sweep)}) {
+      checksums.Number(value);
+    }
     const std::size_t num_peaks = frame.peaks_px.size();
-    bind(sqlite::BindBlob(
-        s, 5, sqlite::LittleEndianBytes(Coordinates(frame.peaks_px), 2 * num_peaks, w.scratch[0]),
-        num_peaks * sizeof(Eigen::Vector2d)));
-    if (frame.image) {  // else the image columns stay NULL
+    const void* peaks =
+        sqlite::LittleEndianBytes(Coordinates(frame.peaks_px), 2 * num_peaks, w.scratch[0]);
+    bind(sqlite::BindBlob(s, 5, peaks, num_peaks * sizeof(Eigen::Vector2d)));
+    checksums.Bytes(peaks, num_peaks * sizeof(Eigen::Vector2d));
+    if (!frame.image) {  // the image columns stay NULL
+      for (int i = 0; i < 4; ++i) checksums.Null();
+    } else {
       const LogImage& image = *frame.image;
       bind(sqlite3_bind_int(s, 6, image.width_px));
       bind(sqlite3_bind_int(s, 7, image.height_px));
       bind(sqlite3_bind_int(s, 8, static_cast<int>(image.format)));
+      for (int value : {image.width_px, image.height_px, static_cast<int>(image.format)}) {
+        checksums.Number(value);
+      }
       const void* pixels = image.bytes.data();
       if constexpr (std::endian::native != std::endian::little) {
         if (image.format == LogPixelFormat::kMono16) {  // little-endian in the file
@@ -338,7 +366,9 @@ std::int64_t DiveLogWriter::AppendFrame(const FrameRecord& frame, const GroundTr
         }
       }
       bind(sqlite::BindBlob(s, 9, pixels, image.bytes.size()));
+      checksums.Bytes(pixels, image.bytes.size());
     }
+    bind(sqlite::BindBlob(s, 10, checksums.blob().data(), checksums.blob().size()));
     if (rc != SQLITE_OK) sqlite::Fail(w.name, "cannot bind " + FrameName(index), w.db.get());
     if (sqlite3_step(s) != SQLITE_DONE) {
       sqlite::Fail(w.name, "cannot insert " + FrameName(index), w.db.get());
@@ -347,14 +377,19 @@ std::int64_t DiveLogWriter::AppendFrame(const FrameRecord& frame, const GroundTr
 
     sqlite3_stmt* t = w.insert_truth.get();
     ResetOnExit reset_truth(t);
+    RowChecksums truth_checksums;
     bind(sqlite3_bind_int64(t, 1, index));
     bind(sqlite::BindPose(t, 2, truth->T_W_C));
-    bind(sqlite::BindBlob(
-        t, 9, sqlite::LittleEndianBytes(Coordinates(truth->points_W), 3 * num_peaks, w.scratch[2]),
-        num_peaks * sizeof(Eigen::Vector3d)));
-    bind(sqlite::BindBlob(
-        t, 10, sqlite::LittleEndianBytes(truth->object_ids.data(), num_peaks, w.scratch[3]),
-        num_peaks * sizeof(std::int32_t)));
+    truth_checksums.Number(double(index));
+    for (double value : sqlite::PoseColumns(truth->T_W_C)) truth_checksums.Number(value);
+    const void* points =
+        sqlite::LittleEndianBytes(Coordinates(truth->points_W), 3 * num_peaks, w.scratch[2]);
+    const void* ids = sqlite::LittleEndianBytes(truth->object_ids.data(), num_peaks, w.scratch[3]);
+    bind(sqlite::BindBlob(t, 9, points, num_peaks * sizeof(Eigen::Vector3d)));
+    bind(sqlite::BindBlob(t, 10, ids, num_peaks * sizeof(std::int32_t)));
+    truth_checksums.Bytes(points, num_peaks * sizeof(Eigen::Vector3d));
+    truth_checksums.Bytes(ids, num_peaks * sizeof(std::int32_t));
+    bind(sqlite::BindBlob(t, 11, truth_checksums.blob().data(), truth_checksums.blob().size()));
     if (rc != SQLITE_OK || sqlite3_step(t) != SQLITE_DONE) {
       sqlite::Fail(w.name, "cannot insert the ground truth of " + FrameName(index), w.db.get());
     }
@@ -370,8 +405,13 @@ void DiveLogWriter::AppendNavigation(const NavigationRecord& nav) {
   CheckPose(nav.T_W_V, where + " at " + std::to_string(nav.time_s) + " s: T_W_V");
   sqlite3_stmt* s = w.insert_navigation.get();
   ResetOnExit reset(s);
+  RowChecksums checksums;
+  checksums.Number(nav.time_s);
+  for (double value : sqlite::PoseColumns(nav.T_W_V)) checksums.Number(value);
   if (sqlite3_bind_double(s, 1, nav.time_s) != SQLITE_OK ||
-      sqlite::BindPose(s, 2, nav.T_W_V) != SQLITE_OK || sqlite3_step(s) != SQLITE_DONE) {
+      sqlite::BindPose(s, 2, nav.T_W_V) != SQLITE_OK ||
+      sqlite::BindBlob(s, 9, checksums.blob().data(), checksums.blob().size()) != SQLITE_OK ||
+      sqlite3_step(s) != SQLITE_DONE) {
     sqlite::Fail(w.name, "cannot insert a navigation sample", w.db.get());
   }  // committed: a statement outside a transaction is its own
 }
@@ -382,7 +422,10 @@ void DiveLogWriter::SetVehicleMount(const Eigen::Isometry3d& T_V_C) {
   CheckPose(T_V_C, w.name + ": vehicle mount T_V_C");
   sqlite3_stmt* s = w.update_mount.get();
   ResetOnExit reset(s);
-  if (sqlite::BindPose(s, 1, T_V_C) != SQLITE_OK || sqlite3_step(s) != SQLITE_DONE) {
+  const RowChecksums checksums = w.HeaderChecksums(&T_V_C);
+  if (sqlite::BindPose(s, 1, T_V_C) != SQLITE_OK ||
+      sqlite::BindBlob(s, 8, checksums.blob().data(), checksums.blob().size()) != SQLITE_OK ||
+      sqlite3_step(s) != SQLITE_DONE) {
     sqlite::Fail(w.name, "cannot store the vehicle mount", w.db.get());
   }  // committed, like a navigation sample
 }

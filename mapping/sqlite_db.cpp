@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "mapping/row_checksums.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping::sqlite {
@@ -48,12 +49,16 @@ int BindBlob(sqlite3_stmt* statement, int column, const void* data, std::size_t 
   return sqlite3_bind_blob64(statement, column, data, bytes, SQLITE_STATIC);
 }
 
-int BindPose(sqlite3_stmt* statement, int first_column, const Eigen::Isometry3d& T) {
+std::array<double, 7> PoseColumns(const Eigen::Isometry3d& T) {
   Eigen::Quaterniond q(Eigen::Matrix3d(T.linear()));
   q.normalize();
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // always the same one of the two
   const Eigen::Vector3d t = T.translation();
-  const std::array<double, 7> columns = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+  return {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+}
+
+int BindPose(sqlite3_stmt* statement, int first_column, const Eigen::Isometry3d& T) {
+  const std::array<double, 7> columns = PoseColumns(T);
   for (int i = 0; i < 7; ++i) {
     const int rc = sqlite3_bind_double(statement, first_column + i, columns[i]);
     if (rc != SQLITE_OK) return rc;
@@ -68,6 +73,18 @@ void Row::Corrupt(int column, const std::string& what) const {
   const char* column_name = sqlite3_column_name(statement_, column);
   throw Error(name_ + ": " + context_ + ": column " + (column_name ? column_name : "?") + " " +
               what);
+}
+
+void Row::VerifyChecksums(int first, int count, int checksum_column) const {
+  RowChecksums computed;
+  for (int column = first; column < first + count; ++column) computed.Column(statement_, column);
+  const int mismatch =
+      computed.FirstMismatch(sqlite3_column_blob(statement_, checksum_column),
+                             static_cast<std::size_t>(sqlite3_column_bytes(statement_, checksum_column)));
+  if (mismatch == count) {
+    Corrupt(checksum_column, "does not hold " + std::to_string(count) + " checksums (damaged)");
+  }
+  if (mismatch >= 0) Corrupt(first + mismatch, "does not match its checksum (damaged)");
 }
 
 bool Row::IsNull(int column) const {

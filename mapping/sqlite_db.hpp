@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <cstring>
@@ -104,7 +105,10 @@ int BindBlob(sqlite3_stmt* statement, int column, const void* data, std::size_t 
 
 // ---- Poses: 7 REAL columns tx ty tz qx qy qz qw ----
 
-// Binds T's translation and its rotation as the unit quaternion with qw >= 0. T's rotation
+// T's translation and its rotation as the unit quaternion with qw >= 0: tx ty tz qx qy qz qw.
+// T's rotation must be orthonormal (checked by the caller).
+std::array<double, 7> PoseColumns(const Eigen::Isometry3d& T);
+// Binds PoseColumns(T). T's rotation
 // must be orthonormal (checked by the caller). Returns SQLite's result code.
 int BindPose(sqlite3_stmt* statement, int first_column, const Eigen::Isometry3d& T);
 
@@ -140,6 +144,9 @@ class Row {
   // Columns first .. first + 6 as written by BindPose. The quaternion must have unit norm to
   // 1e-6 (it is then normalised exactly).
   Eigen::Isometry3d Pose(int first_column) const;
+  // Schema version 3 on: columns first .. first + count - 1 against the per-column checksums in
+  // `checksum_column` (mapping/row_checksums.hpp). Throws naming the first column that differs.
+  void VerifyChecksums(int first, int count, int checksum_column) const;
 
  private:
   // The blob's size after the checks Items describes.

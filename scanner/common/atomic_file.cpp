@@ -1,30 +1,70 @@
 #include "scanner/common/atomic_file.hpp"
 
-#include <fstream>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 
 #include "scanner/common/error.hpp"
 
 namespace uwscan {
+namespace {
 
-void WriteTextAtomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path temp = path.string() + ".part";
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path.string() + ": cannot write (folder missing or not writable)");
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temp, ignored);
-      throw Error(path.string() + ": write failed");
-    }
-  }
+namespace fs = std::filesystem;
+
+// fsync by name; false with errno set when the file cannot be opened or synced.
+bool Sync(const fs::path& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool synced = ::fsync(fd) == 0 || errno == EINVAL;  // EINVAL: cannot be synced (a pipe)
+  ::close(fd);
+  return synced;
+}
+
+}  // namespace
+
+fs::path TemporaryBeside(const fs::path& path) {
+  std::string name = ".";
+  name += path.filename().string();
+  name += ".part-";
+  name += std::to_string(::getpid());
+  return path.parent_path() / name;
+}
+
+void ReplaceWithTemporary(const fs::path& temporary, const fs::path& path) {
   std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    throw Error(path.string() + ": cannot replace the file: " + ec.message());
+  if (!Sync(temporary, O_RDONLY)) {
+    const std::string reason = std::strerror(errno);
+    fs::remove(temporary, ec);
+    throw Error(path.string() + ": cannot write (" + reason + ")");
   }
+  fs::rename(temporary, path, ec);
+  if (ec) {
+    const std::string reason = ec.message();
+    fs::remove(temporary, ec);
+    throw Error(path.string() + ": cannot replace the file (" + reason + ")");
+  }
+  // The rename itself survives a power cut only once the folder is synced; some file systems
+  // refuse to sync a folder, which is no reason to fail a write that happened.
+  Sync(path.has_parent_path() ? path.parent_path() : fs::path("."), O_RDONLY | O_DIRECTORY);
+}
+
+void WriteTextAtomically(const fs::path& path, const std::string& text) {
+  const fs::path temporary = TemporaryBeside(path);
+  std::FILE* file = std::fopen(temporary.c_str(), "wb");
+  if (file == nullptr) throw Error(path.string() + ": cannot write (" + std::strerror(errno) + ")");
+  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
+  const int write_errno = errno;
+  const bool closed = std::fclose(file) == 0;
+  if (!written || !closed) {
+    const std::string reason = std::strerror(written ? errno : write_errno);
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw Error(path.string() + ": cannot write (" + reason + ")");
+  }
+  ReplaceWithTemporary(temporary, path);
 }
 
 }  // namespace uwscan

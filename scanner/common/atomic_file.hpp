@@ -3,10 +3,22 @@
 #include <filesystem>
 #include <string>
 
+// Files that are replaced whole or not at all: written under a temporary name beside the target
+// (same file system, so the rename is atomic) and renamed over it when complete. A failure, a
+// full disk or a process killed at any moment leaves the earlier file (or none) and never half
+// of a new one.
 namespace uwscan {
 
-// Writes text to path through a temporary file beside it (path + ".part") and a rename: a
-// failure or a crash leaves any earlier file untouched. Throws uwscan::Error naming the path.
+// The temporary name `path` is written under: in its folder, hidden, unique to this process
+// ("folder/.name.part-PID").
+std::filesystem::path TemporaryBeside(const std::filesystem::path& path);
+
+// Flushes `temporary` to disk, renames it over `path` and syncs the folder. On failure removes
+// the temporary and throws uwscan::Error naming `path`.
+void ReplaceWithTemporary(const std::filesystem::path& temporary, const std::filesystem::path& path);
+
+// Writes text to path through TemporaryBeside and ReplaceWithTemporary. Throws uwscan::Error
+// naming the path (and the system's reason: no space left, read-only, ...).
 void WriteTextAtomically(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace uwscan

@@ -1,0 +1,128 @@
+#include "bench/reader_probes.hpp"
+
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "mapping/dive_log.hpp"
+#include "perception/cloud_io.hpp"
+#include "perception/descriptor_database.hpp"
+#include "perception/object_database.hpp"
+#include "scanner/calibration/calibration_dataset.hpp"
+#include "scanner/calibration/calibration_scene.hpp"
+#include "scanner/calibration/opencv_camera_import.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/common/triangle_mesh.hpp"
+#include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/scene.hpp"
+#include "viewer/map_report.hpp"
+#include "viewer/tum_trajectory.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open '" + path.string() + "'");
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::size_t ReadCloudFile(const fs::path& path) { return perception::ReadCloud(path).size(); }
+
+std::size_t ReadMeshFile(const fs::path& path) {
+  const scanner::TriangleMesh mesh = scanner::LoadMesh(path);
+  return mesh.vertices.size() + mesh.triangles.size();
+}
+
+std::size_t ReadDiveLog(const fs::path& path) {
+  const mapping::DiveLogReader log(path);
+  std::size_t items = 0;
+  log.ForEachFrame([&](const mapping::FrameRecord&, const mapping::GroundTruthRecord*) { ++items; },
+                   /*with_truth=*/true);
+  items += log.ReadNavigation().size();
+  if (log.vehicle_mount()) ++items;
+  return items;
+}
+
+std::size_t ReadScene(const fs::path& path) {
+  const scanner::sim::Scene scene =
+      scanner::sim::ParseScene(Slurp(path), path.string(), path.parent_path());
+  return scene.objects.size() + 1;
+}
+
+std::size_t ReadCalibrationManifest(const fs::path& path) {
+  // The manifest is read from its folder; the fuzzed file is that folder's manifest.yaml.
+  const scanner::calibration::CalibrationDataset dataset =
+      scanner::calibration::LoadCalibrationDataset(path.parent_path());
+  return dataset.views.size() + dataset.planes.size();
+}
+
+std::vector<ReaderProbe> MakeProbes() {
+  using scanner::calibration::ImportOpenCvCalibration;
+  return {
+      {"cloud_ply", ".ply", ReadCloudFile},
+      {"cloud_pcd", ".pcd", ReadCloudFile},
+      {"cloud_xyz", ".xyz", ReadCloudFile},
+      {"mesh_off", ".off", ReadMeshFile},
+      {"mesh_stl", ".stl", ReadMeshFile},
+      {"mesh_obj", ".obj", ReadMeshFile},
+      {"mesh_ply", ".ply", ReadMeshFile},
+      {"scene_yaml", ".yaml", ReadScene},
+      {"scanner_yaml", ".yaml",
+       [](const fs::path& path) {
+         scanner::ParseScanner(Slurp(path), path.string());
+         return std::size_t{1};
+       }},
+      {"scan_pattern_yaml", ".yaml",
+       [](const fs::path& path) {
+         return static_cast<std::size_t>(
+             scanner::ParseScanPattern(Slurp(path), path.string()).frames_per_sweep());
+       }},
+      {"calibration_scene_yaml", ".yaml",
+       [](const fs::path& path) {
+         scanner::calibration::ParseCalibrationScene(Slurp(path), path.string(), path.parent_path());
+         return std::size_t{1};
+       }},
+      {"calibration_manifest", "manifest.yaml", ReadCalibrationManifest},
+      {"calibration_truth", ".yaml",
+       [](const fs::path& path) {
+         const auto truth = scanner::calibration::LoadDatasetTruth(path);
+         return truth.T_C_O_views.size() + truth.T_C_O_planes.size();
+       }},
+      {"opencv_intrinsics", ".yaml",
+       [](const fs::path& path) {
+         ImportOpenCvCalibration(path);
+         return std::size_t{1};
+       }},
+      {"dive_log", ".uwlog", ReadDiveLog},
+      {"object_database", ".db",
+       [](const fs::path& path) { return perception::ObjectDatabase::Load(path).objects.size(); }},
+      {"descriptor_database", ".esfdb",
+       [](const fs::path& path) { return perception::DescriptorDatabase::Load(path).size(); }},
+      {"map_report", ".json",
+       [](const fs::path& path) { return viewer::ReadMapReport(path).trajectories.size(); }},
+      {"tum_trajectory", ".tum",
+       [](const fs::path& path) { return viewer::ReadTumTrajectory(path).size(); }},
+  };
+}
+
+}  // namespace
+
+const std::vector<ReaderProbe>& ReaderProbes() {
+  static const std::vector<ReaderProbe> probes = MakeProbes();
+  return probes;
+}
+
+const ReaderProbe& FindReaderProbe(const std::string& name) {
+  std::ostringstream names;
+  for (const ReaderProbe& probe : ReaderProbes()) {
+    if (probe.name == name) return probe;
+    names << ' ' << probe.name;
+  }
+  throw Error("no reader called '" + name + "' (readers:" + names.str() + ")");
+}
+
+}  // namespace uwscan::bench

@@ -1,0 +1,66 @@
+// One libFuzzer target for every reader of outside data (bench/reader_probes.hpp): the reader is
+// chosen by the environment variable UWSCAN_FUZZ_READER, so one sanitized link serves them all.
+// An input may end in a clean uwscan::Error or be accepted; any other exception, a crash, a hang
+// or a leak is a finding (libFuzzer stops and keeps the input).
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "bench/reader_probes.hpp"
+#include "scanner/common/error.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const uwscan::bench::ReaderProbe* g_probe = nullptr;
+fs::path g_input;
+
+// The input file the reader sees: a name ending in the probe's extension, in a private folder.
+fs::path InputPath(const uwscan::bench::ReaderProbe& probe) {
+  const fs::path folder = fs::temp_directory_path() / ("uwscan_fuzz_" + std::to_string(getpid()));
+  fs::create_directories(folder);
+  const bool whole_name = !probe.extension.empty() && probe.extension.front() != '.';
+  return folder / (whole_name ? probe.extension : "input" + probe.extension);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  const char* name = std::getenv("UWSCAN_FUZZ_READER");
+  if (name == nullptr) {
+    std::fprintf(stderr, "reader_fuzzer: set UWSCAN_FUZZ_READER to a reader name\n");
+    std::exit(2);
+  }
+  try {
+    g_probe = &uwscan::bench::FindReaderProbe(name);
+  } catch (const uwscan::Error& error) {
+    std::fprintf(stderr, "reader_fuzzer: %s\n", error.what());
+    std::exit(2);
+  }
+  g_input = InputPath(*g_probe);
+  // The folder goes when the fuzzer exits normally; a crash leaves it for inspection.
+  std::atexit([] {
+    std::error_code ignored;
+    fs::remove_all(g_input.parent_path(), ignored);
+  });
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  {
+    std::ofstream out(g_input, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  }
+  try {
+    g_probe->read(g_input);
+  } catch (const uwscan::Error&) {
+    // A clean refusal: what a reader must do with bad input.
+  }
+  return 0;
+}
