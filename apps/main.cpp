@@ -19,6 +19,7 @@
 #include "apps/perception_commands.hpp"
 #include "apps/recognition_bench_command.hpp"
 #include "apps/recognition_commands.hpp"
+#include "apps/robustness_bench_command.hpp"
 #include "apps/plot_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
 #include "apps/slam_bench_command.hpp"
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddRecognitionBenchCommand(*bench);
   uwscan::app::AddViewerBenchCommand(*bench);
   uwscan::app::AddAcquisitionBenchCommand(*bench);
+  uwscan::app::AddRobustnessBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);

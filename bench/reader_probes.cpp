@@ -2,6 +2,8 @@
 
 #include <fstream>
 #include <iterator>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "mapping/dive_log.hpp"
@@ -12,6 +14,7 @@
 #include "scanner/calibration/calibration_scene.hpp"
 #include "scanner/calibration/opencv_camera_import.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/lasers/scanner_file.hpp"
@@ -114,6 +117,26 @@ std::vector<ReaderProbe> MakeProbes() {
 const std::vector<ReaderProbe>& ReaderProbes() {
   static const std::vector<ReaderProbe> probes = MakeProbes();
   return probes;
+}
+
+void PrepareReaderWorkspace(const fs::path& workspace, const fs::path& data_dir) {
+  fs::create_directories(workspace / "scanners");
+  fs::create_directories(workspace / "inputs");
+  for (const fs::directory_entry& entry : fs::directory_iterator(data_dir / "scanners")) {
+    fs::copy_file(entry.path(), workspace / "scanners" / entry.path().filename(),
+                  fs::copy_options::overwrite_existing);
+  }
+  const cv::Mat image(24, 32, CV_8UC1, cv::Scalar(90));
+  for (const char* name : {"v0.png", "v1.png", "v2.png"}) {
+    if (!cv::imwrite((workspace / "inputs" / name).string(), image)) {
+      throw Error("cannot write '" + (workspace / "inputs" / name).string() + "'");
+    }
+  }
+}
+
+fs::path ReaderInputPath(const ReaderProbe& probe, const fs::path& workspace) {
+  const bool whole_name = !probe.extension.empty() && probe.extension.front() != '.';
+  return workspace / "inputs" / (whole_name ? probe.extension : "input" + probe.extension);
 }
 
 const ReaderProbe& FindReaderProbe(const std::string& name) {

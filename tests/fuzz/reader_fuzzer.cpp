@@ -19,15 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 
 const uwscan::bench::ReaderProbe* g_probe = nullptr;
+fs::path g_workspace;
 fs::path g_input;
-
-// The input file the reader sees: a name ending in the probe's extension, in a private folder.
-fs::path InputPath(const uwscan::bench::ReaderProbe& probe) {
-  const fs::path folder = fs::temp_directory_path() / ("uwscan_fuzz_" + std::to_string(getpid()));
-  fs::create_directories(folder);
-  const bool whole_name = !probe.extension.empty() && probe.extension.front() != '.';
-  return folder / (whole_name ? probe.extension : "input" + probe.extension);
-}
 
 }  // namespace
 
@@ -43,11 +36,19 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
     std::fprintf(stderr, "reader_fuzzer: %s\n", error.what());
     std::exit(2);
   }
-  g_input = InputPath(*g_probe);
-  // The folder goes when the fuzzer exits normally; a crash leaves it for inspection.
+  // A private workspace: the input file where the reader expects it, beside the scanner files
+  // and images that scenes and manifests name. Removed when the fuzzer exits normally.
+  g_workspace = fs::temp_directory_path() / ("uwscan_fuzz_" + std::to_string(getpid()));
+  try {
+    uwscan::bench::PrepareReaderWorkspace(g_workspace, UWSCAN_DATA_DIR);
+  } catch (const uwscan::Error& error) {
+    std::fprintf(stderr, "reader_fuzzer: %s\n", error.what());
+    std::exit(2);
+  }
+  g_input = uwscan::bench::ReaderInputPath(*g_probe, g_workspace);
   std::atexit([] {
     std::error_code ignored;
-    fs::remove_all(g_input.parent_path(), ignored);
+    fs::remove_all(g_workspace, ignored);
   });
   return 0;
 }
