@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
-#include <pcl/io/ply_io.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,7 +19,9 @@
 #include <system_error>
 #include <vector>
 
+#include "perception/pcd_reader.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/ply_reader.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -57,17 +58,7 @@ struct RawCloud {
   std::vector<Eigen::Vector3d> normals;
 };
 
-const pcl::PCLPointField* FindField(const pcl::PCLPointCloud2& blob,
-                                    std::initializer_list<const char*> names) {
-  for (const char* name : names) {
-    for (const pcl::PCLPointField& field : blob.fields) {
-      if (field.name == name) return &field;
-    }
-  }
-  return nullptr;
-}
-
-// One scalar of a field, converted to double.
+// One value of a binary point record, as double.
 double FieldValue(const std::uint8_t* point, const pcl::PCLPointField& field) {
   const std::uint8_t* at = point + field.offset;
   auto get = [at](auto value) {
@@ -94,66 +85,6 @@ double FieldValue(const std::uint8_t* point, const pcl::PCLPointField& field) {
     default:
       return std::nan("");
   }
-}
-
-std::size_t FieldSize(std::uint8_t datatype) {
-  switch (datatype) {
-    case pcl::PCLPointField::INT8:
-    case pcl::PCLPointField::UINT8:
-      return 1;
-    case pcl::PCLPointField::INT16:
-    case pcl::PCLPointField::UINT16:
-      return 2;
-    case pcl::PCLPointField::INT32:
-    case pcl::PCLPointField::UINT32:
-    case pcl::PCLPointField::FLOAT32:
-      return 4;
-    case pcl::PCLPointField::FLOAT64:
-      return 8;
-    default:
-      return 0;
-  }
-}
-
-RawCloud FromBlob(const pcl::PCLPointCloud2& blob, const fs::path& path) {
-  const pcl::PCLPointField* xyz[3] = {FindField(blob, {"x"}), FindField(blob, {"y"}),
-                                      FindField(blob, {"z"})};
-  const pcl::PCLPointField* n[3] = {FindField(blob, {"normal_x", "nx"}),
-                                    FindField(blob, {"normal_y", "ny"}),
-                                    FindField(blob, {"normal_z", "nz"})};
-  if (!xyz[0] || !xyz[1] || !xyz[2]) {
-    throw Error("ReadCloud: " + Quoted(path) + " has no x, y and z fields");
-  }
-  const bool has_normals = n[0] && n[1] && n[2];
-  for (const pcl::PCLPointField* field : {xyz[0], xyz[1], xyz[2], n[0], n[1], n[2]}) {
-    if (!field) continue;
-    const std::size_t size = FieldSize(field->datatype);
-    if (size == 0 || field->offset + size > blob.point_step) {
-      throw Error("ReadCloud: " + Quoted(path) + ": field '" + field->name +
-                  "' has an unsupported type or lies outside the point record");
-    }
-  }
-  const std::size_t width = blob.width, height = blob.height;
-  if (blob.data.size() < (height == 0 ? 0 : (height - 1) * std::size_t{blob.row_step}) +
-                             width * std::size_t{blob.point_step}) {
-    throw Error("ReadCloud: " + Quoted(path) + ": the point data is shorter than its header says");
-  }
-  RawCloud raw;
-  raw.points.reserve(width * height);
-  if (has_normals) raw.normals.reserve(width * height);
-  for (std::size_t row = 0; row < height; ++row) {
-    for (std::size_t col = 0; col < width; ++col) {
-      const std::uint8_t* point =
-          blob.data.data() + row * blob.row_step + col * std::size_t{blob.point_step};
-      raw.points.emplace_back(FieldValue(point, *xyz[0]), FieldValue(point, *xyz[1]),
-                              FieldValue(point, *xyz[2]));
-      if (has_normals) {
-        raw.normals.emplace_back(FieldValue(point, *n[0]), FieldValue(point, *n[1]),
-                                 FieldValue(point, *n[2]));
-      }
-    }
-  }
-  return raw;
 }
 
 RawCloud ReadXyz(const fs::path& path) {
@@ -295,35 +226,15 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   RawCloud raw;
   if (*format == Format::kXyz) {
     raw = ReadXyz(path);
+  } else if (*format == Format::kPly) {
+    // uwscan's bounded readers (PCL 1.13's abort on some broken headers and print on bad files).
+    scanner::PlyContent ply = scanner::ReadPly(path, /*faces=*/false);
+    raw.points = std::move(ply.vertices);
+    raw.normals = std::move(ply.normals);
   } else {
-    pcl::PCLPointCloud2 blob;
-    int status = -1;
-    try {
-      if (*format == Format::kPcd) {
-        // PCL 1.13's PCDReader::read crashes on a file without a PCD header: check it first.
-        pcl::PCDReader reader;
-        Eigen::Vector4f origin;
-        Eigen::Quaternionf orientation;
-        int version = 0, data_type = 0;
-        unsigned int data_index = 0;
-        status = reader.readHeader(path.string(), blob, origin, orientation, version, data_type,
-                                   data_index);
-        if (status >= 0 && blob.fields.empty()) status = -1;
-        if (status >= 0 && std::size_t{blob.width} * blob.height > 0) {
-          status = reader.read(path.string(), blob);
-        }
-      } else {
-        pcl::PLYReader reader;
-        status = reader.read(path.string(), blob);
-      }
-    } catch (const std::exception& e) {
-      throw Error("ReadCloud: " + Quoted(path) + ": cannot be parsed (" + e.what() + ")");
-    }
-    if (status < 0) {
-      throw Error("ReadCloud: " + Quoted(path) + ": cannot be parsed as " +
-                  (*format == Format::kPcd ? "PCD" : "PLY"));
-    }
-    raw = FromBlob(blob, path);
+    PcdContent pcd = ReadPcd(path);
+    raw.points = std::move(pcd.points);
+    raw.normals = std::move(pcd.normals);
   }
 
   CloudReadStats local;

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -13,6 +14,8 @@
 #include <system_error>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/off_reader.hpp"
+#include "scanner/common/ply_reader.hpp"
 
 namespace uwscan::scanner {
 
@@ -26,8 +29,26 @@ double TriangleMesh::BoundingBoxDiagonal() const {
   return (hi - lo).norm();
 }
 
-TriangleMesh LoadMesh(const std::filesystem::path& path) {
-  if (!std::filesystem::is_regular_file(path)) throw Error(path.string() + ": no such mesh file");
+namespace {
+
+// PLY and OFF through uwscan's bounded readers: Assimp 5.2's importers crash or hang on damaged
+// files of both (`uwscan bench robustness`); STL and OBJ go through Assimp.
+TriangleMesh LoadPlyMesh(const std::filesystem::path& path) {
+  PlyContent ply = ReadPly(path, /*faces=*/true);
+  TriangleMesh mesh;
+  mesh.vertices = std::move(ply.vertices);
+  mesh.triangles = std::move(ply.triangles);
+  return mesh;
+}
+
+std::string LowerExtension(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+TriangleMesh LoadAssimpMesh(const std::filesystem::path& path) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(
       path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
@@ -51,6 +72,17 @@ TriangleMesh LoadMesh(const std::filesystem::path& path) {
                                   base + static_cast<int>(face.mIndices[2]));
     }
   }
+  return mesh;
+}
+
+}  // namespace
+
+TriangleMesh LoadMesh(const std::filesystem::path& path) {
+  if (!std::filesystem::is_regular_file(path)) throw Error(path.string() + ": no such mesh file");
+  const std::string extension = LowerExtension(path);
+  const TriangleMesh mesh = extension == ".ply"   ? LoadPlyMesh(path)
+                            : extension == ".off" ? ReadOff(path)
+                                                  : LoadAssimpMesh(path);
   if (mesh.triangles.empty()) throw Error(path.string() + ": the mesh has no triangles");
   for (const Eigen::Vector3d& v : mesh.vertices) {
     if (!v.allFinite()) throw Error(path.string() + ": the mesh has a non-finite vertex");
