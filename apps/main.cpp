@@ -2,6 +2,7 @@
 // a one-line reason on stderr and a non-zero exit.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 
 #include "apps/accuracy_command.hpp"
@@ -26,6 +27,17 @@
 #include "apps/stripe_commands.hpp"
 #include "apps/view_command.hpp"
 #include "scanner/common/error.hpp"
+
+// OpenMP's threads wait for work by sleeping, not spinning, unless the user asks otherwise:
+// libgomp's default spin-wait made 2 threads slower than 1 whenever the other core was busy
+// (a vehicle's computer always runs something else; README, "Threads under load"). libgomp reads
+// OMP_WAIT_POLICY in its own constructor, before main; an entry in the program's .preinit_array
+// runs before any shared library's constructor, so the default is set there.
+namespace {
+void PassiveOpenMpWaitByDefault(int, char**, char**) { setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0); }
+}  // namespace
+__attribute__((section(".preinit_array"), used)) static void (*const kPreinit)(int, char**, char**) =
+    &PassiveOpenMpWaitByDefault;
 
 int main(int argc, char** argv) {
   CLI::App app{"uwscan: underwater laser scanner perception toolkit"};
