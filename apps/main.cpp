@@ -12,6 +12,7 @@
 #include "apps/calibration_bench_command.hpp"
 #include "apps/demo_command.hpp"
 #include "apps/dive_commands.hpp"
+#include "apps/inspect_command.hpp"
 #include "apps/kernels_command.hpp"
 #include "apps/map_command.hpp"
 #include "apps/object_commands.hpp"
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddReportCommand(app);
   uwscan::app::AddFakeCameraCommand(app);
   uwscan::app::AddAcquireCommand(app);
+  uwscan::app::AddInspectCommand(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);
