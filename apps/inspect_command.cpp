@@ -34,6 +34,7 @@ struct InspectArgs {
   std::int64_t frames = 0;
   double seconds = 0.0;
   bool images = false;
+  bool ascii = false;
   bool force = false;
   bool view = false;
   std::string screenshot;
@@ -109,6 +110,10 @@ void RunInspect(const InspectArgs& a) {
     if (!path.empty() && !parent.empty() && !std::filesystem::is_directory(parent)) {
       throw Error(std::string(option) + " " + path + ": folder '" + parent.string() + "' does not exist");
     }
+  }
+  const std::string map_extension = std::filesystem::path(a.map).extension().string();
+  if (!a.map.empty() && map_extension != ".ply" && map_extension != ".pcd") {
+    throw Error("-o " + a.map + ": expected a .ply or .pcd file");
   }
   if (!(a.queue_mb > 0.0)) throw Error("--queue-mb must be > 0");
   if (!a.screenshot.empty() && a.frames <= 0 && a.seconds <= 0.0) {
@@ -194,7 +199,7 @@ void RunInspect(const InspectArgs& a) {
 
   const mapping::InspectionStatistics& s = result.statistics;
   PrintStatus(read, s, read.seconds, true);
-  if (!a.map.empty()) perception::WriteCloud(a.map, result.map);
+  if (!a.map.empty()) perception::WriteCloud(a.map, result.map, !a.ascii);
   std::printf("inspect: %lld frames received in %.2f s (%.1f frames/s), %lld lost, %lld undecodable; logged %lld; "
               "mapped %lld, skipped %lld (live queue %d)\n",
               static_cast<long long>(s.frames_received), read.seconds,
@@ -232,7 +237,8 @@ void AddInspectCommand(CLI::App& app) {
       "in the map: from the host receiving it, and from the camera's exposure when its clock is the host's.");
   AddCameraOptions(*cmd, a->camera);
   cmd->add_option("--log", a->log, "dive log to create (.db): every frame received, each committed");
-  cmd->add_option("-o,--map", a->map, "map to write at the end (.ply, .pcd, .xyz), voxelised");
+  cmd->add_option("-o,--map", a->map, "map to write at the end (.ply or .pcd), voxelised");
+  cmd->add_flag("--ascii", a->ascii, "write the map as ASCII instead of binary");
   cmd->add_option("--json", a->json, "figures as JSON: frames received, logged, mapped, skipped, latency");
   cmd->add_option("--frames", a->frames, "stop after this many frames")->check(CLI::PositiveNumber);
   cmd->add_option("--seconds", a->seconds, "stop after this long")->check(CLI::PositiveNumber);
