@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -141,6 +142,17 @@ std::optional<mapping::FrameRecord> CameraFrameDecoder::Decode(const acq::Acquir
     record.sweep = c.sweep;
   }
   return record;
+}
+
+mapping::InspectionFrame ToInspectionFrame(mapping::FrameRecord&& record, const acq::AcquiredFrame& frame) {
+  // A camera clock further than this from the host's is another clock.
+  constexpr double kSameClock_s = 1.0;
+  mapping::InspectionFrame f;
+  f.record = std::move(record);
+  f.receive_time_s = static_cast<double>(frame.host_timestamp_ns) * 1e-9;
+  const double camera_s = static_cast<double>(frame.camera_timestamp_ns) * 1e-9;
+  if (std::abs(camera_s - f.receive_time_s) < kSameClock_s) f.capture_time_s = camera_s;
+  return f;
 }
 
 void CheckNewLogPath(const std::string& path, bool force, const std::string& option) {

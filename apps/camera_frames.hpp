@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mapping/dive_log.hpp"
+#include "mapping/live_inspection.hpp"
 #include "scanner/acquisition/frame_source.hpp"
 #include "scanner/acquisition/mirror_driver.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
@@ -75,6 +76,12 @@ class CameraFrameDecoder {
   scanner::acquisition::SimulatedMirrorDriver pattern_driver_;
   scanner::StripeDetection detection_;
 };
+
+// A decoded frame with its times for live inspection: received at the host's timestamp;
+// captured at the camera's, when the camera's clock is the host's (within a second of it: a
+// PTP-synchronised camera, or the fake camera), else unknown (a camera counting from power-up).
+mapping::InspectionFrame ToInspectionFrame(mapping::FrameRecord&& record,
+                                           const scanner::acquisition::AcquiredFrame& frame);
 
 // A new dive log's path, checked before the camera is opened: its folder exists; an existing
 // file is replaced only with `force` (RemoveLog, once the camera answered). Throws

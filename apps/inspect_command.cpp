@@ -3,7 +3,6 @@
 #include <signal.h>
 #include <unistd.h>
 
-#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -44,19 +43,6 @@ struct InspectArgs {
   int sweeps_per_submap = 4;
   int threads = 0;
 };
-
-// A camera clock further than this from the host's is not the host's clock (a camera counting
-// from its power-up, not synchronised): its timestamps cannot give a latency.
-constexpr double kSameClock_s = 1.0;
-
-mapping::InspectionFrame ToInspectionFrame(mapping::FrameRecord&& record, const acq::AcquiredFrame& frame) {
-  mapping::InspectionFrame f;
-  f.record = std::move(record);
-  f.receive_time_s = static_cast<double>(frame.host_timestamp_ns) * 1e-9;
-  const double camera_s = static_cast<double>(frame.camera_timestamp_ns) * 1e-9;
-  if (std::abs(camera_s - f.receive_time_s) < kSameClock_s) f.capture_time_s = camera_s;
-  return f;
-}
 
 void PrintStatus(const ReadSummary& r, const mapping::InspectionStatistics& s, double seconds, bool final_line) {
   std::fprintf(stderr,
