@@ -74,7 +74,7 @@ StreamFigures Stream(const scanner::sim::Simulator& simulator, const std::string
   args.camera = settings.address;
   args.scene = scene_path;
   const AcquisitionContext context = MakeContext(args, source.payload(), "bench acquisition");
-  CameraFrameDecoder decoder(source.payload(), context);
+  CameraFrameDecoder decoder(source.payload(), context, false);
   std::unique_ptr<mapping::LiveInspection> inspection;
   if (map) {
     mapping::InspectionOptions inspection_options;
@@ -88,7 +88,7 @@ StreamFigures Stream(const scanner::sim::Simulator& simulator, const std::string
   while (source.ElapsedSeconds() < seconds) {
     std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
     if (!frame) continue;
-    std::optional<mapping::FrameRecord> record = decoder.Decode(*frame, false);
+    std::optional<mapping::FrameRecord> record = decoder.Decode(*frame);
     if (!record) continue;
     if (!record->peaks_px.empty()) {
       latencies.push_back((static_cast<double>(RealTimeNs()) - static_cast<double>(frame->camera_timestamp_ns)) * 1e-9);

@@ -116,11 +116,8 @@ void RunAcquire(const AcquireArgs& a) {
   InstallStopHandlers();
   acq::FrameSource source(settings);
   const acq::PayloadDescription& payload = source.payload();
-  if (a.images && payload.profile) {
-    throw Error("--images: camera " + a.camera.camera + " sends profiles (peaks found on the camera), not images");
-  }
   const AcquisitionContext context = MakeContext(a.camera, payload, "acquire");
-  CameraFrameDecoder decoder(payload, context);
+  CameraFrameDecoder decoder(payload, context, a.images);
   RemoveLog(a.output);
   mapping::FrameRecorder recorder(mapping::DiveLogWriter(a.output, context.header),
                                   static_cast<std::size_t>(a.queue_mb * 1e6));
@@ -131,7 +128,7 @@ void RunAcquire(const AcquireArgs& a) {
   std::fflush(stdout);
 
   const ReadSummary summary = ReadFrames(
-      source, decoder, a.images, ReadLimits{a.frames, a.seconds}, "acquire",
+      source, decoder, ReadLimits{a.frames, a.seconds}, "acquire",
       [&recorder](mapping::FrameRecord&& record, const acq::AcquiredFrame&) { recorder.Push(std::move(record)); },
       [&recorder](const ReadSummary& s, double now) { PrintStatus(s, now, recorder.statistics().queued_bytes, false); });
   recorder.Finish();

@@ -91,12 +91,19 @@ AcquisitionContext MakeContext(const CameraArgs& a, const acq::PayloadDescriptio
   return c;
 }
 
-CameraFrameDecoder::CameraFrameDecoder(const acq::PayloadDescription& payload, const AcquisitionContext& context)
-    : payload_(payload), detector_(context.detector), pattern_driver_(context.header.scan_pattern) {
+CameraFrameDecoder::CameraFrameDecoder(const acq::PayloadDescription& payload, const AcquisitionContext& context,
+                                       bool keep_images)
+    : payload_(payload),
+      detector_(context.detector),
+      pattern_driver_(context.header.scan_pattern),
+      keep_images_(keep_images) {
   if (!payload.metadata_row && payload.profile) throw Error("the camera sends profiles without a metadata row");
+  if (keep_images && payload.profile) {
+    throw Error("--images: the camera sends profiles (peaks found on the camera), not images");
+  }
 }
 
-std::optional<mapping::FrameRecord> CameraFrameDecoder::Decode(const acq::AcquiredFrame& frame, bool keep_image) {
+std::optional<mapping::FrameRecord> CameraFrameDecoder::Decode(const acq::AcquiredFrame& frame) {
   mapping::FrameRecord record;
   std::optional<acq::FrameMetadata> metadata;
   if (payload_.profile) {
@@ -118,7 +125,7 @@ std::optional<mapping::FrameRecord> CameraFrameDecoder::Decode(const acq::Acquir
     detector_.Detect(image, &detection_);
     record.peaks_px.reserve(detection_.peaks.size());
     for (const scanner::StripePeak& p : detection_.peaks) record.peaks_px.emplace_back(p.u_px, p.v_px);
-    if (keep_image) {
+    if (keep_images_) {
       mapping::LogImage log_image;
       log_image.width_px = image.width_px;
       log_image.height_px = image.height_px;
@@ -172,7 +179,7 @@ void RemoveLog(const std::string& path) {
   std::filesystem::remove(path + "-shm");
 }
 
-ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder, bool keep_images,
+ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder,
                        const ReadLimits& limits, const std::string& name,
                        const std::function<void(mapping::FrameRecord&&, const acq::AcquiredFrame&)>& consume,
                        const std::function<void(const ReadSummary&, double now_s)>& status) {
@@ -199,7 +206,7 @@ ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder, bo
     }
     if (!frame) continue;
     if (software_trigger) source.SoftwareTrigger();
-    std::optional<mapping::FrameRecord> record = decoder.Decode(*frame, keep_images);
+    std::optional<mapping::FrameRecord> record = decoder.Decode(*frame);
     if (!record) {
       ++summary.undecodable;
       continue;

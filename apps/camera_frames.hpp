@@ -62,19 +62,21 @@ AcquisitionContext MakeContext(const CameraArgs& args, const scanner::acquisitio
 // for its frame number. Not thread-safe.
 class CameraFrameDecoder {
  public:
-  // Throws uwscan::Error when the camera sends profiles without a metadata row (the peaks'
-  // mirror command would be unknown).
-  CameraFrameDecoder(const scanner::acquisition::PayloadDescription& payload, const AcquisitionContext& context);
+  // keep_images: image mode, each image goes into its record as well. Throws uwscan::Error
+  // when the camera sends profiles without a metadata row (the peaks' mirror command would be
+  // unknown), or profiles while images are to be kept.
+  CameraFrameDecoder(const scanner::acquisition::PayloadDescription& payload, const AcquisitionContext& context,
+                     bool keep_images);
 
   // std::nullopt when the payload does not decode (packets lost: its checksum fails).
-  // keep_image: image mode, the image goes into the record as well.
-  std::optional<mapping::FrameRecord> Decode(const scanner::acquisition::AcquiredFrame& frame, bool keep_image);
+  std::optional<mapping::FrameRecord> Decode(const scanner::acquisition::AcquiredFrame& frame);
 
  private:
   scanner::acquisition::PayloadDescription payload_;
   scanner::StripeDetector detector_;
   scanner::acquisition::SimulatedMirrorDriver pattern_driver_;
   scanner::StripeDetection detection_;
+  bool keep_images_;
 };
 
 // A decoded frame with its times for live inspection: received at the host's timestamp;
@@ -108,7 +110,7 @@ struct ReadSummary {
 // `status` about once a second; reports camera gaps (watchdog reopens) on stderr, prefixed by
 // `name`. Software trigger mode: triggers one frame at a time. Stops the camera before it
 // returns.
-ReadSummary ReadFrames(scanner::acquisition::FrameSource& source, CameraFrameDecoder& decoder, bool keep_images,
+ReadSummary ReadFrames(scanner::acquisition::FrameSource& source, CameraFrameDecoder& decoder,
                        const ReadLimits& limits, const std::string& name,
                        const std::function<void(mapping::FrameRecord&&, const scanner::acquisition::AcquiredFrame&)>& consume,
                        const std::function<void(const ReadSummary&, double now_s)>& status);

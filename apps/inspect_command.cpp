@@ -120,11 +120,8 @@ void RunInspect(const InspectArgs& a) {
   InstallStopHandlers();
   acq::FrameSource source(settings);
   const acq::PayloadDescription& payload = source.payload();
-  if (a.images && payload.profile) {
-    throw Error("--images: camera " + a.camera.camera + " sends profiles (peaks found on the camera), not images");
-  }
   const AcquisitionContext context = MakeContext(a.camera, payload, "inspect");
-  CameraFrameDecoder decoder(payload, context);
+  CameraFrameDecoder decoder(payload, context, a.images);
 
   std::unique_ptr<viewer::LiveView> live_view;
   if (view) {
@@ -158,7 +155,7 @@ void RunInspect(const InspectArgs& a) {
   auto acquire = [&] {
     try {
       read = ReadFrames(
-          source, decoder, a.images, ReadLimits{a.frames, a.seconds}, "inspect",
+          source, decoder, ReadLimits{a.frames, a.seconds}, "inspect",
           [&inspection](mapping::FrameRecord&& record, const acq::AcquiredFrame& frame) {
             inspection.Push(ToInspectionFrame(std::move(record), frame));
           },
