@@ -212,12 +212,14 @@ void AddInspectCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "inspect",
       "online inspection: a camera's frames logged (never dropped), stripe peaks triangulated and mapped live "
-      "(the newest frames the mapper keeps up with; skipped ones counted), shown with --view.\n"
-      "Navigation: a camera alone gives none, so the scanner is taken as fixed: the vehicle is held at the origin "
-      "(T_W_V = identity) and the map is in the vehicle frame (the camera frame moved by the scene's camera mount, "
-      "identity for a real camera). Sweeps of a static scene land on each other; a moving vehicle needs "
-      "`uwscan map` on the log with its navigation. Latency is measured to the moment a frame's points are placed "
-      "in the map: from the host receiving it, and from the camera's exposure when its clock is the host's.");
+      "(the newest frames the mapper keeps up with; skipped ones counted), shown with --view");
+  cmd->footer(
+      "Navigation: a camera alone gives none, so the scanner is taken as fixed: the vehicle is held at the origin\n"
+      "(T_W_V = identity at every frame) and the map is in the vehicle frame (the camera frame moved by the\n"
+      "scene's camera mount; identity for a real camera). Sweeps of a static scene land on each other; a moving\n"
+      "vehicle is mapped afterwards with `uwscan map` on a log that has its navigation.\n"
+      "Latency is measured to the moment a frame's points are placed in the map: from the host receiving the\n"
+      "frame, and from the camera's exposure when the camera's clock is the host's (PTP, the fake camera).");
   AddCameraOptions(*cmd, a->camera);
   cmd->add_option("--log", a->log, "dive log to create (.db): every frame received, each committed");
   cmd->add_option("-o,--map", a->map, "map to write at the end (.ply or .pcd), voxelised");
