@@ -13,6 +13,7 @@
 #include "apps/calibration_bench_command.hpp"
 #include "apps/demo_command.hpp"
 #include "apps/dive_commands.hpp"
+#include "apps/inspect_command.hpp"
 #include "apps/kernels_command.hpp"
 #include "apps/log_commands.hpp"
 #include "apps/map_command.hpp"
@@ -59,6 +60,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddReportCommand(app);
   uwscan::app::AddFakeCameraCommand(app);
   uwscan::app::AddAcquireCommand(app);
+  uwscan::app::AddInspectCommand(app);
   uwscan::app::AddLogCommands(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);

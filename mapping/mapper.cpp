@@ -144,6 +144,7 @@ struct Mapper::Impl {
   NavigationBuffer navigation;
   std::deque<FrameRecord> waiting;
   bool finished = false;
+  Mapper::FramePlacedCallback on_placed;
 
   // The submap being filled: points in the navigation's world frame, and its frames.
   std::vector<Eigen::Vector3d> points_W;
@@ -194,6 +195,7 @@ void Mapper::Impl::Place(const FrameRecord& frame) {
   // Held at the first or last sample outside the navigation's span.
   const double t = std::clamp(frame.time_s, navigation.first_time_s(), navigation.last_time_s());
   const Eigen::Isometry3d T_W_C = navigation.T_W_V(t) * T_V_C;
+  const std::size_t first_point = points_W.size();
   for (const scanner::TriangulatedPoint& p : triangulated) {
     if (!p.ok()) continue;
     points_W.push_back(T_W_C * p.p_C);
@@ -202,6 +204,9 @@ void Mapper::Impl::Place(const FrameRecord& frame) {
   frames.emplace_back(frame.index, frame.time_s);
   ++stats.frames;
   stats.triangulation_s += Since(start);
+  if (on_placed) {
+    on_placed(frame, T_W_C, std::span<const Eigen::Vector3d>(points_W).subspan(first_point));
+  }
 }
 
 void Mapper::Impl::CloseSubmap() {
@@ -439,6 +444,8 @@ Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& patt
 }
 
 Mapper::~Mapper() = default;
+
+void Mapper::SetFramePlacedCallback(FramePlacedCallback callback) { impl_->on_placed = std::move(callback); }
 
 void Mapper::AddNavigation(const NavigationRecord& record) {
   if (impl_->finished) throw Error("mapper: navigation added after Finish");

@@ -4,7 +4,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -94,6 +96,15 @@ class Mapper {
   ~Mapper();
   Mapper(const Mapper&) = delete;
   Mapper& operator=(const Mapper&) = delete;
+
+  // Called for every frame as it is placed (inside AddFrame, AddNavigation or Finish, on the
+  // caller's thread), with the camera pose the navigation gave it and its triangulated points
+  // in the navigation's world frame: what a live view draws, and the moment a frame's points
+  // are in the map (the open submap). Set before the first frame.
+  using FramePlacedCallback =
+      std::function<void(const FrameRecord& frame, const Eigen::Isometry3d& T_W_C,
+                         std::span<const Eigen::Vector3d> points_W)>;
+  void SetFramePlacedCallback(FramePlacedCallback callback);
 
   // Feed in time order (navigation may run ahead of frames; frames wait for it).
   void AddNavigation(const NavigationRecord& record);

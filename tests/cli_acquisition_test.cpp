@@ -24,85 +24,17 @@
 #include <vector>
 
 #include "mapping/dive_log.hpp"
+#include "tests/cli_camera_support.hpp"
 #include "tests/cli_run.hpp"
-
-extern char** environ;
 
 namespace {
 
 namespace fs = std::filesystem;
-using uwscan::test::CommandRun;
-using uwscan::test::RunUwscan;
-using Clock = std::chrono::steady_clock;
+using namespace uwscan::test;
 
-fs::path TempPath(const std::string& name) {
-  return fs::temp_directory_path() / ("uwscan_cli_acq_" + std::to_string(getpid()) + "_" + name);
-}
-std::string SourcePath(const std::string& relative) { return std::string(UWSCAN_SOURCE_DIR) + "/" + relative; }
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-nlohmann::json ReadJson(const fs::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
-
-// A `uwscan` process in the background, its output in a file.
-class Background {
- public:
-  Background(const std::vector<std::string>& args, const fs::path& output) : output_(output) {
-    std::vector<std::string> argv = {UWSCAN_BIN};
-    argv.insert(argv.end(), args.begin(), args.end());
-    std::vector<char*> c_argv;
-    for (std::string& a : argv) c_argv.push_back(a.data());
-    c_argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    const int rc = posix_spawn(&pid_, UWSCAN_BIN, &actions, nullptr, c_argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) pid_ = -1;
-  }
-  ~Background() {
-    if (pid_ > 0) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  // Waits until the output holds `text`; false after `seconds` or when the process ended.
-  bool WaitFor(const std::string& text, double seconds) const {
-    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
-    while (Clock::now() < end) {
-      if (Output().find(text) != std::string::npos) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return false;
-  }
-  void Signal(int signal) const { kill(pid_, signal); }
-  // Exit code (-signal when killed by one).
-  int Wait() {
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-  }
-  std::string Output() const { return ReadFile(output_); }
-
- private:
-  pid_t pid_ = -1;
-  fs::path output_;
-};
-
+fs::path TempPath(const std::string& name) { return TempPathOf("uwscan_cli_acq_", name); }
 std::unique_ptr<Background> StartFakeCamera(const std::vector<std::string>& args, const std::string& name) {
-  auto camera = std::make_unique<Background>(args, TempPath(name + ".log"));
-  EXPECT_TRUE(camera->WaitFor("serving", 60.0)) << camera->Output();
-  return camera;
+  return StartFakeCameraLogged(args, TempPath(name + ".log"));
 }
 
 using PeaksByLine = std::map<int, std::vector<double>>;  // row -> sorted u positions
@@ -295,46 +227,6 @@ TEST(CliAcquisition, AWrongAddressFailsClearlyWithinSeconds) {
   EXPECT_NE(run.output.find("camera 127.0.0.2: no GigE Vision camera answers there"), std::string::npos) << run.output;
   EXPECT_LT(seconds, 5.0);
   EXPECT_FALSE(fs::exists(TempPath("none.db")));
-}
-
-// An ASCII PLY's vertices (x y z first on each line).
-std::vector<Eigen::Vector3d> ReadAsciiPly(const fs::path& path) {
-  std::vector<Eigen::Vector3d> points;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line) && line.rfind("end_header", 0) != 0) {
-  }
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    Eigen::Vector3d p;
-    if (s >> p.x() >> p.y() >> p.z()) points.push_back(p);
-  }
-  return points;
-}
-
-// Largest distance from a point of `a` to its nearest point of `b` (a 1 mm grid for the search).
-double MaxNearestDistance(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
-  const double cell = 1e-3;
-  auto key = [cell](const Eigen::Vector3d& p, int dx, int dy, int dz) {
-    const auto i = static_cast<std::int64_t>(std::floor(p.x() / cell)) + dx;
-    const auto j = static_cast<std::int64_t>(std::floor(p.y() / cell)) + dy;
-    const auto k = static_cast<std::int64_t>(std::floor(p.z() / cell)) + dz;
-    return (i * 73856093) ^ (j * 19349663) ^ (k * 83492791);
-  };
-  std::unordered_multimap<std::int64_t, std::size_t> grid;
-  for (std::size_t i = 0; i < b.size(); ++i) grid.emplace(key(b[i], 0, 0, 0), i);
-  double worst = 0.0;
-  for (const Eigen::Vector3d& p : a) {
-    double best = 1.0;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto [first, last] = grid.equal_range(key(p, dx, dy, dz));
-          for (auto it = first; it != last; ++it) best = std::min(best, (b[it->second] - p).norm());
-        }
-    worst = std::max(worst, best);
-  }
-  return worst;
 }
 
 // The scene acquired through the fake camera reconstructs to the cloud `simulate` +
