@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/output_path.hpp"
 #include "apps/progress_bar.hpp"
 #include "scanner/optics/pinhole_camera.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
@@ -27,10 +28,7 @@ struct CalibrateArgs {
 };
 
 void RunCalibrate(const CalibrateArgs& a) {
-  const std::filesystem::path parent = std::filesystem::path(a.output).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw Error("-o " + a.output + ": folder '" + parent.string() + "' does not exist");
-  }
+  CheckOutputPath(a.output, "-o", {a.dataset, a.from, std::filesystem::path(a.dataset) / "manifest.yaml"});
   const scanner::calibration::CalibrationDataset dataset =
       scanner::calibration::LoadCalibrationDataset(a.dataset);
   std::filesystem::path initial;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "apps/output_path.hpp"
 #include "apps/stop_signal.hpp"
 #include "apps/text_file.hpp"
 #include "scanner/common/error.hpp"
@@ -163,10 +164,7 @@ mapping::InspectionFrame ToInspectionFrame(mapping::FrameRecord&& record, const 
 }
 
 void CheckNewLogPath(const std::string& path, bool force, const std::string& option) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw Error(option + " " + path + ": folder '" + parent.string() + "' does not exist");
-  }
+  CheckOutputPath(path, option);
   if (std::filesystem::exists(path)) {
     if (!force) throw Error(path + ": exists (a dive log is never overwritten; use --force)");
     if (!std::filesystem::is_regular_file(path)) throw Error(path + ": exists and is not a file; not replaced");

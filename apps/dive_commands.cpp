@@ -8,6 +8,7 @@
 
 #include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
+#include "apps/output_path.hpp"
 #include "apps/progress_bar.hpp"
 #include "apps/text_file.hpp"
 #include "mapping/dive_log.hpp"
@@ -17,6 +18,7 @@
 #include "scanner/calibration/dataset_simulation.hpp"
 #include "perception/cloud_io.hpp"
 #include "perception/point_cloud.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/scene.hpp"
@@ -24,14 +26,6 @@
 
 namespace uwscan::app {
 namespace {
-
-void RequireWritableFolder(const std::string& path, const char* option) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw Error(std::string(option) + " " + path + ": folder '" + parent.string() +
-                "' does not exist");
-  }
-}
 
 struct SimulateArgs {
   std::string scene;
@@ -71,7 +65,7 @@ void RunSimulateCalibration(const SimulateArgs& a) {
 }
 
 void RunSimulate(const SimulateArgs& a) {
-  RequireWritableFolder(a.output, "-o");
+  CheckOutputPath(a.output, "-o", {a.scene});
   if (IsCalibrationScene(ReadText(a.scene))) return RunSimulateCalibration(a);
   if (std::filesystem::exists(a.output) && !a.force) {
     throw Error(a.output + ": exists (a dive log is never overwritten; use --force)");
@@ -83,21 +77,30 @@ void RunSimulate(const SimulateArgs& a) {
     throw Error("--images: scene " + a.scene +
                 " renders no frames (no image effect is on); its dive holds exact peaks");
   }
-  if (std::filesystem::exists(a.output)) {
-    if (!std::filesystem::is_regular_file(a.output)) throw Error(a.output + ": exists and is not a file; not replaced");
-    std::filesystem::remove(a.output);
-    std::filesystem::remove(a.output + "-wal");
-    std::filesystem::remove(a.output + "-shm");
+  if (std::filesystem::exists(a.output) && !std::filesystem::is_regular_file(a.output)) {
+    throw Error(a.output + ": exists and is not a file; not replaced");
   }
   mapping::DiveSimulationOptions options;
   options.store_images = a.images;
   options.threads = a.threads;
   options.producer = std::string("uwscan simulate ") + UWSCAN_VERSION;
+  // The dive is written under a temporary name and replaces the output (an older log under
+  // --force) only when complete: killed or failing, the output is the old file or none.
+  const std::filesystem::path partial = TemporaryBeside(a.output);
   mapping::DiveSimulationSummary summary;
-  {
+  try {
     ProgressBar bar;
-    summary = mapping::SimulateDive(simulator, ReadText(a.scene), a.output, options,
+    summary = mapping::SimulateDive(simulator, ReadText(a.scene), partial, options,
                                     [&bar](double f) { bar.Update("simulate", f); });
+    // A stray WAL of an earlier log at the output would be replayed into the new one.
+    for (const char* suffix : {"-wal", "-shm", "-journal"}) std::filesystem::remove(a.output + suffix);
+    ReplaceWithTemporary(partial, a.output);
+  } catch (...) {
+    std::error_code ignored;
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
+      std::filesystem::remove(partial.string() + suffix, ignored);
+    }
+    throw;
   }
   std::printf("%s: %lld frames (%s scanner, %s), %lld peaks, %lld navigation records%s, %.2f s\n",
               a.output.c_str(), static_cast<long long>(summary.frames),
@@ -120,8 +123,8 @@ struct ReconstructArgs {
 };
 
 void RunReconstruct(const ReconstructArgs& a) {
-  RequireWritableFolder(a.output, "-o");
-  if (!a.json.empty()) RequireWritableFolder(a.json, "--json");
+  CheckOutputPath(a.output, "-o", {a.log, a.calibration});
+  if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.log, a.calibration, a.output});
   mapping::ReconstructionOptions options;
   if (!a.method.empty()) {
     options.method = scanner::ParseTriangulationMethod(a.method);

@@ -9,6 +9,7 @@
 
 #include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
+#include "apps/output_path.hpp"
 #include "apps/progress_bar.hpp"
 #include "mapping/dive_mapping.hpp"
 #include "mapping/map_report.hpp"
@@ -101,14 +102,7 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
 // Every output is checked before any work: a missing folder, or an output that is the input.
 void RequireOutput(const std::string& path, const char* option, const std::string& log) {
   if (path.empty()) return;
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw Error(std::string(option) + " " + path + ": folder '" + parent.string() + "' does not exist");
-  }
-  std::error_code ec;
-  if (std::filesystem::equivalent(path, log, ec)) {
-    throw Error(std::string(option) + " " + path + ": is the dive log itself");
-  }
+  CheckOutputPath(path, option, {log});
 }
 
 void RunMap(const MapArgs& a) {

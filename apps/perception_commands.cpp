@@ -9,6 +9,7 @@
 
 #include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
+#include "apps/output_path.hpp"
 #include "apps/progress_bar.hpp"
 #include "bench/features_benchmark.hpp"
 #include "bench/registration_benchmark.hpp"
@@ -59,6 +60,8 @@ struct RegisterArgs {
 };
 
 void RunRegister(const RegisterArgs& a) {
+  if (!a.output.empty()) CheckOutputPath(a.output, "-o", {a.source, a.target});
+  if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.source, a.target, a.output});
   const perception::PointCloud source = perception::ReadCloud(a.source);
   const perception::PointCloud target = perception::ReadCloud(a.target);
   const double size = perception::BoundingBoxDiagonal(target);

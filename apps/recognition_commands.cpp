@@ -9,6 +9,7 @@
 
 #include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
+#include "apps/output_path.hpp"
 #include "apps/progress_bar.hpp"
 #include "apps/recognition_json.hpp"
 #include "mapping/dive_log.hpp"
@@ -34,6 +35,9 @@ struct BuildDbArgs {
 };
 
 void RunBuildDb(const BuildDbArgs& a) {
+  std::vector<std::filesystem::path> inputs(a.objects.begin(), a.objects.end());
+  inputs.push_back(a.scanner);
+  CheckOutputPath(a.output, "-o", inputs);
   std::vector<perception::ObjectSource> sources;
   for (const std::string& name : a.objects) {
     sources.push_back(std::filesystem::exists(name) ? perception::MeshObject(name)

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <bit>
 #include <cctype>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -286,6 +287,7 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
   const fs::path temporary = path.parent_path() / temporary_name;
   int status = -1;
   std::string reason;
+  errno = 0;  // what the failing write leaves here (no space left, file too large) is the reason
   try {
     if (*format == Format::kPcd) {
       pcl::PCDWriter writer;
@@ -301,6 +303,7 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
   }
   std::error_code ec;
   if (status < 0 || !SyncFile(temporary)) {
+    if (reason.empty() && errno != 0) reason = std::string(" (") + std::strerror(errno) + ")";
     fs::remove(temporary, ec);
     throw Error("WriteCloud: cannot write " + Quoted(path) + reason);
   }
