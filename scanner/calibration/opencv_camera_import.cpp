@@ -1,7 +1,10 @@
 #include "scanner/calibration/opencv_camera_import.hpp"
 
 #include <array>
+#include <charconv>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <opencv2/core.hpp>
 #include <sstream>
 #include <string>
@@ -53,6 +56,38 @@ class Reader {
   std::string file_;
 };
 
+// OpenCV's FileStorage trusts a matrix's `rows` and `cols` and its text: a damaged byte there
+// made it allocate gigabytes (found by tests/fuzz). An intrinsics file is a few hundred bytes of
+// ASCII with matrices of at most 1x14: anything else is refused before OpenCV parses it.
+void CheckBeforeOpenCv(const std::filesystem::path& yaml, const Reader& reader) {
+  constexpr std::uintmax_t kMaxBytes = 1 << 20;
+  std::error_code error;
+  if (std::filesystem::file_size(yaml, error) > kMaxBytes) reader.Fail("larger than 1 MiB: not a calibration file");
+  std::ifstream in(yaml, std::ios::binary);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if ((c < 0x20 && c != '\n' && c != '\r' && c != '\t') || c > 0x7e) {
+      reader.Fail("byte " + std::to_string(c) + " at offset " + std::to_string(i) +
+                  " is not ASCII text (an OpenCV calibration YAML is)");
+    }
+  }
+  std::istringstream lines(text);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    std::istringstream words(line);
+    std::string key, value;
+    words >> key >> value;
+    if (key != "rows:" && key != "cols:") continue;
+    int size = 0;
+    const auto parsed = std::from_chars(value.data(), value.data() + value.size(), size);
+    if (parsed.ec != std::errc() || parsed.ptr != value.data() + value.size() || size < 1 || size > 16) {
+      reader.Fail("line " + std::to_string(number) + ": matrix " + key.substr(0, 4) + " '" + value.substr(0, 20) +
+                  "' is not a size from 1 to 16");
+    }
+  }
+}
+
 }  // namespace
 
 PinholeCamera ImportOpenCvCalibration(const std::filesystem::path& yaml) {
@@ -61,6 +96,7 @@ PinholeCamera ImportOpenCvCalibration(const std::filesystem::path& yaml) {
   if (!std::filesystem::is_regular_file(yaml, error)) {
     reader.Fail("no such file (expected an OpenCV calibration YAML)");
   }
+  CheckBeforeOpenCv(yaml, reader);
   cv::FileStorage storage;
   try {
     if (!storage.open(yaml.string(), cv::FileStorage::READ)) {
