@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iterator>
 #include <opencv2/core.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -26,7 +27,12 @@ class Reader {
   [[noreturn]] void Fail(const std::string& what) const { throw Error(file_ + ": " + what); }
 
   cv::FileNode Node(const cv::FileStorage& storage, const char* name) const {
-    const cv::FileNode node = storage[name];
+    cv::FileNode node;
+    try {
+      node = storage[name];
+    } catch (const cv::Exception&) {  // OpenCV asserts when the top level is not a map
+      Fail(std::string("missing node '") + name + "' (the file's top level is not a map of nodes)");
+    }
     if (node.empty()) Fail(std::string("missing node '") + name + "'");
     return node;
   }
@@ -72,25 +78,19 @@ void CheckBeforeOpenCv(const std::filesystem::path& yaml, const Reader& reader) 
                   " is not ASCII text (an OpenCV calibration YAML is)");
     }
   }
+  // Any line that speaks of rows or cols must be exactly "rows: N" or "cols: N", 1 <= N <= 16.
+  static const std::regex size_line(R"(^\s*(rows|cols)\s*:\s*([0-9]{1,2})\s*\r?$)");
   std::istringstream lines(text);
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number) {
-    std::istringstream words(line);
-    std::string key, value;
-    words >> key >> value;
-    if (key != "rows:" && key != "cols:") continue;
-    int size = 0;
-    const auto parsed = std::from_chars(value.data(), value.data() + value.size(), size);
-    if (parsed.ec != std::errc() || parsed.ptr != value.data() + value.size() || size < 1 || size > 16) {
-      reader.Fail("line " + std::to_string(number) + ": matrix " + key.substr(0, 4) + " '" + value.substr(0, 20) +
-                  "' is not a size from 1 to 16");
-    }
+    if (line.find("rows") == std::string::npos && line.find("cols") == std::string::npos) continue;
+    std::smatch match;
+    const bool valid = std::regex_match(line, match, size_line) && std::stoi(match[2]) >= 1 && std::stoi(match[2]) <= 16;
+    if (!valid) reader.Fail("line " + std::to_string(number) + ": expected 'rows: N' or 'cols: N' with N from 1 to 16");
   }
 }
 
-}  // namespace
-
-PinholeCamera ImportOpenCvCalibration(const std::filesystem::path& yaml) {
+PinholeCamera ReadOpenCvCalibration(const std::filesystem::path& yaml) {
   const Reader reader(yaml);
   std::error_code error;
   if (!std::filesystem::is_regular_file(yaml, error)) {
@@ -154,6 +154,20 @@ PinholeCamera ImportOpenCvCalibration(const std::filesystem::path& yaml) {
     reader.Fail(e.what());
   }
   return camera;
+}
+
+}  // namespace
+
+PinholeCamera ImportOpenCvCalibration(const std::filesystem::path& yaml) {
+  // OpenCV's parser throws more than cv::Exception on damaged text (std::length_error, found by
+  // tests/fuzz): whatever it throws is a refusal of the file.
+  try {
+    return ReadOpenCvCalibration(yaml);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error(yaml.string() + ": not a readable OpenCV calibration file (" + e.what() + ")");
+  }
 }
 
 }  // namespace uwscan::scanner::calibration

@@ -10,13 +10,18 @@ fuzzer=$1 seeds=$2 seconds=$3
 corpus=${4:-$(mktemp -d)}
 readers=$(ls "$seeds")
 status=0
+skipped=$(grep -v '^#' "$(dirname "$0")/fuzz_skip.txt" | grep -v '^$' || true)
 for reader in $readers; do
+  if grep -qx "$reader" <<<"$skipped"; then
+    echo "fuzz: $reader skipped (tests/fuzz/fuzz_skip.txt)" >&2
+    continue
+  fi
   mkdir -p "$corpus/$reader"
   regressions="$(dirname "$0")/regressions/$reader"
   extra=()
   [ -d "$regressions" ] && extra+=("$regressions")
   echo "fuzz: $reader for ${seconds}s" >&2
-  if ! UWSCAN_FUZZ_READER=$reader "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if ! UWSCAN_FUZZ_READER=$reader "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -seed=1 \
         -artifact_prefix="$corpus/$reader/" -print_final_stats=1 \
         "$corpus/$reader" "$seeds/$reader" "${extra[@]}" >"$corpus/$reader.log" 2>&1; then
     echo "fuzz: $reader FAILED (log: $corpus/$reader.log)" >&2
