@@ -149,8 +149,11 @@ TEST_F(DiveMappingTest, UnusableLogsGiveAClearError) {
   }
   EXPECT_NE(MessageOf([&] { Map(one); }).find("has 1 frame"), std::string::npos);
 
-  RawExec(one, "UPDATE meta SET value = 3 WHERE key = 'schema_version'");
-  EXPECT_NE(MessageOf([&] { Map(one); }).find("schema version 3, this uwscan reads 1 to 2"), std::string::npos);
+  const std::string next = std::to_string(kDiveLogSchemaVersion + 1);
+  RawExec(one, "UPDATE meta SET value = " + next + " WHERE key = 'schema_version'");
+  EXPECT_NE(MessageOf([&] { Map(one); })
+                .find("schema version " + next + ", this uwscan reads 1 to " + std::to_string(kDiveLogSchemaVersion)),
+            std::string::npos);
 }
 
 TEST_F(DiveMappingTest, VersionOneLogsOpenAndMapWithAnAssumedNoise) {
