@@ -47,6 +47,8 @@ bool IsCalibrationScene(const std::string& text) {
 
 void RunSimulateCalibration(const SimulateArgs& a) {
   if (a.images) throw Error("--images: a calibration dataset is made of images already");
+  // A dataset is a folder: an existing one is checked below; a new one needs a writable parent.
+  if (!std::filesystem::exists(a.output)) CheckOutputPath(a.output, "-o", {a.scene});
   if (std::filesystem::exists(a.output)) {
     if (!a.force) throw Error(a.output + ": exists (a dataset folder is never overwritten; use --force)");
     // --force replaces a dataset, never an arbitrary folder.
@@ -65,8 +67,8 @@ void RunSimulateCalibration(const SimulateArgs& a) {
 }
 
 void RunSimulate(const SimulateArgs& a) {
-  CheckOutputPath(a.output, "-o", {a.scene});
   if (IsCalibrationScene(ReadText(a.scene))) return RunSimulateCalibration(a);
+  CheckOutputPath(a.output, "-o", {a.scene});
   if (std::filesystem::exists(a.output) && !a.force) {
     throw Error(a.output + ": exists (a dive log is never overwritten; use --force)");
   }
