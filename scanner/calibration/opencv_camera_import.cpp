@@ -78,15 +78,20 @@ void CheckBeforeOpenCv(const std::filesystem::path& yaml, const Reader& reader) 
                   " is not ASCII text (an OpenCV calibration YAML is)");
     }
   }
-  // Any line that speaks of rows or cols must be exactly "rows: N" or "cols: N", 1 <= N <= 16.
-  static const std::regex size_line(R"(^\s*(rows|cols)\s*:\s*([0-9]{1,2})\s*\r?$)");
+  // Any line that speaks of rows or cols must be exactly "rows: N" or "cols: N" (YAML) or
+  // "<rows>N</rows>" or "<cols>N</cols>" (XML), 1 <= N <= 16.
+  static const std::regex size_line(
+      R"(^\s*(?:(rows|cols)\s*:\s*([0-9]{1,2})|<(rows|cols)>\s*([0-9]{1,2})\s*</(rows|cols)>)\s*\r?$)");
   std::istringstream lines(text);
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number) {
     if (line.find("rows") == std::string::npos && line.find("cols") == std::string::npos) continue;
     std::smatch match;
-    const bool valid = std::regex_match(line, match, size_line) && std::stoi(match[2]) >= 1 && std::stoi(match[2]) <= 16;
-    if (!valid) reader.Fail("line " + std::to_string(number) + ": expected 'rows: N' or 'cols: N' with N from 1 to 16");
+    const bool matched = std::regex_match(line, match, size_line);
+    const int size = matched ? std::stoi(match[2].matched ? match[2].str() : match[4].str()) : 0;
+    if (size < 1 || size > 16) {
+      reader.Fail("line " + std::to_string(number) + ": expected a matrix size 'rows: N' or 'cols: N' (XML <rows>N</rows>) with N from 1 to 16");
+    }
   }
 }
 
