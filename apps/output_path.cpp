@@ -18,10 +18,16 @@ void CheckOutputPath(const fs::path& output, const std::string& option, const st
     throw Error(name + ": folder '" + folder.string() + "' is not writable");
   }
   if (fs::is_directory(output, ec)) throw Error(name + ": is a folder, expected a file name");
+  std::error_code output_ec;
+  const fs::path canonical_output = fs::weakly_canonical(output, output_ec);
   for (const fs::path& input : inputs) {
     if (input.empty()) continue;
-    const bool same = fs::weakly_canonical(output, ec) == fs::weakly_canonical(input, ec) ||
-                      (fs::exists(output, ec) && fs::exists(input, ec) && fs::equivalent(output, input, ec));
+    std::error_code input_ec;
+    const fs::path canonical_input = fs::weakly_canonical(input, input_ec);
+    // The same name once links are resolved, or the same file under another name (a hard link).
+    const bool same_name = !output_ec && !input_ec && canonical_output == canonical_input;
+    const bool same_file = fs::exists(output, ec) && fs::exists(input, ec) && fs::equivalent(output, input, ec);
+    const bool same = same_name || same_file;
     if (same) throw Error(name + ": is also an input ('" + input.string() + "'); refusing to overwrite it");
   }
 }

@@ -1,7 +1,5 @@
 #include "bench/reader_probes.hpp"
 
-#include <fstream>
-#include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -14,6 +12,7 @@
 #include "scanner/calibration/calibration_scene.hpp"
 #include "scanner/calibration/opencv_camera_import.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
@@ -26,12 +25,6 @@ namespace uwscan::bench {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open '" + path.string() + "'");
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 std::size_t ReadCloudFile(const fs::path& path) { return perception::ReadCloud(path).size(); }
 
@@ -51,8 +44,7 @@ std::size_t ReadDiveLog(const fs::path& path) {
 }
 
 std::size_t ReadScene(const fs::path& path) {
-  const scanner::sim::Scene scene =
-      scanner::sim::ParseScene(Slurp(path), path.string(), path.parent_path());
+  const scanner::sim::Scene scene = scanner::sim::LoadScene(path);
   return scene.objects.size() + 1;
 }
 
@@ -76,17 +68,17 @@ std::vector<ReaderProbe> MakeProbes() {
       {"scene_yaml", ".yaml", ReadScene},
       {"scanner_yaml", ".yaml",
        [](const fs::path& path) {
-         scanner::ParseScanner(Slurp(path), path.string());
+         scanner::LoadScanner(path);
          return std::size_t{1};
        }},
       {"scan_pattern_yaml", ".yaml",
        [](const fs::path& path) {
          return static_cast<std::size_t>(
-             scanner::ParseScanPattern(Slurp(path), path.string()).frames_per_sweep());
+             scanner::ParseScanPattern(ReadFileBytes(path), path.string()).frames_per_sweep());
        }},
       {"calibration_scene_yaml", ".yaml",
        [](const fs::path& path) {
-         scanner::calibration::ParseCalibrationScene(Slurp(path), path.string(), path.parent_path());
+         scanner::calibration::LoadCalibrationScene(path);
          return std::size_t{1};
        }},
       {"calibration_manifest", "manifest.yaml", ReadCalibrationManifest},

@@ -7,12 +7,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <random>
 #include <regex>
 #include <vector>
@@ -21,6 +21,7 @@
 #include "bench/reader_seeds.hpp"
 #include "mapping/dive_log.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::bench {
@@ -42,11 +43,6 @@ const char* ToString(Mutation m) {
     case Mutation::kWrongTypes: return "wrong type";
   }
   return "?";
-}
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 void WriteBytes(const fs::path& path, const std::string& bytes) {
@@ -208,7 +204,7 @@ ReaderOutcomes MeasureReader(const ReaderProbe& probe, const std::vector<fs::pat
   ReaderOutcomes outcomes;
   const fs::path input = ReaderInputPath(probe, workspace);
   for (const fs::path& seed_path : seeds) {
-    const std::string seed = ReadBytes(seed_path);
+    const std::string seed = ReadFileBytes(seed_path);
     for (Mutation mutation : kMutations) {
       for (int k = 0; k < options.mutants_per_kind; ++k) {
         WriteBytes(input, Mutate(seed, mutation, rng));
@@ -286,7 +282,7 @@ void StripChecksums(const fs::path& path) {
 
 // Changes `count` bytes at random places of a copy of `original`.
 void DamageCopy(const fs::path& original, const fs::path& copy, int count, std::mt19937_64& rng) {
-  std::string bytes = ReadBytes(original);
+  std::string bytes = ReadFileBytes(original);
   for (int k = 0; k < count; ++k) bytes[rng() % bytes.size()] = static_cast<char>(rng());
   WriteBytes(copy, bytes);
 }

@@ -1,12 +1,9 @@
 #include "perception/cloud_io.hpp"
 
-#include <fcntl.h>
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -21,6 +18,7 @@
 #include <vector>
 
 #include "perception/pcd_reader.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/ply_reader.hpp"
 
@@ -118,14 +116,6 @@ RawCloud ReadXyz(const fs::path& path) {
   }
   if (in.bad()) throw Error("ReadCloud: error while reading " + Quoted(path));
   return raw;
-}
-
-// fsync a file by name, so the rename that follows cannot publish an unwritten file.
-bool SyncFile(const fs::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) return false;
-  const bool ok = ::fsync(fd) == 0;
-  return ::close(fd) == 0 && ok;
 }
 
 pcl::PCLPointCloud2 ToBlob(const PointCloud& cloud, Format format) {
@@ -277,14 +267,7 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
       !blob.fields.empty() && blob.fields.front().datatype == pcl::PCLPointField::FLOAT64;
   const int precision = doubles ? 17 : 9;  // round-trip digits
 
-  static std::atomic<unsigned> counter{0};
-  std::string temporary_name(1, '.');
-  temporary_name.append(path.filename().string());
-  temporary_name.append(".tmp-");
-  temporary_name.append(std::to_string(::getpid()));
-  temporary_name.push_back('-');
-  temporary_name.append(std::to_string(counter++));
-  const fs::path temporary = path.parent_path() / temporary_name;
+  const fs::path temporary = TemporaryBeside(path);
   int status = -1;
   std::string reason;
   errno = 0;  // what the failing write leaves here (no space left, file too large) is the reason
@@ -301,18 +284,13 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
     reason = std::string(" (") + e.what() + ")";
     status = -1;
   }
-  std::error_code ec;
-  if (status < 0 || !SyncFile(temporary)) {
+  if (status < 0) {
     if (reason.empty() && errno != 0) reason = std::string(" (") + std::strerror(errno) + ")";
-    fs::remove(temporary, ec);
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
     throw Error("WriteCloud: cannot write " + Quoted(path) + reason);
   }
-  fs::rename(temporary, path, ec);
-  if (ec) {
-    const std::string message = ec.message();
-    fs::remove(temporary, ec);
-    throw Error("WriteCloud: cannot replace " + Quoted(path) + " (" + message + ")");
-  }
+  ReplaceWithTemporary(temporary, path);  // flushed to disk, then renamed over the old file
 }
 
 }  // namespace uwscan::perception

@@ -7,16 +7,14 @@
 #include <charconv>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <functional>
 #include <initializer_list>
-#include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
 #include <string_view>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -33,6 +31,7 @@ struct Field {
   char type = 0;   // 'I', 'U' or 'F'
   int count = 1;   // values per point
   std::size_t offset = 0;  // within a binary point
+  std::size_t first_value = 0;  // among an ascii point's values
 };
 
 struct Header {
@@ -125,6 +124,7 @@ Header ParseHeader(const std::string& file, const std::string& name) {
     if (!valid) throw Error(name + ": field '" + field.name + "' has type " + field.type + " of size " + std::to_string(field.size));
     field.offset = header.point_step;
     header.point_step += std::size_t(field.size) * std::size_t(field.count);
+    field.first_value = f == 0 ? 0 : header.fields[f - 1].first_value + std::size_t(header.fields[f - 1].count);
   }
   if (!points_seen) {
     if (!width_seen) throw Error(name + ": the header has neither POINTS nor WIDTH");
@@ -186,8 +186,9 @@ class PointValues {
   bool soa_;
 };
 
-void Extract(const Header& header, const std::string& name, PcdContent& content,
-             const std::function<double(const Field&, std::uint64_t)>& value) {
+// `value(field, point)` gives a field's first value at a point.
+template <typename Value>
+void Extract(const Header& header, const std::string& name, PcdContent& content, const Value& value) {
   const Field* xyz[3] = {FindField(header, {"x"}), FindField(header, {"y"}), FindField(header, {"z"})};
   const Field* n[3] = {FindField(header, {"normal_x", "nx"}), FindField(header, {"normal_y", "ny"}),
                        FindField(header, {"normal_z", "nz"})};
@@ -225,31 +226,16 @@ void ReadAscii(const std::string& file, const Header& header, const std::string&
     values.push_back(value);
     p = parsed.ptr;
   }
-  // A field's first value: its position among the values of a point.
-  auto index = [&](const Field& field) {
-    std::size_t at = 0;
-    for (const Field& f : header.fields) {
-      if (&f == &field) break;
-      at += std::size_t(f.count);
-    }
-    return at;
-  };
   Extract(header, name, content, [&](const Field& field, std::uint64_t i) {
-    return values[i * values_per_point + index(field)];
+    return values[i * values_per_point + field.first_value];
   });
 }
 
 }  // namespace
 
 PcdContent ReadPcd(const fs::path& path) {
-  std::string name = "'";  // built piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + string
-  name += path.string();
-  name += '\'';
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw Error(name + ": no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(name + ": cannot be opened");
-  const std::string file{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string name = QuotedPath(path);
+  const std::string file = ReadFileBytes(path);
   const Header header = ParseHeader(file, name);
   PcdContent content;
   if (header.data == "ascii") {

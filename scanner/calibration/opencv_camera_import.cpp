@@ -4,7 +4,6 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
-#include <iterator>
 #include <opencv2/core.hpp>
 #include <regex>
 #include <sstream>
@@ -12,6 +11,7 @@
 #include <system_error>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -69,8 +69,7 @@ void CheckBeforeOpenCv(const std::filesystem::path& yaml, const Reader& reader) 
   constexpr std::uintmax_t kMaxBytes = 1 << 20;
   std::error_code error;
   if (std::filesystem::file_size(yaml, error) > kMaxBytes) reader.Fail("larger than 1 MiB: not a calibration file");
-  std::ifstream in(yaml, std::ios::binary);
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string text = ReadFileBytes(yaml);
   for (std::size_t i = 0; i < text.size(); ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
     if ((c < 0x20 && c != '\n' && c != '\r' && c != '\t') || c > 0x7e) {

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -26,10 +27,13 @@ bool Sync(const fs::path& path, int flags) {
 }  // namespace
 
 fs::path TemporaryBeside(const fs::path& path) {
+  static std::atomic<unsigned> count{0};  // two writes of one process never share a name
   std::string name = ".";
   name += path.filename().string();
   name += ".part-";
   name += std::to_string(::getpid());
+  name += '-';
+  name += std::to_string(count++);
   return path.parent_path() / name;
 }
 

@@ -9,8 +9,8 @@
 // of a new one.
 namespace uwscan {
 
-// The temporary name `path` is written under: in its folder, hidden, unique to this process
-// ("folder/.name.part-PID").
+// The temporary name `path` is written under: in its folder, hidden, unique to this call
+// ("folder/.name.part-PID-N").
 std::filesystem::path TemporaryBeside(const std::filesystem::path& path);
 
 // Flushes `temporary` to disk, renames it over `path` and syncs the folder. On failure removes

@@ -3,13 +3,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -64,12 +63,8 @@ std::vector<double> Numbers(std::string_view line, std::size_t count) {
 }  // namespace
 
 TriangleMesh ReadOff(const fs::path& path) {
-  std::string name = "'";  // built piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + string
-  name += path.string();
-  name += '\'';
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(name + ": cannot be opened");
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string name = QuotedPath(path);
+  const std::string text = ReadFileBytes(path);
   Lines lines(text);
   std::string_view line;
   int number = 0;

@@ -9,14 +9,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -212,14 +211,8 @@ std::size_t MinRowBytes(const Element& element, Encoding encoding) {
 }  // namespace
 
 PlyContent ReadPly(const fs::path& path, bool faces) {
-  std::string name = "'";  // built piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + string
-  name += path.string();
-  name += '\'';
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw Error(name + ": no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(name + ": cannot be opened");
-  const std::string file{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string name = QuotedPath(path);
+  const std::string file = ReadFileBytes(path);
   const Header header = ParseHeader(file, name);
 
   const std::string_view body(file.data() + header.body_offset, file.size() - header.body_offset);
