@@ -12,7 +12,8 @@ namespace uwscan::scanner::calibration {
 // Only OpenCV's standard model k1 k2 p1 p2 k3 is supported: a file whose rational (k4..k6),
 // thin-prism (s1..s4) or tilt (tau_x, tau_y) terms are non-zero is refused, as is a camera
 // matrix with skew, rather than silently dropping terms. Other nodes (the sample's
-// calibration_time, flags, per-view errors, extrinsics) are ignored.
+// calibration_time, flags, per-view errors, extrinsics) are ignored. The file is read without
+// OpenCV (see OpenCvStorage), so a damaged file is refused rather than hanging the process.
 // Throws uwscan::Error naming the file and, where one is at fault, the node: missing or
 // unreadable file, malformed YAML, missing node, wrong type or size, unsupported terms, or
 // intrinsics that PinholeCamera::Check refuses.

@@ -141,5 +141,80 @@ TEST_F(ImportTest, MalformedFilesNameTheFileAndTheNode) {
   ExpectErrorMentions(bad_focal, {"bad_focal.yaml", "fx_px"});
 }
 
+TEST_F(ImportTest, HandWrittenXmlAndFlowYamlAreRead) {
+  // What other tools write in OpenCV's layouts: XML with the data over several lines, and YAML
+  // with "1." numbers and the matrix as a flow map.
+  const std::filesystem::path xml = dir_ / "hand.xml";
+  std::ofstream(xml) << "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>"
+                        "<image_height> 480 </image_height>\n<camera_matrix type_id=\"opencv-matrix\">"
+                        "<rows>3</rows><cols>3</cols><dt>d</dt>\n<data>\n  500. 0. 320.\n  0. 501. 240."
+                        "\n  0. 0. 1.</data></camera_matrix>\n<distortion_coefficients "
+                        "type_id=\"opencv-matrix\"><rows>1</rows><cols>4</cols><dt>f</dt><data>"
+                        "0.1 -0.2 0 0</data></distortion_coefficients>\n</opencv_storage>\n";
+  const PinholeCamera from_xml = ImportOpenCvCalibration(xml);
+  EXPECT_EQ(from_xml.height_px, 480);
+  EXPECT_EQ(from_xml.fy_px, 501.0);
+  EXPECT_EQ(from_xml.k2, -0.2);
+
+  const std::filesystem::path yaml = dir_ / "flow.yaml";
+  std::ofstream(yaml) << "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix "
+                         "{rows: 3, cols: 3, dt: d, data: [500., 0., 320., 0., 501., 240., 0., 0., 1.]}\n"
+                         "distortion_coefficients: !!opencv-matrix\n  rows: 4\n  cols: 1\n  dt: d\n"
+                         "  data: [ 0.1, -0.2, 0., 0. ]\n";
+  const PinholeCamera from_yaml = ImportOpenCvCalibration(yaml);
+  EXPECT_EQ(from_yaml.cx_px, 320.0);
+  EXPECT_EQ(from_yaml.k1, 0.1);
+}
+
+// Damaged files that hung, crashed or exhausted memory in OpenCV's FileStorage, and others of
+// their kind: each is refused with one error naming the file and what is wrong.
+TEST_F(ImportTest, DamagedFilesAreRefused) {
+  const auto write = [this](const std::string& name, const std::string& text) {
+    const std::filesystem::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  };
+  // The input that hung FileStorage (tests/fuzz/regressions/opencv_intrinsics/timeout-*).
+  ExpectErrorMentions(write("hang.yaml", "%YAML:1.x:i! !opencv-matrix\n   row7ro 13 :*:0\n%Y--\nima:"),
+                      {"hang.yaml", "malformed YAML"});
+  ExpectErrorMentions(write("deep.yaml", "image_width: " + std::string(100000, '[')),
+                      {"deep.yaml", "malformed YAML"});
+  ExpectErrorMentions(write("deep.xml", "<opencv_storage>" + std::string(3000, '<') + "</opencv_storage>"),
+                      {"deep.xml", "malformed XML"});
+  std::string nested = "<opencv_storage>";
+  for (int i = 0; i < 1000; ++i) nested += "<a>";
+  ExpectErrorMentions(write("nested.xml", nested), {"nested.xml", "malformed XML"});
+  ExpectErrorMentions(
+      write("entities.xml",
+            "<?xml version=\"1.0\"?><!DOCTYPE a [<!ENTITY a \"aaaaaaaaaa\"><!ENTITY b "
+            "\"&a;&a;&a;&a;&a;&a;&a;&a;\">]><opencv_storage><image_width>&b;</image_width>"
+            "</opencv_storage>"),
+      {"entities.xml"});
+  ExpectErrorMentions(write("root.xml", "<calibration><image_width>640</image_width></calibration>"),
+                      {"root.xml", "<opencv_storage>"});
+  ExpectErrorMentions(
+      write("huge_rows.yaml", "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+                              "  rows: 2000000000\n  cols: 3\n  dt: d\n  data: [1, 2, 3]\n"),
+      {"huge_rows.yaml", "'camera_matrix'", "rows and cols"});
+  ExpectErrorMentions(
+      write("short.yaml", "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+                          "  rows: 3\n  cols: 3\n  dt: d\n  data: [1, 2, 3]\n"),
+      {"short.yaml", "data has 3 values, rows x cols = 9"});
+  ExpectErrorMentions(
+      write("nan.yaml", "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+                        "  rows: 1\n  cols: 3\n  dt: d\n  data: [1, .nan, 3]\n"),
+      {"nan.yaml", "not a finite number"});
+  ExpectErrorMentions(
+      write("short.xml", "<opencv_storage><image_width>640</image_width><image_height>480"
+                         "</image_height><camera_matrix type_id=\"opencv-matrix\"><rows>3</rows>"
+                         "<cols>3</cols><dt>d</dt><data>1 2 3</data></camera_matrix></opencv_storage>"),
+      {"short.xml", "data has 3 values"});
+  ExpectErrorMentions(write("binary.yaml", std::string("image_width: 6\x80\x00\n", 16)),
+                      {"binary.yaml", "not ASCII text"});
+  ExpectErrorMentions(write("list.yaml", "- 1\n- 2\n"), {"list.yaml", "not a map"});
+  ExpectErrorMentions(write("big.yaml", std::string((1 << 20) + 1, ' ')),
+                      {"big.yaml", "larger than 1 MiB"});
+}
+
 }  // namespace
 }  // namespace uwscan::scanner::calibration

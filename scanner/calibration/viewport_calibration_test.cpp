@@ -17,6 +17,7 @@
 #include "scanner/common/error.hpp"
 #include "scanner/optics/refractive_camera.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/common/random_draws.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -60,12 +61,14 @@ Dataset MakeDataset(const RefractiveCamera& camera, const PatternSpec& spec, int
   Dataset data;
   while (static_cast<int>(data.observations.size()) < views) {
     const double depth = 1.0 + 0.5 * unit(rng);
-    const Eigen::Vector2d centre_px(1023.5 + 0.8 * 1024.0 * unit(rng),
-                                    543.5 + 0.8 * 544.0 * unit(rng));
+    const Eigen::Vector2d centre_px =
+        Eigen::Vector2d(1023.5, 543.5) + 0.8 * Eigen::Vector2d(1024.0, 544.0).cwiseProduct(
+                                                   DrawVector2(unit, rng));
+    const Eigen::Vector3d angles = DrawVector3(unit, rng);
     Eigen::Isometry3d T_C_O = Eigen::Isometry3d::Identity();
-    T_C_O.linear() = (Eigen::AngleAxisd(35.0 * kDeg * unit(rng), Eigen::Vector3d::UnitX()) *
-                      Eigen::AngleAxisd(35.0 * kDeg * unit(rng), Eigen::Vector3d::UnitY()) *
-                      Eigen::AngleAxisd(std::numbers::pi * unit(rng), Eigen::Vector3d::UnitZ()))
+    T_C_O.linear() = (Eigen::AngleAxisd(35.0 * kDeg * angles.x(), Eigen::Vector3d::UnitX()) *
+                      Eigen::AngleAxisd(35.0 * kDeg * angles.y(), Eigen::Vector3d::UnitY()) *
+                      Eigen::AngleAxisd(std::numbers::pi * angles.z(), Eigen::Vector3d::UnitZ()))
                          .toRotationMatrix();
     const RayTrace ray = camera.PixelToRayInWater(centre_px);
     if (!ray.ok()) continue;
@@ -80,7 +83,7 @@ Dataset MakeDataset(const RefractiveCamera& camera, const PatternSpec& spec, int
       const std::optional<Eigen::Vector2d> uv = camera.ProjectPointInWater(T_C_O * points_O[id]);
       inside = uv && camera.camera.InImage(*uv);
       if (!inside) break;
-      const Eigen::Vector2d jitter(sigma_px * noise(rng), sigma_px * noise(rng));
+      const Eigen::Vector2d jitter = sigma_px * DrawVector2(noise, rng);
       observation.corner_ids.push_back(static_cast<int>(id));
       observation.corners_px.push_back(*uv + jitter);
     }
@@ -322,8 +325,13 @@ TEST(CalibrateCameraViewport, GlassIndexIsBarelyDetermined) {
   options.refine_glass_index = true;
   const TimedRun run = Calibrate(truth, truth.viewport, data, options);
   Print("n_glass refined, thickness held", truth.viewport, run);
+  options.refine_glass_index = false;
+  const TimedRun held = Calibrate(truth, truth.viewport, data, options);
+  // The index trades against the distance: freeing it leaves the index itself undetermined
+  // (std > 1) and the distance ~20 times less certain than with the index known (over 10 here;
+  // the factor varies with the views drawn).
   EXPECT_GT(run.result.n_glass_std, 1.0);
-  EXPECT_GT(run.result.distance_std_m, 0.1);
+  EXPECT_GT(run.result.distance_std_m, 10.0 * held.result.distance_std_m);
   EXPECT_LT(run.result.normal_std_rad, 2e-3);  // the normal is unaffected
 }
 

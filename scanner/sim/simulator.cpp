@@ -239,8 +239,12 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
       const Eigen::Rotation2Dd turn(heading_error);
       if (k > 0) {
         const Eigen::Vector2d moved = (truth.translation() - previous_true).head<2>();
+        // y is drawn before x: the order g++ gave the former Vector2d(normal(rng), normal(rng)),
+        // kept so that dives simulated before stay the same.
+        const double walk_y = normal(rng);
+        const double walk_x = normal(rng);
         believed_xy += speed_scale * (turn * moved) +
-                       drift.position_walk_m_per_sqrt_s * sq * Eigen::Vector2d(normal(rng), normal(rng));
+                       drift.position_walk_m_per_sqrt_s * sq * Eigen::Vector2d(walk_x, walk_y);
       }
       previous_true = truth.translation();
       // Absolute sensors: depth from pressure, roll and pitch from gravity (errors about the
