@@ -218,6 +218,37 @@ TEST(CliAcquisition, CtrlCLeavesAClosedReadableLog) {
   EXPECT_GT(last.peaks_px.size(), 500u);
 }
 
+// SIGKILL mid-stream (no chance to close anything): the log reads, checks clean, and holds the
+// frames committed before the kill, each whole. The killed acquire still holds the camera's
+// control until the camera's heartbeat runs out: the next acquire waits for it and takes over,
+// while an acquire beside a live one is refused, saying why.
+TEST(CliAcquisition, KilledMidStreamTheLogHoldsEveryCommittedFrame) {
+  const std::string scene = SourcePath("data/scenes/default.yaml");
+  auto camera = StartFakeCamera({"fake-camera", scene}, "killed_camera");
+  for (const int after_ms : {300, 1100}) {
+    const fs::path log = TempPath("killed_" + std::to_string(after_ms) + ".db");
+    Background acquire({"acquire", "--camera", "127.0.0.1", "-o", log.string(), "--scene", scene},
+                       TempPath("killed_acquire.log"));
+    ASSERT_TRUE(acquire.WaitFor("profile mode", 20.0)) << acquire.Output();
+    if (after_ms == 300) {
+      const CommandRun second = RunUwscan("acquire --camera 127.0.0.1 --frames 10 -o " +
+                                          TempPath("second.db").string() + " --scene " + scene);
+      EXPECT_NE(second.exit_code, 0);
+      EXPECT_NE(second.output.find("another program controls the camera"), std::string::npos) << second.output;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
+    acquire.Signal(SIGKILL);
+    acquire.Wait();
+    const CommandRun check = RunUwscan("log check " + log.string());
+    EXPECT_EQ(check.exit_code, 0) << check.output;
+    const uwscan::mapping::DiveLogReader reader(log);
+    EXPECT_GT(reader.frame_count(), 0) << "killed after " << after_ms << " ms:\n" << acquire.Output();
+    for (std::int64_t i = 0; i < reader.frame_count(); ++i) {
+      EXPECT_GT(reader.ReadFrame(i).peaks_px.size(), 500u) << "frame " << i;
+    }
+  }
+}
+
 TEST(CliAcquisition, AWrongAddressFailsClearlyWithinSeconds) {
   const Clock::time_point start = Clock::now();
   const CommandRun run = RunUwscan("acquire --camera 127.0.0.2 -o " + TempPath("none.db").string() +

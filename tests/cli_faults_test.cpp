@@ -15,8 +15,10 @@
 #include <fstream>
 #include <iterator>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "tests/cli_run.hpp"
 
@@ -116,37 +118,95 @@ TEST_F(CliFaults, AFullDiskGivesAClearErrorAndKeepsTheOldFile) {
   EXPECT_NE(run.output.find("files: c.ply\n"), std::string::npos) << "a half-written file was left:\n" << run.output;
 }
 
-// Kills a command at random moments over its run: the output is the old file or the new one.
-void KillAtRandomMoments(const std::string& command, const fs::path& output, const std::string& old_bytes,
-                         const std::string& new_bytes, double run_s, int trials) {
+// One output of a command killed at random moments: what it held before, and what a complete run
+// writes (with `normalise` applied: lines that differ between runs, such as timings, dropped).
+struct KilledOutput {
+  fs::path path;
+  std::string old_bytes;
+  std::string new_bytes;
+};
+
+// A calibration file without the lines of its record that differ between runs (when, how long).
+std::string WithoutRunRecord(const std::string& text) {
+  std::istringstream lines(text);
+  std::string kept, line;
+  while (std::getline(lines, line)) {
+    if (line.find("seconds:") == std::string::npos && line.find("date_utc:") == std::string::npos) kept += line + '\n';
+  }
+  return kept;
+}
+
+pid_t StartShell(const std::string& command) {
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::execl("/bin/sh", "sh", "-c", ("exec " + command + " >/dev/null 2>&1").c_str(), nullptr);
+    ::_exit(127);
+  }
+  return child;
+}
+
+// Runs `command` once to the end (for the complete outputs and its duration), then kills it with
+// SIGKILL at random moments, half over the whole run and half over its last fifth, where the
+// outputs are written: each output must then be its old bytes or the complete new ones.
+void KillAtRandomMoments(const std::string& command, std::vector<KilledOutput> outputs, int trials,
+                         std::string (*normalise)(const std::string&) = nullptr) {
+  const auto normalised = [normalise](const std::string& bytes) { return normalise ? normalise(bytes) : bytes; };
+  for (const KilledOutput& output : outputs) fs::remove(output.path);
+  const auto start = std::chrono::steady_clock::now();
+  const CommandRun complete = RunCommand(command);
+  const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(complete.exit_code, 0) << command << "\n" << complete.output;
+  for (KilledOutput& output : outputs) output.new_bytes = normalised(Bytes(output.path));
+
   std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> moment(0.0, run_s);
+  std::uniform_real_distribution<double> anywhere(0.0, run_s), near_the_end(0.8 * run_s, 1.05 * run_s);
   for (int trial = 0; trial < trials; ++trial) {
-    { std::ofstream(output, std::ios::binary) << old_bytes; }
-    const pid_t child = ::fork();
+    for (const KilledOutput& output : outputs) std::ofstream(output.path, std::ios::binary) << output.old_bytes;
+    const double moment_s = trial % 2 == 0 ? anywhere(rng) : near_the_end(rng);
+    const pid_t child = StartShell(command);
     ASSERT_GE(child, 0);
-    if (child == 0) {
-      ::execl("/bin/sh", "sh", "-c", ("exec " + command + " >/dev/null 2>&1").c_str(), nullptr);
-      ::_exit(127);
-    }
-    std::this_thread::sleep_for(std::chrono::duration<double>(moment(rng)));
+    std::this_thread::sleep_for(std::chrono::duration<double>(moment_s));
     ::kill(child, SIGKILL);
-    int status = 0;
-    ::waitpid(child, &status, 0);
-    const std::string now = Bytes(output);
-    EXPECT_TRUE(now == old_bytes || now == new_bytes)
-        << command << ": killed after trial " << trial << " left " << now.size() << " bytes (old " << old_bytes.size()
-        << ", new " << new_bytes.size() << ")";
+    ::waitpid(child, nullptr, 0);
+    for (const KilledOutput& output : outputs) {
+      const std::string now = Bytes(output.path);
+      EXPECT_TRUE(now == output.old_bytes || normalised(now) == output.new_bytes)
+          << command << ": killed after " << moment_s << " s (of " << run_s << "), " << output.path << " holds "
+          << now.size() << " bytes (old " << output.old_bytes.size() << ", new " << output.new_bytes.size() << ")";
+    }
   }
 }
 
 TEST_F(CliFaults, KilledAtAnyMomentTheOutputIsTheOldFileOrACompleteNewOne) {
   const std::string old_bytes = Bytes(dir_ / "old.ply");
-  const std::string bin = UWSCAN_BIN;
-  // reconstruct: the new cloud is known (the same command run to the end).
+  const std::string bin = UWSCAN_BIN, dive = (dir_ / "dive.db").string();
   const fs::path cloud = dir_ / "killed.ply";
-  const std::string reconstruct = bin + " reconstruct " + (dir_ / "dive.db").string() + " -o " + cloud.string();
-  KillAtRandomMoments(reconstruct, cloud, old_bytes, Bytes(dir_ / "cloud.ply"), 1.5, 8);
+  KillAtRandomMoments(bin + " reconstruct " + dive + " -o " + cloud.string(), {{cloud, old_bytes, ""}}, 8);
+
+  const fs::path registered = dir_ / "registered.ply";
+  KillAtRandomMoments(bin + " register " + (dir_ / "cloud.ply").string() + " " + (dir_ / "old.ply").string() +
+                          " -o " + registered.string(),
+                      {{registered, old_bytes, ""}}, 8);
+
+  const fs::path map = dir_ / "map.ply", trajectory = dir_ / "slam.tum";
+  KillAtRandomMoments(bin + " map " + dive + " -o " + map.string() + " --trajectory " + trajectory.string(),
+                      {{map, old_bytes, ""}, {trajectory, "0 0 0 0 0 0 0 1\n", ""}}, 8);
+
+  const fs::path database = dir_ / "objects.db";
+  KillAtRandomMoments(bin + " build-db pipe -o " + database.string(), {{database, "old database", ""}}, 6);
+
+  // calibrate on a small simulated intrinsics dataset; its record holds the run's date and duration.
+  const fs::path scene = dir_ / "calibration.yaml", dataset = dir_ / "calibration_dataset";
+  std::ofstream(scene) << "uwscan_format: 1\nseed: 5\nwater: {refractive_index: 1.0}\nscanner:\n  file: "
+                       << UWSCAN_SOURCE_DIR << "/data/scanners/galvo_default.yaml\neffects:\n  refraction: false\n"
+                       << "  image: {format: mono8}\ncalibration:\n  step: intrinsics\n  pattern: {type: chessboard, "
+                       << "columns: 9, rows: 6, square_m: 0.03}\n  views: 6\n  distance_m: [0.5, 0.8]\n"
+                       << "  max_tilt_rad: 0.5\n  image_scale: 0.5\n";
+  ASSERT_EQ(RunUwscan("simulate " + scene.string() + " -o " + dataset.string()).exit_code, 0);
+  const fs::path calibration = dir_ / "calibrated.yaml";
+  KillAtRandomMoments(bin + " calibrate intrinsics " + dataset.string() + " -o " + calibration.string() +
+                          " --from " + UWSCAN_SOURCE_DIR + "/data/scanners/galvo_default.yaml",
+                      {{calibration, "old: calibration\n", ""}}, 8, WithoutRunRecord);
 
   // simulate --force over an older log: the output stays a readable log, old or new.
   const fs::path log = dir_ / "killed.db";

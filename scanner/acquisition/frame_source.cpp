@@ -74,6 +74,9 @@ void CameraSettings::Check() const {
   if (!(frame_retention_s > 0.0 && frame_retention_s <= 60.0)) {
     throw Error("camera settings: frame_retention_s must be in (0, 60] s");
   }
+  if (!(control_wait_s >= 0.0 && control_wait_s <= 3600.0)) {
+    throw Error("camera settings: control_wait_s must be in [0, 3600] s");
+  }
   if (trigger == TriggerMode::kLine && trigger_line.empty()) {
     throw Error("camera settings: trigger_line is empty (expected e.g. Line0)");
   }
@@ -116,7 +119,8 @@ struct FrameSource::Impl {
     self->ready.notify_one();
   }
 
-  void Open() {
+  // Opens the camera, waiting up to `control_wait_s` for control of it (0: one attempt).
+  void Open(double control_wait_s) {
     GError* error = nullptr;
     camera = arv_camera_new(settings.address.c_str(), &error);
     if (camera == nullptr || error != nullptr) {
@@ -126,10 +130,32 @@ struct FrameSource::Impl {
       throw Error("camera " + settings.address + ": no GigE Vision camera answers there (" + message + ")");
     }
     try {
+      TakeControl(control_wait_s);
       Configure();
     } catch (...) {
       g_clear_object(&camera);
       throw;
+    }
+  }
+
+  // Aravis asks for control when it opens a GigE camera and carries on as a monitor when
+  // refused. A controller that died keeps the camera until its heartbeat runs out: ask again
+  // until then, so that a restarted acquire takes over from a killed one.
+  void TakeControl(double wait_s) {
+    const std::string where = "camera " + settings.address;
+    if (!arv_camera_is_gv_device(camera)) throw Error(where + ": not a GigE Vision camera");
+    ArvGvDevice* device = ARV_GV_DEVICE(arv_camera_get_device(camera));
+    const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                          std::chrono::duration<double>(wait_s));
+    while (!arv_gv_device_is_controller(device)) {
+      if (Clock::now() >= deadline) {
+        throw Error(where + ": another program controls the camera (still refused after " +
+                    std::to_string(static_cast<int>(std::ceil(wait_s))) + " s; is another acquire running?)");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      GError* error = nullptr;
+      arv_gv_device_take_control(device, &error);
+      if (error != nullptr) g_error_free(error);
     }
   }
 
@@ -247,6 +273,10 @@ struct FrameSource::Impl {
 
   void StartAcquisition() {
     GError* error = nullptr;
+    // A controller that died may have left the camera acquiring, still sending to its own
+    // (now closed) port: stop first, so that the start sends to this stream.
+    arv_camera_stop_acquisition(camera, &error);
+    if (error != nullptr) g_clear_error(&error);
     arv_camera_start_acquisition(camera, &error);
     ThrowIf(error, "camera " + settings.address + ": AcquisitionStart refused");
   }
@@ -289,7 +319,7 @@ struct FrameSource::Impl {
     if (camera != nullptr || now < next_reopen_attempt) return;
     ++stats.gaps.back().reopen_attempts;
     try {
-      Open();
+      Open(0.0);  // one attempt: the watchdog tries again shortly
       CreateStream();
       StartAcquisition();
       ++session;
@@ -304,7 +334,7 @@ struct FrameSource::Impl {
 FrameSource::FrameSource(const CameraSettings& settings) : impl_(std::make_unique<Impl>()) {
   settings.Check();
   impl_->settings = settings;
-  impl_->Open();
+  impl_->Open(settings.control_wait_s);
 }
 
 FrameSource::~FrameSource() {

@@ -54,6 +54,10 @@ struct CameraSettings {
   // Frames still incomplete after this long are handed over incomplete (Aravis's frame
   // retention), seconds.
   double frame_retention_s = 0.2;
+  // When opening, how long to wait for another controller to let go of the camera, seconds. A
+  // program that died holding it (a killed acquire) keeps it until the camera's heartbeat
+  // timeout (GigE Vision's default: 3 s) runs out; a live one keeps it.
+  double control_wait_s = 5.0;
 
   // Throws uwscan::Error naming the field when a value is out of range.
   void Check() const;
