@@ -22,6 +22,7 @@
 #include "apps/recognition_bench_command.hpp"
 #include "apps/recognition_commands.hpp"
 #include "apps/robustness_bench_command.hpp"
+#include "apps/thread_bench_command.hpp"
 #include "apps/plot_commands.hpp"
 #include "apps/simulation_bench_command.hpp"
 #include "apps/slam_bench_command.hpp"
@@ -76,6 +77,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddViewerBenchCommand(*bench);
   uwscan::app::AddAcquisitionBenchCommand(*bench);
   uwscan::app::AddRobustnessBenchCommand(*bench);
+  uwscan::app::AddThreadBenchCommand(*bench);
 
   try {
     app.parse(argc, argv);
