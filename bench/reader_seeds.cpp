@@ -135,6 +135,14 @@ void WriteCalibrationSeeds(const fs::path& folder) {
             "   data: [ 2400., 0., 1024., 0., 2400., 544., 0., 0., 1. ]\n"
             "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
             "   data: [ -0.1, 0.05, 0.001, -0.001, 0. ]\n");
+  // The same in OpenCV's XML layout (read by content, whatever the file's name).
+  WriteText(folder / "opencv_intrinsics" / "seed_1.yaml",
+            "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>2048</image_width>\n"
+            "<image_height>1088</image_height>\n<camera_matrix type_id=\"opencv-matrix\">\n  <rows>3</rows>\n"
+            "  <cols>3</cols>\n  <dt>d</dt>\n  <data>\n    2400. 0. 1024. 0. 2400. 544. 0. 0. 1.</data></camera_matrix>\n"
+            "<distortion_coefficients type_id=\"opencv-matrix\">\n  <rows>5</rows>\n  <cols>1</cols>\n"
+            "  <dt>d</dt>\n  <data>\n    -0.1 0.05 0.001 -0.001 0.</data></distortion_coefficients>\n"
+            "</opencv_storage>\n");
 }
 
 void WriteReportSeeds(const fs::path& folder) {

@@ -121,7 +121,6 @@ TEST(LaserViewportCalibrationTest, RecoversTheViewportFromExactPoints) {
   EXPECT_LT(Angle(result.viewport.normal, truth.laser.viewport.normal), 1e-10);
   EXPECT_NEAR(result.viewport.distance_m, truth.laser.viewport.distance_m, 1e-11);
   EXPECT_NEAR(result.viewport.thickness_m, truth.laser.viewport.thickness_m, 1e-11);
-  EXPECT_LT(Seconds(start), 3.0);
 
   // The seed's p+: the ray-ray triangulator with the refined viewport gives back the points.
   const RayRayTriangulator triangulator(WithLaserViewport(truth, result.viewport));
