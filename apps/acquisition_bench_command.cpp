@@ -40,7 +40,13 @@ struct AcquisitionBenchArgs {
 
 struct StreamFigures {
   double requested_fps = 0.0;
+  // Rates over the span from the first to the last frame received (the wait for the first frame
+  // left out): frames received per second of the host's clock, and frames the camera made per
+  // second of its own clock. The fake camera shares this machine's CPUs with the receiver (and
+  // the mapper), and its frame clock can fall behind the rate asked of it.
+  double camera_frames_per_s = 0.0;
   double frames_per_s = 0.0;
+  double frames_per_s_wall = 0.0;  // frames received / seconds from Start(), the wait included
   double mb_per_s = 0.0;
   std::int64_t frames = 0;
   std::int64_t lost_frames = 0;
@@ -84,10 +90,15 @@ StreamFigures Stream(const scanner::sim::Simulator& simulator, const std::string
                                                            mapping::NavigationNoise{}, inspection_options);
   }
   std::vector<double> latencies;
+  std::optional<acq::AcquiredFrame> first, last;
+  std::int64_t received = 0;
   source.Start();
   while (source.ElapsedSeconds() < seconds) {
     std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
     if (!frame) continue;
+    ++received;
+    if (!first) first = *frame;
+    last = *frame;
     std::optional<mapping::FrameRecord> record = decoder.Decode(*frame);
     if (!record) continue;
     if (!record->peaks_px.empty()) {
@@ -100,9 +111,14 @@ StreamFigures Stream(const scanner::sim::Simulator& simulator, const std::string
   const acq::FrameSourceStatistics s = source.statistics();
   StreamFigures f;
   f.requested_fps = camera.frame_rate_hz();
+  if (received < 2) throw Error("bench acquisition: fewer than 2 frames received in " + std::to_string(seconds) + " s");
+  f.camera_frames_per_s = static_cast<double>(last->frame_number - first->frame_number) /
+                          (static_cast<double>(last->camera_timestamp_ns - first->camera_timestamp_ns) * 1e-9);
+  f.frames_per_s = static_cast<double>(received - 1) /
+                   (static_cast<double>(last->host_timestamp_ns - first->host_timestamp_ns) * 1e-9);
   f.frames = s.frames;
-  f.frames_per_s = s.frames / elapsed;
-  f.mb_per_s = s.bytes / elapsed * 1e-6;
+  f.frames_per_s_wall = s.frames / elapsed;
+  f.mb_per_s = s.frames > 0 ? static_cast<double>(s.bytes) / static_cast<double>(s.frames) * f.frames_per_s * 1e-6 : 0.0;
   f.lost_frames = s.lost_frames;
   if (!latencies.empty()) {
     std::nth_element(latencies.begin(), latencies.begin() + latencies.size() / 2, latencies.end());
@@ -148,7 +164,10 @@ double PeerFramesPerSecond(const scanner::sim::Simulator& simulator, acq::FakeCa
 
 // latency_s: capture to points in the map when the run mapped, else capture to peaks.
 nlohmann::json ToJson(const StreamFigures& f) {
-  nlohmann::json j = {{"requested_frames_per_s", f.requested_fps}, {"frames_per_s", f.frames_per_s},
+  nlohmann::json j = {{"requested_frames_per_s", f.requested_fps},
+                      {"camera_frames_per_s", f.camera_frames_per_s},
+                      {"frames_per_s", f.frames_per_s},
+                      {"frames_per_s_wall", f.frames_per_s_wall},
                       {"mb_per_s", f.mb_per_s}, {"frames", f.frames}, {"lost_frames", f.lost_frames},
                       {"latency_s", f.latency_to_map_s.value_or(f.latency_to_peaks_s)},
                       {"latency_to_peaks_s", f.latency_to_peaks_s}};
@@ -161,8 +180,10 @@ nlohmann::json ToJson(const StreamFigures& f) {
 }
 
 void Print(const char* name, const StreamFigures& f) {
-  std::printf("%-16s asked %6.0f frames/s: got %7.1f frames/s, %7.2f MB/s, %lld lost of %lld, latency to peaks %.2f ms",
-              name, f.requested_fps, f.frames_per_s, f.mb_per_s, static_cast<long long>(f.lost_frames),
+  std::printf("%-16s asked %6.0f frames/s, camera made %7.1f: got %7.1f frames/s, %7.2f MB/s, %lld lost of %lld, "
+              "latency to peaks %.2f ms",
+              name, f.requested_fps, f.camera_frames_per_s, f.frames_per_s, f.mb_per_s,
+              static_cast<long long>(f.lost_frames),
               static_cast<long long>(f.frames + f.lost_frames), f.latency_to_peaks_s * 1e3);
   if (f.latency_to_map_s) {
     std::printf(", to the map %.2f ms (%lld frames mapped, %lld skipped)", *f.latency_to_map_s * 1e3,
@@ -220,6 +241,10 @@ void RunAcquisitionBench(const AcquisitionBenchArgs& a) {
                                      {"image_frames_per_s", peer_image},
                                      {"profile_ratio", ceiling.frames_per_s / peer_profile},
                                      {"image_ratio", image_ceiling.frames_per_s / peer_image}}},
+                           {"rates_measured_over",
+                            "frames_per_s and mb_per_s: the span from the first to the last frame received (host "
+                            "clock); camera_frames_per_s: the camera's frame numbers over its own clock in that span; "
+                            "frames_per_s_wall: frames / seconds from the start of acquisition"},
                            {"latency_measured_to",
                             "latency_s: capture (camera clock) to points in the live map (LiveInspection, as `uwscan "
                             "inspect`) at 339 and 60 frames/s; ceilings: to peaks on the host (no map)"},

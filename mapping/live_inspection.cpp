@@ -1,5 +1,10 @@
 #include "mapping/live_inspection.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cerrno>
+
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
@@ -66,6 +71,7 @@ void InspectionOptions::Check() const {
   if (log_queue_bytes == 0) fail("log_queue_bytes", "> 0 bytes");
   if (live_queue_frames < 1) fail("live_queue_frames", ">= 1");
   if (!(map_voxel_m > 0.0)) fail("map_voxel_m", "> 0 m");
+  if (mapper_nice < 0 || mapper_nice > 19) fail("mapper_nice", "in [0, 19]");
   mapper.Check();
 }
 
@@ -142,6 +148,12 @@ struct LiveInspection::Impl {
   }
 
   void Run() {
+    // On Linux a thread's nice value is its own (PRIO_PROCESS with its thread id) and the threads
+    // it starts inherit it. Being nicer never needs a privilege; failing to be is no error.
+    const id_t thread_id = static_cast<id_t>(::gettid());
+    errno = 0;
+    const int nice_now = ::getpriority(PRIO_PROCESS, thread_id);
+    if (errno == 0) ::setpriority(PRIO_PROCESS, thread_id, std::min(19, nice_now + options.mapper_nice));
     std::unique_lock<std::mutex> lock(mutex);
     while (true) {
       changed.wait(lock, [this] { return !live.empty() || !navigation.empty() || finishing; });

@@ -37,6 +37,11 @@ struct InspectionOptions {
   // is no drift to close). False: the caller feeds the vehicle's navigation (AddNavigation) and
   // frames wait in the mapper until it covers their time.
   bool fixed_scanner = true;
+  // The mapping thread (and the OpenMP threads it starts) runs this much nicer than the caller,
+  // [0, 19] (Linux nice increments): when the CPUs are short, receiving and recording frames,
+  // which must not lose one, keep them, and the live map, which takes the newest frames and
+  // skips the rest anyway, gets what is left.
+  int mapper_nice = 10;
   MapperOptions mapper;
   // Voxel of the map Finish() returns, metres, > 0; also the submaps' (it replaces
   // mapper.clouds.map_voxel_m: the map cannot be finer than its submaps).

@@ -2,6 +2,7 @@
 
 #include <arv.h>
 #include <omp.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "scanner/acquisition/fake_camera_wakeup.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::scanner {
@@ -84,12 +86,24 @@ struct FakeCamera::Impl {
   std::vector<int> frame_sweeps;
 
   ArvGvFakeCamera* gv = nullptr;
+  std::unique_ptr<FakeCameraWakeup> wakeup;  // stopped before gv goes (see ~FakeCamera)
   std::atomic<std::uint64_t> sent{0};
   std::atomic<std::uint64_t> dropped{0};
   std::atomic<std::uint64_t> peaks_lost{0};
   std::uint64_t counter = 0;  // fake camera thread only
+  bool thread_prioritised = false;  // fake camera thread only
 
   explicit Impl(const sim::Simulator& simulator) : driver(simulator.scan_pattern()) {}
+
+  // A real camera has a processor of its own; this one shares the host's CPUs with whatever
+  // receives its frames, and Aravis's frame clock skips a frame period whenever its thread waits
+  // for a CPU past one. The thread (Aravis's, seen first here) is made less nice where the
+  // process may do so (root, or CAP_SYS_NICE); elsewhere it runs as it was.
+  void PrioritiseThisThread() {
+    thread_prioritised = true;
+    const id_t thread_id = static_cast<id_t>(::gettid());
+    ::setpriority(PRIO_PROCESS, thread_id, -10);
+  }
 
   static void Fill(ArvBuffer* buffer, void* data, guint32 exposure_us, guint32 /*gain*/,
                    ArvPixelFormat pixel_format) {
@@ -97,6 +111,7 @@ struct FakeCamera::Impl {
   }
 
   void FillFrame(ArvBuffer* buffer, guint32 exposure_us, ArvPixelFormat pixel_format) {
+    if (!thread_prioritised) PrioritiseThisThread();
     const std::uint64_t n = counter++;
     const std::int64_t index = static_cast<std::int64_t>(n % static_cast<std::uint64_t>(frame_count));
     const std::uint64_t pass = n / static_cast<std::uint64_t>(frame_count);
@@ -275,6 +290,12 @@ struct FakeCamera::Impl {
     arv_fake_camera_write_register(camera, kRegImageWidth, static_cast<guint32>(image_width));
     arv_fake_camera_write_register(camera, kRegImageHeight, static_cast<guint32>(image_height));
     arv_fake_camera_set_fill_pattern(camera, &Impl::Fill, this);
+    // A wake-up well inside a frame period (see FakeCameraWakeup), at most every 0.5 ms.
+    const int wakeup_period_us = static_cast<int>(std::clamp(0.25e6 / frame_rate, 250.0, 500.0));
+    constexpr guint32 kCurrentIpAddressRegister = 0x0024;  // GigE Vision bootstrap register
+    guint32 ip = 0;
+    arv_fake_camera_read_register(camera, kCurrentIpAddressRegister, &ip);
+    wakeup = std::make_unique<FakeCameraWakeup>(ip, wakeup_period_us);
   }
 };
 
@@ -289,6 +310,7 @@ FakeCamera::FakeCamera(const sim::Simulator& simulator, const FakeCameraOptions&
 
 FakeCamera::~FakeCamera() {
   // Stops the fake camera's thread (joined) before the frames it reads go away.
+  impl_->wakeup.reset();
   if (impl_->gv != nullptr) g_clear_object(&impl_->gv);
 }
 
