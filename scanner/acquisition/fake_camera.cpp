@@ -2,7 +2,6 @@
 
 #include <arv.h>
 #include <omp.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -91,19 +90,8 @@ struct FakeCamera::Impl {
   std::atomic<std::uint64_t> dropped{0};
   std::atomic<std::uint64_t> peaks_lost{0};
   std::uint64_t counter = 0;  // fake camera thread only
-  bool thread_prioritised = false;  // fake camera thread only
 
   explicit Impl(const sim::Simulator& simulator) : driver(simulator.scan_pattern()) {}
-
-  // A real camera has a processor of its own; this one shares the host's CPUs with whatever
-  // receives its frames, and Aravis's frame clock skips a frame period whenever its thread waits
-  // for a CPU past one. The thread (Aravis's, seen first here) is made less nice where the
-  // process may do so (root, or CAP_SYS_NICE); elsewhere it runs as it was.
-  void PrioritiseThisThread() {
-    thread_prioritised = true;
-    const id_t thread_id = static_cast<id_t>(::gettid());
-    ::setpriority(PRIO_PROCESS, thread_id, -10);
-  }
 
   static void Fill(ArvBuffer* buffer, void* data, guint32 exposure_us, guint32 /*gain*/,
                    ArvPixelFormat pixel_format) {
@@ -111,7 +99,6 @@ struct FakeCamera::Impl {
   }
 
   void FillFrame(ArvBuffer* buffer, guint32 exposure_us, ArvPixelFormat pixel_format) {
-    if (!thread_prioritised) PrioritiseThisThread();
     const std::uint64_t n = counter++;
     const std::int64_t index = static_cast<std::int64_t>(n % static_cast<std::uint64_t>(frame_count));
     const std::uint64_t pass = n / static_cast<std::uint64_t>(frame_count);
