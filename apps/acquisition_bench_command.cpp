@@ -90,15 +90,22 @@ StreamFigures Stream(const scanner::sim::Simulator& simulator, const std::string
                                                            mapping::NavigationNoise{}, inspection_options);
   }
   std::vector<double> latencies;
-  std::optional<acq::AcquiredFrame> first, last;
+  // The first and last frame received (not their pixels: copying those would cost time here).
+  struct FrameMark {
+    std::int64_t frame_number = 0;
+    std::uint64_t camera_ns = 0, host_ns = 0;
+    std::int64_t session = 0;
+  };
+  std::optional<FrameMark> first;
+  FrameMark last;
   std::int64_t received = 0;
   source.Start();
   while (source.ElapsedSeconds() < seconds) {
     std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
     if (!frame) continue;
     ++received;
-    if (!first) first = *frame;
-    last = *frame;
+    last = {frame->frame_number, frame->camera_timestamp_ns, frame->host_timestamp_ns, frame->session};
+    if (!first) first = last;
     std::optional<mapping::FrameRecord> record = decoder.Decode(*frame);
     if (!record) continue;
     if (!record->peaks_px.empty()) {
@@ -111,11 +118,15 @@ StreamFigures Stream(const scanner::sim::Simulator& simulator, const std::string
   const acq::FrameSourceStatistics s = source.statistics();
   StreamFigures f;
   f.requested_fps = camera.frame_rate_hz();
-  if (received < 2) throw Error("bench acquisition: fewer than 2 frames received in " + std::to_string(seconds) + " s");
-  f.camera_frames_per_s = static_cast<double>(last->frame_number - first->frame_number) /
-                          (static_cast<double>(last->camera_timestamp_ns - first->camera_timestamp_ns) * 1e-9);
-  f.frames_per_s = static_cast<double>(received - 1) /
-                   (static_cast<double>(last->host_timestamp_ns - first->host_timestamp_ns) * 1e-9);
+  if (received < 2 || last.host_ns <= first->host_ns || last.camera_ns <= first->camera_ns) {
+    throw Error("bench acquisition: fewer than 2 frames received in " + std::to_string(seconds) + " s");
+  }
+  if (last.session != first->session) {
+    throw Error("bench acquisition: the camera was reopened during the run (it went silent); run again");
+  }
+  f.camera_frames_per_s = static_cast<double>(last.frame_number - first->frame_number) /
+                          (static_cast<double>(last.camera_ns - first->camera_ns) * 1e-9);
+  f.frames_per_s = static_cast<double>(received - 1) / (static_cast<double>(last.host_ns - first->host_ns) * 1e-9);
   f.frames = s.frames;
   f.frames_per_s_wall = s.frames / elapsed;
   f.mb_per_s = s.frames > 0 ? static_cast<double>(s.bytes) / static_cast<double>(s.frames) * f.frames_per_s * 1e-6 : 0.0;

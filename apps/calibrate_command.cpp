@@ -85,7 +85,7 @@ void RunImportIntrinsics(const ImportArgs& a) {
 void AddImportIntrinsicsCommand(CLI::App& app) {
   auto args = std::make_shared<ImportArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "import-intrinsics", "put intrinsics from OpenCV's calibration YAML into a scanner file");
+      "import-intrinsics", "put intrinsics from OpenCV's calibration YAML or XML into a scanner file");
   cmd->add_option("opencv_yaml", args->opencv_yaml, "camera_matrix + distortion_coefficients (OpenCV)")
       ->required()
       ->check(CLI::ExistingFile);

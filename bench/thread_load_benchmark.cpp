@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sched.h>
+#include <sys/prctl.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -23,18 +24,38 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The highest-numbered CPU this process may run on.
+int LastCpu() {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (::sched_getaffinity(0, sizeof(allowed), &allowed) != 0) {
+    throw Error(std::string("bench threads: cannot read the CPUs allowed (") + std::strerror(errno) + ")");
+  }
+  int last = -1;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (CPU_ISSET(cpu, &allowed)) last = cpu;
+  }
+  if (CPU_COUNT(&allowed) < 2) throw Error("bench threads: needs 2 CPUs or more (this process may use 1)");
+  return last;
+}
+
 // Another program keeping one CPU busy: a child process pinned to the last CPU, spinning until
 // it is killed (here, or by the destructor on any way out).
 class SpinningProcess {
  public:
   SpinningProcess() {
+    const int cpu = LastCpu();
+    const pid_t parent = ::getpid();
     pid_ = ::fork();
     if (pid_ < 0) throw Error(std::string("bench threads: cannot start the load process (") + std::strerror(errno) + ")");
     if (pid_ == 0) {
+      // Never outlive the benchmark, however it ends.
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (::getppid() != parent) ::_exit(0);
       cpu_set_t cpus;
       CPU_ZERO(&cpus);
-      CPU_SET(static_cast<int>(std::thread::hardware_concurrency()) - 1, &cpus);
-      ::sched_setaffinity(0, sizeof(cpus), &cpus);
+      CPU_SET(cpu, &cpus);
+      if (::sched_setaffinity(0, sizeof(cpus), &cpus) != 0) ::_exit(1);
       while (true) asm volatile("" ::: "memory");  // a loop the compiler must keep
     }
   }
@@ -74,26 +95,29 @@ std::vector<char*> Pointers(std::vector<std::string>& strings) {
   return pointers;
 }
 
-// Runs uwscan with `arguments` (output discarded) and returns its wall-clock time.
-double TimedRun(const ThreadLoadOptions& options, const Workload& workload, const std::string& policy, int threads) {
+// Runs uwscan with `arguments` and returns its wall-clock time; its output goes to `log`.
+double TimedRun(const ThreadLoadOptions& options, const Workload& workload, const std::string& policy, int threads,
+                const std::filesystem::path& log) {
   std::vector<std::string> argv = {options.uwscan.string()};
   argv.insert(argv.end(), workload.arguments.begin(), workload.arguments.end());
   std::vector<std::string> env = ChildEnvironment(policy, threads);
   std::vector<char*> c_argv = Pointers(argv), c_env = Pointers(env);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
   const Clock::time_point start = Clock::now();
   pid_t child = -1;
   const int spawned = posix_spawn(&child, argv[0].c_str(), &actions, nullptr, c_argv.data(), c_env.data());
   posix_spawn_file_actions_destroy(&actions);
   if (spawned != 0) throw Error("bench threads: cannot run " + argv[0] + " (" + std::strerror(spawned) + ")");
   int status = 0;
-  ::waitpid(child, &status, 0);
+  const bool waited = ::waitpid(child, &status, 0) == child;
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    throw Error("bench threads: `uwscan " + workload.name + "` failed (run it alone to see why)");
+  if (!waited || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::string command;
+    for (const std::string& a : argv) command += (command.empty() ? "" : " ") + a;
+    throw Error("bench threads: `" + command + "` failed (its output: " + log.string() + ")");
   }
   return seconds;
 }
@@ -154,7 +178,7 @@ ThreadLoadResult RunThreadLoadBenchmark(const ThreadLoadOptions& options, const 
         if (timing.loaded != loaded) continue;
         const auto workload = std::find_if(workloads.begin(), workloads.end(),
                                            [&](const Workload& w) { return w.name == timing.workload; });
-        timing.runs_s.push_back(TimedRun(options, *workload, timing.policy, timing.threads));
+        timing.runs_s.push_back(TimedRun(options, *workload, timing.policy, timing.threads, scratch / "command.log"));
         if (progress) progress(loaded ? "other CPU loaded" : "idle", static_cast<double>(++done) / total);
       }
     }

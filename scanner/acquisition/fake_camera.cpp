@@ -85,13 +85,21 @@ struct FakeCamera::Impl {
   std::vector<int> frame_sweeps;
 
   ArvGvFakeCamera* gv = nullptr;
-  std::unique_ptr<FakeCameraWakeup> wakeup;  // stopped before gv goes (see ~FakeCamera)
+  std::unique_ptr<FakeCameraWakeup> wakeup;  // stopped before gv goes (see ~Impl)
   std::atomic<std::uint64_t> sent{0};
   std::atomic<std::uint64_t> dropped{0};
   std::atomic<std::uint64_t> peaks_lost{0};
   std::uint64_t counter = 0;  // fake camera thread only
 
   explicit Impl(const sim::Simulator& simulator) : driver(simulator.scan_pattern()) {}
+  // Stops the wake-up, then the fake camera's thread (joined), before the frames it reads go
+  // away; also when Start() fails half-way.
+  ~Impl() {
+    wakeup.reset();
+    if (gv != nullptr) g_clear_object(&gv);
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
 
   static void Fill(ArvBuffer* buffer, void* data, guint32 exposure_us, guint32 /*gain*/,
                    ArvPixelFormat pixel_format) {
@@ -295,11 +303,7 @@ FakeCamera::FakeCamera(const sim::Simulator& simulator, const FakeCameraOptions&
   impl_->Start();
 }
 
-FakeCamera::~FakeCamera() {
-  // Stops the fake camera's thread (joined) before the frames it reads go away.
-  impl_->wakeup.reset();
-  if (impl_->gv != nullptr) g_clear_object(&impl_->gv);
-}
+FakeCamera::~FakeCamera() = default;
 
 FakeCameraStatistics FakeCamera::statistics() const {
   FakeCameraStatistics s;

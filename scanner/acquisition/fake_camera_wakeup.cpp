@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstring>
 #include <string>
+#include <system_error>
 
 #include "scanner/common/error.hpp"
 
@@ -33,7 +34,12 @@ std::array<std::uint8_t, 12> ReadVersionRegister(std::uint16_t request_id) {
 FakeCameraWakeup::FakeCameraWakeup(std::uint32_t ipv4_host_order, int period_us) {
   socket_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (socket_ < 0) throw Error(std::string("fake camera: cannot open a UDP socket (") + std::strerror(errno) + ")");
-  thread_ = std::thread([this, ipv4_host_order, period_us] { Run(ipv4_host_order, period_us); });
+  try {
+    thread_ = std::thread([this, ipv4_host_order, period_us] { Run(ipv4_host_order, period_us); });
+  } catch (const std::system_error& e) {
+    ::close(socket_);
+    throw Error(std::string("fake camera: cannot start the wake-up thread (") + e.what() + ")");
+  }
 }
 
 FakeCameraWakeup::~FakeCameraWakeup() {

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <mutex>
@@ -147,10 +148,14 @@ struct FrameSource::Impl {
     ArvGvDevice* device = ARV_GV_DEVICE(arv_camera_get_device(camera));
     const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                           std::chrono::duration<double>(wait_s));
+    const Clock::time_point start = Clock::now();
     while (!arv_gv_device_is_controller(device)) {
       if (Clock::now() >= deadline) {
-        throw Error(where + ": another program controls the camera (still refused after " +
-                    std::to_string(static_cast<int>(std::ceil(wait_s))) + " s; is another acquire running?)");
+        const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
+        char seconds[32];
+        std::snprintf(seconds, sizeof seconds, "%.1f", waited_s);
+        throw Error(where + ": another program controls the camera (control refused, waited " + seconds +
+                    " s; is another acquire running?)");
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(250));
       GError* error = nullptr;

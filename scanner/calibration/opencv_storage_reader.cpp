@@ -45,26 +45,29 @@ std::string_view Trimmed(std::string_view text) {
   return text.substr(first, last - first + 1);
 }
 
-// The checks every matrix passes, whichever syntax carried it.
-OpenCvMatrix MakeMatrix(const std::string& name, std::string_view rows, std::string_view cols,
-                        std::string_view dt, const std::vector<std::string_view>& values) {
-  const std::string node = "node '" + name + "': ";
-  const auto r = ParseWhole<int>(Trimmed(rows));
-  const auto c = ParseWhole<int>(Trimmed(cols));
+// The checks every matrix read passes, whichever syntax carried it. dt is OpenCV's element
+// type: one channel of u, c, w, s, i, f or d (bytes to doubles; all read as double).
+OpenCvMatrix MakeMatrix(const std::string& name, const OpenCvNode& node) {
+  const std::string where = "node '" + name + "': ";
+  if (!node.malformed.empty()) Refuse(where + node.malformed);
+  const auto r = ParseWhole<int>(Trimmed(node.rows));
+  const auto c = ParseWhole<int>(Trimmed(node.cols));
   if (!r || !c || *r < 1 || *c < 1 || *r > kMaxMatrixSide || *c > kMaxMatrixSide) {
-    Refuse(node + "rows and cols must be integers from 1 to " + std::to_string(kMaxMatrixSide));
+    Refuse(where + "rows and cols must be integers from 1 to " + std::to_string(kMaxMatrixSide));
   }
-  const std::string_view type = Trimmed(dt);
-  if (type != "d" && type != "f") Refuse(node + "dt must be 'd' or 'f' (a matrix of numbers)");
-  if (static_cast<int>(values.size()) != *r * *c) {
-    Refuse(node + "data has " + std::to_string(values.size()) + " values, rows x cols = " +
+  const std::string_view type = Trimmed(node.dt);
+  if (type.size() != 1 || std::string_view("ucwsifd").find(type[0]) == std::string_view::npos) {
+    Refuse(where + "dt must be one of u, c, w, s, i, f, d (a single-channel matrix of numbers)");
+  }
+  if (static_cast<int>(node.values.size()) != *r * *c) {
+    Refuse(where + "data has " + std::to_string(node.values.size()) + " values, rows x cols = " +
            std::to_string(*r * *c));
   }
   OpenCvMatrix matrix{*r, *c, {}};
-  for (const std::string_view text : values) {
+  for (const std::string& text : node.values) {
     const auto value = ParseWhole<double>(Trimmed(text));
     if (!value || !std::isfinite(*value)) {
-      Refuse(node + "data value '" + std::string(Trimmed(text)) + "' is not a finite number");
+      Refuse(where + "data value '" + std::string(Trimmed(text)) + "' is not a finite number");
     }
     matrix.values.push_back(*value);
   }
@@ -84,30 +87,35 @@ void CheckText(const std::string& text) {
 
 // --- YAML ---------------------------------------------------------------------------------
 
-OpenCvNode YamlNode(const std::string& name, const YAML::Node& node) {
+OpenCvNode YamlNode(const YAML::Node& node) {
   OpenCvNode out;
   if (node.IsScalar()) {
     out.scalar = node.Scalar();
-  } else if (node.IsMap() && node["rows"] && node["cols"] && node["data"]) {
-    const YAML::Node data = node["data"];
-    const YAML::Node dt = node["dt"];
-    if (!node["rows"].IsScalar() || !node["cols"].IsScalar() || !dt || !dt.IsScalar() ||
-        !data.IsSequence()) {
-      Refuse("node '" + name + "': an OpenCV matrix needs scalar rows, cols and dt and a data list");
+    return out;
+  }
+  if (!node.IsMap() || !node["rows"] || !node["cols"] || !node["data"]) return out;
+  out.is_matrix = true;
+  const YAML::Node rows = node["rows"], cols = node["cols"], dt = node["dt"], data = node["data"];
+  if (!rows.IsScalar() || !cols.IsScalar() || !dt || !dt.IsScalar() || !data.IsSequence()) {
+    out.malformed = "an OpenCV matrix needs scalar rows, cols and dt and a data list";
+    return out;
+  }
+  out.rows = rows.Scalar();
+  out.cols = cols.Scalar();
+  out.dt = dt.Scalar();
+  for (const YAML::Node& value : data) {
+    if (!value.IsScalar()) {
+      out.malformed = "data must be a list of numbers";
+      return out;
     }
-    if (data.size() > kMaxMatrixSide * kMaxMatrixSide) {
-      Refuse("node '" + name + "': data has more values than a calibration matrix");
-    }
-    std::vector<std::string> texts;
-    for (const YAML::Node& value : data) {
-      if (!value.IsScalar()) Refuse("node '" + name + "': data must be a list of numbers");
-      texts.push_back(value.Scalar());
-    }
-    const std::vector<std::string_view> views(texts.begin(), texts.end());
-    out.is_matrix = true;
-    out.matrix = MakeMatrix(name, node["rows"].Scalar(), node["cols"].Scalar(), dt.Scalar(), views);
+    out.values.push_back(value.Scalar());
   }
   return out;
+}
+
+// " at line N" where yaml-cpp knows the position.
+std::string AtLine(const YAML::Mark& mark) {
+  return mark.is_null() ? std::string() : " at line " + std::to_string(mark.line + 1);
 }
 
 std::map<std::string, OpenCvNode> ParseYaml(std::string text) {
@@ -121,18 +129,17 @@ std::map<std::string, OpenCvNode> ParseYaml(std::string text) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    Refuse("malformed YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    Refuse("malformed YAML" + AtLine(e.mark) + ": " + e.msg);
   }
   if (!root.IsMap()) Refuse("the top level is not a map of nodes");
   std::map<std::string, OpenCvNode> nodes;
   try {
     for (const auto& entry : root) {
       if (!entry.first.IsScalar()) Refuse("a top-level key is not a name");
-      const std::string name = entry.first.Scalar();
-      nodes[name] = YamlNode(name, entry.second);
+      nodes[entry.first.Scalar()] = YamlNode(entry.second);
     }
   } catch (const YAML::Exception& e) {
-    Refuse("unreadable YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    Refuse("unreadable YAML" + AtLine(e.mark) + ": " + e.msg);
   }
   return nodes;
 }
@@ -161,20 +168,18 @@ bool HasElementChildren(const xmlNode* element) {
   return false;
 }
 
-std::vector<std::string_view> Words(std::string_view text) {
-  std::vector<std::string_view> words;
+std::vector<std::string> Words(std::string_view text) {
+  std::vector<std::string> words;
   std::size_t i = 0;
-  while (true) {
-    i = text.find_first_not_of(" \t\r\n", i);
-    if (i == std::string_view::npos) return words;
+  while ((i = text.find_first_not_of(" \t\r\n", i)) != std::string_view::npos) {
     const std::size_t end = std::min(text.find_first_of(" \t\r\n", i), text.size());
-    words.push_back(text.substr(i, end - i));
-    if (words.size() > kMaxMatrixSide * kMaxMatrixSide) return words;
+    words.emplace_back(text.substr(i, end - i));
     i = end;
   }
+  return words;
 }
 
-OpenCvNode XmlNode(const std::string& name, const xmlNode* element) {
+OpenCvNode XmlNode(const xmlNode* element) {
   OpenCvNode out;
   if (!HasElementChildren(element)) {
     out.scalar = std::string(Trimmed(ElementText(element)));
@@ -185,9 +190,11 @@ OpenCvNode XmlNode(const std::string& name, const xmlNode* element) {
     if (child->type == XML_ELEMENT_NODE) parts[Name(child)] = ElementText(child);
   }
   if (parts.count("rows") == 0 || parts.count("cols") == 0 || parts.count("data") == 0) return out;
-  const std::string data = parts["data"];
   out.is_matrix = true;
-  out.matrix = MakeMatrix(name, parts["rows"], parts["cols"], parts["dt"], Words(data));
+  out.rows = parts["rows"];
+  out.cols = parts["cols"];
+  out.dt = parts["dt"];
+  out.values = Words(parts["data"]);
   return out;
 }
 
@@ -218,7 +225,7 @@ std::map<std::string, OpenCvNode> ParseXml(const std::string& text) {
   }
   std::map<std::string, OpenCvNode> nodes;
   for (const xmlNode* child = root->children; child != nullptr; child = child->next) {
-    if (child->type == XML_ELEMENT_NODE) nodes[Name(child)] = XmlNode(Name(child), child);
+    if (child->type == XML_ELEMENT_NODE) nodes[Name(child)] = XmlNode(child);
   }
   return nodes;
 }
@@ -236,9 +243,9 @@ OpenCvStorage OpenCvStorage::Read(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path, error)) {
     throw Error(source + ": no such file (expected an OpenCV calibration YAML or XML)");
   }
-  if (std::filesystem::file_size(path, error) > kMaxFileBytes) {
-    throw Error(source + ": larger than 1 MiB: not a calibration file");
-  }
+  const std::uintmax_t bytes = std::filesystem::file_size(path, error);
+  if (error) throw Error(source + ": cannot be read (" + error.message() + ")");
+  if (bytes > kMaxFileBytes) throw Error(source + ": larger than 1 MiB: not a calibration file");
   const std::string text = ReadFileBytes(path);
   try {
     CheckText(text);
@@ -266,7 +273,11 @@ int OpenCvStorage::Integer(const std::string& name) const {
 OpenCvMatrix OpenCvStorage::Matrix(const std::string& name) const {
   const OpenCvNode& node = Find(name);
   if (!node.is_matrix) Fail("node '" + name + "' must be an OpenCV matrix (!!opencv-matrix)");
-  return node.matrix;
+  try {
+    return MakeMatrix(name, node);
+  } catch (const Refusal& refusal) {
+    Fail(refusal.what);
+  }
 }
 
 }  // namespace uwscan::scanner::calibration

@@ -16,19 +16,23 @@ struct OpenCvMatrix {
   std::vector<double> values;
 };
 
-// A top-level node: a matrix, or a scalar's text (empty for a node that is neither).
+// A top-level node: a scalar's text, or a matrix's parts as written (checked only when the
+// matrix is read, so that nodes nobody reads, such as the per-view ones of OpenCV's
+// calibration sample, cannot make a file unreadable).
 struct OpenCvNode {
   bool is_matrix = false;
   std::string scalar;
-  OpenCvMatrix matrix;
+  std::string rows, cols, dt;
+  std::vector<std::string> values;
+  std::string malformed;  // what is wrong with the matrix's layout; empty when nothing is
 };
 
 // The top-level nodes of a file that OpenCV's cv::FileStorage wrote, in YAML or XML, read
 // without OpenCV: its parser hung, threw and allocated gigabytes on damaged files (found by
-// tests/fuzz), while yaml-cpp and libxml2 are bounded and well fuzzed. Only what calibration
-// files hold is kept: scalars and matrices of at most 16 x 16 (a vector of 14 distortion
-// coefficients is the largest); other nodes are skipped. The file must be ASCII text and at
-// most 1 MiB.
+// tests/fuzz), while yaml-cpp and libxml2 are bounded and well fuzzed. Scalars and matrices
+// are kept, other nodes (lists, nested maps) skipped; a matrix read must be single-channel and
+// at most 16 x 16 (a vector of 14 distortion coefficients is the largest a calibration needs).
+// The file must be ASCII text and at most 1 MiB.
 class OpenCvStorage {
  public:
   // Throws uwscan::Error naming the file: missing, too large, not text, malformed YAML or XML,
