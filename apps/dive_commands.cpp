@@ -125,7 +125,7 @@ struct ReconstructArgs {
 };
 
 void RunReconstruct(const ReconstructArgs& a) {
-  CheckOutputPath(a.output, "-o", {a.log, a.calibration});
+  CheckCloudOutputPath(a.output, "-o", {a.log, a.calibration});
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.log, a.calibration, a.output});
   mapping::ReconstructionOptions options;
   if (!a.method.empty()) {

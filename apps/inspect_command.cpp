@@ -13,6 +13,7 @@
 #include "apps/camera_frames.hpp"
 #include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
+#include "apps/output_path.hpp"
 #include "apps/stop_signal.hpp"
 #include "mapping/live_inspection.hpp"
 #include "perception/cloud_io.hpp"
@@ -97,10 +98,7 @@ void RunInspect(const InspectArgs& a) {
       throw Error(std::string(option) + " " + path + ": folder '" + parent.string() + "' does not exist");
     }
   }
-  const std::string map_extension = std::filesystem::path(a.map).extension().string();
-  if (!a.map.empty() && map_extension != ".ply" && map_extension != ".pcd") {
-    throw Error("-o " + a.map + ": expected a .ply or .pcd file");
-  }
+  if (!a.map.empty()) CheckCloudOutputPath(a.map, "-o");
   if (!(a.queue_mb > 0.0)) throw Error("--queue-mb must be > 0");
   if (!a.screenshot.empty() && a.frames <= 0 && a.seconds <= 0.0) {
     throw Error("--screenshot: say when to take the picture with --frames N (or --seconds S)");

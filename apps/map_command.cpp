@@ -111,6 +111,7 @@ void RunMap(const MapArgs& a) {
                                      {a.json, "--json"}}) {
     RequireOutput(path, option, a.log);
   }
+  CheckCloudOutputPath(a.output, "-o", {a.log});
   if (a.threads > 0) omp_set_num_threads(a.threads);
   mapping::DiveMappingOptions options;
   options.map_voxel_m = a.voxel_m;
@@ -155,7 +156,7 @@ void AddMapCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "map", "scan-matching SLAM over a dive log: map, trajectories, per-pose uncertainty, loop closures");
   cmd->add_option("log", args->log, "dive log (.db)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", args->output, "map to write (.ply, .pcd, .xyz), voxelised")->required();
+  cmd->add_option("-o,--output", args->output, "map to write (.ply or .pcd), voxelised")->required();
   cmd->add_option("--trajectory", args->trajectory, "SLAM trajectory to write (TUM: t tx ty tz qx qy qz qw)");
   cmd->add_option("--dead-reckoning", args->dead_reckoning, "the navigation at the same times (TUM)");
   cmd->add_option("--truth", args->truth, "the true trajectory at the same times (TUM; simulated logs)");

@@ -32,4 +32,12 @@ void CheckOutputPath(const fs::path& output, const std::string& option, const st
   }
 }
 
+void CheckCloudOutputPath(const fs::path& output, const std::string& option, const std::vector<fs::path>& inputs) {
+  CheckOutputPath(output, option, inputs);
+  const std::string extension = output.extension().string();
+  if (extension != ".ply" && extension != ".pcd") {
+    throw Error(option + " " + output.string() + ": a point cloud is written as .ply or .pcd");
+  }
+}
+
 }  // namespace uwscan::app

@@ -12,4 +12,9 @@ namespace uwscan::app {
 void CheckOutputPath(const std::filesystem::path& output, const std::string& option,
                      const std::vector<std::filesystem::path>& inputs = {});
 
+// CheckOutputPath for a point cloud, which uwscan writes as .ply or .pcd only: another extension
+// is refused too, before the work rather than after it.
+void CheckCloudOutputPath(const std::filesystem::path& output, const std::string& option,
+                          const std::vector<std::filesystem::path>& inputs = {});
+
 }  // namespace uwscan::app

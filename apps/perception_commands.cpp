@@ -60,7 +60,7 @@ struct RegisterArgs {
 };
 
 void RunRegister(const RegisterArgs& a) {
-  if (!a.output.empty()) CheckOutputPath(a.output, "-o", {a.source, a.target});
+  if (!a.output.empty()) CheckCloudOutputPath(a.output, "-o", {a.source, a.target});
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.source, a.target, a.output});
   const perception::PointCloud source = perception::ReadCloud(a.source);
   const perception::PointCloud target = perception::ReadCloud(a.target);

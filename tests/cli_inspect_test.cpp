@@ -134,7 +134,7 @@ TEST(CliInspect, BadOptionsFailBeforeTheCameraIsOpened) {
   EXPECT_NE(neither.output.find("give --scene"), std::string::npos) << neither.output;
   const CommandRun xyz = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " -o " + TempPath("m.xyz").string());
   EXPECT_EQ(xyz.exit_code, 1);
-  EXPECT_NE(xyz.output.find("expected a .ply or .pcd file"), std::string::npos) << xyz.output;
+  EXPECT_NE(xyz.output.find("a point cloud is written as .ply or .pcd"), std::string::npos) << xyz.output;
   const CommandRun shot = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --screenshot " +
                                     TempPath("never.png").string());
   EXPECT_EQ(shot.exit_code, 1);
