@@ -146,12 +146,10 @@ struct FrameSource::Impl {
     const std::string where = "camera " + settings.address;
     if (!arv_camera_is_gv_device(camera)) throw Error(where + ": not a GigE Vision camera");
     ArvGvDevice* device = ARV_GV_DEVICE(arv_camera_get_device(camera));
-    const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                          std::chrono::duration<double>(wait_s));
     const Clock::time_point start = Clock::now();
     while (!arv_gv_device_is_controller(device)) {
-      if (Clock::now() >= deadline) {
-        const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
+      const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
+      if (waited_s >= wait_s) {
         char seconds[32];
         std::snprintf(seconds, sizeof seconds, "%.1f", waited_s);
         throw Error(where + ": another program controls the camera (control refused, waited " + seconds +
@@ -167,7 +165,6 @@ struct FrameSource::Impl {
   void Configure() {
     GError* error = nullptr;
     const std::string where = "camera " + settings.address;
-    if (!arv_camera_is_gv_device(camera)) throw Error(where + ": not a GigE Vision camera");
     const char* vendor = arv_camera_get_vendor_name(camera, nullptr);
     const char* model = arv_camera_get_model_name(camera, nullptr);
     payload.vendor = vendor != nullptr ? vendor : "";
