@@ -51,10 +51,12 @@ std::optional<Format> FormatOf(const fs::path& path) {
   return std::nullopt;
 }
 
-// Absolute points (and normals, when the file has them) as read, before any filtering.
+// Absolute points (and normals and intensities, when the file has them) as read, before any
+// filtering.
 struct RawCloud {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3d> normals;
+  std::vector<double> intensity;
 };
 
 // One value of a binary point record, as double.
@@ -147,6 +149,9 @@ pcl::PCLPointCloud2 ToBlob(const PointCloud& cloud, Format format) {
     add_field(ply ? "ny" : "normal_y", pcl::PCLPointField::FLOAT32, 4);
     add_field(ply ? "nz" : "normal_z", pcl::PCLPointField::FLOAT32, 4);
   }
+  const bool intensity = cloud.has_intensity();
+  const std::uint32_t intensity_offset = blob.point_step;
+  if (intensity) add_field("intensity", pcl::PCLPointField::FLOAT32, 4);
   blob.width = static_cast<std::uint32_t>(cloud.size());
   blob.height = 1;
   blob.is_dense = true;
@@ -164,6 +169,7 @@ pcl::PCLPointCloud2 ToBlob(const PointCloud& cloud, Format format) {
       }
     }
     if (normals) std::memcpy(at + 3 * xyz_size, cloud.normals[i].data(), 12);
+    if (intensity) std::memcpy(at + intensity_offset, &cloud.intensity[i], 4);
   }
   return blob;
 }
@@ -222,10 +228,12 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
     scanner::PlyContent ply = scanner::ReadPly(path, /*faces=*/false);
     raw.points = std::move(ply.vertices);
     raw.normals = std::move(ply.normals);
+    raw.intensity = std::move(ply.intensity);
   } else {
     PcdContent pcd = ReadPcd(path);
     raw.points = std::move(pcd.points);
     raw.normals = std::move(pcd.normals);
+    raw.intensity = std::move(pcd.intensity);
   }
 
   CloudReadStats local;
@@ -233,6 +241,7 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   local.has_normals = !raw.normals.empty();
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3f> normals;
+  std::vector<float> intensity;
   points.reserve(raw.points.size());
   for (std::size_t i = 0; i < raw.points.size(); ++i) {
     // A normal must be a direction: non-finite or (near) zero-length ones drop their point;
@@ -243,6 +252,7 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
     if (!usable) continue;
     points.push_back(raw.points[i]);
     if (local.has_normals) normals.push_back(raw.normals[i].normalized().cast<float>());
+    if (!raw.intensity.empty()) intensity.push_back(static_cast<float>(raw.intensity[i]));
   }
   local.num_dropped_non_finite = raw.points.size() - points.size();
   if (points.empty()) {
@@ -252,6 +262,7 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   }
   PointCloud cloud = MakeCloud(points);
   cloud.normals = std::move(normals);
+  cloud.intensity = std::move(intensity);
   if (stats) *stats = local;
   return cloud;
 }

@@ -6,6 +6,7 @@
 #include <pcl/point_types.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -116,6 +117,48 @@ TEST_F(CloudReadersTest, ReadsPlyPclWritesAndFacesOfAnyPolygon) {
   EXPECT_EQ(quad.vertices[3], Eigen::Vector3d(0.0, 1.0, 0.25));
   ASSERT_EQ(quad.triangles.size(), 3u);  // the quad fanned into two, then the triangle
   EXPECT_EQ(quad.triangles[1], Eigen::Vector3i(0, 2, 3));
+}
+
+// Intensities as PCL writes them (PointXYZI, float32 "intensity"), and CloudCompare's
+// "scalar_Intensity" PLY property, reach the cloud point for point; uwscan's writer keeps them.
+TEST_F(CloudReadersTest, ReadsIntensityFromPclPcdAndPlyAndKeepsItOnWrite) {
+  pcl::PointCloud<pcl::PointXYZI> with_intensity;
+  for (std::size_t i = 0; i < cloud_.size(); ++i) {
+    pcl::PointXYZI p;
+    p.x = cloud_[i].x;
+    p.y = cloud_[i].y;
+    p.z = cloud_[i].z;
+    p.intensity = 10.0f + 0.5f * static_cast<float>(i);
+    with_intensity.push_back(p);
+  }
+  const fs::path pcd = dir_ / "i.pcd", ply = dir_ / "i.ply";
+  ASSERT_EQ(pcl::PCDWriter().writeBinaryCompressed(pcd.string(), with_intensity), 0);
+  ASSERT_EQ(pcl::PLYWriter().write(ply.string(), with_intensity, true, false), 0);
+  for (const fs::path& path : {pcd, ply}) {
+    SCOPED_TRACE(path.filename().string());
+    const PointCloud read = ReadCloud(path);
+    ASSERT_TRUE(read.has_intensity());
+    for (std::size_t i = 0; i < with_intensity.size(); ++i) {
+      EXPECT_EQ(read.intensity[i], with_intensity[i].intensity) << i;
+    }
+    const fs::path again = dir_ / ("again" + path.extension().string());
+    WriteCloud(again, read, /*binary=*/false);
+    EXPECT_EQ(ReadCloud(again).intensity, read.intensity);
+  }
+
+  const fs::path cloud_compare = dir_ / "cc.ply";
+  {
+    std::ofstream out(cloud_compare);
+    out << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+           "property float scalar_Intensity\nend_header\n0 0 1 0.25\n1 0 1 nan\n";
+  }
+  const PointCloud cc = ReadCloud(cloud_compare);
+  ASSERT_EQ(cc.intensity.size(), 2u);
+  EXPECT_EQ(cc.intensity[0], 0.25f);
+  EXPECT_TRUE(std::isnan(cc.intensity[1]));  // no value: the point stays, its intensity is NaN
+  const fs::path plain = dir_ / "plain.ply";
+  ASSERT_EQ(pcl::PLYWriter().write(plain.string(), cloud_, true, false), 0);
+  EXPECT_FALSE(ReadCloud(plain).has_intensity());
 }
 
 TEST_F(CloudReadersTest, BrokenFilesGiveOneErrorAndPrintNothing) {

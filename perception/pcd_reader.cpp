@@ -193,12 +193,15 @@ void Extract(const Header& header, const std::string& name, PcdContent& content,
   const Field* n[3] = {FindField(header, {"normal_x", "nx"}), FindField(header, {"normal_y", "ny"}),
                        FindField(header, {"normal_z", "nz"})};
   if (!xyz[0] || !xyz[1] || !xyz[2]) throw Error(name + " has no x, y and z fields");
+  const Field* intensity = FindField(header, {"intensity"});
   const bool normals = n[0] && n[1] && n[2];
   content.points.reserve(header.points);
   if (normals) content.normals.reserve(header.points);
+  if (intensity) content.intensity.reserve(header.points);
   for (std::uint64_t i = 0; i < header.points; ++i) {
     content.points.emplace_back(value(*xyz[0], i), value(*xyz[1], i), value(*xyz[2], i));
     if (normals) content.normals.emplace_back(value(*n[0], i), value(*n[1], i), value(*n[2], i));
+    if (intensity) content.intensity.push_back(value(*intensity, i));
   }
 }
 

@@ -6,10 +6,12 @@
 
 namespace uwscan::perception {
 
-// The points of a PCD file (and its normals when it has normal_x/y/z or nx/ny/nz), as read.
+// The points of a PCD file (and its normals when it has normal_x/y/z or nx/ny/nz, and its
+// intensities), as read.
 struct PcdContent {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3d> normals;  // one per point, or empty
+  std::vector<double> intensity;         // one per point when it has an intensity field, or empty
 };
 
 // Reads PCD 0.7 (and older headers without VERSION or COUNT) in ascii, binary and

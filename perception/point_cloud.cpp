@@ -40,6 +40,10 @@ void RequireValidCloud(const PointCloud& cloud, const std::string& what, std::si
       }
     }
   }
+  if (!cloud.intensity.empty() && cloud.intensity.size() != cloud.size()) {
+    throw Error(what + ": has " + std::to_string(cloud.intensity.size()) + " intensities for " +
+                std::to_string(cloud.size()) + " points");
+  }
 }
 
 PointCloud Transformed(const PointCloud& cloud, const Eigen::Isometry3d& T) {
@@ -50,6 +54,7 @@ PointCloud Transformed(const PointCloud& cloud, const Eigen::Isometry3d& T) {
   for (const Eigen::Vector3f& p : cloud.points) out.points.push_back(R * p);
   out.normals.reserve(cloud.normals.size());
   for (const Eigen::Vector3f& n : cloud.normals) out.normals.push_back(R * n);
+  out.intensity = cloud.intensity;
   return out;
 }
 
@@ -71,6 +76,10 @@ PointCloud Subset(const PointCloud& cloud, std::span<const std::size_t> indices)
   if (cloud.has_normals()) {
     out.normals.reserve(indices.size());
     for (std::size_t i : indices) out.normals.push_back(cloud.normals[i]);
+  }
+  if (cloud.has_intensity()) {
+    out.intensity.reserve(indices.size());
+    for (std::size_t i : indices) out.intensity.push_back(cloud.intensity[i]);
   }
   return out;
 }

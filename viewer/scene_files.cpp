@@ -101,6 +101,7 @@ void AddCloudFile(const fs::path& path, Scene& scene) {
   layer.name = path.filename().string();
   layer.origin = cloud.origin;
   layer.points = cloud.points;
+  layer.intensity = cloud.intensity;
   scene.clouds.push_back(std::move(layer));
 }
 

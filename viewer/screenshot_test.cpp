@@ -15,6 +15,7 @@
 #include "viewer/colour_map.hpp"
 #include "viewer/png_image.hpp"
 #include "viewer/point_colours.hpp"
+#include "viewer/scene_files.hpp"
 
 namespace uwscan::viewer {
 namespace {
@@ -193,6 +194,48 @@ TEST(Screenshot, DifferentSceneDoesNotMatchTheBaseline) {
   const ImageDifference d = CompareImages(ReadPng(png), ReadPng(baseline), 40);
   EXPECT_GT(d.fraction_over, 0.01);
   fs::remove(png);
+}
+
+// A PLY with an intensity per point, read through the viewer's file loader and coloured by
+// intensity over a fixed range: each point shows its own intensity's colour.
+TEST(Screenshot, IntensityFromAPlyFileColoursEachPoint) {
+  const fs::path ply = TempPng("intensity").replace_extension(".ply");
+  std::vector<Eigen::Vector3d> grid;
+  std::vector<float> intensity;
+  {
+    std::ofstream out(ply);
+    out << "ply\nformat ascii 1.0\nelement vertex 25\nproperty double x\nproperty double y\n"
+           "property double z\nproperty float intensity\nend_header\n";
+    for (int i = 0; i < 5; ++i) {
+      for (int j = 0; j < 5; ++j) {
+        grid.emplace_back(0.2 * i, 0.2 * j, 3.0);  // a flat grid seen from above: nothing hidden
+        intensity.push_back(static_cast<float>(10 * (i * 5 + j)));
+        out << grid.back().x() << " " << grid.back().y() << " " << grid.back().z() << " " << intensity.back() << "\n";
+      }
+    }
+  }
+  Scene scene;
+  AddFile(ply, mapping::ReconstructionOptions{}, MapReportDrawing{}, scene);
+  fs::remove(ply);
+  ASSERT_EQ(scene.clouds.size(), 1u);
+  ASSERT_EQ(scene.clouds[0].intensity, intensity);
+
+  RenderOptions options = SmallPicture(CameraPreset::kTop);
+  options.colour = ColourMode::kIntensity;
+  options.range = ScalarRange{0.0, 240.0};
+  const fs::path png = TempPng("intensity");
+  const PictureInfo info = SaveScreenshot(scene, options, png);
+  const RgbImage image = ReadPng(png);
+  fs::remove(png);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const std::optional<Eigen::Vector2i> px = info.PixelOf(grid[i]);
+    ASSERT_TRUE(px.has_value()) << i;
+    const Rgb expected = ContinuousColour(intensity[i] / 240.0);
+    const Rgb seen = image.At(px->x(), px->y());
+    EXPECT_TRUE(Near(seen, expected, 3)) << "point " << i << ": seen " << int(seen.r) << "," << int(seen.g) << ","
+                                         << int(seen.b) << " expected " << int(expected.r) << ","
+                                         << int(expected.g) << "," << int(expected.b);
+  }
 }
 
 TEST(Screenshot, ErrorColouringOfACloudWithoutTruthNamesTheLayer) {

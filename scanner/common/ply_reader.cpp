@@ -232,11 +232,13 @@ PlyContent ReadPly(const fs::path& path, bool faces) {
     const int n[3] = {IndexOf(element, {"nx", "normal_x"}), IndexOf(element, {"ny", "normal_y"}),
                       IndexOf(element, {"nz", "normal_z"})};
     const bool with_normals = n[0] >= 0 && n[1] >= 0 && n[2] >= 0;
+    const int intensity = IndexOf(element, {"intensity", "scalar_intensity", "scalar_Intensity"});
     if (is_vertex) {
       if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) throw Error(name + ": element vertex has no x, y and z");
       vertices_seen = true;
       content.vertices.reserve(element.count);
       if (with_normals) content.normals.reserve(element.count);
+      if (intensity >= 0) content.intensity.reserve(element.count);
     }
     std::vector<double> row(element.properties.size());
     for (std::uint64_t r = 0; r < element.count; ++r) {
@@ -273,6 +275,7 @@ PlyContent ReadPly(const fs::path& path, bool faces) {
         if (with_normals) {
           content.normals.emplace_back(row[std::size_t(n[0])], row[std::size_t(n[1])], row[std::size_t(n[2])]);
         }
+        if (intensity >= 0) content.intensity.push_back(row[std::size_t(intensity)]);
       }
     }
   }

@@ -6,12 +6,15 @@
 
 namespace uwscan::scanner {
 
-// What uwscan takes from a PLY file: the vertex element's positions (and normals), and the
-// face element's polygons. Other elements and properties (colours, confidence, ...) are read
-// past and dropped.
+// What uwscan takes from a PLY file: the vertex element's positions (and normals and
+// intensities), and the face element's polygons. Other elements and properties (colours,
+// confidence, ...) are read past and dropped.
 struct PlyContent {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::Vector3d> normals;    // one per vertex when it has nx ny nz, else empty
+  // One per vertex when it has an intensity property ("intensity", or CloudCompare's
+  // "scalar_intensity" / "scalar_Intensity"), in the file's units; else empty.
+  std::vector<double> intensity;
   std::vector<Eigen::Vector3i> triangles;  // polygons fan-triangulated, indices checked
 };
 
