@@ -12,8 +12,7 @@
 #include "apps/output_path.hpp"
 #include "apps/progress_bar.hpp"
 #include "apps/recognition_json.hpp"
-#include "mapping/dive_log.hpp"
-#include "mapping/reconstruction.hpp"
+#include "mapping/scan_file.hpp"
 #include "perception/cloud_io.hpp"
 #include "perception/object_database_builder.hpp"
 #include "perception/object_recognizer.hpp"
@@ -84,22 +83,18 @@ struct RecognizeArgs {
   int threads = 0;
 };
 
-// A scan file, or a dive log triangulated in the camera frame (one static sweep: the sensor at
-// the origin, as recognition assumes).
-perception::PointCloud ReadScan(const std::string& path) {
-  if (std::filesystem::path(path).extension() != ".db") return perception::ReadCloud(path);
-  const mapping::DiveLogReader log(path);
-  mapping::ReconstructionOptions options;
-  options.use_navigation = false;
-  options.table_cache = TableCache();
-  const mapping::Reconstruction r = mapping::Reconstruct(log, options);
-  if (r.points.empty()) throw Error(path + ": the dive log holds no triangulated point");
-  return perception::MakeCloud(r.points);
+// `path` as seen from the folder `file` is in.
+std::string RelativeToFolderOf(const std::string& path, const std::string& file) {
+  const std::filesystem::path folder = std::filesystem::absolute(file).parent_path();
+  return std::filesystem::absolute(path).lexically_normal().lexically_relative(folder.lexically_normal()).string();
 }
 
 void RunRecognize(const RecognizeArgs& a) {
+  if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.scan, a.db});
   const perception::ObjectDatabase db = perception::ObjectDatabase::Load(a.db);
-  const perception::PointCloud scan = ReadScan(a.scan);
+  mapping::ReconstructionOptions log_options;
+  log_options.table_cache = TableCache();
+  const perception::PointCloud scan = mapping::ReadScanFile(a.scan, log_options);
   perception::RecognitionOptions options;
   options.seed = a.seed;
   options.threads = a.threads;
@@ -119,9 +114,10 @@ void RunRecognize(const RecognizeArgs& a) {
                 t.z(), o.free_directions.size(), o.grasps_S.size());
   }
   if (!a.json.empty()) {
-    nlohmann::json j = RecognitionJson(result);
-    j["scan"] = a.scan;
-    j["database"] = a.db;
+    nlohmann::json j = RecognitionJson(result, scan.size());
+    // Relative to the report's folder, so the viewer finds them from anywhere.
+    j["scan"] = RelativeToFolderOf(a.scan, a.json);
+    j["database"] = RelativeToFolderOf(a.db, a.json);
     WriteJsonFile(a.json, j);
   }
 }

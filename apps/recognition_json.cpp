@@ -23,6 +23,7 @@ nlohmann::json Pose(const Eigen::Isometry3d& T) {
 nlohmann::json ObjectJson(const perception::RecognizedObject& o) {
   nlohmann::json j = {{"id", o.object_id},
                       {"points", o.segment.size()},
+                      {"segment", o.segment},
                       {"centroid_m", Vector(o.centroid_S)}};
   nlohmann::json candidates = nlohmann::json::array();
   for (const perception::RecognitionCandidate& c : o.candidates) {
@@ -73,10 +74,12 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o) {
 
 }  // namespace
 
-nlohmann::json RecognitionJson(const perception::RecognitionResult& result) {
+nlohmann::json RecognitionJson(const perception::RecognitionResult& result, std::size_t scan_points) {
   nlohmann::json objects = nlohmann::json::array();
   for (const perception::RecognizedObject& o : result.objects) objects.push_back(ObjectJson(o));
-  return {{"uwscan_recognition", 1},
+  return {{"uwscan_format", 1},
+          {"kind", "recognition_report"},
+          {"scan_points", scan_points},
           {"objects", objects},
           {"plane_points", result.plane_points},
           {"stage_seconds", result.stage_seconds}};

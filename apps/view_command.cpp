@@ -21,7 +21,7 @@ namespace {
 
 struct ViewArgs {
   std::vector<std::string> files;
-  std::string colour = "height";
+  std::string colour;  // empty: by object when a recognition report is shown, else by height
   std::vector<double> range;
   double point_size_px = 2.0;
   bool edl = false;
@@ -54,10 +54,24 @@ std::pair<int, int> ParseSize(const std::string& text) {
   throw Error("--size " + text + ": expected WIDTHxHEIGHT in pixels, e.g. 1280x960");
 }
 
+bool ShowsARecognitionReport(const ViewArgs& a) {
+  for (const std::string& file : a.files) {
+    if (std::filesystem::path(file).extension() == ".json" && std::filesystem::is_regular_file(file) &&
+        viewer::KindOfFile(file) == viewer::FileKind::kRecognitionReport) {
+      return true;
+    }
+  }
+  return false;
+}
+
 viewer::RenderOptions RenderOptionsFrom(const ViewArgs& a) {
   viewer::RenderOptions o;
-  const std::optional<viewer::ColourMode> colour = viewer::ParseColourMode(a.colour);
-  if (!colour) throw Error("--colour " + a.colour + ": use height, error, intensity or object");
+  // A recognition report's scan is in the sensor's frame (y down): by default it is coloured by
+  // object (a segment and its model share a colour) and shown upright as the sensor saw it.
+  const bool recognition = ShowsARecognitionReport(a);
+  const std::string colour_name = !a.colour.empty() ? a.colour : recognition ? "object" : "height";
+  const std::optional<viewer::ColourMode> colour = viewer::ParseColourMode(colour_name);
+  if (!colour) throw Error("--colour " + colour_name + ": use height, error, intensity or object");
   o.colour = *colour;
   const std::optional<viewer::CameraPreset> camera = viewer::ParseCameraPreset(a.camera);
   if (!camera) throw Error("--camera " + a.camera + ": use fit, top or side");
@@ -67,7 +81,11 @@ viewer::RenderOptions RenderOptionsFrom(const ViewArgs& a) {
   o.eye_dome_lighting = a.edl;
   std::tie(o.width_px, o.height_px) = ParseSize(a.size);
   o.max_points = a.max_points;
-  if (!a.up.empty()) o.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
+  if (!a.up.empty()) {
+    o.up = Eigen::Vector3d(a.up[0], a.up[1], a.up[2]);
+  } else if (recognition) {
+    o.up = Eigen::Vector3d(0.0, -1.0, 0.0);
+  }
   o.colour_bar = !a.no_colour_bar;
   try {
     o.Check();
@@ -153,9 +171,11 @@ void AddViewCommand(CLI::App& app) {
   auto a = std::make_shared<ViewArgs>();
   CLI::App* cmd = app.add_subcommand(
       "view", std::string("show clouds (.ply .pcd .xyz), meshes (.ply .off .stl .obj), TUM trajectories "
-                          "(.txt .tum), dive logs (.db) and map reports (.json); keys: ") + viewer::kViewKeys);
+                          "(.txt .tum), dive logs (.db), map and recognition reports (.json); keys: ") + viewer::kViewKeys);
   cmd->add_option("files", a->files, "files to show")->required();
-  cmd->add_option("--colour,--color", a->colour, "height, error (simulated dive logs), intensity or object");
+  cmd->add_option("--colour,--color", a->colour,
+                  "height, error (simulated dive logs), intensity or object (default: object with a recognition "
+                  "report, else height)");
   cmd->add_option("--range", a->range, "fixed colour range LOW HIGH (metres for height and error)")->expected(2);
   cmd->add_option("--point-size", a->point_size_px, "point size in pixels");
   cmd->add_flag("--edl", a->edl, "Eye-Dome Lighting: shades points by depth so shapes read without colour");
@@ -163,7 +183,10 @@ void AddViewCommand(CLI::App& app) {
   cmd->add_option("--size", a->size, "window or picture size WIDTHxHEIGHT (default 1280x960)");
   cmd->add_option("--max-points", a->max_points,
                   "point budget: above it every k-th point is drawn; with --follow, points held");
-  cmd->add_option("--up", a->up, "the world's up direction X Y Z (default 0 0 -1: NED)")->expected(3);
+  cmd->add_option("--up", a->up,
+                  "the world's up direction X Y Z (default 0 0 -1: NED; 0 -1 0 with a recognition report, "
+                  "whose scan is in the sensor's frame)")
+      ->expected(3);
   cmd->add_option("--method", a->method, "dive logs: plane, cone or ray (default: the scanner's)");
   cmd->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
   cmd->add_flag("--no-colour-bar", a->no_colour_bar, "no colour bar");

@@ -137,6 +137,41 @@ TEST(CliView, MapReportIsDrawnWithItsMapTrajectoriesAndEllipsoids) {
   fs::remove_all(dir);
 }
 
+// The recognition pipeline end to end: the demo scene simulated, a database built, `recognize
+// --json` on the dive log, and its report drawn: the scan coloured by object with the models,
+// labels and grasp frames of what was recognised (whatever that is: this checks the report's
+// path from recognize to the viewer, not recognition).
+TEST(CliView, RecognitionReportOfTheDemoSceneIsDrawn) {
+  const fs::path dir = TempPath("recognition");
+  fs::create_directories(dir / "reports");
+  const fs::path log = dir / "demo.db", db = dir / "objects.db", report = dir / "reports" / "r.json";
+  ASSERT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string()).exit_code, 0);
+  const CommandRun build = RunUwscan("build-db valve_wheel flange --views 8 -o " + db.string());
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+  const CommandRun recognise = RunUwscan("recognize " + log.string() + " --db " + db.string() + " --json " + report.string());
+  ASSERT_EQ(recognise.exit_code, 0) << recognise.output;
+  const std::string json = Bytes(report);
+  EXPECT_NE(json.find(R"("kind": "recognition_report")"), std::string::npos);
+  EXPECT_NE(json.find(R"("scan": "../demo.db")"), std::string::npos) << "paths are relative to the report";
+
+  // Drawn from another working directory: the report finds its scan and database.
+  const fs::path png = dir / "r.png";
+  const CommandRun view = RunCommand("cd / && " + std::string(UWSCAN_BIN) + " view " + report.string() +
+                                     " --screenshot " + png.string() + " --size 640x480");
+  ASSERT_EQ(view.exit_code, 0) << view.output;
+  EXPECT_NE(view.output.find("colour by object"), std::string::npos) << view.output;
+  EXPECT_EQ(PngSize(png), std::make_pair(640, 480));
+
+  // A report whose database has gone names it.
+  fs::remove(db);
+  const CommandRun missing = RunUwscan("view " + report.string() + " --screenshot " + png.string());
+  if (json.find(R"("T_S_O")") != std::string::npos) {  // something was recognised: its model is needed
+    EXPECT_EQ(missing.exit_code, 1);
+    EXPECT_NE(missing.output.find("objects.db"), std::string::npos) << missing.output;
+  }
+  fs::remove_all(dir);
+}
+
 // `view --follow` started before the log exists shows every frame `simulate` then writes.
 TEST(CliView, FollowPicksUpADiveWrittenAfterItStarted) {
   const fs::path log = TempPath("follow.db"), png = TempPath("follow.png"), out = TempPath("follow.txt");

@@ -7,6 +7,7 @@
 
 #include "perception/cloud_io.hpp"
 #include "scanner/common/error.hpp"
+#include "viewer/json_fields.hpp"
 #include "viewer/scene_files.hpp"
 
 namespace uwscan::viewer {
@@ -14,32 +15,9 @@ namespace {
 
 using nlohmann::json;
 
-// Errors name the report and the field, e.g. "report.json: trajectories.slam[3]".
-struct Field {
-  const std::string& file;
-  std::string path;
-  [[noreturn]] void Fail(const std::string& what) const { throw Error(file + ": " + path + ": " + what); }
-  Field operator[](const std::string& key) const { return {file, path.empty() ? key : path + "." + key}; }
-  Field operator[](std::size_t i) const { return {file, path + "[" + std::to_string(i) + "]"}; }
-};
-
-const json& Require(const json& object, const std::string& key, const Field& field) {
-  const auto it = object.find(key);
-  if (it == object.end()) field[key].Fail("missing");
-  return *it;
-}
-
-std::vector<double> Numbers(const json& value, std::size_t count, const Field& field) {
-  if (!value.is_array() || value.size() != count) {
-    field.Fail("expected an array of " + std::to_string(count) + " numbers");
-  }
-  std::vector<double> numbers;
-  for (std::size_t i = 0; i < count; ++i) {
-    if (!value[i].is_number() || !std::isfinite(value[i].get<double>())) field[i].Fail("not a finite number");
-    numbers.push_back(value[i].get<double>());
-  }
-  return numbers;
-}
+using internal::Field;
+using internal::Numbers;
+using internal::Require;
 
 std::vector<StampedPose> Trajectory(const json& value, const Field& field) {
   if (!value.is_array()) field.Fail("expected an array of [t tx ty tz qx qy qz qw]");
@@ -77,16 +55,6 @@ LoopClosure Loop(const json& value, const Field& field) {
   return loop;
 }
 
-json ParseJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path.string() + ": cannot read");
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw Error(path.string() + ": not valid JSON (" + e.what() + ")");
-  }
-}
-
 Rgb TrajectoryColour(const std::string& name, int index) {
   if (name == "slam") return CategoricalColour(0);
   if (name == "dead_reckoning") return CategoricalColour(1);
@@ -97,19 +65,15 @@ Rgb TrajectoryColour(const std::string& name, int index) {
 }  // namespace
 
 bool IsMapReport(const std::filesystem::path& path) {
-  const json j = ParseJson(path);
+  const json j = internal::ParseJsonFile(path);
   return j.is_object() && j.value("kind", std::string()) == "map_report";
 }
 
 MapReport ReadMapReport(const std::filesystem::path& path) {
   const std::string file = path.string();
-  const json j = ParseJson(path);
+  const json j = internal::ParseJsonFile(path);
   const Field root{file, ""};
-  if (!j.is_object()) root.Fail("expected a JSON object");
-  const json& format = Require(j, "uwscan_format", root);
-  if (!format.is_number_integer() || format.get<int>() != 1) root["uwscan_format"].Fail("this uwscan reads format 1");
-  const json& kind = Require(j, "kind", root);
-  if (!kind.is_string() || kind.get<std::string>() != "map_report") root["kind"].Fail("expected \"map_report\"");
+  internal::RequireFormatAndKind(j, "map_report", root);
 
   MapReport report;
   if (const auto it = j.find("log"); it != j.end() && it->is_string()) report.log = it->get<std::string>();

@@ -19,6 +19,8 @@ Eigen::Vector3d Scene::Anchor() const {
     if (!trajectory.positions_W.empty()) return trajectory.positions_W.front();
   }
   for (const UncertaintyEllipsoid& e : ellipsoids) return e.centre_W;
+  for (const FrameAxes& f : frames) return f.T_W_F.translation();
+  for (const Label& l : labels) return l.position_W;
   return Eigen::Vector3d::Zero();
 }
 

@@ -49,14 +49,33 @@ struct UncertaintyEllipsoid {
   Rgb colour{200, 200, 200};
 };
 
+// Text at a place in the world (a recognised object's name where it was found), drawn over
+// the scene so that no surface hides it.
+struct Label {
+  Eigen::Vector3d position_W = Eigen::Vector3d::Zero();
+  std::string text;
+  Rgb colour{255, 255, 255};
+};
+
+// A coordinate frame (a grasp pose) drawn as three lines from its origin: x red, y green,
+// z blue (the gripper's approach).
+struct FrameAxes {
+  std::string name;
+  Eigen::Isometry3d T_W_F = Eigen::Isometry3d::Identity();
+  double length_m = 0.05;  // > 0
+};
+
 struct Scene {
   std::vector<CloudLayer> clouds;
   std::vector<MeshLayer> meshes;
   std::vector<TrajectoryLayer> trajectories;
   std::vector<UncertaintyEllipsoid> ellipsoids;
+  std::vector<Label> labels;
+  std::vector<FrameAxes> frames;
 
   bool empty() const {
-    return clouds.empty() && meshes.empty() && trajectories.empty() && ellipsoids.empty();
+    return clouds.empty() && meshes.empty() && trajectories.empty() && ellipsoids.empty() && labels.empty() &&
+           frames.empty();
   }
   std::size_t num_points() const;
   // A point of the scene near its middle (the first cloud's origin, else the first vertex or

@@ -9,6 +9,7 @@
 #include "perception/cloud_io.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"
+#include "viewer/recognition_report.hpp"
 
 namespace uwscan::viewer {
 namespace {
@@ -74,6 +75,8 @@ const char* ToString(FileKind kind) {
       return "dive log";
     case FileKind::kMapReport:
       return "map report";
+    case FileKind::kRecognitionReport:
+      return "recognition report";
   }
   return "?";
 }
@@ -88,11 +91,12 @@ FileKind KindOfFile(const fs::path& path) {
   if (ext == ".db" || ext == ".uwlog") return FileKind::kDiveLog;
   if (ext == ".json") {
     if (IsMapReport(path)) return FileKind::kMapReport;
-    throw Error(path.string() + ": a JSON file that is not a map report (\"kind\": \"map_report\"); "
-                "bench reports are drawn by `uwscan plot`");
+    if (IsRecognitionReport(path)) return FileKind::kRecognitionReport;
+    throw Error(path.string() + ": a JSON file that is neither a map report nor a recognition report (\"kind\": "
+                "\"map_report\" or \"recognition_report\"); bench reports are drawn by `uwscan plot`");
   }
   throw Error(path.string() + ": unknown kind of file (clouds .ply .pcd .xyz, meshes .ply .off .stl .obj, "
-              "trajectories .txt .tum, dive logs .db, map reports .json)");
+              "trajectories .txt .tum, dive logs .db, map and recognition reports .json)");
 }
 
 void AddCloudFile(const fs::path& path, Scene& scene) {
@@ -175,6 +179,8 @@ void AddFile(const fs::path& path, const mapping::ReconstructionOptions& log_opt
       return;
     case FileKind::kMapReport:
       return AddMapReport(ReadMapReport(path), map_drawing, scene);
+    case FileKind::kRecognitionReport:
+      return AddRecognitionReport(ReadRecognitionReport(path), log_options, scene);
   }
 }
 

@@ -13,12 +13,13 @@
 // perception::ReadCloud, meshes through scanner::LoadMesh, dive logs through mapping::Reconstruct.
 namespace uwscan::viewer {
 
-enum class FileKind { kCloud, kMesh, kTrajectory, kDiveLog, kMapReport };
+enum class FileKind { kCloud, kMesh, kTrajectory, kDiveLog, kMapReport, kRecognitionReport };
 const char* ToString(FileKind kind);
 
 // What a file holds, from its extension and, where one extension has two meanings, its first
 // bytes: .pcd .xyz clouds; .ply a mesh when its header declares faces, else a cloud; .off .stl
-// .obj meshes; .txt .tum trajectories; .db .uwlog dive logs (SQLite); .json map reports. Throws
+// .obj meshes; .txt .tum trajectories; .db .uwlog dive logs (SQLite); .json map and recognition
+// reports (by their "kind"). Throws
 // uwscan::Error naming the file when it is missing or of none of these kinds.
 FileKind KindOfFile(const std::filesystem::path& path);
 
@@ -46,7 +47,8 @@ struct DiveLogSummary {
 DiveLogSummary AddDiveLog(const std::filesystem::path& path, const mapping::ReconstructionOptions& options,
                           Scene& scene);
 
-// Whatever KindOfFile says the file is (map reports with `map_drawing`).
+// Whatever KindOfFile says the file is (map reports with `map_drawing`; dive logs, also those a
+// recognition report names, triangulated with `log_options`).
 void AddFile(const std::filesystem::path& path, const mapping::ReconstructionOptions& log_options,
              const MapReportDrawing& map_drawing, Scene& scene);
 

@@ -1,6 +1,7 @@
 #include "viewer/vtk_scene.hpp"
 
 #include <vtkCamera.h>
+#include <vtkCellData.h>
 #include <vtkCellArray.h>
 #include <vtkEDLShading.h>
 #include <vtkFloatArray.h>
@@ -16,6 +17,7 @@
 #include <vtkProperty.h>
 #include <vtkRenderStepsPass.h>
 #include <vtkSphereSource.h>
+#include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
@@ -36,9 +38,59 @@ constexpr double kEllipsoidOpacity = 0.35;
 constexpr int kColourBarEntries = 256;
 constexpr double kTrajectoryPointSizePx = 6.0;  // a vehicle that holds still is still seen
 constexpr double kFitMargin = 0.9;              // of the tightest fit
+constexpr int kLabelFontSizePx = 18;
 
 void SetColour(vtkProperty& property, const Rgb& c) {
   property.SetColor(c.r / 255.0, c.g / 255.0, c.b / 255.0);
+}
+
+// A frame's three axes as lines of exact colours (x red, y green, z blue), unlit.
+vtkSmartPointer<vtkActor> FrameActor(const FrameAxes& frame, const Eigen::Vector3d& anchor_W) {
+  static const unsigned char kAxisColours[3][3] = {{230, 25, 25}, {25, 200, 25}, {40, 80, 255}};
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> lines;
+  vtkNew<vtkUnsignedCharArray> colours;
+  colours->SetNumberOfComponents(3);
+  const Eigen::Vector3d origin = frame.T_W_F.translation() - anchor_W;
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::Vector3d tip = origin + frame.length_m * frame.T_W_F.linear().col(a);
+    const vtkIdType from = points->InsertNextPoint(origin.data());
+    const vtkIdType to = points->InsertNextPoint(tip.data());
+    const vtkIdType line[2] = {from, to};
+    lines->InsertNextCell(2, line);
+    colours->InsertNextTypedTuple(kAxisColours[a]);
+  }
+  vtkNew<vtkPolyData> data;
+  data->SetPoints(points);
+  data->SetLines(lines);
+  data->GetCellData()->SetScalars(colours);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(data);
+  mapper->SetColorModeToDirectScalars();
+  mapper->SetScalarModeToUseCellData();
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetLineWidth(kTrajectoryLineWidthPx);
+  actor->GetProperty()->LightingOff();
+  return actor;
+}
+
+// Text anchored at a world point but drawn over the 3-D scene, so no surface hides it.
+vtkSmartPointer<vtkTextActor> LabelActor(const Label& label, const Eigen::Vector3d& anchor_W) {
+  auto actor = vtkSmartPointer<vtkTextActor>::New();
+  actor->SetInput(label.text.c_str());
+  const Eigen::Vector3d p = label.position_W - anchor_W;
+  actor->GetPositionCoordinate()->SetCoordinateSystemToWorld();
+  actor->GetPositionCoordinate()->SetValue(p.x(), p.y(), p.z());
+  vtkTextProperty* text = actor->GetTextProperty();
+  text->SetFontSize(kLabelFontSizePx);
+  text->BoldOn();
+  text->SetColor(label.colour.r / 255.0, label.colour.g / 255.0, label.colour.b / 255.0);
+  // On a dark plate, so that it reads over an object of its own colour.
+  text->SetBackgroundColor(0.05, 0.05, 0.05);
+  text->SetBackgroundOpacity(0.8);
+  text->SetJustificationToCentered();
+  return actor;
 }
 
 vtkSmartPointer<vtkPoints> FloatPoints(std::size_t n) {
@@ -271,6 +323,11 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
     mapper->SetInputConnection(sphere->GetOutputPort());
     for (const UncertaintyEllipsoid& e : scene.ellipsoids) AddEllipsoid(e, mapper, out);
   }
+  for (const FrameAxes& frame : scene.frames) {
+    if (!(frame.length_m > 0.0)) throw Error("frame " + frame.name + ": axis length must be > 0");
+    out.renderer->AddActor(FrameActor(frame, out.anchor_W));
+  }
+  for (const Label& label : scene.labels) out.renderer->AddActor2D(LabelActor(label, out.anchor_W));
   if (IsContinuous(options.colour) && out.points_total > 0) {
     out.range = range;
     if (options.colour_bar) out.renderer->AddViewProp(ColourBar(range, BarTitle(options.colour)));
