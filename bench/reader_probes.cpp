@@ -19,6 +19,7 @@
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/scene.hpp"
 #include "viewer/map_report.hpp"
+#include "viewer/recognition_report.hpp"
 #include "viewer/tum_trajectory.hpp"
 
 namespace uwscan::bench {
@@ -99,6 +100,8 @@ std::vector<ReaderProbe> MakeProbes() {
        [](const fs::path& path) { return perception::DescriptorDatabase::Load(path).size(); }},
       {"map_report", ".json",
        [](const fs::path& path) { return viewer::ReadMapReport(path).trajectories.size(); }},
+      {"recognition_report", ".json",
+       [](const fs::path& path) { return viewer::ReadRecognitionReport(path).objects.size(); }},
       {"tum_trajectory", ".tum",
        [](const fs::path& path) { return viewer::ReadTumTrajectory(path).size(); }},
   };

@@ -157,6 +157,14 @@ void WriteReportSeeds(const fs::path& folder) {
             "                  \"dead_reckoning\": [[0, 1, 2, 3, 0, 0, 0, 1]]},\n"
             " \"pose_covariance\": [" + covariance + "],\n"
             " \"loops\": [{\"from_submap\": 0, \"to_submap\": 7, \"accepted\": true, \"reason\": \"\"}]}\n");
+  const std::string pose = "{\"matrix\": [[1, 0, 0, 0.2], [0, 0, -1, 0.05], [0, 1, 0, 1.0], [0, 0, 0, 1]]}";
+  WriteText(folder / "recognition_report" / "seed_0.json",
+            "{\"uwscan_format\": 1, \"kind\": \"recognition_report\", \"scan\": \"scan.ply\",\n"
+            " \"database\": \"objects.db\", \"scan_points\": 40,\n"
+            " \"objects\": [{\"id\": \"valve_wheel\", \"segment\": [3, 4, 5, 9], \"centroid_m\": [0.2, 0.05, 1],\n"
+            "   \"score\": 0.9, \"T_S_O\": " + pose + ",\n"
+            "   \"grasps\": [{\"name\": \"rim\", \"matrix\": [[1, 0, 0, 0.2], [0, 1, 0, 0], [0, 0, 1, 0.9], [0, 0, 0, 1]]}]},\n"
+            "  {\"id\": \"unknown\", \"segment\": [0, 1], \"centroid_m\": [0, 0, 1.2]}]}\n");
 }
 
 }  // namespace
@@ -166,7 +174,7 @@ void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
        {"cloud_ply", "cloud_pcd", "cloud_xyz", "mesh_off", "mesh_stl", "mesh_obj", "mesh_ply",
         "scene_yaml", "scanner_yaml", "scan_pattern_yaml", "calibration_scene_yaml",
         "calibration_manifest", "calibration_truth", "opencv_intrinsics", "dive_log",
-        "object_database", "descriptor_database", "map_report", "tum_trajectory"}) {
+        "object_database", "descriptor_database", "map_report", "recognition_report", "tum_trajectory"}) {
     fs::create_directories(folder / reader);
   }
   perception::WriteCloud(folder / "cloud_ply" / "seed_0.ply", SeedCloud(true), true);
