@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "apps/json_output.hpp"
 #include "apps/progress_bar.hpp"
@@ -56,7 +57,20 @@ nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
                      {"seconds", m.seconds},               {"triangulated", m.triangulated}};
   }
   const double ratio = r.methods.at("ray_ray").seconds / r.methods.at("ray_cone").seconds;
+  nlohmann::json resolution = nlohmann::json::array();
+  for (const bench::TableResolutionRow& row : r.resolution) {
+    resolution.push_back({{"table", row.table},
+                          {"value", row.value},
+                          {"setup_s", row.setup_s},
+                          {"ray_plane", {{"points_per_s", row.ray_plane.points_per_s},
+                                         {"mean_err_m", row.ray_plane.mean_err_m},
+                                         {"max_err_m", row.ray_plane.max_err_m}}},
+                          {"ray_cone", {{"points_per_s", row.ray_cone.points_per_s},
+                                        {"mean_err_m", row.ray_cone.mean_err_m},
+                                        {"max_err_m", row.ray_cone.max_err_m}}}});
+  }
   return {{"points", r.points},
+          {"resolution", resolution},
           {"setup_s", r.setup_s},
           {"exact_vs_truth_max_m", r.exact_vs_truth_max_m},
           {"methods", methods},
@@ -105,10 +119,23 @@ void PrintTriangulationTable(const bench::TriangulationBenchResult& r) {
               kSeedRayConeStdErrM * 1e3);
   std::printf("exact ray-ray against the generating points: max %.3g m; tables built in %.2f s\n",
               r.exact_vs_truth_max_m, r.setup_s);
+  if (r.resolution.empty()) return;
+  std::printf("\nTable resolutions, one table at a time (the other at its default: 4 px grid, 35 rays per fan)\n\n");
+  std::printf("| table | resolution | build s | ray-cone points/s | ray-cone mean err mm | ray-cone max err mm | "
+              "ray-plane points/s | ray-plane mean err mm |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const bench::TableResolutionRow& row : r.resolution) {
+    const bool camera = row.table == "camera_rays";
+    std::printf("| %s | %d %s | %.3f | %.3g | %.4f | %.4f | %.3g | %.4f |\n", camera ? "camera rays" : "light surfaces",
+                row.value, camera ? "px grid" : "rays per fan", row.setup_s, row.ray_cone.points_per_s,
+                row.ray_cone.mean_err_m * 1e3, row.ray_cone.max_err_m * 1e3, row.ray_plane.points_per_s,
+                row.ray_plane.mean_err_m * 1e3);
+  }
 }
 
 struct TriangulationArgs {
   std::int64_t points = 1'000'000;
+  std::vector<int> sweep_grid_px;
+  std::vector<int> sweep_rays_per_fan;
   std::uint64_t seed = 1;
   std::string scanner_path;
   std::string json_path;
@@ -119,6 +146,8 @@ void RunTriangulation(const TriangulationArgs& args) {
   bench::TriangulationBenchOptions options;
   options.points = args.points;
   options.seed = args.seed;
+  options.sweep_camera_grid_px = args.sweep_grid_px;
+  options.sweep_rays_per_fan = args.sweep_rays_per_fan;
   const scanner::GalvoScannerModel model = LoadModel(args.scanner_path);
   bench::TriangulationBenchResult result;
   {
@@ -133,6 +162,10 @@ void AddTriangulationOptions(CLI::App& command, TriangulationArgs& args) {
   command.add_option("--points", args.points, "stripe pixels to triangulate")
       ->check(CLI::PositiveNumber);
   command.add_option("--seed", args.seed, "random seed of the generated pixels");
+  command.add_option("--sweep-grid-px", args.sweep_grid_px,
+                     "also measure camera-ray tables of these grid spacings, px (e.g. 1 2 4 8 16)");
+  command.add_option("--sweep-rays-per-fan", args.sweep_rays_per_fan,
+                     "also measure light-surface tables fitted to these rays per fan (e.g. 9 17 35 70)");
   command.add_option("--scanner", args.scanner_path, "scanner YAML (default: embedded)")
       ->check(CLI::ExistingFile);
 }

@@ -69,9 +69,9 @@ void RunRegister(const RegisterArgs& a) {
   if (!a.voxel_set && !(size > 0.0)) {
     throw Error(a.target + ": the target cloud has no extent (give --voxel)");
   }
-  perception::RegistrationPipelineOptions options =
-      perception::RegistrationPipelineOptions::ForObjectSize(a.voxel_set ? 50.0 * a.voxel_m : size,
-                                                             a.seed, a.threads);
+  // Without an extent (one point) the object's size is taken from the voxel.
+  perception::RegistrationPipelineOptions options = perception::RegistrationPipelineOptions::ForObjectSize(
+      size > 0.0 ? size : 50.0 * a.voxel_m, a.seed, a.threads, a.voxel_set ? a.voxel_m : 0.0);
   std::optional<Eigen::Isometry3d> init;
   if (!a.init.empty()) init = ParsePose(a.init);
   const perception::RegistrationPipelineResult r =
@@ -105,6 +105,7 @@ struct RegistrationBenchArgs {
   int threads = 2;
   std::uint64_t seed = 1;
   bool no_pcl = false, no_open3d = false, no_real_scans = false;
+  std::vector<double> sweep_voxel;
 };
 
 void RunRegistrationBench(const RegistrationBenchArgs& a) {
@@ -116,26 +117,29 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
   o.threads = a.threads;
   o.run_pcl = !a.no_pcl;
   o.run_open3d = !a.no_open3d;
+  o.sweep_voxel_fractions = a.sweep_voxel;
   bench::RegistrationBenchResult r;
   {
     ProgressBar bar;
     r = bench::RunRegistrationBenchmark(o, bar.Callback());
   }
   std::printf("Registration on %d pairs (%d threads): success = rotation < 2 deg and translation "
-              "< 1 %% of the object size\n\n",
+              "< 1 %% of the object size; ADD-S success = mean distance to the nearest truly placed "
+              "point < 1 %% of the object size (a symmetric object's equivalent poses pass)\n\n",
               r.pipelines.at("uwscan").pairs, a.threads);
-  std::printf("| pipeline | success | s/pair | downsample | normals | features | coarse | icp |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf("| pipeline | success | ADD-S success | s/pair | downsample | normals | features | coarse | icp |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json pipelines = nlohmann::json::object();
   for (const auto& [name, s] : r.pipelines) {
     auto stage = [&](const char* k) {
       const auto it = s.stage_seconds_per_pair.find(k);
       return it == s.stage_seconds_per_pair.end() ? 0.0 : it->second;
     };
-    std::printf("| %s | %d/%d | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n", name.c_str(),
-                s.successes, s.pairs, s.seconds_per_pair, stage("downsample"), stage("normals"),
-                stage("features"), stage("coarse"), stage("icp"));
+    std::printf("| %s | %d/%d | %d/%d | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n", name.c_str(),
+                s.successes, s.pairs, s.symmetric_successes, s.pairs, s.seconds_per_pair, stage("downsample"),
+                stage("normals"), stage("features"), stage("coarse"), stage("icp"));
     pipelines[name] = {{"success_rate", s.success_rate},
+                       {"symmetric_success_rate", s.symmetric_success_rate},
                        {"seconds_per_pair", s.seconds_per_pair},
                        {"pairs", s.pairs},
                        {"successes", s.successes},
@@ -154,11 +158,31 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
                         {"pipeline", p.pipeline},
                         {"rotation_error_deg", p.rotation_error_rad * kRadToDeg},
                         {"translation_error_m", p.translation_error_m},
+                        {"symmetric_error_m", p.symmetric_error_m},
                         {"seconds", p.seconds},
-                        {"success", p.success}});
+                        {"success", p.success},
+                        {"symmetric_success", p.symmetric_success}});
+  }
+  nlohmann::json sweep = nlohmann::json::array();
+  if (!r.voxel_sweep.empty()) {
+    std::printf("\nuwscan's pipeline by voxel size (radii and distances scale with it)\n\n"
+                "| voxel / object size | success | ADD-S success | s/pair |\n|---:|---:|---:|---:|\n");
+  }
+  for (const bench::VoxelSweepRow& row : r.voxel_sweep) {
+    const bench::PipelineSummary& s = row.summary;
+    std::printf("| %.4f | %d/%d | %d/%d | %.3f |\n", row.voxel_fraction, s.successes, s.pairs, s.symmetric_successes,
+                s.pairs, s.seconds_per_pair);
+    sweep.push_back({{"voxel_fraction", row.voxel_fraction},
+                     {"success_rate", s.success_rate},
+                     {"symmetric_success_rate", s.symmetric_success_rate},
+                     {"seconds_per_pair", s.seconds_per_pair}});
   }
   if (!a.json.empty()) {
-    WriteJsonFile(a.json, {{"pipelines", pipelines}, {"ratios", ratios}, {"pairs", outcomes}});
+    WriteJsonFile(a.json, {{"bench", "registration"},
+                           {"pipelines", pipelines},
+                           {"ratios", ratios},
+                           {"pairs", outcomes},
+                           {"voxel_sweep", sweep}});
   }
 }
 
@@ -220,6 +244,8 @@ void AddPerceptionBenchCommands(CLI::App& bench) {
   reg->add_flag("--no-pcl", a->no_pcl, "skip PCL's pipeline");
   reg->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
   reg->add_flag("--no-real-scans", a->no_real_scans, "only the mesh pairs");
+  reg->add_option("--sweep-voxel", a->sweep_voxel,
+                  "also run uwscan's pipeline at these voxel sizes, fractions of the object size (e.g. 0.01 0.02 0.04)");
   reg->add_option("--json", a->json, "write the figures as JSON");
   reg->callback([a] { RunRegistrationBench(*a); });
 

@@ -69,12 +69,14 @@ struct BenchRun {
 
 // The quick form of every bench: a run in minutes whose figures keep their order.
 std::vector<BenchRun> QuickBenches(const std::string& data) {
-  return {{"triangulation", "triangulation --points 200000"},
+  return {{"triangulation", "triangulation --points 200000 --sweep-grid-px 1 2 4 8 16 --sweep-rays-per-fan 9 17 35 70"},
           {"stripe", "stripe --frames 2"},
           {"deformation", "deformation"},
           {"accuracy", "accuracy --quick --data " + Quoted(data)},
           {"calibration", "calibration --quick --data " + Quoted(data)},
-          {"registration", "registration --pairs-per-mesh 1 --no-open3d"},
+          {"registration", "registration --pairs-per-mesh 1 --no-open3d --sweep-voxel 0.01 0.02 0.04"},
+          {"recognition", "recognition --scans 6 --views 16 --no-images"},
+          {"slam", "slam --scene " + Quoted(data + "/scenes/inspection_short.yaml") + " --no-open3d"},
           {"viewer", "viewer --points 200000 1000000 --frames 3"}};
 }
 
@@ -201,7 +203,7 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "folder to write (created)")->required();
   cmd->add_option("--data", a->data, "the data folder (scanners, scenes) of the accuracy and calibration benches");
   cmd->add_option("--only", a->only, "only these benches (triangulation stripe deformation accuracy calibration "
-                                     "registration viewer)");
+                                     "registration recognition slam viewer)");
   cmd->callback([a] { RunReport(*a); });
 }
 

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "perception/cloud_io.hpp"
+#include "perception/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 
@@ -150,6 +151,27 @@ PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3
   const Eigen::Isometry3d delta = truth.inverse() * estimate;
   const double cos_angle = std::clamp((delta.linear().trace() - 1.0) / 2.0, -1.0, 1.0);
   return PoseError{std::acos(cos_angle), (estimate * at_point - truth * at_point).norm()};
+}
+
+double SymmetricSurfaceError(const perception::PointCloud& source, const Eigen::Isometry3d& estimate,
+                             const Eigen::Isometry3d& truth, std::size_t max_points) {
+  if (source.empty()) throw Error("SymmetricSurfaceError: empty source cloud");
+  // Coordinates relative to where the truth puts the source's origin keep the floats small.
+  const Eigen::Vector3d centre = truth * source.origin;
+  std::vector<Eigen::Vector3f> true_points;
+  true_points.reserve(source.size());
+  for (std::size_t i = 0; i < source.size(); ++i) true_points.push_back((truth * source.Point(i) - centre).cast<float>());
+  const perception::KnnIndex index(true_points);
+  const std::size_t stride = std::max<std::size_t>(1, (source.size() + max_points - 1) / std::max<std::size_t>(1, max_points));
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared_m2;
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < source.size(); i += stride, ++n) {
+    index.Query((estimate * source.Point(i) - centre).cast<float>(), 1, nearest, squared_m2);
+    sum += std::sqrt(static_cast<double>(squared_m2.front()));
+  }
+  return sum / static_cast<double>(n);
 }
 
 }  // namespace uwscan::bench

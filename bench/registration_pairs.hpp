@@ -51,4 +51,11 @@ struct PoseError {
 PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth,
                        const Eigen::Vector3d& at_point);
 
+// ADD-S, the error of a pose that a symmetric object cannot show wrong: the mean distance from
+// each source point moved by `estimate` to the nearest source point moved by `truth` (at most
+// `max_points` source points, evenly spaced, are measured). A pose that differs from the truth
+// by a symmetry of the surface scores (near) zero, where the rotation error does not.
+double SymmetricSurfaceError(const perception::PointCloud& source, const Eigen::Isometry3d& estimate,
+                             const Eigen::Isometry3d& truth, std::size_t max_points = 2000);
+
 }  // namespace uwscan::bench

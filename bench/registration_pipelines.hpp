@@ -20,7 +20,8 @@ struct PipelineParameters {
   std::uint64_t seed = 1;
   int threads = 1;
 };
-PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads);
+// voxel_m > 0: that leaf (and the radii and distances scaled to it) instead of size / 50.
+PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads, double voxel_m = 0.0);
 
 // What one pipeline produced on one pair, and the time each stage took.
 struct PipelineRun {

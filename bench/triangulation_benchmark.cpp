@@ -160,6 +160,63 @@ void CompareTo(const std::vector<std::vector<scanner::TriangulatedPoint>>& resul
   figures->max_err_m = max;
 }
 
+void SetRate(std::int64_t points, MethodFigures* figures) {
+  figures->points_per_s = figures->seconds > 0.0 ? points / figures->seconds : 0.0;
+}
+
+// The table methods with these tables on the frames, against the exact points.
+TableResolutionRow MeasureTables(std::shared_ptr<const scanner::CameraRayTable> rays,
+                                 std::shared_ptr<const scanner::LightSurfaceTable> surfaces,
+                                 const std::vector<Frame>& frames, std::int64_t points,
+                                 const std::vector<std::vector<scanner::TriangulatedPoint>>& exact, int repeats) {
+  TableResolutionRow row;
+  std::vector<std::vector<scanner::TriangulatedPoint>> approximate;
+  const scanner::RayPlaneTriangulator ray_plane(rays, surfaces);
+  const scanner::RayConeTriangulator ray_cone(rays, surfaces);
+  row.ray_plane.seconds = RunMethod(ray_plane, frames, repeats, &approximate, {});
+  CompareTo(approximate, exact, &row.ray_plane);
+  SetRate(points, &row.ray_plane);
+  row.ray_cone.seconds = RunMethod(ray_cone, frames, repeats, &approximate, {});
+  CompareTo(approximate, exact, &row.ray_cone);
+  SetRate(points, &row.ray_cone);
+  return row;
+}
+
+// Each table resolution of the options in turn, the other table at its default.
+std::vector<TableResolutionRow> SweepResolutions(const scanner::GalvoScannerModel& model,
+                                                 const TriangulationBenchOptions& o,
+                                                 std::shared_ptr<const scanner::CameraRayTable> default_rays,
+                                                 std::shared_ptr<const scanner::LightSurfaceTable> default_surfaces,
+                                                 const std::vector<Frame>& frames, std::int64_t points,
+                                                 const std::vector<std::vector<scanner::TriangulatedPoint>>& exact,
+                                                 const Progress& progress) {
+  std::vector<TableResolutionRow> rows;
+  const double total = static_cast<double>(o.sweep_camera_grid_px.size() + o.sweep_rays_per_fan.size());
+  for (const int grid_px : o.sweep_camera_grid_px) {
+    const Clock::time_point start = Clock::now();
+    auto rays = std::make_shared<const scanner::CameraRayTable>(model.camera, grid_px);
+    const double setup_s = SecondsSince(start);
+    rows.push_back(MeasureTables(rays, default_surfaces, frames, points, exact, o.repeats));
+    rows.back().table = "camera_rays";
+    rows.back().value = grid_px;
+    rows.back().setup_s = setup_s;
+    if (progress) progress("table resolutions", rows.size() / total);
+  }
+  for (const int rays_per_fan : o.sweep_rays_per_fan) {
+    scanner::LightSurfaceTableOptions surface_options = o.surfaces;
+    surface_options.rays_per_fan = rays_per_fan;
+    const Clock::time_point start = Clock::now();
+    auto surfaces = std::make_shared<const scanner::LightSurfaceTable>(model.laser, surface_options);
+    const double setup_s = SecondsSince(start);
+    rows.push_back(MeasureTables(default_rays, surfaces, frames, points, exact, o.repeats));
+    rows.back().table = "light_surfaces";
+    rows.back().value = rays_per_fan;
+    rows.back().setup_s = setup_s;
+    if (progress) progress("table resolutions", rows.size() / total);
+  }
+  return rows;
+}
+
 }  // namespace
 
 void TriangulationBenchOptions::Check() const {
@@ -171,6 +228,14 @@ void TriangulationBenchOptions::Check() const {
   if (repeats < 1) throw Error("bench triangulation: repeats must be >= 1");
   if (camera_grid_px < 1) throw Error("bench triangulation: camera_grid_px must be >= 1");
   surfaces.Check();
+  for (const int g : sweep_camera_grid_px) {
+    if (g < 1) throw Error("bench triangulation: a camera-ray table spacing must be >= 1 px");
+  }
+  for (const int r : sweep_rays_per_fan) {
+    scanner::LightSurfaceTableOptions swept = surfaces;
+    swept.rays_per_fan = r;
+    swept.Check();
+  }
 }
 
 TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerModel& model,
@@ -215,9 +280,10 @@ TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerMo
   result.limit_seconds = RunLimit(*rays, frames, o.repeats, &limit_points, progress);
   result.limit_points_per_s = result.points / result.limit_seconds;
   for (auto& [name, figures] : result.methods) {
-    figures.points_per_s = figures.seconds > 0.0 ? result.points / figures.seconds : 0.0;
+    SetRate(result.points, &figures);
     figures.fraction_of_limit = figures.points_per_s / result.limit_points_per_s;
   }
+  result.resolution = SweepResolutions(model, o, rays, surfaces, frames, result.points, exact, progress);
   return result;
 }
 

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "bench/progress.hpp"
 #include "scanner/triangulation/light_surface_table.hpp"
@@ -25,6 +26,11 @@ struct TriangulationBenchOptions {
   int repeats = 5;  // passes per method; the fastest is reported
   int camera_grid_px = 4;
   scanner::LightSurfaceTableOptions surfaces;
+  // Table resolutions to sweep, one table at a time (the other at its default), on the same
+  // pixels: camera-ray table spacings (px) and rays sampled per fan for the plane/cone fits.
+  // Empty: no sweep.
+  std::vector<int> sweep_camera_grid_px;
+  std::vector<int> sweep_rays_per_fan;
 
   void Check() const;
 };
@@ -40,6 +46,15 @@ struct MethodFigures {
   double fraction_of_limit = 0.0;  // points_per_s / TriangulationBenchResult::limit_points_per_s
 };
 
+// One table resolution of the sweep: what building the table took and what the table methods
+// then give (errors against exact ray-ray on the same pixels).
+struct TableResolutionRow {
+  std::string table;  // "camera_rays" (value: grid spacing, px) or "light_surfaces" (rays per fan)
+  int value = 0;
+  double setup_s = 0.0;  // building this table
+  MethodFigures ray_plane, ray_cone;
+};
+
 struct TriangulationBenchResult {
   std::int64_t points = 0;
   double setup_s = 0.0;              // tables: camera rays, plane and cone fits per step
@@ -49,6 +64,7 @@ struct TriangulationBenchResult {
   // table lookup (prefetched) and one multiply-add per coordinate.
   double limit_seconds = 0.0;
   double limit_points_per_s = 0.0;
+  std::vector<TableResolutionRow> resolution;  // the sweep, when asked
 };
 
 TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerModel& model,

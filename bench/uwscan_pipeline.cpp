@@ -5,9 +5,9 @@
 
 namespace uwscan::bench {
 
-PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads) {
+PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads, double voxel_m) {
   const perception::RegistrationPipelineOptions o =
-      perception::RegistrationPipelineOptions::ForObjectSize(object_size_m, seed, threads);
+      perception::RegistrationPipelineOptions::ForObjectSize(object_size_m, seed, threads, voxel_m);
   PipelineParameters p;
   p.voxel_m = o.voxel_m;
   p.normal_radius_m = o.normal_radius_m;
@@ -23,7 +23,7 @@ PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int t
 PipelineRun RunUwscanPipeline(const RegistrationPair& pair, const PipelineParameters& p) {
   perception::RegistrationPipelineOptions o =
       perception::RegistrationPipelineOptions::ForObjectSize(pair.object_size_m, p.seed,
-                                                             p.threads);
+                                                             p.threads, p.voxel_m);
   o.source_viewpoint = pair.source_viewpoint;
   o.target_viewpoint = pair.target_viewpoint;
   const perception::RegistrationPipelineResult result =

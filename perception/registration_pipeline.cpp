@@ -56,13 +56,16 @@ Prepared Prepare(const PointCloud& cloud, const Eigen::Vector3d& viewpoint,
 
 RegistrationPipelineOptions RegistrationPipelineOptions::ForObjectSize(double size_m,
                                                                        std::uint64_t seed,
-                                                                       int threads) {
+                                                                       int threads, double voxel_m) {
   if (!(size_m > 0.0) || !std::isfinite(size_m)) {
     throw Error("registration: object size must be finite and > 0 (got " +
                 std::to_string(size_m) + " m)");
   }
+  if (!(voxel_m >= 0.0) || !std::isfinite(voxel_m)) {
+    throw Error("registration: voxel must be finite and > 0 (got " + std::to_string(voxel_m) + " m)");
+  }
   RegistrationPipelineOptions o;
-  o.voxel_m = size_m / 50.0;
+  o.voxel_m = voxel_m > 0.0 ? voxel_m : size_m / 50.0;
   o.normal_radius_m = 2.5 * o.voxel_m;
   o.feature_radius_m = 5.0 * o.voxel_m;
   o.coarse.inlier_distance_m = 1.5 * o.voxel_m;

@@ -28,13 +28,14 @@ struct RegistrationPipelineOptions {
   IcpOptions icp;
   int threads = 0;  // OpenMP threads for every stage (overrides coarse.threads, icp.threads)
 
-  // Parameters scaled to an object of the given bounding-box diagonal: voxel = size / 50,
+  // Parameters scaled to an object of the given bounding-box diagonal: voxel = size / 50 (or
+  // `voxel_m` when > 0),
   // normals 2.5 voxels, FPFH 5 voxels, RANSAC inliers and ICP 1.5 voxels, then 0.75; a coarse
   // result is accepted from 1 % of the keypoints in agreement (features are computed at every
   // point, so most have no counterpart in a partial view). ICP has converged once a step moves
   // the object's edge by less than 1 % of a voxel or the RMS changes by less than 1e-4 of it.
   static RegistrationPipelineOptions ForObjectSize(double size_m, std::uint64_t seed = 1,
-                                                   int threads = 0);
+                                                   int threads = 0, double voxel_m = 0.0);
   void Check() const;
 };
 

@@ -49,6 +49,26 @@ PlotSeries VerticalLine(const std::string& label, double x, const std::vector<Pl
   return {label, {x, x}, {lo, hi}, SeriesStyle::kLine, {0, 0, 0}};
 }
 
+// The resolution sweep: ray-cone error against what the table took to build, one line per
+// table (the other table at its default), a point per resolution.
+PlotSpec TableResolution(const json& rows, const std::string& file) {
+  PlotSpec p{"Table resolution: ray-cone error against build time", "table build time (s)", "mean error (mm)", true,
+             true, {}, {}};
+  PlotSeries camera{"camera-ray table, grid px", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
+  PlotSeries surfaces{"light-surface fits, rays per fan", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
+  for (const json& row : rows) {
+    PlotSeries& s = row.at("table").get<std::string>() == "camera_rays" ? camera : surfaces;
+    s.label.push_back(' ');  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on " " + string
+    s.label.append(std::to_string(static_cast<int>(Number(row, "value", file))));
+    s.x.push_back(Number(row, "setup_s", file));
+    s.y.push_back(Number(row.at("ray_cone"), "mean_err_m", file) * 1e3);
+  }
+  for (PlotSeries* s : {&camera, &surfaces}) {
+    if (!s->x.empty()) p.series.push_back(*s);
+  }
+  return p;
+}
+
 std::vector<PlotSpec> Triangulation(const json& j, const std::string& file) {
   PlotSpec p{"Triangulation: accuracy against time (one core)", "time per point (ns)", "mean error (mm)", true, true, {}, {}};
   int colour = 0;
@@ -68,7 +88,11 @@ std::vector<PlotSpec> Triangulation(const json& j, const std::string& file) {
     p.series.push_back(VerticalLine("limit: table lookup + multiply-add", 1e9 / Number(*limit, "points_per_s", file), p.series));
   }
   p.series.push_back(front);
-  return {p};
+  std::vector<PlotSpec> plots = {p};
+  if (const auto rows = j.find("resolution"); rows != j.end() && !rows->empty()) {
+    plots.push_back(TableResolution(*rows, file));
+  }
+  return plots;
 }
 
 std::vector<PlotSpec> Stripe(const json& j, const std::string& file) {
@@ -93,6 +117,71 @@ std::vector<PlotSpec> Registration(const json& j, const std::string& file) {
     p.series.push_back(Point(name, Number(s, "seconds_per_pair", file), Number(s, "success_rate", file), colour++));
   }
   p.series.push_back(FrontOf(p.series, -1.0));  // higher success is better
+  // Judged modulo symmetry (ADD-S), where the bench reports it, in the next colours.
+  for (const auto& [name, s] : j.at("pipelines").items()) {
+    if (!s.contains("symmetric_success_rate")) continue;
+    p.series.push_back(Point(name + " (ADD-S)", Number(s, "seconds_per_pair", file),
+                             Number(s, "symmetric_success_rate", file), colour++));
+  }
+  std::vector<PlotSpec> plots = {p};
+  if (const auto sweep = j.find("voxel_sweep"); sweep != j.end() && !sweep->empty()) {
+    PlotSpec v{"Registration: voxel size (uwscan)", "voxel / object size", "success rate", true, false, {}, {}};
+    PlotSeries plain{"success (rotation and translation)", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
+    PlotSeries adds{"ADD-S success", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
+    PlotSpec t{"Registration: time against voxel size (uwscan)", "voxel / object size", "seconds per pair", true, true,
+               {}, {}};
+    PlotSeries seconds{"seconds per pair", {}, {}, SeriesStyle::kLine, CategoricalColour(2)};
+    for (const json& row : *sweep) {
+      const double f = Number(row, "voxel_fraction", file);
+      plain.x.push_back(f);
+      plain.y.push_back(Number(row, "success_rate", file));
+      adds.x.push_back(f);
+      adds.y.push_back(Number(row, "symmetric_success_rate", file));
+      seconds.x.push_back(f);
+      seconds.y.push_back(Number(row, "seconds_per_pair", file));
+    }
+    v.series = {plain, adds};
+    t.series = {seconds};
+    plots.push_back(v);
+    plots.push_back(t);
+  }
+  return plots;
+}
+
+// Recognition: each pipeline's recognition rate (and pose success among what it recognised)
+// against its time per scan.
+std::vector<PlotSpec> Recognition(const json& j, const std::string& file) {
+  PlotSpec p{"Recognition: rate against time", "seconds per scan", "rate", true, false, {}, {}};
+  int colour = 0;
+  for (const auto& [name, s] : j.at("pipelines").items()) {
+    const double seconds = Number(s, "seconds_per_scan", file);
+    p.series.push_back(Point(name + ": recognised", seconds, Number(s, "recognition_rate", file), colour));
+    p.series.push_back(Point(name + ": pose within 5 mm, 2 deg", seconds, Number(s, "pose_success_rate", file),
+                             colour + 3));  // the three pipelines' recognition points take 0..2
+    ++colour;
+  }
+  return {p};
+}
+
+// SLAM: each dive's trajectory error for dead reckoning, SLAM and Open3D's multiway
+// registration against the time each took (dead reckoning at the time SLAM took, for reference).
+std::vector<PlotSpec> Slam(const json& j, const std::string& file) {
+  PlotSpec p{"SLAM: trajectory error against processing time", "seconds", "ATE (m)", true, true, {}, {}};
+  int colour = 0;
+  for (const json& dive : j.at("dives")) {
+    const std::string name = dive.at("name").get<std::string>();
+    const double slam_s = Number(dive.at("slam"), "seconds", file);
+    PlotSeries line{name, {}, {}, SeriesStyle::kLine, CategoricalColour(colour)};
+    line.x = {slam_s, slam_s};
+    line.y = {Number(dive.at("dr"), "ate_m", file), Number(dive.at("slam"), "ate_m", file)};
+    line.label = name + ": dead reckoning -> SLAM";
+    p.series.push_back(line);
+    if (const auto open3d = dive.find("open3d"); open3d != dive.end() && !open3d->is_null()) {
+      p.series.push_back(Point(name + ": Open3D multiway", Number(*open3d, "seconds", file),
+                               Number(*open3d, "ate_m", file), colour));
+    }
+    ++colour;
+  }
   return {p};
 }
 
@@ -190,7 +279,9 @@ BenchPlots ReadBenchPlots(const std::filesystem::path& path) {
   try {
     if (j.contains("exact_vs_truth_max_m")) return {"triangulation", Triangulation(j, file)};
     if (j.contains("methods") && j.contains("image")) return {"stripe", Stripe(j, file)};
+    if (j.contains("pipelines") && j.contains("confusion")) return {"recognition", Recognition(j, file)};
     if (j.contains("pipelines")) return {"registration", Registration(j, file)};
+    if (j.contains("dives")) return {"slam", Slam(j, file)};
     if (j.contains("waypoints") || j.contains("gauges")) return {"accuracy", Accuracy(j, file)};
     if (j.contains("steps")) return {"calibration", Calibration(j, file)};
     if (j.value("bench", std::string()) == "viewer") return {"viewer", Viewer(j, file)};
@@ -199,7 +290,7 @@ BenchPlots ReadBenchPlots(const std::filesystem::path& path) {
     throw Error(file + ": a field has the wrong type or is missing (" + e.what() + ")");
   }
   throw Error(file + ": not the JSON of a bench this uwscan can plot (triangulation, stripe, registration, "
-              "accuracy, calibration, deformation, viewer)");
+              "recognition, slam, accuracy, calibration, deformation, viewer)");
 }
 
 }  // namespace uwscan::viewer

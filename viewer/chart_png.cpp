@@ -58,16 +58,16 @@ void FillChart(vtkChartXY& chart, const PlotSpec& spec) {
   for (const PlotSeries& s : spec.series) {
     vtkSmartPointer<vtkTable> table = SeriesTable(s, spec.log_x, spec.log_y);
     if (table->GetNumberOfRows() == 0) continue;
-    const int type = s.style == SeriesStyle::kBars ? vtkChart::BAR
-                     : s.style == SeriesStyle::kLine ? vtkChart::LINE
-                                                      : vtkChart::POINTS;
+    // A line of one point is drawn as that point (VTK refuses to paint it and says so).
+    const bool line = s.style == SeriesStyle::kLine && table->GetNumberOfRows() >= 2;
+    const int type = s.style == SeriesStyle::kBars ? vtkChart::BAR : line ? vtkChart::LINE : vtkChart::POINTS;
     vtkPlot* plot = chart.AddPlot(type);
     plot->SetInputData(table, 0, 1);
     plot->SetColor(s.colour.r, s.colour.g, s.colour.b, 255);
     plot->SetWidth(kLineWidthPx);
     plot->SetLabel(s.label);
     if (auto* points = vtkPlotPoints::SafeDownCast(plot)) {
-      points->SetMarkerStyle(s.style == SeriesStyle::kPoints ? vtkPlotPoints::CIRCLE : vtkPlotPoints::NONE);
+      points->SetMarkerStyle(line ? vtkPlotPoints::NONE : vtkPlotPoints::CIRCLE);
       points->SetMarkerSize(kMarkerSizePx);
     }
     ++drawn;
