@@ -75,8 +75,8 @@ std::vector<BenchRun> QuickBenches(const std::string& data) {
           {"accuracy", "accuracy --quick --data " + Quoted(data)},
           {"calibration", "calibration --quick --data " + Quoted(data)},
           {"registration", "registration --pairs-per-mesh 1 --no-open3d --sweep-voxel 0.01 0.02 0.04"},
-          {"recognition", "recognition --scans 6 --views 16 --no-images"},
-          {"slam", "slam --scene " + Quoted(data + "/scenes/inspection_short.yaml") + " --no-open3d"},
+          {"recognition", "recognition --scans 6 --views 16 --no-images --no-peers"},
+          {"slam", "slam --scene " + Quoted(data + "/scenes/inspection_short.yaml")},
           {"viewer", "viewer --points 200000 1000000 --frames 3"}};
 }
 

@@ -19,8 +19,23 @@ mkdir -p docs
 "$UWSCAN" view "$work/dive.db" --colour error --screenshot docs/demo_error.png --size 1280x800
 "$UWSCAN" view "$work/dive.db" --edl --point-size 3 --camera top --screenshot docs/demo_edl_top.png --size 1280x800
 
-# Trade-offs: triangulation methods and stripe detectors, accuracy against time.
-"$UWSCAN" bench triangulation --points 1000000 --json "$work/triangulation.json" >/dev/null
+# Recognition on the demo scene: its valve and flange looked up in a database of IMR objects,
+# each recognised model drawn where it was found, with its label and grasp frame.
+"$UWSCAN" build-db valve_wheel flange pipe --views 32 -o "$work/objects.db" >/dev/null
+"$UWSCAN" recognize "$work/dive.db" --db "$work/objects.db" --json "$work/recognition.json" >/dev/null
+"$UWSCAN" view "$work/recognition.json" --screenshot docs/recognition_demo.png --size 1280x800
+
+# A map of the short inspection dive: SLAM (blue), dead reckoning (orange) and truth (green)
+# over the SLAM map, with 3-sigma position ellipsoids.
+"$UWSCAN" simulate data/scenes/inspection_short.yaml -o "$work/inspection.db" >/dev/null
+"$UWSCAN" map "$work/inspection.db" -o "$work/map.ply" --json "$work/map.json" >/dev/null
+"$UWSCAN" view "$work/map.json" --camera top --ellipsoid-every 2 --screenshot docs/map_inspection_short.png \
+  --size 1280x800
+
+# Trade-offs: triangulation methods (and their tables' resolutions) and stripe detectors,
+# accuracy against time.
+"$UWSCAN" bench triangulation --points 1000000 --sweep-grid-px 1 2 4 8 16 --sweep-rays-per-fan 9 17 35 70 \
+  --json "$work/triangulation.json" >/dev/null
 "$UWSCAN" plot "$work/triangulation.json" -o docs/triangulation_tradeoff.png
 "$UWSCAN" bench stripe --json "$work/stripe.json" >/dev/null
 "$UWSCAN" plot "$work/stripe.json" -o docs/stripe_tradeoff.png

@@ -176,6 +176,7 @@ std::vector<PlotSpec> Slam(const json& j, const std::string& file) {
     line.y = {Number(dive.at("dr"), "ate_m", file), Number(dive.at("slam"), "ate_m", file)};
     line.label = name + ": dead reckoning -> SLAM";
     p.series.push_back(line);
+    p.series.push_back(Point(name + ": SLAM", slam_s, line.y[1], colour));
     if (const auto open3d = dive.find("open3d"); open3d != dive.end() && !open3d->is_null()) {
       p.series.push_back(Point(name + ": Open3D multiway", Number(*open3d, "seconds", file),
                                Number(*open3d, "ate_m", file), colour));
