@@ -283,8 +283,9 @@ BenchPlots ReadBenchPlots(const std::filesystem::path& path) {
     if (j.contains("pipelines") && j.contains("confusion")) return {"recognition", Recognition(j, file)};
     if (j.contains("pipelines")) return {"registration", Registration(j, file)};
     if (j.contains("dives")) return {"slam", Slam(j, file)};
-    if (j.contains("waypoints") || j.contains("gauges")) return {"accuracy", Accuracy(j, file)};
+    // The calibration bench reports gauges too: its "steps" tell it from the accuracy bench.
     if (j.contains("steps")) return {"calibration", Calibration(j, file)};
+    if (j.contains("waypoints") || j.contains("gauges")) return {"accuracy", Accuracy(j, file)};
     if (j.value("bench", std::string()) == "viewer") return {"viewer", Viewer(j, file)};
     if (j.contains("rows")) return {"deformation", Deformation(j, file)};
   } catch (const json::exception& e) {

@@ -80,5 +80,13 @@ TEST(BenchPlots, RecognitionAndSlamAreTellApartFromRegistration) {
   EXPECT_THROW(PlotsOf(R"({"dives": [{"name": "loop", "dr": {}, "slam": {"ate_m": 1, "seconds": 1}}]})"), Error);
 }
 
+TEST(BenchPlots, CalibrationWithGaugesIsNotTakenForTheAccuracyBench) {
+  const BenchPlots plots = PlotsOf(R"({"gauges": [], "seconds": 50,
+    "steps": {"intrinsics": {"seconds": 3.5}, "laser": {"seconds": 20}}})");
+  EXPECT_EQ(plots.bench, "calibration");
+  ASSERT_EQ(plots.plots.size(), 1u);
+  EXPECT_EQ(plots.plots[0].series[0].y, (std::vector<double>{3.5, 20}));
+}
+
 }  // namespace
 }  // namespace uwscan::viewer
