@@ -192,15 +192,18 @@ std::vector<TableResolutionRow> SweepResolutions(const scanner::GalvoScannerMode
                                                  const Progress& progress) {
   std::vector<TableResolutionRow> rows;
   const double total = static_cast<double>(o.sweep_camera_grid_px.size() + o.sweep_rays_per_fan.size());
+  const auto add = [&](const char* table, int value, double setup_s, TableResolutionRow row) {
+    row.table = table;
+    row.value = value;
+    row.setup_s = setup_s;
+    rows.push_back(std::move(row));
+    if (progress) progress("table resolutions", rows.size() / total);
+  };
   for (const int grid_px : o.sweep_camera_grid_px) {
     const Clock::time_point start = Clock::now();
     auto rays = std::make_shared<const scanner::CameraRayTable>(model.camera, grid_px);
     const double setup_s = SecondsSince(start);
-    rows.push_back(MeasureTables(rays, default_surfaces, frames, points, exact, o.repeats));
-    rows.back().table = "camera_rays";
-    rows.back().value = grid_px;
-    rows.back().setup_s = setup_s;
-    if (progress) progress("table resolutions", rows.size() / total);
+    add("camera_rays", grid_px, setup_s, MeasureTables(rays, default_surfaces, frames, points, exact, o.repeats));
   }
   for (const int rays_per_fan : o.sweep_rays_per_fan) {
     scanner::LightSurfaceTableOptions surface_options = o.surfaces;
@@ -208,11 +211,8 @@ std::vector<TableResolutionRow> SweepResolutions(const scanner::GalvoScannerMode
     const Clock::time_point start = Clock::now();
     auto surfaces = std::make_shared<const scanner::LightSurfaceTable>(model.laser, surface_options);
     const double setup_s = SecondsSince(start);
-    rows.push_back(MeasureTables(default_rays, surfaces, frames, points, exact, o.repeats));
-    rows.back().table = "light_surfaces";
-    rows.back().value = rays_per_fan;
-    rows.back().setup_s = setup_s;
-    if (progress) progress("table resolutions", rows.size() / total);
+    add("light_surfaces", rays_per_fan, setup_s,
+        MeasureTables(default_rays, surfaces, frames, points, exact, o.repeats));
   }
   return rows;
 }

@@ -21,7 +21,7 @@ mkdir -p docs
 
 # Recognition on the demo scene: its valve and flange looked up in a database of IMR objects,
 # each recognised model drawn where it was found, with its label and grasp frame.
-"$UWSCAN" build-db valve_wheel flange pipe --views 32 -o "$work/objects.db" >/dev/null
+"$UWSCAN" build-db valve_wheel flange pipe --views 16 -o "$work/objects.db" >/dev/null
 "$UWSCAN" recognize "$work/dive.db" --db "$work/objects.db" --json "$work/recognition.json" >/dev/null
 "$UWSCAN" view "$work/recognition.json" --screenshot docs/recognition_demo.png --size 1280x800
 
