@@ -15,9 +15,9 @@ struct TriangleMesh {
   double BoundingBoxDiagonal() const;
 };
 
-// Reads PLY, OFF, STL or OBJ through Assimp (triangulating polygons, merging duplicate
-// vertices). Throws uwscan::Error naming the file when it is missing, unreadable or holds no
-// triangles.
+// Reads PLY, OFF and STL through uwscan's bounded readers and OBJ through Assimp (polygons
+// triangulated; STL's repeated vertices merged). Throws uwscan::Error naming the file when it
+// is missing, unreadable, holds no triangles or a non-finite vertex.
 TriangleMesh LoadMesh(const std::filesystem::path& path);
 
 // Writes binary little-endian PLY (float32 x y z, int32 vertex indices), which LoadMesh and

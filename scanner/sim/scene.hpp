@@ -22,7 +22,7 @@ enum class ObjectShape {
   kBox,       // size_m: [x, y, z], centred on {O}
   kSphere,    // radius_m, centred on {O}; ray cast exactly, not tessellated
   kCylinder,  // radius_m, length_m along z_O, centred, closed
-  kMesh,      // file: PLY/OFF/STL/OBJ (Assimp), scale (default 1)
+  kMesh,      // file: PLY/OFF/STL/OBJ (LoadMesh), scale (default 1)
   kPipe,      // straight pipe: outer radius, wall, length along z_O
   kElbow,     // pipe elbow: outer radius, wall, bend radius, bend angle
   kTee,       // T-junction of two pipes
