@@ -53,7 +53,7 @@ PlotSeries VerticalLine(const std::string& label, double x, const std::vector<Pl
 // table (the other table at its default), a point per resolution.
 PlotSpec TableResolution(const json& rows, const std::string& file) {
   PlotSpec p{"Table resolution: ray-cone error against build time", "table build time (s)", "mean error (mm)", true,
-             true, {}, {}};
+             true, {}, {}, {}};
   PlotSeries camera{"camera-ray table, grid px", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
   PlotSeries surfaces{"light-surface fits, rays per fan", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
   for (const json& row : rows) {
@@ -70,7 +70,7 @@ PlotSpec TableResolution(const json& rows, const std::string& file) {
 }
 
 std::vector<PlotSpec> Triangulation(const json& j, const std::string& file) {
-  PlotSpec p{"Triangulation: accuracy against time (one core)", "time per point (ns)", "mean error (mm)", true, true, {}, {}};
+  PlotSpec p{"Triangulation: accuracy against time (one core)", "time per point (ns)", "mean error (mm)", true, true, {}, {}, {}};
   int colour = 0;
   for (const auto& [name, m] : j.at("methods").items()) {
     double err_mm = Number(m, "mean_err_m", file) * 1e3;
@@ -97,7 +97,7 @@ std::vector<PlotSpec> Triangulation(const json& j, const std::string& file) {
 
 std::vector<PlotSpec> Stripe(const json& j, const std::string& file) {
   PlotSpec p{"Stripe detectors: sub-pixel error against time (2048x1088, one core)", "time per frame (us)",
-             "RMSE at sigma 1.5 px", true, true, {}, {}};
+             "RMSE at sigma 1.5 px", true, true, {}, {}, {}};
   int colour = 0;
   for (const auto& [name, m] : j.at("methods").items()) {
     p.series.push_back(Point(name, 1e6 / Number(m, "frames_per_s", file), Number(m, "rmse_px_sigma1_5", file), colour++));
@@ -111,7 +111,8 @@ std::vector<PlotSpec> Stripe(const json& j, const std::string& file) {
 }
 
 std::vector<PlotSpec> Registration(const json& j, const std::string& file) {
-  PlotSpec p{"Registration: success against time", "seconds per pair", "success rate", true, false, {}, {}};
+  PlotSpec p{"Registration: success against time", "seconds per pair", "success rate", true, false, {}, {}, {}};
+  p.y_range = {{0.0, 1.05}};
   int colour = 0;
   for (const auto& [name, s] : j.at("pipelines").items()) {
     p.series.push_back(Point(name, Number(s, "seconds_per_pair", file), Number(s, "success_rate", file), colour++));
@@ -125,11 +126,12 @@ std::vector<PlotSpec> Registration(const json& j, const std::string& file) {
   }
   std::vector<PlotSpec> plots = {p};
   if (const auto sweep = j.find("voxel_sweep"); sweep != j.end() && !sweep->empty()) {
-    PlotSpec v{"Registration: voxel size (uwscan)", "voxel / object size", "success rate", true, false, {}, {}};
+    PlotSpec v{"Registration: voxel size (uwscan)", "voxel / object size", "success rate", true, false, {}, {}, {}};
+    v.y_range = {{0.0, 1.05}};
     PlotSeries plain{"success (rotation and translation)", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
     PlotSeries adds{"ADD-S success", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
     PlotSpec t{"Registration: time against voxel size (uwscan)", "voxel / object size", "seconds per pair", true, true,
-               {}, {}};
+               {}, {}, {}};
     PlotSeries seconds{"seconds per pair", {}, {}, SeriesStyle::kLine, CategoricalColour(2)};
     for (const json& row : *sweep) {
       const double f = Number(row, "voxel_fraction", file);
@@ -151,7 +153,8 @@ std::vector<PlotSpec> Registration(const json& j, const std::string& file) {
 // Recognition: each pipeline's recognition rate (and pose success among what it recognised)
 // against its time per scan.
 std::vector<PlotSpec> Recognition(const json& j, const std::string& file) {
-  PlotSpec p{"Recognition: rate against time", "seconds per scan", "rate", true, false, {}, {}};
+  PlotSpec p{"Recognition: rate against time", "seconds per scan", "rate", true, false, {}, {}, {}};
+  p.y_range = {{0.0, 1.05}};
   int colour = 0;
   for (const auto& [name, s] : j.at("pipelines").items()) {
     const double seconds = Number(s, "seconds_per_scan", file);
@@ -166,7 +169,7 @@ std::vector<PlotSpec> Recognition(const json& j, const std::string& file) {
 // SLAM: each dive's trajectory error for dead reckoning, SLAM and Open3D's multiway
 // registration against the time each took (dead reckoning at the time SLAM took, for reference).
 std::vector<PlotSpec> Slam(const json& j, const std::string& file) {
-  PlotSpec p{"SLAM: trajectory error against processing time", "seconds", "ATE (m)", true, true, {}, {}};
+  PlotSpec p{"SLAM: trajectory error against processing time", "seconds", "ATE (m)", true, true, {}, {}, {}};
   int colour = 0;
   for (const json& dive : j.at("dives")) {
     const std::string name = dive.at("name").get<std::string>();
@@ -189,8 +192,8 @@ std::vector<PlotSpec> Slam(const json& j, const std::string& file) {
 std::vector<PlotSpec> Accuracy(const json& j, const std::string& file) {
   std::vector<PlotSpec> plots;
   if (const auto w = j.find("waypoints"); w != j.end() && !w->empty()) {
-    PlotSpec rms{"MEMS: plane residual against waypoints per line", "waypoints per line", "plane rms (mm)", true, true, {}, {}};
-    PlotSpec speed{"MEMS: lines per second against waypoints per line", "waypoints per line", "lines/s", true, true, {}, {}};
+    PlotSpec rms{"MEMS: plane residual against waypoints per line", "waypoints per line", "plane rms (mm)", true, true, {}, {}, {}};
+    PlotSpec speed{"MEMS: lines per second against waypoints per line", "waypoints per line", "lines/s", true, true, {}, {}, {}};
     PlotSeries real{"realistic", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
     PlotSeries exact{"exact peaks", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
     PlotSeries lines{"lines/s", {}, {}, SeriesStyle::kLine, CategoricalColour(2)};
@@ -209,7 +212,7 @@ std::vector<PlotSpec> Accuracy(const json& j, const std::string& file) {
     plots.push_back(speed);
   }
   if (const auto plane = j.find("plane"); plane != j.end() && !plane->empty()) {
-    PlotSpec p{"MEMS: plane residual against range", "range (m)", "plane rms (mm)", false, false, {}, {}};
+    PlotSpec p{"MEMS: plane residual against range", "range (m)", "plane rms (mm)", false, false, {}, {}, {}};
     PlotSeries s{"plane rms", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
     for (const json& row : *plane) {
       s.x.push_back(Number(row, "distance_m", file));
@@ -223,7 +226,7 @@ std::vector<PlotSpec> Accuracy(const json& j, const std::string& file) {
 }
 
 std::vector<PlotSpec> Calibration(const json& j, const std::string& file) {
-  PlotSpec p{"Calibration: time per step", "", "seconds", false, false, {}, {}};
+  PlotSpec p{"Calibration: time per step", "", "seconds", false, false, {}, {}, {}};
   PlotSeries bars{"time", {}, {}, SeriesStyle::kBars, CategoricalColour(0)};
   for (const auto& [name, step] : j.at("steps").items()) {
     bars.x.push_back(static_cast<double>(bars.x.size() + 1));
@@ -235,7 +238,7 @@ std::vector<PlotSpec> Calibration(const json& j, const std::string& file) {
 }
 
 std::vector<PlotSpec> Deformation(const json& j, const std::string& file) {
-  PlotSpec p{"Refracted laser fan: plane and cone fit residual", "incidence (deg)", "fit rms (mm)", false, true, {}, {}};
+  PlotSpec p{"Refracted laser fan: plane and cone fit residual", "incidence (deg)", "fit rms (mm)", false, true, {}, {}, {}};
   PlotSeries plane{"plane", {}, {}, SeriesStyle::kLine, CategoricalColour(3)};
   PlotSeries cone{"elliptic cone", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
   for (const json& row : j.at("rows")) {
@@ -250,7 +253,7 @@ std::vector<PlotSpec> Deformation(const json& j, const std::string& file) {
 }
 
 std::vector<PlotSpec> Viewer(const json& j, const std::string& file) {
-  PlotSpec p{"Viewer: render time against points (Xvfb, software)", "points", "seconds", true, true, {}, {}};
+  PlotSpec p{"Viewer: render time against points (Xvfb, software)", "points", "seconds", true, true, {}, {}, {}};
   PlotSeries first{"time to first picture", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
   PlotSeries frame{"per frame", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
   for (const json& row : j.at("rows")) {

@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "scanner/common/error.hpp"
 #include "viewer/display.hpp"
@@ -47,6 +48,26 @@ vtkSmartPointer<vtkTable> SeriesTable(const PlotSeries& s, bool log_x, bool log_
   return table;
 }
 
+void FixRange(vtkAxis& axis, double lo, double hi) {
+  axis.SetBehavior(vtkAxis::FIXED);
+  axis.SetRange(lo, hi);
+}
+
+// One x value for every point (a single pipeline's point) leaves VTK an empty range, drawn
+// without ticks: widen it around the value.
+void WidenIfDegenerate(vtkAxis& axis, const std::vector<PlotSeries>& series, bool log) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const PlotSeries& s : series) {
+    for (const double x : s.x) {
+      if (std::isfinite(x) && (!log || x > 0.0)) lo = std::min(lo, x), hi = std::max(hi, x);
+    }
+  }
+  if (!(lo <= hi) || hi - lo > 1e-9 * std::max(1.0, std::abs(hi))) return;
+  if (log) return FixRange(axis, lo / 2.0, hi * 2.0);
+  const double half = lo == 0.0 ? 1.0 : 0.5 * std::abs(lo);
+  FixRange(axis, lo - half, hi + half);
+}
+
 void FillChart(vtkChartXY& chart, const PlotSpec& spec) {
   chart.SetTitle(spec.title);
   chart.GetTitleProperties()->SetFontSize(15);
@@ -73,6 +94,8 @@ void FillChart(vtkChartXY& chart, const PlotSpec& spec) {
     ++drawn;
   }
   if (drawn == 0) throw Error("plot '" + spec.title + "': no point to draw");
+  if (spec.y_range) FixRange(*chart.GetAxis(vtkAxis::LEFT), spec.y_range->first, spec.y_range->second);
+  WidenIfDegenerate(*chart.GetAxis(vtkAxis::BOTTOM), spec.series, spec.log_x);
   if (!spec.x_tick_labels.empty()) {
     vtkNew<vtkDoubleArray> positions;
     vtkNew<vtkStringArray> labels;

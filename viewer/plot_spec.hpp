@@ -1,7 +1,9 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "viewer/colour_map.hpp"
@@ -24,6 +26,8 @@ struct PlotSpec {
   std::vector<PlotSeries> series;
   // Bar charts: the names under the bars at x = 1, 2, ...
   std::vector<std::string> x_tick_labels;
+  // A fixed y axis (e.g. 0 to 1 for rates); std::nullopt: fitted to the points.
+  std::optional<std::pair<double, double>> y_range;
 };
 
 // Indices of the points no other point beats in both coordinates (smaller x and smaller y are
