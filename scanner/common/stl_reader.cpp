@@ -154,8 +154,13 @@ TriangleMesh ReadAscii(const std::string& text, const std::string& name) {
       for (std::size_t k = 1; k + 1 < loop.size(); ++k) merger.AddTriangle(loop[0], loop[k], loop[k + 1]);
       in_loop = false;
     } else if (word == "endsolid") {
+      if (in_loop) throw at("'endsolid' inside a loop");
       ended = true;
-      break;  // a name may follow; anything after the solid is not read
+      words.SkipLine();  // past the solid's name
+    } else if (word == "solid") {
+      if (!ended) throw at("'solid' inside a solid");
+      ended = false;  // files with several solids: one mesh of them all
+      words.SkipLine();
     }
     // "facet normal nx ny nz", "outer" and "endfacet" carry nothing needed.
   }

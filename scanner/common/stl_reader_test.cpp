@@ -137,6 +137,14 @@ TEST_F(StlReaderTest, LoopsOfMoreCornersAreFannedAndDegenerateTrianglesDropped) 
   EXPECT_EQ(mesh.vertices.size(), 4u);
   ASSERT_EQ(mesh.triangles.size(), 2u);  // the quad in two; the triangle with a repeated corner gone
   EXPECT_EQ(mesh.triangles[1], Eigen::Vector3i(0, 2, 3));
+
+  // Two solids in one file make one mesh; their shared corner is one vertex.
+  const TriangleMesh two = ReadStl(WriteAscii("two_solids.stl",
+                                              "solid a\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                                              "endloop\nendsolid a\nsolid b\nouter loop\nvertex 0 0 0\n"
+                                              "vertex 0 0 1\nvertex 0 1 0\nendloop\nendsolid b\n"));
+  EXPECT_EQ(two.triangles.size(), 2u);
+  EXPECT_EQ(two.vertices.size(), 4u);
 }
 
 TEST_F(StlReaderTest, BrokenFilesNameTheFileAndWhatIsWrong) {
