@@ -89,7 +89,7 @@ nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
             {"ray_cone_std_err_m", kSeedRayConeStdErrM}}}};
 }
 
-void PrintTriangulationTable(const bench::TriangulationBenchResult& r) {
+void PrintTriangulationTable(const bench::TriangulationBenchResult& r, int grid_px, int rays_per_fan) {
   std::printf("Triangulation of %lld stripe pixels on one core (errors against exact ray-ray)\n\n",
               static_cast<long long>(r.points));
   std::printf("| method | points/s | fraction of limit | time s | mean err mm | std err mm | max err mm | points |\n");
@@ -120,7 +120,8 @@ void PrintTriangulationTable(const bench::TriangulationBenchResult& r) {
   std::printf("exact ray-ray against the generating points: max %.3g m; tables built in %.2f s\n",
               r.exact_vs_truth_max_m, r.setup_s);
   if (r.resolution.empty()) return;
-  std::printf("\nTable resolutions, one table at a time (the other at its default: 4 px grid, 35 rays per fan)\n\n");
+  std::printf("\nTable resolutions, one table at a time (the other at the bench's: %d px grid, %d rays per fan)\n\n",
+              grid_px, rays_per_fan);
   std::printf("| table | resolution | build s | ray-cone points/s | ray-cone mean err mm | ray-cone max err mm | "
               "ray-plane points/s | ray-plane mean err mm |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const bench::TableResolutionRow& row : r.resolution) {
@@ -154,7 +155,7 @@ void RunTriangulation(const TriangulationArgs& args) {
     ProgressBar bar;
     result = bench::RunTriangulationBenchmark(model, options, bar.Callback());
   }
-  PrintTriangulationTable(result);
+  PrintTriangulationTable(result, options.camera_grid_px, options.surfaces.rays_per_fan);
   if (!args.json_path.empty()) WriteJsonFile(args.json_path, ToJson(result));
 }
 

@@ -41,7 +41,8 @@ PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
     outcome.pipeline = name;
     outcome.rotation_error_rad = error.rotation_rad;
     outcome.translation_error_m = error.translation_m;
-    outcome.symmetric_error_m = SymmetricSurfaceError(pair.source, run.T_target_source, pair.T_target_source_true);
+    outcome.symmetric_error_m = SymmetricSurfaceError(pair.source, pair.surface, run.T_target_source,
+                                                     pair.T_target_source_true);
     outcome.seconds = run.seconds;
     outcome.success = error.rotation_rad < o.max_rotation_error_rad && error.translation_m < limit_m;
     outcome.symmetric_success = outcome.symmetric_error_m < limit_m;

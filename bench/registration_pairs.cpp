@@ -96,6 +96,10 @@ void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOpti
       pair.source_viewpoint = T_source_target * pair.source_viewpoint;
       pair.target = perception::MakeCloud(target);
       pair.source = perception::MakeCloud(source);
+      std::vector<Eigen::Vector3d> surface_in_source;
+      surface_in_source.reserve(other.points.size());
+      for (const Eigen::Vector3d& p : other.points) surface_in_source.push_back(T_source_target * p);
+      pair.surface = perception::MakeCloud(surface_in_source);
       pair.T_target_source_true = T_source_target.inverse();
       pair.object_size_m = perception::BoundingBoxDiagonal(pair.target);
       pairs->push_back(std::move(pair));
@@ -121,6 +125,10 @@ void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng, std:
     pair.source = perception::MakeCloud(
         Resampled(points, scan.keep, 1e-3 * size, T_source_target, rng));
     pair.source_viewpoint = T_source_target * Eigen::Vector3d::Zero();  // the scanner's origin
+    std::vector<Eigen::Vector3d> surface_in_source;  // every point, no draw: the pairs stay as they were
+    surface_in_source.reserve(points.size());
+    for (const Eigen::Vector3d& p : points) surface_in_source.push_back(T_source_target * p);
+    pair.surface = perception::MakeCloud(surface_in_source);
     pair.T_target_source_true = T_source_target.inverse();
     pair.object_size_m = size;
     pairs->push_back(std::move(pair));
@@ -153,14 +161,15 @@ PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3
   return PoseError{std::acos(cos_angle), (estimate * at_point - truth * at_point).norm()};
 }
 
-double SymmetricSurfaceError(const perception::PointCloud& source, const Eigen::Isometry3d& estimate,
-                             const Eigen::Isometry3d& truth, std::size_t max_points) {
-  if (source.empty()) throw Error("SymmetricSurfaceError: empty source cloud");
+double SymmetricSurfaceError(const perception::PointCloud& source, const perception::PointCloud& surface,
+                             const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth,
+                             std::size_t max_points) {
+  if (source.empty() || surface.empty()) throw Error("SymmetricSurfaceError: empty source or surface");
   // Coordinates relative to where the truth puts the source's origin keep the floats small.
   const Eigen::Vector3d centre = truth * source.origin;
   std::vector<Eigen::Vector3f> true_points;
-  true_points.reserve(source.size());
-  for (std::size_t i = 0; i < source.size(); ++i) true_points.push_back((truth * source.Point(i) - centre).cast<float>());
+  true_points.reserve(surface.size());
+  for (std::size_t i = 0; i < surface.size(); ++i) true_points.push_back((truth * surface.Point(i) - centre).cast<float>());
   const perception::KnnIndex index(true_points);
   const std::size_t stride = std::max<std::size_t>(1, (source.size() + max_points - 1) / std::max<std::size_t>(1, max_points));
   std::vector<std::uint32_t> nearest;

@@ -19,6 +19,10 @@ struct RegistrationPair {
   Eigen::Vector3d source_viewpoint = Eigen::Vector3d::Zero();  // sensor, in the source's frame
   Eigen::Vector3d target_viewpoint = Eigen::Vector3d::Zero();  // sensor, in the target's frame
   double object_size_m = 0.0;  // bounding-box diagonal of the target, for the success test
+  // The whole object's surface in the source's frame (a mesh's full sampling; a scan's every
+  // point): what a symmetry-aware error measures against, since a pose equivalent by symmetry
+  // may move the seen side onto a side the source view never saw.
+  perception::PointCloud surface;
 };
 
 struct RegistrationPairOptions {
@@ -52,10 +56,12 @@ PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3
                        const Eigen::Vector3d& at_point);
 
 // ADD-S, the error of a pose that a symmetric object cannot show wrong: the mean distance from
-// each source point moved by `estimate` to the nearest source point moved by `truth` (at most
-// `max_points` source points, evenly spaced, are measured). A pose that differs from the truth
-// by a symmetry of the surface scores (near) zero, where the rotation error does not.
-double SymmetricSurfaceError(const perception::PointCloud& source, const Eigen::Isometry3d& estimate,
-                             const Eigen::Isometry3d& truth, std::size_t max_points = 2000);
+// each source point moved by `estimate` to the nearest point of the object's whole `surface`
+// (source frame) moved by `truth` (at most `max_points` source points, evenly spaced, are
+// measured). A pose that differs from the truth by a symmetry of the surface scores (near)
+// zero, where the rotation error does not.
+double SymmetricSurfaceError(const perception::PointCloud& source, const perception::PointCloud& surface,
+                             const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth,
+                             std::size_t max_points = 2000);
 
 }  // namespace uwscan::bench

@@ -62,7 +62,7 @@ RegistrationPipelineOptions RegistrationPipelineOptions::ForObjectSize(double si
                 std::to_string(size_m) + " m)");
   }
   if (!(voxel_m >= 0.0) || !std::isfinite(voxel_m)) {
-    throw Error("registration: voxel must be finite and > 0 (got " + std::to_string(voxel_m) + " m)");
+    throw Error("registration: voxel must be finite and >= 0 (0: size / 50; got " + std::to_string(voxel_m) + " m)");
   }
   RegistrationPipelineOptions o;
   o.voxel_m = voxel_m > 0.0 ? voxel_m : size_m / 50.0;

@@ -48,9 +48,10 @@ vtkSmartPointer<vtkTable> SeriesTable(const PlotSeries& s, bool log_x, bool log_
   return table;
 }
 
+// lo and hi in data units, on linear and log axes alike.
 void FixRange(vtkAxis& axis, double lo, double hi) {
   axis.SetBehavior(vtkAxis::FIXED);
-  axis.SetRange(lo, hi);
+  axis.SetUnscaledRange(lo, hi);
 }
 
 // One x value for every point (a single pipeline's point) leaves VTK an empty range, drawn

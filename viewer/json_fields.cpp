@@ -39,6 +39,13 @@ std::vector<double> Numbers(const json& value, std::size_t count, const Field& f
   return numbers;
 }
 
+std::string ReportKind(const std::filesystem::path& path) {
+  const json j = ParseJsonFile(path);
+  if (!j.is_object()) return {};
+  const auto kind = j.find("kind");
+  return kind != j.end() && kind->is_string() ? kind->get<std::string>() : std::string();
+}
+
 void RequireFormatAndKind(const json& root, const std::string& kind, const Field& field) {
   if (!root.is_object()) field.Fail("expected a JSON object");
   const json& format = Require(root, "uwscan_format", field);

@@ -25,6 +25,9 @@ nlohmann::json ParseJsonFile(const std::filesystem::path& path);
 const nlohmann::json& Require(const nlohmann::json& object, const std::string& key, const Field& field);
 // An array of exactly `count` finite numbers.
 std::vector<double> Numbers(const nlohmann::json& value, std::size_t count, const Field& field);
+// The "kind" a report says it is; empty when the file is not a JSON object with a string
+// "kind". Throws uwscan::Error naming the file when it cannot be read or is not JSON.
+std::string ReportKind(const std::filesystem::path& path);
 // Fails unless the root holds "uwscan_format": 1 and "kind": `kind`.
 void RequireFormatAndKind(const nlohmann::json& root, const std::string& kind, const Field& field);
 

@@ -65,8 +65,7 @@ Rgb TrajectoryColour(const std::string& name, int index) {
 }  // namespace
 
 bool IsMapReport(const std::filesystem::path& path) {
-  const json j = internal::ParseJsonFile(path);
-  return j.is_object() && j.value("kind", std::string()) == "map_report";
+  return internal::ReportKind(path) == "map_report";
 }
 
 MapReport ReadMapReport(const std::filesystem::path& path) {

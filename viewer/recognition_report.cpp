@@ -79,8 +79,7 @@ ReportedObject Object(const json& value, std::size_t scan_points, const Field& f
 }  // namespace
 
 bool IsRecognitionReport(const std::filesystem::path& path) {
-  const json j = internal::ParseJsonFile(path);
-  return j.is_object() && j.value("kind", std::string()) == "recognition_report";
+  return internal::ReportKind(path) == "recognition_report";
 }
 
 RecognitionReport ReadRecognitionReport(const std::filesystem::path& path) {
@@ -104,7 +103,11 @@ RecognitionReport ReadRecognitionReport(const std::filesystem::path& path) {
 
 void AddRecognitionReport(const RecognitionReport& report, const mapping::ReconstructionOptions& log_options,
                           Scene& scene) {
-  const perception::PointCloud scan = mapping::ReadScanFile(report.scan, log_options);
+  // `recognize` triangulates a dive log with the scanner's default method: so must the viewer,
+  // or the segments' indices would fall on other points.
+  mapping::ReconstructionOptions scan_options = log_options;
+  scan_options.method = std::nullopt;
+  const perception::PointCloud scan = mapping::ReadScanFile(report.scan, scan_options);
   if (scan.size() != report.scan_points) {
     throw Error(report.scan.string() + ": has " + std::to_string(scan.size()) + " points, the recognition report " +
                 std::to_string(report.scan_points) + "; was it changed after `uwscan recognize`?");

@@ -40,11 +40,12 @@ RecognitionReport ReadRecognitionReport(const std::filesystem::path& path);
 // Whether a JSON file says it is a recognition report.
 bool IsRecognitionReport(const std::filesystem::path& path);
 
-// The scan (sensor frame) with each segment's points carrying its object's index (-1 for
-// plane and unsegmented points), each recognised object's model from the database placed at
+// The scan (sensor frame) with each recognised segment's points carrying its object's index
+// (-1 for planes, unsegmented points and unknown segments), each recognised object's model from the database placed at
 // its pose with the same index (so colouring by object pairs a segment with its model), a
-// label with its id and score above it, and its grasp frames. `log_options` triangulate a scan
-// that is a dive log, as `recognize` did. Throws uwscan::Error naming the report when its scan
+// label with its id and score in front of it, and its grasp frames. A scan that is a dive log is
+// triangulated as `recognize` did (the scanner's default method, whatever `log_options` say;
+// their table cache is used). Throws uwscan::Error naming the report when its scan
 // or database cannot be read, the scan no longer has the report's point count, or the database
 // lacks a recognised object.
 void AddRecognitionReport(const RecognitionReport& report, const mapping::ReconstructionOptions& log_options,

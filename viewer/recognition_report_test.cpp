@@ -136,6 +136,10 @@ TEST_F(RecognitionReportTest, SegmentAndModelShareTheObjectsColourAndTheGraspSho
   for (std::size_t i = 0; i < model_S_.size(); ++i) {
     EXPECT_LT((scene.clouds[1].Point(i) - model_S_[i]).norm(), 1e-6) << "model point " << i << " not at the pose";
   }
+  // The segment's points (after the 81 wall points) carry the object's index; the wall none.
+  const std::vector<std::int32_t>& ids = scene.clouds[0].object_ids;
+  ASSERT_EQ(ids.size(), 81u + 25u);
+  for (std::size_t i = 0; i < ids.size(); ++i) EXPECT_EQ(ids[i], i < 81 ? -1 : 0) << "scan point " << i;
 
   RenderOptions options;
   options.width_px = 400;

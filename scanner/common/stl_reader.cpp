@@ -10,6 +10,7 @@
 
 #include "scanner/common/error.hpp"
 #include "scanner/common/file_bytes.hpp"
+#include "scanner/common/fnv1a.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -46,9 +47,7 @@ class VertexMerger {
   };
   struct Hash {
     std::size_t operator()(const Key& k) const {
-      std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the 12 bytes' words
-      for (const std::uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
-      return static_cast<std::size_t>(h);
+      return static_cast<std::size_t>(Fnv1a64(reinterpret_cast<const char*>(k.bits), sizeof(k.bits)));
     }
   };
   TriangleMesh& mesh_;

@@ -74,7 +74,8 @@ class StlReaderTest : public ::testing::Test {
     return out.str();
   }
 
-  // What Assimp makes of the file, with the options uwscan used to give it.
+  // What Assimp makes of the file, its triangles and merged vertices (the box has no degenerate
+  // triangle, so the options that drop them do not matter here).
   static TriangleMesh ByAssimp(const fs::path& path) {
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
