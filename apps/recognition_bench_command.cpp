@@ -25,9 +25,28 @@ double Median(std::vector<double> v) {
 
 double Ratio(int a, int b) { return b == 0 ? 0.0 : static_cast<double>(a) / b; }
 
+// One line per object, then one per candidate uwscan weighed for it.
+void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
+  std::printf("uwscan per object (scan, truth -> answer, its points, pose error):\n");
+  for (const bench::ObjectOutcome& o : outcomes) {
+    std::printf("  scan %3d  %-12s -> %-12s %6d pts, %6d in a segment of %6d", o.scan, o.truth.c_str(),
+                o.answer.c_str(), o.points, o.points_in_segment, o.segment_points);
+    if (o.rotation_error_rad >= 0.0) {
+      std::printf("  %.2f deg %.1f mm", o.rotation_error_rad * kRadToDeg, o.translation_error_m * 1e3);
+    }
+    std::printf("\n");
+    for (const perception::RecognitionCandidate& c : o.candidates) {
+      std::printf("      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f rmse %.2f mm%s\n",
+                  c.object_id.c_str(), c.chi_square, c.view, c.fitness, c.close, c.missing, c.rmse_m * 1e3,
+                  c.verified ? " verified" : "");
+    }
+  }
+}
+
 struct Args {
   bench::RecognitionBenchOptions options;
   bool no_images = false;
+  bool details = false;
   std::string json;
 };
 
@@ -75,6 +94,7 @@ void Run(Args a) {
       std::printf("\n");
     }
   }
+  if (a.details) PrintOutcomes(r.outcomes);
   if (!a.json.empty()) {
     nlohmann::json stages(r.uwscan_stage_seconds);
     for (auto& [stage, s] : stages.items()) s = s.get<double>() / r.scans;
@@ -102,6 +122,7 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
   cmd->add_flag("--no-peers", [a](std::int64_t) { a->options.run_peers = false; }, "uwscan only");
   cmd->add_option("--threads", a->options.threads, "threads")->check(CLI::Range(1, 256));
   cmd->add_option("--seed", a->options.seed, "scene and noise seed");
+  cmd->add_flag("--details", a->details, "print every object's answer and the candidates weighed for it");
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { Run(*a); });
 }

@@ -149,18 +149,19 @@ std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
   return peers;
 }
 
-// Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame.
-void Score(const std::string& truth, const std::string& answer,
+// Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
+// the pose error modulo symmetry when the answer is right.
+std::optional<perception::SymmetricPoseError> Score(const std::string& truth, const std::string& answer,
            const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
            const ObjectDatabase& db, PipelineFigures& figures) {
   figures.confusion[truth][answer] += 1;
   if (truth == "foreign") {
     ++figures.foreign;
     if (answer == "unknown") ++figures.foreign_unknown;
-    return;
+    return std::nullopt;
   }
   ++figures.objects;
-  if (answer != truth || !T_S_O) return;
+  if (answer != truth || !T_S_O) return std::nullopt;
   ++figures.recognised;
   const ObjectModel& model = *std::find_if(db.objects.begin(), db.objects.end(),
                                            [&](const ObjectModel& o) { return o.id == truth; });
@@ -173,7 +174,7 @@ void Score(const std::string& truth, const std::string& answer,
   figures.translation_errors_m.push_back(e.translation_m);
   if (e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005) ++figures.pose_success;
   if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
-  if (model.grasps.empty()) return;
+  if (model.grasps.empty()) return e;
   const Eigen::Isometry3d T_true = T_S_O_true * symmetries[e.symmetry];
   double worst_position = 0.0, worst_angle = 0.0;
   for (const perception::GraspFrame& g : model.grasps) {
@@ -185,6 +186,7 @@ void Score(const std::string& truth, const std::string& answer,
   figures.grasp_position_errors_m.push_back(worst_position);
   figures.grasp_angle_errors_rad.push_back(worst_angle);
   if (worst_position <= 0.005 && worst_angle <= 3.0 * kDeg) ++figures.grasp_success;
+  return e;
 }
 
 }  // namespace
@@ -280,6 +282,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
       const std::string& truth = scene.classes[o];
       if (best_segment < 0) {
+        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}});
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
@@ -288,7 +291,13 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
         continue;
       }
       const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
-      Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"]);
+      ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
+                            -1.0, -1.0, ours.candidates};
+      if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"])) {
+        outcome.rotation_error_rad = e->rotation_rad;
+        outcome.translation_error_m = e->translation_m;
+      }
+      result.outcomes.push_back(std::move(outcome));
       if (!options.run_peers) continue;
       const PointCloud segment = perception::VoxelDownsample(
           perception::Subset(cloud, ours.segment), perception::VoxelFilterOptions{db.parameters.voxel_m});

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bench/progress.hpp"
+#include "perception/object_recognizer.hpp"
 
 namespace uwscan::bench {
 
@@ -42,6 +43,18 @@ struct PipelineFigures {
   std::map<std::string, std::map<std::string, int>> confusion;
 };
 
+// What uwscan made of one object of one scan, for reading failures one by one.
+struct ObjectOutcome {
+  int scan = 0;
+  std::string truth;   // catalogue id or "foreign"
+  std::string answer;  // uwscan's id or "unknown"
+  int points = 0;      // scan points on the object
+  int points_in_segment = 0;  // of those, in the segment uwscan answered for it
+  int segment_points = 0;     // scan points in that segment
+  double rotation_error_rad = -1.0, translation_error_m = -1.0;  // modulo symmetry; -1: no pose
+  std::vector<perception::RecognitionCandidate> candidates;  // uwscan's, best first
+};
+
 struct RecognitionBenchResult {
   int scans = 0;
   double database_seconds = 0.0;
@@ -49,6 +62,7 @@ struct RecognitionBenchResult {
   std::map<std::string, PipelineFigures> pipelines;  // uwscan, pcl_esf, opencv_ppf
   std::map<std::string, double> uwscan_stage_seconds;  // summed over scans
   double ppf_training_seconds = 0.0;
+  std::vector<ObjectOutcome> outcomes;  // uwscan's, in scan order
 };
 
 RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& options,

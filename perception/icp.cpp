@@ -256,12 +256,35 @@ void IcpOptions::Check() const {
   }
 }
 
+struct IcpTarget::Tree {
+  explicit Tree(const PointCloud& cloud) : tree(cloud) {}
+  TargetTree tree;
+};
+
+IcpTarget::IcpTarget(const PointCloud& cloud) : cloud_(cloud) {
+  RequireValidCloud(cloud, "AlignIcp: target", 3);
+  tree_ = std::make_unique<Tree>(cloud);
+  centroid_rel_.setZero();
+  for (const Eigen::Vector3f& q : cloud.points) centroid_rel_ += q.cast<double>();
+  centroid_rel_ /= static_cast<double>(cloud.size());
+}
+
+IcpTarget::~IcpTarget() = default;
+
 RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
                             const Eigen::Isometry3d& T_target_source_init,
                             const IcpOptions& options) {
   options.Check();
   RequireValidCloud(source, "AlignIcp: source", 3);
-  RequireValidCloud(target, "AlignIcp: target", 3);
+  return AlignIcp(source, IcpTarget(target), T_target_source_init, options);
+}
+
+RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
+                            const Eigen::Isometry3d& T_target_source_init,
+                            const IcpOptions& options) {
+  options.Check();
+  RequireValidCloud(source, "AlignIcp: source", 3);
+  const PointCloud& target = prepared.cloud_;
   if (options.method == IcpMethod::kPointToPlane && !target.has_normals()) {
     throw Error("AlignIcp: target has no normals; point-to-plane needs one per target point");
   }
@@ -273,9 +296,7 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
                             Eigen::Translation3d(source.origin);
   std::vector<Eigen::Vector3d> source_rel(source.size());
   for (std::size_t i = 0; i < source.size(); ++i) source_rel[i] = source.points[i].cast<double>();
-  Eigen::Vector3d target_centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& q : target.points) target_centroid += q.cast<double>();
-  target_centroid /= static_cast<double>(target.size());
+  const Eigen::Vector3d target_centroid = prepared.centroid_rel_;
 
   // With a prior the linearisation is about the target origin, where the prior's information
   // is expressed; without one about the centroid, which conditions the step best.
@@ -287,7 +308,7 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
             : Eigen::Isometry3d::Identity();
   if (prior) RequireRigid(prior->T_target_source);
 
-  const TargetTree tree(target);
+  const TargetTree& tree = prepared.tree_->tree;
   std::vector<int> pairs;
   std::vector<Eigen::Vector3d> moved, matched;  // point-to-point pairs, reused
   RegistrationResult result;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -82,6 +83,33 @@ struct IcpOptions {
 // point-to-plane is asked for and the target has no normals, T_target_source_init is not
 // finite or not a rotation plus translation, or the options are invalid.
 RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
+                            const Eigen::Isometry3d& T_target_source_init,
+                            const IcpOptions& options = {});
+
+// The target of ICP prepared once (checked, its k-d tree and centroid), for aligning many
+// sources or many starting poses onto the same cloud, e.g. pose hypotheses on an object model.
+// Keeps a reference to `cloud`, which must outlive it. Throws uwscan::Error when the cloud has
+// fewer than 3 points or a non-finite point or normal.
+class IcpTarget {
+ public:
+  explicit IcpTarget(const PointCloud& cloud);
+  ~IcpTarget();
+  IcpTarget(const IcpTarget&) = delete;
+  IcpTarget& operator=(const IcpTarget&) = delete;
+
+  const PointCloud& cloud() const { return cloud_; }
+
+ private:
+  friend RegistrationResult AlignIcp(const PointCloud&, const IcpTarget&, const Eigen::Isometry3d&,
+                                     const IcpOptions&);
+  struct Tree;
+  const PointCloud& cloud_;
+  std::unique_ptr<Tree> tree_;
+  Eigen::Vector3d centroid_rel_;  // relative to cloud_.origin
+};
+
+// AlignIcp onto a prepared target: the same result as AlignIcp(source, target.cloud(), ...).
+RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& target,
                             const Eigen::Isometry3d& T_target_source_init,
                             const IcpOptions& options = {});
 

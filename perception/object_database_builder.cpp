@@ -46,16 +46,6 @@ PointCloud ModelCloud(const scanner::TriangleMesh& mesh, double voxel_m, std::ui
   return model;
 }
 
-double Diameter(const PointCloud& cloud) {
-  double best = 0.0;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    for (std::size_t j = i + 1; j < cloud.size(); ++j) {
-      best = std::max(best, static_cast<double>((cloud.points[i] - cloud.points[j]).squaredNorm()));
-    }
-  }
-  return std::sqrt(best);
-}
-
 }  // namespace
 
 void DatabaseBuildOptions::Check() const {
@@ -105,7 +95,7 @@ ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
     model.source = source.source;
     model.grasps = source.grasps;
     model.model = ModelCloud(source.mesh, p.voxel_m, Mix(options.seed, k));
-    model.diameter_m = Diameter(model.model);
+    model.diameter_m = Diameter(model.model, model.model.size());
     std::vector<std::size_t> all(model.model.size());
     for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
     model.features = ComputeFpfh(model.model, all, FpfhOptions{p.feature_radius_m, threads});

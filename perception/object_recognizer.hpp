@@ -15,14 +15,29 @@ namespace uwscan::perception {
 struct RecognitionOptions {
   double plane_distance_m = 0.01;      // seabed / wall inliers, metres
   double plane_min_fraction = 0.15;    // a plane is removed while it holds this share of the scan
-  double cluster_tolerance_m = 0.015;  // points closer than this belong to one segment, metres
-  int min_segment_points = 150;        // voxelised points; smaller segments are ignored
+  double cluster_tolerance_m = 0.025;  // points closer than this belong to one segment, metres
+  int min_segment_points = 150;        // voxelised points; smaller segments are ignored...
+  double attach_distance_m = 0.075;    // ...or join the nearest segment within this, metres
   int top_views = 20;                  // nearest views by chi-square considered
   int max_candidates = 3;              // objects among them whose pose is estimated
+  // Pose starts per candidate: FPFH + RANSAC onto its nearest view, and for each of its
+  // `pose_views` nearest views `pose_rolls` rolls about the line of sight (ViewPoseHypotheses).
+  // Each start gets a short ICP on at most `sift_points` segment points; the `refined_starts`
+  // best distinct ones by fit get the full ICP and the verification, and the best score wins
+  // (poses the segment alone cannot tell apart, such as a valve body turned half a turn about
+  // its stem, differ in the surface they leave unseen, e.g. where the handle is).
+  int pose_views = 2;
+  int pose_rolls = 12;
+  int sift_points = 200;
+  int refined_starts = 3;
   // "unknown" when the nearest view is farther than this (chi-square, histograms summing to 1)
   double max_chi_square = 0.9;
   // Verification: at least this share of the segment within 1.5 voxels of the posed model...
   double min_fitness = 0.85;
+  // ...at least this share within close_distance_m of the model's surface (point to plane:
+  // the wrong object, or the right one in a wrong pose, lies near but not on it)...
+  double min_close = 0.6;
+  double close_distance_m = 0.002;
   // ...and at most this share of the model surface facing the sensor (within the segment's
   // extent along the view) left without a scan point within 2 voxels.
   double max_missing = 0.45;
@@ -48,9 +63,10 @@ struct RecognitionCandidate {
   double chi_square = 0.0;  // to its nearest view
   int view = -1;            // that view's index in the object's views
   double fitness = 0.0;     // share of the segment on the posed model
+  double close = 0.0;       // share of the segment within close_distance_m of its surface
   double missing = 1.0;     // share of the expected visible model surface not seen
   double rmse_m = 0.0;      // point-to-plane RMS of the final ICP
-  double score = 0.0;       // fitness x (1 - missing); the best verified one wins
+  double score = 0.0;       // close x (1 - missing); the best verified one wins
   bool verified = false;
   Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();
 };
@@ -75,13 +91,15 @@ struct RecognizedObject {
 struct RecognitionResult {
   std::vector<RecognizedObject> objects;  // one per segment, largest segment first
   std::size_t plane_points = 0;           // removed as planes
-  std::map<std::string, double> stage_seconds;  // preprocess, segment, describe, match, pose, verify
+  // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine; verify
+  std::map<std::string, double> stage_seconds;
 };
 
 // Plane removal, Euclidean segments, ESF against every view by chi-square, then for the best
-// few objects a pose by FPFH + RANSAC (correspondences restricted to the model surface the
-// matched view saw) and point-to-plane ICP of the segment onto the whole model, verified by fit
-// and by model surface that should have been seen. The scan is in the sensor's frame (the
+// few objects a pose: starts from FPFH + RANSAC (correspondences restricted to the model
+// surface the matched view saw) and from the nearest views rolled about the line of sight,
+// sifted by a short ICP, the best refined by point-to-plane ICP of the segment onto the whole
+// model and verified by fit and by model surface that should have been seen. The scan is in the sensor's frame (the
 // sensor at its origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
 // invalid scan (NaN) or options.
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,

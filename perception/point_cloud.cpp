@@ -58,6 +58,17 @@ PointCloud Transformed(const PointCloud& cloud, const Eigen::Isometry3d& T) {
   return out;
 }
 
+double Diameter(const PointCloud& cloud, std::size_t max_points) {
+  const std::size_t stride = std::max<std::size_t>(1, (cloud.size() + max_points - 1) / std::max<std::size_t>(max_points, 1));
+  float best = 0.0f;
+  for (std::size_t i = 0; i < cloud.size(); i += stride) {
+    for (std::size_t j = i + stride; j < cloud.size(); j += stride) {
+      best = std::max(best, (cloud.points[i] - cloud.points[j]).squaredNorm());
+    }
+  }
+  return std::sqrt(static_cast<double>(best));
+}
+
 double BoundingBoxDiagonal(const PointCloud& cloud) {
   if (cloud.size() < 2) return 0.0;
   Eigen::Vector3f lo = cloud.points.front(), hi = cloud.points.front();

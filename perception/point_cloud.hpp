@@ -41,6 +41,11 @@ PointCloud Transformed(const PointCloud& cloud, const Eigen::Isometry3d& T);
 // Axis-aligned bounding box diagonal, metres (0 for fewer than 2 points).
 double BoundingBoxDiagonal(const PointCloud& cloud);
 
+// Largest distance between two points, metres (0 below two points). Exact over an evenly
+// strided subset of at most max_points points (all of them when the cloud is no larger), so
+// it never exceeds the true diameter; O(max_points^2).
+double Diameter(const PointCloud& cloud, std::size_t max_points = 4000);
+
 // The subset of a cloud at the given indices (normals and intensities kept when present).
 PointCloud Subset(const PointCloud& cloud, std::span<const std::size_t> indices);
 
