@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "perception/cloud_io.hpp"
 #include "perception/object_catalogue.hpp"
 #include "perception/object_database.hpp"
 #include "perception/object_database_builder.hpp"
@@ -124,6 +125,62 @@ TEST(ObjectRecognition, AnObjectNotInTheDatabaseIsUnknown) {
   const RecognitionResult r = RecognizeObjects(elbow.cloud, PipeFlangeValveDb());
   ASSERT_NE(Nearest(r, elbow), nullptr);
   EXPECT_EQ(Nearest(r, elbow)->object_id, "unknown");
+}
+
+// A pipe much longer than the sweep is wide, so its ends are never seen: it is the database's
+// pipe, its roll about its axis is a symmetry and its slide along the axis is left free.
+TEST(ObjectRecognition, APipeSeenWithoutItsEndsReportsItsFreeSlideAndRoll) {
+  sim::PipeShape shape;
+  shape.length_m = 3.0;
+  const Scan scan = ScanOnSeabed(sim::MakePipe(shape), Eigen::Vector3d(0.45, 0.0, 0.45), 7);
+  const RecognitionResult r = RecognizeObjects(scan.cloud, PipeFlangeValveDb());
+  const RecognizedObject* pipe = Nearest(r, scan);
+  ASSERT_NE(pipe, nullptr);
+  ASSERT_EQ(pipe->object_id, "pipe");
+  const Eigen::Vector3d axis_S = scan.T_S_O.linear() * Eigen::Vector3d::UnitZ();
+  bool slide = false, roll = false;
+  for (const FreeDirection& f : pipe->free_directions) {
+    const bool along = std::abs(f.axis_S.dot(axis_S)) > 0.98;
+    slide |= f.kind == "unconstrained" && f.motion == "translation" && along;
+    roll |= f.kind == "symmetry" && f.motion == "rotation" && f.order == 0 && along;
+  }
+  EXPECT_TRUE(slide);
+  EXPECT_TRUE(roll);
+  // Across the axis the pose is pinned: the model's axis lies on the true one.
+  const Eigen::Vector3d estimated_axis_S = pipe->T_S_O.linear() * Eigen::Vector3d::UnitZ();
+  EXPECT_GT(std::abs(estimated_axis_S.dot(axis_S)), std::cos(2.0 * std::numbers::pi / 180.0));
+  const Eigen::Vector3d offset = pipe->T_S_O.translation() - scan.T_S_O.translation();
+  EXPECT_LT((offset - offset.dot(axis_S) * axis_S).norm(), 0.003);
+}
+
+// Recognition needs nothing but points in the sensor's frame: a scan by another sensor (the
+// MEMS scanner; the database was made by the galvanometer scanner) read back from a plain PLY.
+TEST(ObjectRecognition, APlainPlyFromAnotherSensorIsRecognised) {
+  sim::VirtualScannerOptions options;
+  options.pattern.kind = scanner::ScannerKind::kMems;
+  options.pattern.mems.lines = 250;
+  const sim::VirtualScanner mems(scanner::DefaultScanner(scanner::ScannerKind::kMems), options);
+  const scanner::TriangleMesh valve = CatalogueObject("valve_wheel").mesh;
+  const Scan truth = ScanOnSeabed(valve, Eigen::Vector3d(0.3, -0.35, 0.6), 3);  // for its pose
+  sim::SceneObject seabed;
+  seabed.name = "seabed";
+  seabed.shape = sim::ObjectShape::kPlane;
+  seabed.mesh = sim::MakeRectangle(4.0, 4.0);
+  Eigen::Isometry3d T_W_O = Eigen::Isometry3d::Identity();
+  T_W_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  double lowest = 1e9;
+  for (const Eigen::Vector3d& v : valve.vertices) lowest = std::min(lowest, (T_W_O.linear() * v).z());
+  T_W_O.translation() = Eigen::Vector3d(0.0, 0.0, -lowest);
+  const Eigen::Isometry3d T_W_C = T_W_O * truth.T_S_O.inverse();
+  const sim::VirtualScan scan = mems.Scan({seabed, Placed(valve, T_W_O)}, T_W_C, 3);
+  const std::filesystem::path ply = std::filesystem::temp_directory_path() / "uwscan_mems_valve.ply";
+  WriteCloud(ply, MakeCloud(scan.points_C));
+  const Scan from_file{ReadCloud(ply), truth.T_S_O};
+  const RecognitionResult r = RecognizeObjects(from_file.cloud, PipeFlangeValveDb());
+  const RecognizedObject* found = Nearest(r, from_file);
+  ASSERT_NE(found, nullptr);
+  EXPECT_EQ(found->object_id, "valve_wheel");
+  EXPECT_LT((found->T_S_O.translation() - truth.T_S_O.translation()).norm(), 0.005);
 }
 
 TEST(ObjectDatabaseFile, TruncatedForeignAndNewerFilesGiveOneLineErrors) {

@@ -104,6 +104,15 @@ struct SceneAround {
 
   Bin BinOf(const Eigen::Vector2d& a) const { return {std::lround(a.x() / bin_rad), std::lround(a.y() / bin_rad)}; }
   bool InWindow(const Eigen::Vector2d& a) const { return (a.array() >= lo.array()).all() && (a.array() <= hi.array()).all(); }
+  // Some scan point, of anything, within a bin of this direction: the sweep looked there.
+  bool Covered(const Bin& bin) const {
+    for (long du = -1; du <= 1; ++du) {
+      for (long dv = -1; dv <= 1; ++dv) {
+        if (nearest_depth.count({bin.first + du, bin.second + dv}) != 0) return true;
+      }
+    }
+    return false;
+  }
 };
 
 SceneAround SceneAroundSegment(const PointCloud& scene, const KnnIndex& index, const PointCloud& whole_scan,
@@ -135,8 +144,10 @@ SceneAround SceneAroundSegment(const PointCloud& scene, const KnnIndex& index, c
 // `radius_m`. Seen: facing the sensor (not grazing), within the segment's window of directions
 // (the sweep may have covered only part of the object), nearest to the sensor along its line of
 // sight among the model's own points (a depth buffer over the scene's direction bins), so parts
-// the object hides from itself are not expected, and not behind anything else the scan saw
-// nearer in that direction (an object in front, a pipe lying across it). Any non-plane scan
+// the object hides from itself are not expected, not behind anything else the scan saw nearer
+// in that direction (an object in front, a pipe lying across it), and where the scan has some
+// point, of anything, within a bin (a MEMS pattern or a fan covers a shape of its own, and
+// what it did not light is not evidence; a missing part in front of a seabed is). Any non-plane scan
 // point counts, not only the segment's: a valve's handle that occlusion cut off from its body
 // into a segment of its own still shows that the handle is there.
 double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
@@ -163,6 +174,7 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
     if (depth > model_depth[bin] + radius_m) continue;  // hidden by the object itself
     const auto in_front = scene.nearest_depth.find(bin);
     if (in_front != scene.nearest_depth.end() && in_front->second < depth - radius_m) continue;  // occluded
+    if (!scene.Covered(bin)) continue;  // the sweep did not look there
     ++expected;
     scene.index.Query((x - scene.points.origin).cast<float>(), 1, nearest, squared);
     if (nearest.empty() || squared[0] > radius_m * radius_m) ++missing;
