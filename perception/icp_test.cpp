@@ -189,6 +189,28 @@ TEST_P(IcpMethods, IdenticalWithOneAndTwoThreads) {
   }
 }
 
+// A target prepared once gives the same bits as AlignIcp on the cloud, start after start.
+TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
+  const PointCloud target = BumpySurface(8000, 4, -0.25, 0.0005);
+  const PointCloud source = Transformed(BumpySurface(3000, 5, -0.1, 0.0005), KnownMotion().inverse());
+  const IcpTarget prepared(target);
+  const IcpOptions options = Options(GetParam());
+  for (const double angle_deg : {0.0, 3.0, -4.0}) {
+    Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+    start.linear() = Eigen::AngleAxisd(angle_deg * kDeg, Eigen::Vector3d::UnitZ()).matrix();
+    const RegistrationResult plain = AlignIcp(source, target, start, options);
+    const RegistrationResult reused = AlignIcp(source, prepared, start, options);
+    EXPECT_TRUE(plain.T_target_source.matrix() == reused.T_target_source.matrix());
+    EXPECT_EQ(plain.fitness, reused.fitness);
+    EXPECT_EQ(plain.iterations, reused.iterations);
+    EXPECT_TRUE(plain.information == reused.information);
+    EXPECT_LT(TranslationErrorM(reused.T_target_source, KnownMotion()), 0.005);  // independent samples
+  }
+  PointCloud two_points;
+  two_points.points = {Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX()};
+  EXPECT_THROW(IcpTarget{two_points}, Error);
+}
+
 // Moving both clouds (and the start) by M moves the answer by M: T' = M T M^-1.
 TEST_P(IcpMethods, InvariantToARigidMotionOfBothInputs) {
   const PointCloud target = BumpySurface(6000, 6);
