@@ -396,6 +396,56 @@ std::vector<std::vector<std::size_t>> Segments(const PointCloud& cloud, const Re
   return segments;
 }
 
+// The smaller of a point set's two spans across a plane's normal, metres (sqrt(12) standard
+// deviations: the width of a uniformly covered strip).
+double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t i : plane.inliers) mean += cloud.Point(i);
+  mean /= static_cast<double>(plane.inliers.size());
+  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - plane.normal * plane.normal.transpose();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (std::size_t i : plane.inliers) {
+    const Eigen::Vector3d d = across * (cloud.Point(i) - mean);
+    scatter += d * d.transpose();
+  }
+  scatter /= static_cast<double>(plane.inliers.size());
+  // Eigenvalues ascending: 0 along the normal, then the narrow and the wide in-plane variance.
+  const Eigen::Vector3d variances = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
+  return std::sqrt(12.0 * std::max(variances(1), 0.0));
+}
+
+// The planes objects rest on or stand beside: the dominant plane (the seabed), then others only
+// while they are wider than any object of the database both ways (a wall). A flat face of an
+// object, or a slab cut through the tops of lying pipes, holds many points too, but removing it
+// would cut the object in pieces.
+PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_object_m,
+                                       const RecognitionOptions& options) {
+  PlaneRemovalOptions planes;
+  planes.distance_threshold_m = options.plane_distance_m;
+  planes.max_planes = 1;
+  planes.seed = options.seed;
+  planes.threads = options.threads;
+  PlaneRemovalResult result;
+  result.remaining = down;
+  for (std::size_t i = 0; i < down.size(); ++i) result.remaining_indices.push_back(i);
+  for (int k = 0; k < 3 && !result.remaining.empty(); ++k) {
+    // min_fraction is of the cloud handed over; keep it a share of the whole scan.
+    planes.min_fraction = std::min(1.0, options.plane_min_fraction * static_cast<double>(down.size()) /
+                                            static_cast<double>(result.remaining.size()));
+    PlaneRemovalResult step = RemovePlanes(result.remaining, planes);
+    if (step.planes.empty()) break;
+    DetectedPlane& plane = step.planes.front();
+    if (k > 0 && NarrowSpan(result.remaining, plane) < largest_object_m) break;
+    for (std::size_t& i : plane.inliers) i = result.remaining_indices[i];
+    std::vector<std::size_t> kept;
+    for (std::size_t i : step.remaining_indices) kept.push_back(result.remaining_indices[i]);
+    result.remaining_indices = std::move(kept);
+    result.remaining = std::move(step.remaining);
+    result.planes.push_back(std::move(plane));
+  }
+  return result;
+}
+
 }  // namespace
 
 void RecognitionOptions::Check() const {
@@ -438,13 +488,9 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   StageClock clock(result.stage_seconds);
 
   const PointCloud down = VoxelDownsample(scan, VoxelFilterOptions{p.voxel_m});
-  PlaneRemovalOptions planes;
-  planes.distance_threshold_m = options.plane_distance_m;
-  planes.min_fraction = options.plane_min_fraction;
-  planes.max_planes = 3;
-  planes.seed = options.seed;
-  planes.threads = options.threads;
-  const PlaneRemovalResult removed = RemovePlanes(down, planes);
+  double largest_object_m = 0.0;
+  for (const ObjectModel& o : db.objects) largest_object_m = std::max(largest_object_m, o.diameter_m);
+  const PlaneRemovalResult removed = RemoveSupportPlanes(down, largest_object_m, options);
   for (const DetectedPlane& plane : removed.planes) result.plane_points += plane.inliers.size();
   clock.Lap("preprocess");
 

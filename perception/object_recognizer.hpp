@@ -14,7 +14,10 @@ namespace uwscan::perception {
 
 struct RecognitionOptions {
   double plane_distance_m = 0.01;      // seabed / wall inliers, metres
-  double plane_min_fraction = 0.15;    // a plane is removed while it holds this share of the scan
+  // A plane is removed while it holds this share of the scan: the dominant one (the seabed),
+  // then up to two more wider both ways than any object of the database (walls), never an
+  // object's own flat face.
+  double plane_min_fraction = 0.15;
   double cluster_tolerance_m = 0.025;  // points closer than this belong to one segment, metres
   int min_segment_points = 150;        // voxelised points; smaller segments are ignored...
   double attach_distance_m = 0.075;    // ...or join the nearest segment within this, metres
@@ -95,7 +98,7 @@ struct RecognitionResult {
   std::map<std::string, double> stage_seconds;
 };
 
-// Plane removal, Euclidean segments, ESF against every view by chi-square, then for the best
+// Plane removal (RemoveSupportPlanes), Euclidean segments, ESF against every view by chi-square, then for the best
 // few objects a pose: starts from FPFH + RANSAC (correspondences restricted to the model
 // surface the matched view saw) and from the nearest views rolled about the line of sight,
 // sifted by a short ICP, the best refined by point-to-plane ICP of the segment onto the whole
