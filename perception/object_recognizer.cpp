@@ -238,7 +238,9 @@ IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int thr
   icp.max_correspondence_distance_m = {4.0 * p.voxel_m, 2.0 * p.voxel_m, 1.5 * p.voxel_m};
   icp.translation_tolerance_m = 0.01 * p.voxel_m;
   icp.rotation_tolerance_rad = icp.translation_tolerance_m / (0.5 * diameter_m);
-  icp.relative_rmse_tolerance = 1e-4;
+  icp.relative_rmse_tolerance = 1e-6;
+  icp.max_iterations = 300;
+  icp.max_iterations_per_stage = 100;
   icp.threads = threads;
   return icp;
 }
