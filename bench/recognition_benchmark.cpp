@@ -247,8 +247,10 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   std::optional<PpfPeer> ppf_peer;
   if (options.run_peers) {
     std::vector<PeerObject> peers = PeerObjects(db, catalogue, db_scanner, options.seed, options.threads);
-    ppf_peer.emplace(peers);
-    result.ppf_training_seconds = ppf_peer->training_seconds();
+    if (options.run_ppf) {
+      ppf_peer.emplace(peers);
+      result.ppf_training_seconds = ppf_peer->training_seconds();
+    }
     pcl_peer.emplace(std::move(peers));
   }
 
@@ -286,7 +288,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
-          Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["opencv_ppf"]);
+          if (ppf_peer) Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["opencv_ppf"]);
         }
         continue;
       }
@@ -305,6 +307,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       const PeerAnswer pcl = pcl_peer->Recognize(segment);
       result.pipelines["pcl_esf"].seconds += Seconds(start);
       Score(truth, pcl.id, pcl.T_S_O, T_S_O_true, db, result.pipelines["pcl_esf"]);
+      if (!ppf_peer) continue;
       start = std::chrono::steady_clock::now();
       perception::NormalOptions normals;
       normals.radius_m = db.parameters.normal_radius_m;
