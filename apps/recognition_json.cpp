@@ -31,6 +31,7 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o) {
                           {"chi_square", c.chi_square},
                           {"view", c.view},
                           {"fitness", c.fitness},
+                          {"close", c.close},
                           {"missing", c.missing},
                           {"rmse_m", c.rmse_m},
                           {"score", c.score},

@@ -88,11 +88,13 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
 
 // The target of ICP prepared once (checked, its k-d tree and centroid), for aligning many
 // sources or many starting poses onto the same cloud, e.g. pose hypotheses on an object model.
-// Keeps a reference to `cloud`, which must outlive it. Throws uwscan::Error when the cloud has
-// fewer than 3 points or a non-finite point or normal.
+// Keeps a reference to `cloud`, which must outlive it unchanged (a temporary is refused at
+// compile time). AlignIcp may run on one target from several threads at once. Throws
+// uwscan::Error when the cloud has fewer than 3 points or a non-finite point or normal.
 class IcpTarget {
  public:
   explicit IcpTarget(const PointCloud& cloud);
+  explicit IcpTarget(const PointCloud&&) = delete;
   ~IcpTarget();
   IcpTarget(const IcpTarget&) = delete;
   IcpTarget& operator=(const IcpTarget&) = delete;

@@ -208,7 +208,7 @@ TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
   }
   PointCloud two_points;
   two_points.points = {Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX()};
-  EXPECT_THROW(IcpTarget{two_points}, Error);
+  EXPECT_THROW(IcpTarget target(two_points), Error);
 }
 
 // Moving both clouds (and the start) by M moves the answer by M: T' = M T M^-1.

@@ -17,6 +17,7 @@ namespace uwscan::perception {
 namespace {
 
 constexpr int kMinViewPoints = 50;
+constexpr std::size_t kMinModelPoints = 50;  // visible model samples an object needs
 
 std::uint64_t Mix(std::uint64_t a, std::uint64_t b) {
   std::uint64_t z = a * 0x9E3779B97F4A7C15ull + b + 0x632BE59BD9B4E019ull;
@@ -30,7 +31,8 @@ std::uint64_t Mix(std::uint64_t a, std::uint64_t b) {
 // centroid of those samples. A real sample stays on the surface, where a centroid would sit
 // between the outer and inner walls of a thin pipe (5 mm apart, one voxel) and pull every ICP
 // on the model a few millimetres inwards; splitting by facing keeps both walls.
-PointCloud ModelCloud(const scanner::TriangleMesh& mesh, double voxel_m, std::uint64_t seed) {
+PointCloud ModelCloud(const std::string& id, const scanner::TriangleMesh& mesh, double voxel_m,
+                      std::uint64_t seed) {
   double area = 0.0;
   for (const Eigen::Vector3i& t : mesh.triangles) {
     const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(t[0])];
@@ -73,13 +75,22 @@ PointCloud ModelCloud(const scanner::TriangleMesh& mesh, double voxel_m, std::ui
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (std::size_t i : members) centroid += samples.points[i];
     centroid /= static_cast<double>(members.size());
-    std::size_t best = members.front();
-    for (std::size_t i : members) {
-      if ((samples.points[i] - centroid).squaredNorm() < (samples.points[best] - centroid).squaredNorm()) best = i;
-    }
-    if (!visible(best)) continue;
-    points.push_back(samples.points[best]);
-    normals.push_back(samples.normals[best]);
+    // The visible sample nearest the centroid, among the four nearest (a group hidden as a
+    // whole, a bore's, is dropped without casting for every sample).
+    std::vector<std::size_t> order = members;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return (samples.points[a] - centroid).squaredNorm() < (samples.points[b] - centroid).squaredNorm();
+    });
+    order.resize(std::min<std::size_t>(order.size(), 4));
+    const auto seen = std::find_if(order.begin(), order.end(), visible);
+    if (seen == order.end()) continue;
+    points.push_back(samples.points[*seen]);
+    normals.push_back(samples.normals[*seen]);
+  }
+  if (points.size() < kMinModelPoints) {
+    throw Error("build-db: only " + std::to_string(points.size()) + " surface samples of '" + id +
+                "' are visible from outside (is the mesh closed and wound counter-clockwise seen "
+                "from outside?)");
   }
   PointCloud model = MakeCloud(points);
   for (const Eigen::Vector3d& n : normals) model.normals.push_back(n.cast<float>());
@@ -134,7 +145,7 @@ ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
     model.id = source.id;
     model.source = source.source;
     model.grasps = source.grasps;
-    model.model = ModelCloud(source.mesh, p.voxel_m, Mix(options.seed, k));
+    model.model = ModelCloud(source.id, source.mesh, p.voxel_m, Mix(options.seed, k));
     model.diameter_m = Diameter(model.model, model.model.size());
     std::vector<std::size_t> all(model.model.size());
     for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;

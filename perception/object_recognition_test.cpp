@@ -55,12 +55,8 @@ sim::SceneObject Placed(const scanner::TriangleMesh& mesh, const Eigen::Isometry
   return o;
 }
 
-// An object lying on a seabed (z = 0, up +z, its y_O up and z_O along y), scanned from `eye`.
-struct Scan {
-  PointCloud cloud;
-  Eigen::Isometry3d T_S_O;
-};
-Scan ScanOnSeabed(const scanner::TriangleMesh& mesh, const Eigen::Vector3d& eye, std::uint64_t seed) {
+// A seabed (z = 0, up +z) and the object lying on it, its y_O up and z_O along y.
+std::vector<sim::SceneObject> OnSeabed(const scanner::TriangleMesh& mesh) {
   sim::SceneObject seabed;
   seabed.name = "seabed";
   seabed.shape = sim::ObjectShape::kPlane;
@@ -70,9 +66,20 @@ Scan ScanOnSeabed(const scanner::TriangleMesh& mesh, const Eigen::Vector3d& eye,
   double lowest = 1e9;
   for (const Eigen::Vector3d& v : mesh.vertices) lowest = std::min(lowest, (T_W_O.linear() * v).z());
   T_W_O.translation() = Eigen::Vector3d(0.0, 0.0, -lowest);
+  return {seabed, Placed(mesh, T_W_O)};
+}
+
+// That scene scanned from `eye`, looking at the object.
+struct Scan {
+  PointCloud cloud;
+  Eigen::Isometry3d T_S_O;
+};
+Scan ScanOnSeabed(const scanner::TriangleMesh& mesh, const Eigen::Vector3d& eye, std::uint64_t seed) {
+  const std::vector<sim::SceneObject> scene = OnSeabed(mesh);
+  const Eigen::Isometry3d T_W_O = scene[1].T_W_O;
   const Eigen::Isometry3d T_W_C =
       sim::LookAt(eye, T_W_O.translation(), Eigen::Vector3d::UnitZ());
-  const sim::VirtualScan scan = Scanner().Scan({seabed, Placed(mesh, T_W_O)}, T_W_C, seed);
+  const sim::VirtualScan scan = Scanner().Scan(scene, T_W_C, seed);
   return {MakeCloud(scan.points_C), T_W_C.inverse() * T_W_O};
 }
 
@@ -162,17 +169,8 @@ TEST(ObjectRecognition, APlainPlyFromAnotherSensorIsRecognised) {
   const sim::VirtualScanner mems(scanner::DefaultScanner(scanner::ScannerKind::kMems), options);
   const scanner::TriangleMesh valve = CatalogueObject("valve_wheel").mesh;
   const Scan truth = ScanOnSeabed(valve, Eigen::Vector3d(0.3, -0.35, 0.6), 3);  // for its pose
-  sim::SceneObject seabed;
-  seabed.name = "seabed";
-  seabed.shape = sim::ObjectShape::kPlane;
-  seabed.mesh = sim::MakeRectangle(4.0, 4.0);
-  Eigen::Isometry3d T_W_O = Eigen::Isometry3d::Identity();
-  T_W_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
-  double lowest = 1e9;
-  for (const Eigen::Vector3d& v : valve.vertices) lowest = std::min(lowest, (T_W_O.linear() * v).z());
-  T_W_O.translation() = Eigen::Vector3d(0.0, 0.0, -lowest);
-  const Eigen::Isometry3d T_W_C = T_W_O * truth.T_S_O.inverse();
-  const sim::VirtualScan scan = mems.Scan({seabed, Placed(valve, T_W_O)}, T_W_C, 3);
+  const std::vector<sim::SceneObject> scene = OnSeabed(valve);
+  const sim::VirtualScan scan = mems.Scan(scene, scene[1].T_W_O * truth.T_S_O.inverse(), 3);
   const std::filesystem::path ply = std::filesystem::temp_directory_path() / "uwscan_mems_valve.ply";
   WriteCloud(ply, MakeCloud(scan.points_C));
   const Scan from_file{ReadCloud(ply), truth.T_S_O};

@@ -90,7 +90,7 @@ class SightAngles {
   Eigen::Vector3d w_, u_, v_;
 };
 
-// What the scan saw around one segment: its non-plane points (scan frame) and their index,
+// What the scan saw around one segment: all its points (scan frame, planes too) and their index,
 // the segment's window of directions (where the sweep is known to have looked) and, over
 // direction bins about `radius_m` wide at the segment, the nearest depth of any scan point.
 using Bin = std::pair<long, long>;
@@ -115,12 +115,12 @@ struct SceneAround {
   }
 };
 
-SceneAround SceneAroundSegment(const PointCloud& scene, const KnnIndex& index, const PointCloud& whole_scan,
-                               const PointCloud& segment, double radius_m) {
+SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
+                               double radius_m) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < segment.size(); ++i) centroid += segment.Point(i);
   centroid /= static_cast<double>(segment.size());
-  SceneAround around{scene, index, SightAngles(centroid.norm() > 0.0 ? centroid : Eigen::Vector3d::UnitZ()),
+  SceneAround around{whole_scan, index, SightAngles(centroid.norm() > 0.0 ? centroid : Eigen::Vector3d::UnitZ()),
                      std::max(radius_m / std::max(centroid.norm(), 1e-3), 1e-4),
                      Eigen::Vector2d::Constant(1e9), Eigen::Vector2d::Constant(-1e9), {}};
   for (std::size_t i = 0; i < segment.size(); ++i) {
@@ -147,9 +147,10 @@ SceneAround SceneAroundSegment(const PointCloud& scene, const KnnIndex& index, c
 // the object hides from itself are not expected, not behind anything else the scan saw nearer
 // in that direction (an object in front, a pipe lying across it), and where the scan has some
 // point, of anything, within a bin (a MEMS pattern or a fan covers a shape of its own, and
-// what it did not light is not evidence; a missing part in front of a seabed is). Any non-plane scan
+// what it did not light is not evidence; a missing part in front of a seabed is). Any scan
 // point counts, not only the segment's: a valve's handle that occlusion cut off from its body
-// into a segment of its own still shows that the handle is there.
+// into a segment of its own still shows that the handle is there, and the seabed points
+// removed as a plane still show the object's lowest rim.
 double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
                     double radius_m) {
   std::map<Bin, double> model_depth;
@@ -305,8 +306,8 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
                                           const ObjectDatabaseParameters& p,
                                           const RecognitionOptions& options) {
   std::vector<Eigen::Isometry3d> kept;
-  const std::size_t stride =
-      std::max<std::size_t>(1, segment.size() / static_cast<std::size_t>(options.sift_points));
+  const std::size_t sift = static_cast<std::size_t>(options.sift_points);
+  const std::size_t stride = std::max<std::size_t>(1, (segment.size() + sift - 1) / sift);
   std::vector<std::size_t> every;
   for (std::size_t i = 0; i < segment.size(); i += stride) every.push_back(i);
   if (every.size() < 3 || starts.empty()) return kept;
@@ -362,21 +363,35 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
   return kept;
 }
 
+// A segment: its points (increasing indices) and the diameter of its own cluster, before the
+// small clusters near it joined.
+struct Segment {
+  std::vector<std::size_t> indices;
+  double core_diameter_m = 0.0;
+};
+
 // Euclidean clusters of at least min_segment_points, each with the smaller clusters within
 // attach_distance_m of it (to the nearest segment): the parts of one object that occlusion
-// separated, such as a valve's handle hiding its own stem from a sensor above it.
-std::vector<std::vector<std::size_t>> Segments(const PointCloud& cloud, const RecognitionOptions& options) {
+// separated, such as a valve's handle hiding its own stem from a sensor above it. Largest
+// first (equal sizes in cluster order).
+std::vector<Segment> Segments(const PointCloud& cloud, const RecognitionOptions& options) {
   ClusteringOptions clustering;
   clustering.tolerance_m = options.cluster_tolerance_m;
-  std::vector<std::vector<std::size_t>> segments, small;
+  std::vector<Segment> segments;
+  std::vector<std::vector<std::size_t>> small;
   for (std::vector<std::size_t>& c : EuclideanClusters(cloud, clustering)) {
-    (c.size() >= static_cast<std::size_t>(options.min_segment_points) ? segments : small).push_back(std::move(c));
+    if (c.size() < static_cast<std::size_t>(options.min_segment_points)) {
+      small.push_back(std::move(c));
+      continue;
+    }
+    const double diameter = Diameter(Subset(cloud, c));
+    segments.push_back({std::move(c), diameter});
   }
   if (segments.empty() || small.empty()) return segments;
   std::vector<Eigen::Vector3f> points;
   std::vector<std::size_t> owner;
   for (std::size_t k = 0; k < segments.size(); ++k) {
-    for (std::size_t i : segments[k]) {
+    for (std::size_t i : segments[k].indices) {
       points.push_back(cloud.points[i]);
       owner.push_back(k);
     }
@@ -392,9 +407,13 @@ std::vector<std::vector<std::size_t>> Segments(const PointCloud& cloud, const Re
       if (squared[0] < best) best = squared[0], to = owner[nearest[0]];
     }
     if (best <= options.attach_distance_m * options.attach_distance_m) {
-      segments[to].insert(segments[to].end(), part.begin(), part.end());
+      segments[to].indices.insert(segments[to].indices.end(), part.begin(), part.end());
     }
   }
+  for (Segment& segment : segments) std::sort(segment.indices.begin(), segment.indices.end());
+  std::stable_sort(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) {
+    return a.indices.size() > b.indices.size();
+  });
   return segments;
 }
 
@@ -416,8 +435,9 @@ double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
   return std::sqrt(12.0 * std::max(variances(1), 0.0));
 }
 
-// The planes objects rest on or stand beside: the dominant plane (the seabed), then others only
-// while they are wider than any object of the database both ways (a wall). A flat face of an
+// The planes objects rest on or stand beside: the dominant plane (the seabed), then others while
+// they are wider than any object of the database both ways (a wall); the search stops at the
+// first narrower one. A flat face of an
 // object, or a slab cut through the tops of lying pipes, holds many points too, but removing it
 // would cut the object in pieces.
 PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_object_m,
@@ -461,13 +481,17 @@ void RecognitionOptions::Check() const {
     throw Error("recognition: attach_distance_m must be >= 0");
   }
   if (min_segment_points < 10) throw Error("recognition: min_segment_points must be >= 10");
-  if (top_views < 1 || max_candidates < 1) {
-    throw Error("recognition: top_views and max_candidates must be >= 1");
-  }
-  if (pose_views < 0 || pose_rolls < 1 || sift_points < 10 || refined_starts < 1) {
-    throw Error("recognition: pose_views must be >= 0, pose_rolls and refined_starts >= 1, "
-                "sift_points >= 10");
-  }
+  if (max_candidates < 1) throw Error("recognition: max_candidates must be >= 1, got " + std::to_string(max_candidates));
+  auto in_range = [](const char* field, int value, int lo, int hi) {
+    if (value < lo || value > hi) {
+      throw Error(std::string("recognition: ") + field + " must be in [" + std::to_string(lo) + ", " +
+                  std::to_string(hi) + "], got " + std::to_string(value));
+    }
+  };
+  in_range("pose_views", pose_views, 0, 64);
+  in_range("pose_rolls", pose_rolls, 1, 360);
+  in_range("sift_points", sift_points, 10, 100000);
+  in_range("refined_starts", refined_starts, 1, 64);
   if (!positive(max_chi_square)) throw Error("recognition: max_chi_square must be > 0");
   if (!(min_fitness >= 0.0 && min_fitness <= 1.0) || !(max_missing >= 0.0 && max_missing <= 1.0) ||
       !(min_close >= 0.0 && min_close <= 1.0)) {
@@ -496,7 +520,9 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   for (const DetectedPlane& plane : removed.planes) result.plane_points += plane.inliers.size();
   clock.Lap("preprocess");
 
-  const std::vector<std::vector<std::size_t>> clusters = Segments(removed.remaining, options);
+  const std::vector<Segment> found = Segments(removed.remaining, options);
+  std::vector<std::vector<std::size_t>> clusters;
+  for (const Segment& f : found) clusters.push_back(f.indices);
   // Every scan point goes to the segment of the voxel point nearest to it.
   std::vector<int> segment_of_down(down.size(), -1);
   for (std::size_t c = 0; c < clusters.size(); ++c) {
@@ -516,13 +542,13 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   }
   clock.Lap("segment");
 
-  const KnnIndex scene_index(removed.remaining.points);
+  const KnnIndex scene_index(down.points);
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     RecognizedObject object;
     object.object_id = "unknown";
     object.segment = segments[c];
     const PointCloud segment = Subset(removed.remaining, clusters[c]);
-    const SceneAround around = SceneAroundSegment(removed.remaining, scene_index, down, segment, 2.0 * p.voxel_m);
+    const SceneAround around = SceneAroundSegment(down, scene_index, segment, 2.0 * p.voxel_m);
     for (std::size_t i = 0; i < segment.size(); ++i) object.centroid_S += segment.Point(i);
     object.centroid_S /= static_cast<double>(segment.size());
 
@@ -545,8 +571,9 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(),
                      [&](std::size_t a, std::size_t b) { return nearest[a].first < nearest[b].first; });
-    // The segment's own diameter: a bounding-box diagonal can exceed it by up to sqrt(3).
-    const double extent = Diameter(segment);
+    // The segment's own cluster's diameter (a bounding-box diagonal can exceed it by up to
+    // sqrt(3); debris that joined it may lie beyond the object).
+    const double extent = found[c].core_diameter_m;
     std::vector<std::size_t> candidates;
     for (std::size_t i : order) {
       if (static_cast<int>(candidates.size()) >= options.max_candidates) break;

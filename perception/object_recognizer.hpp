@@ -21,7 +21,6 @@ struct RecognitionOptions {
   double cluster_tolerance_m = 0.025;  // points closer than this belong to one segment, metres
   int min_segment_points = 150;        // voxelised points; smaller segments are ignored...
   double attach_distance_m = 0.075;    // ...or join the nearest segment within this, metres
-  int top_views = 20;                  // nearest views by chi-square considered
   int max_candidates = 3;              // objects among them whose pose is estimated
   // Pose starts per candidate: FPFH + RANSAC onto its nearest view, and for each of its
   // `pose_views` nearest views `pose_rolls` rolls about the line of sight (ViewPoseHypotheses).

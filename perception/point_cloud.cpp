@@ -59,7 +59,8 @@ PointCloud Transformed(const PointCloud& cloud, const Eigen::Isometry3d& T) {
 }
 
 double Diameter(const PointCloud& cloud, std::size_t max_points) {
-  const std::size_t stride = std::max<std::size_t>(1, (cloud.size() + max_points - 1) / std::max<std::size_t>(max_points, 1));
+  if (max_points < 2) throw Error("Diameter: max_points must be >= 2");
+  const std::size_t stride = std::max<std::size_t>(1, (cloud.size() + max_points - 1) / max_points);
   float best = 0.0f;
   for (std::size_t i = 0; i < cloud.size(); i += stride) {
     for (std::size_t j = i + stride; j < cloud.size(); j += stride) {

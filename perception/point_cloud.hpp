@@ -43,7 +43,7 @@ double BoundingBoxDiagonal(const PointCloud& cloud);
 
 // Largest distance between two points, metres (0 below two points). Exact over an evenly
 // strided subset of at most max_points points (all of them when the cloud is no larger), so
-// it never exceeds the true diameter; O(max_points^2).
+// it never exceeds the true diameter; O(max_points^2). Throws uwscan::Error when max_points < 2.
 double Diameter(const PointCloud& cloud, std::size_t max_points = 4000);
 
 // The subset of a cloud at the given indices (normals and intensities kept when present).

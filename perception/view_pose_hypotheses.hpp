@@ -15,7 +15,8 @@ namespace uwscan::perception {
 // first roll lines up the principal axes of the two point sets seen across the line of sight
 // (an elongated pipe, tee or lever then starts aligned, up to a half turn); the others follow
 // at equal steps of 2 pi / rolls, so round outlines, whose principal axes mean nothing, are
-// covered too.
+// covered too. An even `rolls` includes the first roll's half turn (the principal axis has no
+// sign).
 //
 // segment_S: the segment in the sensor frame (sensor at the origin). Returns T_O_S per roll,
 // the segment's frame in the object frame, first roll first. Throws uwscan::Error when rolls
