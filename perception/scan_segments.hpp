@@ -1,0 +1,36 @@
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "perception/object_recognizer.hpp"
+#include "perception/plane_removal.hpp"
+#include "perception/point_cloud.hpp"
+
+namespace uwscan::perception {
+
+// The segmentation stage of RecognizeObjects: the planes objects rest on, then the segments
+// that may each be one object.
+
+// A segment: its points (increasing indices) and the diameter of its own cluster, before the
+// small clusters near it joined.
+struct Segment {
+  std::vector<std::size_t> indices;
+  double core_diameter_m = 0.0;
+};
+
+// The planes objects rest on or stand beside: the dominant plane (the seabed), then others while
+// they are wider than any object of the database both ways (a wall); the search stops at the
+// first narrower one. A flat face of an object, or a slab cut through the tops of lying pipes,
+// holds many points too, but removing it would cut the object in pieces. Uses options'
+// plane_distance_m, plane_min_fraction (of `down`), seed and threads.
+PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_object_m,
+                                       const RecognitionOptions& options);
+
+// Euclidean clusters (cluster_tolerance_m) of at least min_segment_points, each with the smaller
+// clusters within attach_distance_m of it (to the nearest segment): the parts of one object that
+// occlusion separated, such as a valve's handle hiding its own stem from a sensor above it.
+// Largest first (equal sizes in cluster order).
+std::vector<Segment> Segments(const PointCloud& cloud, const RecognitionOptions& options);
+
+}  // namespace uwscan::perception
