@@ -41,7 +41,7 @@ struct InspectArgs {
   double queue_mb = 512.0;
   int live_queue = 4;
   double voxel_m = 0.005;
-  int sweeps_per_submap = 4;
+  int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
   int threads = 0;
 };
 

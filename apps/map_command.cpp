@@ -27,7 +27,7 @@ struct MapArgs {
   std::string truth;
   std::string json;
   double voxel_m = 0.005;
-  int sweeps_per_submap = 4;
+  int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
   int threads = 0;
 };
 
@@ -86,7 +86,10 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
                        {"seconds", m.seconds},
                        {"real_time_factor", s.real_time_factor},
                        {"registrations", m.stats.registrations},
-                       {"registrations_left_to_navigation", m.stats.registrations_failed},
+                       {"registrations_left_to_navigation", m.stats.registrations_failed + m.stats.registrations_inconsistent},
+                       {"registrations_inconsistent", m.stats.registrations_inconsistent},
+                       {"dead_reckoning_scale_error", m.calibration.scale_error},
+                       {"dead_reckoning_misalignment_rad", m.calibration.misalignment_rad},
                        {"loops_accepted", s.loops_accepted},
                        {"loops_rejected", s.loops_rejected},
                        {"loops_false", Optional(s.loops_false)},
@@ -134,8 +137,11 @@ void RunMap(const MapArgs& a) {
   const mapping::MapSummary s = mapping::Summarise(m);
   std::printf("%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
               a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
-  std::printf("registrations %d (%d left to navigation), loops accepted %d, rejected %d\n",
-              m.stats.registrations, m.stats.registrations_failed, s.loops_accepted, s.loops_rejected);
+  std::printf("registrations %d (%d left to navigation, %d of them inconsistent with it), loops accepted %d, rejected %d\n",
+              m.stats.registrations, m.stats.registrations_failed + m.stats.registrations_inconsistent,
+              m.stats.registrations_inconsistent, s.loops_accepted, s.loops_rejected);
+  std::printf("dead reckoning as estimated: speed scale error %+.2f %%, misalignment %+.2f mrad\n",
+              100.0 * m.calibration.scale_error, 1000.0 * m.calibration.misalignment_rad);
   std::printf("time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, graph %.2f s\n",
               m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s, m.stats.graph_s);
   if (m.navigation_noise_assumed) {

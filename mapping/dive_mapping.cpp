@@ -81,6 +81,7 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
   result.map = mapper.Map(options.map_voxel_m);
   result.map_dead_reckoning = mapper.Map(options.map_voxel_m, /*with_navigation=*/true);
   result.stats = mapper.stats();
+  result.calibration = mapper.calibration();
   result.dive_duration_s = last_time - first_time;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

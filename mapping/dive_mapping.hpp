@@ -37,6 +37,7 @@ struct DiveMapping {
   // submaps; filled only when DiveMappingOptions::keep_submaps.
   std::vector<perception::PointCloud> submap_clouds;
   MapperStats stats;
+  DeadReckoningCalibration calibration;  // the DVL's scale error and misalignment as estimated
   bool navigation_noise_assumed = false;  // the log did not record it (schema 1)
   double dive_duration_s = 0.0;
   double seconds = 0.0;  // processing time, reading the log included

@@ -126,6 +126,7 @@ void MapperOptions::Check() const {
   if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
   if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
   if (!(loop_chi2_gate > 0.0)) fail("loop_chi2_gate", "> 0");
+  if (!(registration_chi2_gate > 0.0)) fail("registration_chi2_gate", "> 0");
   if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
   if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
   if (threads < 0) fail("threads", ">= 0");
@@ -146,14 +147,23 @@ struct Mapper::Impl {
   bool finished = false;
   Mapper::FramePlacedCallback on_placed;
 
-  // The submap being filled: points in the navigation's world frame, and its frames.
+  // The submap being filled: points in the navigation's world frame, and its frames. Its frames
+  // are placed with the navigation corrected by the calibration estimated when it opened, about
+  // the navigation's position at its first frame.
   std::vector<Eigen::Vector3d> points_W;
+  DeadReckoningCalibration placement;
+  Eigen::Vector3d placement_origin_W = Eigen::Vector3d::Zero();
   std::vector<std::pair<std::int64_t, double>> frames;  // index, time
   int first_sweep = 0;
   std::vector<scanner::TriangulatedPoint> triangulated;
 
-  std::vector<Submap> submaps;                 // node i of the graph is submaps[i]
-  std::vector<Matrix6d> increment_covariance;  // of T_{i-1,i} in frame i-1 (0 for i = 0)
+  // Submap i has two nodes in the graph: its anchor (the vehicle at its middle frame, which
+  // the navigation measures) and its scan (the pose at which its cloud, bent by the navigation
+  // that placed its frames, fits the scene best, which registration measures); a distortion
+  // edge ties them (SubmapDistortionCovariance). Bending is then a bounded offset per submap,
+  // not a step that accumulates along a chain of registrations.
+  std::vector<Submap> submaps;
+  std::vector<Matrix6d> increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
   PoseGraph graph;
   std::vector<LoopClosure> loops;
   MapperStats stats;
@@ -169,10 +179,32 @@ struct Mapper::Impl {
   perception::RegistrationResult Register(const Submap& source, const perception::PointCloud& target,
                                           const Eigen::Isometry3d& T_init, const Matrix6d& prior_covariance,
                                           const std::vector<double>& distances) const;
-  Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& a, const Submap& b) const;
+  // The registration's own information (its pairs), weak directions removed. It relates the
+  // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
+  Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
+                                   const Submap& source) const;
+  // How far a submap's effective pose may sit from its anchor's navigation pose.
+  Matrix6d Distortion(const Submap& s, SystematicErrors systematic_errors) const;
+  // The navigation's motion between two submaps' effective poses (in a's frame).
+  Matrix6d MotionCovariance(const Submap& a, const Submap& b, SystematicErrors systematic_errors) const;
   Matrix6d ChainCovariance(int from, int to) const;
   void TryLoopClosures(int k);
   void Solve();
+  static int AnchorNode(int submap) { return 2 * submap; }
+  static int ScanNode(int submap) { return 2 * submap + 1; }
+  Eigen::Isometry3d AnchorPose(int submap) const { return graph.pose(AnchorNode(submap)); }
+  Eigen::Isometry3d ScanPose(int submap) const { return graph.pose(ScanNode(submap)); }
+  SystematicErrors systematic() const {
+    return options.estimate_dead_reckoning_calibration ? SystematicErrors::kEstimated : SystematicErrors::kAsNoise;
+  }
+  // The navigation at t (held at its ends) with its motion since the submap's first frame
+  // corrected by the placement calibration.
+  Eigen::Isometry3d PlacementPose(double time_s) const {
+    Eigen::Isometry3d T_W_V =
+        navigation.T_W_V(std::clamp(time_s, navigation.first_time_s(), navigation.last_time_s()));
+    T_W_V.translation() = placement_origin_W + placement.Correct(T_W_V.translation() - placement_origin_W);
+    return T_W_V;
+  }
 };
 
 void Mapper::Impl::Drain(bool hold_at_ends) {
@@ -188,13 +220,18 @@ void Mapper::Impl::Drain(bool hold_at_ends) {
 
 void Mapper::Impl::Place(const FrameRecord& frame) {
   if (!frames.empty() && frame.sweep >= first_sweep + options.sweeps_per_submap) CloseSubmap();
-  if (frames.empty()) first_sweep = frame.sweep;
+  if (frames.empty()) {
+    first_sweep = frame.sweep;
+    placement = graph.calibration();
+    placement_origin_W = navigation
+                             .T_W_V(std::clamp(frame.time_s, navigation.first_time_s(), navigation.last_time_s()))
+                             .translation();
+  }
   const Clock::time_point start = Clock::now();
   triangulated.resize(frame.peaks_px.size());
   triangulator->TriangulateFrame(frame.command, frame.peaks_px, triangulated);
   // Held at the first or last sample outside the navigation's span.
-  const double t = std::clamp(frame.time_s, navigation.first_time_s(), navigation.last_time_s());
-  const Eigen::Isometry3d T_W_C = navigation.T_W_V(t) * T_V_C;
+  const Eigen::Isometry3d T_W_C = PlacementPose(frame.time_s) * T_V_C;
   const std::size_t first_point = points_W.size();
   for (const scanner::TriangulatedPoint& p : triangulated) {
     if (!p.ok()) continue;
@@ -227,7 +264,8 @@ void Mapper::Impl::CloseSubmap() {
   };
   submap.T_W_V_start = clamped(submap.start_s);
   submap.T_W_V_end = clamped(submap.end_s);
-  const Eigen::Isometry3d T_V_W = submap.T_W_V_nav.inverse();
+  // The points in the anchor's frame as the corrected navigation placed it.
+  const Eigen::Isometry3d T_V_W = PlacementPose(anchor.second).inverse();
   std::vector<Eigen::Vector3d> points_V;
   points_V.reserve(points_W.size());
   for (const Eigen::Vector3d& p : points_W) points_V.push_back(T_V_W * p);
@@ -270,23 +308,37 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
   return perception::AlignIcp(source.sparse, target, T_init, icp);
 }
 
-Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& a,
-                                               const Submap& b) const {
+Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
+                                               const Submap& source) const {
   const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
-  const Matrix6d points = WithoutWeakDirections(r.information / (sigma * sigma), b.sparse, r.T_target_source,
+  const Matrix6d points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse, r.T_target_source,
                                                 options.weak_direction_ratio);
-  // Both submaps may be bent by the navigation that placed their frames.
-  const Matrix6d distortion =
-      uncertainty.SubmapDistortionCovariance(a.T_W_V_start, a.T_W_V_end, a.end_s - a.start_s) +
-      uncertainty.SubmapDistortionCovariance(b.T_W_V_start, b.T_W_V_end, b.end_s - b.start_s);
-  return InformationOfSum(points, distortion);
+  // The pairs' residuals are not independent: what the navigation bent in each submap beyond a
+  // rigid offset stays in every pair. Both submaps' bending floors the registration's covariance.
+  const Matrix6d floor = uncertainty.BendingCovariance(target.end_s - target.start_s, target.rms_radius_m) +
+                         uncertainty.BendingCovariance(source.end_s - source.start_s, source.rms_radius_m);
+  return InformationOfSum(points, floor);
+}
+
+Matrix6d Mapper::Impl::Distortion(const Submap& s, SystematicErrors systematic_errors) const {
+  return uncertainty.SubmapDistortionCovariance(s.T_W_V_start, s.T_W_V_end, s.end_s - s.start_s, s.rms_radius_m,
+                                                systematic_errors);
+}
+
+Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b, SystematicErrors systematic_errors) const {
+  const Eigen::Isometry3d T_a_b = a.T_W_V_nav.inverse() * b.T_W_V_nav;
+  const Matrix6d ad = Adjoint(T_a_b);
+  const Matrix6d covariance =
+      uncertainty.IncrementCovariance(a.T_W_V_nav, b.T_W_V_nav, b.anchor_time_s - a.anchor_time_s, systematic_errors) +
+      Distortion(a, systematic_errors) + ad * Distortion(b, systematic_errors) * ad.transpose();
+  return 0.5 * (covariance + covariance.transpose());
 }
 
 Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
   Matrix6d covariance = Matrix6d::Zero();
-  const Eigen::Isometry3d T_from_W = graph.pose(from).inverse();
+  const Eigen::Isometry3d T_from_W = ScanPose(from).inverse();
   for (int i = from + 1; i <= to; ++i) {
-    const Matrix6d ad = Adjoint(T_from_W * graph.pose(i - 1));
+    const Matrix6d ad = Adjoint(T_from_W * ScanPose(i - 1));
     covariance += ad * increment_covariance[static_cast<size_t>(i)] * ad.transpose();
   }
   return covariance;
@@ -296,48 +348,61 @@ void Mapper::Impl::AddToGraph(Submap submap) {
   const int k = static_cast<int>(submaps.size());
   submap.index = k;
   const NavigationNoise& noise = uncertainty.noise();
-  Eigen::Isometry3d initial = submap.T_W_V_nav;
+  Eigen::Isometry3d anchor_initial = submap.T_W_V_nav;
+  Eigen::Isometry3d scan_initial = submap.T_W_V_nav;
   Matrix6d increment_cov = Matrix6d::Zero();
   std::optional<RelativePoseEdge> registration;
   if (k > 0) {
     const Submap& previous = submaps.back();
-    const Eigen::Isometry3d T_nav = previous.T_W_V_nav.inverse() * submap.T_W_V_nav;
-    const double dt = submap.anchor_time_s - previous.anchor_time_s;
-    increment_cov = uncertainty.IncrementCovariance(previous.T_W_V_nav, submap.T_W_V_nav, dt);
-    initial = graph.pose(k - 1) * T_nav;
+    const Eigen::Isometry3d T_nav =
+        graph.calibration().CorrectMotion(previous.T_W_V_nav.inverse() * submap.T_W_V_nav);
+    // The registration starts from the corrected navigation, and is judged against it, with
+    // everything the navigation may be off by (the calibration may still be settling).
+    increment_cov = MotionCovariance(previous, submap, SystematicErrors::kAsNoise);
+    // The scan's motion as the navigation predicts it, from the previous scan's offset.
+    const Eigen::Isometry3d T_predicted = ScanPose(k - 1).inverse() * AnchorPose(k - 1) * T_nav;
+    anchor_initial = AnchorPose(k - 1) * T_nav;
+    scan_initial = anchor_initial;
 
     const Clock::time_point start = Clock::now();
     perception::PointCloud local;
-    const Eigen::Isometry3d T_prev_W = graph.pose(k - 1).inverse();
+    const Eigen::Isometry3d T_prev_W = ScanPose(k - 1).inverse();
     for (int j = std::max(0, k - options.local_map_submaps); j < k; ++j) {
-      AppendMoved(submaps[static_cast<size_t>(j)].cloud, T_prev_W * graph.pose(j), &local);
+      AppendMoved(submaps[static_cast<size_t>(j)].cloud, T_prev_W * ScanPose(j), &local);
     }
     const perception::RegistrationResult r =
-        Register(submap, local, T_nav, increment_cov, options.icp_distances_m);
+        Register(submap, local, T_predicted, increment_cov, options.icp_distances_m);
     stats.registration_s += Since(start);
-    const Matrix6d nav_information = increment_cov.inverse();
-    if (r.fitness >= options.min_fitness) {
-      const Matrix6d information = RegistrationInformation(r, previous, submap);
-      registration = RelativePoseEdge{k - 1, k, r.T_target_source, information, false, 3.0};
-      initial = graph.pose(k - 1) * r.T_target_source;
-      increment_cov = (nav_information + information).inverse();
+    const Matrix6d information = RegistrationInformation(r, previous, submap);
+    const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
+    const double chi2 = innovation.dot(InformationOfSum(information, increment_cov) * innovation);
+    if (r.fitness >= options.min_fitness && chi2 <= options.registration_chi2_gate) {
+      registration = RelativePoseEdge{ScanNode(k - 1), ScanNode(k), r.T_target_source, information, false, 3.0};
+      scan_initial = ScanPose(k - 1) * r.T_target_source;
+      const Matrix6d combined = (increment_cov.inverse() + information).inverse();
+      increment_cov = combined;
       ++stats.registrations;
     } else {
-      ++stats.registrations_failed;
+      ++(r.fitness >= options.min_fitness ? stats.registrations_inconsistent : stats.registrations_failed);
     }
   }
-  const int node = graph.AddNode(initial);
+  const int anchor = graph.AddNode(anchor_initial);
+  const int scan = graph.AddNode(scan_initial);
+  if (anchor != AnchorNode(k) || scan != ScanNode(k)) throw Error("mapper: graph nodes out of step with submaps");
+  graph.AddEdge({anchor, scan, Eigen::Isometry3d::Identity(), Distortion(submap, systematic()).inverse(), false, 3.0});
   if (k == 0) {
-    graph.AddPrior({node, submap.T_W_V_nav, StartInformation()});
+    graph.AddPrior({anchor, submap.T_W_V_nav, StartInformation()});
   } else {
     const Submap& previous = submaps.back();
-    const double dt = submap.anchor_time_s - previous.anchor_time_s;
-    graph.AddEdge({k - 1, k, previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
-                   uncertainty.OdometryInformation(previous.T_W_V_nav, submap.T_W_V_nav, dt), false, 3.0});
+    const Matrix6d odometry_cov = uncertainty.IncrementCovariance(
+        previous.T_W_V_nav, submap.T_W_V_nav, submap.anchor_time_s - previous.anchor_time_s, systematic());
+    graph.AddEdge({AnchorNode(k - 1), anchor, previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
+                   HeadingAndPositionInformation(odometry_cov, previous.T_W_V_nav), false, 3.0,
+                   options.estimate_dead_reckoning_calibration});
     if (registration) graph.AddEdge(*registration);
   }
-  graph.AddDepth({node, submap.T_W_V_nav.translation().z(), noise.depth_sigma_m});
-  graph.AddGravity({node, submap.T_W_V_nav.linear().transpose() * Eigen::Vector3d::UnitZ(), noise.roll_pitch_sigma_rad});
+  graph.AddDepth({anchor, submap.T_W_V_nav.translation().z(), noise.depth_sigma_m});
+  graph.AddGravity({anchor, submap.T_W_V_nav.linear().transpose() * Eigen::Vector3d::UnitZ(), noise.roll_pitch_sigma_rad});
   submaps.push_back(std::move(submap));
   increment_covariance.push_back(0.5 * (increment_cov + increment_cov.transpose()));
 
@@ -351,7 +416,7 @@ void Mapper::Impl::TryLoopClosures(int k) {
   if (options.max_loop_candidates == 0) return;
   const Clock::time_point start = Clock::now();
   const Submap& current = submaps[static_cast<size_t>(k)];
-  const Eigen::Vector3d centre_k = graph.pose(k) * current.centroid_V;
+  const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
   struct Candidate {
     int j;
     double distance;
@@ -360,11 +425,11 @@ void Mapper::Impl::TryLoopClosures(int k) {
   std::vector<Candidate> candidates;
   for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
     const Submap& old = submaps[static_cast<size_t>(j)];
-    const double distance = (graph.pose(j) * old.centroid_V - centre_k).norm();
+    const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
     const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
     if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
     const Matrix6d covariance = ChainCovariance(j, k);
-    const Eigen::Vector3d t = (graph.pose(j).inverse() * graph.pose(k)).translation();
+    const Eigen::Vector3d t = (ScanPose(j).inverse() * ScanPose(k)).translation();
     const double sigma = LargestStd(PositionCovariance(covariance, t));
     if (distance - overlap > options.gate_sigmas * sigma) continue;
     candidates.push_back({j, distance, covariance});
@@ -378,9 +443,9 @@ void Mapper::Impl::TryLoopClosures(int k) {
     const int j = c.j;
     perception::PointCloud target;
     for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
-      AppendMoved(submaps[static_cast<size_t>(i)].cloud, graph.pose(j).inverse() * graph.pose(i), &target);
+      AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i), &target);
     }
-    const Eigen::Isometry3d T_pred = graph.pose(j).inverse() * graph.pose(k);
+    const Eigen::Isometry3d T_pred = ScanPose(j).inverse() * ScanPose(k);
     const Eigen::Vector3d t = T_pred.translation();
     // The first stage reaches as far as the prediction may be off.
     std::vector<double> distances = options.loop_icp_distances_m;
@@ -411,7 +476,7 @@ void Mapper::Impl::TryLoopClosures(int k) {
       const double sigma_m = LargestStd(points_cov.bottomRightCorner<3, 3>());
       const double sigma_rad = LargestStd(points_cov.topLeftCorner<3, 3>());
       const Vector6d innovation = PoseError(r.T_target_source, T_pred);
-      loop.chi2 = innovation.dot((c.covariance + information.inverse()).ldlt().solve(innovation));
+      loop.chi2 = innovation.dot(InformationOfSum(information, c.covariance) * innovation);
       if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
         loop.reason = "degenerate: registration std " + std::to_string(sigma_m) + " m, " +
                       std::to_string(sigma_rad) + " rad";
@@ -419,7 +484,7 @@ void Mapper::Impl::TryLoopClosures(int k) {
         loop.reason = "inconsistent with the prediction: chi2 " + std::to_string(loop.chi2);
       } else {
         loop.accepted = true;
-        graph.AddEdge({j, k, r.T_target_source, information, true, 3.0});
+        graph.AddEdge({ScanNode(j), ScanNode(k), r.T_target_source, information, true, 3.0});
       }
     }
     loops.push_back(loop);
@@ -439,6 +504,10 @@ Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& patt
                const std::filesystem::path& table_cache)
     : impl_(std::make_unique<Impl>(options, T_V_C, noise)) {
   options.Check();
+  if (impl_->options.estimate_dead_reckoning_calibration) {
+    const NavigationNoise& floored = impl_->uncertainty.noise();
+    impl_->graph.EstimateDeadReckoningCalibration(floored.speed_scale_sigma, floored.heading_bias_sigma_rad);
+  }
   impl_->triangulator = scanner::MakeTriangulator(scanner, pattern, scanner::DefaultTriangulationMethod(pattern.kind),
                                                   scanner::TriangulatorBuildOptions{table_cache});
 }
@@ -486,12 +555,22 @@ void Mapper::Finish() {
 
 int Mapper::submap_count() const { return static_cast<int>(impl_->submaps.size()); }
 const Submap& Mapper::submap(int index) const { return impl_->submaps.at(static_cast<size_t>(index)); }
-Eigen::Isometry3d Mapper::pose(int index) const { return impl_->graph.pose(index); }
+Eigen::Isometry3d Mapper::pose(int index) const {
+  if (index < 0 || index >= submap_count()) throw Error("mapper: no submap " + std::to_string(index));
+  return impl_->AnchorPose(index);
+}
+Eigen::Isometry3d Mapper::scan_pose(int index) const {
+  if (index < 0 || index >= submap_count()) throw Error("mapper: no submap " + std::to_string(index));
+  return impl_->ScanPose(index);
+}
 const std::vector<LoopClosure>& Mapper::loops() const { return impl_->loops; }
 const MapperStats& Mapper::stats() const { return impl_->stats; }
+DeadReckoningCalibration Mapper::calibration() const { return impl_->graph.calibration(); }
 
 std::optional<std::vector<Matrix6d>> Mapper::Covariances() const {
-  return impl_->graph.Covariances();
+  std::vector<int> anchors;
+  for (int i = 0; i < submap_count(); ++i) anchors.push_back(impl_->AnchorNode(i));
+  return impl_->graph.Covariances(anchors);
 }
 
 perception::PointCloud Mapper::Map(double voxel_m, bool with_navigation) const {
@@ -500,7 +579,7 @@ perception::PointCloud Mapper::Map(double voxel_m, bool with_navigation) const {
   for (int i = 0; i < submap_count(); ++i) {
     const Submap& s = impl_->submaps[static_cast<size_t>(i)];
     clouds.push_back(&s.cloud);
-    poses.push_back(with_navigation ? s.T_W_V_nav : pose(i));
+    poses.push_back(with_navigation ? s.T_W_V_nav : scan_pose(i));
   }
   return MergeClouds(clouds, poses, voxel_m);
 }

@@ -23,7 +23,7 @@
 namespace uwscan::mapping {
 
 struct MapperOptions {
-  int sweeps_per_submap = 4;            // sweeps grouped into one submap, > 0
+  int sweeps_per_submap = 1;            // sweeps grouped into one submap, > 0
   SubmapCloudOptions clouds;            // voxel sizes, normals
   int local_map_submaps = 3;            // previous submaps the new one is registered to, > 0
   // ICP stages (metres, non-increasing) for consecutive submaps and for loop closures.
@@ -31,12 +31,14 @@ struct MapperOptions {
   std::vector<double> loop_icp_distances_m = {0.10, 0.04, 0.02, 0.01};
   double point_sigma_floor_m = 0.0003;  // a point-to-plane residual is never trusted beyond this
   double min_fitness = 0.3;             // registration edge kept only above this fitness
+  // and only if it agrees with the navigation's motion (chi-square, 6 dof, 99.9 %).
+  double registration_chi2_gate = 22.46;
   // Loop closures: candidates at least this many submaps back, whose overlap is plausible
   // within gate_sigmas of the relative uncertainty; at most max_loop_candidates tried per
   // submap. Accepted only if the registration's fitness, its own uncertainty (every direction
   // constrained) and its consistency with the prediction (chi-square, 6 dof) all agree.
   int loop_min_index_gap = 6;
-  int max_loop_candidates = 2;
+  int max_loop_candidates = 1;
   double gate_sigmas = 3.0;
   // Two submaps overlap enough to match when their centres are closer than this fraction of
   // the sum of their radii (1 = they just touch).
@@ -48,7 +50,11 @@ struct MapperOptions {
   double loop_max_sigma_m = 0.01;     // registration std along any direction
   double loop_max_sigma_rad = 0.005;  // registration std about any axis
   double loop_chi2_gate = 22.46;      // 6 dof, 99.9 %
-  int solve_every_submaps = 1;        // whole-graph solve also without a loop closure, > 0
+  int solve_every_submaps = 2;        // whole-graph solve also without a loop closure, > 0
+  // Estimate the DVL's speed scale error and misalignment in the graph (odometry edges then
+  // carry only the random walks) and place new frames with the corrected navigation; false:
+  // both are treated as noise of each motion.
+  bool estimate_dead_reckoning_calibration = true;
   // Registration directions whose normalised information is below this fraction of the
   // strongest are left to the navigation (Conditioning in mapper.cpp).
   double weak_direction_ratio = 0.02;
@@ -71,7 +77,8 @@ struct MapperStats {
   std::int64_t frames = 0;
   std::int64_t points = 0;
   int registrations = 0;         // consecutive submaps registered (fitness above the floor)
-  int registrations_failed = 0;  // left to odometry alone
+  int registrations_failed = 0;  // left to odometry alone: fitness below the floor
+  int registrations_inconsistent = 0;  // left to odometry alone: too far from the navigation
   double triangulation_s = 0.0;
   double submap_s = 0.0;  // voxels and normals
   double registration_s = 0.0;
@@ -116,9 +123,15 @@ class Mapper {
   int submap_count() const;
   const Submap& submap(int index) const;
   Eigen::Isometry3d pose(int index) const;  // current estimate of T_W_V at the submap's anchor
+  // The pose its cloud is placed with: the anchor's, off by the bending of the navigation that
+  // placed its frames (SubmapDistortionCovariance in navigation_uncertainty.hpp).
+  Eigen::Isometry3d scan_pose(int index) const;
   const std::vector<LoopClosure>& loops() const;
   const MapperStats& stats() const;
-  // Per-submap marginal covariances ([rotation, position] in the world, pose_graph.hpp).
+  // The dead reckoning's calibration as currently estimated (zero when not estimated).
+  DeadReckoningCalibration calibration() const;
+  // Per-submap marginal covariances of the anchors ([rotation, position] in the world,
+  // pose_graph.hpp).
   std::optional<std::vector<Matrix6d>> Covariances() const;
   // Every submap's cloud placed with the current estimates (or the navigation), voxelised at
   // `voxel_m`, origin at the first submap's position.

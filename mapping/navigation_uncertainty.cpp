@@ -5,8 +5,8 @@
 namespace uwscan::mapping {
 namespace {
 
-// A submap shorter than this is taken as this long when its tilt error is bounded.
-constexpr double kMinSubmapLength_m = 0.1;
+// A footprint smaller than this is taken as this large when its turn and tilt are bounded.
+constexpr double kMinFootprintRadius_m = 0.1;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -44,8 +44,8 @@ NavigationUncertainty::NavigationUncertainty(const NavigationNoise& noise) : noi
   noise_.roll_pitch_sigma_rad = std::max(noise_.roll_pitch_sigma_rad, kFloorRollPitch_rad);
 }
 
-Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W_a,
-                                                    const Eigen::Isometry3d& T_W_b, double dt_s) const {
+Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
+                                                    double dt_s, SystematicErrors systematic) const {
   const double dt = std::max(dt_s, 0.0);
   const Eigen::Vector2d moved = (T_W_b.translation() - T_W_a.translation()).head<2>();
   const double distance = moved.norm();
@@ -56,7 +56,7 @@ Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W
   world(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * dt;
   Eigen::Matrix2d xy = Eigen::Matrix2d::Identity() *
                        (noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * dt);
-  if (distance > 0.0) {
+  if (distance > 0.0 && systematic == SystematicErrors::kAsNoise) {
     const Eigen::Vector2d along = moved / distance;
     const Eigen::Vector2d across(-along.y(), along.x());
     const double scale = noise_.speed_scale_sigma * distance;
@@ -68,14 +68,41 @@ Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W
   return WorldAxesToFrame(world, T_W_a.linear());
 }
 
-Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_a,
-                                                           const Eigen::Isometry3d& T_W_b, double span_s) const {
-  Matrix6d covariance = IncrementCovariance(T_W_a, T_W_b, span_s);
-  const double length = std::max((T_W_b.translation() - T_W_a.translation()).norm(), kMinSubmapLength_m);
-  const double tilt = 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m / (length * length);
+Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_start,
+                                                           const Eigen::Isometry3d& T_W_end, double span_s,
+                                                           double footprint_radius_m,
+                                                           SystematicErrors systematic) const {
+  const double walk2 = noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * std::max(span_s, 0.0);
+  const double radius = std::max(footprint_radius_m, kMinFootprintRadius_m);
   Matrix6d world = Matrix6d::Zero();
-  world(0, 0) = world(1, 1) = tilt;
-  return covariance + WorldAxesToFrame(world, T_W_a.linear());
+  // Roll and pitch: the depth error changing across the footprint.
+  world(0, 0) = world(1, 1) = 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m / (radius * radius);
+  // Heading: its own walk, and the sideways walk of the frames across the footprint.
+  world(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * span_s + walk2 / (radius * radius);
+  // Position: the walk since the anchor averaged over the span (a third of its variance at the
+  // ends, the rigid fit's share of a Brownian path pinned at the middle, with margin).
+  Eigen::Matrix2d xy = Eigen::Matrix2d::Identity() * (walk2 / 3.0);
+  const Eigen::Vector2d moved = (T_W_end.translation() - T_W_start.translation()).head<2>();
+  const double distance = moved.norm();
+  if (distance > 0.0 && systematic == SystematicErrors::kAsNoise) {
+    // Stretched by the scale error and sheared by the misalignment about the middle.
+    const Eigen::Vector2d along = moved / distance;
+    const Eigen::Vector2d across(-along.y(), along.x());
+    const double scale = 0.5 * noise_.speed_scale_sigma * distance;
+    const double bias = 0.5 * noise_.heading_bias_sigma_rad * distance;
+    xy += scale * scale * along * along.transpose() + bias * bias * across * across.transpose();
+  }
+  world.block<2, 2>(3, 3) = xy;
+  world(5, 5) = noise_.depth_sigma_m * noise_.depth_sigma_m;
+  return WorldAxesToFrame(world, T_W_start.linear());
+}
+
+Matrix6d NavigationUncertainty::BendingCovariance(double span_s, double footprint_radius_m) const {
+  const double bridge2 = 0.25 * noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * std::max(span_s, 0.0);
+  const double radius = std::max(footprint_radius_m, kMinFootprintRadius_m);
+  Matrix6d covariance = Matrix6d::Zero();
+  covariance.diagonal() << Eigen::Vector3d::Constant(bridge2 / (radius * radius)), Eigen::Vector3d::Constant(bridge2);
+  return covariance;
 }
 
 Matrix6d InformationOfSum(const Matrix6d& information_a, const Matrix6d& covariance_b) {
@@ -85,11 +112,14 @@ Matrix6d InformationOfSum(const Matrix6d& information_a, const Matrix6d& covaria
   return 0.5 * (sum + sum.transpose());
 }
 
-Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a,
-                                                    const Eigen::Isometry3d& T_W_b, double dt_s) const {
+Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
+                                                    double dt_s, SystematicErrors systematic) const {
+  return HeadingAndPositionInformation(IncrementCovariance(T_W_a, T_W_b, dt_s, systematic), T_W_a);
+}
+
+Matrix6d HeadingAndPositionInformation(const Matrix6d& covariance_in_a, const Eigen::Isometry3d& T_W_a) {
   // Heading, x and y (world axes 2, 3, 4) inverted together; the other three carry nothing.
-  const Matrix6d world_cov = WorldAxesToFrame(IncrementCovariance(T_W_a, T_W_b, dt_s),
-                                              T_W_a.linear().transpose());
+  const Matrix6d world_cov = WorldAxesToFrame(covariance_in_a, T_W_a.linear().transpose());
   const int kept[3] = {2, 3, 4};
   Eigen::Matrix3d sub;
   for (int r = 0; r < 3; ++r) {

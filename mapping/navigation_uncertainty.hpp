@@ -7,6 +7,11 @@
 
 namespace uwscan::mapping {
 
+// Whether a dead-reckoned motion's covariance holds the speed scale error and the misalignment
+// (kAsNoise), or leaves them out because the pose graph estimates them (kEstimated,
+// dead_reckoning_calibration.hpp).
+enum class SystematicErrors { kAsNoise, kEstimated };
+
 // What the navigation's noise model says about its own estimates, in the pose graph's error
 // convention (pose_graph.hpp: [w (rad), v (m)], a left perturbation in the first pose's frame).
 // Each noise value is floored (kFloor... below) so a dive simulated without drift still gives
@@ -18,28 +23,42 @@ class NavigationUncertainty {
   const NavigationNoise& noise() const { return noise_; }  // floored
 
   // Covariance of the dead-reckoned motion from a to b (their navigation poses, dt apart):
-  // x, y and heading from the dead reckoning (random walks over dt, the speed scale error
-  // along the motion, the heading bias across it); depth, roll and pitch differences from the
-  // absolute sensors (twice their variance).
-  Matrix6d IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
-                               double dt_s) const;
+  // x, y and heading from the dead reckoning (random walks over dt and, kAsNoise, the speed
+  // scale error along the motion and the misalignment across it); depth, roll and pitch
+  // differences from the absolute sensors (twice their variance).
+  Matrix6d IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b, double dt_s,
+                               SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
-  // How much the navigation may have bent a submap whose frames it placed while the vehicle
-  // went from a to b (span_s): the dead-reckoning covariance over that span, plus the tilt a
-  // change of depth error across the submap's length would give (depth errors are not white).
-  // Added to a registration's own covariance: scan matching cannot be more certain than the
-  // shapes it matches are rigid. In a's frame.
-  Matrix6d SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
-                                      double span_s) const;
+  // How far from its anchor's pose a submap, bent by the navigation that placed its frames
+  // between start and end (span_s apart), is best fitted by a rigid pose: scan matching aligns
+  // shapes, so it measures that effective pose, not the anchor's. The frames sit off by the
+  // random walk since the anchor; a rigid fit over the span keeps about a third of its variance
+  // as a shift, and its sideways part across the footprint (RMS radius of the points) as a turn;
+  // depth errors across the footprint tilt it; with kAsNoise, the scale error stretches it and
+  // the misalignment shears it about the middle. In start's frame. The graph's nodes are the
+  // effective poses: this covariance goes into the navigation's edges and priors, not the
+  // registrations'.
+  Matrix6d SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_start, const Eigen::Isometry3d& T_W_end,
+                                      double span_s, double footprint_radius_m,
+                                      SystematicErrors systematic = SystematicErrors::kAsNoise) const;
+
+  // What a rigid pose cannot take out of that bending: the random walk's departure from a
+  // straight path over the span (half its spread at the middle), as a shift, and as a turn
+  // across the footprint. Isotropic, so the same in any frame.
+  Matrix6d BendingCovariance(double span_s, double footprint_radius_m) const;
 
   // Information of the same motion in x, y and heading only, zero in depth, roll and pitch:
   // the odometry edge of the graph, where absolute priors hold those three.
-  Matrix6d OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
-                               double dt_s) const;
+  Matrix6d OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b, double dt_s,
+                               SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
  private:
   NavigationNoise noise_;
 };
+
+// The information in heading, x and y (about the world's axes) of a covariance of a motion
+// from a (in a's frame), zero in depth, roll and pitch.
+Matrix6d HeadingAndPositionInformation(const Matrix6d& covariance_in_a, const Eigen::Isometry3d& T_W_a);
 
 // The floors: below these a sensor is taken as exact to this much.
 inline constexpr double kFloorWalk_m_per_sqrt_s = 1e-4;

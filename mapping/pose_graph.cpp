@@ -49,6 +49,42 @@ struct RelativeCost {
   }
 };
 
+// A dead-reckoned motion: as RelativeCost, its measured translation corrected by the
+// calibration c = [scale error, misalignment] first.
+struct DeadReckonedCost {
+  Eigen::Quaterniond q_meas;
+  Eigen::Vector3d t_meas;
+  Matrix6d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* q_a_raw, const T* p_a_raw, const T* q_b_raw, const T* p_b_raw, const T* c,
+                  T* residual_raw) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_a_raw), q_b(q_b_raw);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_a_raw), p_b(p_b_raw);
+    const Eigen::Matrix<T, 3, 1> t_true =
+        DeadReckoningCalibration::Correct<T>(t_meas.cast<T>(), c[0], c[1]);
+    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
+    Eigen::Quaternion<T> q_delta = (q_a_inverse * q_b) * q_meas.conjugate().cast<T>();
+    if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
+    Eigen::Matrix<T, 6, 1> e;
+    e << T(2) * q_delta.vec(), q_a_inverse * (p_b - p_a) - q_delta * t_true;
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
+    residual = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
+// The calibration's zero-mean prior.
+struct CalibrationPriorCost {
+  double scale_sigma, misalignment_sigma_rad;
+  template <typename T>
+  bool operator()(const T* c, T* residual) const {
+    residual[0] = c[0] / T(scale_sigma);
+    residual[1] = c[1] / T(misalignment_sigma_rad);
+    return true;
+  }
+};
+
 struct PriorCost {
   Eigen::Quaterniond q_meas;
   Eigen::Vector3d t_meas;
@@ -132,6 +168,8 @@ struct PoseGraph::Impl {
   std::vector<std::unique_ptr<std::array<double, 4>>> rotations;
   std::vector<std::unique_ptr<std::array<double, 3>>> positions;
   std::unique_ptr<ceres::Problem> problem;
+  // The dead reckoning's [scale error, misalignment], a parameter block once estimated.
+  std::unique_ptr<std::array<double, 2>> calibration;
 
   Impl() {
     ceres::Problem::Options options;
@@ -171,13 +209,44 @@ void PoseGraph::AddEdge(const RelativePoseEdge& edge) {
   m.RequireNode(edge.to, "AddEdge");
   RequireRigid(edge.T_from_to, "AddEdge");
   RequireInformation(edge.information, "AddEdge");
-  auto* cost = new ceres::AutoDiffCostFunction<RelativeCost, 6, 4, 3, 4, 3>(new RelativeCost{
-      Eigen::Quaterniond(edge.T_from_to.linear()), edge.T_from_to.translation(), SqrtPsd(edge.information)});
   if (edge.robust && !(edge.huber_scale > 0.0)) throw Error("pose graph: AddEdge: huber_scale must be > 0");
+  if (edge.dead_reckoned && !m.calibration) {
+    throw Error("pose graph: AddEdge: a dead-reckoned edge needs EstimateDeadReckoningCalibration first");
+  }
   // The problem owns each loss (one per edge: Ceres deletes them one by one).
   ceres::LossFunction* loss = edge.robust ? new ceres::HuberLoss(edge.huber_scale) : nullptr;
-  m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from),
-                              m.q(edge.to), m.p(edge.to));
+  const Eigen::Quaterniond q_meas(edge.T_from_to.linear());
+  if (edge.dead_reckoned) {
+    auto* cost = new ceres::AutoDiffCostFunction<DeadReckonedCost, 6, 4, 3, 4, 3, 2>(
+        new DeadReckonedCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
+    m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to), m.p(edge.to),
+                                m.calibration->data());
+    return;
+  }
+  auto* cost = new ceres::AutoDiffCostFunction<RelativeCost, 6, 4, 3, 4, 3>(
+      new RelativeCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
+  m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to), m.p(edge.to));
+}
+
+void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma, double misalignment_sigma_rad) {
+  Impl& m = *impl_;
+  if (m.calibration) throw Error("pose graph: EstimateDeadReckoningCalibration: called twice");
+  if (!(scale_sigma > 0.0 && std::isfinite(scale_sigma)) ||
+      !(misalignment_sigma_rad > 0.0 && std::isfinite(misalignment_sigma_rad))) {
+    throw Error("pose graph: EstimateDeadReckoningCalibration: expected finite sigmas > 0");
+  }
+  m.calibration = std::make_unique<std::array<double, 2>>(std::array<double, 2>{0.0, 0.0});
+  m.problem->AddParameterBlock(m.calibration->data(), 2);
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<CalibrationPriorCost, 2, 2>(
+                                  new CalibrationPriorCost{scale_sigma, misalignment_sigma_rad}),
+                              nullptr, m.calibration->data());
+}
+
+bool PoseGraph::estimates_calibration() const { return impl_->calibration != nullptr; }
+
+DeadReckoningCalibration PoseGraph::calibration() const {
+  if (!impl_->calibration) return {};
+  return {(*impl_->calibration)[0], (*impl_->calibration)[1]};
 }
 
 void PoseGraph::AddDepth(const DepthPrior& prior) {
@@ -250,21 +319,28 @@ PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
 }
 
 std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(int threads) const {
+  std::vector<int> nodes(static_cast<size_t>(node_count()));
+  for (int i = 0; i < node_count(); ++i) nodes[static_cast<size_t>(i)] = i;
+  return Covariances(nodes, threads);
+}
+
+std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(const std::vector<int>& nodes, int threads) const {
   Impl& m = *impl_;
+  for (const int node : nodes) m.RequireNode(node, "Covariances");
   ceres::Covariance::Options options;
   options.algorithm_type = ceres::SPARSE_QR;
   options.num_threads = std::max(1, threads);
   ceres::Covariance covariance(options);
   std::vector<std::pair<const double*, const double*>> blocks;
-  const int n = node_count();
-  for (int i = 0; i < n; ++i) {
+  for (const int i : nodes) {
     blocks.emplace_back(m.q(i), m.q(i));
     blocks.emplace_back(m.q(i), m.p(i));
     blocks.emplace_back(m.p(i), m.p(i));
   }
   if (!covariance.Compute(blocks, m.problem.get())) return std::nullopt;
-  std::vector<Matrix6d> out(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
+  std::vector<Matrix6d> out(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const int i = nodes[k];
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> qq, qp, pp;
     if (!covariance.GetCovarianceBlockInTangentSpace(m.q(i), m.q(i), qq.data()) ||
         !covariance.GetCovarianceBlockInTangentSpace(m.q(i), m.p(i), qp.data()) ||
@@ -273,7 +349,7 @@ std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(int threads) const {
     }
     // Ceres's quaternion tangent is half the rotation vector (Plus = [cos|d|, sin|d| d/|d|] * q):
     // scale to radians of rotation.
-    Matrix6d& c = out[static_cast<size_t>(i)];
+    Matrix6d& c = out[k];
     c << 4.0 * qq, 2.0 * qp, 2.0 * qp.transpose(), pp;
   }
   return out;

@@ -5,6 +5,8 @@
 #include <optional>
 #include <vector>
 
+#include "mapping/dead_reckoning_calibration.hpp"
+
 // A pose graph of vehicle poses T_W_V solved with Ceres (SE(3): position + unit quaternion on
 // Ceres's quaternion manifold). Ceres stays inside pose_graph.cpp.
 namespace uwscan::mapping {
@@ -25,6 +27,9 @@ struct RelativePoseEdge {
   Matrix6d information = Matrix6d::Zero();  // symmetric PSD
   bool robust = false;
   double huber_scale = 3.0;  // > 0, used when robust
+  // A dead-reckoned motion: its translation is corrected by the graph's estimate of the dead
+  // reckoning's calibration before it is compared (EstimateDeadReckoningCalibration first).
+  bool dead_reckoned = false;
 };
 
 // Absolute measurements of one node from the vehicle's own sensors.
@@ -74,6 +79,13 @@ class PoseGraph {
   void AddDepth(const DepthPrior& prior);
   void AddGravity(const GravityPrior& prior);
   void AddPrior(const PosePrior& prior);
+  // Estimates the dead reckoning's speed scale error and misalignment with the poses, from a
+  // zero-mean prior with these standard deviations (> 0). Call once, before the first
+  // dead-reckoned edge.
+  void EstimateDeadReckoningCalibration(double scale_sigma, double misalignment_sigma_rad);
+  bool estimates_calibration() const;
+  // The current estimate (zero until estimated).
+  DeadReckoningCalibration calibration() const;
 
   int node_count() const;
   Eigen::Isometry3d pose(int node) const;
@@ -86,6 +98,8 @@ class PoseGraph {
   // position (m)], both in the world frame: T_W_V = exp([w, 0]) applied to the rotation,
   // position + v. std::nullopt when the graph leaves a direction unconstrained (rank deficient).
   std::optional<std::vector<Matrix6d>> Covariances(int threads = 1) const;
+  // The same for the given nodes only, in their order.
+  std::optional<std::vector<Matrix6d>> Covariances(const std::vector<int>& nodes, int threads = 1) const;
 
  private:
   struct Impl;

@@ -1,6 +1,7 @@
 #include "mapping/submap.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "perception/normals.hpp"
 #include "perception/voxel_filter.hpp"
@@ -41,11 +42,15 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
   for (std::size_t i = 0; i < submap->cloud.size(); ++i) centroid += submap->cloud.Point(i);
   centroid /= static_cast<double>(submap->cloud.size());
   double radius = 0.0;
+  double sum_squared = 0.0;
   for (std::size_t i = 0; i < submap->cloud.size(); ++i) {
-    radius = std::max(radius, (submap->cloud.Point(i) - centroid).norm());
+    const double squared = (submap->cloud.Point(i) - centroid).squaredNorm();
+    radius = std::max(radius, std::sqrt(squared));
+    sum_squared += squared;
   }
   submap->centroid_V = centroid;
   submap->radius_m = radius;
+  submap->rms_radius_m = std::sqrt(sum_squared / static_cast<double>(submap->cloud.size()));
 }
 
 perception::PointCloud MergeClouds(const std::vector<const perception::PointCloud*>& clouds,

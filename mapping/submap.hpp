@@ -25,6 +25,7 @@ struct Submap {
   perception::PointCloud sparse;  // voxelised at the registration voxel (ICP source)
   Eigen::Vector3d centroid_V = Eigen::Vector3d::Zero();  // of the cloud, in {V_k}
   double radius_m = 0.0;          // largest distance of a point from the centroid
+  double rms_radius_m = 0.0;      // root mean square distance of the points from the centroid
 };
 
 struct SubmapCloudOptions {
