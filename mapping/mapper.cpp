@@ -389,7 +389,9 @@ void Mapper::Impl::AddToGraph(Submap submap) {
   const int anchor = graph.AddNode(anchor_initial);
   const int scan = graph.AddNode(scan_initial);
   if (anchor != AnchorNode(k) || scan != ScanNode(k)) throw Error("mapper: graph nodes out of step with submaps");
-  graph.AddEdge({anchor, scan, Eigen::Isometry3d::Identity(), Distortion(submap, systematic()).inverse(), false, 3.0});
+  const Matrix6d distortion_information = Distortion(submap, systematic()).inverse();
+  graph.AddEdge({anchor, scan, Eigen::Isometry3d::Identity(),
+                 0.5 * (distortion_information + distortion_information.transpose()), false, 3.0});
   if (k == 0) {
     graph.AddPrior({anchor, submap.T_W_V_nav, StartInformation()});
   } else {

@@ -94,6 +94,8 @@ Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry
   }
   world.block<2, 2>(3, 3) = xy;
   world(5, 5) = noise_.depth_sigma_m * noise_.depth_sigma_m;
+  // A submap of one frame is not bent at all; its covariance still has to be invertible.
+  for (int k = 0; k < 6; ++k) world(k, k) += k < 3 ? kFloorHeadingBias_rad * kFloorHeadingBias_rad : kFloorDepth_m * kFloorDepth_m;
   return WorldAxesToFrame(world, T_W_start.linear());
 }
 
