@@ -186,7 +186,9 @@ struct Mapper::Impl {
   // How far a submap's effective pose may sit from its anchor's navigation pose.
   Matrix6d Distortion(const Submap& s, SystematicErrors systematic_errors) const;
   // The navigation's motion between two submaps' effective poses (in a's frame).
-  Matrix6d MotionCovariance(const Submap& a, const Submap& b, SystematicErrors systematic_errors) const;
+  // Everything it may be off by: the scale error and misalignment as noise, as the
+  // calibration may still be settling.
+  Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
   Matrix6d ChainCovariance(int from, int to) const;
   void TryLoopClosures(int k);
   void Solve();
@@ -325,7 +327,8 @@ Matrix6d Mapper::Impl::Distortion(const Submap& s, SystematicErrors systematic_e
                                                 systematic_errors);
 }
 
-Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b, SystematicErrors systematic_errors) const {
+Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b) const {
+  const SystematicErrors systematic_errors = SystematicErrors::kAsNoise;
   const Eigen::Isometry3d T_a_b = a.T_W_V_nav.inverse() * b.T_W_V_nav;
   const Matrix6d ad = Adjoint(T_a_b);
   const Matrix6d covariance =
@@ -358,7 +361,7 @@ void Mapper::Impl::AddToGraph(Submap submap) {
         graph.calibration().CorrectMotion(previous.T_W_V_nav.inverse() * submap.T_W_V_nav);
     // The registration starts from the corrected navigation, and is judged against it, with
     // everything the navigation may be off by (the calibration may still be settling).
-    increment_cov = MotionCovariance(previous, submap, SystematicErrors::kAsNoise);
+    increment_cov = MotionCovariance(previous, submap);
     // The scan's motion as the navigation predicts it, from the previous scan's offset.
     const Eigen::Isometry3d T_predicted = ScanPose(k - 1).inverse() * AnchorPose(k - 1) * T_nav;
     anchor_initial = AnchorPose(k - 1) * T_nav;
@@ -396,11 +399,10 @@ void Mapper::Impl::AddToGraph(Submap submap) {
     graph.AddPrior({anchor, submap.T_W_V_nav, StartInformation()});
   } else {
     const Submap& previous = submaps.back();
-    const Matrix6d odometry_cov = uncertainty.IncrementCovariance(
-        previous.T_W_V_nav, submap.T_W_V_nav, submap.anchor_time_s - previous.anchor_time_s, systematic());
     graph.AddEdge({AnchorNode(k - 1), anchor, previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
-                   HeadingAndPositionInformation(odometry_cov, previous.T_W_V_nav), false, 3.0,
-                   options.estimate_dead_reckoning_calibration});
+                   uncertainty.OdometryInformation(previous.T_W_V_nav, submap.T_W_V_nav,
+                                                   submap.anchor_time_s - previous.anchor_time_s, systematic()),
+                   false, 3.0, options.estimate_dead_reckoning_calibration});
     if (registration) graph.AddEdge(*registration);
   }
   graph.AddDepth({anchor, submap.T_W_V_nav.translation().z(), noise.depth_sigma_m});

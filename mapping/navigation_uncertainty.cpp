@@ -22,6 +22,26 @@ Matrix6d WorldAxesToFrame(const Matrix6d& in_world_axes, const Eigen::Matrix3d& 
   return B * in_world_axes * B.transpose();
 }
 
+// The information in heading, x and y (about the world's axes) of a covariance of a motion
+// from a (in a's frame), zero in depth, roll and pitch.
+Matrix6d HeadingAndPositionInformation(const Matrix6d& covariance_in_a, const Eigen::Isometry3d& T_W_a) {
+  // Heading, x and y (world axes 2, 3, 4) inverted together; the other three carry nothing.
+  const Matrix6d world_cov = WorldAxesToFrame(covariance_in_a, T_W_a.linear().transpose());
+  const int kept[3] = {2, 3, 4};
+  Eigen::Matrix3d sub;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) sub(r, c) = world_cov(kept[r], kept[c]);
+  }
+  const Eigen::Matrix3d sub_info = sub.inverse();
+  Matrix6d world_info = Matrix6d::Zero();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) world_info(kept[r], kept[c]) = sub_info(r, c);
+  }
+  // Information transforms with the inverse of the covariance's map: e_W = B^-1 e_a, B
+  // orthogonal, so the same rotation applies.
+  return WorldAxesToFrame(world_info, T_W_a.linear());
+}
+
 }  // namespace
 
 Matrix6d Adjoint(const Eigen::Isometry3d& T) {
@@ -117,24 +137,6 @@ Matrix6d InformationOfSum(const Matrix6d& information_a, const Matrix6d& covaria
 Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
                                                     double dt_s, SystematicErrors systematic) const {
   return HeadingAndPositionInformation(IncrementCovariance(T_W_a, T_W_b, dt_s, systematic), T_W_a);
-}
-
-Matrix6d HeadingAndPositionInformation(const Matrix6d& covariance_in_a, const Eigen::Isometry3d& T_W_a) {
-  // Heading, x and y (world axes 2, 3, 4) inverted together; the other three carry nothing.
-  const Matrix6d world_cov = WorldAxesToFrame(covariance_in_a, T_W_a.linear().transpose());
-  const int kept[3] = {2, 3, 4};
-  Eigen::Matrix3d sub;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) sub(r, c) = world_cov(kept[r], kept[c]);
-  }
-  const Eigen::Matrix3d sub_info = sub.inverse();
-  Matrix6d world_info = Matrix6d::Zero();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) world_info(kept[r], kept[c]) = sub_info(r, c);
-  }
-  // Information transforms with the inverse of the covariance's map: e_W = B^-1 e_a, B
-  // orthogonal, so the same rotation applies.
-  return WorldAxesToFrame(world_info, T_W_a.linear());
 }
 
 }  // namespace uwscan::mapping

@@ -56,10 +56,6 @@ class NavigationUncertainty {
   NavigationNoise noise_;
 };
 
-// The information in heading, x and y (about the world's axes) of a covariance of a motion
-// from a (in a's frame), zero in depth, roll and pitch.
-Matrix6d HeadingAndPositionInformation(const Matrix6d& covariance_in_a, const Eigen::Isometry3d& T_W_a);
-
 // The floors: below these a sensor is taken as exact to this much.
 inline constexpr double kFloorWalk_m_per_sqrt_s = 1e-4;
 inline constexpr double kFloorHeadingWalk_rad_per_sqrt_s = 1e-5;

@@ -20,11 +20,11 @@ namespace {
 // The left-perturbation error of a predicted relative pose against a measured one, for Jets.
 template <typename T>
 Eigen::Matrix<T, 6, 1> LeftError(const Eigen::Quaternion<T>& q_hat, const Eigen::Matrix<T, 3, 1>& t_hat,
-                                 const Eigen::Quaterniond& q_meas, const Eigen::Vector3d& t_meas) {
+                                 const Eigen::Quaterniond& q_meas, const Eigen::Matrix<T, 3, 1>& t_meas) {
   Eigen::Quaternion<T> q_delta = q_hat * q_meas.conjugate().cast<T>();
   // q and -q are the same rotation: take the one with w >= 0, so the error is the short way.
   if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
-  const Eigen::Matrix<T, 3, 1> t_delta = t_hat - q_delta * t_meas.cast<T>();
+  const Eigen::Matrix<T, 3, 1> t_delta = t_hat - q_delta * t_meas;
   Eigen::Matrix<T, 6, 1> e;
   e << T(2) * q_delta.vec(), t_delta;
   return e;
@@ -42,7 +42,8 @@ struct RelativeCost {
     const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_a_raw), q_b(q_b_raw);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_a_raw), p_b(p_b_raw);
     const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
-    const Eigen::Matrix<T, 6, 1> e = LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_meas);
+    const Eigen::Matrix<T, 6, 1> e =
+        LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_meas.cast<T>());
     Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
     residual = sqrt_information.cast<T>() * e;
     return true;
@@ -64,10 +65,7 @@ struct DeadReckonedCost {
     const Eigen::Matrix<T, 3, 1> t_true =
         DeadReckoningCalibration::Correct<T>(t_meas.cast<T>(), c[0], c[1]);
     const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
-    Eigen::Quaternion<T> q_delta = (q_a_inverse * q_b) * q_meas.conjugate().cast<T>();
-    if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
-    Eigen::Matrix<T, 6, 1> e;
-    e << T(2) * q_delta.vec(), q_a_inverse * (p_b - p_a) - q_delta * t_true;
+    const Eigen::Matrix<T, 6, 1> e = LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_true);
     Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
     residual = sqrt_information.cast<T>() * e;
     return true;
