@@ -124,6 +124,7 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
                 "leave OpenCV's PPF out of the peers (its match can loop without end on some segments)");
   cmd->add_option("--threads", a->options.threads, "threads")->check(CLI::Range(1, 256));
   cmd->add_option("--seed", a->options.seed, "scene and noise seed");
+  cmd->add_option("--only", a->options.only, "run only these scenes (indices below --scans), to look at a case");
   cmd->add_flag("--details", a->details, "print every object's answer and the candidates weighed for it");
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { Run(*a); });

@@ -12,6 +12,7 @@
 #include "bench/recognition_peers.hpp"
 #include "perception/normals.hpp"
 #include "perception/object_database_builder.hpp"
+#include "perception/object_pose_search.hpp"
 #include "perception/object_recognizer.hpp"
 #include "perception/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
@@ -201,7 +202,6 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
                                            const Progress& progress) {
   options.Check();
   RecognitionBenchResult result;
-  result.scans = options.scans;
   std::vector<perception::ObjectSource> catalogue;
   for (const std::string& name : perception::CatalogueNames()) {
     catalogue.push_back(perception::CatalogueObject(name));
@@ -254,10 +254,13 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
     pcl_peer.emplace(std::move(peers));
   }
 
+  perception::ViewFeatureCache view_features(db);
   perception::RecognitionOptions recognition;
   recognition.seed = options.seed;
   recognition.threads = options.threads;
   for (int s = 0; s < options.scans; ++s) {
+    if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), s) == options.only.end()) continue;
+    ++result.scans;
     const Scene scene = MakeScene(s, catalogue, foreign, options.seed);
     start = std::chrono::steady_clock::now();
     const sim::VirtualScan scan = scene_scanner.Scan(scene.objects, scene.T_W_C, options.seed + 1000 + s);
@@ -266,7 +269,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
     const PointCloud cloud = perception::MakeCloud(scan.points_C);
 
     start = std::chrono::steady_clock::now();
-    const perception::RecognitionResult answer = perception::RecognizeObjects(cloud, db, recognition);
+    const perception::RecognitionResult answer = perception::RecognizeObjects(cloud, db, view_features, recognition);
     result.pipelines["uwscan"].seconds += Seconds(start);
     for (const auto& [stage, seconds] : answer.stage_seconds) result.uwscan_stage_seconds[stage] += seconds;
 

@@ -18,6 +18,7 @@ namespace uwscan::bench {
 // on the same segments.
 struct RecognitionBenchOptions {
   int scans = 100;                 // scenes, each scanned once, >= 1
+  std::vector<int> only;           // when not empty, only these scenes of the `scans` (to look at a case)
   int views = 24;                  // database views per object, >= 1
   bool images = true;              // render and detect frames (else exact peaks + 0.1 px noise)
   int galvo_stride = 2;            // mirror steps per frame, >= 1 (2: 101 frames per sweep)

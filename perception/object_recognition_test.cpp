@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "perception/cloud_io.hpp"
+#include "perception/clustering.hpp"
 #include "perception/object_catalogue.hpp"
 #include "perception/object_database.hpp"
 #include "perception/object_database_builder.hpp"
@@ -132,6 +134,53 @@ TEST(ObjectRecognition, AnObjectNotInTheDatabaseIsUnknown) {
   const RecognitionResult r = RecognizeObjects(elbow.cloud, PipeFlangeValveDb());
   ASSERT_NE(Nearest(r, elbow), nullptr);
   EXPECT_EQ(Nearest(r, elbow)->object_id, "unknown");
+}
+
+// A valve in line with a pipe, touching its end: one Euclidean segment, which neither object explains alone.
+// Both come out, each with its own points and pose.
+TEST(ObjectRecognition, TwoTouchingObjectsAreBothRecognised) {
+  const scanner::TriangleMesh pipe = CatalogueObject("pipe").mesh, valve = CatalogueObject("valve_wheel").mesh;
+  std::vector<sim::SceneObject> scene = OnSeabed(pipe);
+  sim::SceneObject second = OnSeabed(valve)[1];
+  // In line with the pipe, the valve's stub (120 mm from its centre) against the pipe's end.
+  second.T_W_O.translation().y() += 0.36;
+  scene.push_back(second);
+  const Eigen::Vector3d middle = 0.5 * (scene[1].T_W_O.translation() + scene[2].T_W_O.translation());
+  const Eigen::Isometry3d T_W_C = sim::LookAt(middle + Eigen::Vector3d(0.5, 0.1, 0.7), middle, Eigen::Vector3d::UnitZ());
+  const sim::VirtualScan scan = Scanner().Scan(scene, T_W_C, 11);
+  const PointCloud cloud = MakeCloud(scan.points_C);
+
+  // They do touch: their points form one cluster at the recognizer's tolerance.
+  std::vector<std::size_t> on_objects;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (scan.object_index[i] >= 1) on_objects.push_back(i);
+  }
+  ClusteringOptions clustering;
+  clustering.tolerance_m = RecognitionOptions{}.cluster_tolerance_m;
+  const auto clusters = EuclideanClusters(Subset(cloud, on_objects), clustering);
+  ASSERT_FALSE(clusters.empty());
+  EXPECT_GT(clusters.front().size(), 0.95 * static_cast<double>(on_objects.size()));
+
+  const RecognitionResult r = RecognizeObjects(cloud, PipeFlangeValveDb());
+  for (int o : {1, 2}) {
+    const RecognizedObject* holder = nullptr;
+    std::size_t most = 0;
+    for (const RecognizedObject& found : r.objects) {
+      const std::size_t count = static_cast<std::size_t>(std::count_if(
+          found.segment.begin(), found.segment.end(), [&](std::size_t i) { return scan.object_index[i] == o; }));
+      if (count > most) most = count, holder = &found;
+    }
+    ASSERT_NE(holder, nullptr);
+    const Eigen::Isometry3d T_S_O = T_W_C.inverse() * scene[static_cast<std::size_t>(o)].T_W_O;
+    EXPECT_EQ(holder->object_id, o == 1 ? "pipe" : "valve_wheel");
+    // The pipe may slide along its axis; across it, and the valve altogether, are pinned.
+    Eigen::Vector3d offset = holder->T_S_O.translation() - T_S_O.translation();
+    if (o == 1) {
+      const Eigen::Vector3d axis_S = T_S_O.linear() * Eigen::Vector3d::UnitZ();
+      offset -= offset.dot(axis_S) * axis_S;
+    }
+    EXPECT_LT(offset.norm(), 0.005) << "object " << o;
+  }
 }
 
 // A pipe much longer than the sweep is wide, so its ends are never seen: it is the database's

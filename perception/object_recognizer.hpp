@@ -32,6 +32,7 @@ struct RecognitionOptions {
   int pose_rolls = 12;
   int sift_points = 200;
   int refined_starts = 3;
+  int refine_points = 1000;  // segment points the fine ICP of each refined start uses
   // "unknown" when the nearest view is farther than this (chi-square, histograms summing to 1)
   double max_chi_square = 0.9;
   // Verification: at least this share of the segment within 1.5 voxels of the posed model...
@@ -43,6 +44,15 @@ struct RecognitionOptions {
   // ...and at most this share of the model surface facing the sensor (within the segment's
   // extent along the view) left without a scan point within 2 voxels.
   double max_missing = 0.45;
+  // Verified candidates scoring within this of the best are ranked by chi-square instead.
+  double score_tie = 0.02;
+  // A segment no single object explains may be several touching each other: the object that
+  // explains the largest part of it (at least this share of its points) is taken out and the
+  // rest recognised again, as is what a recognised object leaves unexplained; at most
+  // max_objects_per_segment objects come out of one segment.
+  double min_part_share = 0.25;
+  double min_part_close = 0.8;  // min_close for such a part: it was picked among many hypotheses
+  int max_objects_per_segment = 3;
   // A pose direction is free when its information is below this fraction of the largest.
   double free_direction_ratio = 0.02;
   std::uint64_t seed = 1;
@@ -68,7 +78,7 @@ struct RecognitionCandidate {
   double close = 0.0;       // share of the segment within close_distance_m of its surface
   double missing = 1.0;     // share of the expected visible model surface not seen
   double rmse_m = 0.0;      // point-to-plane RMS of the final ICP
-  double score = 0.0;       // close x (1 - missing); the best verified one wins
+  double score = 0.0;       // close x (1 - missing); the best verified one wins (score_tie)
   bool verified = false;
   Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();
 };
@@ -91,7 +101,8 @@ struct RecognizedObject {
 };
 
 struct RecognitionResult {
-  std::vector<RecognizedObject> objects;  // one per segment, largest segment first
+  // One per segment, largest segment first, then the parts split off segments in that order.
+  std::vector<RecognizedObject> objects;
   std::size_t plane_points = 0;           // removed as planes
   // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine; verify
   std::map<std::string, double> stage_seconds;
@@ -101,10 +112,19 @@ struct RecognitionResult {
 // few objects a pose: starts from FPFH + RANSAC (correspondences restricted to the model
 // surface the matched view saw) and from the nearest views rolled about the line of sight,
 // sifted by a short ICP, the best refined by point-to-plane ICP of the segment onto the whole
-// model and verified by fit and by model surface that should have been seen. The scan is in the sensor's frame (the
-// sensor at its origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
+// model and verified by fit and by model surface that should have been seen. A segment no
+// object explains is searched for the object explaining the largest part of it (FPFH + RANSAC
+// against each whole model), which is taken out, and the rest is recognised again; so is what a
+// recognised object leaves unexplained. The scan is in the sensor's frame (the sensor at its
+// origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
 // invalid scan (NaN) or options.
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
+                                   const RecognitionOptions& options = {});
+
+// The same, keeping the features of the database views it describes in `views` (made for `db`)
+// for the next scans: the answer is the same, only faster.
+class ViewFeatureCache;
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, ViewFeatureCache& views,
                                    const RecognitionOptions& options = {});
 
 }  // namespace uwscan::perception

@@ -12,8 +12,8 @@ namespace uwscan::perception {
 // The segmentation stage of RecognizeObjects: the planes objects rest on, then the segments
 // that may each be one object.
 
-// A segment: its points (increasing indices) and the diameter of its own cluster, before the
-// small clusters near it joined.
+// A segment: its points (increasing indices) and the diameter of its own cluster (or clusters,
+// when nearby segments joined), without the small fragments that joined it.
 struct Segment {
   std::vector<std::size_t> indices;
   double core_diameter_m = 0.0;
@@ -30,7 +30,11 @@ PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_ob
 // Euclidean clusters (cluster_tolerance_m) of at least min_segment_points, each with the smaller
 // clusters within attach_distance_m of it (to the nearest segment): the parts of one object that
 // occlusion separated, such as a valve's handle hiding its own stem from a sensor above it.
-// Largest first (equal sizes in cluster order).
-std::vector<Segment> Segments(const PointCloud& cloud, const RecognitionOptions& options);
+// Then segments within attach_distance_m of each other join, smallest first into its nearest,
+// while together they are no wider than `largest_object_m`: a handwheel cut off from its valve
+// by its own shadow is too big to attach as a fragment, yet alone it is no object of the
+// database. (Two objects joined by mistake are split again by recognition.) Largest first
+// (equal sizes in cluster order).
+std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m, const RecognitionOptions& options);
 
 }  // namespace uwscan::perception

@@ -1,0 +1,194 @@
+#include "perception/object_pose_search.hpp"
+
+#include <omp.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <numbers>
+
+#include "perception/coarse_alignment.hpp"
+#include "perception/normals.hpp"
+#include "perception/view_pose_hypotheses.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+// Half turns about the three principal axes of a cloud through its centroid.
+std::vector<Eigen::Isometry3d> HalfTurns(const PointCloud& cloud) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) centroid += cloud.Point(i);
+  centroid /= static_cast<double>(cloud.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d d = cloud.Point(i) - centroid;
+    scatter += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+  std::vector<Eigen::Isometry3d> turns;
+  for (int k = 0; k < 3; ++k) {
+    turns.push_back(Eigen::Translation3d(centroid) *
+                    Eigen::AngleAxisd(std::numbers::pi, eigen.eigenvectors().col(k)) *
+                    Eigen::Translation3d(-centroid));
+  }
+  return turns;
+}
+
+}  // namespace
+
+ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads) {
+  NormalOptions normals;
+  normals.radius_m = p.normal_radius_m;
+  normals.threads = threads;
+  ViewFeatures v;
+  v.cloud = AttachNormals(view.cloud, EstimateNormals(view.cloud, normals)).cloud;
+  std::vector<std::size_t> all(v.cloud.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  v.features = ComputeFpfh(v.cloud, all, FpfhOptions{p.feature_radius_m, threads});
+  return v;
+}
+
+const ViewFeatures& ViewFeatureCache::Get(std::size_t object, std::size_t view, int threads) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return GetLocked(object, view, threads);
+}
+
+const ViewFeatures& ViewFeatureCache::AllViews(std::size_t object, int threads) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_ptr<ViewFeatures>& slot = all_views_[object];
+  if (slot) return *slot;
+  slot = std::make_unique<ViewFeatures>();
+  const ObjectModel& model = db_.objects.at(object);
+  slot->cloud.origin = model.model.origin;
+  for (std::size_t v = 0; v < model.views.size(); ++v) {
+    const ViewFeatures& view = GetLocked(object, v, threads);
+    const PointCloud in_O = Transformed(view.cloud, model.views[v].T_O_C);
+    const std::size_t first = slot->cloud.size();
+    const Eigen::Vector3f shift = (in_O.origin - slot->cloud.origin).cast<float>();
+    for (std::size_t i = 0; i < in_O.size(); ++i) {
+      slot->cloud.points.push_back(in_O.points[i] + shift);
+      slot->cloud.normals.push_back(in_O.normals[i]);
+    }
+    for (std::size_t k = 0; k < view.features.indices.size(); ++k) {
+      slot->features.indices.push_back(first + view.features.indices[k]);
+      slot->features.descriptors.push_back(view.features.descriptors[k]);
+    }
+  }
+  return *slot;
+}
+
+const ViewFeatures& ViewFeatureCache::GetLocked(std::size_t object, std::size_t view, int threads) {
+  std::unique_ptr<ViewFeatures>& slot = described_[{object, view}];
+  if (!slot) {
+    slot = std::make_unique<ViewFeatures>(DescribeView(db_.objects.at(object).views.at(view), db_.parameters, threads));
+  }
+  return *slot;
+}
+
+// Point-to-plane ICP of a segment onto a model, to the scale of the data.
+IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int threads) {
+  IcpOptions icp;
+  icp.method = IcpMethod::kPointToPlane;
+  icp.max_correspondence_distance_m = {4.0 * p.voxel_m, 2.0 * p.voxel_m, 1.5 * p.voxel_m};
+  icp.translation_tolerance_m = 0.01 * p.voxel_m;
+  icp.rotation_tolerance_rad = icp.translation_tolerance_m / (0.5 * diameter_m);
+  icp.relative_rmse_tolerance = 1e-6;
+  icp.max_iterations = 300;
+  icp.max_iterations_per_stage = 100;
+  icp.threads = threads;
+  return icp;
+}
+
+// Starting poses T_O_S of a segment on one object: FPFH + RANSAC onto its nearest view (when
+// RANSAC finds one), then each of its nearest views rolled about the line of sight.
+std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhFeatures& segment_features,
+                                          std::size_t object, const std::vector<std::pair<double, int>>& views,
+                                          ViewFeatureCache& cache, const ObjectDatabase& db,
+                                          const RecognitionOptions& options) {
+  const ObjectModel& model = db.objects[object];
+  const ObjectDatabaseParameters& p = db.parameters;
+  std::vector<Eigen::Isometry3d> starts;
+  const std::size_t nearest_view = static_cast<std::size_t>(views.front().second);
+  const ObjectView& nearest = model.views[nearest_view];
+  const ViewFeatures& described = cache.Get(object, nearest_view, options.threads);
+  CoarseAlignmentOptions coarse;
+  coarse.inlier_distance_m = 2.0 * p.voxel_m;
+  coarse.max_iterations = 20000;
+  coarse.min_inlier_fraction = 0.02;
+  coarse.seed = options.seed;
+  coarse.threads = options.threads;
+  // The segment onto the view it resembles, which places it on the model.
+  const RegistrationResult rough =
+      AlignCoarse(segment, segment_features, described.cloud, described.features, coarse);
+  if (rough.converged) starts.push_back(nearest.T_O_C * rough.T_target_source);
+  for (int v = 0; v < std::min<int>(options.pose_views, std::ssize(views)); ++v) {
+    const ObjectView& view = model.views[static_cast<std::size_t>(views[static_cast<std::size_t>(v)].second)];
+    for (const Eigen::Isometry3d& T_O_S : ViewPoseHypotheses(segment, view, options.pose_rolls)) {
+      starts.push_back(T_O_S);
+    }
+  }
+  return starts;
+}
+
+std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTarget& target,
+                                          const std::vector<Eigen::Isometry3d>& starts, double diameter_m,
+                                          const ObjectDatabaseParameters& p,
+                                          const RecognitionOptions& options) {
+  std::vector<Eigen::Isometry3d> kept;
+  const std::size_t sift = static_cast<std::size_t>(options.sift_points);
+  const std::size_t stride = std::max<std::size_t>(1, (segment.size() + sift - 1) / sift);
+  std::vector<std::size_t> every;
+  for (std::size_t i = 0; i < segment.size(); i += stride) every.push_back(i);
+  if (every.size() < 3 || starts.empty()) return kept;
+  const PointCloud subset = Subset(segment, every);
+  IcpOptions icp;
+  icp.method = IcpMethod::kPointToPlane;
+  // From a tenth of the object's size (a roll step off at its rim) down to the fine ICP's start.
+  icp.max_correspondence_distance_m = {std::max(0.1 * diameter_m, 8.0 * p.voxel_m), 4.0 * p.voxel_m,
+                                       2.0 * p.voxel_m};
+  icp.max_iterations_per_stage = 8;
+  icp.max_iterations = 20;
+  icp.translation_tolerance_m = 0.1 * p.voxel_m;
+  icp.rotation_tolerance_rad = icp.translation_tolerance_m / (0.5 * diameter_m);
+  icp.relative_rmse_tolerance = 1e-3;
+  icp.threads = 1;
+  auto quick_icp = [&](const std::vector<Eigen::Isometry3d>& from, std::vector<double>& fitness,
+                       std::vector<Eigen::Isometry3d>& moved) {
+    const std::size_t first = moved.size();
+    fitness.resize(first + from.size(), 0.0);
+    moved.resize(first + from.size());
+    const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (std::ptrdiff_t s = 0; s < std::ssize(from); ++s) {
+      const RegistrationResult quick = AlignIcp(subset, target, from[static_cast<std::size_t>(s)], icp);
+      fitness[first + static_cast<std::size_t>(s)] = quick.fitness;
+      moved[first + static_cast<std::size_t>(s)] = quick.T_target_source;
+    }
+  };
+  std::vector<double> fitness;
+  std::vector<Eigen::Isometry3d> moved;
+  quick_icp(starts, fitness, moved);
+  // The best pose turned half a turn about each principal axis of the model: a nearly
+  // symmetric object (a valve's body) fits either way, and only a detail (its handle) decides.
+  const std::size_t best = static_cast<std::size_t>(
+      std::max_element(fitness.begin(), fitness.end()) - fitness.begin());
+  std::vector<Eigen::Isometry3d> flipped;
+  for (const Eigen::Isometry3d& half_turn : HalfTurns(target.cloud())) flipped.push_back(half_turn * moved[best]);
+  quick_icp(flipped, fitness, moved);
+  std::vector<std::size_t> order(moved.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return fitness[a] > fitness[b]; });
+  // Distinct poses only: starts that ended in the same basin are refined once.
+  const double same_m = p.voxel_m, same_rad = p.voxel_m / (0.5 * diameter_m);
+  for (std::size_t s : order) {
+    if (kept.size() == static_cast<std::size_t>(options.refined_starts)) break;
+    const bool repeat = std::any_of(kept.begin(), kept.end(), [&](const Eigen::Isometry3d& k) {
+      const Eigen::Isometry3d d = k.inverse() * moved[s];
+      return d.translation().norm() < same_m && Eigen::AngleAxisd(d.linear()).angle() < same_rad;
+    });
+    if (!repeat) kept.push_back(moved[s]);
+  }
+  return kept;
+}
+
+}  // namespace uwscan::perception

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <utility>
+#include <vector>
+
+#include "perception/fpfh.hpp"
+#include "perception/icp.hpp"
+#include "perception/object_database.hpp"
+#include "perception/object_recognizer.hpp"
+#include "perception/point_cloud.hpp"
+
+namespace uwscan::perception {
+
+// The pose search of RecognizeObjects: starting poses of a segment on an object model, sifted
+// by a short ICP, the best ones for the fine ICP.
+
+// A database view's points with normals (facing its camera at the origin) and FPFH at every one.
+struct ViewFeatures {
+  PointCloud cloud;
+  FpfhFeatures features;
+};
+ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads);
+
+// The features of a database's views, each computed the first time it is asked for and kept:
+// recognition comes back to the same views segment after segment and scan after scan. Safe to
+// use from several threads; what Get returns does not depend on which call computed it.
+class ViewFeatureCache {
+ public:
+  explicit ViewFeatureCache(const ObjectDatabase& db) : db_(db) {}
+  const ViewFeatures& Get(std::size_t object, std::size_t view, int threads);
+  // Every view of the object together, in the object frame: the surface scans see, each part
+  // with the features a scan gives it (unlike the whole model, whose thin walls and inner bores
+  // have neighbourhoods no scan sees).
+  const ViewFeatures& AllViews(std::size_t object, int threads);
+
+ private:
+  const ViewFeatures& GetLocked(std::size_t object, std::size_t view, int threads);
+  const ObjectDatabase& db_;
+  std::mutex mutex_;
+  std::map<std::pair<std::size_t, std::size_t>, std::unique_ptr<ViewFeatures>> described_;
+  std::map<std::size_t, std::unique_ptr<ViewFeatures>> all_views_;
+};
+
+// Point-to-plane ICP of a segment onto a model, to the scale of the data.
+IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int threads);
+
+// Starting poses T_O_S of a segment on one object: FPFH + RANSAC onto its nearest view (when
+// RANSAC finds one), then each of its nearest `options.pose_views` views rolled about the line
+// of sight. `views`: (chi-square, view index) of the object's nearest views, nearest first.
+std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhFeatures& segment_features,
+                                          std::size_t object, const std::vector<std::pair<double, int>>& views,
+                                          ViewFeatureCache& cache, const ObjectDatabase& db,
+                                          const RecognitionOptions& options);
+
+// The starts worth a full ICP: each gets a short ICP on a strided subset of the segment, and
+// the `options.refined_starts` best distinct poses it reached by fit (then by order) are
+// returned, best first. The fit is taken at two voxels, where a start in the right basin
+// already has the segment on the model and a wrong one does not. The best pose is also tried
+// turned half a turn about each principal axis of the model: a nearly symmetric object (a
+// valve's body) fits either way, and only a detail (its handle) decides. Parallel over starts,
+// chosen in a fixed order: the same for any thread count.
+std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTarget& target,
+                                          const std::vector<Eigen::Isometry3d>& starts, double diameter_m,
+                                          const ObjectDatabaseParameters& p,
+                                          const RecognitionOptions& options);
+
+}  // namespace uwscan::perception
