@@ -10,6 +10,7 @@
 #include <deque>
 #include <limits>
 #include <optional>
+#include <tuple>
 
 #include "perception/cloud_neighbors.hpp"
 #include "perception/clustering.hpp"
@@ -380,6 +381,34 @@ void Accept(const PosedObject& posed, const ObjectModel& model, double other_chi
   for (const GraspFrame& g : model.grasps) object.grasps_S.emplace_back(g.name, best.T_S_O * g.T_O_G);
 }
 
+// indices[i] for the positions i listed in `positions` (increasing), and for the others.
+std::pair<std::vector<std::size_t>, std::vector<std::size_t>> Partition(const std::vector<std::size_t>& indices,
+                                                                        const std::vector<std::size_t>& positions) {
+  std::pair<std::vector<std::size_t>, std::vector<std::size_t>> split;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const bool listed = k < positions.size() && positions[k] == i;
+    (listed ? split.first : split.second).push_back(indices[i]);
+    k += listed ? 1 : 0;
+  }
+  return split;
+}
+
+// The smallest of `chi_square` other than object `o`'s (infinity when there is none).
+double NearestOther(std::size_t o, const std::vector<double>& chi_square) {
+  double other = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < chi_square.size(); ++i) {
+    if (i != o) other = std::min(other, chi_square[i]);
+  }
+  return other;
+}
+
+Eigen::Vector3d Centroid(const PointCloud& cloud) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) sum += cloud.Point(i);
+  return sum / static_cast<double>(std::max<std::size_t>(cloud.size(), 1));
+}
+
 // A segment waiting to be recognised: indices into the scan's points left after plane removal.
 struct PendingSegment {
   std::vector<std::size_t> indices;
@@ -475,8 +504,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
     object.object_id = "unknown";
     std::vector<std::size_t> kept = next.indices;
     const PointCloud segment = Subset(removed.remaining, next.indices);
-    for (std::size_t i = 0; i < segment.size(); ++i) object.centroid_S += segment.Point(i);
-    object.centroid_S /= static_cast<double>(segment.size());
+    object.centroid_S = Centroid(segment);
     const SceneAround around = SceneAroundSegment(down, down_index, segment, 2.0 * p.voxel_m);
     const DescribedSegment described = DescribeSegment(segment, ctx);
     const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed);
@@ -489,61 +517,45 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
                        [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
       BreakTie(options.score_tie, posed);
       for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
-      auto nearest_other = [&](std::size_t o, const std::vector<double>& chi_square) {
-        double other = std::numeric_limits<double>::infinity();
-        for (std::size_t i = 0; i < chi_square.size(); ++i) {
-          if (i != o) other = std::min(other, chi_square[i]);
-        }
-        return other;
-      };
       const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
       if (!posed.empty() && posed.front().candidate.verified) {
         const PosedObject& best = posed.front();
         const ObjectModel& model = db.objects[best.object];
-        Accept(best, model, nearest_other(best.object, nearest_chi_square), ctx, object);
+        Accept(best, model, NearestOther(best.object, nearest_chi_square), ctx, object);
         if (split_allowed) {
           // What the object leaves unexplained may be another one touching it.
           const KnnIndex model_index(model.model.points);
-          const std::vector<std::size_t> on = PointsOnModel(described.cloud, model, model_index,
-                                                            best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m);
-          std::vector<std::size_t> rest;
-          std::size_t k = 0;
-          for (std::size_t i = 0; i < next.indices.size(); ++i) {
-            if (k < on.size() && on[k] == i) ++k; else rest.push_back(next.indices[i]);
-          }
+          const std::vector<std::size_t> rest =
+              Partition(next.indices, PointsOnModel(described.cloud, model, model_index,
+                                                    best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m)).second;
           const std::size_t queued = pending.size();
           QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);
+          std::vector<std::size_t> taken;
           for (std::size_t q = queued; q < pending.size(); ++q) {
-            for (std::size_t i : pending[q].indices) std::erase(kept, i);
+            taken.insert(taken.end(), pending[q].indices.begin(), pending[q].indices.end());
           }
+          std::sort(taken.begin(), taken.end());
+          std::erase_if(kept, [&](std::size_t i) { return std::binary_search(taken.begin(), taken.end(), i); });
         }
       } else if (split_allowed && segment.size() >= 2 * static_cast<std::size_t>(options.min_segment_points)) {
         if (std::optional<ExplainedPart> part = ExplainPart(described, ctx)) {
-          const ObjectModel& model = db.objects[part->posed.object];
           const PointCloud part_cloud = Subset(segment, part->points);
+          // The part's own ESF for its chi-square and margin.
           const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed);
           std::vector<double> part_chi_square;
           if (part_esf.ok) {
-            for (const auto& views_of : NearestViews(part_esf.histogram, db, 1)) part_chi_square.push_back(views_of.front().first);
+            for (const auto& nearest : NearestViews(part_esf.histogram, db, 1)) {
+              part_chi_square.push_back(nearest.front().first);
+              if (part_chi_square.size() == part->posed.object + 1) part->posed.candidate.view = nearest.front().second;
+            }
             part->posed.candidate.chi_square = part_chi_square[part->posed.object];
-            part->posed.candidate.view = NearestViews(part_esf.histogram, db, 1)[part->posed.object].front().second;
           }
           object.candidates.insert(object.candidates.begin(), part->posed.candidate);
-          Accept(part->posed, model, part_esf.ok ? nearest_other(part->posed.object, part_chi_square) : 0.0, ctx, object);
-          kept.clear();
+          Accept(part->posed, db.objects[part->posed.object],
+                 part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);
+          object.centroid_S = Centroid(part_cloud);
           std::vector<std::size_t> rest;
-          std::size_t k = 0;
-          for (std::size_t i = 0; i < next.indices.size(); ++i) {
-            if (k < part->points.size() && part->points[k] == i) {
-              kept.push_back(next.indices[i]);
-              ++k;
-            } else {
-              rest.push_back(next.indices[i]);
-            }
-          }
-          object.centroid_S = Eigen::Vector3d::Zero();
-          for (std::size_t i = 0; i < part_cloud.size(); ++i) object.centroid_S += part_cloud.Point(i);
-          object.centroid_S /= static_cast<double>(part_cloud.size());
+          std::tie(kept, rest) = Partition(next.indices, part->points);
           QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);
         }
       }
