@@ -49,34 +49,6 @@ ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters
 
 const ViewFeatures& ViewFeatureCache::Get(std::size_t object, std::size_t view, int threads) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  return GetLocked(object, view, threads);
-}
-
-const ViewFeatures& ViewFeatureCache::AllViews(std::size_t object, int threads) {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  std::unique_ptr<ViewFeatures>& slot = all_views_[object];
-  if (slot) return *slot;
-  slot = std::make_unique<ViewFeatures>();
-  const ObjectModel& model = db_.objects.at(object);
-  slot->cloud.origin = model.model.origin;
-  for (std::size_t v = 0; v < model.views.size(); ++v) {
-    const ViewFeatures& view = GetLocked(object, v, threads);
-    const PointCloud in_O = Transformed(view.cloud, model.views[v].T_O_C);
-    const std::size_t first = slot->cloud.size();
-    const Eigen::Vector3f shift = (in_O.origin - slot->cloud.origin).cast<float>();
-    for (std::size_t i = 0; i < in_O.size(); ++i) {
-      slot->cloud.points.push_back(in_O.points[i] + shift);
-      slot->cloud.normals.push_back(in_O.normals[i]);
-    }
-    for (std::size_t k = 0; k < view.features.indices.size(); ++k) {
-      slot->features.indices.push_back(first + view.features.indices[k]);
-      slot->features.descriptors.push_back(view.features.descriptors[k]);
-    }
-  }
-  return *slot;
-}
-
-const ViewFeatures& ViewFeatureCache::GetLocked(std::size_t object, std::size_t view, int threads) {
   std::unique_ptr<ViewFeatures>& slot = described_[{object, view}];
   if (!slot) {
     slot = std::make_unique<ViewFeatures>(DescribeView(db_.objects.at(object).views.at(view), db_.parameters, threads));

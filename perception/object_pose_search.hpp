@@ -33,17 +33,11 @@ class ViewFeatureCache {
  public:
   explicit ViewFeatureCache(const ObjectDatabase& db) : db_(db) {}
   const ViewFeatures& Get(std::size_t object, std::size_t view, int threads);
-  // Every view of the object together, in the object frame: the surface scans see, each part
-  // with the features a scan gives it (unlike the whole model, whose thin walls and inner bores
-  // have neighbourhoods no scan sees).
-  const ViewFeatures& AllViews(std::size_t object, int threads);
 
  private:
-  const ViewFeatures& GetLocked(std::size_t object, std::size_t view, int threads);
   const ObjectDatabase& db_;
   std::mutex mutex_;
   std::map<std::pair<std::size_t, std::size_t>, std::unique_ptr<ViewFeatures>> described_;
-  std::map<std::size_t, std::unique_ptr<ViewFeatures>> all_views_;
 };
 
 // Point-to-plane ICP of a segment onto a model, to the scale of the data.

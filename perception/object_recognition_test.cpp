@@ -142,7 +142,7 @@ TEST(ObjectRecognition, TwoTouchingObjectsAreBothRecognised) {
   const scanner::TriangleMesh pipe = CatalogueObject("pipe").mesh, valve = CatalogueObject("valve_wheel").mesh;
   std::vector<sim::SceneObject> scene = OnSeabed(pipe);
   sim::SceneObject second = OnSeabed(valve)[1];
-  // In line with the pipe, the valve's stub (120 mm from its centre) against the pipe's end.
+  // In line with the pipe, the valve's pipe end (120 mm from its centre) against the pipe's end.
   second.T_W_O.translation().y() += 0.36;
   scene.push_back(second);
   const Eigen::Vector3d middle = 0.5 * (scene[1].T_W_O.translation() + scene[2].T_W_O.translation());
