@@ -77,6 +77,7 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
     const Eigen::Vector3d& t = l.T_from_to.translation();
     loops.push_back({{"from_submap", l.from}, {"to_submap", l.to}, {"accepted", l.accepted},
                      {"reason", l.reason}, {"fitness", l.fitness}, {"chi2", l.chi2},
+                     {"constrained_directions", l.constrained_directions},
                      {"T_from_to", {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}}});
   }
   report["loops"] = loops;

@@ -43,6 +43,9 @@ void Print(const bench::DiveFigures& f) {
   row("dead reckoning", f.dead_reckoning);
   row("uwscan SLAM", f.slam);
   if (f.open3d) row("Open3D multiway", *f.open3d);
+  const bench::SurfaceDistance& floor = f.true_poses_map;
+  std::printf("| true poses (the sensor's floor) | | | %.2f mm | %.2f mm | %.2f mm | |\n", floor.mean_m * 1e3,
+              floor.rms_m * 1e3, floor.p95_m * 1e3);
   std::printf("SLAM/DR: ATE %.3f, map rms %.3f; loops accepted %d (false %d), rejected %d; NEES %.2f (6 = consistent); "
               "%.1fx real time\n",
               f.slam.ate_m / f.dead_reckoning.ate_m, f.slam.map.rms_m / f.dead_reckoning.map.rms_m, f.loops_accepted,
@@ -79,7 +82,8 @@ void RunSlamBench(const SlamBenchArgs& a) {
                            {"submaps", f.submaps},
                            {"threads", a.threads},
                            {"dr", TrajectoryJson(f.dead_reckoning)},
-                           {"slam", slam}};
+                           {"slam", slam},
+                           {"true_poses_map", MapJson(f.true_poses_map)}};
     dive["open3d"] = f.open3d ? TrajectoryJson(*f.open3d) : nlohmann::json(nullptr);
     json["dives"].push_back(dive);
   }

@@ -10,6 +10,8 @@
 #include <open3d/utility/Logging.h>
 
 #include <chrono>
+#include <optional>
+#include <utility>
 #endif
 
 #include "scanner/common/error.hpp"
@@ -48,6 +50,34 @@ Eigen::Matrix4d Icp(const open3d::geometry::PointCloud& source, const open3d::ge
   return T;
 }
 
+// The pairs Open3D registers: each submap with the previous kLocalPairs (consecutive ones are the
+// tutorial's certain odometry edges), and with the older submap nearest to it by the navigation
+// among those at least kLoopGap back whose clouds overlap: the pairs uwscan's mapper tries with
+// its default options (local map of 3, one loop candidate per submap, 6 back). Every
+// overlapping pair, as the tutorial registers, is tens of thousands of ICPs on a dive of
+// one-sweep submaps.
+constexpr std::size_t kLocalPairs = 3;
+constexpr std::size_t kLoopGap = 6;
+// uwscan's mapper registers a 15 mm source onto a 5 mm target; Open3D gets the same reach.
+constexpr double kSourceVoxel_m = 0.015;
+
+std::vector<std::pair<std::size_t, std::size_t>> Pairs(const std::vector<Eigen::Vector3d>& centres,
+                                                       const std::vector<double>& radii) {
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t j = 1; j < centres.size(); ++j) {
+    for (std::size_t i = j > kLocalPairs ? j - kLocalPairs : 0; i < j; ++i) pairs.emplace_back(i, j);
+    std::optional<std::size_t> nearest;
+    double nearest_m = 0.0;
+    for (std::size_t i = 0; i + kLoopGap <= j; ++i) {
+      const double d = (centres[i] - centres[j]).norm();
+      if (d > 0.6 * (radii[i] + radii[j])) continue;
+      if (!nearest || d < nearest_m) nearest = i, nearest_m = d;
+    }
+    if (nearest) pairs.emplace_back(*nearest, j);
+  }
+  return pairs;
+}
+
 }  // namespace
 
 bool Open3dMultiwayAvailable() { return true; }
@@ -57,30 +87,29 @@ std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& m, in
   open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
   const auto start = std::chrono::steady_clock::now();
   const std::size_t n = m.submap_clouds.size();
-  std::vector<open3d::geometry::PointCloud> clouds;
-  for (const perception::PointCloud& c : m.submap_clouds) clouds.push_back(ToOpen3d(c));
+  std::vector<open3d::geometry::PointCloud> targets, sources;
+  for (const perception::PointCloud& c : m.submap_clouds) {
+    targets.push_back(ToOpen3d(c));
+    sources.push_back(*targets.back().VoxelDownSample(kSourceVoxel_m));
+  }
   std::vector<Eigen::Vector3d> centres(n);
   std::vector<double> radii(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d c = clouds[i].GetCenter();
+    const Eigen::Vector3d c = targets[i].GetCenter();
     centres[i] = m.dead_reckoning[i].T_W_V * c;
     double r = 0.0;
-    for (const Eigen::Vector3d& p : clouds[i].points_) r = std::max(r, (p - c).norm());
+    for (const Eigen::Vector3d& p : targets[i].points_) r = std::max(r, (p - c).norm());
     radii[i] = r;
   }
   reg::PoseGraph graph;
   for (std::size_t i = 0; i < n; ++i) graph.nodes_.emplace_back(m.dead_reckoning[i].T_W_V.matrix());
   // Edges as in Open3D's multiway tutorial: transformation maps the source (i) into the target
   // (j); consecutive pairs are odometry (certain), the others loop candidates (uncertain).
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i + 1; j < n; ++j) {
-      const bool consecutive = j == i + 1;
-      if (!consecutive && (centres[i] - centres[j]).norm() > 0.6 * (radii[i] + radii[j])) continue;
-      const Eigen::Matrix4d T_init = (m.dead_reckoning[j].T_W_V.inverse() * m.dead_reckoning[i].T_W_V).matrix();
-      Eigen::Matrix6d information;
-      const Eigen::Matrix4d T = Icp(clouds[i], clouds[j], T_init, &information);
-      graph.edges_.emplace_back(static_cast<int>(i), static_cast<int>(j), T, information, !consecutive);
-    }
+  for (const auto& [i, j] : Pairs(centres, radii)) {
+    const Eigen::Matrix4d T_init = (m.dead_reckoning[j].T_W_V.inverse() * m.dead_reckoning[i].T_W_V).matrix();
+    Eigen::Matrix6d information;
+    const Eigen::Matrix4d T = Icp(sources[i], targets[j], T_init, &information);
+    graph.edges_.emplace_back(static_cast<int>(i), static_cast<int>(j), T, information, j != i + 1);
   }
   reg::GlobalOptimizationOption option(kFine_m, 0.25, 1.0, 0);
   reg::GlobalOptimization(graph, reg::GlobalOptimizationLevenbergMarquardt(),

@@ -11,7 +11,9 @@
 #include "bench/scratch_folder.hpp"
 #include "mapping/dive_simulation.hpp"
 #include "mapping/map_report.hpp"
+#include "mapping/reconstruction.hpp"
 #include "mapping/submap.hpp"
+#include "perception/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
@@ -52,6 +54,34 @@ SurfaceDistance DistanceToScene(const perception::PointCloud& map, const scanner
   std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(k), distances.end());
   out.p95_m = distances[k];
   return out;
+}
+
+// The dive's frames triangulated as the mapper does and placed with the true camera pose of each:
+// the map no trajectory estimate can beat, voxelised as the maps it is compared with. What
+// separates it from the true surfaces is the sensor's own error (peak noise, refraction at
+// grazing angles, voxel centroids across edges).
+perception::PointCloud TruePoseMap(const mapping::DiveLogReader& log, const std::filesystem::path& table_cache,
+                                   double voxel_m) {
+  mapping::ReconstructionOptions options;
+  options.use_navigation = false;
+  options.table_cache = table_cache;
+  const mapping::Reconstruction r = mapping::Reconstruct(log, options);
+  std::vector<Eigen::Vector3d> points_W;
+  points_W.reserve(r.points.size());
+  std::int64_t frame = -1;
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    if (r.frame_of_point[i] != frame) {
+      frame = r.frame_of_point[i];
+      const std::optional<mapping::GroundTruthRecord> truth = log.ReadGroundTruth(frame);
+      if (!truth) throw Error(log.path().string() + ": frame " + std::to_string(frame) + " has no ground truth");
+      T_W_C = truth->T_W_C;
+    }
+    points_W.push_back(T_W_C * r.points[i]);
+  }
+  perception::VoxelFilterOptions voxel;
+  voxel.leaf_m = voxel_m;
+  return perception::VoxelDownsample(perception::MakeCloud(points_W), voxel);
 }
 
 }  // namespace
@@ -107,6 +137,8 @@ std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Pro
     f.slam.rpe_per_m = s.rpe_slam_per_m;
     f.slam.map = DistanceToScene(m.map, caster, options.threads);
     f.slam.seconds = m.seconds;
+    f.true_poses_map = DistanceToScene(TruePoseMap(log, options.table_cache, map_options.map_voxel_m), caster,
+                                       options.threads);
     if (options.run_open3d && Open3dMultiwayAvailable()) {
       if (progress) progress("open3d " + f.name, 0.0);
       TrajectoryFigures o;

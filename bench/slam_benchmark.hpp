@@ -41,6 +41,8 @@ struct DiveFigures {
   int submaps = 0;
   TrajectoryFigures dead_reckoning, slam;
   std::optional<TrajectoryFigures> open3d;
+  // The same frames placed with the true poses: the map's floor, the sensor's own error.
+  SurfaceDistance true_poses_map;
   int loops_accepted = 0, loops_rejected = 0, loops_false = 0;
   std::optional<double> nees_mean;
   double real_time_factor = 0.0;
@@ -49,10 +51,10 @@ struct DiveFigures {
 
 std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Progress& progress = {});
 
-// Open3D's multiway registration (pairwise point-to-plane ICP between consecutive submaps and
-// between submaps whose navigated positions overlap, then GlobalOptimization with its line
-// process) on the submaps of `mapping`, started from the dead reckoning: the submap poses it
-// finds. Throws when Open3D is not built in.
+// Open3D's multiway registration (pairwise point-to-plane ICP of each submap with the three
+// before it and with the nearest older one its navigated position overlaps, the pairs uwscan's
+// mapper tries; then GlobalOptimization with its line process) on the submaps of `mapping`,
+// started from the dead reckoning: the submap poses it finds. Throws when Open3D is not built in.
 std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& mapping, int threads, double* seconds);
 bool Open3dMultiwayAvailable();
 

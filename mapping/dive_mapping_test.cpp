@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <string>
 
 #include "mapping/dive_log_test_support.hpp"
@@ -101,6 +103,57 @@ TEST_F(DiveMappingTest, AlongASinglePipeTheMapFollowsTheNavigation) {
     EXPECT_LT(slam_x, dr_x + 0.01) << "submap " << i;
   }
   EXPECT_LE(AbsoluteTrajectoryError(m.slam, m.truth), AbsoluteTrajectoryError(m.dead_reckoning, m.truth) + 0.005);
+}
+
+TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {
+  // The pipe dive whole: coming back over the pipe closes loops that see the pipe without its
+  // ends. They are kept in the five directions they pin and bring the sideways drift of the
+  // dead reckoning back onto the pipe; along it they claim nothing.
+  const scanner::sim::Scene scene =
+      scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_pipe.yaml");
+  const DiveMapping m = Map(Simulate(scene, "pipe_loop.db"));
+  ASSERT_EQ(m.truth.size(), m.slam.size());
+  int accepted = 0;
+  for (const LoopClosure& loop : m.loops) {
+    if (!loop.accepted) continue;
+    ++accepted;
+    EXPECT_EQ(loop.constrained_directions, 5) << loop.from << " -> " << loop.to;
+    // Along the pipe (x of the earlier submap, which flew along it) nothing is measured.
+    Vector6d slide = Vector6d::Zero();
+    slide(3) = 1.0;
+    EXPECT_LT(slide.dot(loop.information * slide), 1e-9 * loop.information.norm());
+  }
+  EXPECT_GT(accepted, 10);
+  EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 0);
+  double slam_sideways = 0.0, dr_sideways = 0.0;
+  for (std::size_t i = 0; i < m.slam.size(); ++i) {
+    const double y = m.truth[i].T_W_V.translation().y();
+    slam_sideways = std::max(slam_sideways, std::abs(m.slam[i].T_W_V.translation().y() - y));
+    dr_sideways = std::max(dr_sideways, std::abs(m.dead_reckoning[i].T_W_V.translation().y() - y));
+  }
+  EXPECT_LT(slam_sideways, 0.5 * dr_sideways);
+}
+
+TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
+  DiveMapping m;
+  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
+  far.translation().x() = 1.0;
+  m.truth = {{0.0, Eigen::Isometry3d::Identity()}, {1.0, far}};
+  m.slam = m.dead_reckoning = m.truth;
+  LoopClosure slid;  // off by 20 cm along the pipe it cannot see along
+  slid.from = 0;
+  slid.to = 1;
+  slid.accepted = true;
+  slid.T_from_to = far;
+  slid.T_from_to.translation().x() += 0.2;
+  slid.information.diagonal() << 1e6, 1e6, 1e6, 0.0, 1e6, 1e6;
+  m.loops = {slid};
+  EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 0);
+  LoopClosure sideways = slid;  // off by 20 cm across it: a wrong association
+  sideways.T_from_to = far;
+  sideways.T_from_to.translation().y() += 0.2;
+  m.loops = {slid, sideways};
+  EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 1);
 }
 
 TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {

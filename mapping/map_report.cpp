@@ -1,9 +1,27 @@
 #include "mapping/map_report.hpp"
 
 #include <algorithm>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 namespace uwscan::mapping {
+
+namespace {
+
+// The part of a loop's error [w, v] along what it measures: along a pipe a loop pins all but
+// the slide, where its pose is only the prediction and may be off by the drift.
+Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& error, const Matrix6d& information) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (information + information.transpose()));
+  const double largest = eigen.eigenvalues()(5);
+  Eigen::Matrix<double, 6, 1> measured = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int k = 0; k < 6; ++k) {
+    if (!(eigen.eigenvalues()(k) > 1e-9 * largest)) continue;
+    measured += eigen.eigenvectors().col(k).dot(error) * eigen.eigenvectors().col(k);
+  }
+  return measured;
+}
+
+}  // namespace
 
 MapSummary Summarise(const DiveMapping& m) {
   MapSummary s;
@@ -20,9 +38,8 @@ MapSummary Summarise(const DiveMapping& m) {
     if (!loop.accepted) continue;
     const Eigen::Isometry3d truth = m.truth[static_cast<size_t>(loop.from)].T_W_V.inverse() *
                                     m.truth[static_cast<size_t>(loop.to)].T_W_V;
-    const Eigen::Isometry3d error = truth.inverse() * loop.T_from_to;
-    if (error.translation().norm() > kFalseLoopTranslation_m ||
-        Eigen::AngleAxisd(error.linear()).angle() > kFalseLoopRotation_rad) {
+    const Eigen::Matrix<double, 6, 1> error = MeasuredPart(PoseError(loop.T_from_to, truth), loop.information);
+    if (error.tail<3>().norm() > kFalseLoopTranslation_m || error.head<3>().norm() > kFalseLoopRotation_rad) {
       ++false_loops;
     }
   }

@@ -6,8 +6,8 @@
 
 namespace uwscan::mapping {
 
-// A loop closure counts as false when its registered motion is further than this from the
-// true one: a wrong association, not an imprecise right one.
+// A loop closure counts as false when its registered motion, in the directions it measures, is
+// further than this from the true one: a wrong association, not an imprecise right one.
 inline constexpr double kFalseLoopTranslation_m = 0.05;
 inline constexpr double kFalseLoopRotation_rad = 0.035;  // 2 degrees
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -89,21 +90,72 @@ double Conditioning(const Matrix6d& information, const perception::PointCloud& s
   return values(5) > 0.0 ? std::max(0.0, values(0)) / values(5) : 0.0;
 }
 
+// A weak direction whose eigenvector lies at least this much in translation (normalised) is a
+// slide.
+constexpr double kSlideShare = 0.9;
+
 // The information with its weakly constrained directions (normalised eigenvalue below `ratio`
 // of the largest) removed: along a pipe or over a flat seabed the pairs still sum to something,
 // but ICP's answer there is the noise's, not the scene's; the navigation decides those.
+// `kept`, when given, receives how many directions are left and `covariance` the covariance of
+// what the kept directions measure (zero along the removed ones).
 Matrix6d WithoutWeakDirections(const Matrix6d& information, const perception::PointCloud& source,
-                               const Eigen::Isometry3d& T_target_source, double ratio) {
+                               const Eigen::Isometry3d& T_target_source, double ratio, int* kept_count = nullptr,
+                               Matrix6d* covariance = nullptr) {
   const Matrix6d N = Normaliser(source, T_target_source);
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(N.transpose() * information * N);
   Vector6d values = eigen.eigenvalues();
+  Vector6d inverse_values = Vector6d::Zero();
   for (int k = 0; k < 6; ++k) {
-    if (!(values(k) >= ratio * values(5))) values(k) = 0.0;
+    if (!(values(k) > 0.0 && values(k) >= ratio * values(5))) values(k) = 0.0;
+    if (values(k) > 0.0) inverse_values(k) = 1.0 / values(k);
+  }
+  if (kept_count) *kept_count = static_cast<int>((values.array() > 0.0).count());
+  if (covariance) {
+    const Matrix6d c = N * eigen.eigenvectors() * inverse_values.asDiagonal() * eigen.eigenvectors().transpose() *
+                       N.transpose();
+    *covariance = 0.5 * (c + c.transpose());
   }
   const Matrix6d N_inverse = N.inverse();
-  const Matrix6d kept = N_inverse.transpose() * eigen.eigenvectors() * values.asDiagonal() *
-                        eigen.eigenvectors().transpose() * N_inverse;
+  Matrix6d kept = N_inverse.transpose() * eigen.eigenvectors() * values.asDiagonal() *
+                  eigen.eigenvectors().transpose() * N_inverse;
+  // A slide along a pipe is a pure translation, but noise tilts its eigenvector by a few
+  // milliradians per metre: what is left then measures a sliver of the slide, from the start
+  // ICP was given. Sliding directions are taken out exactly.
+  Matrix6d P = Matrix6d::Identity();
+  for (int k = 0; k < 6; ++k) {
+    if (values(k) > 0.0 || eigen.eigenvectors().col(k).tail<3>().norm() < kSlideShare) continue;
+    Vector6d slide = Vector6d::Zero();
+    slide.tail<3>() = (N * eigen.eigenvectors().col(k)).tail<3>();
+    slide = P * slide;  // orthogonal to the slides already taken out (a bare seabed has two)
+    if (slide.norm() < 1e-6) continue;
+    slide.normalize();
+    P -= slide * slide.transpose();
+  }
+  kept = P * kept * P;
   return 0.5 * (kept + kept.transpose());
+}
+
+// Where a registration leaves a slide free (a pipe seen without its ends), the scan's position
+// along it is not measured at all: it is tied to its anchor there only with sigma_m, so that
+// what the pairs leak along the slide moves the scan and not the vehicle (through the anchor,
+// the dead reckoning's scale error would take it up). In the source's frame.
+Matrix6d SlideCovariance(const Matrix6d& information, const Eigen::Isometry3d& T_target_source, double sigma_m) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(information);
+  Matrix6d covariance = Matrix6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const Vector6d direction = eigen.eigenvectors().col(k);
+    if (eigen.eigenvalues()(k) > 1e-9 * eigen.eigenvalues()(5) || direction.tail<3>().norm() < kSlideShare) continue;
+    const Eigen::Vector3d slide = T_target_source.linear().transpose() * direction.tail<3>().normalized();
+    covariance.bottomRightCorner<3, 3>() += sigma_m * sigma_m * slide * slide.transpose();
+  }
+  return covariance;
+}
+
+// The 99.9 % quantile of the chi-square distribution with `dof` degrees of freedom (1 to 6).
+double Chi2Quantile999(int dof) {
+  static constexpr std::array<double, 6> kQuantiles = {10.828, 13.816, 16.266, 18.467, 20.515, 22.458};
+  return kQuantiles.at(static_cast<std::size_t>(std::clamp(dof, 1, 6) - 1));
 }
 
 }  // namespace
@@ -118,17 +170,17 @@ void MapperOptions::Check() const {
   if (!(point_sigma_floor_m > 0.0)) fail("point_sigma_floor_m", "> 0 m");
   if (!(min_fitness >= 0.0 && min_fitness <= 1.0)) fail("min_fitness", "in [0, 1]");
   if (!(loop_min_fitness >= 0.0 && loop_min_fitness <= 1.0)) fail("loop_min_fitness", "in [0, 1]");
-  if (!(loop_min_conditioning >= 0.0 && loop_min_conditioning < 1.0)) fail("loop_min_conditioning", "in [0, 1)");
+  if (loop_min_directions < 1 || loop_min_directions > 6) fail("loop_min_directions", "in [1, 6]");
   if (loop_min_index_gap <= local_map_submaps) fail("loop_min_index_gap", "> local_map_submaps");
   if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
   if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
   if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0)) fail("loop_overlap_ratio", "in (0, 1]");
   if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
   if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
-  if (!(loop_chi2_gate > 0.0)) fail("loop_chi2_gate", "> 0");
   if (!(registration_chi2_gate > 0.0)) fail("registration_chi2_gate", "> 0");
   if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
   if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
+  if (!(slide_sigma_m >= 0.0)) fail("slide_sigma_m", ">= 0 m");
   if (threads < 0) fail("threads", ">= 0");
   perception::IcpOptions icp;
   icp.max_correspondence_distance_m = icp_distances_m;
@@ -355,6 +407,7 @@ void Mapper::Impl::AddToGraph(Submap submap) {
   Eigen::Isometry3d scan_initial = submap.T_W_V_nav;
   Matrix6d increment_cov = Matrix6d::Zero();
   std::optional<RelativePoseEdge> registration;
+  Matrix6d slides = Matrix6d::Zero();
   if (k > 0) {
     const Submap& previous = submaps.back();
     const Eigen::Isometry3d T_nav =
@@ -381,6 +434,7 @@ void Mapper::Impl::AddToGraph(Submap submap) {
     const double chi2 = innovation.dot(InformationOfSum(information, increment_cov) * innovation);
     if (r.fitness >= options.min_fitness && chi2 <= options.registration_chi2_gate) {
       registration = RelativePoseEdge{ScanNode(k - 1), ScanNode(k), r.T_target_source, information, false, 3.0};
+      slides = SlideCovariance(information, r.T_target_source, options.slide_sigma_m);
       scan_initial = ScanPose(k - 1) * r.T_target_source;
       const Matrix6d combined = (increment_cov.inverse() + information).inverse();
       increment_cov = combined;
@@ -392,7 +446,7 @@ void Mapper::Impl::AddToGraph(Submap submap) {
   const int anchor = graph.AddNode(anchor_initial);
   const int scan = graph.AddNode(scan_initial);
   if (anchor != AnchorNode(k) || scan != ScanNode(k)) throw Error("mapper: graph nodes out of step with submaps");
-  const Matrix6d distortion_information = Distortion(submap, systematic()).inverse();
+  const Matrix6d distortion_information = (Distortion(submap, systematic()) + slides).inverse();
   graph.AddEdge({anchor, scan, Eigen::Isometry3d::Identity(),
                  0.5 * (distortion_information + distortion_information.transpose()), false, 3.0});
   if (k == 0) {
@@ -463,29 +517,33 @@ void Mapper::Impl::TryLoopClosures(int k) {
     loop.fitness = r.fitness;
     loop.T_from_to = r.T_target_source;
     const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
-    const Matrix6d points_information = r.information / (sigma * sigma);
-    const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(points_information);
-    const double conditioning = Conditioning(r.information, current.sparse, r.T_target_source);
-    loop.conditioning = conditioning;
+    int constrained = 0;
+    Matrix6d points_cov = Matrix6d::Zero();
+    WithoutWeakDirections(r.information / (sigma * sigma), current.sparse, r.T_target_source,
+                          options.weak_direction_ratio, &constrained, &points_cov);
+    loop.conditioning = Conditioning(r.information, current.sparse, r.T_target_source);
+    loop.constrained_directions = constrained;
     const Matrix6d information = RegistrationInformation(r, submaps[static_cast<size_t>(j)], current);
+    loop.information = information;
+    // Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
+    // others, as for consecutive submaps, are left to the navigation), and the registration
+    // must be certain and consistent with the prediction in them.
+    const double sigma_m = LargestStd(points_cov.bottomRightCorner<3, 3>());
+    const double sigma_rad = LargestStd(points_cov.topLeftCorner<3, 3>());
     if (r.fitness < options.loop_min_fitness) {
       loop.reason = "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
-    } else if (!(eigen.eigenvalues()(0) > 0.0) || conditioning < options.loop_min_conditioning) {
-      loop.reason = "degenerate: the scans barely constrain a direction (conditioning " +
-                    std::to_string(conditioning) + ")";
+    } else if (constrained < options.loop_min_directions) {
+      loop.reason = "degenerate: the scans pin " + std::to_string(constrained) + " directions, fewer than " +
+                    std::to_string(options.loop_min_directions);
+    } else if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
+      loop.reason = "uncertain: registration std " + std::to_string(sigma_m) + " m, " + std::to_string(sigma_rad) +
+                    " rad";
     } else {
-      // The geometry alone must pin every direction; the consistency test also allows for
-      // the submaps' bending.
-      const Matrix6d points_cov = points_information.inverse();
-      const double sigma_m = LargestStd(points_cov.bottomRightCorner<3, 3>());
-      const double sigma_rad = LargestStd(points_cov.topLeftCorner<3, 3>());
       const Vector6d innovation = PoseError(r.T_target_source, T_pred);
       loop.chi2 = innovation.dot(InformationOfSum(information, c.covariance) * innovation);
-      if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
-        loop.reason = "degenerate: registration std " + std::to_string(sigma_m) + " m, " +
-                      std::to_string(sigma_rad) + " rad";
-      } else if (!(loop.chi2 <= options.loop_chi2_gate)) {
-        loop.reason = "inconsistent with the prediction: chi2 " + std::to_string(loop.chi2);
+      if (!(loop.chi2 <= Chi2Quantile999(constrained))) {
+        loop.reason = "inconsistent with the prediction: chi2 " + std::to_string(loop.chi2) + " in " +
+                      std::to_string(constrained) + " directions";
       } else {
         loop.accepted = true;
         graph.AddEdge({ScanNode(j), ScanNode(k), r.T_target_source, information, true, 3.0});

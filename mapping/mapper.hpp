@@ -35,8 +35,8 @@ struct MapperOptions {
   double registration_chi2_gate = 22.46;
   // Loop closures: candidates at least this many submaps back, whose overlap is plausible
   // within gate_sigmas of the relative uncertainty; at most max_loop_candidates tried per
-  // submap. Accepted only if the registration's fitness, its own uncertainty (every direction
-  // constrained) and its consistency with the prediction (chi-square, 6 dof) all agree.
+  // submap. Accepted only if the registration's fitness, its own uncertainty in the directions
+  // it pins and its consistency with the prediction there (chi-square) all agree.
   int loop_min_index_gap = 6;
   int max_loop_candidates = 1;
   double gate_sigmas = 3.0;
@@ -44,12 +44,13 @@ struct MapperOptions {
   // the sum of their radii (1 = they just touch).
   double loop_overlap_ratio = 0.6;
   double loop_min_fitness = 0.5;
-  // A loop's pairs must pin every direction: smallest / largest eigenvalue of the information,
-  // rotations scaled by the data's radius (a long pipe on a flat seabed stays below it).
-  double loop_min_conditioning = 0.02;
-  double loop_max_sigma_m = 0.01;     // registration std along any direction
-  double loop_max_sigma_rad = 0.005;  // registration std about any axis
-  double loop_chi2_gate = 22.46;      // 6 dof, 99.9 %
+  // A loop keeps the directions its pairs pin (weak_direction_ratio), at least this many: along
+  // a pipe on a flat seabed it pins all but the slide along the pipe (5), over a bare seabed
+  // only depth, roll and pitch (3), which the vehicle's own sensors already hold.
+  int loop_min_directions = 5;
+  double loop_max_sigma_m = 0.01;     // registration std along any kept direction
+  double loop_max_sigma_rad = 0.005;  // registration std about any kept axis
+  // Consistency with the prediction: chi-square at 99.9 % for the number of kept directions.
   int solve_every_submaps = 2;        // whole-graph solve also without a loop closure, > 0
   // Estimate the DVL's speed scale error and misalignment in the graph (odometry edges then
   // carry only the random walks) and place new frames with the corrected navigation; false:
@@ -58,6 +59,10 @@ struct MapperOptions {
   // Registration directions whose normalised information is below this fraction of the
   // strongest are left to the navigation (Conditioning in mapper.cpp).
   double weak_direction_ratio = 0.02;
+  // A scan whose registration leaves a slide free (a pipe without its ends in view) is tied to
+  // its anchor along that slide only this loosely (metres): its place there is not measured,
+  // and what the pairs leak along it must not pull the vehicle (SlideCovariance, mapper.cpp).
+  double slide_sigma_m = 0.03;
   int threads = 0;                    // OpenMP threads of ICP and normals, 0 = default
   void Check() const;
 };
@@ -70,7 +75,11 @@ struct LoopClosure {
   double fitness = 0.0;
   double chi2 = 0.0;   // of the registration against the prediction
   double conditioning = 0.0;  // smallest / largest normalised eigenvalue of its information
+  int constrained_directions = 0;  // directions the registration pins (the rest are left free)
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
+  // What it measures ([w, v] in `from`'s frame, pose_graph.hpp): zero along the directions it
+  // leaves free (the slide along a pipe), where T_from_to is only the prediction.
+  Matrix6d information = Matrix6d::Zero();
 };
 
 struct MapperStats {
