@@ -52,8 +52,9 @@ Eigen::Matrix4d Icp(const open3d::geometry::PointCloud& source, const open3d::ge
 
 // The pairs Open3D registers: each submap with the previous kLocalPairs (consecutive ones are the
 // tutorial's certain odometry edges), and with the older submap nearest to it by the navigation
-// among those at least kLoopGap back whose clouds overlap: the pairs uwscan's mapper tries with
-// its default options (local map of 3, one loop candidate per submap, 6 back). Every
+// among those at least kLoopGap back whose clouds overlap: about the pairs uwscan's mapper tries
+// with its default options (a local map of 3 merged, one loop candidate per submap, 6 back,
+// chosen at its estimated poses within its uncertainty). Every
 // overlapping pair, as the tutorial registers, is tens of thousands of ICPs on a dive of
 // one-sweep submaps.
 constexpr std::size_t kLocalPairs = 3;

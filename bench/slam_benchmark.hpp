@@ -52,8 +52,8 @@ struct DiveFigures {
 std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Progress& progress = {});
 
 // Open3D's multiway registration (pairwise point-to-plane ICP of each submap with the three
-// before it and with the nearest older one its navigated position overlaps, the pairs uwscan's
-// mapper tries; then GlobalOptimization with its line process) on the submaps of `mapping`,
+// before it and with the nearest older one its navigated position overlaps, about the pairs
+// uwscan's mapper tries; then GlobalOptimization with its line process) on the submaps of `mapping`,
 // started from the dead reckoning: the submap poses it finds. Throws when Open3D is not built in.
 std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& mapping, int threads, double* seconds);
 bool Open3dMultiwayAvailable();

@@ -10,9 +10,12 @@ namespace {
 
 // The part of a loop's error [w, v] along what it measures: along a pipe a loop pins all but
 // the slide, where its pose is only the prediction and may be off by the drift.
+// Exact when the free direction is a pure translation (a slide, mapper.cpp); a loop without a
+// usable information is judged whole.
 Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& error, const Matrix6d& information) {
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (information + information.transpose()));
   const double largest = eigen.eigenvalues()(5);
+  if (!information.allFinite() || !(largest > 0.0)) return error;
   Eigen::Matrix<double, 6, 1> measured = Eigen::Matrix<double, 6, 1>::Zero();
   for (int k = 0; k < 6; ++k) {
     if (!(eigen.eigenvalues()(k) > 1e-9 * largest)) continue;

@@ -97,11 +97,12 @@ constexpr double kSlideShare = 0.9;
 // The information with its weakly constrained directions (normalised eigenvalue below `ratio`
 // of the largest) removed: along a pipe or over a flat seabed the pairs still sum to something,
 // but ICP's answer there is the noise's, not the scene's; the navigation decides those.
-// `kept`, when given, receives how many directions are left and `covariance` the covariance of
-// what the kept directions measure (zero along the removed ones).
+// `kept`, when given, receives how many directions are left, `covariance` the covariance of
+// what the kept directions measure (zero along the removed ones) and `slides` the slides taken
+// out (orthonormal, target frame).
 Matrix6d WithoutWeakDirections(const Matrix6d& information, const perception::PointCloud& source,
                                const Eigen::Isometry3d& T_target_source, double ratio, int* kept_count = nullptr,
-                               Matrix6d* covariance = nullptr) {
+                               Matrix6d* covariance = nullptr, std::vector<Eigen::Vector3d>* slides = nullptr) {
   const Matrix6d N = Normaliser(source, T_target_source);
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(N.transpose() * information * N);
   Vector6d values = eigen.eigenvalues();
@@ -125,12 +126,16 @@ Matrix6d WithoutWeakDirections(const Matrix6d& information, const perception::Po
   Matrix6d P = Matrix6d::Identity();
   for (int k = 0; k < 6; ++k) {
     if (values(k) > 0.0 || eigen.eigenvectors().col(k).tail<3>().norm() < kSlideShare) continue;
+    // The data's own translation (about its centroid): the same vector about any point, where
+    // the eigenvector's translation about the target origin would carry its small turn times
+    // the lever arm (about 20 mrad off the pipe here).
     Vector6d slide = Vector6d::Zero();
-    slide.tail<3>() = (N * eigen.eigenvectors().col(k)).tail<3>();
+    slide.tail<3>() = eigen.eigenvectors().col(k).tail<3>();
     slide = P * slide;  // orthogonal to the slides already taken out (a bare seabed has two)
     if (slide.norm() < 1e-6) continue;
     slide.normalize();
     P -= slide * slide.transpose();
+    if (slides) slides->push_back(slide.tail<3>());
   }
   kept = P * kept * P;
   return 0.5 * (kept + kept.transpose());
@@ -139,15 +144,14 @@ Matrix6d WithoutWeakDirections(const Matrix6d& information, const perception::Po
 // Where a registration leaves a slide free (a pipe seen without its ends), the scan's position
 // along it is not measured at all: it is tied to its anchor there only with sigma_m, so that
 // what the pairs leak along the slide moves the scan and not the vehicle (through the anchor,
-// the dead reckoning's scale error would take it up). In the source's frame.
-Matrix6d SlideCovariance(const Matrix6d& information, const Eigen::Isometry3d& T_target_source, double sigma_m) {
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(information);
+// the dead reckoning's scale error would take it up). `slides` in the target's frame, the
+// covariance in the source's.
+Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides, const Eigen::Isometry3d& T_target_source,
+                         double sigma_m) {
   Matrix6d covariance = Matrix6d::Zero();
-  for (int k = 0; k < 6; ++k) {
-    const Vector6d direction = eigen.eigenvectors().col(k);
-    if (eigen.eigenvalues()(k) > 1e-9 * eigen.eigenvalues()(5) || direction.tail<3>().norm() < kSlideShare) continue;
-    const Eigen::Vector3d slide = T_target_source.linear().transpose() * direction.tail<3>().normalized();
-    covariance.bottomRightCorner<3, 3>() += sigma_m * sigma_m * slide * slide.transpose();
+  for (const Eigen::Vector3d& slide : slides) {
+    const Eigen::Vector3d in_source = T_target_source.linear().transpose() * slide;
+    covariance.bottomRightCorner<3, 3>() += sigma_m * sigma_m * in_source * in_source.transpose();
   }
   return covariance;
 }
@@ -234,7 +238,7 @@ struct Mapper::Impl {
   // The registration's own information (its pairs), weak directions removed. It relates the
   // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
   Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
-                                   const Submap& source) const;
+                                   const Submap& source, std::vector<Eigen::Vector3d>* slides = nullptr) const;
   // How far a submap's effective pose may sit from its anchor's navigation pose.
   Matrix6d Distortion(const Submap& s, SystematicErrors systematic_errors) const;
   // The navigation's motion between two submaps' effective poses (in a's frame).
@@ -363,10 +367,10 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
 }
 
 Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
-                                               const Submap& source) const {
+                                               const Submap& source, std::vector<Eigen::Vector3d>* slides) const {
   const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
   const Matrix6d points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse, r.T_target_source,
-                                                options.weak_direction_ratio);
+                                                options.weak_direction_ratio, nullptr, nullptr, slides);
   // The pairs' residuals are not independent: what the navigation bent in each submap beyond a
   // rigid offset stays in every pair. Both submaps' bending floors the registration's covariance.
   const Matrix6d floor = uncertainty.BendingCovariance(target.end_s - target.start_s, target.rms_radius_m) +
@@ -429,12 +433,13 @@ void Mapper::Impl::AddToGraph(Submap submap) {
     const perception::RegistrationResult r =
         Register(submap, local, T_predicted, increment_cov, options.icp_distances_m);
     stats.registration_s += Since(start);
-    const Matrix6d information = RegistrationInformation(r, previous, submap);
+    std::vector<Eigen::Vector3d> slide_directions;
+    const Matrix6d information = RegistrationInformation(r, previous, submap, &slide_directions);
     const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
     const double chi2 = innovation.dot(InformationOfSum(information, increment_cov) * innovation);
     if (r.fitness >= options.min_fitness && chi2 <= options.registration_chi2_gate) {
       registration = RelativePoseEdge{ScanNode(k - 1), ScanNode(k), r.T_target_source, information, false, 3.0};
-      slides = SlideCovariance(information, r.T_target_source, options.slide_sigma_m);
+      slides = SlideCovariance(slide_directions, r.T_target_source, options.slide_sigma_m);
       scan_initial = ScanPose(k - 1) * r.T_target_source;
       const Matrix6d combined = (increment_cov.inverse() + information).inverse();
       increment_cov = combined;

@@ -50,7 +50,7 @@ struct MapperOptions {
   int loop_min_directions = 5;
   double loop_max_sigma_m = 0.01;     // registration std along any kept direction
   double loop_max_sigma_rad = 0.005;  // registration std about any kept axis
-  // Consistency with the prediction: chi-square at 99.9 % for the number of kept directions.
+                                      // (and chi-square at 99.9 % for the kept directions)
   int solve_every_submaps = 2;        // whole-graph solve also without a loop closure, > 0
   // Estimate the DVL's speed scale error and misalignment in the graph (odometry edges then
   // carry only the random walks) and place new frames with the corrected navigation; false:
