@@ -55,7 +55,7 @@ Eigen::Matrix4d Icp(const open3d::geometry::PointCloud& source, const open3d::ge
 // among those at least kLoopGap back whose clouds overlap: about the pairs uwscan's mapper tries
 // with its default options (a local map of 3 merged, one loop candidate per submap, 6 back,
 // chosen at its estimated poses within its uncertainty). Every
-// overlapping pair, as the tutorial registers, is tens of thousands of ICPs on a dive of
+// overlapping pair, as the tutorial registers, is thousands of ICPs on a dive of
 // one-sweep submaps.
 constexpr std::size_t kLocalPairs = 3;
 constexpr std::size_t kLoopGap = 6;

@@ -2,13 +2,13 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <deque>
 
 #include "mapping/navigation_buffer.hpp"
 #include "mapping/navigation_uncertainty.hpp"
+#include "mapping/registration_information.hpp"
 #include "perception/icp.hpp"
 #include "perception/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
@@ -56,110 +56,6 @@ Eigen::Matrix3d PositionCovariance(const Matrix6d& covariance, const Eigen::Vect
 
 double LargestStd(const Eigen::Matrix3d& covariance) {
   return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
-}
-
-// How evenly the pairs of a registration pin the six directions: the smallest over the largest
-// eigenvalue of its information, with the rotation taken about the source's centroid (in the
-// target frame) and scaled by the source's RMS radius, so that both are displacements of the
-// data. 0: a direction is free (a plane, a long pipe); 1: all six equally constrained.
-// The map taking [w, v] about the target origin to the normalised coordinates of Conditioning:
-// normalised = N^T information N.
-Matrix6d Normaliser(const perception::PointCloud& source, const Eigen::Isometry3d& T_target_source) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < source.size(); ++i) centroid += T_target_source * source.Point(i);
-  centroid /= static_cast<double>(source.size());
-  double radius2 = 0.0;
-  for (std::size_t i = 0; i < source.size(); ++i) {
-    radius2 += (T_target_source * source.Point(i) - centroid).squaredNorm();
-  }
-  const double radius = std::sqrt(radius2 / static_cast<double>(source.size()));
-  // [w, v_origin] = A [w, v_centroid]: a rotation about the centroid moves the origin by -w x c.
-  Matrix6d A = Matrix6d::Identity();
-  Eigen::Matrix3d skew;
-  skew << 0.0, -centroid.z(), centroid.y(), centroid.z(), 0.0, -centroid.x(), -centroid.y(), centroid.x(), 0.0;
-  A.bottomLeftCorner<3, 3>() = skew;
-  Matrix6d S = Matrix6d::Identity();
-  S.topLeftCorner<3, 3>() /= std::max(radius, 1e-3);
-  return A * S;
-}
-
-double Conditioning(const Matrix6d& information, const perception::PointCloud& source,
-                    const Eigen::Isometry3d& T_target_source) {
-  const Matrix6d N = Normaliser(source, T_target_source);
-  const Vector6d values = Eigen::SelfAdjointEigenSolver<Matrix6d>(N.transpose() * information * N).eigenvalues();
-  return values(5) > 0.0 ? std::max(0.0, values(0)) / values(5) : 0.0;
-}
-
-// A weak direction whose eigenvector lies at least this much in translation (normalised) is a
-// slide.
-constexpr double kSlideShare = 0.9;
-
-// The information with its weakly constrained directions (normalised eigenvalue below `ratio`
-// of the largest) removed: along a pipe or over a flat seabed the pairs still sum to something,
-// but ICP's answer there is the noise's, not the scene's; the navigation decides those.
-// `kept`, when given, receives how many directions are left, `covariance` the covariance of
-// what the kept directions measure (zero along the removed ones) and `slides` the slides taken
-// out (orthonormal, target frame).
-Matrix6d WithoutWeakDirections(const Matrix6d& information, const perception::PointCloud& source,
-                               const Eigen::Isometry3d& T_target_source, double ratio, int* kept_count = nullptr,
-                               Matrix6d* covariance = nullptr, std::vector<Eigen::Vector3d>* slides = nullptr) {
-  const Matrix6d N = Normaliser(source, T_target_source);
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(N.transpose() * information * N);
-  Vector6d values = eigen.eigenvalues();
-  Vector6d inverse_values = Vector6d::Zero();
-  for (int k = 0; k < 6; ++k) {
-    if (!(values(k) > 0.0 && values(k) >= ratio * values(5))) values(k) = 0.0;
-    if (values(k) > 0.0) inverse_values(k) = 1.0 / values(k);
-  }
-  if (kept_count) *kept_count = static_cast<int>((values.array() > 0.0).count());
-  if (covariance) {
-    const Matrix6d c = N * eigen.eigenvectors() * inverse_values.asDiagonal() * eigen.eigenvectors().transpose() *
-                       N.transpose();
-    *covariance = 0.5 * (c + c.transpose());
-  }
-  const Matrix6d N_inverse = N.inverse();
-  Matrix6d kept = N_inverse.transpose() * eigen.eigenvectors() * values.asDiagonal() *
-                  eigen.eigenvectors().transpose() * N_inverse;
-  // A slide along a pipe is a pure translation, but noise tilts its eigenvector by a few
-  // milliradians per metre: what is left then measures a sliver of the slide, from the start
-  // ICP was given. Sliding directions are taken out exactly.
-  Matrix6d P = Matrix6d::Identity();
-  for (int k = 0; k < 6; ++k) {
-    if (values(k) > 0.0 || eigen.eigenvectors().col(k).tail<3>().norm() < kSlideShare) continue;
-    // The data's own translation (about its centroid): the same vector about any point, where
-    // the eigenvector's translation about the target origin would carry its small turn times
-    // the lever arm (about 20 mrad off the pipe here).
-    Vector6d slide = Vector6d::Zero();
-    slide.tail<3>() = eigen.eigenvectors().col(k).tail<3>();
-    slide = P * slide;  // orthogonal to the slides already taken out (a bare seabed has two)
-    if (slide.norm() < 1e-6) continue;
-    slide.normalize();
-    P -= slide * slide.transpose();
-    if (slides) slides->push_back(slide.tail<3>());
-  }
-  kept = P * kept * P;
-  return 0.5 * (kept + kept.transpose());
-}
-
-// Where a registration leaves a slide free (a pipe seen without its ends), the scan's position
-// along it is not measured at all: it is tied to its anchor there only with sigma_m, so that
-// what the pairs leak along the slide moves the scan and not the vehicle (through the anchor,
-// the dead reckoning's scale error would take it up). `slides` in the target's frame, the
-// covariance in the source's.
-Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides, const Eigen::Isometry3d& T_target_source,
-                         double sigma_m) {
-  Matrix6d covariance = Matrix6d::Zero();
-  for (const Eigen::Vector3d& slide : slides) {
-    const Eigen::Vector3d in_source = T_target_source.linear().transpose() * slide;
-    covariance.bottomRightCorner<3, 3>() += sigma_m * sigma_m * in_source * in_source.transpose();
-  }
-  return covariance;
-}
-
-// The 99.9 % quantile of the chi-square distribution with `dof` degrees of freedom (1 to 6).
-double Chi2Quantile999(int dof) {
-  static constexpr std::array<double, 6> kQuantiles = {10.828, 13.816, 16.266, 18.467, 20.515, 22.458};
-  return kQuantiles.at(static_cast<std::size_t>(std::clamp(dof, 1, 6) - 1));
 }
 
 }  // namespace
@@ -237,8 +133,9 @@ struct Mapper::Impl {
                                           const std::vector<double>& distances) const;
   // The registration's own information (its pairs), weak directions removed. It relates the
   // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
+  // `kept`, when given, receives what the pairs alone pin (KeptDirections).
   Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
-                                   const Submap& source, std::vector<Eigen::Vector3d>* slides = nullptr) const;
+                                   const Submap& source, KeptDirections* kept = nullptr) const;
   // How far a submap's effective pose may sit from its anchor's navigation pose.
   Matrix6d Distortion(const Submap& s, SystematicErrors systematic_errors) const;
   // The navigation's motion between two submaps' effective poses (in a's frame).
@@ -367,15 +264,17 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
 }
 
 Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
-                                               const Submap& source, std::vector<Eigen::Vector3d>* slides) const {
+                                               const Submap& source, KeptDirections* kept) const {
   const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
-  const Matrix6d points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse, r.T_target_source,
-                                                options.weak_direction_ratio, nullptr, nullptr, slides);
+  KeptDirections points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse, r.T_target_source,
+                                                 options.weak_direction_ratio);
   // The pairs' residuals are not independent: what the navigation bent in each submap beyond a
   // rigid offset stays in every pair. Both submaps' bending floors the registration's covariance.
   const Matrix6d floor = uncertainty.BendingCovariance(target.end_s - target.start_s, target.rms_radius_m) +
                          uncertainty.BendingCovariance(source.end_s - source.start_s, source.rms_radius_m);
-  return InformationOfSum(points, floor);
+  const Matrix6d information = InformationOfSum(points.information, floor);
+  if (kept) *kept = std::move(points);
+  return information;
 }
 
 Matrix6d Mapper::Impl::Distortion(const Submap& s, SystematicErrors systematic_errors) const {
@@ -433,13 +332,13 @@ void Mapper::Impl::AddToGraph(Submap submap) {
     const perception::RegistrationResult r =
         Register(submap, local, T_predicted, increment_cov, options.icp_distances_m);
     stats.registration_s += Since(start);
-    std::vector<Eigen::Vector3d> slide_directions;
-    const Matrix6d information = RegistrationInformation(r, previous, submap, &slide_directions);
+    KeptDirections kept;
+    const Matrix6d information = RegistrationInformation(r, previous, submap, &kept);
     const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
     const double chi2 = innovation.dot(InformationOfSum(information, increment_cov) * innovation);
     if (r.fitness >= options.min_fitness && chi2 <= options.registration_chi2_gate) {
       registration = RelativePoseEdge{ScanNode(k - 1), ScanNode(k), r.T_target_source, information, false, 3.0};
-      slides = SlideCovariance(slide_directions, r.T_target_source, options.slide_sigma_m);
+      slides = SlideCovariance(kept.slides, r.T_target_source, options.slide_sigma_m);
       scan_initial = ScanPose(k - 1) * r.T_target_source;
       const Matrix6d combined = (increment_cov.inverse() + information).inverse();
       increment_cov = combined;
@@ -521,20 +420,16 @@ void Mapper::Impl::TryLoopClosures(int k) {
     loop.to = k;
     loop.fitness = r.fitness;
     loop.T_from_to = r.T_target_source;
-    const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
-    int constrained = 0;
-    Matrix6d points_cov = Matrix6d::Zero();
-    WithoutWeakDirections(r.information / (sigma * sigma), current.sparse, r.T_target_source,
-                          options.weak_direction_ratio, &constrained, &points_cov);
-    loop.conditioning = Conditioning(r.information, current.sparse, r.T_target_source);
+    KeptDirections kept;
+    const Matrix6d information = RegistrationInformation(r, submaps[static_cast<size_t>(j)], current, &kept);
+    const int constrained = kept.count;
     loop.constrained_directions = constrained;
-    const Matrix6d information = RegistrationInformation(r, submaps[static_cast<size_t>(j)], current);
     loop.information = information;
     // Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
     // others, as for consecutive submaps, are left to the navigation), and the registration
     // must be certain and consistent with the prediction in them.
-    const double sigma_m = LargestStd(points_cov.bottomRightCorner<3, 3>());
-    const double sigma_rad = LargestStd(points_cov.topLeftCorner<3, 3>());
+    const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
+    const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
     if (r.fitness < options.loop_min_fitness) {
       loop.reason = "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
     } else if (constrained < options.loop_min_directions) {

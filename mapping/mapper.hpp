@@ -74,7 +74,6 @@ struct LoopClosure {
   std::string reason;  // why it was rejected ("" when accepted)
   double fitness = 0.0;
   double chi2 = 0.0;   // of the registration against the prediction
-  double conditioning = 0.0;  // smallest / largest normalised eigenvalue of its information
   int constrained_directions = 0;  // directions the registration pins (the rest are left free)
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
   // What it measures ([w, v] in `from`'s frame, pose_graph.hpp): zero along the directions it
