@@ -26,5 +26,7 @@ function(uwscan_add_test name)
   target_compile_definitions(${name} PRIVATE UWSCAN_SOURCE_DIR_FOR_TESTS="${PROJECT_SOURCE_DIR}")
   uwscan_set_warnings(${name})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60)
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
+                       PROPERTIES ENVIRONMENT "UWSCAN_TEST_CACHE=${UWSCAN_TEST_CACHE}"
+                                  FIXTURES_REQUIRED uwscan_test_cache)
 endfunction()

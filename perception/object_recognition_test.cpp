@@ -1,10 +1,14 @@
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -16,6 +20,7 @@
 #include "perception/object_database_builder.hpp"
 #include "perception/object_recognizer.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/test_cache.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/virtual_scanner.hpp"
@@ -43,8 +48,24 @@ ObjectDatabase Build(const std::vector<std::string>& names, int threads) {
   return BuildObjectDatabase(sources, Scanner(), options);
 }
 
+// Read back from its file, as `recognize` reads a database. Under CTest the file is built by the
+// first test that needs it and shared by the others (scanner/common/test_cache.hpp).
 const ObjectDatabase& PipeFlangeValveDb() {
-  static const ObjectDatabase db = Build({"pipe", "flange", "valve_wheel"}, 2);
+  static const ObjectDatabase db = [] {
+    const std::optional<std::filesystem::path> cache = test::TestCacheFolder();
+    const std::filesystem::path file =
+        cache ? *cache / "pipe_flange_valve.db"
+              : std::filesystem::temp_directory_path() / ("uwscan_pipe_flange_valve_" + std::to_string(getpid()) + ".db");
+    std::filesystem::create_directories(file.parent_path());
+    // Tests running side by side wait for the one building it instead of building it too.
+    const int lock = ::open((file.string() + ".lock").c_str(), O_CREAT | O_RDWR, 0644);
+    if (lock >= 0) ::flock(lock, LOCK_EX);
+    if (!std::filesystem::exists(file)) Build({"pipe", "flange", "valve_wheel"}, 2).Save(file);
+    if (lock >= 0) ::close(lock);  // releases the lock
+    ObjectDatabase loaded = ObjectDatabase::Load(file);
+    if (!cache) std::filesystem::remove(file);
+    return loaded;
+  }();
   return db;
 }
 

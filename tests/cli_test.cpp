@@ -170,10 +170,12 @@ namespace {
 TEST(Cli, RegistrationBenchComparesThePipelines) {
   const std::filesystem::path json = TempPath("registration.json");
   const CommandRun run =
-      RunUwscan("bench registration --pairs-per-mesh 1 --no-real-scans --json " + json.string());
+      RunUwscan("bench registration --pairs-per-mesh 1 --no-real-scans --no-pcl --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
-  for (const char* name : {"uwscan", "pcl"}) {
+  // PCL's pipeline is left out: its RANSAC takes ~10 s a pair, 90 % of this test's time.
+  EXPECT_FALSE(j.at("pipelines").contains("pcl"));
+  for (const char* name : {"uwscan", "open3d"}) {
     const nlohmann::json& p = j.at("pipelines").at(name);
     EXPECT_EQ(p.at("pairs").get<int>(), 9) << name;
     EXPECT_GT(p.at("seconds_per_pair").get<double>(), 0.0) << name;

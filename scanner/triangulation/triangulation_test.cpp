@@ -4,11 +4,14 @@
 #include <omp.h>
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <random>
 #include <vector>
 
+#include "scanner/common/test_cache.hpp"
 #include "scanner/triangulation/light_cone.hpp"
+#include "scanner/triangulation/light_surface_cache.hpp"
 #include "scanner/triangulation/ray_ray_triangulator.hpp"
 #include "scanner/triangulation/surface_triangulators.hpp"
 
@@ -38,7 +41,11 @@ class TriangulationTest : public ::testing::Test {
   static void SetUpTestSuite() {
     model_ = std::make_unique<GalvoScannerModel>(DefaultGalvoScannerModel());
     rays_ = std::make_shared<const CameraRayTable>(model_->camera, 4);
-    surfaces_ = std::make_shared<const LightSurfaceTable>(model_->laser, LightSurfaceTableOptions{});
+    // Each test runs in its own process: the table is fitted by the first and read back by the
+    // others (the file holds the exact inputs and the fitting version, so any folder is safe).
+    const std::filesystem::path folder =
+        test::TestCacheFolder().value_or(std::filesystem::temp_directory_path() / "uwscan_test_light_surfaces");
+    surfaces_ = LoadOrBuildLightSurfaceTable(model_->laser, LightSurfaceTableOptions{}, folder).table;
   }
   static void TearDownTestSuite() {
     model_.reset();
