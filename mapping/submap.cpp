@@ -1,7 +1,10 @@
 #include "mapping/submap.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
+#include <exception>
 
 #include "perception/normals.hpp"
 #include "perception/voxel_filter.hpp"
@@ -27,7 +30,32 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
   for (const Eigen::Vector3d& p : points_V) raw.points.push_back(p.cast<float>());
   if (raw.size() < 10) return;
 
-  const perception::PointCloud voxels = perception::VoxelDownsample(raw, {options.map_voxel_m});
+  // The two voxel grids are independent and each is a serial sort: one per thread.
+  perception::PointCloud voxels, sparse;
+  std::exception_ptr failure;
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+#pragma omp parallel sections num_threads(std::min(2, threads))
+  {
+#pragma omp section
+    {
+      try {
+        voxels = perception::VoxelDownsample(raw, {options.map_voxel_m});
+      } catch (...) {
+#pragma omp critical(submap_voxel_failure)
+        failure = std::current_exception();
+      }
+    }
+#pragma omp section
+    {
+      try {
+        sparse = perception::VoxelDownsample(raw, {options.registration_voxel_m});
+      } catch (...) {
+#pragma omp critical(submap_voxel_failure)
+        failure = std::current_exception();
+      }
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
   perception::NormalOptions normal_options;
   normal_options.k = options.normal_neighbours;
   normal_options.viewpoint = options.viewpoint_V;
@@ -36,7 +64,7 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
       perception::AttachNormals(voxels, perception::EstimateNormals(voxels, normal_options));
   if (with_normals.cloud.size() < 10) return;
   submap->cloud = std::move(with_normals.cloud);
-  submap->sparse = perception::VoxelDownsample(raw, {options.registration_voxel_m});
+  submap->sparse = std::move(sparse);
 
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < submap->cloud.size(); ++i) centroid += submap->cloud.Point(i);

