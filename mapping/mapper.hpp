@@ -51,9 +51,7 @@ struct MapperOptions {
   double loop_max_sigma_m = 0.01;     // registration std along any kept direction
   double loop_max_sigma_rad = 0.005;  // registration std about any kept axis
                                       // (and chi-square at 99.9 % for the kept directions)
-  int solve_every_submaps = 4;        // whole-graph solve also without a loop closure, > 0
-                                      // (new submaps start from the last solve composed with
-                                      // their edges; 4 instead of 2: loop dive graph 3.3 -> 2.7 s)
+  int solve_every_submaps = 2;        // whole-graph solve also without a loop closure, > 0
   // Estimate the DVL's speed scale error and misalignment in the graph (odometry edges then
   // carry only the random walks) and place new frames with the corrected navigation; false:
   // both are treated as noise of each motion.
