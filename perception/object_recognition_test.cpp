@@ -58,7 +58,7 @@ const ObjectDatabase& PipeFlangeValveDb() {
               : std::filesystem::temp_directory_path() / ("uwscan_pipe_flange_valve_" + std::to_string(getpid()) + ".db");
     std::filesystem::create_directories(file.parent_path());
     // Tests running side by side wait for the one building it instead of building it too.
-    const int lock = ::open((file.string() + ".lock").c_str(), O_CREAT | O_RDWR, 0644);
+    const int lock = cache ? ::open((file.string() + ".lock").c_str(), O_CREAT | O_RDWR, 0644) : -1;
     if (lock >= 0) ::flock(lock, LOCK_EX);
     if (!std::filesystem::exists(file)) Build({"pipe", "flange", "valve_wheel"}, 2).Save(file);
     if (lock >= 0) ::close(lock);  // releases the lock

@@ -296,7 +296,8 @@ TEST_F(TriangulationTest, CameraRayTableMatchesExactRays) {
 TEST_F(TriangulationTest, ResultsAreIdenticalRunToRunAndForAnyThreadCount) {
   const RayRayTriangulator a(*model_), b(*model_);
   const int threads = omp_get_max_threads();
-  omp_set_num_threads(threads == 1 ? 2 : 1);  // the suite's table was built with `threads`
+  // The suite's table was built (here or by the test that cached it) with `threads`.
+  omp_set_num_threads(threads == 1 ? 2 : 1);
   const LightSurfaceTable again(model_->laser, LightSurfaceTableOptions{});
   omp_set_num_threads(threads);
   for (int step : {-90, 0, 90}) {
