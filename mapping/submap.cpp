@@ -30,9 +30,11 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
   for (const Eigen::Vector3d& p : points_V) raw.points.push_back(p.cast<float>());
   if (raw.size() < 10) return;
 
-  // The two voxel grids are independent and each is a serial sort: one per thread.
+  // The two voxel grids are independent and each is a serial sort: one per thread. Each one's
+  // error is raised where the grid was made one after the other (the sparse one's only when
+  // the submap is kept).
   perception::PointCloud voxels, sparse;
-  std::exception_ptr failure;
+  std::exception_ptr voxels_failure, sparse_failure;
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
 #pragma omp parallel sections num_threads(std::min(2, threads))
   {
@@ -41,8 +43,7 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
       try {
         voxels = perception::VoxelDownsample(raw, {options.map_voxel_m});
       } catch (...) {
-#pragma omp critical(submap_voxel_failure)
-        failure = std::current_exception();
+        voxels_failure = std::current_exception();
       }
     }
 #pragma omp section
@@ -50,12 +51,11 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
       try {
         sparse = perception::VoxelDownsample(raw, {options.registration_voxel_m});
       } catch (...) {
-#pragma omp critical(submap_voxel_failure)
-        failure = std::current_exception();
+        sparse_failure = std::current_exception();
       }
     }
   }
-  if (failure) std::rethrow_exception(failure);
+  if (voxels_failure) std::rethrow_exception(voxels_failure);
   perception::NormalOptions normal_options;
   normal_options.k = options.normal_neighbours;
   normal_options.viewpoint = options.viewpoint_V;
@@ -63,6 +63,7 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
   perception::CloudWithNormals with_normals =
       perception::AttachNormals(voxels, perception::EstimateNormals(voxels, normal_options));
   if (with_normals.cloud.size() < 10) return;
+  if (sparse_failure) std::rethrow_exception(sparse_failure);
   submap->cloud = std::move(with_normals.cloud);
   submap->sparse = std::move(sparse);
 

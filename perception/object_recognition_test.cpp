@@ -48,6 +48,23 @@ ObjectDatabase Build(const std::vector<std::string>& names, int threads) {
   return BuildObjectDatabase(sources, Scanner(), options);
 }
 
+// An exclusive lock on `path` (none for an empty path) until the end of its scope.
+class FileLock {
+ public:
+  explicit FileLock(const std::string& path)
+      : fd_(path.empty() ? -1 : ::open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644)) {
+    if (fd_ >= 0) ::flock(fd_, LOCK_EX);
+  }
+  ~FileLock() {
+    if (fd_ >= 0) ::close(fd_);  // closing releases the lock
+  }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_;
+};
+
 // Read back from its file, as `recognize` reads a database. Under CTest the file is built by the
 // first test that needs it and shared by the others (scanner/common/test_cache.hpp).
 const ObjectDatabase& PipeFlangeValveDb() {
@@ -57,11 +74,11 @@ const ObjectDatabase& PipeFlangeValveDb() {
         cache ? *cache / "pipe_flange_valve.db"
               : std::filesystem::temp_directory_path() / ("uwscan_pipe_flange_valve_" + std::to_string(getpid()) + ".db");
     std::filesystem::create_directories(file.parent_path());
-    // Tests running side by side wait for the one building it instead of building it too.
-    const int lock = cache ? ::open((file.string() + ".lock").c_str(), O_CREAT | O_RDWR, 0644) : -1;
-    if (lock >= 0) ::flock(lock, LOCK_EX);
-    if (!std::filesystem::exists(file)) Build({"pipe", "flange", "valve_wheel"}, 2).Save(file);
-    if (lock >= 0) ::close(lock);  // releases the lock
+    {
+      // Tests running side by side wait for the one building it instead of building it too.
+      const FileLock lock(cache ? file.string() + ".lock" : std::string());
+      if (!std::filesystem::exists(file)) Build({"pipe", "flange", "valve_wheel"}, 2).Save(file);
+    }
     ObjectDatabase loaded = ObjectDatabase::Load(file);
     if (!cache) std::filesystem::remove(file);
     return loaded;

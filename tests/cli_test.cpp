@@ -174,9 +174,10 @@ TEST(Cli, RegistrationBenchComparesThePipelines) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   // PCL's pipeline is left out: its RANSAC takes ~10 s a pair, 90 % of this test's time.
+  // Open3D's is there when the build found Open3D.
   EXPECT_FALSE(j.at("pipelines").contains("pcl"));
-  for (const char* name : {"uwscan", "open3d"}) {
-    const nlohmann::json& p = j.at("pipelines").at(name);
+  ASSERT_TRUE(j.at("pipelines").contains("uwscan"));
+  for (const auto& [name, p] : j.at("pipelines").items()) {
     EXPECT_EQ(p.at("pairs").get<int>(), 9) << name;
     EXPECT_GT(p.at("seconds_per_pair").get<double>(), 0.0) << name;
   }

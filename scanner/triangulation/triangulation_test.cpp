@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -41,11 +42,13 @@ class TriangulationTest : public ::testing::Test {
   static void SetUpTestSuite() {
     model_ = std::make_unique<GalvoScannerModel>(DefaultGalvoScannerModel());
     rays_ = std::make_shared<const CameraRayTable>(model_->camera, 4);
-    // Each test runs in its own process: the table is fitted by the first and read back by the
-    // others (the file holds the exact inputs and the fitting version, so any folder is safe).
-    const std::filesystem::path folder =
-        test::TestCacheFolder().value_or(std::filesystem::temp_directory_path() / "uwscan_test_light_surfaces");
-    surfaces_ = LoadOrBuildLightSurfaceTable(model_->laser, LightSurfaceTableOptions{}, folder).table;
+    // Under CTest each test runs in its own process: the table is fitted by the first and read
+    // back by the others, all with the same default thread count. Outside CTest it is fitted here.
+    if (const std::optional<std::filesystem::path> folder = test::TestCacheFolder()) {
+      surfaces_ = LoadOrBuildLightSurfaceTable(model_->laser, LightSurfaceTableOptions{}, *folder).table;
+    } else {
+      surfaces_ = std::make_shared<const LightSurfaceTable>(model_->laser, LightSurfaceTableOptions{});
+    }
   }
   static void TearDownTestSuite() {
     model_.reset();
@@ -296,7 +299,7 @@ TEST_F(TriangulationTest, CameraRayTableMatchesExactRays) {
 TEST_F(TriangulationTest, ResultsAreIdenticalRunToRunAndForAnyThreadCount) {
   const RayRayTriangulator a(*model_), b(*model_);
   const int threads = omp_get_max_threads();
-  // The suite's table was built (here or by the test that cached it) with `threads`.
+  // The suite's table was built with `threads` (the default, here or in the process that cached it).
   omp_set_num_threads(threads == 1 ? 2 : 1);
   const LightSurfaceTable again(model_->laser, LightSurfaceTableOptions{});
   omp_set_num_threads(threads);
