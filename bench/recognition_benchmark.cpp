@@ -168,15 +168,14 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
                                            [&](const ObjectModel& o) { return o.id == truth; });
   std::vector<Eigen::Vector3d> points;
   for (std::size_t i = 0; i < model.model.size(); i += 4) points.push_back(model.model.Point(i));
-  const std::vector<Eigen::Isometry3d> symmetries = perception::SymmetryTransforms(model.symmetries);
   const perception::SymmetricPoseError e =
-      perception::PoseErrorModuloSymmetry(*T_S_O, T_S_O_true, points, symmetries);
+      perception::PoseErrorModuloSymmetry(*T_S_O, T_S_O_true, points, model.symmetries);
   figures.rotation_errors_rad.push_back(e.rotation_rad);
   figures.translation_errors_m.push_back(e.translation_m);
   if (e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005) ++figures.pose_success;
   if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
   if (model.grasps.empty()) return e;
-  const Eigen::Isometry3d T_true = T_S_O_true * symmetries[e.symmetry];
+  const Eigen::Isometry3d& T_true = e.T_symmetric;
   double worst_position = 0.0, worst_angle = 0.0;
   for (const perception::GraspFrame& g : model.grasps) {
     const Eigen::Isometry3d est = *T_S_O * g.T_O_G, truth_g = T_true * g.T_O_G;

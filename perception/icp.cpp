@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -31,15 +32,22 @@ int ThreadCount(int threads) { return threads > 0 ? threads : omp_get_max_thread
 
 // The nearest point within a radius: a FLANN result set of capacity 1 that starts with the
 // radius as its worst distance, so the tree prunes everything beyond it.
+// With a normal gate, only points whose normal is within the gate's angle of the query's count.
 class NearestWithin : public flann::ResultSet<float> {
  public:
   void Reset(float radius_sq) {
     worst_ = radius_sq;
     index_ = kNoMatch;
   }
+  // Candidates must have normals[index] . normal >= min_cos; normals == nullptr: no gate.
+  void Gate(const std::vector<Eigen::Vector3f>* normals, const Eigen::Vector3f& normal, float min_cos) {
+    normals_ = normals;
+    normal_ = normal;
+    min_cos_ = min_cos;
+  }
   bool full() const override { return true; }
   void addPoint(float dist, size_t index) override {
-    if (dist < worst_) {
+    if (dist < worst_ && (normals_ == nullptr || (*normals_)[index].dot(normal_) >= min_cos_)) {
       worst_ = dist;
       index_ = static_cast<int>(index);
     }
@@ -50,6 +58,9 @@ class NearestWithin : public flann::ResultSet<float> {
  private:
   float worst_ = 0.0f;
   int index_ = kNoMatch;
+  const std::vector<Eigen::Vector3f>* normals_ = nullptr;
+  Eigen::Vector3f normal_ = Eigen::Vector3f::Zero();
+  float min_cos_ = -1.0f;
 };
 
 // Exact nearest-neighbour search on the target points (relative to the target origin).
@@ -99,14 +110,22 @@ struct Sums {
   }
 };
 
+// Unit normals of the source and target and the least cosine between paired ones, when
+// IcpOptions::max_normal_angle_rad gates the pairs.
+struct NormalGate {
+  const std::vector<Eigen::Vector3f>* source = nullptr;
+  const std::vector<Eigen::Vector3f>* target = nullptr;
+  float min_cos = -1.0f;
+};
+
 // One pass over the source: pairs every moved point p = T_rel s with its nearest target point q
-// within the radius (pairs[i] = target index or kNoMatch) and, with `accumulate`, sums the
-// Gauss-Newton terms with the rotation about `pivot`: rows [(p - c) x n, n] for point-to-plane,
-// [-[p - c]x, I] for point-to-point.
+// within the radius (and the normal gate, when there is one; pairs[i] = target index or
+// kNoMatch) and, with `accumulate`, sums the Gauss-Newton terms with the rotation about `pivot`:
+// rows [(p - c) x n, n] for point-to-plane, [-[p - c]x, I] for point-to-point.
 Sums Pass(const std::vector<Eigen::Vector3d>& source_rel, const PointCloud& target,
           const TargetTree& tree, const Eigen::Isometry3d& T_rel, double radius,
           const Eigen::Vector3d& pivot, IcpMethod method, bool accumulate, int threads,
-          std::vector<int>& pairs) {
+          const NormalGate& gate, std::vector<int>& pairs) {
   const auto n = static_cast<std::ptrdiff_t>(source_rel.size());
   const auto radius_sq = static_cast<float>(radius * radius);
   const std::ptrdiff_t blocks = (n + kBlockSize - 1) / kBlockSize;
@@ -121,6 +140,10 @@ Sums Pass(const std::vector<Eigen::Vector3d>& source_rel, const PointCloud& targ
       const std::ptrdiff_t end = std::min(n, (block + 1) * kBlockSize);
       for (std::ptrdiff_t i = block * kBlockSize; i < end; ++i) {
         const Eigen::Vector3d p = T_rel * source_rel[static_cast<std::size_t>(i)];
+        if (gate.source != nullptr) {
+          const Eigen::Vector3d n = T_rel.linear() * (*gate.source)[static_cast<std::size_t>(i)].cast<double>();
+          result.Gate(gate.target, n.cast<float>(), gate.min_cos);
+        }
         const int j = tree.Nearest(p, radius_sq, result);
         pairs[static_cast<std::size_t>(i)] = j;
         if (j == kNoMatch || !accumulate) continue;
@@ -242,6 +265,9 @@ void IcpOptions::Check() const {
   require_tolerance("translation_tolerance_m", translation_tolerance_m);
   require_tolerance("relative_rmse_tolerance", relative_rmse_tolerance);
   if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
+  if (!(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi)) {
+    fail("max_normal_angle_rad", "an angle in [0, pi] rad");
+  }
   if (prior) {
     if (method != IcpMethod::kPointToPlane) fail("prior", "point-to-plane (method kPointToPlane)");
     if (!(std::isfinite(prior->point_sigma_m) && prior->point_sigma_m > 0.0)) {
@@ -289,6 +315,17 @@ RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
     throw Error("AlignIcp: target has no normals; point-to-plane needs one per target point");
   }
   RequireRigid(T_target_source_init);
+  // Unit normals for the gate, computed once.
+  std::vector<Eigen::Vector3f> source_normals, target_normals;
+  NormalGate gate;
+  if (options.max_normal_angle_rad > 0.0) {
+    if (!source.has_normals() || !target.has_normals()) {
+      throw Error("AlignIcp: max_normal_angle_rad needs normals on both the source and the target");
+    }
+    for (const Eigen::Vector3f& n : source.normals) source_normals.push_back(n.normalized());
+    for (const Eigen::Vector3f& n : target.normals) target_normals.push_back(n.normalized());
+    gate = {&source_normals, &target_normals, static_cast<float>(std::cos(options.max_normal_angle_rad))};
+  }
 
   // Everything below is relative to the target origin: T_rel maps source points relative to
   // their origin to target points relative to theirs.
@@ -322,7 +359,7 @@ RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
     for (int k = 0;
          k < options.max_iterations_per_stage && result.iterations < options.max_iterations; ++k) {
       const Sums sums = Pass(source_rel, target, tree, T_rel, radius, pivot,
-                             options.method, point_to_plane, options.threads, pairs);
+                             options.method, point_to_plane, options.threads, gate, pairs);
       Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
       double rmse = 0.0;
       if (point_to_plane) {
@@ -382,7 +419,7 @@ RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
   // the information's rotation is about the target origin.
   const Sums final_sums =
       Pass(source_rel, target, tree, T_rel, options.max_correspondence_distance_m.back(),
-           Eigen::Vector3d::Zero(), options.method, true, options.threads, pairs);
+           Eigen::Vector3d::Zero(), options.method, true, options.threads, gate, pairs);
   result.T_target_source =
       Eigen::Translation3d(target.origin) * T_rel * Eigen::Translation3d(-source.origin);
   result.fitness = static_cast<double>(final_sums.count) / static_cast<double>(source.size());

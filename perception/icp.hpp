@@ -43,6 +43,12 @@ struct IcpOptions {
   double translation_tolerance_m = 1e-6;  // metres
   double relative_rmse_tolerance = 1e-6;  // dimensionless
   int threads = 0;  // OpenMP threads for the nearest-neighbour search, 0 = OpenMP's default, >= 0
+  // When > 0, a source point pairs only with target points whose normal is within this angle of
+  // its own (rotated) normal; both clouds then need normals, facing the same way (a scan's
+  // towards the sensor, a model's outwards). This keeps a scan of a pipe's outside off the
+  // model's inner wall a few millimetres below it, where the point-to-plane distances are small
+  // but the surface faces the other way. Radians, in [0, pi]; 0 = off.
+  double max_normal_angle_rad = 0.0;
   // Point-to-plane only; with a prior, rotations are linearised about the target origin.
   std::optional<IcpPrior> prior;
 
@@ -66,7 +72,8 @@ struct IcpOptions {
 // added in a fixed order, so any thread count gives the same bits.
 //
 // Result, evaluated at the returned transform with the last stage's distance:
-//   fitness = fraction of source points with a target point within that distance;
+//   fitness = fraction of source points with a target point within that distance (and within
+//     the normal gate, when there is one);
 //   inlier_rmse = RMS of |p - q| over those pairs, metres (point-to-point distance for both
 //     methods);
 //   iterations = iterations over all stages;

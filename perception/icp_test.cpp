@@ -377,6 +377,82 @@ TEST(IcpSinglePlane, APriorDecidesTheDirectionsThePlaneLeavesFree) {
   EXPECT_THROW(options.Check(), Error);
 }
 
+// A pipe's wall sampled on both faces with outward normals (the outer face's away from the
+// axis, the bore's towards it), and a scan of its top from a sensor above, normals towards it.
+PointCloud PipeWalls(double outer_m, double inner_m, double length_m) {
+  std::vector<Eigen::Vector3d> points;
+  PointCloud cloud;
+  for (const double radius : {outer_m, inner_m}) {
+    const int around = static_cast<int>(2.0 * std::numbers::pi * radius / 0.003);
+    for (int i = 0; i < around; ++i) {
+      const double a = 2.0 * std::numbers::pi * i / around;
+      const Eigen::Vector3d radial(std::cos(a), std::sin(a), 0.0);
+      for (double z = -0.5 * length_m; z <= 0.5 * length_m; z += 0.003) {
+        points.push_back(radius * radial + Eigen::Vector3d(0, 0, z));
+        cloud.normals.push_back((radius == outer_m ? radial : -radial).cast<float>());
+      }
+    }
+  }
+  const PointCloud made = MakeCloud(points);
+  cloud.origin = made.origin;
+  cloud.points = made.points;
+  return cloud;
+}
+
+PointCloud PipeTopScan(double outer_m, double length_m) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3f> normals;
+  for (double a = 0.25 * std::numbers::pi; a <= 0.75 * std::numbers::pi; a += 0.05) {
+    const Eigen::Vector3d radial(std::cos(a), std::sin(a), 0.0);
+    for (double z = -0.4 * length_m; z <= 0.4 * length_m; z += 0.004) {
+      points.push_back(outer_m * radial + Eigen::Vector3d(0, 0, z));
+      normals.push_back(radial.cast<float>());
+    }
+  }
+  PointCloud cloud = MakeCloud(points);
+  cloud.normals = normals;
+  return cloud;
+}
+
+TEST(IcpNormalGate, KeepsAScanOfAPipesOutsideOffItsBore) {
+  const double outer = 0.05, inner = 0.045, length = 0.3;
+  const PointCloud model = PipeWalls(outer, inner, length);
+  const PointCloud scan = PipeTopScan(outer, length);
+  // Started a wall's thickness too low, the scan lies on the bore, where the point-to-plane
+  // distances are as small as on the outside.
+  const Eigen::Isometry3d start(Eigen::Translation3d(0.0, -(outer - inner), 0.0));
+  IcpOptions options = Options(IcpMethod::kPointToPlane);
+  options.max_correspondence_distance_m = {0.01, 0.0075};
+  auto mean_radius = [&](const RegistrationResult& r) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < scan.size(); ++i) sum += (r.T_target_source * scan.Point(i)).head<2>().norm();
+    return sum / static_cast<double>(scan.size());
+  };
+  const RegistrationResult ungated = AlignIcp(scan, model, start, options);
+  EXPECT_LT(mean_radius(ungated), inner + 0.001);  // the trap the gate is for
+  options.max_normal_angle_rad = 60.0 * kDeg;
+  const RegistrationResult gated = AlignIcp(scan, model, start, options);
+  EXPECT_NEAR(mean_radius(gated), outer, 2e-4);
+  EXPECT_TRUE(gated.converged);
+  EXPECT_GT(gated.fitness, 0.99);
+}
+
+TEST(IcpNormalGate, NeedsNormalsOnBothClouds) {
+  const PointCloud model = PipeWalls(0.05, 0.045, 0.3);
+  PointCloud scan = PipeTopScan(0.05, 0.3);
+  scan.normals.clear();
+  IcpOptions options = Options(IcpMethod::kPointToPlane);
+  options.max_normal_angle_rad = 1.0;
+  try {
+    AlignIcp(scan, model, Eigen::Isometry3d::Identity(), options);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("max_normal_angle_rad"), std::string::npos);
+  }
+  options.max_normal_angle_rad = 4.0;
+  EXPECT_THROW(options.Check(), Error);
+}
+
 TEST(IcpBadInput, EmptyOnePointAndNaNCloudsThrow) {
   const PointCloud good = BumpySurface(100, 13);
   PointCloud empty;

@@ -66,6 +66,10 @@ IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int thr
   icp.relative_rmse_tolerance = 1e-6;
   icp.max_iterations = 300;
   icp.max_iterations_per_stage = 100;
+  // The model has its bores and inner walls (seen through a pipe's ends), a wall's thickness
+  // below its outside: a scan of the outside laid on them fits within a millimetre, a false
+  // minimum (elbows settled there 2-7 degrees off). Pairs whose normals disagree are not made.
+  icp.max_normal_angle_rad = std::numbers::pi / 3.0;
   icp.threads = threads;
   return icp;
 }
@@ -122,6 +126,8 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
   icp.translation_tolerance_m = 0.1 * p.voxel_m;
   icp.rotation_tolerance_rad = icp.translation_tolerance_m / (0.5 * diameter_m);
   icp.relative_rmse_tolerance = 1e-3;
+  // No normal gate here (the fine ICP has one): gating the sift too posed a few more objects
+  // but recognised fewer (100 scans: 84.3 % against 87.9 %).
   icp.threads = 1;
   auto quick_icp = [&](const std::vector<Eigen::Isometry3d>& from, std::vector<double>& fitness,
                        std::vector<Eigen::Isometry3d>& moved) {

@@ -40,7 +40,8 @@ class ViewFeatureCache {
   std::map<std::pair<std::size_t, std::size_t>, std::unique_ptr<ViewFeatures>> described_;
 };
 
-// Point-to-plane ICP of a segment onto a model, to the scale of the data.
+// Point-to-plane ICP of a segment onto a model, to the scale of the data, pairing only points
+// whose normals agree within 60 degrees (the segment's facing the sensor, the model's outwards).
 IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int threads);
 
 // Starting poses T_O_S of a segment on one object: FPFH + RANSAC onto its nearest view (when

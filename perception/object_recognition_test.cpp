@@ -310,5 +310,34 @@ TEST(ObjectSymmetry, FoundFromTheMesh) {
   EXPECT_EQ(elbow[0].order, 2);
 }
 
+TEST(ObjectSymmetry, ARollAboutAContinuousAxisIsNoError) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  // A pipe: continuous about z, two-fold about x. The estimate is rolled about the axis by an
+  // angle between two samples of the continuous symmetry and tilted by 0.4 degrees.
+  const std::vector<SymmetryAxis> axes = {{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0},
+                                          {Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 2}};
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 360; i += 10) {
+    for (double z = -0.25; z <= 0.25; z += 0.05) {
+      points.emplace_back(0.05 * std::cos(i * kDeg), 0.05 * std::sin(i * kDeg), z);
+    }
+  }
+  const Eigen::Isometry3d T_true = Eigen::Translation3d(1.0, -2.0, 3.0) *
+                                   Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized());
+  const double tilt = 0.4 * kDeg;
+  for (const bool flipped : {false, true}) {
+    const Eigen::Isometry3d flip(Eigen::AngleAxisd(flipped ? std::numbers::pi : 0.0, Eigen::Vector3d::UnitX()));
+    const Eigen::Isometry3d T_est = T_true * flip * Eigen::AngleAxisd(3.7 * kDeg, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX());
+    const SymmetricPoseError exact = PoseErrorModuloSymmetry(T_est, T_true, points, axes);
+    EXPECT_NEAR(exact.rotation_rad, tilt, 1e-9);
+    EXPECT_NEAR(exact.translation_m, 0.0, 1e-9);
+    EXPECT_LT(exact.mssd_m, std::hypot(0.25, 0.05) * tilt + 1e-9);  // how far the tilt moves a rim point at an end
+    // The 5-degree samples alone count the rest of the roll as an error.
+    const SymmetricPoseError sampled = PoseErrorModuloSymmetry(T_est, T_true, points, SymmetryTransforms(axes));
+    EXPECT_GT(sampled.rotation_rad, 1.0 * kDeg);
+  }
+}
+
 }  // namespace
 }  // namespace uwscan::perception

@@ -143,9 +143,35 @@ SymmetricPoseError PoseErrorModuloSymmetry(const Eigen::Isometry3d& T_est,
       best.symmetry = s;
       best.rotation_rad = Eigen::AngleAxisd((T.linear().transpose() * T_est.linear())).angle();
       best.translation_m = (T_est.translation() - T.translation()).norm();
+      best.T_symmetric = T;
     }
   }
   return best;
+}
+
+SymmetricPoseError PoseErrorModuloSymmetry(const Eigen::Isometry3d& T_est,
+                                           const Eigen::Isometry3d& T_true,
+                                           std::span<const Eigen::Vector3d> model_points_O,
+                                           std::span<const SymmetryAxis> axes) {
+  const std::vector<Eigen::Isometry3d> symmetries = SymmetryTransforms(axes);
+  SymmetricPoseError e = PoseErrorModuloSymmetry(T_est, T_true, model_points_O, symmetries);
+  for (const SymmetryAxis& axis : axes) {
+    if (!axis.continuous()) continue;
+    // With q = (w, v) the relative rotation, turning the truth by t about the axis a leaves
+    // cos(t / 2) w + sin(t / 2) (a . v) as the real part, largest at t = 2 atan2(a . v, w).
+    const Eigen::Vector3d a = axis.axis_O.normalized();
+    const Eigen::Quaterniond q(e.T_symmetric.linear().transpose() * T_est.linear());
+    const double turn = 2.0 * std::atan2(a.dot(q.vec()), q.w());
+    e.T_symmetric = e.T_symmetric * RotationAbout(SymmetryAxis{axis.point_O, a, 0}, turn);
+  }
+  double worst = 0.0;
+  for (const Eigen::Vector3d& x : model_points_O) {
+    worst = std::max(worst, (T_est * x - e.T_symmetric * x).squaredNorm());
+  }
+  e.mssd_m = std::min(e.mssd_m, std::sqrt(worst));  // still the least over the symmetries tried
+  e.rotation_rad = Eigen::AngleAxisd(e.T_symmetric.linear().transpose() * T_est.linear()).angle();
+  e.translation_m = (T_est.translation() - e.T_symmetric.translation()).norm();
+  return e;
 }
 
 }  // namespace uwscan::perception

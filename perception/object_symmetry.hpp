@@ -46,7 +46,8 @@ struct SymmetricPoseError {
   double mssd_m = 0.0;        // max over model points of |T_est x - T_true S x|, min over S
   double rotation_rad = 0.0;  // angle of (T_true S)^-1 T_est for that S
   double translation_m = 0.0; // |t_est - t_(T_true S)|
-  std::size_t symmetry = 0;   // index of S in the symmetries given
+  std::size_t symmetry = 0;   // index of S in the symmetries given (the sampled branch)
+  Eigen::Isometry3d T_symmetric = Eigen::Isometry3d::Identity();  // T_true S, the truth measured against
 };
 // `symmetries` as SymmetryTransforms gives them (at least the identity); model points in {O}.
 // Throws uwscan::Error when either is empty.
@@ -54,5 +55,14 @@ SymmetricPoseError PoseErrorModuloSymmetry(const Eigen::Isometry3d& T_est,
                                            const Eigen::Isometry3d& T_true,
                                            std::span<const Eigen::Vector3d> model_points_O,
                                            std::span<const Eigen::Isometry3d> symmetries);
+
+// The same with the symmetries given as axes: the branch found among SymmetryTransforms(axes),
+// then the angle about each continuous axis chosen exactly, as the turn about it that brings the
+// truth's orientation nearest the estimate's. A pipe rolled about its axis by an angle between
+// two samples (5 degrees apart) then counts no rotation error for the roll, only for the tilt.
+SymmetricPoseError PoseErrorModuloSymmetry(const Eigen::Isometry3d& T_est,
+                                           const Eigen::Isometry3d& T_true,
+                                           std::span<const Eigen::Vector3d> model_points_O,
+                                           std::span<const SymmetryAxis> axes);
 
 }  // namespace uwscan::perception
