@@ -140,7 +140,6 @@ SymmetricPoseError PoseErrorModuloSymmetry(const Eigen::Isometry3d& T_est,
     const double mssd = std::sqrt(worst);
     if (mssd < best.mssd_m) {
       best.mssd_m = mssd;
-      best.symmetry = s;
       best.rotation_rad = Eigen::AngleAxisd((T.linear().transpose() * T_est.linear())).angle();
       best.translation_m = (T_est.translation() - T.translation()).norm();
       best.T_symmetric = T;

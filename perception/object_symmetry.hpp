@@ -46,7 +46,6 @@ struct SymmetricPoseError {
   double mssd_m = 0.0;        // max over model points of |T_est x - T_true S x|, min over S
   double rotation_rad = 0.0;  // angle of (T_true S)^-1 T_est for that S
   double translation_m = 0.0; // |t_est - t_(T_true S)|
-  std::size_t symmetry = 0;   // index of S in the symmetries given (the sampled branch)
   Eigen::Isometry3d T_symmetric = Eigen::Isometry3d::Identity();  // T_true S, the truth measured against
 };
 // `symmetries` as SymmetryTransforms gives them (at least the identity); model points in {O}.
