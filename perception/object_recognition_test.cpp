@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "perception/cloud_io.hpp"
+#include "perception/cloud_neighbors.hpp"
 #include "perception/clustering.hpp"
 #include "perception/object_catalogue.hpp"
 #include "perception/object_database.hpp"
@@ -308,6 +309,76 @@ TEST(ObjectSymmetry, FoundFromTheMesh) {
   const std::vector<SymmetryAxis> elbow = DetectSymmetries(CatalogueObject("elbow").mesh);
   ASSERT_EQ(elbow.size(), 1u);
   EXPECT_EQ(elbow[0].order, 2);
+}
+
+// The 95th percentile over samples of `moved` of their distance to the tangent plane of the
+// nearest sample of `surface`, metres: near zero when `moved` lies on the surface, whatever
+// the sampling (only the distance along the surface's normal counts).
+double SurfaceDistanceP95(const scanner::SurfaceSamples& surface, const KnnIndex& index,
+                          const std::vector<Eigen::Vector3d>& moved) {
+  std::vector<double> distances;
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared;
+  for (const Eigen::Vector3d& p : moved) {
+    index.Query(p.cast<float>(), 1, nearest, squared);
+    const std::size_t q = nearest[0];
+    distances.push_back(std::abs(surface.normals[q].dot(p - surface.points[q])));
+  }
+  std::nth_element(distances.begin(), distances.begin() + distances.size() * 95 / 100, distances.end());
+  return distances[distances.size() * 95 / 100];
+}
+
+TEST(ObjectSymmetry, DeclaredForTheCatalogueHoldOnItsMeshesAndDetectionAgrees) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  for (const std::string& name : CatalogueNames()) {
+    SCOPED_TRACE(name);
+    const ObjectSource object = CatalogueObject(name);
+    ASSERT_TRUE(object.symmetries.has_value());
+    const scanner::SurfaceSamples surface = scanner::SampleSurface(object.mesh, 200000, 1);
+    const scanner::SurfaceSamples test = scanner::SampleSurface(object.mesh, 2000, 2);
+    std::vector<Eigen::Vector3f> surface_f;
+    for (const Eigen::Vector3d& p : surface.points) surface_f.push_back(p.cast<float>());
+    const KnnIndex index(surface_f);
+    auto moved_by = [&](const Eigen::Isometry3d& T) {
+      std::vector<Eigen::Vector3d> moved;
+      for (const Eigen::Vector3d& p : test.points) moved.push_back(T * p);
+      return moved;
+    };
+    const double unmoved = SurfaceDistanceP95(surface, index, test.points);
+    for (const Eigen::Isometry3d& S : SymmetryTransforms(*object.symmetries, 0.5)) {
+      EXPECT_LT(SurfaceDistanceP95(surface, index, moved_by(S)), unmoved + 0.1e-3);
+    }
+    // The test sees an axis 0.5 degrees off: a half turn about it is no symmetry. (Tilted the
+    // wrong way, an elbow's bisector only adds a turn about the torus's own axis, which moves
+    // the bend along itself: the larger of two perpendicular tilts counts.)
+    for (const SymmetryAxis& s : *object.symmetries) {
+      const Eigen::Vector3d u = s.axis_O.unitOrthogonal();
+      double off = 0.0;
+      for (const Eigen::Vector3d& about : {u, s.axis_O.cross(u)}) {
+        const Eigen::Vector3d tilted = Eigen::AngleAxisd(0.5 * kDeg, about) * s.axis_O;
+        off = std::max(off, SurfaceDistanceP95(surface, index,
+                                               moved_by(Eigen::Translation3d(s.point_O) *
+                                                        Eigen::AngleAxisd(std::numbers::pi, tilted) *
+                                                        Eigen::Translation3d(-s.point_O))));
+      }
+      EXPECT_GT(off, unmoved + 0.2e-3) << "axis " << s.axis_O.transpose();
+    }
+    // Detection from the mesh, an independent finder, agrees on every axis, except that a
+    // half turn perpendicular to a continuous axis may be found about any such perpendicular.
+    const std::vector<SymmetryAxis> detected = DetectSymmetries(object.mesh);
+    const auto continuous = std::find_if(object.symmetries->begin(), object.symmetries->end(),
+                                         [](const SymmetryAxis& s) { return s.continuous(); });
+    for (const SymmetryAxis& s : *object.symmetries) {
+      const bool any_perpendicular = continuous != object.symmetries->end() && s.order == 2 &&
+                                     std::abs(s.axis_O.dot(continuous->axis_O)) < 1e-9;
+      const auto same = std::find_if(detected.begin(), detected.end(), [&](const SymmetryAxis& d) {
+        if (d.order != s.order) return false;
+        if (any_perpendicular) return std::abs(d.axis_O.dot(continuous->axis_O)) < std::sin(1.0 * kDeg);
+        return std::abs(d.axis_O.dot(s.axis_O)) > std::cos(1.0 * kDeg);
+      });
+      EXPECT_NE(same, detected.end()) << "axis " << s.axis_O.transpose() << " order " << s.order;
+    }
+  }
 }
 
 TEST(ObjectSymmetry, ARollAboutAContinuousAxisIsNoError) {
