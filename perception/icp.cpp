@@ -264,6 +264,7 @@ void IcpOptions::Check() const {
   require_tolerance("rotation_tolerance_rad", rotation_tolerance_rad);
   require_tolerance("translation_tolerance_m", translation_tolerance_m);
   require_tolerance("relative_rmse_tolerance", relative_rmse_tolerance);
+  if (stall_iterations < 0) fail("stall_iterations", ">= 0 (0 = off), got " + std::to_string(stall_iterations));
   if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
   if (!(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi)) {
     fail("max_normal_angle_rad", "an angle in [0, pi] rad");
@@ -356,6 +357,10 @@ RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
     const double radius = options.max_correspondence_distance_m[stage];
     bool stage_converged = false;
     double previous_rmse = std::numeric_limits<double>::quiet_NaN();
+    // The stage's lowest residual, the pose it was measured at, and iterations since.
+    double lowest_rmse = std::numeric_limits<double>::infinity();
+    Eigen::Isometry3d T_lowest = T_rel;
+    int since_lowest = 0;
     for (int k = 0;
          k < options.max_iterations_per_stage && result.iterations < options.max_iterations; ++k) {
       const Sums sums = Pass(source_rel, target, tree, T_rel, radius, pivot,
@@ -395,6 +400,15 @@ RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
         }
         rmse = std::sqrt(squared / static_cast<double>(moved.size()));
         increment = step.T_target_source;
+      }
+      if (rmse < lowest_rmse * (1.0 - options.relative_rmse_tolerance)) {
+        lowest_rmse = rmse;
+        T_lowest = T_rel;
+        since_lowest = 0;
+      } else if (options.stall_iterations > 0 && ++since_lowest >= options.stall_iterations) {
+        T_rel = T_lowest;
+        ++result.iterations;
+        break;
       }
       T_rel = increment * T_rel;
       ++result.iterations;

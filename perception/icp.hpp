@@ -42,6 +42,12 @@ struct IcpOptions {
   double rotation_tolerance_rad = 1e-6;   // radians
   double translation_tolerance_m = 1e-6;  // metres
   double relative_rmse_tolerance = 1e-6;  // dimensionless
+  // When > 0, a stage also ends (not converged) once its RMS residual has not gone below its
+  // lowest so far by relative_rmse_tolerance for this many iterations, and the pose goes back to
+  // where the residual was lowest. Changing pairs can make ICP cycle between poses (a pipe
+  // rolling about its axis, a wrong object's pose hopping between two fits) until its cap; this
+  // ends that. 0 = off, >= 0.
+  int stall_iterations = 0;
   int threads = 0;  // OpenMP threads for the nearest-neighbour search, 0 = OpenMP's default, >= 0
   // When > 0, a source point pairs only with target points whose normal is within this angle of
   // its own (rotated) normal; both clouds then need normals, facing the same way (a scan's
@@ -78,7 +84,7 @@ struct IcpOptions {
 //     methods);
 //   iterations = iterations over all stages;
 //   converged = the last stage met a tolerance within its cap and options.max_iterations; false
-//     also when an iteration found fewer than 3 pairs (it stops there) or, for point-to-point,
+//     also when it stalled (options.stall_iterations), when an iteration found fewer than 3 pairs (it stops there) or, for point-to-point,
 //     the pairs were collinear (AlignSvd degenerate);
 //   information = sum over those pairs of J^T J with the pose perturbed as
 //     p -> p + w x p + v, p relative to target.origin, ordered [w (rad), v (m)]:

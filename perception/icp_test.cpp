@@ -453,6 +453,41 @@ TEST(IcpNormalGate, NeedsNormalsOnBothClouds) {
   EXPECT_THROW(options.Check(), Error);
 }
 
+// A scan of a 50 mm pipe on the model of a 70 mm one (a wrong object): point-to-plane ICP hops
+// between fits until its cap. With stall_iterations it stops and keeps its lowest residual.
+TEST(IcpStall, AWrongModelStopsCyclingAtItsLowestResidual) {
+  const PointCloud scan = PipeTopScan(0.05, 0.3);
+  const PointCloud wrong_model = PipeWalls(0.07, 0.065, 0.3);
+  IcpOptions options = Options(IcpMethod::kPointToPlane);
+  options.max_correspondence_distance_m = {0.02};
+  options.max_iterations = options.max_iterations_per_stage = 200;
+  options.rotation_tolerance_rad = options.translation_tolerance_m = 0.0;
+  options.relative_rmse_tolerance = 1e-9;
+  const RegistrationResult cycling = AlignIcp(scan, wrong_model, Eigen::Isometry3d::Identity(), options);
+  EXPECT_EQ(cycling.iterations, 200);  // the trap: the whole cap spent
+  EXPECT_FALSE(cycling.converged);
+  options.stall_iterations = 10;
+  const RegistrationResult stalled = AlignIcp(scan, wrong_model, Eigen::Isometry3d::Identity(), options);
+  EXPECT_LT(stalled.iterations, 40);
+  EXPECT_FALSE(stalled.converged);  // stopping is not converging
+  EXPECT_LE(stalled.inlier_plane_rmse, cycling.inlier_plane_rmse);
+}
+
+// Where every iteration lowers the residual until a tolerance is met, the stall rule never
+// fires: the same bits with it on or off.
+TEST_P(IcpMethods, StallRuleChangesNothingWhereICPConverges) {
+  const PointCloud target = BumpySurface(8000, 2);
+  const PointCloud source = Transformed(SubsetWithNoise(target, 0.0, 0.0005, 3), KnownMotion().inverse());
+  IcpOptions options = Options(GetParam());
+  const RegistrationResult off = AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
+  options.stall_iterations = 3;
+  const RegistrationResult on = AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
+  ASSERT_TRUE(off.converged);
+  EXPECT_TRUE(on.converged);
+  EXPECT_EQ(on.iterations, off.iterations);
+  EXPECT_TRUE(on.T_target_source.matrix() == off.T_target_source.matrix());
+}
+
 TEST(IcpBadInput, EmptyOnePointAndNaNCloudsThrow) {
   const PointCloud good = BumpySurface(100, 13);
   PointCloud empty;
@@ -511,6 +546,9 @@ TEST(IcpOptions, CheckNamesTheField) {
   EXPECT_NE(field_of(options).find("max_correspondence_distance_m[1]"), std::string::npos);
   options.max_correspondence_distance_m = {0.01, -1.0};
   EXPECT_NE(field_of(options).find("max_correspondence_distance_m[1]"), std::string::npos);
+  options = {};
+  options.stall_iterations = -1;
+  EXPECT_NE(field_of(options).find("stall_iterations"), std::string::npos);
   options = {};
   options.rotation_tolerance_rad = std::nan("");
   EXPECT_NE(field_of(options).find("rotation_tolerance_rad"), std::string::npos);
