@@ -247,7 +247,6 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
   icp.max_correspondence_distance_m = distances;
   icp.max_iterations = 120;
   icp.max_iterations_per_stage = 30;
-  // Converged once a step moves less than a hundredth of the finest voxel.
   // Converged once a step moves the data less than a twentieth of the finest voxel: finer
   // steps are the pairing flickering between neighbours, not progress.
   icp.translation_tolerance_m = 0.05 * options.clouds.map_voxel_m;

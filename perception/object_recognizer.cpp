@@ -207,9 +207,10 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   return best;
 }
 
-// Up to max_candidates objects whose nearest view is within max_chi_square and that are not
-// smaller than the segment's own cluster (a bounding-box diagonal can exceed it by up to
-// sqrt(3); debris that joined it may lie beyond the object), nearest first, each posed.
+// Up to max_candidates objects whose nearest view is within max_chi_square (and within
+// max_chi_square_ratio of the best object's) and that are not smaller than the segment's own
+// cluster (a bounding-box diagonal can exceed it by up to sqrt(3); debris that joined it may
+// lie beyond the object), nearest first, each posed.
 // `nearest_chi_square` gets every object's distance to its nearest view.
 std::vector<PosedObject> PoseCandidates(const DescribedSegment& s, const EsfDescriptor& esf, double extent_m,
                                         const SceneAround& around, const ScanContext& ctx,
@@ -228,6 +229,7 @@ std::vector<PosedObject> PoseCandidates(const DescribedSegment& s, const EsfDesc
   for (std::size_t i : order) {
     if (static_cast<int>(chosen.size()) >= ctx.options.max_candidates) break;
     if (nearest_views[i].front().first > ctx.options.max_chi_square) break;
+    if (nearest_views[i].front().first > ctx.options.max_chi_square_ratio * nearest_views[order.front()].front().first) break;
     if (extent_m > 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m) continue;
     chosen.push_back(i);
   }
@@ -457,6 +459,7 @@ void RecognitionOptions::Check() const {
   in_range("refined_starts", refined_starts, 1, 64);
   in_range("refine_points", refine_points, 10, 10000000);
   if (!positive(max_chi_square)) throw Error("recognition: max_chi_square must be > 0");
+  if (!(max_chi_square_ratio >= 1.0)) throw Error("recognition: max_chi_square_ratio must be >= 1");
   if (!(min_fitness >= 0.0 && min_fitness <= 1.0) || !(max_missing >= 0.0 && max_missing <= 1.0) ||
       !(min_close >= 0.0 && min_close <= 1.0)) {
     throw Error("recognition: min_fitness, min_close and max_missing must be in [0, 1]");
