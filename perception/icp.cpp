@@ -264,6 +264,9 @@ void IcpOptions::Check() const {
   require_tolerance("rotation_tolerance_rad", rotation_tolerance_rad);
   require_tolerance("translation_tolerance_m", translation_tolerance_m);
   require_tolerance("relative_rmse_tolerance", relative_rmse_tolerance);
+  // A relative change of the whole residual is no tolerance (and would make every iteration a
+  // stall, stall_iterations counting a residual as lower only by this fraction).
+  if (!(relative_rmse_tolerance < 1.0)) fail("relative_rmse_tolerance", "a value below 1");
   if (stall_iterations < 0) fail("stall_iterations", ">= 0 (0 = off), got " + std::to_string(stall_iterations));
   if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
   if (!(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi)) {

@@ -38,7 +38,8 @@ struct IcpOptions {
   std::vector<double> max_correspondence_distance_m = {0.05, 0.02, 0.01};
   // A stage has converged when an iteration's increment rotates by less than
   // rotation_tolerance_rad and moves the target centroid by less than translation_tolerance_m,
-  // or when the RMS residual changed by less than relative_rmse_tolerance of its value. All >= 0.
+  // or when the RMS residual changed by less than relative_rmse_tolerance of its value. All >= 0,
+  // relative_rmse_tolerance < 1.
   double rotation_tolerance_rad = 1e-6;   // radians
   double translation_tolerance_m = 1e-6;  // metres
   double relative_rmse_tolerance = 1e-6;  // dimensionless

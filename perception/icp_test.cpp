@@ -558,6 +558,8 @@ TEST(IcpOptions, CheckNamesTheField) {
   options = {};
   options.relative_rmse_tolerance = -1.0;
   EXPECT_NE(field_of(options).find("relative_rmse_tolerance"), std::string::npos);
+  options.relative_rmse_tolerance = 1.0;
+  EXPECT_NE(field_of(options).find("relative_rmse_tolerance"), std::string::npos);
   options = {};
   options.threads = -2;
   EXPECT_NE(field_of(options).find("threads"), std::string::npos);
