@@ -85,8 +85,9 @@ struct IcpOptions {
 //     methods);
 //   iterations = iterations over all stages;
 //   converged = the last stage met a tolerance within its cap and options.max_iterations; false
-//     also when it stalled (options.stall_iterations), when an iteration found fewer than 3 pairs (it stops there) or, for point-to-point,
-//     the pairs were collinear (AlignSvd degenerate);
+//     also when it stalled (options.stall_iterations), when an iteration found fewer than 3
+//     pairs (it stops there) or, for point-to-point, the pairs were collinear (AlignSvd
+//     degenerate);
 //   information = sum over those pairs of J^T J with the pose perturbed as
 //     p -> p + w x p + v, p relative to target.origin, ordered [w (rad), v (m)]:
 //     point-to-plane rows [(p x n)^T, n^T]; point-to-point 3 rows per pair [-[p]x, I].

@@ -226,10 +226,12 @@ std::vector<PosedObject> PoseCandidates(const DescribedSegment& s, const EsfDesc
     return nearest_views[a].front().first < nearest_views[b].front().first;
   });
   std::vector<std::size_t> chosen;
+  const double best_chi_square = order.empty() ? 0.0 : nearest_views[order.front()].front().first;
   for (std::size_t i : order) {
+    const double chi_square = nearest_views[i].front().first;
     if (static_cast<int>(chosen.size()) >= ctx.options.max_candidates) break;
-    if (nearest_views[i].front().first > ctx.options.max_chi_square) break;
-    if (nearest_views[i].front().first > ctx.options.max_chi_square_ratio * nearest_views[order.front()].front().first) break;
+    if (chi_square > ctx.options.max_chi_square) break;
+    if (chi_square > ctx.options.max_chi_square_ratio * best_chi_square) break;
     if (extent_m > 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m) continue;
     chosen.push_back(i);
   }
