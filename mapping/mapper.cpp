@@ -278,6 +278,7 @@ Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationRes
 
 Matrix6d Mapper::Impl::Distortion(const Submap& s, SystematicErrors systematic_errors) const {
   return uncertainty.SubmapDistortionCovariance(s.T_W_V_start, s.T_W_V_end, s.end_s - s.start_s, s.rms_radius_m,
+                                                s.centroid_V,
                                                 systematic_errors);
 }
 

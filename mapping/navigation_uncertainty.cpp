@@ -7,6 +7,11 @@ namespace {
 
 // A footprint smaller than this is taken as this large when its turn and tilt are bounded.
 constexpr double kMinFootprintRadius_m = 0.1;
+// The share of the sideways walk's variance over a sweep (over the footprint's squared RMS
+// radius) that a rigid fit takes as a turn. For a Brownian path whose frames cross the
+// footprint at a steady rate, the least-squares slope has variance 1.2 sigma^2 T over the
+// squared extent crossed, 12 times the squared RMS radius of a uniform spread: 0.1.
+constexpr double kTurnShare = 0.1;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -91,14 +96,19 @@ Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W
 Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_start,
                                                            const Eigen::Isometry3d& T_W_end, double span_s,
                                                            double footprint_radius_m,
+                                                           const Eigen::Vector3d& footprint_centre,
                                                            SystematicErrors systematic) const {
   const double walk2 = noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * std::max(span_s, 0.0);
   const double radius = std::max(footprint_radius_m, kMinFootprintRadius_m);
   Matrix6d world = Matrix6d::Zero();
-  // Roll and pitch: the depth error changing across the footprint.
-  world(0, 0) = world(1, 1) = 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m / (radius * radius);
-  // Heading: its own walk, and the sideways walk of the frames across the footprint.
-  world(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * span_s + walk2 / (radius * radius);
+  // Roll and pitch: the depth error changing as the stripe crosses the footprint (at most the
+  // difference of two independent errors), taken by the fit as a tilt as the sideways walk is
+  // taken as a turn.
+  world(0, 0) = world(1, 1) = kTurnShare * 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m / (radius * radius);
+  // Heading: its own walk, and the sideways walk of the frames as the stripe crosses the
+  // footprint (kTurnShare of the walk's variance over the radius).
+  world(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * span_s +
+                kTurnShare * walk2 / (radius * radius);
   // Position: the walk since the anchor averaged over the span (a third of its variance at the
   // ends, the rigid fit's share of a Brownian path pinned at the middle, with margin).
   Eigen::Matrix2d xy = Eigen::Matrix2d::Identity() * (walk2 / 3.0);
@@ -116,7 +126,12 @@ Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry
   world(5, 5) = noise_.depth_sigma_m * noise_.depth_sigma_m;
   // A submap of one frame is not bent at all; its covariance still has to be invertible.
   for (int k = 0; k < 6; ++k) world(k, k) += k < 3 ? kFloorHeadingBias_rad * kFloorHeadingBias_rad : kFloorDepth_m * kFloorDepth_m;
-  return WorldAxesToFrame(world, T_W_start.linear());
+  // All of the above is about the footprint's centre, where the fit turns; at the vehicle's
+  // origin a turn w also moves it by -w x centre.
+  Matrix6d about_origin = Matrix6d::Identity();
+  about_origin.bottomLeftCorner<3, 3>() = Skew(footprint_centre);
+  const Matrix6d in_start = WorldAxesToFrame(world, T_W_start.linear());
+  return about_origin * in_start * about_origin.transpose();
 }
 
 Matrix6d NavigationUncertainty::BendingCovariance(double span_s, double footprint_radius_m) const {

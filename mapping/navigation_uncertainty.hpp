@@ -33,13 +33,16 @@ class NavigationUncertainty {
   // between start and end (span_s apart), is best fitted by a rigid pose: scan matching aligns
   // shapes, so it measures that effective pose, not the anchor's. The frames sit off by the
   // random walk since the anchor; a rigid fit over the span keeps about a third of its variance
-  // as a shift, and its sideways part across the footprint (RMS radius of the points) as a turn;
-  // depth errors across the footprint tilt it; with kAsNoise, the scale error stretches it and
-  // the misalignment shears it about the middle. In start's frame. The graph's nodes are the
+  // as a shift, and a tenth of its sideways part over the footprint's squared RMS radius as a
+  // turn; depth errors across the footprint tilt it; with kAsNoise, the scale error stretches
+  // it and the misalignment shears it about the middle. All of this happens about the
+  // footprint's centre (`footprint_centre`, in the anchor's frame), so a turn also moves the
+  // anchor's origin sideways. In start's frame. The graph's nodes are the
   // effective poses: this covariance goes into the navigation's edges and priors, not the
   // registrations'.
   Matrix6d SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_start, const Eigen::Isometry3d& T_W_end,
                                       double span_s, double footprint_radius_m,
+                                      const Eigen::Vector3d& footprint_centre,
                                       SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
   // What a rigid pose cannot take out of that bending: the random walk's departure from a
