@@ -99,7 +99,8 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
                        {"ate_dead_reckoning_m", Optional(s.ate_dead_reckoning_m)},
                        {"rpe_slam_per_m", Optional(s.rpe_slam_per_m)},
                        {"rpe_dead_reckoning_per_m", Optional(s.rpe_dead_reckoning_per_m)},
-                       {"nees_mean", Optional(s.nees_mean)}};
+                       {"nees_mean", Optional(s.nees_mean)},
+                       {"expected_map_error_m", Optional(m.expected_map_error_m)}};
   return report;
 }
 
@@ -145,6 +146,10 @@ void RunMap(const MapArgs& a) {
               100.0 * m.calibration.scale_error, 1000.0 * m.calibration.misalignment_rad);
   std::printf("time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, graph %.2f s\n",
               m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s, m.stats.graph_s);
+  if (m.expected_map_error_m) {
+    std::printf("expected map error from the poses' uncertainty: %.2f mm RMS along the normals\n",
+                *m.expected_map_error_m * 1e3);
+  }
   if (m.navigation_noise_assumed) {
     std::printf("navigation noise: not recorded in the log (schema 1), a typical AUV's assumed\n");
   }

@@ -84,10 +84,106 @@ perception::PointCloud TruePoseMap(const mapping::DiveLogReader& log, const std:
   return perception::VoxelDownsample(perception::MakeCloud(points_W), voxel);
 }
 
+// The dive's submaps placed with other poses (the dead reckoning's, a peer's), voxelised.
+perception::PointCloud PlacedMap(const mapping::DiveMapping& m, const std::vector<mapping::TimedPose>& poses,
+                                 double voxel_m) {
+  std::vector<const perception::PointCloud*> clouds;
+  std::vector<Eigen::Isometry3d> placed;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    clouds.push_back(&m.submap_clouds[i]);
+    placed.push_back(poses[i].T_W_V);
+  }
+  return mapping::MergeClouds(clouds, placed, voxel_m);
+}
+
+// The scene's text with its top-level seed set to `seed` (added when it has none), so that the
+// log records the scene it was simulated from.
+std::string WithSeed(const std::string& yaml_text, std::uint64_t seed) {
+  std::istringstream in(yaml_text);
+  std::ostringstream out;
+  bool found = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("seed:", 0) == 0) {
+      line = "seed: " + std::to_string(seed);
+      found = true;
+    }
+    out << line << '\n';
+  }
+  if (!found) out << "seed: " << seed << '\n';
+  return out.str();
+}
+
+// One dive of a scene with the given seed: simulated into a log in `folder`, mapped, measured;
+// the log is removed afterwards (a long dive's is hundreds of MB).
+DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t seed, const SlamBenchOptions& options,
+                      const std::filesystem::path& folder, const Progress& progress) {
+  DiveFigures f;
+  f.name = scene_path.stem().string();
+  f.seed = seed;
+  const std::string scene_text = WithSeed(ReadText(scene_path), f.seed);
+  const scanner::sim::Scene scene =
+      scanner::sim::ParseScene(scene_text, scene_path.string(), scene_path.parent_path());
+  const std::string label = f.name + " (seed " + std::to_string(f.seed) + ")";
+  const std::filesystem::path log_path = folder / (f.name + "_" + std::to_string(f.seed) + ".db");
+  {
+    const scanner::sim::Simulator simulator(scene);
+    mapping::DiveSimulationOptions sim_options;
+    sim_options.threads = options.threads;
+    sim_options.producer = "uwscan bench slam";
+    const mapping::DiveSimulationSummary summary = mapping::SimulateDive(
+        simulator, scene_text, log_path, sim_options,
+        [&](double fraction) { if (progress) progress("simulate " + label, fraction); });
+    f.simulate_seconds = summary.seconds;
+  }
+  mapping::DiveMappingOptions map_options;
+  map_options.mapper.threads = options.threads;
+  map_options.table_cache = options.table_cache;
+  map_options.keep_submaps = true;
+  omp_set_num_threads(options.threads);
+  const mapping::DiveLogReader log(log_path);
+  const mapping::DiveMapping m = mapping::MapDive(
+      log, map_options, [&](double fraction) { if (progress) progress("map " + label, fraction); });
+  if (m.truth.empty()) throw Error(f.name + ": the simulated log has no truth");
+  const mapping::MapSummary s = mapping::Summarise(m);
+  f.duration_s = m.dive_duration_s;
+  f.submaps = m.submaps;
+  f.loops_accepted = s.loops_accepted;
+  f.loops_rejected = s.loops_rejected;
+  f.loops_false = s.loops_false.value_or(0);
+  f.nees_mean = s.nees_mean;
+  f.real_time_factor = s.real_time_factor;
+  f.expected_map_error_m = m.expected_map_error_m;
+
+  const scanner::sim::RayCaster caster(scene.objects);
+  if (progress) progress("surface distances " + label, 0.0);
+  f.dead_reckoning.ate_m = *s.ate_dead_reckoning_m;
+  f.dead_reckoning.rpe_per_m = s.rpe_dead_reckoning_per_m;
+  f.dead_reckoning.map = DistanceToScene(PlacedMap(m, m.dead_reckoning, map_options.map_voxel_m), caster, options.threads);
+  f.slam.ate_m = *s.ate_slam_m;
+  f.slam.rpe_per_m = s.rpe_slam_per_m;
+  f.slam.map = DistanceToScene(m.map, caster, options.threads);
+  f.slam.seconds = m.seconds;
+  f.true_poses_map = DistanceToScene(TruePoseMap(log, options.table_cache, map_options.map_voxel_m), caster,
+                                     options.threads);
+  if (options.run_open3d && Open3dMultiwayAvailable()) {
+    if (progress) progress("open3d " + label, 0.0);
+    TrajectoryFigures o;
+    const std::vector<mapping::TimedPose> poses = Open3dMultiway(m, options.threads, &o.seconds);
+    o.ate_m = mapping::AbsoluteTrajectoryError(poses, m.truth);
+    o.rpe_per_m = mapping::RelativeErrorPerMetre(poses, m.truth);
+    o.map = DistanceToScene(PlacedMap(m, poses, map_options.map_voxel_m), caster, options.threads);
+    f.open3d = o;
+  }
+  if (progress) progress("surface distances " + label, 1.0);
+  std::filesystem::remove(log_path);
+  return f;
+}
+
 }  // namespace
 
 void SlamBenchOptions::Check() const {
   if (scenes.empty()) throw Error("bench slam: no scene");
+  if (seeds < 1) throw Error("bench slam: seeds must be > 0");
   if (threads < 1) throw Error("bench slam: threads must be > 0");
 }
 
@@ -96,66 +192,11 @@ std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Pro
   ScratchFolder scratch("bench-slam");
   std::vector<DiveFigures> dives;
   for (const std::filesystem::path& scene_path : options.scenes) {
-    DiveFigures f;
-    f.name = scene_path.stem().string();
-    const scanner::sim::Scene scene = scanner::sim::LoadScene(scene_path);
-    const std::filesystem::path log_path = scratch.path() / (f.name + ".db");
-    {
-      const scanner::sim::Simulator simulator(scene);
-      mapping::DiveSimulationOptions sim_options;
-      sim_options.threads = options.threads;
-      sim_options.producer = "uwscan bench slam";
-      const mapping::DiveSimulationSummary summary = mapping::SimulateDive(
-          simulator, ReadText(scene_path), log_path, sim_options,
-          [&](double fraction) { if (progress) progress("simulate " + f.name, fraction); });
-      f.simulate_seconds = summary.seconds;
+    const std::uint64_t first_seed = scanner::sim::LoadScene(scene_path).seed;
+    for (int draw = 0; draw < options.seeds; ++draw) {
+      dives.push_back(BenchDive(scene_path, first_seed + static_cast<std::uint64_t>(draw), options, scratch.path(),
+                                progress));
     }
-    mapping::DiveMappingOptions map_options;
-    map_options.mapper.threads = options.threads;
-    map_options.table_cache = options.table_cache;
-    map_options.keep_submaps = true;
-    omp_set_num_threads(options.threads);
-    const mapping::DiveLogReader log(log_path);
-    const mapping::DiveMapping m = mapping::MapDive(
-        log, map_options, [&](double fraction) { if (progress) progress("map " + f.name, fraction); });
-    if (m.truth.empty()) throw Error(f.name + ": the simulated log has no truth");
-    const mapping::MapSummary s = mapping::Summarise(m);
-    f.duration_s = m.dive_duration_s;
-    f.submaps = m.submaps;
-    f.loops_accepted = s.loops_accepted;
-    f.loops_rejected = s.loops_rejected;
-    f.loops_false = s.loops_false.value_or(0);
-    f.nees_mean = s.nees_mean;
-    f.real_time_factor = s.real_time_factor;
-
-    const scanner::sim::RayCaster caster(scene.objects);
-    if (progress) progress("surface distances " + f.name, 0.0);
-    f.dead_reckoning.ate_m = *s.ate_dead_reckoning_m;
-    f.dead_reckoning.rpe_per_m = s.rpe_dead_reckoning_per_m;
-    f.dead_reckoning.map = DistanceToScene(m.map_dead_reckoning, caster, options.threads);
-    f.slam.ate_m = *s.ate_slam_m;
-    f.slam.rpe_per_m = s.rpe_slam_per_m;
-    f.slam.map = DistanceToScene(m.map, caster, options.threads);
-    f.slam.seconds = m.seconds;
-    f.true_poses_map = DistanceToScene(TruePoseMap(log, options.table_cache, map_options.map_voxel_m), caster,
-                                       options.threads);
-    if (options.run_open3d && Open3dMultiwayAvailable()) {
-      if (progress) progress("open3d " + f.name, 0.0);
-      TrajectoryFigures o;
-      const std::vector<mapping::TimedPose> poses = Open3dMultiway(m, options.threads, &o.seconds);
-      o.ate_m = mapping::AbsoluteTrajectoryError(poses, m.truth);
-      o.rpe_per_m = mapping::RelativeErrorPerMetre(poses, m.truth);
-      std::vector<const perception::PointCloud*> clouds;
-      std::vector<Eigen::Isometry3d> placed;
-      for (std::size_t i = 0; i < poses.size(); ++i) {
-        clouds.push_back(&m.submap_clouds[i]);
-        placed.push_back(poses[i].T_W_V);
-      }
-      o.map = DistanceToScene(mapping::MergeClouds(clouds, placed, map_options.map_voxel_m), caster, options.threads);
-      f.open3d = o;
-    }
-    if (progress) progress("surface distances " + f.name, 1.0);
-    dives.push_back(f);
   }
   return dives;
 }

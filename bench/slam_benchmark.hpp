@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -14,6 +15,9 @@ namespace uwscan::bench {
 // same submaps, on simulated inspection dives, in one run.
 struct SlamBenchOptions {
   std::vector<std::filesystem::path> scenes;  // dive scenes (data/scenes/inspection_*.yaml)
+  // Each scene is dived this many times, with its own seed and the next ones: one seed's drift
+  // draw is luck, good or bad, as much as it is the mapper.
+  int seeds = 1;
   int threads = 2;
   bool run_open3d = true;
   std::filesystem::path table_cache;
@@ -37,6 +41,7 @@ struct TrajectoryFigures {
 
 struct DiveFigures {
   std::string name;
+  std::uint64_t seed = 0;  // the scene's, which draws the navigation's drift and the peaks' noise
   double duration_s = 0.0;
   int submaps = 0;
   TrajectoryFigures dead_reckoning, slam;
@@ -45,6 +50,10 @@ struct DiveFigures {
   SurfaceDistance true_poses_map;
   int loops_accepted = 0, loops_rejected = 0, loops_false = 0;
   std::optional<double> nees_mean;
+  // What the SLAM map's distance to the true surfaces should be from its poses' uncertainty
+  // alone (mapping::ExpectedSurfaceErrorRms): with a consistent covariance, what the
+  // navigation and the scene allow.
+  std::optional<double> expected_map_error_m;
   double real_time_factor = 0.0;
   double simulate_seconds = 0.0;
 };

@@ -3,9 +3,17 @@
 #include <chrono>
 #include <string>
 
+#include "mapping/map_uncertainty.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
+namespace {
+
+// Every this many points of each submap go into the expected map error: an RMS over tens of
+// thousands of points, not millions.
+constexpr std::size_t kExpectedErrorStride = 8;
+
+}  // namespace
 
 void DiveMappingOptions::Check() const {
   mapper.Check();
@@ -77,10 +85,18 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
     }
   }
   if (result.truth.size() != result.slam.size()) result.truth.clear();
-  if (std::optional<std::vector<Matrix6d>> covariances = mapper.Covariances()) result.covariances = *covariances;
+  if (const std::optional<Mapper::SubmapCovariances> covariances = mapper.Covariances()) {
+    result.covariances = covariances->anchors;
+    std::vector<const perception::PointCloud*> clouds;
+    std::vector<Eigen::Isometry3d> placed;
+    for (int i = 0; i < mapper.submap_count(); ++i) {
+      clouds.push_back(&mapper.submap(i).cloud);
+      placed.push_back(mapper.scan_pose(i));
+    }
+    result.expected_map_error_m = ExpectedSurfaceErrorRms(clouds, placed, covariances->scans, kExpectedErrorStride);
+  }
   result.loops = mapper.loops();
   result.map = mapper.Map(options.map_voxel_m);
-  result.map_dead_reckoning = mapper.Map(options.map_voxel_m, /*with_navigation=*/true);
   result.stats = mapper.stats();
   result.calibration = mapper.calibration();
   result.dive_duration_s = last_time - first_time;

@@ -31,9 +31,11 @@ struct DiveMapping {
   std::vector<TimedPose> truth;           // the truth at the same times (simulated logs only)
   std::vector<TimedPose> scan_poses;      // the pose each submap's cloud is placed with
   std::vector<Matrix6d> covariances;      // per pose, [rotation, position] (empty: not computed)
+  // The map's expected distance to the true surfaces from its poses' uncertainty alone (RMS
+  // along the normals, ExpectedSurfaceErrorRms); empty with the covariances.
+  std::optional<double> expected_map_error_m;
   std::vector<LoopClosure> loops;
   perception::PointCloud map;             // voxelised, world frame (SLAM poses)
-  perception::PointCloud map_dead_reckoning;  // the same submaps placed by the navigation
   // Each submap's cloud in its own frame (normals attached), for peers that take the same
   // submaps; filled only when DiveMappingOptions::keep_submaps.
   std::vector<perception::PointCloud> submap_clouds;

@@ -73,12 +73,14 @@ void MapperOptions::Check() const {
   if (loop_min_directions < 1 || loop_min_directions > 6) fail("loop_min_directions", "in [1, 6]");
   if (loop_min_index_gap <= local_map_submaps) fail("loop_min_index_gap", "> local_map_submaps");
   if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
+  if (loop_every_submaps < 1) fail("loop_every_submaps", "> 0");
   if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
   if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0)) fail("loop_overlap_ratio", "in (0, 1]");
   if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
   if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
   if (!(registration_chi2_gate > 0.0)) fail("registration_chi2_gate", "> 0");
   if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
+  if (!(running_solve_tolerance > 0.0 && running_solve_tolerance < 1.0)) fail("running_solve_tolerance", "in (0, 1)");
   if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
   if (!(slide_sigma_m >= 0.0)) fail("slide_sigma_m", ">= 0 m");
   if (threads < 0) fail("threads", ">= 0");
@@ -144,7 +146,7 @@ struct Mapper::Impl {
   Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
   Matrix6d ChainCovariance(int from, int to) const;
   void TryLoopClosures(int k);
-  void Solve();
+  void Solve(bool last = false);  // last: the solve at Finish, to the full tolerance
   static int AnchorNode(int submap) { return 2 * submap; }
   static int ScanNode(int submap) { return 2 * submap + 1; }
   Eigen::Isometry3d AnchorPose(int submap) const { return graph.pose(AnchorNode(submap)); }
@@ -375,7 +377,7 @@ void Mapper::Impl::AddToGraph(Submap submap) {
 }
 
 void Mapper::Impl::TryLoopClosures(int k) {
-  if (options.max_loop_candidates == 0) return;
+  if (options.max_loop_candidates == 0 || k % options.loop_every_submaps != 0) return;
   const Clock::time_point start = Clock::now();
   const Submap& current = submaps[static_cast<size_t>(k)];
   const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
@@ -454,9 +456,11 @@ void Mapper::Impl::TryLoopClosures(int k) {
   stats.loop_s += Since(start);
 }
 
-void Mapper::Impl::Solve() {
+void Mapper::Impl::Solve(bool last) {
   const Clock::time_point start = Clock::now();
-  graph.Solve(PoseGraphOptions{});
+  PoseGraphOptions solve;
+  if (!last) solve.function_tolerance = options.running_solve_tolerance;
+  graph.Solve(solve);
   since_solve = 0;
   stats.graph_s += Since(start);
 }
@@ -512,7 +516,7 @@ void Mapper::Finish() {
   m.Drain(true);
   m.CloseSubmap();
   m.finished = true;
-  if (!m.submaps.empty()) m.Solve();
+  if (!m.submaps.empty()) m.Solve(/*last=*/true);
 }
 
 int Mapper::submap_count() const { return static_cast<int>(impl_->submaps.size()); }
@@ -529,10 +533,17 @@ const std::vector<LoopClosure>& Mapper::loops() const { return impl_->loops; }
 const MapperStats& Mapper::stats() const { return impl_->stats; }
 DeadReckoningCalibration Mapper::calibration() const { return impl_->graph.calibration(); }
 
-std::optional<std::vector<Matrix6d>> Mapper::Covariances() const {
-  std::vector<int> anchors;
-  for (int i = 0; i < submap_count(); ++i) anchors.push_back(impl_->AnchorNode(i));
-  return impl_->graph.Covariances(anchors);
+std::optional<Mapper::SubmapCovariances> Mapper::Covariances() const {
+  const int n = submap_count();
+  std::vector<int> nodes;
+  for (int i = 0; i < n; ++i) nodes.push_back(impl_->AnchorNode(i));
+  for (int i = 0; i < n; ++i) nodes.push_back(impl_->ScanNode(i));
+  std::optional<std::vector<Matrix6d>> all = impl_->graph.Covariances(nodes);
+  if (!all) return std::nullopt;
+  SubmapCovariances out;
+  out.anchors.assign(all->begin(), all->begin() + n);
+  out.scans.assign(all->begin() + n, all->end());
+  return out;
 }
 
 perception::PointCloud Mapper::Map(double voxel_m, bool with_navigation) const {

@@ -144,6 +144,9 @@ void RequireRigid(const Eigen::Isometry3d& T, const std::string& what) {
 void PoseGraphOptions::Check() const {
   if (max_iterations < 1) throw Error("PoseGraphOptions.max_iterations: expected > 0");
   if (threads < 1) throw Error("PoseGraphOptions.threads: expected > 0");
+  if (!(function_tolerance > 0.0 && function_tolerance < 1.0)) {
+    throw Error("PoseGraphOptions.function_tolerance: expected in (0, 1)");
+  }
 }
 
 Vector6d PoseError(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) {
@@ -303,7 +306,7 @@ PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.max_num_iterations = options.max_iterations;
   solver.num_threads = options.threads;
-  solver.function_tolerance = 1e-10;
+  solver.function_tolerance = options.function_tolerance;
   solver.gradient_tolerance = 1e-12;
   solver.parameter_tolerance = 1e-10;
   ceres::Solver::Summary summary;

@@ -55,6 +55,8 @@ struct PosePrior {
 struct PoseGraphOptions {
   int max_iterations = 50;  // Levenberg-Marquardt iterations, > 0
   int threads = 1;          // Ceres threads, > 0
+  // A solve stops once an iteration lowers the cost by less than this fraction, in (0, 1).
+  double function_tolerance = 1e-10;
   void Check() const;
 };
 
