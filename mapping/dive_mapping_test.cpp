@@ -14,6 +14,7 @@
 #include "mapping/dive_simulation.hpp"
 #include "mapping/map_report.hpp"
 #include "mapping/navigation_uncertainty.hpp"
+#include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 
@@ -91,6 +92,24 @@ TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
   EXPECT_LT(*s.nees_mean, 3.0 * 6.0);
   EXPECT_EQ(s.loops_false.value_or(-1), 0);
   for (const Matrix6d& c : m.covariances) EXPECT_GT(PoseStd(c).head<2>().minCoeff(), 0.0);
+}
+
+TEST_F(DiveMappingTest, TheMapsExpectedErrorIsWhatItsDistanceToTheTruthComesTo) {
+  const scanner::sim::Scene scene = ShortScene();
+  const DiveMapping m = Map(Simulate(scene, "drift.db"));
+  ASSERT_TRUE(m.expected_map_error_m.has_value());
+  // The map's distance to the scene's true surfaces, against what its poses' covariance says.
+  const scanner::sim::RayCaster caster(scene.objects);
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < m.map.size(); i += 7) {
+    const double d = caster.DistanceToSurface(m.map.Point(i), 0.5).value_or(0.5);
+    sum += d * d;
+    ++count;
+  }
+  const double measured = std::sqrt(sum / static_cast<double>(count));
+  EXPECT_GT(measured, 0.3 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
+  EXPECT_LT(measured, 3.0 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
 }
 
 TEST_F(DiveMappingTest, AlongASinglePipeTheMapFollowsTheNavigation) {

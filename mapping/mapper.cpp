@@ -78,7 +78,6 @@ void MapperOptions::Check() const {
   if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0)) fail("loop_overlap_ratio", "in (0, 1]");
   if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
   if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
-  if (!(registration_chi2_gate > 0.0)) fail("registration_chi2_gate", "> 0");
   if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
   if (!(running_solve_tolerance > 0.0 && running_solve_tolerance < 1.0)) fail("running_solve_tolerance", "in (0, 1)");
   if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
@@ -338,7 +337,9 @@ void Mapper::Impl::AddToGraph(Submap submap) {
     const Matrix6d information = RegistrationInformation(r, previous, submap, &kept);
     const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
     const double chi2 = innovation.dot(InformationOfSum(information, increment_cov) * innovation);
-    if (r.fitness >= options.min_fitness && chi2 <= options.registration_chi2_gate) {
+    // Along a slide the registration measures nothing, so the test has as many degrees of
+    // freedom as directions it pins.
+    if (r.fitness >= options.min_fitness && chi2 <= Chi2Quantile999(kept.count)) {
       registration = RelativePoseEdge{ScanNode(k - 1), ScanNode(k), r.T_target_source, information, false, 3.0};
       slides = SlideCovariance(kept.slides, r.T_target_source, options.slide_sigma_m);
       scan_initial = ScanPose(k - 1) * r.T_target_source;

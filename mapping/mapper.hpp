@@ -30,9 +30,9 @@ struct MapperOptions {
   std::vector<double> icp_distances_m = {0.04, 0.02, 0.01};
   std::vector<double> loop_icp_distances_m = {0.10, 0.04, 0.02, 0.01};
   double point_sigma_floor_m = 0.0003;  // a point-to-plane residual is never trusted beyond this
-  double min_fitness = 0.3;             // registration edge kept only above this fitness
-  // and only if it agrees with the navigation's motion (chi-square, 6 dof, 99.9 %).
-  double registration_chi2_gate = 22.46;
+  // A registration edge is kept only above this fitness, and only if it agrees with the
+  // navigation's motion in the directions it pins (chi-square at 99.9 % for their number).
+  double min_fitness = 0.3;
   // Loop closures: candidates at least this many submaps back, whose overlap is plausible
   // within gate_sigmas of the relative uncertainty; at most max_loop_candidates tried per
   // submap. Accepted only if the registration's fitness, its own uncertainty in the directions
