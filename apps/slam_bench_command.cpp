@@ -74,7 +74,7 @@ struct SceneSummary {
   double map_rms_mean_m = 0.0, map_ratio_mean = 0.0, expected_map_error_mean_m = 0.0;
   double nees_mean = 0.0, real_time_factor_mean = 0.0, real_time_factor_min = 0.0;
   int loops_false = 0;
-  std::optional<double> open3d_ate_ratio_mean;  // uwscan / Open3D
+  std::optional<double> open3d_ate_ratio_mean, open3d_time_ratio_mean;  // uwscan / Open3D
 };
 
 std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives) {
@@ -98,7 +98,11 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
     it->real_time_factor_mean += f.real_time_factor;
     it->real_time_factor_min = std::min(it->real_time_factor_min, f.real_time_factor);
     it->loops_false += f.loops_false;
-    if (f.open3d) it->open3d_ate_ratio_mean = it->open3d_ate_ratio_mean.value_or(0.0) + f.slam.ate_m / f.open3d->ate_m;
+    if (f.open3d) {
+      it->open3d_ate_ratio_mean = it->open3d_ate_ratio_mean.value_or(0.0) + f.slam.ate_m / f.open3d->ate_m;
+      it->open3d_time_ratio_mean =
+          it->open3d_time_ratio_mean.value_or(0.0) + f.slam.seconds / f.open3d->seconds;
+    }
   }
   for (SceneSummary& s : scenes) {
     const double n = s.seeds;
@@ -107,6 +111,7 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
       *v /= n;
     }
     if (s.open3d_ate_ratio_mean) *s.open3d_ate_ratio_mean /= n;
+    if (s.open3d_time_ratio_mean) *s.open3d_time_ratio_mean /= n;
   }
   return scenes;
 }
@@ -114,14 +119,14 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
 void Print(const std::vector<SceneSummary>& scenes) {
   std::printf("\nOver the seeds (means; SLAM/DR ratios; the worst ATE ratio and real-time factor):\n");
   std::printf("| dive | seeds | ATE ratio (worst) | map rms | map ratio | predicted map rms | NEES | real time (worst) "
-              "| false loops | uwscan/Open3D ATE |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+              "| false loops | uwscan/Open3D ATE, time |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const SceneSummary& s : scenes) {
     std::printf("| %s | %d | %.3f (%.3f) | %.2f mm | %.3f | %.2f mm | %.2f | %.1fx (%.1fx) | %d | ", s.name.c_str(),
                 s.seeds, s.ate_ratio_mean, s.ate_ratio_max, s.map_rms_mean_m * 1e3, s.map_ratio_mean,
                 s.expected_map_error_mean_m * 1e3, s.nees_mean, s.real_time_factor_mean, s.real_time_factor_min,
                 s.loops_false);
     if (s.open3d_ate_ratio_mean) {
-      std::printf("%.3f |\n", *s.open3d_ate_ratio_mean);
+      std::printf("%.3f, %.2f |\n", *s.open3d_ate_ratio_mean, s.open3d_time_ratio_mean.value_or(NAN));
     } else {
       std::printf("|\n");
     }
@@ -141,7 +146,9 @@ nlohmann::json SummaryJson(const SceneSummary& s) {
           {"real_time_factor_min", s.real_time_factor_min},
           {"loops_false", s.loops_false},
           {"open3d_ate_ratio_mean",
-           s.open3d_ate_ratio_mean ? nlohmann::json(*s.open3d_ate_ratio_mean) : nlohmann::json(nullptr)}};
+           s.open3d_ate_ratio_mean ? nlohmann::json(*s.open3d_ate_ratio_mean) : nlohmann::json(nullptr)},
+          {"open3d_time_ratio_mean",
+           s.open3d_time_ratio_mean ? nlohmann::json(*s.open3d_time_ratio_mean) : nlohmann::json(nullptr)}};
 }
 
 void RunSlamBench(const SlamBenchArgs& a) {

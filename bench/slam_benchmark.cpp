@@ -113,28 +113,12 @@ std::string WithSeed(const std::string& yaml_text, std::uint64_t seed) {
   return out.str();
 }
 
-// One dive of a scene with the given seed: simulated into a log in `folder`, mapped, measured;
-// the log is removed afterwards (a long dive's is hundreds of MB).
-DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t seed, const SlamBenchOptions& options,
-                      const std::filesystem::path& folder, const Progress& progress) {
-  DiveFigures f;
-  f.name = scene_path.stem().string();
-  f.seed = seed;
-  const std::string scene_text = WithSeed(ReadText(scene_path), f.seed);
-  const scanner::sim::Scene scene =
-      scanner::sim::ParseScene(scene_text, scene_path.string(), scene_path.parent_path());
-  const std::string label = f.name + " (seed " + std::to_string(f.seed) + ")";
-  const std::filesystem::path log_path = folder / (f.name + "_" + std::to_string(f.seed) + ".db");
-  {
-    const scanner::sim::Simulator simulator(scene);
-    mapping::DiveSimulationOptions sim_options;
-    sim_options.threads = options.threads;
-    sim_options.producer = "uwscan bench slam";
-    const mapping::DiveSimulationSummary summary = mapping::SimulateDive(
-        simulator, scene_text, log_path, sim_options,
-        [&](double fraction) { if (progress) progress("simulate " + label, fraction); });
-    f.simulate_seconds = summary.seconds;
-  }
+// Maps the dive's log and measures it against the truth (the scene's surfaces) and the peers,
+// into `f`; the log is closed on return.
+void MapAndMeasure(const std::filesystem::path& log_path, const scanner::sim::Scene& scene,
+                   const SlamBenchOptions& options, const std::string& label, const Progress& progress,
+                   DiveFigures* out) {
+  DiveFigures& f = *out;
   mapping::DiveMappingOptions map_options;
   map_options.mapper.threads = options.threads;
   map_options.table_cache = options.table_cache;
@@ -158,7 +142,8 @@ DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t see
   if (progress) progress("surface distances " + label, 0.0);
   f.dead_reckoning.ate_m = *s.ate_dead_reckoning_m;
   f.dead_reckoning.rpe_per_m = s.rpe_dead_reckoning_per_m;
-  f.dead_reckoning.map = DistanceToScene(PlacedMap(m, m.dead_reckoning, map_options.map_voxel_m), caster, options.threads);
+  f.dead_reckoning.map =
+      DistanceToScene(PlacedMap(m, m.dead_reckoning, map_options.map_voxel_m), caster, options.threads);
   f.slam.ate_m = *s.ate_slam_m;
   f.slam.rpe_per_m = s.rpe_slam_per_m;
   f.slam.map = DistanceToScene(m.map, caster, options.threads);
@@ -174,8 +159,40 @@ DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t see
     o.map = DistanceToScene(PlacedMap(m, poses, map_options.map_voxel_m), caster, options.threads);
     f.open3d = o;
   }
+}
+
+// One dive of a scene with the given seed: simulated into a log in `folder`, mapped, measured;
+// the log is removed afterwards (a long dive's is hundreds of MB).
+DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t seed, const SlamBenchOptions& options,
+                      const std::filesystem::path& folder, const Progress& progress) {
+  DiveFigures f;
+  f.name = scene_path.stem().string();
+  f.seed = seed;
+  const std::string scene_text = WithSeed(ReadText(scene_path), f.seed);
+  const scanner::sim::Scene scene =
+      scanner::sim::ParseScene(scene_text, scene_path.string(), scene_path.parent_path());
+  if (scene.seed != f.seed) {
+    throw Error(scene_path.string() + ": its seed could not be set to " + std::to_string(f.seed) +
+                " (expected one top-level line 'seed: N')");
+  }
+  const std::string label = f.name + " (seed " + std::to_string(f.seed) + ")";
+  const std::filesystem::path log_path = folder / (f.name + "_" + std::to_string(f.seed) + ".db");
+  {
+    const scanner::sim::Simulator simulator(scene);
+    mapping::DiveSimulationOptions sim_options;
+    sim_options.threads = options.threads;
+    sim_options.producer = "uwscan bench slam";
+    const mapping::DiveSimulationSummary summary = mapping::SimulateDive(
+        simulator, scene_text, log_path, sim_options,
+        [&](double fraction) { if (progress) progress("simulate " + label, fraction); });
+    f.simulate_seconds = summary.seconds;
+  }
+  MapAndMeasure(log_path, scene, options, label, progress, &f);
   if (progress) progress("surface distances " + label, 1.0);
-  std::filesystem::remove(log_path);
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
+    std::error_code ignored;  // a leftover the scratch folder removes at the end anyway
+    std::filesystem::remove(log_path.string() + suffix, ignored);
+  }
   return f;
 }
 

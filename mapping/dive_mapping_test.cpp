@@ -52,6 +52,14 @@ void ExpectSameBits(const DiveMapping& a, const DiveMapping& b) {
                                           std::bit_cast<std::uint32_t>(b.map.points[i][k]));
   }
   ASSERT_EQ(a.loops.size(), b.loops.size());
+  ASSERT_EQ(a.covariances.size(), b.covariances.size());
+  // The covariances come from a sparse QR (SuiteSparseQR through ceres::Covariance) whose
+  // rounding is not reproducible to the bit (2.6e-15 relative seen): equal to rounding.
+  for (std::size_t i = 0; i < a.covariances.size(); ++i) {
+    EXPECT_LT((a.covariances[i] - b.covariances[i]).norm(), 1e-12 * a.covariances[i].norm()) << "pose " << i;
+  }
+  ASSERT_TRUE(a.expected_map_error_m && b.expected_map_error_m);
+  EXPECT_NEAR(*a.expected_map_error_m, *b.expected_map_error_m, 1e-12 * *a.expected_map_error_m);
 }
 
 TEST_F(DiveMappingTest, WithoutDriftTheMapLiesOnTheTruth) {
@@ -108,8 +116,8 @@ TEST_F(DiveMappingTest, TheMapsExpectedErrorIsWhatItsDistanceToTheTruthComesTo) 
     ++count;
   }
   const double measured = std::sqrt(sum / static_cast<double>(count));
-  EXPECT_GT(measured, 0.3 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
-  EXPECT_LT(measured, 3.0 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
+  EXPECT_GT(measured, 0.6 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
+  EXPECT_LT(measured, 1.5 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
 }
 
 TEST_F(DiveMappingTest, AlongASinglePipeTheMapFollowsTheNavigation) {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "scanner/common/error.hpp"
 
@@ -58,7 +59,8 @@ TEST(ExpectedSurfaceError, AgreesWithPosesDrawnFromTheCovariance) {
     for (int k = 0; k < 6; ++k) z(k) = normal(rng);
     const Eigen::Matrix<double, 6, 1> e = llt.matrixL() * z;
     Eigen::Isometry3d moved = T_W_V;
-    moved.linear() = Eigen::AngleAxisd(e.head<3>().norm(), e.head<3>().normalized()).toRotationMatrix() * T_W_V.linear();
+    const Eigen::AngleAxisd turn(e.head<3>().norm(), e.head<3>().normalized());
+    moved.linear() = turn.toRotationMatrix() * T_W_V.linear();
     moved.translation() += e.tail<3>();
     for (std::size_t i = 0; i < seabed.size(); i += 7) {
       const Eigen::Vector3d n_W = T_W_V.linear() * seabed.normals[i].cast<double>();
@@ -71,13 +73,29 @@ TEST(ExpectedSurfaceError, AgreesWithPosesDrawnFromTheCovariance) {
   EXPECT_NEAR(expected / sampled, 1.0, 0.05) << expected << " m predicted, " << sampled << " m sampled";
 }
 
+// The message of the uwscan::Error `call` throws ("" when it throws none).
+template <typename Call>
+std::string ErrorOf(Call call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(ExpectedSurfaceError, MismatchedInputsGiveAClearError) {
   const perception::PointCloud seabed = Seabed();
   perception::PointCloud bare = seabed;
   bare.normals.clear();
-  EXPECT_THROW(ExpectedSurfaceErrorRms({&seabed}, {}, {Matrix6d::Identity()}), Error);
-  EXPECT_THROW(ExpectedSurfaceErrorRms({&bare}, {Eigen::Isometry3d::Identity()}, {Matrix6d::Identity()}), Error);
-  EXPECT_THROW(ExpectedSurfaceErrorRms({&seabed}, {Eigen::Isometry3d::Identity()}, {Matrix6d::Identity()}, 0), Error);
+  const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  const auto says = [](const std::string& message, const char* what) {
+    EXPECT_NE(message.find(what), std::string::npos) << "'" << message << "' does not say '" << what << "'";
+  };
+  says(ErrorOf([&] { ExpectedSurfaceErrorRms({&seabed}, {}, {Matrix6d::Identity()}); }),
+       "1 clouds, 0 poses and 1 covariances");
+  says(ErrorOf([&] { ExpectedSurfaceErrorRms({&bare}, {pose}, {Matrix6d::Identity()}); }), "submap 0 has no normals");
+  says(ErrorOf([&] { ExpectedSurfaceErrorRms({&seabed}, {pose}, {Matrix6d::Identity()}, 0); }), "stride must be > 0");
 }
 
 }  // namespace

@@ -278,9 +278,14 @@ Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationRes
 }
 
 Matrix6d Mapper::Impl::Distortion(const Submap& s, SystematicErrors systematic_errors) const {
-  return uncertainty.SubmapDistortionCovariance(s.T_W_V_start, s.T_W_V_end, s.end_s - s.start_s, s.rms_radius_m,
-                                                s.centroid_V,
-                                                systematic_errors);
+  SweepPlacement sweep;
+  sweep.T_W_start = s.T_W_V_start;
+  sweep.T_W_anchor = s.T_W_V_nav;
+  sweep.T_W_end = s.T_W_V_end;
+  sweep.span_s = s.end_s - s.start_s;
+  sweep.footprint_radius_m = s.rms_radius_m;
+  sweep.footprint_centre_V = s.centroid_V;
+  return uncertainty.SubmapDistortionCovariance(sweep, systematic_errors);
 }
 
 Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b) const {
@@ -547,13 +552,13 @@ std::optional<Mapper::SubmapCovariances> Mapper::Covariances() const {
   return out;
 }
 
-perception::PointCloud Mapper::Map(double voxel_m, bool with_navigation) const {
+perception::PointCloud Mapper::Map(double voxel_m) const {
   std::vector<const perception::PointCloud*> clouds;
   std::vector<Eigen::Isometry3d> poses;
   for (int i = 0; i < submap_count(); ++i) {
     const Submap& s = impl_->submaps[static_cast<size_t>(i)];
     clouds.push_back(&s.cloud);
-    poses.push_back(with_navigation ? s.T_W_V_nav : scan_pose(i));
+    poses.push_back(scan_pose(i));
   }
   return MergeClouds(clouds, poses, voxel_m);
 }

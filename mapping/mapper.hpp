@@ -41,7 +41,7 @@ struct MapperOptions {
   int max_loop_candidates = 1;
   // Loop closures are tried at every this many submaps, > 0. A sweep's footprint is several
   // times what the vehicle moves during it, so every other one still ties each stretch of a
-  // revisit: over five seeds per dive, the same map error at 0.6x the mapping time.
+  // revisit: over five seeds per dive, the same map error at 0.75x the mapping time.
   int loop_every_submaps = 2;
   double gate_sigmas = 3.0;
   // Two submaps overlap enough to match when their centres are closer than this fraction of
@@ -153,9 +153,9 @@ class Mapper {
     std::vector<Matrix6d> anchors, scans;
   };
   std::optional<SubmapCovariances> Covariances() const;
-  // Every submap's cloud placed with the current estimates (or the navigation), voxelised at
-  // `voxel_m`, origin at the first submap's position.
-  perception::PointCloud Map(double voxel_m, bool with_navigation = false) const;
+  // Every submap's cloud placed with the current estimates, voxelised at `voxel_m`, origin at
+  // the first submap's position.
+  perception::PointCloud Map(double voxel_m) const;
 
  private:
   struct Impl;

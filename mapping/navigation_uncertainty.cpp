@@ -93,26 +93,25 @@ Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W
   return WorldAxesToFrame(world, T_W_a.linear());
 }
 
-Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_start,
-                                                           const Eigen::Isometry3d& T_W_end, double span_s,
-                                                           double footprint_radius_m,
-                                                           const Eigen::Vector3d& footprint_centre,
+Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const SweepPlacement& sweep,
                                                            SystematicErrors systematic) const {
-  const double walk2 = noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * std::max(span_s, 0.0);
-  const double radius = std::max(footprint_radius_m, kMinFootprintRadius_m);
-  Matrix6d world = Matrix6d::Zero();
+  const double span_s = std::max(sweep.span_s, 0.0);
+  const double walk2 = noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * span_s;
+  const double radius = std::max(sweep.footprint_radius_m, kMinFootprintRadius_m);
+  // About the footprint's centre, along the world's axes.
+  Matrix6d at_centre = Matrix6d::Zero();
   // Roll and pitch: the depth error changing as the stripe crosses the footprint (at most the
   // difference of two independent errors), taken by the fit as a tilt as the sideways walk is
-  // taken as a turn.
-  world(0, 0) = world(1, 1) = kTurnShare * 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m / (radius * radius);
-  // Heading: its own walk, and the sideways walk of the frames as the stripe crosses the
-  // footprint (kTurnShare of the walk's variance over the radius).
-  world(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * span_s +
-                kTurnShare * walk2 / (radius * radius);
+  // taken as a turn. The footprint's RMS radius spans all three axes, not only the one the
+  // stripe crosses, so both shares err on the cautious side.
+  at_centre(0, 0) = at_centre(1, 1) =
+      kTurnShare * 2.0 * noise_.depth_sigma_m * noise_.depth_sigma_m / (radius * radius);
+  // Heading: the sideways walk of the frames as the stripe crosses the footprint.
+  at_centre(2, 2) = kTurnShare * walk2 / (radius * radius);
   // Position: the walk since the anchor averaged over the span (a third of its variance at the
   // ends, the rigid fit's share of a Brownian path pinned at the middle, with margin).
   Eigen::Matrix2d xy = Eigen::Matrix2d::Identity() * (walk2 / 3.0);
-  const Eigen::Vector2d moved = (T_W_end.translation() - T_W_start.translation()).head<2>();
+  const Eigen::Vector2d moved = (sweep.T_W_end.translation() - sweep.T_W_start.translation()).head<2>();
   const double distance = moved.norm();
   if (distance > 0.0 && systematic == SystematicErrors::kAsNoise) {
     // Stretched by the scale error and sheared by the misalignment about the middle.
@@ -122,16 +121,22 @@ Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const Eigen::Isometry
     const double bias = 0.5 * noise_.heading_bias_sigma_rad * distance;
     xy += scale * scale * along * along.transpose() + bias * bias * across * across.transpose();
   }
-  world.block<2, 2>(3, 3) = xy;
-  world(5, 5) = noise_.depth_sigma_m * noise_.depth_sigma_m;
-  // A submap of one frame is not bent at all; its covariance still has to be invertible.
-  for (int k = 0; k < 6; ++k) world(k, k) += k < 3 ? kFloorHeadingBias_rad * kFloorHeadingBias_rad : kFloorDepth_m * kFloorDepth_m;
-  // All of the above is about the footprint's centre, where the fit turns; at the vehicle's
-  // origin a turn w also moves it by -w x centre.
+  at_centre.block<2, 2>(3, 3) = xy;
+  at_centre(5, 5) = noise_.depth_sigma_m * noise_.depth_sigma_m;
+  // At the vehicle's origin (the anchor) a turn w about the centre also moves it by -w x centre.
   Matrix6d about_origin = Matrix6d::Identity();
-  about_origin.bottomLeftCorner<3, 3>() = Skew(footprint_centre);
-  const Matrix6d in_start = WorldAxesToFrame(world, T_W_start.linear());
-  return about_origin * in_start * about_origin.transpose();
+  about_origin.bottomLeftCorner<3, 3>() = Skew(sweep.footprint_centre_V);
+  const Eigen::Matrix3d& R_W_anchor = sweep.T_W_anchor.linear();
+  Matrix6d covariance = about_origin * WorldAxesToFrame(at_centre, R_W_anchor) * about_origin.transpose();
+  // The heading's own walk turns the frames about the vehicle, not about the footprint.
+  Matrix6d own_heading = Matrix6d::Zero();
+  own_heading(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * span_s;
+  covariance += WorldAxesToFrame(own_heading, R_W_anchor);
+  // A submap of one frame is not bent at all; its covariance still has to be invertible.
+  for (int k = 0; k < 6; ++k) {
+    covariance(k, k) += k < 3 ? kFloorHeadingBias_rad * kFloorHeadingBias_rad : kFloorDepth_m * kFloorDepth_m;
+  }
+  return covariance;
 }
 
 Matrix6d NavigationUncertainty::BendingCovariance(double span_s, double footprint_radius_m) const {

@@ -7,6 +7,17 @@
 
 namespace uwscan::mapping {
 
+// A submap's sweep as the navigation placed it: what its bending depends on.
+struct SweepPlacement {
+  // The navigation at the sweep's first, middle (the anchor) and last frame.
+  Eigen::Isometry3d T_W_start = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_W_anchor = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_W_end = Eigen::Isometry3d::Identity();
+  double span_s = 0.0;                // first to last frame
+  double footprint_radius_m = 0.0;    // RMS distance of its points from their centre
+  Eigen::Vector3d footprint_centre_V = Eigen::Vector3d::Zero();  // in the anchor's frame
+};
+
 // Whether a dead-reckoned motion's covariance holds the speed scale error and the misalignment
 // (kAsNoise), or leaves them out because the pose graph estimates them (kEstimated,
 // dead_reckoning_calibration.hpp).
@@ -29,20 +40,17 @@ class NavigationUncertainty {
   Matrix6d IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b, double dt_s,
                                SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
-  // How far from its anchor's pose a submap, bent by the navigation that placed its frames
-  // between start and end (span_s apart), is best fitted by a rigid pose: scan matching aligns
-  // shapes, so it measures that effective pose, not the anchor's. The frames sit off by the
-  // random walk since the anchor; a rigid fit over the span keeps about a third of its variance
-  // as a shift, and a tenth of its sideways part over the footprint's squared RMS radius as a
-  // turn; depth errors across the footprint tilt it; with kAsNoise, the scale error stretches
-  // it and the misalignment shears it about the middle. All of this happens about the
-  // footprint's centre (`footprint_centre`, in the anchor's frame), so a turn also moves the
-  // anchor's origin sideways. In start's frame. The graph's nodes are the
-  // effective poses: this covariance goes into the navigation's edges and priors, not the
-  // registrations'.
-  Matrix6d SubmapDistortionCovariance(const Eigen::Isometry3d& T_W_start, const Eigen::Isometry3d& T_W_end,
-                                      double span_s, double footprint_radius_m,
-                                      const Eigen::Vector3d& footprint_centre,
+  // How far from its anchor's pose a submap, bent by the navigation that placed its frames, is
+  // best fitted by a rigid pose: scan matching aligns shapes, so it measures that effective
+  // pose, not the anchor's. The frames sit off by the random walk since the anchor; a rigid fit
+  // over the span keeps about a third of its variance as a shift, and a tenth of its sideways
+  // part over the footprint's squared RMS radius as a turn; depth errors across the footprint
+  // tilt it; with kAsNoise, the scale error stretches it and the misalignment shears it about
+  // the middle. All of this happens about the footprint's centre, so a turn also moves the
+  // anchor's origin sideways; the heading's own walk turns it about the origin. As the
+  // [w, v] of T_anchor_scan, in the anchor's frame. The graph's nodes are the effective poses:
+  // this covariance goes into the navigation's edges and priors, not the registrations'.
+  Matrix6d SubmapDistortionCovariance(const SweepPlacement& sweep,
                                       SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
   // What a rigid pose cannot take out of that bending: the random walk's departure from a

@@ -14,7 +14,7 @@ namespace {
 // vehicle at a steady rate while the dead reckoning's position walks sideways. The rigid pose
 // that best fits the frames as placed onto where they truly are is the submap's effective pose;
 // its spread over many walks is what SubmapDistortionCovariance has to describe.
-struct SweepGeometry {
+struct WalkingSweep {
   Eigen::Vector3d centre{0.7, 0.0, 1.0};  // footprint centre in the anchor's frame (m)
   double length_m = 0.7;                  // crossed by the stripe during the sweep, along x
   double width_m = 0.45;                  // the stripe's length, along y
@@ -23,7 +23,7 @@ struct SweepGeometry {
   double span_s = 0.5;
 };
 
-std::vector<Eigen::Vector3d> Footprint(const SweepGeometry& g) {
+std::vector<Eigen::Vector3d> Footprint(const WalkingSweep& g) {
   std::vector<Eigen::Vector3d> points;
   for (int k = 0; k < g.frames; ++k) {
     const double x = g.length_m * (static_cast<double>(k) / (g.frames - 1) - 0.5);
@@ -43,7 +43,7 @@ double RmsRadius(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector
 
 // [w, v] of the best rigid fit of the frames placed with a walking position onto their truth,
 // for `trials` walks pinned at the middle frame (the anchor).
-std::vector<Vector6d> FittedOffsets(const SweepGeometry& g, double walk_m_per_sqrt_s, int trials) {
+std::vector<Vector6d> FittedOffsets(const WalkingSweep& g, double walk_m_per_sqrt_s, int trials) {
   const std::vector<Eigen::Vector3d> truth = Footprint(g);
   const double step = walk_m_per_sqrt_s * std::sqrt(g.span_s / (g.frames - 1));
   std::mt19937_64 rng(7);
@@ -78,15 +78,20 @@ Matrix6d SampleCovariance(const std::vector<Vector6d>& samples) {
 }
 
 TEST(NavigationUncertainty, SubmapDistortionMatchesTheRigidFitOfAWalkingSweep) {
-  const SweepGeometry g;
+  const WalkingSweep g;
   NavigationNoise noise{0.003, 0.0, 0.0, 0.0, 0.0, 0.0};
   const NavigationUncertainty model(noise);
   const std::vector<Eigen::Vector3d> points = Footprint(g);
-  Eigen::Isometry3d end = Eigen::Isometry3d::Identity();
-  end.translation().x() = 0.125;  // 0.25 m/s over the sweep
-  const Matrix6d predicted = model.SubmapDistortionCovariance(Eigen::Isometry3d::Identity(), end, g.span_s,
-                                                              RmsRadius(points, g.centre), g.centre,
-                                                              SystematicErrors::kEstimated);
+  // Heading 0.7 rad east of north, 0.25 m/s over the sweep: the model works in the anchor's frame.
+  SweepPlacement sweep;
+  const Eigen::Matrix3d R_W_V = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  sweep.T_W_start.linear() = sweep.T_W_anchor.linear() = sweep.T_W_end.linear() = R_W_V;
+  sweep.T_W_anchor.translation() = R_W_V * Eigen::Vector3d(0.0625, 0.0, 0.0);
+  sweep.T_W_end.translation() = R_W_V * Eigen::Vector3d(0.125, 0.0, 0.0);
+  sweep.span_s = g.span_s;
+  sweep.footprint_radius_m = RmsRadius(points, g.centre);
+  sweep.footprint_centre_V = g.centre;
+  const Matrix6d predicted = model.SubmapDistortionCovariance(sweep, SystematicErrors::kEstimated);
   const Matrix6d measured = SampleCovariance(FittedOffsets(g, noise.position_walk_m_per_sqrt_s, 4000));
 
   // The turn the fit takes from the sideways walk, within a quarter of the model's.
