@@ -78,7 +78,6 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
     const Submap& s = mapper.submap(i);
     result.slam.push_back({s.anchor_time_s, mapper.pose(i)});
     result.dead_reckoning.push_back({s.anchor_time_s, s.T_W_V_nav});
-    result.scan_poses.push_back({s.anchor_time_s, mapper.scan_pose(i)});
     if (options.keep_submaps) result.submap_clouds.push_back(s.cloud);
     if (const std::optional<GroundTruthRecord> truth = log.ReadGroundTruth(s.anchor_frame)) {
       result.truth.push_back({s.anchor_time_s, truth->T_W_C * T_C_V});

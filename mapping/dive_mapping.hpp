@@ -29,7 +29,6 @@ struct DiveMapping {
   std::vector<TimedPose> slam;            // T_W_V of each submap's anchor, estimated
   std::vector<TimedPose> dead_reckoning;  // the navigation at the same times
   std::vector<TimedPose> truth;           // the truth at the same times (simulated logs only)
-  std::vector<TimedPose> scan_poses;      // the pose each submap's cloud is placed with
   std::vector<Matrix6d> covariances;      // per pose, [rotation, position] (empty: not computed)
   // The map's expected distance to the true surfaces from its poses' uncertainty alone (RMS
   // along the normals, ExpectedSurfaceErrorRms); empty with the covariances.
