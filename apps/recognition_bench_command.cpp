@@ -121,7 +121,7 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
   cmd->add_flag("--no-images", a->no_images, "exact peaks with 0.1 px noise instead of rendered frames");
   cmd->add_flag("--no-peers", [a](std::int64_t) { a->options.run_peers = false; }, "uwscan only");
   cmd->add_flag("--no-ppf", [a](std::int64_t) { a->options.run_ppf = false; },
-                "leave OpenCV's PPF out of the peers (its match can loop without end on some segments)");
+                "leave OpenCV's PPF out of the peers (about 30 s of training, then seconds per scan)");
   cmd->add_option("--threads", a->options.threads, "threads")->check(CLI::Range(1, 256));
   cmd->add_option("--seed", a->options.seed, "scene and noise seed");
   cmd->add_option("--only", a->options.only, "run only these scenes (indices below --scans), to look at a case");

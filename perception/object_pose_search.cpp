@@ -4,6 +4,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <numbers>
 
 #include "perception/coarse_alignment.hpp"
@@ -170,6 +172,54 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
     if (!repeat) kept.push_back(moved[s]);
   }
   return kept;
+}
+
+double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const KnnIndex& model_index,
+                         const Eigen::Isometry3d& T_O_S, double voxel_m) {
+  const double cap = voxel_m * voxel_m;
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < sample.size(); ++i) {
+    const Eigen::Vector3d x_O = T_O_S * sample.Point(i);
+    model_index.Query((x_O - model.model.origin).cast<float>(), 1, nearest, squared);
+    if (nearest.empty() || squared[0] > cap) {
+      sum += cap;
+      continue;
+    }
+    const double along_normal =
+        model.model.normals[nearest[0]].cast<double>().dot(x_O - model.model.Point(nearest[0]));
+    sum += std::min(along_normal * along_normal, cap);
+  }
+  return sum;
+}
+
+std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, const ObjectModel& model,
+                                                   const KnnIndex& model_index, const SymmetryAxis& axis,
+                                                   const Eigen::Isometry3d& T_O_S, double voxel_m) {
+  if (axis.order < 3 || sample.size() == 0 || !model.model.has_normals()) return {};
+  const double period = 2.0 * std::numbers::pi / axis.order;
+  const double step = std::min(period / 8.0, 0.5 * voxel_m / std::max(0.5 * model.diameter_m, voxel_m));
+  const int steps = static_cast<int>(std::ceil(0.5 * period / step));
+  auto turned = [&](double angle) {
+    return Eigen::Translation3d(axis.point_O) * Eigen::AngleAxisd(angle, axis.axis_O.normalized()) *
+           Eigen::Translation3d(-axis.point_O) * T_O_S;
+  };
+  std::vector<double> residual;
+  for (int k = -steps; k <= steps; ++k) {
+    residual.push_back(TruncatedResidual(sample, model, model_index, turned(k * step), voxel_m));
+  }
+  const std::size_t lowest = static_cast<std::size_t>(std::min_element(residual.begin(), residual.end()) - residual.begin());
+  const double near = residual[lowest] + 0.5 * voxel_m * voxel_m;
+  std::size_t first = lowest, last = lowest;
+  while (first > 0 && residual[first - 1] <= near) --first;
+  while (last + 1 < residual.size() && residual[last + 1] <= near) ++last;
+  std::vector<Eigen::Isometry3d> starts;
+  const double lowest_turn = static_cast<double>(lowest) - steps;
+  const double middle_turn = std::round(0.5 * static_cast<double>(first + last)) - steps;
+  if (lowest_turn != 0.0) starts.push_back(turned(lowest_turn * step));
+  if (middle_turn != 0.0 && middle_turn != lowest_turn) starts.push_back(turned(middle_turn * step));
+  return starts;
 }
 
 }  // namespace uwscan::perception

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "perception/cloud_neighbors.hpp"
 #include "perception/fpfh.hpp"
 #include "perception/icp.hpp"
 #include "perception/object_database.hpp"
@@ -63,5 +64,23 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
                                           const std::vector<Eigen::Isometry3d>& starts, double diameter_m,
                                           const ObjectDatabaseParameters& p,
                                           const RecognitionOptions& options);
+
+// Sum over `sample` (segment frame) of the squared point-to-plane distances to the nearest
+// points of the model posed by T_O_S, each at most voxel_m^2: a point farther than a voxel from
+// every model point counts the cap, as no pair at all. `model_index` holds model.model's points.
+double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const KnnIndex& model_index,
+                         const Eigen::Isometry3d& T_O_S, double voxel_m);
+
+// Phases worth trying about one of the model's symmetry axes of order N >= 3 (a surface of
+// revolution whose details repeat N times: a flange's bolt heads): the pose turned about the
+// axis in steps of about half a voxel at the object's rim over one period (2 pi / N), each
+// scored by TruncatedResidual; returned are the lowest turn and the middle of the run of turns
+// within half a point's cap of it (small details sampled at the voxel fit alike over a few
+// steps), those other than the pose itself. ICP alone does not find that phase: the details
+// stand off the surface beyond its pairing distance unless they already overlap. T_O_S as ICP
+// gives it (segment to object), and the same for the results.
+std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, const ObjectModel& model,
+                                                   const KnnIndex& model_index, const SymmetryAxis& axis,
+                                                   const Eigen::Isometry3d& T_O_S, double voxel_m);
 
 }  // namespace uwscan::perception
