@@ -62,6 +62,9 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o) {
                     {"order", f.order}});
   }
   j["free_directions"] = free;
+  nlohmann::json equivalent = nlohmann::json::array();
+  for (const Eigen::Isometry3d& T_S_O : o.equivalent_poses_S) equivalent.push_back(Pose(T_S_O));
+  j["equivalent_poses"] = equivalent;
   nlohmann::json grasps = nlohmann::json::array();
   for (const auto& [name, T_S_G] : o.grasps_S) {
     nlohmann::json g = Pose(T_S_G);

@@ -150,11 +150,33 @@ std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
   return peers;
 }
 
+// Whether a pose off the truth is right but for what its answer reports it cannot tell: one of
+// the equivalent poses is within 5 mm and 2 degrees (modulo symmetry), or the pose is once the
+// translation along its reported free directions is left out.
+bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
+                               const Eigen::Isometry3d& T_S_O_true, const std::vector<Eigen::Vector3d>& points,
+                               const ObjectModel& model, const perception::RecognizedObject* reported) {
+  if (reported == nullptr) return false;
+  for (const Eigen::Isometry3d& T : reported->equivalent_poses_S) {
+    const perception::SymmetricPoseError other =
+        perception::PoseErrorModuloSymmetry(T, T_S_O_true, points, model.symmetries);
+    if (other.rotation_rad <= 2.0 * kDeg && other.translation_m <= 0.005) return true;
+  }
+  if (e.rotation_rad > 2.0 * kDeg) return false;
+  Eigen::Vector3d offset = T_S_O.translation() - e.T_symmetric.translation();
+  for (const perception::FreeDirection& f : reported->free_directions) {
+    if (f.kind == "unconstrained" && f.motion == "translation") offset -= offset.dot(f.axis_S) * f.axis_S;
+  }
+  return offset.norm() <= 0.005;
+}
+
 // Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
 // the pose error modulo symmetry when the answer is right.
+// `reported`: uwscan's answer, for its equivalent poses and free slides (none for the peers).
 std::optional<perception::SymmetricPoseError> Score(const std::string& truth, const std::string& answer,
            const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
-           const ObjectDatabase& db, PipelineFigures& figures) {
+           const ObjectDatabase& db, PipelineFigures& figures,
+           const perception::RecognizedObject* reported = nullptr) {
   figures.confusion[truth][answer] += 1;
   if (truth == "foreign") {
     ++figures.foreign;
@@ -172,7 +194,9 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
       perception::PoseErrorModuloSymmetry(*T_S_O, T_S_O_true, points, model.symmetries);
   figures.rotation_errors_rad.push_back(e.rotation_rad);
   figures.translation_errors_m.push_back(e.translation_m);
-  if (e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005) ++figures.pose_success;
+  const bool posed = e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005;
+  figures.pose_success += posed;
+  figures.pose_or_reported += posed || PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, reported);
   if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
   if (model.grasps.empty()) return e;
   const Eigen::Isometry3d& T_true = e.T_symmetric;
@@ -286,7 +310,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
       const std::string& truth = scene.classes[o];
       if (best_segment < 0) {
-        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}});
+        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0});
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
@@ -296,8 +320,8 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       }
       const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
       ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
-                            -1.0, -1.0, ours.candidates};
-      if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"])) {
+                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size())};
+      if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"], &ours)) {
         outcome.rotation_error_rad = e->rotation_rad;
         outcome.translation_error_m = e->translation_m;
       }

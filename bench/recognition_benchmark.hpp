@@ -37,6 +37,10 @@ struct PipelineFigures {
   int objects = 0;              // catalogue objects in the scans (the rate's denominator)
   int recognised = 0;           // with the right id
   int pose_success = 0;         // of those: within 5 mm and 2 degrees modulo symmetry
+  // ...or wrong only in what the answer says it cannot tell: one of its equivalent poses is
+  // within 5 mm and 2 degrees, or the pose is once its reported free slides are left out
+  // (peers report neither: the same as pose_success)
+  int pose_or_reported = 0;
   int mssd_success = 0;         // of those: MSSD below 0.1 x diameter
   int grasp_success = 0;        // of those: grasp within 5 mm and 3 degrees
   int foreign = 0, foreign_unknown = 0;  // foreign meshes, and those called "unknown"
@@ -57,6 +61,7 @@ struct ObjectOutcome {
   int segment_points = 0;     // scan points in that segment
   double rotation_error_rad = -1.0, translation_error_m = -1.0;  // modulo symmetry; -1: no pose
   std::vector<perception::RecognitionCandidate> candidates;  // uwscan's, best first
+  int equivalent_poses = 0;   // other poses uwscan reported as fitting as well
 };
 
 struct RecognitionBenchResult {

@@ -13,29 +13,6 @@
 #include "perception/view_pose_hypotheses.hpp"
 
 namespace uwscan::perception {
-namespace {
-
-// Half turns about the three principal axes of a cloud through its centroid.
-std::vector<Eigen::Isometry3d> HalfTurns(const PointCloud& cloud) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i) centroid += cloud.Point(i);
-  centroid /= static_cast<double>(cloud.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3d d = cloud.Point(i) - centroid;
-    scatter += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
-  std::vector<Eigen::Isometry3d> turns;
-  for (int k = 0; k < 3; ++k) {
-    turns.push_back(Eigen::Translation3d(centroid) *
-                    Eigen::AngleAxisd(std::numbers::pi, eigen.eigenvectors().col(k)) *
-                    Eigen::Translation3d(-centroid));
-  }
-  return turns;
-}
-
-}  // namespace
 
 ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads) {
   NormalOptions normals;
@@ -57,6 +34,26 @@ const ViewFeatures& ViewFeatureCache::Get(std::size_t object, std::size_t view, 
   }
   return *slot;
 }
+
+std::vector<Eigen::Isometry3d> HalfTurns(const PointCloud& cloud) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) centroid += cloud.Point(i);
+  centroid /= static_cast<double>(cloud.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d d = cloud.Point(i) - centroid;
+    scatter += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+  std::vector<Eigen::Isometry3d> turns;
+  for (int k = 0; k < 3; ++k) {
+    turns.push_back(Eigen::Translation3d(centroid) *
+                    Eigen::AngleAxisd(std::numbers::pi, eigen.eigenvectors().col(k)) *
+                    Eigen::Translation3d(-centroid));
+  }
+  return turns;
+}
+
 
 // Point-to-plane ICP of a segment onto a model, to the scale of the data.
 IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int threads) {

@@ -41,6 +41,9 @@ class ViewFeatureCache {
   std::map<std::pair<std::size_t, std::size_t>, std::unique_ptr<ViewFeatures>> described_;
 };
 
+// Half turns about the three principal axes of a cloud through its centroid (T_new_old).
+std::vector<Eigen::Isometry3d> HalfTurns(const PointCloud& cloud);
+
 // Point-to-plane ICP of a segment onto a model, to the scale of the data, pairing only points
 // whose normals agree within 60 degrees (the segment's facing the sensor, the model's outwards).
 IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int threads);

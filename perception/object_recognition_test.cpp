@@ -319,6 +319,32 @@ TEST(ObjectPoseSearch, TheBoltsPhaseIsFound) {
   EXPECT_TRUE(SymmetryPhaseStarts(sample, *flange, index, half_turn, off, voxel_m).empty());
 }
 
+// A lever valve whose lever the scan does not hold (cut off the mesh scanned, as when it lies
+// out of the sweep): its body fits the model turned half a turn about the stem as well, and the
+// answer says so with an equivalent pose turned about the stem.
+TEST(ObjectRecognition, AValveWithoutItsHandleInViewReportsTheTurnAboutItsStem) {
+  const ObjectSource lever = CatalogueObject("valve_lever");
+  sim::ValveShape shape;
+  scanner::TriangleMesh body = lever.mesh;
+  std::erase_if(body.triangles, [&](const Eigen::Vector3i& t) {
+    const double low = std::min({body.vertices[t[0]].y(), body.vertices[t[1]].y(), body.vertices[t[2]].y()});
+    return low > shape.stem_length_m - 0.011;  // the lever (12 mm thick, 2 mm above the stem) and the stem's cap
+  });
+  const ObjectDatabase db = Build({"valve_lever"}, 2);
+  const Scan scan = ScanOnSeabed(body, Eigen::Vector3d(0.05, 0.1, 0.75), 9);  // from above: both sides in view
+  const RecognitionResult r = RecognizeObjects(scan.cloud, db);
+  const RecognizedObject* found = Nearest(r, scan);
+  ASSERT_NE(found, nullptr);
+  ASSERT_EQ(found->object_id, "valve_lever");
+  const Eigen::Vector3d stem_S = found->T_S_O.linear() * Eigen::Vector3d::UnitY();
+  bool turned_about_stem = false;
+  for (const Eigen::Isometry3d& T : found->equivalent_poses_S) {
+    const Eigen::AngleAxisd turn((T * found->T_S_O.inverse()).linear());
+    turned_about_stem |= turn.angle() > 170.0 * std::numbers::pi / 180.0 && std::abs(turn.axis().dot(stem_S)) > 0.98;
+  }
+  EXPECT_TRUE(turned_about_stem) << found->equivalent_poses_S.size() << " equivalent poses";
+}
+
 // Recognition needs nothing but points in the sensor's frame: a scan by another sensor (the
 // MEMS scanner; the database was made by the galvanometer scanner) read back from a plain PLY.
 TEST(ObjectRecognition, APlainPlyFromAnotherSensorIsRecognised) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <tuple>
 
@@ -19,6 +20,7 @@
 #include "perception/normals.hpp"
 #include "perception/object_database_builder.hpp"
 #include "perception/object_pose_search.hpp"
+#include "perception/object_symmetry.hpp"
 #include "perception/plane_removal.hpp"
 #include "perception/recognition_verification.hpp"
 #include "perception/scan_segments.hpp"
@@ -239,6 +241,53 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   }
   ctx.clock.Lap("final");
   return best;
+}
+
+// Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
+// equivalent_poses_S): its pose turned half a turn about each principal axis of the model and
+// each axis of its frame (where a nearly symmetric object, a valve's body or a tee's run, fits
+// either way), refined by
+// the fine ICP and verified like it; kept when verified, scoring within score_tie of it and
+// more than 5 degrees or 2 voxels from it and from each other modulo the object's symmetries.
+// T_S_O each.
+std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const PosedObject& posed,
+                                               const SceneAround& around, const ScanContext& ctx) {
+  const ObjectModel& model = ctx.db.objects[posed.object];
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
+  const IcpTarget target(model.model);
+  const KnnIndex model_index(model.model.points);
+  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
+  // About the model's principal axes, and about its own frame's axes through its origin (a
+  // procedural object's stem or run: a valve's lever tilts the principal axes off its stem).
+  std::vector<Eigen::Isometry3d> turns = HalfTurns(model.model);
+  for (int axis = 0; axis < 3; ++axis) {
+    turns.emplace_back(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::Unit(axis)));
+  }
+  std::vector<RecognitionCandidate> turned(turns.size());
+  const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+  for (std::ptrdiff_t k = 0; k < std::ssize(turns); ++k) {
+    const std::size_t i = static_cast<std::size_t>(k);
+    const RegistrationResult refined = AlignIcp(sample, target, turns[i] * posed.fine.T_target_source,
+                                                FineIcp(model.diameter_m, p, 1));
+    Verify(s.cloud, model, model_index, around, refined, ctx, turned[i]);
+  }
+  std::vector<Eigen::Vector3d> points_O;
+  for (std::size_t i = 0; i < model.model.size(); i += 4) points_O.push_back(model.model.Point(i));
+  const double same_rad = 5.0 * std::numbers::pi / 180.0, same_m = 2.0 * p.voxel_m;
+  std::vector<Eigen::Isometry3d> equivalent;
+  for (const RecognitionCandidate& c : turned) {
+    if (!c.verified || c.score < posed.candidate.score - ctx.options.score_tie) continue;
+    bool seen = false;
+    for (const Eigen::Isometry3d& known : equivalent) {
+      const SymmetricPoseError e = PoseErrorModuloSymmetry(c.T_S_O, known, points_O, model.symmetries);
+      seen |= e.rotation_rad < same_rad && e.translation_m < same_m;
+    }
+    const SymmetricPoseError e = PoseErrorModuloSymmetry(c.T_S_O, posed.candidate.T_S_O, points_O, model.symmetries);
+    seen |= e.rotation_rad < same_rad && e.translation_m < same_m;
+    if (!seen) equivalent.push_back(c.T_S_O);
+  }
+  return equivalent;
 }
 
 // Up to max_candidates objects whose nearest view is within max_chi_square (and within
@@ -561,6 +610,8 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
         const PosedObject& best = posed.front();
         const ObjectModel& model = db.objects[best.object];
         Accept(best, model, NearestOther(best.object, nearest_chi_square), ctx, object);
+        object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
+        clock.Lap("equivalents");
         if (split_allowed) {
           // What the object leaves unexplained may be another one touching it.
           const KnnIndex model_index(model.model.points);

@@ -98,6 +98,11 @@ struct RecognizedObject {
   // point-to-plane residual. Free directions carry none (0 there).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   std::vector<FreeDirection> free_directions;
+  // Other poses of this object that fit the scan as well (verified, scoring within score_tie)
+  // and are not the same modulo its symmetries: what the scan cannot tell apart, such as a
+  // valve's body turned half a turn about its stem while its handle is out of the sweep, or a
+  // tee turned about its run while its branch is. T_S_O each; empty when the pose is unique.
+  std::vector<Eigen::Isometry3d> equivalent_poses_S;
   std::vector<std::pair<std::string, Eigen::Isometry3d>> grasps_S;  // name, T_S_G
   std::vector<RecognitionCandidate> candidates;  // every object considered, best first
   std::vector<std::size_t> segment;              // indices into the input scan
@@ -108,7 +113,8 @@ struct RecognitionResult {
   // One per segment, largest segment first, then the parts split off segments in that order.
   std::vector<RecognizedObject> objects;
   std::size_t plane_points = 0;           // removed as planes
-  // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine; verify
+  // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine, final;
+  // equivalents (other poses that fit as well); verify
   std::map<std::string, double> stage_seconds;
 };
 
