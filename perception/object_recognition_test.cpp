@@ -167,6 +167,10 @@ TEST(ObjectRecognition, SameDatabaseAndAnswerForOneAndTwoThreads) {
     EXPECT_EQ(a.objects[i].object_id, c.objects[i].object_id);
     EXPECT_TRUE(a.objects[i].T_S_O.matrix() == b.objects[i].T_S_O.matrix());
     EXPECT_TRUE(a.objects[i].T_S_O.matrix() == c.objects[i].T_S_O.matrix());
+    ASSERT_EQ(a.objects[i].equivalent_poses_S.size(), b.objects[i].equivalent_poses_S.size());
+    for (std::size_t k = 0; k < a.objects[i].equivalent_poses_S.size(); ++k) {
+      EXPECT_TRUE(a.objects[i].equivalent_poses_S[k].matrix() == b.objects[i].equivalent_poses_S[k].matrix());
+    }
   }
 }
 

@@ -259,9 +259,23 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
   // About the model's principal axes, and about its own frame's axes through its origin (a
   // procedural object's stem or run: a valve's lever tilts the principal axes off its stem).
-  std::vector<Eigen::Isometry3d> turns = HalfTurns(model.model);
+  // Turns that are the object's own symmetries, or repeat another, would end where they
+  // started: not refined.
+  std::vector<Eigen::Isometry3d> candidates = HalfTurns(model.model);
   for (int axis = 0; axis < 3; ++axis) {
-    turns.emplace_back(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::Unit(axis)));
+    candidates.emplace_back(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::Unit(axis)));
+  }
+  const double same_rad = 5.0 * std::numbers::pi / 180.0, same_m = 2.0 * p.voxel_m;
+  auto alike = [&](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+    const Eigen::Isometry3d d = a.inverse() * b;
+    return Eigen::AngleAxisd(d.linear()).angle() < same_rad && (d * model.model.origin - model.model.origin).norm() < same_m;
+  };
+  std::vector<Eigen::Isometry3d> known = SymmetryTransforms(model.symmetries);
+  std::vector<Eigen::Isometry3d> turns;
+  for (const Eigen::Isometry3d& turn : candidates) {
+    if (std::any_of(known.begin(), known.end(), [&](const Eigen::Isometry3d& k) { return alike(k, turn); })) continue;
+    turns.push_back(turn);
+    known.push_back(turn);
   }
   std::vector<RecognitionCandidate> turned(turns.size());
   const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
@@ -274,7 +288,6 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   }
   std::vector<Eigen::Vector3d> points_O;
   for (std::size_t i = 0; i < model.model.size(); i += 4) points_O.push_back(model.model.Point(i));
-  const double same_rad = 5.0 * std::numbers::pi / 180.0, same_m = 2.0 * p.voxel_m;
   std::vector<Eigen::Isometry3d> equivalent;
   for (const RecognitionCandidate& c : turned) {
     if (!c.verified || c.score < posed.candidate.score - ctx.options.score_tie) continue;
