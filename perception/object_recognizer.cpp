@@ -176,10 +176,34 @@ PointCloud Strided(const PointCloud& cloud, std::size_t count) {
   return Subset(cloud, every);
 }
 
+// The pose's phase about each N-fold axis of the model (SymmetryPhaseStarts): details repeating
+// about an axis (a flange's bolts) are out of the ICP's reach when off, and the verification's
+// score barely sees them, so a phase the search found stands unless it scores clearly worse than
+// the pose it turned; of two, the better scoring.
+void SearchSymmetryPhases(const DescribedSegment& s, const PointCloud& sample, const ObjectModel& model,
+                          const IcpTarget& target, const KnnIndex& model_index, const IcpOptions& fine,
+                          const SceneAround& around, const ScanContext& ctx, PosedObject& best) {
+  for (const SymmetryAxis& axis : model.symmetries) {
+    const PosedObject before = best;
+    bool turned_once = false;
+    for (const Eigen::Isometry3d& turned : SymmetryPhaseStarts(sample, model, model_index, axis,
+                                                               before.fine.T_target_source, ctx.db.parameters.voxel_m)) {
+      const RegistrationResult refined = AlignIcp(sample, target, turned, fine);
+      RecognitionCandidate c = before.candidate;
+      Verify(s.cloud, model, model_index, around, refined, ctx, c);
+      if (c.verified < before.candidate.verified || c.score < before.candidate.score - ctx.options.score_tie) continue;
+      if (turned_once && !Better(c, best.candidate)) continue;
+      turned_once = true;
+      best.candidate = c;
+      best.fine = refined;
+    }
+  }
+}
+
 // An object's best pose on the whole segment from `starts`: sifted, the best few refined by the
-// fine ICP on refine_points of the segment's points and verified on all of them; the winner is
-// refined once more on all its points (the pose barely moves, but its information is that of
-// every point) and verified again.
+// fine ICP on refine_points of the segment's points and verified on all of them; the winner's
+// phase about any N-fold axis is searched, then it is refined once more on all its points (the
+// pose barely moves, but its information is that of every point) and verified again.
 PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const std::vector<Eigen::Isometry3d>& starts,
                           const SceneAround& around, const ScanContext& ctx) {
   const ObjectModel& model = ctx.db.objects[object];
@@ -213,24 +237,7 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
     best.fine = refined[i];
   }
   if (posed) {
-    // Details repeating about an axis (a flange's bolts) are out of the ICP's reach when off,
-    // and the verification's score barely sees them: a phase the search found stands unless it
-    // scores clearly worse than the pose it turned, the better scoring of two.
-    for (const SymmetryAxis& axis : model.symmetries) {
-      const PosedObject before = best;
-      bool turned_once = false;
-      for (const Eigen::Isometry3d& turned :
-           SymmetryPhaseStarts(sample, model, model_index, axis, before.fine.T_target_source, p.voxel_m)) {
-        const RegistrationResult refined = AlignIcp(sample, target, turned, fine);
-        RecognitionCandidate c = before.candidate;
-        Verify(s.cloud, model, model_index, around, refined, ctx, c);
-        if (c.verified < before.candidate.verified || c.score < before.candidate.score - ctx.options.score_tie) continue;
-        if (turned_once && !Better(c, best.candidate)) continue;
-        turned_once = true;
-        best.candidate = c;
-        best.fine = refined;
-      }
-    }
+    SearchSymmetryPhases(s, sample, model, target, model_index, fine, around, ctx, best);
     ctx.clock.Lap("refine");
     // The pose has converged on the sample: the last stage alone, on every point, for the
     // information of them all (the coarser stages took 34 iterations on average to get back).
@@ -243,32 +250,20 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   return best;
 }
 
-// Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
-// equivalent_poses_S): its pose turned half a turn about each principal axis of the model and
-// each axis of its frame (where a nearly symmetric object, a valve's body or a tee's run, fits
-// either way), refined by
-// the fine ICP and verified like it; kept when verified, scoring within score_tie of it and
-// more than 5 degrees or 2 voxels from it and from each other modulo the object's symmetries.
-// T_S_O each.
-std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const PosedObject& posed,
-                                               const SceneAround& around, const ScanContext& ctx) {
-  const ObjectModel& model = ctx.db.objects[posed.object];
-  const ObjectDatabaseParameters& p = ctx.db.parameters;
-  const IcpTarget target(model.model);
-  const KnnIndex model_index(model.model.points);
-  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
-  // About the model's principal axes, and about its own frame's axes through its origin (a
-  // procedural object's stem or run: a valve's lever tilts the principal axes off its stem).
-  // Turns that are the object's own symmetries, or repeat another, would end where they
-  // started: not refined.
+// Half turns of a model (T_O_O') about its principal axes and about its own frame's axes through
+// its origin (a procedural object's stem or run: a valve's lever tilts the principal axes off
+// its stem), without those that are its symmetries or repeat another (within 5 degrees and 2
+// voxels at its centre): they would end where they started.
+std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, double voxel_m) {
   std::vector<Eigen::Isometry3d> candidates = HalfTurns(model.model);
   for (int axis = 0; axis < 3; ++axis) {
     candidates.emplace_back(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::Unit(axis)));
   }
-  const double same_rad = 5.0 * std::numbers::pi / 180.0, same_m = 2.0 * p.voxel_m;
+  const Eigen::Vector3d centre_O = model.model.origin;
   auto alike = [&](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
     const Eigen::Isometry3d d = a.inverse() * b;
-    return Eigen::AngleAxisd(d.linear()).angle() < same_rad && (d * model.model.origin - model.model.origin).norm() < same_m;
+    return Eigen::AngleAxisd(d.linear()).angle() < 5.0 * std::numbers::pi / 180.0 &&
+           (d * centre_O - centre_O).norm() < 2.0 * voxel_m;
   };
   std::vector<Eigen::Isometry3d> known = SymmetryTransforms(model.symmetries);
   std::vector<Eigen::Isometry3d> turns;
@@ -277,6 +272,22 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
     turns.push_back(turn);
     known.push_back(turn);
   }
+  return turns;
+}
+
+// Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
+// equivalent_poses_S): its pose turned by each of DistinctHalfTurns (a nearly symmetric object,
+// a valve's body, fits either way), refined by the fine ICP and verified like it; kept when
+// verified, scoring within score_tie of it and more than 5 degrees or 2 voxels from it and from
+// each other modulo the object's symmetries. T_S_O each.
+std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const PosedObject& posed,
+                                               const SceneAround& around, const ScanContext& ctx) {
+  const ObjectModel& model = ctx.db.objects[posed.object];
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
+  const IcpTarget target(model.model);
+  const KnnIndex model_index(model.model.points);
+  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
+  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, p.voxel_m);
   std::vector<RecognitionCandidate> turned(turns.size());
   const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
@@ -288,12 +299,13 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   }
   std::vector<Eigen::Vector3d> points_O;
   for (std::size_t i = 0; i < model.model.size(); i += 4) points_O.push_back(model.model.Point(i));
+  const double same_rad = 5.0 * std::numbers::pi / 180.0, same_m = 2.0 * p.voxel_m;
   std::vector<Eigen::Isometry3d> equivalent;
   for (const RecognitionCandidate& c : turned) {
     if (!c.verified || c.score < posed.candidate.score - ctx.options.score_tie) continue;
     bool seen = false;
-    for (const Eigen::Isometry3d& known : equivalent) {
-      const SymmetricPoseError e = PoseErrorModuloSymmetry(c.T_S_O, known, points_O, model.symmetries);
+    for (const Eigen::Isometry3d& other : equivalent) {
+      const SymmetricPoseError e = PoseErrorModuloSymmetry(c.T_S_O, other, points_O, model.symmetries);
       seen |= e.rotation_rad < same_rad && e.translation_m < same_m;
     }
     const SymmetricPoseError e = PoseErrorModuloSymmetry(c.T_S_O, posed.candidate.T_S_O, points_O, model.symmetries);
