@@ -54,7 +54,6 @@ std::vector<Eigen::Isometry3d> HalfTurns(const PointCloud& cloud) {
   return turns;
 }
 
-
 // Point-to-plane ICP of a segment onto a model, to the scale of the data.
 IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int threads) {
   IcpOptions icp;
