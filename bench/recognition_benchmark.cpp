@@ -277,7 +277,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
     pcl_peer.emplace(std::move(peers));
   }
 
-  perception::ViewFeatureCache view_features(db);
+  perception::RecognitionCache cache(db);
   perception::RecognitionOptions recognition;
   recognition.seed = options.seed;
   recognition.threads = options.threads;
@@ -292,7 +292,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
     const PointCloud cloud = perception::MakeCloud(scan.points_C);
 
     start = std::chrono::steady_clock::now();
-    const perception::RecognitionResult answer = perception::RecognizeObjects(cloud, db, view_features, recognition);
+    const perception::RecognitionResult answer = perception::RecognizeObjects(cloud, db, cache, recognition);
     result.pipelines["uwscan"].seconds += Seconds(start);
     for (const auto& [stage, seconds] : answer.stage_seconds) result.uwscan_stage_seconds[stage] += seconds;
 

@@ -26,12 +26,19 @@ ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters
   return v;
 }
 
-const ViewFeatures& ViewFeatureCache::Get(std::size_t object, std::size_t view, int threads) {
+const ViewFeatures& RecognitionCache::View(std::size_t object, std::size_t view, int threads) {
   const std::lock_guard<std::mutex> lock(mutex_);
   std::unique_ptr<ViewFeatures>& slot = described_[{object, view}];
   if (!slot) {
     slot = std::make_unique<ViewFeatures>(DescribeView(db_.objects.at(object).views.at(view), db_.parameters, threads));
   }
+  return *slot;
+}
+
+const ModelIndexes& RecognitionCache::Model(std::size_t object) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_ptr<ModelIndexes>& slot = models_[object];
+  if (!slot) slot = std::make_unique<ModelIndexes>(db_.objects.at(object).model);
   return *slot;
 }
 
@@ -79,14 +86,14 @@ IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int thr
 // RANSAC finds one), then each of its nearest views rolled about the line of sight.
 std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhFeatures& segment_features,
                                           std::size_t object, const std::vector<std::pair<double, int>>& views,
-                                          ViewFeatureCache& cache, const ObjectDatabase& db,
+                                          RecognitionCache& cache, const ObjectDatabase& db,
                                           const RecognitionOptions& options) {
   const ObjectModel& model = db.objects[object];
   const ObjectDatabaseParameters& p = db.parameters;
   std::vector<Eigen::Isometry3d> starts;
   const std::size_t nearest_view = static_cast<std::size_t>(views.front().second);
   const ObjectView& nearest = model.views[nearest_view];
-  const ViewFeatures& described = cache.Get(object, nearest_view, options.threads);
+  const ViewFeatures& described = cache.View(object, nearest_view, options.threads);
   CoarseAlignmentOptions coarse;
   coarse.inlier_distance_m = 2.0 * p.voxel_m;
   coarse.max_iterations = 20000;

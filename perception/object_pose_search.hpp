@@ -27,18 +27,28 @@ struct ViewFeatures {
 };
 ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads);
 
-// The features of a database's views, each computed the first time it is asked for and kept:
-// recognition comes back to the same views segment after segment and scan after scan. Safe to
-// use from several threads; what Get returns does not depend on which call computed it.
-class ViewFeatureCache {
+// A model's search structures: its k-d tree as an ICP target and for nearest points.
+struct ModelIndexes {
+  explicit ModelIndexes(const PointCloud& model) : target(model), nearest(model.points) {}
+  IcpTarget target;
+  KnnIndex nearest;
+};
+
+// What recognition derives from a database and comes back to segment after segment and scan
+// after scan: the features of its views and its models' search structures, each computed the
+// first time it is asked for and kept. Safe to use from several threads; what it returns does
+// not depend on which call computed it.
+class RecognitionCache {
  public:
-  explicit ViewFeatureCache(const ObjectDatabase& db) : db_(db) {}
-  const ViewFeatures& Get(std::size_t object, std::size_t view, int threads);
+  explicit RecognitionCache(const ObjectDatabase& db) : db_(db) {}
+  const ViewFeatures& View(std::size_t object, std::size_t view, int threads);
+  const ModelIndexes& Model(std::size_t object);
 
  private:
   const ObjectDatabase& db_;
   std::mutex mutex_;
   std::map<std::pair<std::size_t, std::size_t>, std::unique_ptr<ViewFeatures>> described_;
+  std::map<std::size_t, std::unique_ptr<ModelIndexes>> models_;
 };
 
 // Half turns about the three principal axes of a cloud through its centroid (T_new_old).
@@ -53,7 +63,7 @@ IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int thr
 // of sight. `views`: (chi-square, view index) of the object's nearest views, nearest first.
 std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhFeatures& segment_features,
                                           std::size_t object, const std::vector<std::pair<double, int>>& views,
-                                          ViewFeatureCache& cache, const ObjectDatabase& db,
+                                          RecognitionCache& cache, const ObjectDatabase& db,
                                           const RecognitionOptions& options);
 
 // The starts worth a full ICP: each gets a short ICP on a strided subset of the segment, and

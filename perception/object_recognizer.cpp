@@ -130,7 +130,7 @@ std::vector<PosedObject> PoseCandidates(const DescribedSegment& s, const EsfDesc
   std::vector<PosedObject> posed;
   for (std::size_t i : chosen) {
     const std::vector<Eigen::Isometry3d> starts =
-        PoseStarts(s.cloud, s.features, i, nearest_views[i], ctx.views, db, ctx.options);
+        PoseStarts(s.cloud, s.features, i, nearest_views[i], ctx.cache, db, ctx.options);
     ctx.clock.Lap("coarse");
     PosedObject p = PoseOnSegment(s, i, starts, around, ctx);
     p.candidate.object_id = db.objects[i].id;
@@ -227,8 +227,9 @@ std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanCo
         PoseCandidates(described, esf.histogram, Diameter(half_cloud), half_around, ctx, nearest_chi_square);
     for (const PosedObject& c : posed) {
       const ObjectModel& model = db.objects[c.object];
-      const IcpTarget target(model.model);
-      const KnnIndex model_index(model.model.points);
+      const ModelIndexes& indexes = ctx.cache.Model(c.object);
+      const IcpTarget& target = indexes.target;
+      const KnnIndex& model_index = indexes.nearest;
       const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
       const RegistrationResult on_segment = AlignIcp(sample, target, c.fine.T_target_source, fine);
       std::vector<std::size_t> points =
@@ -366,11 +367,11 @@ void RecognitionOptions::Check() const {
 
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
                                    const RecognitionOptions& options) {
-  ViewFeatureCache views(db);
-  return RecognizeObjects(scan, db, views, options);
+  RecognitionCache cache(db);
+  return RecognizeObjects(scan, db, cache, options);
 }
 
-RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, ViewFeatureCache& views,
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, RecognitionCache& cache,
                                    const RecognitionOptions& options) {
   options.Check();
   RequireValidCloud(scan, "scan", 1);
@@ -391,7 +392,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   clock.Lap("segment");
 
   const KnnIndex down_index(down.points);
-  const ScanContext ctx{db, options, views, down, down_index, clock};
+  const ScanContext ctx{db, options, cache, down, down_index, clock};
   std::vector<std::vector<std::size_t>> object_points;  // per object, into removed.remaining
   while (!pending.empty()) {
     const PendingSegment next = std::move(pending.front());
@@ -422,9 +423,8 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
         clock.Lap("equivalents");
         if (split_allowed) {
           // What the object leaves unexplained may be another one touching it.
-          const KnnIndex model_index(model.model.points);
           const std::vector<std::size_t> rest =
-              Partition(next.indices, PointsOnModel(described.cloud, model, model_index,
+              Partition(next.indices, PointsOnModel(described.cloud, model, cache.Model(best.object).nearest,
                                                     best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m)).second;
           const std::size_t queued = pending.size();
           QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);

@@ -131,10 +131,10 @@ struct RecognitionResult {
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
                                    const RecognitionOptions& options = {});
 
-// The same, keeping the features of the database views it describes in `views` (made for `db`)
-// for the next scans: the answer is the same, only faster.
-class ViewFeatureCache;
-RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, ViewFeatureCache& views,
+// The same, keeping what it derives from the database (its views' features, its models' search
+// structures) in `cache` (made for `db`) for the next scans: the answer is the same, only faster.
+class RecognitionCache;
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, RecognitionCache& cache,
                                    const RecognitionOptions& options = {});
 
 }  // namespace uwscan::perception

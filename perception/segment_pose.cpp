@@ -112,8 +112,9 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
                           const SceneAround& around, const ScanContext& ctx) {
   const ObjectModel& model = ctx.db.objects[object];
   const ObjectDatabaseParameters& p = ctx.db.parameters;
-  const IcpTarget target(model.model);
-  const KnnIndex model_index(model.model.points);
+  const ModelIndexes& indexes = ctx.cache.Model(object);
+  const IcpTarget& target = indexes.target;
+  const KnnIndex& model_index = indexes.nearest;
   const std::vector<Eigen::Isometry3d> sifted = SiftStarts(s.cloud, target, starts, model.diameter_m, p, ctx.options);
   ctx.clock.Lap("sift");
   const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
@@ -163,8 +164,9 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
                                                const SceneAround& around, const ScanContext& ctx) {
   const ObjectModel& model = ctx.db.objects[posed.object];
   const ObjectDatabaseParameters& p = ctx.db.parameters;
-  const IcpTarget target(model.model);
-  const KnnIndex model_index(model.model.points);
+  const ModelIndexes& indexes = ctx.cache.Model(posed.object);
+  const IcpTarget& target = indexes.target;
+  const KnnIndex& model_index = indexes.nearest;
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
   const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, p.voxel_m);
   std::vector<RecognitionCandidate> turned(turns.size());

@@ -39,7 +39,7 @@ class StageClock {
 struct ScanContext {
   const ObjectDatabase& db;
   const RecognitionOptions& options;
-  ViewFeatureCache& views;
+  RecognitionCache& cache;
   const PointCloud& down;  // the voxelised scan, planes included
   const KnnIndex& down_index;
   StageClock& clock;
