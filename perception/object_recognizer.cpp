@@ -1,10 +1,13 @@
 #include "perception/object_recognizer.hpp"
 
+#include <omp.h>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <deque>
+#include <map>
 #include <limits>
 #include <optional>
 #include <tuple>
@@ -98,47 +101,48 @@ void BreakTie(double tie, std::vector<PosedObject>& ranked) {
 }
 
 
-// Up to max_candidates objects whose nearest view is within max_chi_square (and within
-// max_chi_square_ratio of the best object's) and that are not smaller than the segment's own
-// cluster (a bounding-box diagonal can exceed it by up to sqrt(3); debris that joined it may
-// lie beyond the object), nearest first, each posed.
-// `nearest_chi_square` gets every object's distance to its nearest view.
-std::vector<PosedObject> PoseCandidates(const DescribedSegment& s, const EsfDescriptor& esf, double extent_m,
-                                        const SceneAround& around, const ScanContext& ctx,
-                                        std::vector<double>& nearest_chi_square) {
+// The objects worth posing on a segment: up to max_candidates whose nearest view is within
+// max_chi_square (and within max_chi_square_ratio of the best object's) and that are not smaller
+// than the segment's own cluster (a bounding-box diagonal can exceed it by up to sqrt(3); debris
+// that joined it may lie beyond the object), nearest first, with their nearest views.
+struct ChosenObjects {
+  std::vector<std::size_t> objects;
+  std::vector<std::vector<std::pair<double, int>>> nearest_views;  // of every object
+  std::vector<double> nearest_chi_square;                          // of every object
+};
+ChosenObjects ChooseObjects(const EsfDescriptor& esf, double extent_m, const ScanContext& ctx) {
   const ObjectDatabase& db = ctx.db;
-  const std::vector<std::vector<std::pair<double, int>>> nearest_views =
-      NearestViews(esf, db, std::max(1, ctx.options.pose_views));
-  nearest_chi_square.clear();
-  for (const auto& views : nearest_views) nearest_chi_square.push_back(views.front().first);
+  ChosenObjects c;
+  c.nearest_views = NearestViews(esf, db, std::max(1, ctx.options.pose_views));
+  for (const auto& views : c.nearest_views) c.nearest_chi_square.push_back(views.front().first);
   std::vector<std::size_t> order(db.objects.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return nearest_views[a].front().first < nearest_views[b].front().first;
+    return c.nearest_chi_square[a] < c.nearest_chi_square[b];
   });
-  std::vector<std::size_t> chosen;
-  const double best_chi_square = order.empty() ? 0.0 : nearest_views[order.front()].front().first;
+  const double best_chi_square = order.empty() ? 0.0 : c.nearest_chi_square[order.front()];
   for (std::size_t i : order) {
-    const double chi_square = nearest_views[i].front().first;
-    if (static_cast<int>(chosen.size()) >= ctx.options.max_candidates) break;
+    const double chi_square = c.nearest_chi_square[i];
+    if (static_cast<int>(c.objects.size()) >= ctx.options.max_candidates) break;
     if (chi_square > ctx.options.max_chi_square) break;
     if (chi_square > ctx.options.max_chi_square_ratio * best_chi_square) break;
     if (extent_m > 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m) continue;
-    chosen.push_back(i);
+    c.objects.push_back(i);
   }
-  ctx.clock.Lap("match");
-  std::vector<PosedObject> posed;
-  for (std::size_t i : chosen) {
-    const std::vector<Eigen::Isometry3d> starts =
-        PoseStarts(s.cloud, s.features, i, nearest_views[i], ctx.cache, db, ctx.options);
-    ctx.clock.Lap("coarse");
-    PosedObject p = PoseOnSegment(s, i, starts, around, ctx);
-    p.candidate.object_id = db.objects[i].id;
-    p.candidate.chi_square = nearest_views[i].front().first;
-    p.candidate.view = nearest_views[i].front().second;
-    posed.push_back(std::move(p));
-  }
-  return posed;
+  return c;
+}
+
+// Object `i` posed on a segment from its starts (PoseStarts), with its chi-square and view.
+PosedObject PoseCandidate(const DescribedSegment& s, std::size_t i, const ChosenObjects& chosen,
+                          const SceneAround& around, const ScanContext& ctx) {
+  const std::vector<Eigen::Isometry3d> starts =
+      PoseStarts(s.cloud, s.features, i, chosen.nearest_views[i], ctx.cache, ctx.db, ctx.options);
+  ctx.clock.Lap("coarse");
+  PosedObject p = PoseOnSegment(s, i, starts, around, ctx);
+  p.candidate.object_id = ctx.db.objects[i].id;
+  p.candidate.chi_square = chosen.nearest_views[i].front().first;
+  p.candidate.view = chosen.nearest_views[i].front().second;
+  return p;
 }
 
 // The points of `segment` within `distance_m` of the posed model's surface points.
@@ -197,59 +201,110 @@ std::array<std::vector<std::size_t>, 2> Halves(const PointCloud& cloud, int prin
   return halves;
 }
 
-// The object explaining the largest share of a segment that no single object explains (objects
-// touching each other fall into one segment, whose outline resembles neither). The segment is
-// cut in two halves (Halves), each recognised as a segment of its own for pose candidates;
-// from each candidate's pose the trimmed fine ICP of the whole segment leaves the other
-// objects' points out, and the points it puts on the model form the part, posed again and
-// verified on its own. The part must hold min_part_share of the segment; parts are ranked by
-// share x score.
-std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanContext& ctx) {
-  const ObjectDatabase& db = ctx.db;
-  const ObjectDatabaseParameters& p = db.parameters;
-  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
-  std::optional<ExplainedPart> best;
+// A half of a segment recognised as a segment of its own, for pose candidates (ExplainPart).
+struct DescribedHalf {
+  DescribedSegment described;
+  SceneAround around;
+  ChosenObjects chosen;
+};
+
+// The halves of a segment worth recognising: Halves across its two longest principal axes,
+// distinct, with min_segment_points and an ESF.
+std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const ScanContext& ctx) {
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
   std::vector<std::vector<std::size_t>> halves;
   for (int axis = 0; axis < 2; ++axis) {
     for (std::vector<std::size_t>& half : Halves(s.cloud, axis)) {
+      if (half.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) continue;
       if (std::find(halves.begin(), halves.end(), half) == halves.end()) halves.push_back(std::move(half));
     }
   }
-  for (const std::vector<std::size_t>& half : halves) {
-    if (half.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) continue;
-    const PointCloud half_cloud = Subset(s.cloud, half);
+  std::vector<std::optional<DescribedHalf>> described(halves.size());
+  const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+  for (std::ptrdiff_t h = 0; h < std::ssize(halves); ++h) {
+    const PointCloud half_cloud = Subset(s.cloud, halves[static_cast<std::size_t>(h)]);
     const EsfResult esf = VoxelisedEsf(half_cloud, p.voxel_m, ctx.options.seed);
     if (!esf.ok) continue;
-    const DescribedSegment described{half_cloud, DescribeSegment(half_cloud, ctx).features};
-    const SceneAround half_around = SceneAroundSegment(ctx.down, ctx.down_index, half_cloud, 2.0 * p.voxel_m);
-    std::vector<double> nearest_chi_square;
-    const std::vector<PosedObject> posed =
-        PoseCandidates(described, esf.histogram, Diameter(half_cloud), half_around, ctx, nearest_chi_square);
-    for (const PosedObject& c : posed) {
-      const ObjectModel& model = db.objects[c.object];
-      const ModelIndexes& indexes = ctx.cache.Model(c.object);
-      const IcpTarget& target = indexes.target;
-      const KnnIndex& model_index = indexes.nearest;
-      const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
-      const RegistrationResult on_segment = AlignIcp(sample, target, c.fine.T_target_source, fine);
-      std::vector<std::size_t> points =
-          PointsOnModel(s.cloud, model, model_index, on_segment.T_target_source, 1.5 * p.voxel_m);
-      const double share = static_cast<double>(points.size()) / static_cast<double>(s.cloud.size());
-      if (share < ctx.options.min_part_share || points.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) {
-        continue;
-      }
-      const PointCloud part = Subset(s.cloud, points);
-      const RegistrationResult refined = AlignIcp(part, target, on_segment.T_target_source, fine);
-      const SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, part, 2.0 * p.voxel_m);
-      ExplainedPart candidate{c, std::move(points), share};
-      candidate.posed.fine = refined;
-      Verify(part, model, model_index, around, refined, ctx, candidate.posed.candidate);
-      if (!candidate.posed.candidate.verified || candidate.posed.candidate.close < ctx.options.min_part_close) continue;
-      if (!best || share * candidate.posed.candidate.score > best->share * best->posed.candidate.score) {
-        best = std::move(candidate);
-      }
+    RecognitionOptions one_thread = ctx.options;
+    one_thread.threads = 1;
+    std::map<std::string, double> untimed;
+    StageClock clock(untimed);
+    const ScanContext half_ctx{ctx.db, one_thread, ctx.cache, ctx.down, ctx.down_index, clock};
+    described[static_cast<std::size_t>(h)].emplace(DescribedHalf{
+        {half_cloud, DescribeSegment(half_cloud, half_ctx).features},
+        SceneAroundSegment(ctx.down, ctx.down_index, half_cloud, 2.0 * p.voxel_m),
+        ChooseObjects(esf.histogram, Diameter(half_cloud), half_ctx)});
+  }
+  std::vector<DescribedHalf> kept;
+  for (std::optional<DescribedHalf>& d : described) {
+    if (d) kept.push_back(std::move(*d));
+  }
+  return kept;
+}
+
+// Object `object`, posed on a half of segment `s`, as the part of `s` it explains: from its pose
+// the trimmed fine ICP of the whole segment leaves the other objects' points out, and the points
+// it puts on the model form the part, posed again and verified on its own. None when the part is
+// under min_part_share of the segment, or not verified with min_part_close.
+std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCloud& sample, const DescribedHalf& half,
+                                        std::size_t object, const ScanContext& ctx) {
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
+  const ObjectModel& model = ctx.db.objects[object];
+  const PosedObject posed = PoseCandidate(half.described, object, half.chosen, half.around, ctx);
+  const ModelIndexes& indexes = ctx.cache.Model(object);
+  const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
+  const RegistrationResult on_segment = AlignIcp(sample, indexes.target, posed.fine.T_target_source, fine);
+  std::vector<std::size_t> points =
+      PointsOnModel(s.cloud, model, indexes.nearest, on_segment.T_target_source, 1.5 * p.voxel_m);
+  const double share = static_cast<double>(points.size()) / static_cast<double>(s.cloud.size());
+  if (share < ctx.options.min_part_share || points.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) {
+    return std::nullopt;
+  }
+  const PointCloud part = Subset(s.cloud, points);
+  const RegistrationResult refined = AlignIcp(part, indexes.target, on_segment.T_target_source, fine);
+  const SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, part, 2.0 * p.voxel_m);
+  ExplainedPart candidate{posed, std::move(points), share};
+  candidate.posed.fine = refined;
+  Verify(part, model, indexes.nearest, around, refined, ctx, candidate.posed.candidate);
+  if (!candidate.posed.candidate.verified || candidate.posed.candidate.close < ctx.options.min_part_close) {
+    return std::nullopt;
+  }
+  return candidate;
+}
+
+// The object explaining the largest share of a segment that no single object explains (objects
+// touching each other fall into one segment, whose outline resembles neither). The segment is
+// cut in two halves (Halves), each recognised as a segment of its own for pose candidates, and
+// each candidate gives the part it explains (PartOnHalf). The part must hold min_part_share of
+// the segment; parts are ranked by share x score, ties to the earlier half and candidate.
+// Parallel over (half, candidate), each on one thread: the same answer for any thread count.
+std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanContext& ctx) {
+  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
+  const std::vector<DescribedHalf> halves = DescribedHalves(s, ctx);
+  std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (half, object)
+  for (std::size_t h = 0; h < halves.size(); ++h) {
+    for (std::size_t object : halves[h].chosen.objects) tasks.emplace_back(h, object);
+  }
+  std::vector<std::optional<ExplainedPart>> parts(tasks.size());
+  const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+  for (std::ptrdiff_t t = 0; t < std::ssize(tasks); ++t) {
+    const auto [h, object] = tasks[static_cast<std::size_t>(t)];
+    // Each task on one thread, with a clock of its own: the caller times the whole.
+    RecognitionOptions one_thread = ctx.options;
+    one_thread.threads = 1;
+    std::map<std::string, double> untimed;
+    StageClock clock(untimed);
+    const ScanContext task_ctx{ctx.db, one_thread, ctx.cache, ctx.down, ctx.down_index, clock};
+    parts[static_cast<std::size_t>(t)] = PartOnHalf(s, sample, halves[h], object, task_ctx);
+  }
+  std::optional<ExplainedPart> best;
+  for (std::optional<ExplainedPart>& part : parts) {
+    if (!part) continue;
+    if (!best || part->share * part->posed.candidate.score > best->share * best->posed.candidate.score) {
+      best = std::move(part);
     }
-    ctx.clock.Lap("refine");
   }
   return best;
 }
@@ -407,9 +462,11 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
     const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed);
     clock.Lap("describe");
     if (esf.ok && described.cloud.size() >= 10) {
-      std::vector<double> nearest_chi_square;
-      std::vector<PosedObject> posed =
-          PoseCandidates(described, esf.histogram, next.core_diameter_m, around, ctx, nearest_chi_square);
+      const ChosenObjects chosen = ChooseObjects(esf.histogram, next.core_diameter_m, ctx);
+      const std::vector<double>& nearest_chi_square = chosen.nearest_chi_square;
+      clock.Lap("match");
+      std::vector<PosedObject> posed;
+      for (std::size_t i : chosen.objects) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
       std::stable_sort(posed.begin(), posed.end(),
                        [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
       BreakTie(options.score_tie, posed);
@@ -436,7 +493,9 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
           std::erase_if(kept, [&](std::size_t i) { return std::binary_search(taken.begin(), taken.end(), i); });
         }
       } else if (split_allowed && segment.size() >= 2 * static_cast<std::size_t>(options.min_segment_points)) {
-        if (std::optional<ExplainedPart> part = ExplainPart(described, ctx)) {
+        std::optional<ExplainedPart> part = ExplainPart(described, ctx);
+        clock.Lap("split");
+        if (part) {
           const PointCloud part_cloud = Subset(segment, part->points);
           // The part's own ESF for its chi-square and margin.
           const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed);
