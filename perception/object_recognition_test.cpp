@@ -181,19 +181,36 @@ TEST(ObjectRecognition, AnObjectNotInTheDatabaseIsUnknown) {
   EXPECT_EQ(Nearest(r, elbow)->object_id, "unknown");
 }
 
-// A valve in line with a pipe, touching its end: one Euclidean segment, which neither object explains alone.
-// Both come out, each with its own points and pose.
-TEST(ObjectRecognition, TwoTouchingObjectsAreBothRecognised) {
+// A valve in line with a pipe, touching its end, scanned: objects 1 (pipe) and 2 (valve).
+struct TouchingObjects {
+  std::vector<sim::SceneObject> scene;
+  Eigen::Isometry3d T_W_C;
+  sim::VirtualScan scan;
+  PointCloud cloud;
+};
+TouchingObjects PipeAgainstValve() {
+  TouchingObjects t;
   const scanner::TriangleMesh pipe = CatalogueObject("pipe").mesh, valve = CatalogueObject("valve_wheel").mesh;
-  std::vector<sim::SceneObject> scene = OnSeabed(pipe);
+  t.scene = OnSeabed(pipe);
   sim::SceneObject second = OnSeabed(valve)[1];
   // In line with the pipe, the valve's pipe end (120 mm from its centre) against the pipe's end.
   second.T_W_O.translation().y() += 0.36;
-  scene.push_back(second);
-  const Eigen::Vector3d middle = 0.5 * (scene[1].T_W_O.translation() + scene[2].T_W_O.translation());
-  const Eigen::Isometry3d T_W_C = sim::LookAt(middle + Eigen::Vector3d(0.5, 0.1, 0.7), middle, Eigen::Vector3d::UnitZ());
-  const sim::VirtualScan scan = Scanner().Scan(scene, T_W_C, 11);
-  const PointCloud cloud = MakeCloud(scan.points_C);
+  t.scene.push_back(second);
+  const Eigen::Vector3d middle = 0.5 * (t.scene[1].T_W_O.translation() + t.scene[2].T_W_O.translation());
+  t.T_W_C = sim::LookAt(middle + Eigen::Vector3d(0.5, 0.1, 0.7), middle, Eigen::Vector3d::UnitZ());
+  t.scan = Scanner().Scan(t.scene, t.T_W_C, 11);
+  t.cloud = MakeCloud(t.scan.points_C);
+  return t;
+}
+
+// One Euclidean segment, which neither object explains alone. Both come out, each with its own
+// points and pose.
+TEST(ObjectRecognition, TwoTouchingObjectsAreBothRecognised) {
+  const TouchingObjects touching = PipeAgainstValve();
+  const std::vector<sim::SceneObject>& scene = touching.scene;
+  const Eigen::Isometry3d& T_W_C = touching.T_W_C;
+  const sim::VirtualScan& scan = touching.scan;
+  const PointCloud& cloud = touching.cloud;
 
   // They do touch: their points form one cluster at the recognizer's tolerance.
   std::vector<std::size_t> on_objects;
@@ -225,6 +242,25 @@ TEST(ObjectRecognition, TwoTouchingObjectsAreBothRecognised) {
       offset -= offset.dot(axis_S) * axis_S;
     }
     EXPECT_LT(offset.norm(), 0.005) << "object " << o;
+  }
+}
+
+// The segment split into the objects it holds (in parallel over halves and candidates) gives
+// the same objects, points and poses for one thread and two.
+TEST(ObjectRecognition, ASplitSegmentIsTheSameForOneAndTwoThreads) {
+  const TouchingObjects touching = PipeAgainstValve();
+  RecognitionOptions options;
+  options.threads = 1;
+  const RecognitionResult a = RecognizeObjects(touching.cloud, PipeFlangeValveDb(), options);
+  options.threads = 2;
+  const RecognitionResult b = RecognizeObjects(touching.cloud, PipeFlangeValveDb(), options);
+  ASSERT_EQ(a.objects.size(), b.objects.size());
+  ASSERT_GE(a.objects.size(), 2u);
+  for (std::size_t i = 0; i < a.objects.size(); ++i) {
+    EXPECT_EQ(a.objects[i].object_id, b.objects[i].object_id);
+    EXPECT_EQ(a.objects[i].segment, b.objects[i].segment);
+    EXPECT_TRUE(a.objects[i].T_S_O.matrix() == b.objects[i].T_S_O.matrix());
+    EXPECT_EQ(a.objects[i].candidates.size(), b.objects[i].candidates.size());
   }
 }
 
