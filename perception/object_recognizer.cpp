@@ -201,6 +201,27 @@ std::array<std::vector<std::size_t>, 2> Halves(const PointCloud& cloud, int prin
   return halves;
 }
 
+// The context of one task of a parallel loop over a scan's work: one thread, and a clock of its
+// own, untimed (the caller times the whole loop; a clock is not shared between threads).
+class OneThreadContext {
+ public:
+  explicit OneThreadContext(const ScanContext& outer)
+      : options_(OneThread(outer.options)),
+        clock_(untimed_),
+        ctx_{outer.db, options_, outer.cache, outer.down, outer.down_index, clock_} {}
+  const ScanContext& ctx() const { return ctx_; }
+
+ private:
+  static RecognitionOptions OneThread(RecognitionOptions options) {
+    options.threads = 1;
+    return options;
+  }
+  RecognitionOptions options_;  // initialised in this order: each refers to those above it
+  std::map<std::string, double> untimed_;
+  StageClock clock_;
+  ScanContext ctx_;
+};
+
 // A half of a segment recognised as a segment of its own, for pose candidates (ExplainPart).
 struct DescribedHalf {
   DescribedSegment described;
@@ -226,15 +247,11 @@ std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const Scan
     const PointCloud half_cloud = Subset(s.cloud, halves[static_cast<std::size_t>(h)]);
     const EsfResult esf = VoxelisedEsf(half_cloud, p.voxel_m, ctx.options.seed);
     if (!esf.ok) continue;
-    RecognitionOptions one_thread = ctx.options;
-    one_thread.threads = 1;
-    std::map<std::string, double> untimed;
-    StageClock clock(untimed);
-    const ScanContext half_ctx{ctx.db, one_thread, ctx.cache, ctx.down, ctx.down_index, clock};
+    const OneThreadContext task(ctx);
     described[static_cast<std::size_t>(h)].emplace(DescribedHalf{
-        {half_cloud, DescribeSegment(half_cloud, half_ctx).features},
+        {half_cloud, DescribeSegment(half_cloud, task.ctx()).features},
         SceneAroundSegment(ctx.down, ctx.down_index, half_cloud, 2.0 * p.voxel_m),
-        ChooseObjects(esf.histogram, Diameter(half_cloud), half_ctx)});
+        ChooseObjects(esf.histogram, Diameter(half_cloud), task.ctx())});
   }
   std::vector<DescribedHalf> kept;
   for (std::optional<DescribedHalf>& d : described) {
@@ -291,13 +308,8 @@ std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanCo
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
   for (std::ptrdiff_t t = 0; t < std::ssize(tasks); ++t) {
     const auto [h, object] = tasks[static_cast<std::size_t>(t)];
-    // Each task on one thread, with a clock of its own: the caller times the whole.
-    RecognitionOptions one_thread = ctx.options;
-    one_thread.threads = 1;
-    std::map<std::string, double> untimed;
-    StageClock clock(untimed);
-    const ScanContext task_ctx{ctx.db, one_thread, ctx.cache, ctx.down, ctx.down_index, clock};
-    parts[static_cast<std::size_t>(t)] = PartOnHalf(s, sample, halves[h], object, task_ctx);
+    const OneThreadContext task(ctx);
+    parts[static_cast<std::size_t>(t)] = PartOnHalf(s, sample, halves[h], object, task.ctx());
   }
   std::optional<ExplainedPart> best;
   for (std::optional<ExplainedPart>& part : parts) {
