@@ -1,7 +1,5 @@
 #include "perception/object_pose_search.hpp"
 
-#include <omp.h>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -10,6 +8,7 @@
 
 #include "perception/coarse_alignment.hpp"
 #include "perception/normals.hpp"
+#include "perception/parallel_tasks.hpp"
 #include "perception/view_pose_hypotheses.hpp"
 
 namespace uwscan::perception {
@@ -142,13 +141,11 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
     const std::size_t first = moved.size();
     fitness.resize(first + from.size(), 0.0);
     moved.resize(first + from.size());
-    const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (std::ptrdiff_t s = 0; s < std::ssize(from); ++s) {
+    RunParallelTasks(std::ssize(from), options.threads, [&](std::ptrdiff_t s) {
       const RegistrationResult quick = AlignIcp(subset, target, from[static_cast<std::size_t>(s)], icp);
       fitness[first + static_cast<std::size_t>(s)] = quick.fitness;
       moved[first + static_cast<std::size_t>(s)] = quick.T_target_source;
-    }
+    });
   };
   std::vector<double> fitness;
   std::vector<Eigen::Isometry3d> moved;

@@ -43,6 +43,7 @@ class RecognitionCache {
   explicit RecognitionCache(const ObjectDatabase& db) : db_(db) {}
   const ViewFeatures& View(std::size_t object, std::size_t view, int threads);
   const ModelIndexes& Model(std::size_t object);
+  const ObjectDatabase& db() const { return db_; }
 
  private:
   const ObjectDatabase& db_;

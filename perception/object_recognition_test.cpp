@@ -254,13 +254,32 @@ TEST(ObjectRecognition, ASplitSegmentIsTheSameForOneAndTwoThreads) {
   const RecognitionResult a = RecognizeObjects(touching.cloud, PipeFlangeValveDb(), options);
   options.threads = 2;
   const RecognitionResult b = RecognizeObjects(touching.cloud, PipeFlangeValveDb(), options);
+  EXPECT_TRUE(a.stage_seconds.contains("split")) << "the segment was not split";
   ASSERT_EQ(a.objects.size(), b.objects.size());
   ASSERT_GE(a.objects.size(), 2u);
   for (std::size_t i = 0; i < a.objects.size(); ++i) {
     EXPECT_EQ(a.objects[i].object_id, b.objects[i].object_id);
     EXPECT_EQ(a.objects[i].segment, b.objects[i].segment);
+    EXPECT_EQ(a.objects[i].score, b.objects[i].score);
     EXPECT_TRUE(a.objects[i].T_S_O.matrix() == b.objects[i].T_S_O.matrix());
     EXPECT_EQ(a.objects[i].candidates.size(), b.objects[i].candidates.size());
+    ASSERT_EQ(a.objects[i].equivalent_poses_S.size(), b.objects[i].equivalent_poses_S.size());
+    for (std::size_t k = 0; k < a.objects[i].equivalent_poses_S.size(); ++k) {
+      EXPECT_TRUE(a.objects[i].equivalent_poses_S[k].matrix() == b.objects[i].equivalent_poses_S[k].matrix());
+    }
+  }
+}
+
+// A cache holds the models of the database it was made for: given another, recognition refuses.
+TEST(ObjectRecognition, ACacheOfAnotherDatabaseIsRefused) {
+  const ObjectDatabase copy = PipeFlangeValveDb();
+  RecognitionCache cache(copy);
+  const Scan elbow = ScanOnSeabed(CatalogueObject("elbow").mesh, Eigen::Vector3d(0.5, 0.2, 0.6), 4);
+  try {
+    RecognizeObjects(elbow.cloud, PipeFlangeValveDb(), cache);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("another object database"), std::string::npos) << e.what();
   }
 }
 

@@ -1,7 +1,5 @@
 #include "perception/object_recognizer.hpp"
 
-#include <omp.h>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
@@ -20,6 +18,7 @@
 #include "perception/object_database_builder.hpp"
 #include "perception/object_pose_search.hpp"
 #include "perception/object_symmetry.hpp"
+#include "perception/parallel_tasks.hpp"
 #include "perception/plane_removal.hpp"
 #include "perception/recognition_verification.hpp"
 #include "perception/scan_segments.hpp"
@@ -201,27 +200,6 @@ std::array<std::vector<std::size_t>, 2> Halves(const PointCloud& cloud, int prin
   return halves;
 }
 
-// The context of one task of a parallel loop over a scan's work: one thread, and a clock of its
-// own, untimed (the caller times the whole loop; a clock is not shared between threads).
-class OneThreadContext {
- public:
-  explicit OneThreadContext(const ScanContext& outer)
-      : options_(OneThread(outer.options)),
-        clock_(untimed_),
-        ctx_{outer.db, options_, outer.cache, outer.down, outer.down_index, clock_} {}
-  const ScanContext& ctx() const { return ctx_; }
-
- private:
-  static RecognitionOptions OneThread(RecognitionOptions options) {
-    options.threads = 1;
-    return options;
-  }
-  RecognitionOptions options_;  // initialised in this order: each refers to those above it
-  std::map<std::string, double> untimed_;
-  StageClock clock_;
-  ScanContext ctx_;
-};
-
 // A half of a segment recognised as a segment of its own, for pose candidates (ExplainPart).
 struct DescribedHalf {
   DescribedSegment described;
@@ -241,18 +219,16 @@ std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const Scan
     }
   }
   std::vector<std::optional<DescribedHalf>> described(halves.size());
-  const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-  for (std::ptrdiff_t h = 0; h < std::ssize(halves); ++h) {
+  RunParallelTasks(std::ssize(halves), ctx.options.threads, [&](std::ptrdiff_t h) {
     const PointCloud half_cloud = Subset(s.cloud, halves[static_cast<std::size_t>(h)]);
     const EsfResult esf = VoxelisedEsf(half_cloud, p.voxel_m, ctx.options.seed);
-    if (!esf.ok) continue;
+    if (!esf.ok) return;
     const OneThreadContext task(ctx);
     described[static_cast<std::size_t>(h)].emplace(DescribedHalf{
         {half_cloud, DescribeSegment(half_cloud, task.ctx()).features},
         SceneAroundSegment(ctx.down, ctx.down_index, half_cloud, 2.0 * p.voxel_m),
         ChooseObjects(esf.histogram, Diameter(half_cloud), task.ctx())});
-  }
+  });
   std::vector<DescribedHalf> kept;
   for (std::optional<DescribedHalf>& d : described) {
     if (d) kept.push_back(std::move(*d));
@@ -263,7 +239,7 @@ std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const Scan
 // Object `object`, posed on a half of segment `s`, as the part of `s` it explains: from its pose
 // the trimmed fine ICP of the whole segment leaves the other objects' points out, and the points
 // it puts on the model form the part, posed again and verified on its own. None when the part is
-// under min_part_share of the segment, or not verified with min_part_close.
+// under min_part_share of the segment, or not verified.
 std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCloud& sample, const DescribedHalf& half,
                                         std::size_t object, const ScanContext& ctx) {
   const ObjectDatabaseParameters& p = ctx.db.parameters;
@@ -284,9 +260,7 @@ std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCl
   ExplainedPart candidate{posed, std::move(points), share};
   candidate.posed.fine = refined;
   Verify(part, model, indexes.nearest, around, refined, ctx, candidate.posed.candidate);
-  if (!candidate.posed.candidate.verified || candidate.posed.candidate.close < ctx.options.min_part_close) {
-    return std::nullopt;
-  }
+  if (!candidate.posed.candidate.verified) return std::nullopt;
   return candidate;
 }
 
@@ -304,13 +278,11 @@ std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanCo
     for (std::size_t object : halves[h].chosen.objects) tasks.emplace_back(h, object);
   }
   std::vector<std::optional<ExplainedPart>> parts(tasks.size());
-  const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-  for (std::ptrdiff_t t = 0; t < std::ssize(tasks); ++t) {
+  RunParallelTasks(std::ssize(tasks), ctx.options.threads, [&](std::ptrdiff_t t) {
     const auto [h, object] = tasks[static_cast<std::size_t>(t)];
     const OneThreadContext task(ctx);
     parts[static_cast<std::size_t>(t)] = PartOnHalf(s, sample, halves[h], object, task.ctx());
-  }
+  });
   std::optional<ExplainedPart> best;
   for (std::optional<ExplainedPart>& part : parts) {
     if (!part) continue;
@@ -425,6 +397,8 @@ void RecognitionOptions::Check() const {
       !(min_close >= 0.0 && min_close <= 1.0)) {
     throw Error("recognition: min_fitness, min_close and max_missing must be in [0, 1]");
   }
+  if (!(min_part_share >= 0.0 && min_part_share <= 1.0)) throw Error("recognition: min_part_share must be in [0, 1]");
+  if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
   if (!(free_direction_ratio > 0.0 && free_direction_ratio < 1.0)) {
     throw Error("recognition: free_direction_ratio must be in (0, 1)");
@@ -441,6 +415,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, RecognitionCache& cache,
                                    const RecognitionOptions& options) {
   options.Check();
+  if (&cache.db() != &db) throw Error("recognition: the RecognitionCache was made for another object database");
   RequireValidCloud(scan, "scan", 1);
   if (db.objects.empty()) throw Error("recognition: the object database is empty");
   const ObjectDatabaseParameters& p = db.parameters;

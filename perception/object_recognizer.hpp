@@ -55,9 +55,9 @@ struct RecognitionOptions {
   // A segment no single object explains may be several touching each other: the object that
   // explains the largest part of it (at least this share of its points) is taken out and the
   // rest recognised again, as is what a recognised object leaves unexplained; at most
-  // max_objects_per_segment objects come out of one segment.
+  // max_objects_per_segment objects come out of one segment. A part is verified as any
+  // candidate is.
   double min_part_share = 0.25;
-  double min_part_close = 0.8;  // min_close for such a part: it was picked among many hypotheses
   int max_objects_per_segment = 3;
   // A pose direction is free when its information is below this fraction of the largest.
   double free_direction_ratio = 0.02;
@@ -116,7 +116,8 @@ struct RecognitionResult {
   std::vector<RecognizedObject> objects;
   std::size_t plane_points = 0;           // removed as planes
   // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine, final;
-  // equivalents (other poses that fit as well); verify
+  // equivalents (other poses that fit as well); split (a segment no object explains searched
+  // for the objects it holds: its own poses are not counted in coarse to final); verify
   std::map<std::string, double> stage_seconds;
 };
 
@@ -125,8 +126,9 @@ struct RecognitionResult {
 // surface the matched view saw) and from the nearest views rolled about the line of sight,
 // sifted by a short ICP, the best refined by point-to-plane ICP of the segment onto the whole
 // model and verified by fit and by model surface that should have been seen. A segment no
-// object explains is searched for the object explaining the largest part of it (FPFH + RANSAC
-// against each whole model), which is taken out, and the rest is recognised again; so is what a
+// object explains is searched for the object explaining the largest part of it (each of its
+// halves recognised as a segment for pose candidates), which is taken out, and the rest is
+// recognised again; so is what a
 // recognised object leaves unexplained. The scan is in the sensor's frame (the sensor at its
 // origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
 // invalid scan (NaN) or options.
@@ -134,7 +136,8 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
                                    const RecognitionOptions& options = {});
 
 // The same, keeping what it derives from the database (its views' features, its models' search
-// structures) in `cache` (made for `db`) for the next scans: the answer is the same, only faster.
+// structures) in `cache` for the next scans: the answer is the same, only faster. Throws
+// uwscan::Error when `cache` was made for another database.
 class RecognitionCache;
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, RecognitionCache& cache,
                                    const RecognitionOptions& options = {});

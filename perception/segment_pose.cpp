@@ -1,12 +1,11 @@
 #include "perception/segment_pose.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <numbers>
 
 #include "perception/normals.hpp"
 #include "perception/object_symmetry.hpp"
+#include "perception/parallel_tasks.hpp"
 
 namespace uwscan::perception::recognition {
 namespace {
@@ -128,13 +127,11 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   from_sift.threads = 1;
   std::vector<RegistrationResult> refined(sifted.size());
   std::vector<RecognitionCandidate> checked(sifted.size());
-  const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-  for (std::ptrdiff_t k = 0; k < std::ssize(sifted); ++k) {
+  RunParallelTasks(std::ssize(sifted), ctx.options.threads, [&](std::ptrdiff_t k) {
     const std::size_t i = static_cast<std::size_t>(k);
     refined[i] = AlignIcp(sample, target, sifted[i], from_sift);
     Verify(s.cloud, model, model_index, around, refined[i], ctx, checked[i]);
-  }
+  });
   for (std::size_t i = 0; i < sifted.size(); ++i) {
     if (posed && !Better(checked[i], best.candidate)) continue;
     posed = true;
@@ -170,14 +167,12 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
   const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, p.voxel_m);
   std::vector<RecognitionCandidate> turned(turns.size());
-  const int threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-  for (std::ptrdiff_t k = 0; k < std::ssize(turns); ++k) {
+  RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
     const std::size_t i = static_cast<std::size_t>(k);
     const RegistrationResult refined = AlignIcp(sample, target, turns[i] * posed.fine.T_target_source,
                                                 FineIcp(model.diameter_m, p, 1));
     Verify(s.cloud, model, model_index, around, refined, ctx, turned[i]);
-  }
+  });
   std::vector<Eigen::Vector3d> points_O;
   for (std::size_t i = 0; i < model.model.size(); i += 4) points_O.push_back(model.model.Point(i));
   const double same_rad = 5.0 * std::numbers::pi / 180.0, same_m = 2.0 * p.voxel_m;

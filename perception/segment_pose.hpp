@@ -45,6 +45,29 @@ struct ScanContext {
   StageClock& clock;
 };
 
+// The context of one task of a parallel loop over a scan's work: one thread, and a clock of its
+// own, untimed (the caller times the whole loop; a clock is not shared between threads).
+class OneThreadContext {
+ public:
+  explicit OneThreadContext(const ScanContext& outer)
+      : options_(OneThread(outer.options)),
+        clock_(untimed_),
+        ctx_{outer.db, options_, outer.cache, outer.down, outer.down_index, clock_} {}
+  OneThreadContext(const OneThreadContext&) = delete;  // ctx_ refers to the members beside it
+  OneThreadContext& operator=(const OneThreadContext&) = delete;
+  const ScanContext& ctx() const { return ctx_; }
+
+ private:
+  static RecognitionOptions OneThread(RecognitionOptions options) {
+    options.threads = 1;
+    return options;
+  }
+  RecognitionOptions options_;  // initialised in this order: each refers to those above it
+  std::map<std::string, double> untimed_;
+  StageClock clock_;
+  ScanContext ctx_;
+};
+
 // A segment's voxelised points with normals (scan frame) and FPFH at every one.
 struct DescribedSegment {
   PointCloud cloud;
