@@ -7,13 +7,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <map>
 #include <memory>
 #include <string>
 
 #include "perception/sphere_fit.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/triangulation/light_plane.hpp"
 #include "scanner/sim/imr_objects.hpp"
@@ -101,22 +101,14 @@ std::vector<std::vector<Eigen::Vector3d>> SimulateAndTriangulate(const Simulator
                                                                  int threads) {
   const std::int64_t count = simulator.frame_count();
   std::vector<std::vector<Eigen::Vector3d>> points(static_cast<size_t>(count));
-  std::exception_ptr failure;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-  for (std::int64_t i = 0; i < count; ++i) {
-    try {
-      const scanner::sim::SimulatedFrame frame = simulator.Frame(i);
-      std::vector<scanner::TriangulatedPoint> out(frame.peaks_px.size());
-      triangulator.TriangulateFrame(frame.command, frame.peaks_px, out);
-      for (const scanner::TriangulatedPoint& p : out) {
-        if (p.ok()) points[static_cast<size_t>(i)].push_back(frame.T_W_C * p.p_C);
-      }
-    } catch (...) {
-#pragma omp critical(uwscan_accuracy_failure)
-      if (!failure) failure = std::current_exception();
+  RunParallelTasks(count, threads, [&](std::ptrdiff_t i) {
+    const scanner::sim::SimulatedFrame frame = simulator.Frame(i);
+    std::vector<scanner::TriangulatedPoint> out(frame.peaks_px.size());
+    triangulator.TriangulateFrame(frame.command, frame.peaks_px, out);
+    for (const scanner::TriangulatedPoint& p : out) {
+      if (p.ok()) points[static_cast<size_t>(i)].push_back(frame.T_W_C * p.p_C);
     }
-  }
-  if (failure) std::rethrow_exception(failure);
+  });
   return points;
 }
 

@@ -3,11 +3,11 @@
 #include <omp.h>
 
 #include <chrono>
-#include <exception>
 #include <vector>
 
 #include "mapping/dive_log.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -80,17 +80,9 @@ DiveSimulationSummary SimulateDive(const scanner::sim::Simulator& simulator,
   for (std::int64_t first = 0; first < total; first += block) {
     const std::int64_t count = std::min(block, total - first);
     frames.assign(static_cast<size_t>(count), {});
-    std::exception_ptr failure;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-    for (std::int64_t k = 0; k < count; ++k) {
-      try {
-        frames[static_cast<size_t>(k)] = simulator.Frame(first + k);
-      } catch (...) {
-#pragma omp critical(uwscan_dive_simulation_failure)
-        if (!failure) failure = std::current_exception();
-      }
-    }
-    if (failure) std::rethrow_exception(failure);
+    RunParallelTasks(count, threads, [&](std::ptrdiff_t k) {
+      frames[static_cast<size_t>(k)] = simulator.Frame(first + k);
+    });
     for (const scanner::sim::SimulatedFrame& f : frames) {
       FrameRecord record;
       record.time_s = f.time_s;

@@ -8,8 +8,8 @@
 
 #include "perception/coarse_alignment.hpp"
 #include "perception/normals.hpp"
-#include "perception/parallel_tasks.hpp"
 #include "perception/view_pose_hypotheses.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::perception {
 

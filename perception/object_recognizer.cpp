@@ -18,13 +18,13 @@
 #include "perception/object_database_builder.hpp"
 #include "perception/object_pose_search.hpp"
 #include "perception/object_symmetry.hpp"
-#include "perception/parallel_tasks.hpp"
 #include "perception/plane_removal.hpp"
 #include "perception/recognition_verification.hpp"
 #include "perception/scan_segments.hpp"
 #include "perception/segment_pose.hpp"
 #include "perception/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::perception {
 namespace {

@@ -128,9 +128,8 @@ struct RecognitionResult {
 // model and verified by fit and by model surface that should have been seen. A segment no
 // object explains is searched for the object explaining the largest part of it (each of its
 // halves recognised as a segment for pose candidates), which is taken out, and the rest is
-// recognised again; so is what a
-// recognised object leaves unexplained. The scan is in the sensor's frame (the sensor at its
-// origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
+// recognised again; so is what a recognised object leaves unexplained. The scan is in the
+// sensor's frame (the sensor at its origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
 // invalid scan (NaN) or options.
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
                                    const RecognitionOptions& options = {});

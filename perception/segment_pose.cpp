@@ -5,7 +5,7 @@
 
 #include "perception/normals.hpp"
 #include "perception/object_symmetry.hpp"
-#include "perception/parallel_tasks.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::perception::recognition {
 namespace {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <fstream>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
@@ -12,6 +11,7 @@
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_yaml.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/effective_scanner.hpp"
 #include "scanner/sim/imr_objects.hpp"
@@ -321,23 +321,6 @@ Eigen::Isometry3d DrawPose(const Setup& s, std::mt19937_64& rng, bool plane) {
               (s.galvo ? "mirror_steps" : "image_scale"));
 }
 
-// Runs body(i) for i in [0, n) on OpenMP threads; the first exception is rethrown after.
-template <typename Body>
-void ParallelFor(int n, const Body& body) {
-  std::exception_ptr failure;
-  std::mutex mutex;
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int i = 0; i < n; ++i) {
-    try {
-      body(i);
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(mutex);
-      if (!failure) failure = std::current_exception();
-    }
-  }
-  if (failure) std::rethrow_exception(failure);
-}
-
 }  // namespace
 
 void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_folder,
@@ -415,7 +398,7 @@ void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_
       if (!lit.effects.AnyImageStage()) lit.effects.image.on = true;
       lit.seed = Seed(cs.scene.seed, 2, static_cast<std::uint64_t>(p));
       const sim::Simulator simulator(lit);
-      ParallelFor(static_cast<int>(cs.mirror_steps.size()), [&](int k) {
+      RunParallelTasks(std::ssize(cs.mirror_steps), 0, [&](std::ptrdiff_t k) {
         const int step = cs.mirror_steps[static_cast<size_t>(k)];
         const sim::SimulatedFrame frame = simulator.Frame(step - step_min);
         WriteImage(out_folder / StripeImageName(p, step), *frame.image);
@@ -432,7 +415,7 @@ void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_
       dark.white_level = MaxPixelValue(dark.format);
       dark.noise_sigma = effects.sensor_noise.on ? effects.sensor_noise.read_sigma : 0.0;
       const std::vector<Dot> dots = DotsOnBoard(s, T_C_O);
-      ParallelFor(static_cast<int>(dots.size()), [&](int k) {
+      RunParallelTasks(std::ssize(dots), 0, [&](std::ptrdiff_t k) {
         const Dot& dot = dots[static_cast<size_t>(k)];
         TargetRenderOptions options = dark;
         options.seed = Seed(cs.scene.seed, 3, static_cast<std::uint64_t>(p) * 1000003u + dot.index);

@@ -1,11 +1,11 @@
 #include "scanner/triangulation/light_surface_table.hpp"
 
 #include <cmath>
-#include <exception>
 #include <string>
 #include <utility>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::scanner {
 
@@ -55,28 +55,21 @@ LightSurfaceTable::LightSurfaceTable(const GalvoLaser& laser,
   const int count = step_max_ - step_min_ + 1;
   surfaces_.resize(static_cast<size_t>(count));
   const double max_fan_tan = laser.MaxFanTan();
-  std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic)
-  for (int i = 0; i < count; ++i) {
-    try {
-      const FanSamples samples = SampleFan(laser.FanAtStep(step_min_ + i), max_fan_tan, options);
-      const PlaneFit plane = FitPlane(samples.points_C);
-      LightSurfaces& surfaces = surfaces_[static_cast<size_t>(i)];
-      surfaces.plane = plane.plane;
-      surfaces.plane_rms_m = plane.rms_m;
-      if (options.fit_cones) {
-        const ConeFit cone = FitCone(samples.points_C, samples.propagation_dir_C,
-                                     samples.apex_hint_C, options.cone);
-        surfaces.cone = cone.cone;
-        surfaces.cone_rms_m = cone.rms_m;
-        surfaces.cone_converged = cone.converged;
-      }
-    } catch (...) {
-#pragma omp critical
-      if (!failure) failure = std::current_exception();
+  RunParallelTasks(count, 0, [&](std::ptrdiff_t i) {
+    const FanSamples samples =
+        SampleFan(laser.FanAtStep(step_min_ + static_cast<int>(i)), max_fan_tan, options);
+    const PlaneFit plane = FitPlane(samples.points_C);
+    LightSurfaces& surfaces = surfaces_[static_cast<size_t>(i)];
+    surfaces.plane = plane.plane;
+    surfaces.plane_rms_m = plane.rms_m;
+    if (options.fit_cones) {
+      const ConeFit cone = FitCone(samples.points_C, samples.propagation_dir_C,
+                                   samples.apex_hint_C, options.cone);
+      surfaces.cone = cone.cone;
+      surfaces.cone_rms_m = cone.rms_m;
+      surfaces.cone_converged = cone.converged;
     }
-  }
-  if (failure) std::rethrow_exception(failure);
+  });
 }
 
 LightSurfaceTable::LightSurfaceTable(int step_min, std::vector<LightSurfaces> surfaces, bool has_cones)

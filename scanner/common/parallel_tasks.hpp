@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <exception>
 
-namespace uwscan::perception {
+namespace uwscan {
 
 // Runs task(i) for every i in [0, count) on `threads` OpenMP threads (0: OpenMP's default), each
 // index to whichever thread is free next. An exception a task throws is rethrown here once every
@@ -26,4 +26,4 @@ void RunParallelTasks(std::ptrdiff_t count, int threads, const Task& task) {
   if (failure) std::rethrow_exception(failure);
 }
 
-}  // namespace uwscan::perception
+}  // namespace uwscan
