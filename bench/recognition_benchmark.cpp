@@ -10,12 +10,14 @@
 #include <random>
 
 #include "bench/recognition_peers.hpp"
+#include "bench/recognition_scan_cache.hpp"
 #include "perception/normals.hpp"
 #include "perception/object_database_builder.hpp"
 #include "perception/object_pose_search.hpp"
 #include "perception/object_recognizer.hpp"
 #include "perception/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/fnv1a.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
@@ -213,6 +215,40 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
   return e;
 }
 
+// What decides scan `s` of the bench: its scene (objects, meshes, poses), the camera, the noise
+// seed and the rendering settings.
+CachedScanKey KeyOf(const Scene& scene, int s, const RecognitionBenchOptions& options) {
+  std::string bytes;
+  auto add = [&bytes](const auto* data, std::size_t count) {
+    bytes.append(reinterpret_cast<const char*>(data), count * sizeof(*data));
+  };
+  for (const sim::SceneObject& o : scene.objects) {
+    bytes += o.name;
+    add(o.T_W_O.matrix().data(), 16);
+    add(&o.reflectance, 1);
+    for (const Eigen::Vector3d& v : o.mesh.vertices) add(v.data(), 3);
+    for (const auto& t : o.mesh.triangles) add(t.data(), t.size());
+  }
+  add(scene.T_W_C.matrix().data(), 16);
+  const std::uint64_t seed = options.seed;
+  const int settings[] = {s, options.images ? 1 : 0, options.galvo_stride};
+  add(&seed, 1);
+  add(settings, 3);
+  return {s, Fnv1a64(bytes.data(), bytes.size())};
+}
+
+// Scan `s` of the bench, from the scan cache when it holds it (then saved there).
+sim::VirtualScan ScanOf(const Scene& scene, int s, const sim::VirtualScanner& scanner,
+                        const RecognitionBenchOptions& options) {
+  const CachedScanKey key = KeyOf(scene, s, options);
+  if (!options.scan_cache.empty()) {
+    if (std::optional<sim::VirtualScan> cached = LoadCachedScan(options.scan_cache, key)) return std::move(*cached);
+  }
+  sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, options.seed + 1000 + static_cast<std::uint64_t>(s));
+  if (!options.scan_cache.empty()) SaveCachedScan(options.scan_cache, key, scan);
+  return scan;
+}
+
 }  // namespace
 
 void RecognitionBenchOptions::Check() const {
@@ -286,7 +322,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
     ++result.scans;
     const Scene scene = MakeScene(s, catalogue, foreign, options.seed);
     start = std::chrono::steady_clock::now();
-    const sim::VirtualScan scan = scene_scanner.Scan(scene.objects, scene.T_W_C, options.seed + 1000 + s);
+    const sim::VirtualScan scan = ScanOf(scene, s, scene_scanner, options);
     result.simulation_seconds += Seconds(start);
     if (scan.points_C.empty()) continue;
     const PointCloud cloud = perception::MakeCloud(scan.points_C);

@@ -30,6 +30,9 @@ struct RecognitionBenchOptions {
   bool run_ppf = true;
   std::filesystem::path data_cache;   // foreign meshes (scripts/fetch_data.sh)
   std::filesystem::path table_cache;  // cone table kept between runs
+  // Simulated scans kept between runs (recognition_scan_cache.hpp) when not empty: simulation time
+  // then counts reading them.
+  std::filesystem::path scan_cache;
   void Check() const;
 };
 
