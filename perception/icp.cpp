@@ -12,9 +12,11 @@
 #include <cstddef>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "perception/nearest_grid.hpp"
 #include "perception/svd_alignment.hpp"
 #include "scanner/common/error.hpp"
 
@@ -46,8 +48,12 @@ class NearestWithin : public flann::ResultSet<float> {
     min_cos_ = min_cos;
   }
   bool full() const override { return true; }
+  // Whether target point `index` passes the gate.
+  bool Accepts(std::size_t index) const {
+    return normals_ == nullptr || (*normals_)[index].dot(normal_) >= min_cos_;
+  }
   void addPoint(float dist, size_t index) override {
-    if (dist < worst_ && (normals_ == nullptr || (*normals_)[index].dot(normal_) >= min_cos_)) {
+    if (dist < worst_ && Accepts(index)) {
       worst_ = dist;
       index_ = static_cast<int>(index);
     }
@@ -63,19 +69,27 @@ class NearestWithin : public flann::ResultSet<float> {
   float min_cos_ = -1.0f;
 };
 
-// Exact nearest-neighbour search on the target points (relative to the target origin).
+// Exact nearest-neighbour search on the target points (relative to the target origin): FLANN's
+// kd-tree, and for radii up to grid_radius_m (when > 0) a NearestGrid of cells a quarter of it.
 class TargetTree {
  public:
-  explicit TargetTree(const PointCloud& target)
+  TargetTree(const PointCloud& target, double grid_radius_m)
       : index_(flann::Matrix<float>(const_cast<float*>(target.points.front().data()), target.size(),
                                     3),
                flann::KDTreeSingleIndexParams(10)) {
     index_.buildIndex();
+    if (grid_radius_m > 0.0) {
+      grid_.emplace(target.points, 0.25 * grid_radius_m, grid_radius_m);
+      grid_radius_sq_ = static_cast<float>(grid_radius_m * grid_radius_m);
+    }
   }
   // Index of the nearest target point within `radius` of p, or kNoMatch. Thread-safe.
   int Nearest(const Eigen::Vector3d& p, float radius_sq, NearestWithin& result) const {
     const Eigen::Vector3f query = p.cast<float>();
     result.Reset(radius_sq);
+    if (grid_ && radius_sq <= grid_radius_sq_) {
+      return static_cast<int>(grid_->Nearest(query, radius_sq, [&](std::uint32_t j) { return result.Accepts(j); }));
+    }
     index_.findNeighbors(result, query.data(), exact_);
     return result.index();
   }
@@ -83,6 +97,8 @@ class TargetTree {
  private:
   flann::KDTreeSingleIndex<flann::L2_3D<float>> index_;
   flann::SearchParams exact_{-1, 0.0f};  // unlimited checks, eps = 0: exact
+  std::optional<NearestGrid> grid_;
+  float grid_radius_sq_ = 0.0f;
 };
 
 // -[p]x, so that w x p = MinusSkew(p) w.
@@ -287,13 +303,16 @@ void IcpOptions::Check() const {
 }
 
 struct IcpTarget::Tree {
-  explicit Tree(const PointCloud& cloud) : tree(cloud) {}
+  Tree(const PointCloud& cloud, double grid_radius_m) : tree(cloud, grid_radius_m) {}
   TargetTree tree;
 };
 
-IcpTarget::IcpTarget(const PointCloud& cloud) : cloud_(cloud) {
+IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m) : cloud_(cloud) {
   RequireValidCloud(cloud, "AlignIcp: target", 3);
-  tree_ = std::make_unique<Tree>(cloud);
+  if (!(grid_radius_m >= 0.0 && std::isfinite(grid_radius_m))) {
+    throw Error("IcpTarget: grid_radius_m must be finite and >= 0, got " + std::to_string(grid_radius_m));
+  }
+  tree_ = std::make_unique<Tree>(cloud, grid_radius_m);
   centroid_rel_.setZero();
   for (const Eigen::Vector3f& q : cloud.points) centroid_rel_ += q.cast<double>();
   centroid_rel_ /= static_cast<double>(cloud.size());

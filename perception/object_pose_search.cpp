@@ -12,6 +12,10 @@
 #include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::perception {
+namespace {
+
+
+}  // namespace
 
 ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads) {
   NormalOptions normals;
@@ -37,7 +41,7 @@ const ViewFeatures& RecognitionCache::View(std::size_t object, std::size_t view,
 const ModelIndexes& RecognitionCache::Model(std::size_t object) {
   const std::lock_guard<std::mutex> lock(mutex_);
   std::unique_ptr<ModelIndexes>& slot = models_[object];
-  if (!slot) slot = std::make_unique<ModelIndexes>(db_.objects.at(object).model);
+  if (!slot) slot = std::make_unique<ModelIndexes>(db_.objects.at(object).model, db_.parameters.voxel_m);
   return *slot;
 }
 
@@ -174,28 +178,27 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
   return kept;
 }
 
-double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const KnnIndex& model_index,
+double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
                          const Eigen::Isometry3d& T_O_S, double voxel_m) {
   const double cap = voxel_m * voxel_m;
-  std::vector<std::uint32_t> nearest;
-  std::vector<float> squared;
   double sum = 0.0;
   for (std::size_t i = 0; i < sample.size(); ++i) {
     const Eigen::Vector3d x_O = T_O_S * sample.Point(i);
-    model_index.Query((x_O - model.model.origin).cast<float>(), 1, nearest, squared);
-    if (nearest.empty() || squared[0] > cap) {
+    const std::int64_t j = model_grid.Nearest((x_O - model.model.origin).cast<float>(), static_cast<float>(cap),
+                                              [](std::size_t) { return true; });
+    if (j < 0) {
       sum += cap;
       continue;
     }
-    const double along_normal =
-        model.model.normals[nearest[0]].cast<double>().dot(x_O - model.model.Point(nearest[0]));
+    const std::size_t nearest = static_cast<std::size_t>(j);
+    const double along_normal = model.model.normals[nearest].cast<double>().dot(x_O - model.model.Point(nearest));
     sum += std::min(along_normal * along_normal, cap);
   }
   return sum;
 }
 
 std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, const ObjectModel& model,
-                                                   const KnnIndex& model_index, const SymmetryAxis& axis,
+                                                   const NearestGrid& model_grid, const SymmetryAxis& axis,
                                                    const Eigen::Isometry3d& T_O_S, double voxel_m) {
   if (axis.order < 3 || sample.size() == 0 || !model.model.has_normals()) return {};
   const double period = 2.0 * std::numbers::pi / axis.order;
@@ -207,7 +210,7 @@ std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, con
   };
   std::vector<double> residual;
   for (int k = -steps; k <= steps; ++k) {
-    residual.push_back(TruncatedResidual(sample, model, model_index, turned(k * step), voxel_m));
+    residual.push_back(TruncatedResidual(sample, model, model_grid, turned(k * step), voxel_m));
   }
   const std::size_t lowest = static_cast<std::size_t>(std::min_element(residual.begin(), residual.end()) - residual.begin());
   const double near = residual[lowest] + 0.5 * voxel_m * voxel_m;

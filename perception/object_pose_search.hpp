@@ -11,6 +11,7 @@
 #include "perception/cloud_neighbors.hpp"
 #include "perception/fpfh.hpp"
 #include "perception/icp.hpp"
+#include "perception/nearest_grid.hpp"
 #include "perception/object_database.hpp"
 #include "perception/object_recognizer.hpp"
 #include "perception/point_cloud.hpp"
@@ -27,11 +28,14 @@ struct ViewFeatures {
 };
 ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads);
 
-// A model's search structures: its k-d tree as an ICP target and for nearest points.
+// A model's search structures: its ICP target (k-d tree, and a grid for radii up to 4 voxels)
+// and its nearest points within up to 4 voxels (verification, parts, symmetry phases), both
+// on grids of one voxel: the model's points are about a voxel apart (NearestGrid).
 struct ModelIndexes {
-  explicit ModelIndexes(const PointCloud& model) : target(model), nearest(model.points) {}
+  ModelIndexes(const PointCloud& model, double voxel_m)
+      : target(model, 4.0 * voxel_m), nearest(model.points, voxel_m, 4.0 * voxel_m) {}
   IcpTarget target;
-  KnnIndex nearest;
+  NearestGrid nearest;
 };
 
 // What recognition derives from a database and comes back to segment after segment and scan
@@ -81,8 +85,8 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
 
 // Sum over `sample` (segment frame) of the squared point-to-plane distances to the nearest
 // points of the model posed by T_O_S, each at most voxel_m^2: a point farther than a voxel from
-// every model point counts the cap, as no pair at all. `model_index` holds model.model's points.
-double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const KnnIndex& model_index,
+// every model point counts the cap, as no pair at all. `model_grid` holds model.model's points.
+double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
                          const Eigen::Isometry3d& T_O_S, double voxel_m);
 
 // Phases worth trying about one of the model's symmetry axes of order N >= 3 (a surface of
@@ -94,7 +98,7 @@ double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, con
 // stand off the surface beyond its pairing distance unless they already overlap. T_O_S as ICP
 // gives it (segment to object), and the same for the results.
 std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, const ObjectModel& model,
-                                                   const KnnIndex& model_index, const SymmetryAxis& axis,
+                                                   const NearestGrid& model_grid, const SymmetryAxis& axis,
                                                    const Eigen::Isometry3d& T_O_S, double voxel_m);
 
 }  // namespace uwscan::perception

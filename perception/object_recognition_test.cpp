@@ -16,6 +16,7 @@
 #include "perception/cloud_io.hpp"
 #include "perception/cloud_neighbors.hpp"
 #include "perception/clustering.hpp"
+#include "perception/nearest_grid.hpp"
 #include "perception/object_catalogue.hpp"
 #include "perception/object_database.hpp"
 #include "perception/object_database_builder.hpp"
@@ -360,8 +361,8 @@ TEST(ObjectPoseSearch, TheBoltsPhaseIsFound) {
   }
   PointCloud sample = MakeCloud(points);
   sample.normals = normals;
-  const KnnIndex index(flange->model.points);
   const double voxel_m = db.parameters.voxel_m;
+  const NearestGrid index(flange->model.points, voxel_m, 4.0 * voxel_m);
   // The truth is the identity (the sample is in the object's frame); the estimate is turned.
   auto phase_error_rad = [&](const Eigen::Isometry3d& T_O_S) {
     const double angle = Eigen::AngleAxisd(T_O_S.linear()).angle();

@@ -144,16 +144,16 @@ PosedObject PoseCandidate(const DescribedSegment& s, std::size_t i, const Chosen
   return p;
 }
 
-// The points of `segment` within `distance_m` of the posed model's surface points.
-std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model, const KnnIndex& model_index,
+// The points of `segment` within `distance_m` (at most model_grid's radius) of the posed model's surface points.
+std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
                                        const Eigen::Isometry3d& T_O_S, double distance_m) {
   std::vector<std::size_t> on;
-  std::vector<std::uint32_t> nearest;
-  std::vector<float> squared;
+  const float distance_sq = static_cast<float>(distance_m * distance_m);
   for (std::size_t i = 0; i < segment.size(); ++i) {
     const Eigen::Vector3d x = T_O_S * segment.Point(i);
-    model_index.Query((x - model.model.origin).cast<float>(), 1, nearest, squared);
-    if (!nearest.empty() && squared[0] <= distance_m * distance_m) on.push_back(i);
+    if (model_grid.Nearest((x - model.model.origin).cast<float>(), distance_sq, [](std::size_t) { return true; }) >= 0) {
+      on.push_back(i);
+    }
   }
   return on;
 }

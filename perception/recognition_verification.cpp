@@ -63,17 +63,17 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
   return expected == 0 ? 1.0 : static_cast<double>(missing) / static_cast<double>(expected);
 }
 
-double CloseShare(const PointCloud& model, const KnnIndex& model_index, const PointCloud& segment_O,
+double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const PointCloud& segment_O,
                   double distance_m, double reach_m) {
-  std::vector<std::uint32_t> nearest;
-  std::vector<float> squared;
+  const float reach_sq = static_cast<float>(reach_m * reach_m);
   std::size_t close = 0;
   for (std::size_t i = 0; i < segment_O.size(); ++i) {
     const Eigen::Vector3d x = segment_O.Point(i);
-    model_index.Query((x - model.origin).cast<float>(), 1, nearest, squared);
-    if (nearest.empty() || squared[0] > reach_m * reach_m) continue;
-    const Eigen::Vector3d n = model.normals[nearest[0]].cast<double>().normalized();
-    close += std::abs(n.dot(x - model.Point(nearest[0]))) <= distance_m ? 1 : 0;
+    const std::int64_t j = model_grid.Nearest((x - model.origin).cast<float>(), reach_sq, [](std::size_t) { return true; });
+    if (j < 0) continue;
+    const std::size_t nearest = static_cast<std::size_t>(j);
+    const Eigen::Vector3d n = model.normals[nearest].cast<double>().normalized();
+    close += std::abs(n.dot(x - model.Point(nearest))) <= distance_m ? 1 : 0;
   }
   return segment_O.empty() ? 0.0 : static_cast<double>(close) / static_cast<double>(segment_O.size());
 }

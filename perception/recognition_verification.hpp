@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "perception/cloud_neighbors.hpp"
+#include "perception/nearest_grid.hpp"
 #include "perception/object_database.hpp"
 #include "perception/point_cloud.hpp"
 
@@ -77,8 +78,8 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
 // Share of the segment (object frame) within `distance_m` of the model's surface: the
 // point-to-plane distance to the nearest model point, when that point is within `reach_m` (about
 // the model's sample spacing, so that a point beside a thin part, on the part's tangent plane but
-// off its surface, does not count).
-double CloseShare(const PointCloud& model, const KnnIndex& model_index, const PointCloud& segment_O,
+// off its surface, does not count; at most model_grid's radius).
+double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const PointCloud& segment_O,
                   double distance_m, double reach_m);
 
 }  // namespace uwscan::perception

@@ -15,16 +15,16 @@ namespace {
 // score barely sees them, so a phase the search found stands unless it scores clearly worse than
 // the pose it turned; of two, the better scoring.
 void SearchSymmetryPhases(const DescribedSegment& s, const PointCloud& sample, const ObjectModel& model,
-                          const IcpTarget& target, const KnnIndex& model_index, const IcpOptions& fine,
+                          const IcpTarget& target, const NearestGrid& model_grid, const IcpOptions& fine,
                           const SceneAround& around, const ScanContext& ctx, PosedObject& best) {
   for (const SymmetryAxis& axis : model.symmetries) {
     const PosedObject before = best;
     bool turned_once = false;
-    for (const Eigen::Isometry3d& turned : SymmetryPhaseStarts(sample, model, model_index, axis,
+    for (const Eigen::Isometry3d& turned : SymmetryPhaseStarts(sample, model, model_grid, axis,
                                                                before.fine.T_target_source, ctx.db.parameters.voxel_m)) {
       const RegistrationResult refined = AlignIcp(sample, target, turned, fine);
       RecognitionCandidate c = before.candidate;
-      Verify(s.cloud, model, model_index, around, refined, ctx, c);
+      Verify(s.cloud, model, model_grid, around, refined, ctx, c);
       if (c.verified < before.candidate.verified || c.score < before.candidate.score - ctx.options.score_tie) continue;
       if (turned_once && !Better(c, best.candidate)) continue;
       turned_once = true;
@@ -74,7 +74,7 @@ DescribedSegment DescribeSegment(const PointCloud& segment, const ScanContext& c
 }
 
 // The posed model verified on `segment`: fit, closeness and missing surface.
-void Verify(const PointCloud& segment, const ObjectModel& model, const KnnIndex& model_index,
+void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
             const SceneAround& around, const RegistrationResult& refined, const ScanContext& ctx,
             RecognitionCandidate& c) {
   const ObjectDatabaseParameters& p = ctx.db.parameters;
@@ -83,7 +83,7 @@ void Verify(const PointCloud& segment, const ObjectModel& model, const KnnIndex&
   c.fitness = refined.fitness;
   c.rmse_m = refined.inlier_plane_rmse;
   c.missing = MissingShare(model, c.T_S_O, around, 2.0 * p.voxel_m);
-  c.close = CloseShare(model.model, model_index, Transformed(segment, T_O_S), ctx.options.close_distance_m, p.voxel_m);
+  c.close = CloseShare(model.model, model_grid, Transformed(segment, T_O_S), ctx.options.close_distance_m, p.voxel_m);
   c.score = c.close * (1.0 - c.missing);
   c.verified = c.fitness >= ctx.options.min_fitness && c.close >= ctx.options.min_close &&
                c.missing <= ctx.options.max_missing;
@@ -113,7 +113,7 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   const ObjectDatabaseParameters& p = ctx.db.parameters;
   const ModelIndexes& indexes = ctx.cache.Model(object);
   const IcpTarget& target = indexes.target;
-  const KnnIndex& model_index = indexes.nearest;
+  const NearestGrid& model_grid = indexes.nearest;
   const std::vector<Eigen::Isometry3d> sifted = SiftStarts(s.cloud, target, starts, model.diameter_m, p, ctx.options);
   ctx.clock.Lap("sift");
   const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
@@ -130,7 +130,7 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   RunParallelTasks(std::ssize(sifted), ctx.options.threads, [&](std::ptrdiff_t k) {
     const std::size_t i = static_cast<std::size_t>(k);
     refined[i] = AlignIcp(sample, target, sifted[i], from_sift);
-    Verify(s.cloud, model, model_index, around, refined[i], ctx, checked[i]);
+    Verify(s.cloud, model, model_grid, around, refined[i], ctx, checked[i]);
   });
   for (std::size_t i = 0; i < sifted.size(); ++i) {
     if (posed && !Better(checked[i], best.candidate)) continue;
@@ -139,14 +139,14 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
     best.fine = refined[i];
   }
   if (posed) {
-    SearchSymmetryPhases(s, sample, model, target, model_index, fine, around, ctx, best);
+    SearchSymmetryPhases(s, sample, model, target, model_grid, fine, around, ctx, best);
     ctx.clock.Lap("refine");
     // The pose has converged on the sample: the last stage alone, on every point, for the
     // information of them all (the coarser stages took 34 iterations on average to get back).
     IcpOptions last = fine;
     last.max_correspondence_distance_m = {fine.max_correspondence_distance_m.back()};
     best.fine = AlignIcp(s.cloud, target, best.fine.T_target_source, last);
-    Verify(s.cloud, model, model_index, around, best.fine, ctx, best.candidate);
+    Verify(s.cloud, model, model_grid, around, best.fine, ctx, best.candidate);
   }
   ctx.clock.Lap("final");
   return best;
@@ -163,7 +163,7 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   const ObjectDatabaseParameters& p = ctx.db.parameters;
   const ModelIndexes& indexes = ctx.cache.Model(posed.object);
   const IcpTarget& target = indexes.target;
-  const KnnIndex& model_index = indexes.nearest;
+  const NearestGrid& model_grid = indexes.nearest;
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
   const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, p.voxel_m);
   std::vector<RecognitionCandidate> turned(turns.size());
@@ -171,7 +171,7 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
     const std::size_t i = static_cast<std::size_t>(k);
     const RegistrationResult refined = AlignIcp(sample, target, turns[i] * posed.fine.T_target_source,
                                                 FineIcp(model.diameter_m, p, 1));
-    Verify(s.cloud, model, model_index, around, refined, ctx, turned[i]);
+    Verify(s.cloud, model, model_grid, around, refined, ctx, turned[i]);
   });
   std::vector<Eigen::Vector3d> points_O;
   for (std::size_t i = 0; i < model.model.size(); i += 4) points_O.push_back(model.model.Point(i));

@@ -83,7 +83,7 @@ struct PosedObject {
 };
 
 // The posed model verified on `segment`: fit, closeness and missing surface.
-void Verify(const PointCloud& segment, const ObjectModel& model, const KnnIndex& model_index,
+void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
             const SceneAround& around, const RegistrationResult& refined, const ScanContext& ctx,
             RecognitionCandidate& c);
 
