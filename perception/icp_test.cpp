@@ -189,23 +189,28 @@ TEST_P(IcpMethods, IdenticalWithOneAndTwoThreads) {
   }
 }
 
-// A target prepared once gives the same bits as AlignIcp on the cloud, start after start.
+// A target prepared once gives the same bits as AlignIcp on the cloud, start after start, and so
+// does one searched through a grid (NearestGrid) at the stages within its radius.
 TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
   const PointCloud target = BumpySurface(8000, 4, -0.25, 0.0005);
   const PointCloud source = Transformed(BumpySurface(3000, 5, -0.1, 0.0005), KnownMotion().inverse());
   const IcpTarget prepared(target);
+  const IcpTarget gridded(target, 0.02);  // the last two of the three stages
   const IcpOptions options = Options(GetParam());
   for (const double angle_deg : {0.0, 3.0, -4.0}) {
     Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
     start.linear() = Eigen::AngleAxisd(angle_deg * kDeg, Eigen::Vector3d::UnitZ()).matrix();
     const RegistrationResult plain = AlignIcp(source, target, start, options);
-    const RegistrationResult reused = AlignIcp(source, prepared, start, options);
-    EXPECT_TRUE(plain.T_target_source.matrix() == reused.T_target_source.matrix());
-    EXPECT_EQ(plain.fitness, reused.fitness);
-    EXPECT_EQ(plain.iterations, reused.iterations);
-    EXPECT_TRUE(plain.information == reused.information);
-    EXPECT_LT(TranslationErrorM(reused.T_target_source, KnownMotion()), 0.005);  // independent samples
+    for (const IcpTarget* reused_target : {&prepared, &gridded}) {
+      const RegistrationResult reused = AlignIcp(source, *reused_target, start, options);
+      EXPECT_TRUE(plain.T_target_source.matrix() == reused.T_target_source.matrix());
+      EXPECT_EQ(plain.fitness, reused.fitness);
+      EXPECT_EQ(plain.iterations, reused.iterations);
+      EXPECT_TRUE(plain.information == reused.information);
+      EXPECT_LT(TranslationErrorM(reused.T_target_source, KnownMotion()), 0.005);  // independent samples
+    }
   }
+  EXPECT_THROW(IcpTarget(target, -0.01), Error);
   PointCloud two_points;
   two_points.points = {Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX()};
   EXPECT_THROW(IcpTarget target(two_points), Error);
@@ -435,6 +440,10 @@ TEST(IcpNormalGate, KeepsAScanOfAPipesOutsideOffItsBore) {
   EXPECT_NEAR(mean_radius(gated), outer, 2e-4);
   EXPECT_TRUE(gated.converged);
   EXPECT_GT(gated.fitness, 0.99);
+  // The grid search honours the gate as the tree does: the same bits.
+  const RegistrationResult gridded = AlignIcp(scan, IcpTarget(model, 0.01), start, options);
+  EXPECT_TRUE(gridded.T_target_source.matrix() == gated.T_target_source.matrix());
+  EXPECT_EQ(gridded.iterations, gated.iterations);
 }
 
 TEST(IcpNormalGate, NeedsNormalsOnBothClouds) {
