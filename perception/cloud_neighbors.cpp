@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "perception/flann_distance.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
@@ -21,18 +22,6 @@ void RequireIndexable(std::size_t size, const char* what) {
     throw Error(std::string(what) + ": " + std::to_string(size) +
                 " points; at most 2^32 - 1 are supported");
   }
-}
-
-// FLANN's L2_Simple distance, term by term in the same order.
-inline float SquaredDistance(float qx, float qy, float qz, float px, float py, float pz) {
-  const float dx = qx - px;
-  const float dy = qy - py;
-  const float dz = qz - pz;
-  float d = 0.0f;
-  d += dx * dx;
-  d += dy * dy;
-  d += dz * dz;
-  return d;
 }
 
 }  // namespace
@@ -157,7 +146,7 @@ void RadiusGrid::Query(const Eigen::Vector3f& q, std::vector<std::uint32_t>& ind
       CellRange(column + static_cast<std::uint64_t>(z_lo),
                 column + static_cast<std::uint64_t>(z_hi), begin, end);
       for (std::uint32_t s = begin; s < end; ++s) {
-        const float d = SquaredDistance(qx, qy, qz, x_[s], y_[s], z_[s]);
+        const float d = FlannSquaredDistance(qx, qy, qz, x_[s], y_[s], z_[s]);
         if (d < radius_sq_) {
           indices.push_back(index_[s]);
           squared_distances_m2.push_back(d);

@@ -11,6 +11,8 @@
 #include <span>
 #include <vector>
 
+#include "perception/flann_distance.hpp"
+
 namespace uwscan::perception {
 
 // A uniform grid of cubic cells (a few times smaller than the search radius) holding a cloud's
@@ -36,16 +38,6 @@ class NearestGrid {
   double max_radius_m() const { return max_radius_m_; }
 
  private:
-  static float SquaredDistance(float qx, float qy, float qz, float px, float py, float pz) {
-    const float dx = qx - px;
-    const float dy = qy - py;
-    const float dz = qz - pz;
-    float d = 0.0f;
-    d += dx * dx;
-    d += dy * dy;
-    d += dz * dz;
-    return d;
-  }
   std::uint64_t Key(int x, int y, int z) const {
     return (static_cast<std::uint64_t>(x) * static_cast<std::uint64_t>(n_.y()) + static_cast<std::uint64_t>(y)) *
                static_cast<std::uint64_t>(n_.z()) +
@@ -84,7 +76,7 @@ std::int64_t NearestGrid::Nearest(const Eigen::Vector3f& q, float radius_sq_m2, 
   const float qx = q.x(), qy = q.y(), qz = q.z();
   auto visit = [&](std::uint64_t key_lo, std::uint64_t key_hi) {
     for (std::uint32_t s = cell_start_[key_lo]; s < cell_start_[key_hi + 1]; ++s) {
-      const float d = SquaredDistance(qx, qy, qz, x_[s], y_[s], z_[s]);
+      const float d = FlannSquaredDistance(qx, qy, qz, x_[s], y_[s], z_[s]);
       if (d > best || (d == best && (found < 0 || index_[s] > found))) continue;
       if (accept(index_[s])) {
         best = d;
