@@ -8,7 +8,7 @@
 namespace uwscan::perception {
 namespace {
 
-constexpr std::uint64_t kMaxCells = std::uint64_t{1} << 27;
+constexpr std::uint64_t kMaxCells = std::uint64_t{1} << 24;  // 84 MB of cell starts and rings
 
 // One pass of the chessboard distance transform along a line of `count` values `stride` apart:
 // each becomes min over the line's j of max(|i - j|, value[j]), looking at most `cap` cells away
@@ -28,27 +28,38 @@ void ChessboardPass(std::uint8_t* values, int count, std::ptrdiff_t stride, int 
 }  // namespace
 
 NearestGrid::NearestGrid(std::span<const Eigen::Vector3f> points, double cell_m, double max_radius_m)
-    : cell_m_(cell_m), inverse_cell_m_(1.0 / cell_m), max_radius_m_(max_radius_m) {
+    : max_radius_m_(max_radius_m) {
   if (!(std::isfinite(cell_m) && cell_m > 0.0 && std::isfinite(max_radius_m) && max_radius_m >= cell_m)) {
     throw Error("NearestGrid: need a finite cell_m > 0 and max_radius_m >= cell_m, got " + std::to_string(cell_m) +
                 " and " + std::to_string(max_radius_m));
   }
+  if (max_radius_m / cell_m > 200.0) throw Error("NearestGrid: max_radius_m is more than 200 cells");
   if (points.size() >= std::numeric_limits<std::uint32_t>::max()) throw Error("NearestGrid: too many points");
-  max_rings_ = static_cast<int>(std::ceil(max_radius_m / cell_m));
-  if (max_rings_ > 200) throw Error("NearestGrid: max_radius_m is more than 200 cells");
-  if (points.empty()) return;
-  Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  Eigen::Array3d lo_m = Eigen::Array3d::Constant(std::numeric_limits<double>::infinity()), hi_m = -lo_m;
   for (const Eigen::Vector3f& p : points) {
     if (!p.allFinite()) throw Error("NearestGrid: a point is not finite");
-    const Eigen::Array3d c = (p.cast<double>().array() * inverse_cell_m_).floor();
-    lo = lo.min(c);
-    hi = hi.max(c);
+    lo_m = lo_m.min(p.cast<double>().array());
+    hi_m = hi_m.max(p.cast<double>().array());
   }
-  const int margin = max_rings_ + 1;
+  // Cells twice as wide until the grid fits its budget (a large object's model): the search
+  // stays exact, only slower.
+  Eigen::Array3d lo, hi;
+  int margin = 0;
+  for (;; cell_m *= 2.0) {
+    inverse_cell_m_ = 1.0 / cell_m;
+    max_rings_ = static_cast<int>(std::ceil(max_radius_m / cell_m));
+    margin = max_rings_ + 1;
+    if (points.empty()) break;
+    lo = (lo_m * inverse_cell_m_).floor();
+    hi = (hi_m * inverse_cell_m_).floor();
+    if ((hi - lo + 1.0 + 2.0 * margin).prod() <= static_cast<double>(kMaxCells)) break;
+  }
+  cell_m_ = cell_m;
+  if (points.empty()) return;
+  if (!(lo.abs().maxCoeff() < 1e9 && hi.abs().maxCoeff() < 1e9)) {
+    throw Error("NearestGrid: coordinates too large for cells of " + std::to_string(cell_m) + " m");
+  }
   const Eigen::Array3d extent = hi - lo + 1.0 + 2.0 * margin;
-  if (!(lo.abs().maxCoeff() < 1e9 && hi.abs().maxCoeff() < 1e9) || extent.prod() > static_cast<double>(kMaxCells)) {
-    throw Error("NearestGrid: cells of " + std::to_string(cell_m) + " m are too small for the cloud's extent");
-  }
   first_ = lo.cast<int>() - margin;
   n_ = extent.cast<int>();
   const std::uint64_t cells = static_cast<std::uint64_t>(n_.x()) * static_cast<std::uint64_t>(n_.y()) *

@@ -27,7 +27,8 @@ namespace uwscan::perception {
 class NearestGrid {
  public:
   // Copies the points (finite). cell_m > 0; queries may use any radius up to max_radius_m
-  // (>= cell_m). Throws uwscan::Error on invalid sizes, or when the grid would exceed 2^27 cells.
+  // (>= cell_m, at most 200 cells). Cells are made twice as wide, as often as it takes, to keep
+  // the grid within 2^24 cells. Throws uwscan::Error on invalid sizes or non-finite points.
   NearestGrid(std::span<const Eigen::Vector3f> points, double cell_m, double max_radius_m);
 
   // The nearest point to q strictly within sqrt(radius_sq_m2) (at most max_radius_m) among those

@@ -95,10 +95,22 @@ TEST(NearestGrid, RefusesBadSizesAndAnswersNothingWhenEmpty) {
   EXPECT_EQ(empty.Nearest(Eigen::Vector3f::Zero(), 1.0f, [](std::size_t) { return true; }), -1);
   EXPECT_THROW(NearestGrid(none, 0.0, 0.02), Error);
   EXPECT_THROW(NearestGrid(none, 0.005, 0.001), Error);
-  const std::vector<Eigen::Vector3f> spread = {{0.0f, 0.0f, 0.0f}, {1000.0f, 1000.0f, 1000.0f}};
-  EXPECT_THROW(NearestGrid(spread, 0.001, 0.002), Error);  // far too many cells
   const std::vector<Eigen::Vector3f> bad = {{NAN, 0.0f, 0.0f}};
   EXPECT_THROW(NearestGrid(bad, 0.005, 0.02), Error);
+}
+
+TEST(NearestGrid, AWideCloudGetsWiderCellsAndStaysExact) {
+  // A kilometre across at 1 mm cells would be 10^18 cells: the grid widens its cells instead.
+  std::mt19937 rng(9);
+  std::vector<Eigen::Vector3f> points = SurfacePoints(rng, 500);
+  points.emplace_back(1000.0f, 1000.0f, 1000.0f);
+  const NearestGrid grid(points, 0.001, 0.002);
+  const auto all = [](std::size_t) { return true; };
+  std::normal_distribution<float> off(0.0f, 0.001f);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f q = points[i] + Eigen::Vector3f(off(rng), off(rng), off(rng));
+    ASSERT_EQ(grid.Nearest(q, 4e-6f, all), BruteNearest(points, q, 4e-6f, all)) << "point " << i;
+  }
 }
 
 }  // namespace
