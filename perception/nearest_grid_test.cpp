@@ -92,7 +92,7 @@ TEST(NearestGrid, TakesTheLowestIndexOfEquallyNearPointsAndRefusesTheRadiusItsel
 TEST(NearestGrid, RefusesBadSizesAndAnswersNothingWhenEmpty) {
   const std::vector<Eigen::Vector3f> none;
   const NearestGrid empty(none, 0.005, 0.02);
-  EXPECT_EQ(empty.Nearest(Eigen::Vector3f::Zero(), 1.0f, [](std::size_t) { return true; }), -1);
+  EXPECT_EQ(empty.Nearest(Eigen::Vector3f::Zero(), 4e-4f, [](std::size_t) { return true; }), -1);
   EXPECT_THROW(NearestGrid(none, 0.0, 0.02), Error);
   EXPECT_THROW(NearestGrid(none, 0.005, 0.001), Error);
   const std::vector<Eigen::Vector3f> bad = {{NAN, 0.0f, 0.0f}};

@@ -34,14 +34,37 @@ void SearchSymmetryPhases(const DescribedSegment& s, const PointCloud& sample, c
   }
 }
 
+// Share of the model's points (every 4th) that `turn` (T_O_O') puts within a voxel of the model.
+double SelfOverlap(const ObjectModel& model, const NearestGrid& model_grid, const Eigen::Isometry3d& turn,
+                   double voxel_m) {
+  std::size_t on = 0, count = 0;
+  for (std::size_t i = 0; i < model.model.size(); i += 4, ++count) {
+    const Eigen::Vector3d x = turn * model.model.Point(i);
+    on += model_grid.Nearest((x - model.model.origin).cast<float>(), static_cast<float>(voxel_m * voxel_m),
+                             [](std::size_t) { return true; }) >= 0 ? 1 : 0;
+  }
+  return count == 0 ? 0.0 : static_cast<double>(on) / static_cast<double>(count);
+}
+
 // Half turns of a model (T_O_O') about its principal axes and about its own frame's axes through
 // its origin (a procedural object's stem or run: a valve's lever tilts the principal axes off
-// its stem), without those that are its symmetries or repeat another (within 5 degrees and 2
-// voxels at its centre): they would end where they started.
-std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, double voxel_m) {
+// its stem), and about the bisectors of two frame axes when such a turn lays at least half the
+// model back on itself (a tee seen as an L, its run's one half and its branch, fits turned about
+// their bisector); without those that are its symmetries or repeat another (within 5 degrees
+// and 2 voxels at its centre): they would end where they started.
+std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, const NearestGrid& model_grid, double voxel_m) {
   std::vector<Eigen::Isometry3d> candidates = HalfTurns(model.model);
   for (int axis = 0; axis < 3; ++axis) {
     candidates.emplace_back(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::Unit(axis)));
+  }
+  for (int a = 0; a < 3; ++a) {
+    for (int b = a + 1; b < 3; ++b) {
+      for (double sign : {1.0, -1.0}) {
+        const Eigen::Vector3d bisector = (Eigen::Vector3d::Unit(a) + sign * Eigen::Vector3d::Unit(b)).normalized();
+        const Eigen::Isometry3d turn(Eigen::AngleAxisd(std::numbers::pi, bisector));
+        if (SelfOverlap(model, model_grid, turn, voxel_m) >= 0.5) candidates.push_back(turn);
+      }
+    }
   }
   const Eigen::Vector3d centre_O = model.model.origin;
   auto alike = [&](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -165,7 +188,7 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   const IcpTarget& target = indexes.target;
   const NearestGrid& model_grid = indexes.nearest;
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
-  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, p.voxel_m);
+  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, indexes.nearest, p.voxel_m);
   std::vector<RecognitionCandidate> turned(turns.size());
   RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
     const std::size_t i = static_cast<std::size_t>(k);

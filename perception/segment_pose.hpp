@@ -102,7 +102,7 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
 
 // Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
 // equivalent_poses_S): its pose turned by each of DistinctHalfTurns (a nearly symmetric object,
-// a valve's body, fits either way), refined by the fine ICP and verified like it; kept when
+// a valve's body, fits either way; a tee seen as an L fits turned about the L's bisector), refined by the fine ICP and verified like it; kept when
 // verified, scoring within score_tie of it and more than 5 degrees or 2 voxels from it and from
 // each other modulo the object's symmetries. T_S_O each.
 std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const PosedObject& posed,
