@@ -35,6 +35,10 @@ class NearestGrid {
   // whose index passes accept(index), or -1 when there is none (or q is not finite).
   template <typename Accept>
   std::int64_t Nearest(const Eigen::Vector3f& q, float radius_sq_m2, Accept&& accept) const;
+  // The same over every point.
+  std::int64_t Nearest(const Eigen::Vector3f& q, float radius_sq_m2) const {
+    return Nearest(q, radius_sq_m2, [](std::size_t) { return true; });
+  }
 
   double max_radius_m() const { return max_radius_m_; }
 

@@ -12,10 +12,6 @@
 #include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::perception {
-namespace {
-
-
-}  // namespace
 
 ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads) {
   NormalOptions normals;
@@ -184,8 +180,7 @@ double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, con
   double sum = 0.0;
   for (std::size_t i = 0; i < sample.size(); ++i) {
     const Eigen::Vector3d x_O = T_O_S * sample.Point(i);
-    const std::int64_t j = model_grid.Nearest((x_O - model.model.origin).cast<float>(), static_cast<float>(cap),
-                                              [](std::size_t) { return true; });
+    const std::int64_t j = model_grid.Nearest((x_O - model.model.origin).cast<float>(), static_cast<float>(cap));
     if (j < 0) {
       sum += cap;
       continue;

@@ -151,7 +151,7 @@ std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectMo
   const float distance_sq = static_cast<float>(distance_m * distance_m);
   for (std::size_t i = 0; i < segment.size(); ++i) {
     const Eigen::Vector3d x = T_O_S * segment.Point(i);
-    if (model_grid.Nearest((x - model.model.origin).cast<float>(), distance_sq, [](std::size_t) { return true; }) >= 0) {
+    if (model_grid.Nearest((x - model.model.origin).cast<float>(), distance_sq) >= 0) {
       on.push_back(i);
     }
   }

@@ -69,7 +69,7 @@ double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const 
   std::size_t close = 0;
   for (std::size_t i = 0; i < segment_O.size(); ++i) {
     const Eigen::Vector3d x = segment_O.Point(i);
-    const std::int64_t j = model_grid.Nearest((x - model.origin).cast<float>(), reach_sq, [](std::size_t) { return true; });
+    const std::int64_t j = model_grid.Nearest((x - model.origin).cast<float>(), reach_sq);
     if (j < 0) continue;
     const std::size_t nearest = static_cast<std::size_t>(j);
     const Eigen::Vector3d n = model.normals[nearest].cast<double>().normalized();

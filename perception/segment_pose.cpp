@@ -40,8 +40,7 @@ double SelfOverlap(const ObjectModel& model, const NearestGrid& model_grid, cons
   std::size_t on = 0, count = 0;
   for (std::size_t i = 0; i < model.model.size(); i += 4, ++count) {
     const Eigen::Vector3d x = turn * model.model.Point(i);
-    on += model_grid.Nearest((x - model.model.origin).cast<float>(), static_cast<float>(voxel_m * voxel_m),
-                             [](std::size_t) { return true; }) >= 0 ? 1 : 0;
+    on += model_grid.Nearest((x - model.model.origin).cast<float>(), static_cast<float>(voxel_m * voxel_m)) >= 0 ? 1 : 0;
   }
   return count == 0 ? 0.0 : static_cast<double>(on) / static_cast<double>(count);
 }
@@ -188,7 +187,7 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   const IcpTarget& target = indexes.target;
   const NearestGrid& model_grid = indexes.nearest;
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
-  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, indexes.nearest, p.voxel_m);
+  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, model_grid, p.voxel_m);
   std::vector<RecognitionCandidate> turned(turns.size());
   RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
     const std::size_t i = static_cast<std::size_t>(k);
