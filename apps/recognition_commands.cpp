@@ -112,6 +112,13 @@ void RunRecognize(const RecognizeArgs& a) {
                 "%zu free directions, %zu grasps\n",
                 o.object_id.c_str(), o.segment.size(), o.score, o.chi_square, o.margin, t.x(), t.y(),
                 t.z(), o.free_directions.size(), o.grasps_S.size());
+    if (!o.equivalent_poses_S.empty()) {
+      std::printf("    %zu other pose%s fit as well (--json: equivalent_poses)\n", o.equivalent_poses_S.size(),
+                  o.equivalent_poses_S.size() > 1 ? "s" : "");
+    }
+    for (const auto& [id, T_S_O] : o.equivalent_objects_S) {
+      std::printf("    or %s: the scan fits it as well\n", id.c_str());
+    }
   }
   if (!a.json.empty()) {
     nlohmann::json j = RecognitionJson(result, scan.size());

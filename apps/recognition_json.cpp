@@ -65,6 +65,13 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o) {
   nlohmann::json equivalent = nlohmann::json::array();
   for (const Eigen::Isometry3d& T_S_O : o.equivalent_poses_S) equivalent.push_back(Pose(T_S_O));
   j["equivalent_poses"] = equivalent;
+  nlohmann::json equivalent_objects = nlohmann::json::array();
+  for (const auto& [id, T_S_O] : o.equivalent_objects_S) {
+    nlohmann::json e = Pose(T_S_O);
+    e["id"] = id;
+    equivalent_objects.push_back(e);
+  }
+  j["equivalent_objects"] = equivalent_objects;
   nlohmann::json grasps = nlohmann::json::array();
   for (const auto& [name, T_S_G] : o.grasps_S) {
     nlohmann::json g = Pose(T_S_G);

@@ -186,8 +186,15 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
     return std::nullopt;
   }
   ++figures.objects;
-  if (answer != truth || !T_S_O) return std::nullopt;
+  const bool reported_as_equivalent =
+      reported != nullptr && std::any_of(reported->equivalent_objects_S.begin(), reported->equivalent_objects_S.end(),
+                                         [&](const auto& e) { return e.first == truth; });
+  if (answer != truth || !T_S_O) {
+    figures.recognised_or_reported += reported_as_equivalent;
+    return std::nullopt;
+  }
   ++figures.recognised;
+  ++figures.recognised_or_reported;
   const ObjectModel& model = *std::find_if(db.objects.begin(), db.objects.end(),
                                            [&](const ObjectModel& o) { return o.id == truth; });
   std::vector<Eigen::Vector3d> points;
@@ -346,7 +353,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
       const std::string& truth = scene.classes[o];
       if (best_segment < 0) {
-        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0});
+        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}});
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
@@ -356,7 +363,8 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       }
       const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
       ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
-                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size())};
+                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}};
+      for (const auto& [id, T] : ours.equivalent_objects_S) outcome.equivalent_objects.push_back(id);
       if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"], &ours)) {
         outcome.rotation_error_rad = e->rotation_rad;
         outcome.translation_error_m = e->translation_m;

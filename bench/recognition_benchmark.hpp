@@ -39,6 +39,9 @@ struct RecognitionBenchOptions {
 struct PipelineFigures {
   int objects = 0;              // catalogue objects in the scans (the rate's denominator)
   int recognised = 0;           // with the right id
+  // ...or with another id, but the right one among the objects the answer reports fit as well
+  // (equivalent_objects_S; peers report none: the same as recognised)
+  int recognised_or_reported = 0;
   int pose_success = 0;         // of those: within 5 mm and 2 degrees modulo symmetry
   // ...or wrong only in what the answer says it cannot tell: one of its equivalent poses is
   // within 5 mm and 2 degrees, or the pose is once its reported free slides are left out
@@ -65,6 +68,7 @@ struct ObjectOutcome {
   double rotation_error_rad = -1.0, translation_error_m = -1.0;  // modulo symmetry; -1: no pose
   std::vector<perception::RecognitionCandidate> candidates;  // uwscan's, best first
   int equivalent_poses = 0;   // other poses uwscan reported as fitting as well
+  std::vector<std::string> equivalent_objects;  // other objects uwscan reported as fitting as well
 };
 
 struct RecognitionBenchResult {

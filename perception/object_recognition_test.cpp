@@ -310,6 +310,38 @@ TEST(ObjectRecognition, APipeSeenWithoutItsEndsReportsItsFreeSlideAndRoll) {
   EXPECT_LT((offset - offset.dot(axis_S) * axis_S).norm(), 0.003);
 }
 
+// A database with two pipes of one bore, 0.5 and 0.8 m long: seen without its ends, a long pipe
+// is either, and the answer says so; a flange, whose rim the scan would have shown, is not.
+TEST(ObjectRecognition, ObjectsTheScanCannotTellApartAreReportedAsEquivalent) {
+  ObjectSource pipe = CatalogueObject("pipe");
+  ObjectSource long_pipe = pipe;
+  long_pipe.id = "pipe_0.8m";
+  sim::PipeShape long_shape;
+  long_shape.length_m = 0.8;
+  long_pipe.mesh = sim::MakePipe(long_shape);
+  DatabaseBuildOptions build;
+  build.views = 16;
+  build.threads = 2;
+  const std::vector<ObjectSource> sources = {pipe, long_pipe, CatalogueObject("flange")};
+  const ObjectDatabase db = BuildObjectDatabase(sources, Scanner(), build);
+  sim::PipeShape shape;
+  shape.length_m = 3.0;
+  const Scan scan = ScanOnSeabed(sim::MakePipe(shape), Eigen::Vector3d(0.45, 0.0, 0.45), 7);
+  const RecognitionResult r = RecognizeObjects(scan.cloud, db);
+  const RecognizedObject* found = Nearest(r, scan);
+  ASSERT_NE(found, nullptr);
+  ASSERT_TRUE(found->object_id == "pipe" || found->object_id == "pipe_0.8m") << found->object_id;
+  const std::string other = found->object_id == "pipe" ? "pipe_0.8m" : "pipe";
+  ASSERT_EQ(found->equivalent_objects_S.size(), 1u);
+  EXPECT_EQ(found->equivalent_objects_S[0].first, other);
+  // The alternative's pose lies on the same axis.
+  const Eigen::Vector3d axis_S = scan.T_S_O.linear() * Eigen::Vector3d::UnitZ();
+  const Eigen::Isometry3d& T_S_other = found->equivalent_objects_S[0].second;
+  EXPECT_GT(std::abs((T_S_other.linear() * Eigen::Vector3d::UnitZ()).dot(axis_S)), std::cos(2.0 * std::numbers::pi / 180.0));
+  const Eigen::Vector3d offset = T_S_other.translation() - scan.T_S_O.translation();
+  EXPECT_LT((offset - offset.dot(axis_S) * axis_S).norm(), 0.003);
+}
+
 // A flange's bolt heads are its only features about its axis (eight of them: a 45-degree
 // period), 8 mm proud of its face: ICP pairs nothing with them unless they already overlap, so
 // the phase about the axis must be searched. Rolled by angles across the period, each flange

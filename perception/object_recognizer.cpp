@@ -99,6 +99,20 @@ void BreakTie(double tie, std::vector<PosedObject>& ranked) {
   std::rotate(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(pick), ranked.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
 }
 
+// The other verified objects BreakTie chose among: scoring within `tie` of the best score.
+std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(const std::vector<PosedObject>& ranked,
+                                                                         double tie) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (const PosedObject& p : ranked) {
+    if (p.candidate.verified) top = std::max(top, p.candidate.score);
+  }
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent;
+  for (std::size_t k = 1; k < ranked.size(); ++k) {
+    const RecognitionCandidate& c = ranked[k].candidate;
+    if (c.verified && c.score >= top - tie) equivalent.emplace_back(c.object_id, c.T_S_O);
+  }
+  return equivalent;
+}
 
 // The objects worth posing on a segment: up to max_candidates whose nearest view is within
 // max_chi_square (and within max_chi_square_ratio of the best object's) and that are not smaller
@@ -463,6 +477,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
         const PosedObject& best = posed.front();
         const ObjectModel& model = db.objects[best.object];
         Accept(best, model, NearestOther(best.object, nearest_chi_square), ctx, object);
+        object.equivalent_objects_S = EquivalentObjects(posed, options.score_tie);
         object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
         clock.Lap("equivalents");
         if (split_allowed) {

@@ -105,6 +105,12 @@ struct RecognizedObject {
   // valve's body turned half a turn about its stem while its handle is out of the sweep, or a
   // tee turned about its run while its branch is. T_S_O each; empty when the pose is unique.
   std::vector<Eigen::Isometry3d> equivalent_poses_S;
+  // Other objects that explain the segment as well (verified, scoring within score_tie of the
+  // best): what the scan cannot tell apart, such as a lever valve and a wheel valve whose handle
+  // the sweep did not reach, or a pipe and a tee whose branch it did not. The answer is the one
+  // whose views the segment resembles most (chi-square). Each with its pose T_S_O; empty when
+  // the identity is clear.
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent_objects_S;
   std::vector<std::pair<std::string, Eigen::Isometry3d>> grasps_S;  // name, T_S_G
   std::vector<RecognitionCandidate> candidates;  // every object considered, best first
   std::vector<std::size_t> segment;              // indices into the input scan
