@@ -2,6 +2,8 @@
 
 #include <pcl/features/esf.h>
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -363,6 +365,7 @@ void EsfOptions::Check() const {
     throw Error("EsfOptions.grid_size: expected an even number in 16..256, got " +
                 std::to_string(grid_size));
   }
+  if (threads < 0) throw Error("EsfOptions.threads: expected >= 0, got " + std::to_string(threads));
 }
 
 EsfResult ComputeEsf(const PointCloud& cloud, const EsfOptions& options) {
@@ -416,7 +419,8 @@ EsfResult ComputeEsf(const PointCloud& cloud, const EsfOptions& options) {
   const OccupancyGrid grid = Occupancy(scaled.voxels, options.grid_size);
   Counts total;
   const long long count = static_cast<long long>(triangles.size());
-#pragma omp parallel
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+#pragma omp parallel num_threads(threads)
   {
     Counts local;
 #pragma omp for schedule(static)

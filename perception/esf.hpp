@@ -36,6 +36,9 @@ struct EsfOptions {
   // Voxels per side of the occupancy grid (even, 16..256). PCL uses 64, and its in/out voxel-count
   // thresholds, which are kept as they are, were tuned for 64.
   int grid_size = 64;
+  // OpenMP threads binning the triples, 0 = OpenMP's default; the histogram does not depend on it
+  // (integer counts).
+  int threads = 0;
   // Throws uwscan::Error naming the offending field.
   void Check() const;
 };

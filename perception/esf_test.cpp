@@ -145,6 +145,16 @@ TEST(EsfTest, IdenticalForOneAndTwoThreads) {
   const EsfDescriptor two = Esf(cloud, 3);
   omp_set_num_threads(threads);
   EXPECT_TRUE(one == two);
+  // The same through EsfOptions::threads, whatever OpenMP's default.
+  EsfOptions options;
+  options.seed = 3;
+  options.threads = 1;
+  const EsfResult by_option_one = ComputeEsf(cloud, options);
+  options.threads = 2;
+  const EsfResult by_option_two = ComputeEsf(cloud, options);
+  ASSERT_TRUE(by_option_one.ok && by_option_two.ok);
+  EXPECT_TRUE(by_option_one.histogram == one);
+  EXPECT_TRUE(by_option_two.histogram == one);
 }
 
 TEST(EsfTest, ThreeDistinctPointsAreEnough) {
@@ -328,6 +338,8 @@ TEST(EsfTest, InvalidOptionsThrow) {
   EXPECT_THROW(options.Check(), Error);
   options.grid_size = 32;
   EXPECT_NO_THROW(options.Check());
+  options.threads = -1;
+  EXPECT_THROW(options.Check(), Error);
 }
 
 // Timing printout for the report, not an assertion (DESIGN.md: benchmarks, never timed tests).

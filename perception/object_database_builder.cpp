@@ -112,9 +112,10 @@ void DatabaseBuildOptions::Check() const {
   if (threads < 0) throw Error("build-db: threads must be >= 0");
 }
 
-EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t seed) {
+EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t seed, int threads) {
   EsfOptions options;
   options.seed = seed;
+  options.threads = threads;
   return ComputeEsf(VoxelDownsample(cloud, VoxelFilterOptions{voxel_m}), options);
 }
 
@@ -168,7 +169,7 @@ ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
       const scanner::sim::VirtualScan scan = scanner.Scan(scene, T_O_C, seed);
       if (scan.points_C.size() < kMinViewPoints) continue;
       const PointCloud cloud = MakeCloud(scan.points_C);
-      const EsfResult esf = VoxelisedEsf(cloud, p.voxel_m, seed);
+      const EsfResult esf = VoxelisedEsf(cloud, p.voxel_m, seed, 1);  // the views run in parallel
       if (!esf.ok) continue;
       ObjectView view;
       view.T_O_C = T_O_C;

@@ -23,8 +23,9 @@ struct DatabaseBuildOptions {
 };
 
 // The ESF of a cloud as recognition computes it for both views and scan segments: voxelised at
-// voxel_m first, so that the descriptor sees the same density whatever the range.
-EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t seed);
+// voxel_m first, so that the descriptor sees the same density whatever the range. `threads` as
+// EsfOptions::threads.
+EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t seed, int threads);
 
 // Each object scanned by the virtual scanner from `views` directions (views with fewer than
 // 50 points are dropped: the object fell outside the sweep), its model cloud with normals and

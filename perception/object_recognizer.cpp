@@ -235,7 +235,7 @@ std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const Scan
   std::vector<std::optional<DescribedHalf>> described(halves.size());
   RunParallelTasks(std::ssize(halves), ctx.options.threads, [&](std::ptrdiff_t h) {
     const PointCloud half_cloud = Subset(s.cloud, halves[static_cast<std::size_t>(h)]);
-    const EsfResult esf = VoxelisedEsf(half_cloud, p.voxel_m, ctx.options.seed);
+    const EsfResult esf = VoxelisedEsf(half_cloud, p.voxel_m, ctx.options.seed, 1);  // one task per thread
     if (!esf.ok) return;
     const OneThreadContext task(ctx);
     described[static_cast<std::size_t>(h)].emplace(DescribedHalf{
@@ -460,7 +460,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
     object.centroid_S = Centroid(segment);
     const SceneAround around = SceneAroundSegment(down, down_index, segment, 2.0 * p.voxel_m);
     const DescribedSegment described = DescribeSegment(segment, ctx);
-    const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed);
+    const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed, options.threads);
     clock.Lap("describe");
     if (esf.ok && described.cloud.size() >= 10) {
       const ChosenObjects chosen = ChooseObjects(esf.histogram, next.core_diameter_m, ctx);
@@ -500,7 +500,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
         if (part) {
           const PointCloud part_cloud = Subset(segment, part->points);
           // The part's own ESF for its chi-square and margin.
-          const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed);
+          const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed, options.threads);
           std::vector<double> part_chi_square;
           if (part_esf.ok) {
             for (const auto& nearest : NearestViews(part_esf.histogram, db, 1)) {
