@@ -93,6 +93,7 @@ class TargetTree {
     index_.findNeighbors(result, query.data(), exact_);
     return result.index();
   }
+  const NearestGrid* grid() const { return grid_ ? &*grid_ : nullptr; }
 
  private:
   flann::KDTreeSingleIndex<flann::L2_3D<float>> index_;
@@ -319,6 +320,8 @@ IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m) : cloud_(clo
 }
 
 IcpTarget::~IcpTarget() = default;
+
+const NearestGrid* IcpTarget::grid() const { return tree_->tree.grid(); }
 
 RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
                             const Eigen::Isometry3d& T_target_source_init,

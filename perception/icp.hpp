@@ -106,6 +106,8 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
 // Keeps a reference to `cloud`, which must outlive it unchanged (a temporary is refused at
 // compile time). AlignIcp may run on one target from several threads at once. Throws
 // uwscan::Error when the cloud has fewer than 3 points or a non-finite point or normal.
+class NearestGrid;
+
 class IcpTarget {
  public:
   // grid_radius_m > 0: searches within up to that radius use a grid of cells a quarter of it
@@ -118,6 +120,9 @@ class IcpTarget {
   IcpTarget& operator=(const IcpTarget&) = delete;
 
   const PointCloud& cloud() const { return cloud_; }
+  // The grid searches within grid_radius_m use (cells a quarter of it), for other exact nearest
+  // queries on the same points; nullptr when grid_radius_m is 0.
+  const NearestGrid* grid() const;
 
  private:
   friend RegistrationResult AlignIcp(const PointCloud&, const IcpTarget&, const Eigen::Isometry3d&,

@@ -196,6 +196,9 @@ TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
   const PointCloud source = Transformed(BumpySurface(3000, 5, -0.1, 0.0005), KnownMotion().inverse());
   const IcpTarget prepared(target);
   const IcpTarget gridded(target, 0.02);  // the last two of the three stages
+  EXPECT_EQ(prepared.grid(), nullptr);
+  ASSERT_NE(gridded.grid(), nullptr);
+  EXPECT_EQ(gridded.grid()->max_radius_m(), 0.02);
   const IcpOptions options = Options(GetParam());
   for (const double angle_deg : {0.0, 3.0, -4.0}) {
     Eigen::Isometry3d start = Eigen::Isometry3d::Identity();

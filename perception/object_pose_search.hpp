@@ -28,14 +28,14 @@ struct ViewFeatures {
 };
 ViewFeatures DescribeView(const ObjectView& view, const ObjectDatabaseParameters& p, int threads);
 
-// A model's search structures: its ICP target (k-d tree, and a grid for radii up to 4 voxels)
-// and its nearest points within up to 4 voxels (verification, parts, symmetry phases), both
-// on grids of one voxel: the model's points are about a voxel apart (NearestGrid).
+// A model's search structures: its ICP target (k-d tree, and a grid of one-voxel cells for radii
+// up to 4 voxels: the model's points are about a voxel apart), whose grid also answers the
+// nearest model points within up to 4 voxels (verification, parts, symmetry phases).
 struct ModelIndexes {
-  ModelIndexes(const PointCloud& model, double voxel_m)
-      : target(model, 4.0 * voxel_m), nearest(model.points, voxel_m, 4.0 * voxel_m) {}
+  ModelIndexes(const PointCloud& model, double voxel_m) : target(model, 4.0 * voxel_m) {}
   IcpTarget target;
-  NearestGrid nearest;
+  // Nearest model points within 4 voxels: the target's own grid (one-voxel cells).
+  const NearestGrid& nearest() const { return *target.grid(); }
 };
 
 // What recognition derives from a database and comes back to segment after segment and scan

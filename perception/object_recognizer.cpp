@@ -263,7 +263,7 @@ std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCl
   const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
   const RegistrationResult on_segment = AlignIcp(sample, indexes.target, posed.fine.T_target_source, fine);
   std::vector<std::size_t> points =
-      PointsOnModel(s.cloud, model, indexes.nearest, on_segment.T_target_source, 1.5 * p.voxel_m);
+      PointsOnModel(s.cloud, model, indexes.nearest(), on_segment.T_target_source, 1.5 * p.voxel_m);
   const double share = static_cast<double>(points.size()) / static_cast<double>(s.cloud.size());
   if (share < ctx.options.min_part_share || points.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) {
     return std::nullopt;
@@ -273,7 +273,7 @@ std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCl
   const SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, part, 2.0 * p.voxel_m);
   ExplainedPart candidate{posed, std::move(points), share};
   candidate.posed.fine = refined;
-  Verify(part, model, indexes.nearest, around, refined, ctx, candidate.posed.candidate);
+  Verify(part, model, indexes.nearest(), around, refined, ctx, candidate.posed.candidate);
   if (!candidate.posed.candidate.verified) return std::nullopt;
   return candidate;
 }
@@ -483,7 +483,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
         if (split_allowed) {
           // What the object leaves unexplained may be another one touching it.
           const std::vector<std::size_t> rest =
-              Partition(next.indices, PointsOnModel(described.cloud, model, cache.Model(best.object).nearest,
+              Partition(next.indices, PointsOnModel(described.cloud, model, cache.Model(best.object).nearest(),
                                                     best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m)).second;
           const std::size_t queued = pending.size();
           QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);

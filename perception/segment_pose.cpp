@@ -135,7 +135,7 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   const ObjectDatabaseParameters& p = ctx.db.parameters;
   const ModelIndexes& indexes = ctx.cache.Model(object);
   const IcpTarget& target = indexes.target;
-  const NearestGrid& model_grid = indexes.nearest;
+  const NearestGrid& model_grid = indexes.nearest();
   const std::vector<Eigen::Isometry3d> sifted = SiftStarts(s.cloud, target, starts, model.diameter_m, p, ctx.options);
   ctx.clock.Lap("sift");
   const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
@@ -185,7 +185,7 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
   const ObjectDatabaseParameters& p = ctx.db.parameters;
   const ModelIndexes& indexes = ctx.cache.Model(posed.object);
   const IcpTarget& target = indexes.target;
-  const NearestGrid& model_grid = indexes.nearest;
+  const NearestGrid& model_grid = indexes.nearest();
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
   const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, model_grid, p.voxel_m);
   std::vector<RecognitionCandidate> turned(turns.size());
