@@ -1,4 +1,5 @@
 #include "perception/icp.hpp"
+#include "perception/nearest_grid.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
