@@ -1,5 +1,4 @@
 #include "perception/icp.hpp"
-#include "perception/nearest_grid.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -13,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "perception/nearest_grid.hpp"
 #include "perception/point_cloud.hpp"
 #include "scanner/common/error.hpp"
 
