@@ -20,7 +20,9 @@ void SearchSymmetryPhases(const DescribedSegment& s, const PointCloud& sample, c
   for (const SymmetryAxis& axis : model.symmetries) {
     const PosedObject before = best;
     bool turned_once = false;
-    for (const Eigen::Isometry3d& turned : SymmetryPhaseStarts(sample, model, model_grid, axis,
+    // Scored on every segment point, not the ICP's sample: the bolt heads are a few percent of
+    // the segment, and a sample of 1000 points keeps a handful of them.
+    for (const Eigen::Isometry3d& turned : SymmetryPhaseStarts(s.cloud, model, model_grid, axis,
                                                                before.fine.T_target_source, ctx.db.parameters.voxel_m)) {
       const RegistrationResult refined = AlignIcp(sample, target, turned, fine);
       RecognitionCandidate c = before.candidate;
