@@ -153,6 +153,10 @@ TEST(CliView, RecognitionReportOfTheDemoSceneIsDrawn) {
   const std::string json = Bytes(report);
   EXPECT_NE(json.find(R"("kind": "recognition_report")"), std::string::npos);
   EXPECT_NE(json.find(R"("scan": "../demo.db")"), std::string::npos) << "paths are relative to the report";
+  if (json.find(R"("T_S_O")") != std::string::npos) {  // a recognised object lists what fits as well
+    EXPECT_NE(json.find(R"("equivalent_objects")"), std::string::npos);
+    EXPECT_NE(json.find(R"("equivalent_poses")"), std::string::npos);
+  }
 
   // Drawn from another working directory: the report finds its scan and database.
   const fs::path png = dir / "r.png";
