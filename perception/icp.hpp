@@ -101,13 +101,13 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
                             const Eigen::Isometry3d& T_target_source_init,
                             const IcpOptions& options = {});
 
+class NearestGrid;
+
 // The target of ICP prepared once (checked, its k-d tree and centroid), for aligning many
 // sources or many starting poses onto the same cloud, e.g. pose hypotheses on an object model.
 // Keeps a reference to `cloud`, which must outlive it unchanged (a temporary is refused at
 // compile time). AlignIcp may run on one target from several threads at once. Throws
 // uwscan::Error when the cloud has fewer than 3 points or a non-finite point or normal.
-class NearestGrid;
-
 class IcpTarget {
  public:
   // grid_radius_m > 0: searches within up to that radius use a grid of cells a quarter of it
