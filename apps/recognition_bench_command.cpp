@@ -36,6 +36,7 @@ void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
     }
     if (o.equivalent_poses > 0) std::printf(", %d equivalent pose%s", o.equivalent_poses, o.equivalent_poses > 1 ? "s" : "");
     for (const std::string& id : o.equivalent_objects) std::printf(", or %s", id.c_str());
+    if (o.free_slides + o.free_turns > 0) std::printf(", free: %d slide, %d turn", o.free_slides, o.free_turns);
     std::printf("\n");
     for (const perception::RecognitionCandidate& c : o.candidates) {
       std::printf("      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f rmse %.2f mm%s\n",

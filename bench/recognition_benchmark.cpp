@@ -152,9 +152,26 @@ std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
   return peers;
 }
 
+// The offset left once the translation along the answer's reported free slides is taken out.
+Eigen::Vector3d OffsetAcrossFreeSlides(Eigen::Vector3d offset, const perception::RecognizedObject& reported) {
+  for (const perception::FreeDirection& f : reported.free_directions) {
+    if (f.kind == "unconstrained" && f.motion == "translation") offset -= offset.dot(f.axis_S) * f.axis_S;
+  }
+  return offset;
+}
+
+// Whether a pose is within 5 mm and 2 degrees of the truth (modulo symmetry) but for a slide
+// along the answer's reported free slides.
+bool PosedButForFreeSlides(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
+                           const perception::RecognizedObject& reported) {
+  return e.rotation_rad <= 2.0 * kDeg &&
+         OffsetAcrossFreeSlides(T_S_O.translation() - e.T_symmetric.translation(), reported).norm() <= 0.005;
+}
+
 // Whether a pose off the truth is right but for what its answer reports it cannot tell: one of
 // the equivalent poses is within 5 mm and 2 degrees (modulo symmetry), or the pose is once the
-// translation along its reported free directions is left out.
+// translation along its reported free slides is left out and it is turned about one of its
+// reported free rotation axes (searched by the degree over a full turn).
 bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
                                const Eigen::Isometry3d& T_S_O_true, const std::vector<Eigen::Vector3d>& points,
                                const ObjectModel& model, const perception::RecognizedObject* reported) {
@@ -164,12 +181,19 @@ bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Ei
         perception::PoseErrorModuloSymmetry(T, T_S_O_true, points, model.symmetries);
     if (other.rotation_rad <= 2.0 * kDeg && other.translation_m <= 0.005) return true;
   }
-  if (e.rotation_rad > 2.0 * kDeg) return false;
-  Eigen::Vector3d offset = T_S_O.translation() - e.T_symmetric.translation();
+  if (PosedButForFreeSlides(e, T_S_O, *reported)) return true;
   for (const perception::FreeDirection& f : reported->free_directions) {
-    if (f.kind == "unconstrained" && f.motion == "translation") offset -= offset.dot(f.axis_S) * f.axis_S;
+    if (f.kind != "unconstrained" || f.motion != "rotation") continue;
+    for (int degrees = -180; degrees < 180; ++degrees) {
+      const Eigen::Isometry3d turn = Eigen::Translation3d(f.point_S) *
+                                     Eigen::AngleAxisd(degrees * kDeg, f.axis_S) * Eigen::Translation3d(-f.point_S);
+      const Eigen::Isometry3d turned = turn * T_S_O;
+      const perception::SymmetricPoseError t =
+          perception::PoseErrorModuloSymmetry(turned, T_S_O_true, points, model.symmetries);
+      if (PosedButForFreeSlides(t, turned, *reported)) return true;
+    }
   }
-  return offset.norm() <= 0.005;
+  return false;
 }
 
 // Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
@@ -353,7 +377,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
       const std::string& truth = scene.classes[o];
       if (best_segment < 0) {
-        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}});
+        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}, 0, 0});
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
@@ -363,8 +387,12 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       }
       const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
       ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
-                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}};
+                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}, 0, 0};
       for (const auto& [id, T] : ours.equivalent_objects_S) outcome.equivalent_objects.push_back(id);
+      for (const perception::FreeDirection& f : ours.free_directions) {
+        if (f.kind != "unconstrained") continue;
+        ++(f.motion == "translation" ? outcome.free_slides : outcome.free_turns);
+      }
       if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"], &ours)) {
         outcome.rotation_error_rad = e->rotation_rad;
         outcome.translation_error_m = e->translation_m;

@@ -69,6 +69,7 @@ struct ObjectOutcome {
   std::vector<perception::RecognitionCandidate> candidates;  // uwscan's, best first
   int equivalent_poses = 0;   // other poses uwscan reported as fitting as well
   std::vector<std::string> equivalent_objects;  // other objects uwscan reported as fitting as well
+  int free_slides = 0, free_turns = 0;  // directions uwscan reported unconstrained by the scan
 };
 
 struct RecognitionBenchResult {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <deque>
 #include <map>
+#include <numbers>
 #include <limits>
 #include <optional>
 #include <tuple>
@@ -31,7 +32,7 @@ namespace {
 
 using namespace recognition;
 
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
+constexpr double kDegree = std::numbers::pi / 180.0;
 
 
 // The `count` nearest views of each object by chi-square, nearest first: (distance, view index).
@@ -54,34 +55,32 @@ std::vector<std::vector<std::pair<double, int>>> NearestViews(const EsfDescripto
 }
 
 
-// Free directions from the ICP information (object frame, rotations about the model's centroid
-// centre_O), and the covariance over the constrained ones.
-void AnalyseInformation(const Matrix6d& information, double sigma_m, double length_m,
-                        double ratio, const Eigen::Isometry3d& T_S_O,
-                        const Eigen::Vector3d& centre_O, RecognizedObject& out) {
-  // Rotations scaled by the object's radius so both halves are in metres before comparing.
-  Matrix6d D = Matrix6d::Identity();
-  D.topLeftCorner<3, 3>() *= 1.0 / length_m;
-  const Matrix6d scaled = D * information * D;
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(scaled);
-  const double largest = eigen.eigenvalues().maxCoeff();
-  Matrix6d inverse_scaled = Matrix6d::Zero();
-  for (int k = 0; k < 6; ++k) {
-    const Eigen::Matrix<double, 6, 1> u = eigen.eigenvectors().col(k);
-    if (largest > 0.0 && eigen.eigenvalues()[k] > ratio * largest) {
-      inverse_scaled += u * u.transpose() / eigen.eigenvalues()[k];
-      continue;
-    }
-    FreeDirection f;
-    f.kind = "unconstrained";
-    const bool rotation = u.head<3>().norm() > u.tail<3>().norm();
-    f.motion = rotation ? "rotation" : "translation";
-    const Eigen::Vector3d axis_O = (rotation ? u.head<3>() : u.tail<3>()).normalized();
-    f.axis_S = T_S_O.linear() * axis_O;
-    f.point_S = T_S_O * centre_O;
+// Whether a free rotation found in the data is one of the object's continuous symmetries, which
+// are reported as such: the same axis (within a degree) through the same line (within 2 mm).
+bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& model) {
+  for (const SymmetryAxis& s : model.symmetries) {
+    if (s.order != 0 || std::abs(s.axis_O.dot(rotation_O.axis_S)) < std::cos(kDegree)) continue;
+    const Eigen::Vector3d d = rotation_O.point_S - s.point_O;
+    if ((d - d.dot(s.axis_O) * s.axis_O).norm() < 0.002) return true;
+  }
+  return false;
+}
+
+// The directions the fine ICP leaves free (those the object's continuous symmetries already
+// name left out), in the scan frame, and the covariance over the others.
+void AddPoseConstraints(const PosedObject& posed, const ObjectModel& model, double tolerance_m,
+                        RecognizedObject& out) {
+  const PoseConstraints c =
+      AnalysePoseConstraints(posed.fine.information, model.model.origin, std::max(posed.fine.inlier_plane_rmse, 1e-5),
+                             0.5 * model.diameter_m, tolerance_m);
+  const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
+  for (FreeDirection f : c.free_O) {
+    if (f.motion == "rotation" && IsContinuousSymmetry(f, model)) continue;
+    f.axis_S = T_S_O.linear() * f.axis_S;
+    f.point_S = T_S_O * f.point_S;
     out.free_directions.push_back(f);
   }
-  out.covariance = sigma_m * sigma_m * (D * inverse_scaled * D);
+  out.covariance = c.covariance;
 }
 
 // Verified candidates whose scores are within `tie` of the best one's are told apart by their
@@ -325,8 +324,7 @@ void Accept(const PosedObject& posed, const ObjectModel& model, double other_chi
     f.order = s.order;
     object.free_directions.push_back(f);
   }
-  AnalyseInformation(posed.fine.information, std::max(posed.fine.inlier_plane_rmse, 1e-5), 0.5 * model.diameter_m,
-                     ctx.options.free_direction_ratio, best.T_S_O, model.model.origin, object);
+  AddPoseConstraints(posed, model, ctx.options.free_direction_std_m, object);
   for (const GraspFrame& g : model.grasps) object.grasps_S.emplace_back(g.name, best.T_S_O * g.T_O_G);
 }
 
@@ -414,9 +412,7 @@ void RecognitionOptions::Check() const {
   if (!(min_part_share >= 0.0 && min_part_share <= 1.0)) throw Error("recognition: min_part_share must be in [0, 1]");
   if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
-  if (!(free_direction_ratio > 0.0 && free_direction_ratio < 1.0)) {
-    throw Error("recognition: free_direction_ratio must be in (0, 1)");
-  }
+  if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
   if (threads < 0) throw Error("recognition: threads must be >= 0");
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "perception/free_directions.hpp"
 #include "perception/object_database.hpp"
 #include "perception/point_cloud.hpp"
 
@@ -59,20 +60,13 @@ struct RecognitionOptions {
   // candidate is.
   double min_part_share = 0.25;
   int max_objects_per_segment = 3;
-  // A pose direction is free when its information is below this fraction of the largest.
-  double free_direction_ratio = 0.02;
+  // A pose direction is free when the final ICP pins it to no better than this standard
+  // deviation (its point-to-plane residual over the square root of its information; a
+  // rotation's at the object's radius), metres: what a grasp cannot take as known.
+  double free_direction_std_m = 0.002;
   std::uint64_t seed = 1;
   int threads = 0;  // OpenMP threads, 0 = OpenMP's default; the answer does not depend on it
   void Check() const;  // throws uwscan::Error naming the field
-};
-
-// A direction the pose leaves undetermined.
-struct FreeDirection {
-  std::string kind;           // "symmetry" (of the object) or "unconstrained" (by the data)
-  std::string motion;         // "rotation" or "translation"
-  Eigen::Vector3d axis_S = Eigen::Vector3d::UnitZ();   // unit, scan frame
-  Eigen::Vector3d point_S = Eigen::Vector3d::Zero();   // a point on a rotation axis, scan frame
-  int order = 0;              // symmetry: 0 continuous, N-fold; unconstrained: 0
 };
 
 // One object considered for a segment.

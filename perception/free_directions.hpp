@@ -1,0 +1,46 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+namespace uwscan::perception {
+
+// A direction a recognised object's pose leaves undetermined.
+struct FreeDirection {
+  std::string kind;    // "symmetry" (of the object) or "unconstrained" (by the data)
+  std::string motion;  // "rotation" or "translation"
+  Eigen::Vector3d axis_S = Eigen::Vector3d::UnitZ();  // unit, scan frame
+  Eigen::Vector3d point_S = Eigen::Vector3d::Zero();  // a point on a rotation axis, scan frame
+  int order = 0;  // symmetry: 0 continuous, N-fold; unconstrained: 0
+};
+
+// What the information of a point-to-plane fit says about the pose it pinned.
+struct PoseConstraints {
+  // Rigid motions the fit does not pin to within the tolerance, in the object frame: pure
+  // translations, then rotations each about its own axis (FreeDirection::point_S and axis_S are
+  // in the object frame here).
+  std::vector<FreeDirection> free_O;
+  // Covariance over [w (rad), v (m)], the object moved by x -> x + w x (x - c) + v, restricted to
+  // the directions the fit pins (none along the free ones).
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+};
+
+// Splits the pose of a point-to-plane fit into what it pins and what it leaves free.
+//   information: sum of J^T J over the fit's pairs, rows [(x - c) x n, n] (IcpResult's, about c);
+//   sigma_m: the fit's point-to-plane residual; radius_m: the object's radius, the lever that
+//   turns a rotation into metres; tolerance_m: a direction is free when its standard deviation,
+//   sigma over the square root of its information, exceeds this (a rotation's at radius_m).
+// The free subspace is split into pure translations (slides) and rotations, each rotation
+// reported about its own axis: the axis of the free screw, with any free slide taken out of it,
+// and when two rotations are free, the two pure rotations they combine into (a screw system of
+// two free rotations holds exactly two zero-pitch screws, e.g. an elbow's bend axis and its
+// tube's tangent) rather than an arbitrary mixture of them.
+// Throws uwscan::Error when the information is not finite and symmetric or a scalar is not
+// positive.
+PoseConstraints AnalysePoseConstraints(const Eigen::Matrix<double, 6, 6>& information,
+                                       const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
+                                       double tolerance_m);
+
+}  // namespace uwscan::perception
