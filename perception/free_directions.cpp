@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "scanner/common/error.hpp"
 
@@ -17,10 +18,13 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 // this share of its motion is a slide (locally, a rotation about an axis that far away is one).
 constexpr double kTranslationShare = 0.1;
 
-void Check(const Matrix6d& information, const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
-           double tolerance_m) {
+void Check(const Matrix6d& information, const Matrix6d& patch_spread, const Eigen::Vector3d& centre_O,
+           double sigma_m, double radius_m, double tolerance_m) {
   if (!information.allFinite() || !information.isApprox(information.transpose(), 1e-9)) {
     throw Error("free directions: the information must be a finite, symmetric 6x6 matrix");
+  }
+  if (!patch_spread.allFinite() || !patch_spread.isApprox(patch_spread.transpose(), 1e-9)) {
+    throw Error("free directions: the patch spread must be a finite, symmetric 6x6 matrix");
   }
   if (!centre_O.allFinite()) throw Error("free directions: the centre must be finite");
   if (!(sigma_m > 0.0 && std::isfinite(sigma_m))) throw Error("free directions: sigma_m must be positive");
@@ -71,28 +75,33 @@ std::pair<Vector6d, Vector6d> PureRotations(const Vector6d& a, const Vector6d& b
 
 }  // namespace
 
-PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Eigen::Vector3d& centre_O, double sigma_m,
-                                       double radius_m, double tolerance_m) {
-  Check(information, centre_O, sigma_m, radius_m, tolerance_m);
+PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix6d& patch_spread,
+                                       const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
+                                       double tolerance_m) {
+  Check(information, patch_spread, centre_O, sigma_m, radius_m, tolerance_m);
   // Rotations scaled by the radius: both halves in metres, so one tolerance judges both.
   Matrix6d D = Matrix6d::Identity();
   D.topLeftCorner<3, 3>() *= 1.0 / radius_m;
   const Matrix6d scaled = D * (0.5 * (information + information.transpose())) * D;
+  const Matrix6d spread = D * (0.5 * (patch_spread + patch_spread.transpose())) * D;
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(scaled);
-  // std = sigma / sqrt(lambda) > tolerance  <=>  lambda < (sigma / tolerance)^2.
-  const double free_below = (sigma_m / tolerance_m) * (sigma_m / tolerance_m);
   PoseConstraints out;
+  Matrix6d inverse = Matrix6d::Zero();  // over the pinned directions, scaled
   Eigen::Matrix<double, 6, Eigen::Dynamic> free(6, 0);
   for (int k = 0; k < 6; ++k) {
     const Vector6d u = eigen.eigenvectors().col(k);
     const double lambda = eigen.eigenvalues()[k];
-    if (lambda >= free_below) {
-      out.covariance += sigma_m * sigma_m * (D * u) * (D * u).transpose() / lambda;
+    // Variance along u: sigma^2 / lambda + u^T S u / lambda^2 (infinite with no information).
+    const double variance = lambda > 0.0 ? (sigma_m * sigma_m + u.dot(spread * u) / lambda) / lambda
+                                         : std::numeric_limits<double>::infinity();
+    if (variance <= tolerance_m * tolerance_m) {
+      inverse += u * u.transpose() / lambda;
     } else {
       free.conservativeResize(Eigen::NoChange, free.cols() + 1);
       free.col(free.cols() - 1) = u;
     }
   }
+  out.covariance = D * (sigma_m * sigma_m * inverse + inverse * spread * inverse) * D;
   if (free.cols() == 0) return out;
 
   // Combinations of the free directions by how much they turn: the right singular vectors of

@@ -29,17 +29,22 @@ struct PoseConstraints {
 
 // Splits the pose of a point-to-plane fit into what it pins and what it leaves free.
 //   information: sum of J^T J over the fit's pairs, rows [(x - c) x n, n] (IcpResult's, about c);
-//   sigma_m: the fit's point-to-plane residual; radius_m: the object's radius, the lever that
-//   turns a rotation into metres; tolerance_m: a direction is free when its standard deviation,
-//   sigma over the square root of its information, exceeds this (a rotation's at radius_m).
+//   patch_spread: how the fit's gradient spreads over surface patches (ResidualPatchSpread), or
+//   zero; sigma_m: the fit's point-to-plane residual; radius_m: the object's radius, the lever
+//   that turns a rotation into metres; tolerance_m: a direction is free when its standard
+//   deviation exceeds this (a rotation's at radius_m).
+// The covariance is sigma^2 H^-1 (every residual independent) plus H^-1 S H^-1 (residuals
+// correlated within patches, independent between them), over the directions the fit pins: the
+// first alone is overconfident where misfits span patches (a flange's phase held by its bolt
+// heads), the sum at worst twice the variance where residuals are independent.
 // The free subspace is split into pure translations (slides) and rotations, each rotation
 // reported about its own axis: the axis of the free screw, with any free slide taken out of it,
 // and when two rotations are free, the two pure rotations they combine into (a screw system of
 // two free rotations holds exactly two zero-pitch screws, e.g. an elbow's bend axis and its
 // tube's tangent) rather than an arbitrary mixture of them.
-// Throws uwscan::Error when the information is not finite and symmetric or a scalar is not
-// positive.
+// Throws uwscan::Error when a matrix is not finite and symmetric or a scalar is not positive.
 PoseConstraints AnalysePoseConstraints(const Eigen::Matrix<double, 6, 6>& information,
+                                       const Eigen::Matrix<double, 6, 6>& patch_spread,
                                        const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
                                        double tolerance_m);
 

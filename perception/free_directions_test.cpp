@@ -16,6 +16,7 @@ namespace {
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 constexpr double kPi = std::numbers::pi;
+const Matrix6d kNoSpread = Matrix6d::Zero();
 
 struct Surface {
   std::vector<Eigen::Vector3d> points, normals;
@@ -66,7 +67,7 @@ TEST(FreeDirections, APipeWithoutEndsSlidesAndRollsAboutItsOwnAxis) {
     }
   }
   const Eigen::Vector3d centre = pipe.Centroid();  // off the axis: half the circumference
-  const PoseConstraints c = AnalysePoseConstraints(Information(pipe, centre), centre, 5e-4, 0.2, 1e-3);
+  const PoseConstraints c = AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, 0.2, 1e-3);
   ASSERT_EQ(c.free_O.size(), 2u);
   const auto slides = Of(c, "translation"), rolls = Of(c, "rotation");
   ASSERT_EQ(slides.size(), 1u);
@@ -95,7 +96,7 @@ TEST(FreeDirections, AnElbowWithoutEndsTurnsAboutItsBendAxis) {
     }
   }
   const Eigen::Vector3d centre = elbow.Centroid();
-  const PoseConstraints c = AnalysePoseConstraints(Information(elbow, centre), centre, 1e-4, 0.2, 1e-3);
+  const PoseConstraints c = AnalysePoseConstraints(Information(elbow, centre), kNoSpread, centre, 1e-4, 0.2, 1e-3);
   ASSERT_EQ(c.free_O.size(), 1u);
   const FreeDirection& turn = c.free_O[0];
   EXPECT_EQ(turn.motion, "rotation");
@@ -125,7 +126,7 @@ TEST(FreeDirections, TwoFreeRotationsComeBackAboutTheirOwnAxes) {
   D_inverse.topLeftCorner<3, 3>() *= radius;
   const Matrix6d information = D_inverse * scaled * D_inverse;
 
-  const PoseConstraints c = AnalysePoseConstraints(information, centre, 1e-3, radius, 1e-3);
+  const PoseConstraints c = AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, radius, 1e-3);
   const auto rotations = Of(c, "rotation");
   ASSERT_EQ(c.free_O.size(), 2u);
   ASSERT_EQ(rotations.size(), 2u);
@@ -148,7 +149,7 @@ TEST(FreeDirections, APlaneSlidesInItselfAndTurnsAboutItsNormal) {
     }
   }
   const Eigen::Vector3d centre = plane.Centroid();
-  const PoseConstraints c = AnalysePoseConstraints(Information(plane, centre), centre, 1e-4, 0.1, 1e-3);
+  const PoseConstraints c = AnalysePoseConstraints(Information(plane, centre), kNoSpread, centre, 1e-4, 0.1, 1e-3);
   const auto slides = Of(c, "translation"), turns = Of(c, "rotation");
   ASSERT_EQ(slides.size(), 2u);
   ASSERT_EQ(turns.size(), 1u);
@@ -170,10 +171,35 @@ TEST(FreeDirections, ABoxCornerIsPinnedAndItsCovarianceIsTheInverse) {
   const Eigen::Vector3d centre = corner.Centroid();
   const Matrix6d information = Information(corner, centre);
   const double sigma = 3e-4;
-  const PoseConstraints c = AnalysePoseConstraints(information, centre, sigma, 0.1, 1e-3);
+  const PoseConstraints c = AnalysePoseConstraints(information, kNoSpread, centre, sigma, 0.1, 1e-3);
   EXPECT_TRUE(c.free_O.empty());
   const Matrix6d expected = sigma * sigma * information.inverse();
   EXPECT_LT((c.covariance - expected).norm(), 1e-9 * expected.norm());
+
+  // Residuals correlated over patches add the sandwich H^-1 S H^-1.
+  Vector6d push;
+  push << 0.3, -0.1, 0.2, 1e-3, 2e-3, -1e-3;
+  const Matrix6d spread = 1e-8 * push * push.transpose();
+  const PoseConstraints patched = AnalysePoseConstraints(information, spread, centre, sigma, 0.1, 1.0);
+  const Matrix6d sandwich = expected + information.inverse() * spread * information.inverse();
+  EXPECT_LT((patched.covariance - sandwich).norm(), 1e-9 * sandwich.norm());
+}
+
+// A direction the independent residuals pin but patches of correlated residuals push apart is
+// free: its variance is sigma^2 / lambda + u^T S u / lambda^2.
+TEST(FreeDirections, ResidualsCorrelatedOverPatchesLoosenTheDirectionTheyPush) {
+  const double sigma = 1e-3, tolerance = 2e-3, radius = 0.5;
+  Matrix6d information = Matrix6d::Identity() * 1e6;
+  const double lambda = 1.0;  // slide along z: std sigma = 1 mm, pinned alone
+  information(5, 5) = lambda;
+  const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  EXPECT_TRUE(AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance).free_O.empty());
+  Matrix6d spread = Matrix6d::Zero();
+  spread(5, 5) = 4e-6 * lambda * lambda;  // adds (2 mm)^2
+  const PoseConstraints c = AnalysePoseConstraints(information, spread, centre, sigma, radius, tolerance);
+  ASSERT_EQ(c.free_O.size(), 1u);
+  EXPECT_EQ(c.free_O[0].motion, "translation");
+  EXPECT_NEAR(std::abs(c.free_O[0].axis_S.z()), 1.0, 1e-12);
 }
 
 // The tolerance is a standard deviation: a direction known to 0.9 of it is pinned, one known
@@ -188,10 +214,10 @@ TEST(FreeDirections, TheToleranceIsAStandardDeviationInMetres) {
     return info;
   };
   const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  EXPECT_TRUE(AnalysePoseConstraints(information_for(0.9 * tolerance, 0.9 * tolerance), centre, sigma, radius,
+  EXPECT_TRUE(AnalysePoseConstraints(information_for(0.9 * tolerance, 0.9 * tolerance), kNoSpread, centre, sigma, radius,
                                      tolerance).free_O.empty());
   const PoseConstraints loose =
-      AnalysePoseConstraints(information_for(1.1 * tolerance, 1.1 * tolerance), centre, sigma, radius, tolerance);
+      AnalysePoseConstraints(information_for(1.1 * tolerance, 1.1 * tolerance), kNoSpread, centre, sigma, radius, tolerance);
   EXPECT_EQ(Of(loose, "translation").size(), 1u);
   EXPECT_EQ(Of(loose, "rotation").size(), 1u);
 }
@@ -199,13 +225,16 @@ TEST(FreeDirections, TheToleranceIsAStandardDeviationInMetres) {
 TEST(FreeDirections, BadInputIsRefused) {
   Matrix6d information = Matrix6d::Identity();
   const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  EXPECT_THROW(AnalysePoseConstraints(information, centre, 0.0, 0.1, 1e-3), Error);
-  EXPECT_THROW(AnalysePoseConstraints(information, centre, 1e-3, -0.1, 1e-3), Error);
-  EXPECT_THROW(AnalysePoseConstraints(information, centre, 1e-3, 0.1, 0.0), Error);
+  EXPECT_THROW(AnalysePoseConstraints(information, kNoSpread, centre, 0.0, 0.1, 1e-3), Error);
+  EXPECT_THROW(AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, -0.1, 1e-3), Error);
+  EXPECT_THROW(AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, 0.1, 0.0), Error);
   information(0, 1) = 1.0;  // not symmetric
-  EXPECT_THROW(AnalysePoseConstraints(information, centre, 1e-3, 0.1, 1e-3), Error);
+  EXPECT_THROW(AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, 0.1, 1e-3), Error);
   information(0, 1) = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(AnalysePoseConstraints(information, centre, 1e-3, 0.1, 1e-3), Error);
+  EXPECT_THROW(AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, 0.1, 1e-3), Error);
+  Matrix6d spread = Matrix6d::Zero();
+  spread(2, 3) = 1.0;  // not symmetric
+  EXPECT_THROW(AnalysePoseConstraints(Matrix6d::Identity(), spread, centre, 1e-3, 0.1, 1e-3), Error);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "perception/object_symmetry.hpp"
 #include "perception/plane_removal.hpp"
 #include "perception/recognition_verification.hpp"
+#include "perception/residual_patches.hpp"
 #include "perception/scan_segments.hpp"
 #include "perception/segment_pose.hpp"
 #include "perception/voxel_filter.hpp"
@@ -66,13 +67,19 @@ bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& mo
   return false;
 }
 
-// The directions the fine ICP leaves free (those the object's continuous symmetries already
-// name left out), in the scan frame, and the covariance over the others.
-void AddPoseConstraints(const PosedObject& posed, const ObjectModel& model, double tolerance_m,
-                        RecognizedObject& out) {
+// The directions the fine ICP on `fitted` leaves free (those the object's continuous symmetries
+// already name left out), in the scan frame, and the covariance over the others.
+void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
+                        const ScanContext& ctx, RecognizedObject& out) {
+  const double radius_m = 0.5 * model.diameter_m;
+  const double pair_distance_m =
+      FineIcp(model.diameter_m, ctx.db.parameters, 1).max_correspondence_distance_m.back();
+  const Eigen::Matrix<double, 6, 6> spread =
+      ResidualPatchSpread(fitted, posed.fine.T_target_source, model.model, ctx.cache.Model(posed.object).nearest(),
+                          pair_distance_m, model.model.origin, ctx.options.residual_patch_m);
   const PoseConstraints c =
-      AnalysePoseConstraints(posed.fine.information, model.model.origin, std::max(posed.fine.inlier_plane_rmse, 1e-5),
-                             0.5 * model.diameter_m, tolerance_m);
+      AnalysePoseConstraints(posed.fine.information, spread, model.model.origin,
+                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
   const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
   for (FreeDirection f : c.free_O) {
     if (f.motion == "rotation" && IsContinuousSymmetry(f, model)) continue;
@@ -307,8 +314,8 @@ std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanCo
 }
 
 // The recognised object's identity, pose, free directions, covariance and grasps.
-void Accept(const PosedObject& posed, const ObjectModel& model, double other_chi_square, const ScanContext& ctx,
-            RecognizedObject& object) {
+void Accept(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model, double other_chi_square,
+            const ScanContext& ctx, RecognizedObject& object) {
   const RecognitionCandidate& best = posed.candidate;
   object.object_id = best.object_id;
   object.score = best.score;
@@ -324,7 +331,7 @@ void Accept(const PosedObject& posed, const ObjectModel& model, double other_chi
     f.order = s.order;
     object.free_directions.push_back(f);
   }
-  AddPoseConstraints(posed, model, ctx.options.free_direction_std_m, object);
+  AddPoseConstraints(posed, fitted, model, ctx, object);
   for (const GraspFrame& g : model.grasps) object.grasps_S.emplace_back(g.name, best.T_S_O * g.T_O_G);
 }
 
@@ -413,6 +420,7 @@ void RecognitionOptions::Check() const {
   if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
   if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
+  if (!positive(residual_patch_m)) throw Error("recognition: residual_patch_m must be > 0");
   if (threads < 0) throw Error("recognition: threads must be >= 0");
 }
 
@@ -472,7 +480,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
       if (!posed.empty() && posed.front().candidate.verified) {
         const PosedObject& best = posed.front();
         const ObjectModel& model = db.objects[best.object];
-        Accept(best, model, NearestOther(best.object, nearest_chi_square), ctx, object);
+        Accept(best, described.cloud, model, NearestOther(best.object, nearest_chi_square), ctx, object);
         object.equivalent_objects_S = EquivalentObjects(posed, options.score_tie);
         object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
         clock.Lap("equivalents");
@@ -506,7 +514,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
             part->posed.candidate.chi_square = part_chi_square[part->posed.object];
           }
           object.candidates.insert(object.candidates.begin(), part->posed.candidate);
-          Accept(part->posed, db.objects[part->posed.object],
+          Accept(part->posed, part_cloud, db.objects[part->posed.object],
                  part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);
           object.centroid_S = Centroid(part_cloud);
           std::vector<std::size_t> rest;

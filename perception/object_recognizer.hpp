@@ -64,6 +64,9 @@ struct RecognitionOptions {
   // deviation (its point-to-plane residual over the square root of its information; a
   // rotation's at the object's radius), metres: what a grasp cannot take as known.
   double free_direction_std_m = 0.002;
+  // Residuals within a cube of this side are taken as correlated (one misfit: a bolt head, a
+  // facet), independent from cube to cube, for the pose covariance (ResidualPatchSpread), metres.
+  double residual_patch_m = 0.02;
   std::uint64_t seed = 1;
   int threads = 0;  // OpenMP threads, 0 = OpenMP's default; the answer does not depend on it
   void Check() const;  // throws uwscan::Error naming the field
