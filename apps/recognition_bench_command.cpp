@@ -23,6 +23,12 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+double Mean(const std::vector<double>& v) {
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+}
+
 double Ratio(int a, int b) { return b == 0 ? 0.0 : static_cast<double>(a) / b; }
 
 // One line per object, then one per candidate uwscan weighed for it.
@@ -89,11 +95,22 @@ void Run(Args a) {
                        {"median_grasp_position_error_m", Median(f.grasp_position_errors_m)},
                        {"median_grasp_angle_error_deg", Median(f.grasp_angle_errors_rad) * kRadToDeg},
                        {"seconds_per_scan", per_scan}};
+    if (!f.pose_nees_per_dimension.empty()) {
+      pipelines[name]["pose_nees_per_dimension_mean"] = Mean(f.pose_nees_per_dimension);
+      pipelines[name]["pose_nees_per_dimension_median"] = Median(f.pose_nees_per_dimension);
+      pipelines[name]["pose_nees_poses"] = f.pose_nees_per_dimension.size();
+    }
     confusion[name] = f.confusion;
   }
   std::printf("uwscan stages (s per scan):");
   for (const auto& [stage, s] : r.uwscan_stage_seconds) std::printf(" %s %.3f", stage.c_str(), s / r.scans);
   std::printf("\n");
+  if (r.pipelines.count("uwscan") && !r.pipelines.at("uwscan").pose_nees_per_dimension.empty()) {
+    const std::vector<double>& nees = r.pipelines.at("uwscan").pose_nees_per_dimension;
+    std::printf("uwscan pose covariance: NEES per pinned direction mean %.2f, median %.2f over %zu poses within "
+                "10 deg and 5 cm (1 when consistent)\n",
+                Mean(nees), Median(nees), nees.size());
+  }
   if (r.pipelines.count("uwscan")) {
     std::printf("uwscan confusion (true -> answers):\n");
     for (const auto& [truth, row] : r.pipelines.at("uwscan").confusion) {

@@ -9,6 +9,7 @@
 #include <optional>
 #include <random>
 
+#include "bench/pose_nees.hpp"
 #include "bench/recognition_peers.hpp"
 #include "bench/recognition_scan_cache.hpp"
 #include "perception/normals.hpp"
@@ -231,6 +232,11 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
   figures.pose_success += posed;
   figures.pose_or_reported += posed || PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, reported);
   if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
+  if (reported != nullptr && e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
+    if (const auto nees = PoseNeesPerPinnedDirection(*T_S_O, e.T_symmetric, model.model.origin, reported->covariance)) {
+      figures.pose_nees_per_dimension.push_back(*nees);
+    }
+  }
   if (model.grasps.empty()) return e;
   const Eigen::Isometry3d& T_true = e.T_symmetric;
   double worst_position = 0.0, worst_angle = 0.0;
