@@ -44,8 +44,9 @@ struct PipelineFigures {
   int recognised_or_reported = 0;
   int pose_success = 0;         // of those: within 5 mm and 2 degrees modulo symmetry
   // ...or wrong only in what the answer says it cannot tell: one of its equivalent poses is
-  // within 5 mm and 2 degrees, or the pose is once its reported free slides are left out
-  // (peers report neither: the same as pose_success)
+  // within 5 mm and 2 degrees, or the pose is once its reported free slides are left out and it
+  // is turned about one of its reported free rotation axes (peers report neither: the same as
+  // pose_success)
   int pose_or_reported = 0;
   int mssd_success = 0;         // of those: MSSD below 0.1 x diameter
   int grasp_success = 0;        // of those: grasp within 5 mm and 3 degrees
