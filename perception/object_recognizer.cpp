@@ -5,9 +5,9 @@
 #include <array>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <map>
 #include <numbers>
-#include <limits>
 #include <optional>
 #include <tuple>
 

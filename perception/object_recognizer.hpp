@@ -96,8 +96,9 @@ struct RecognizedObject {
   double margin = 0.0;  // chi-square of the best other object's nearest view minus this one's
   Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();  // pose in the scan frame
   // Covariance of the pose over [w (rad), v (m)] in the object frame: the object moved by
-  // x -> x + w x (x - c) + v, c the model's centroid; from the ICP's information and
-  // point-to-plane residual. Free directions carry none (0 there).
+  // x -> x + w x (x - c) + v, c the model's centroid; from the ICP's information, its
+  // point-to-plane residual and how its residuals spread over residual_patch_m cubes
+  // (AnalysePoseConstraints). Free directions carry none (0 there).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   std::vector<FreeDirection> free_directions;
   // Other poses of this object that fit the scan as well (verified, scoring within score_tie)
