@@ -18,7 +18,7 @@
 #include "apps/camera_frames.hpp"
 #include "apps/data_cache.hpp"
 #include "apps/json_output.hpp"
-#include "mapping/live_inspection.hpp"
+#include "mapping/inspection/live_inspection.hpp"
 #include "scanner/acquisition/fake_camera.hpp"
 #include "scanner/acquisition/frame_source.hpp"
 #include "scanner/common/error.hpp"

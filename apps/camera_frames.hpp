@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "mapping/dive_log.hpp"
-#include "mapping/live_inspection.hpp"
+#include "mapping/inspection/live_inspection.hpp"
+#include "mapping/log/dive_log.hpp"
 #include "scanner/acquisition/frame_source.hpp"
 #include "scanner/acquisition/mirror_driver.hpp"
 #include "scanner/stripe/stripe_detector.hpp"

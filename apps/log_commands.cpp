@@ -6,7 +6,7 @@
 
 #include "apps/json_output.hpp"
 #include "apps/output_path.hpp"
-#include "mapping/dive_log.hpp"
+#include "mapping/log/dive_log.hpp"
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 

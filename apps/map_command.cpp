@@ -11,9 +11,9 @@
 #include "apps/json_output.hpp"
 #include "apps/output_path.hpp"
 #include "apps/progress_bar.hpp"
-#include "mapping/dive_mapping.hpp"
-#include "mapping/map_report.hpp"
-#include "perception/cloud_io.hpp"
+#include "mapping/slam/dive_mapping.hpp"
+#include "mapping/slam/map_report.hpp"
+#include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::app {

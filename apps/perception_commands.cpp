@@ -13,8 +13,8 @@
 #include "apps/progress_bar.hpp"
 #include "bench/features_benchmark.hpp"
 #include "bench/registration_benchmark.hpp"
-#include "perception/cloud_io.hpp"
-#include "perception/registration_pipeline.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/registration/registration_pipeline.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::app {

@@ -2,7 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "perception/object_recognizer.hpp"
+#include "perception/recognition/object_recognizer.hpp"
 
 namespace uwscan::app {
 

@@ -11,13 +11,13 @@
 #include <memory>
 #include <string>
 
-#include "perception/sphere_fit.hpp"
+#include "perception/preprocessing/sphere_fit.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/parallel_tasks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
-#include "scanner/triangulation/light_plane.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/simulator.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 #include "scanner/triangulation/triangulator_factory.hpp"
 
 namespace uwscan::bench {

@@ -4,10 +4,10 @@
 #include <numeric>
 
 #include "bench/registration_pipelines.hpp"
-#include "perception/esf.hpp"
-#include "perception/fpfh.hpp"
-#include "perception/normals.hpp"
-#include "perception/voxel_filter.hpp"
+#include "perception/features/esf.hpp"
+#include "perception/features/fpfh.hpp"
+#include "perception/preprocessing/normals.hpp"
+#include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::bench {

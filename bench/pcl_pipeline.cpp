@@ -9,7 +9,7 @@
 #include <cstdlib>
 
 #include "bench/registration_pipelines.hpp"
-#include "perception/pcl_conversion.hpp"
+#include "perception/cloud/pcl_conversion.hpp"
 
 namespace uwscan::bench {
 namespace {

@@ -4,16 +4,16 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
-#include "mapping/dive_log.hpp"
-#include "perception/cloud_io.hpp"
-#include "perception/descriptor_database.hpp"
-#include "perception/object_database.hpp"
+#include "mapping/log/dive_log.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/features/descriptor_database.hpp"
+#include "perception/recognition/object_database.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_scene.hpp"
 #include "scanner/calibration/opencv_camera_import.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/file_bytes.hpp"
-#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/lasers/scanner_file.hpp"

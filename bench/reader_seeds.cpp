@@ -4,10 +4,10 @@
 #include <string>
 #include <vector>
 
-#include "mapping/dive_log.hpp"
-#include "perception/cloud_io.hpp"
-#include "perception/descriptor_database.hpp"
-#include "perception/object_database.hpp"
+#include "mapping/log/dive_log.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/features/descriptor_database.hpp"
+#include "perception/recognition/object_database.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "bench/progress.hpp"
-#include "perception/object_recognizer.hpp"
+#include "perception/recognition/object_recognizer.hpp"
 
 namespace uwscan::bench {
 

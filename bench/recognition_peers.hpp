@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "perception/esf.hpp"
-#include "perception/point_cloud.hpp"
+#include "perception/cloud/point_cloud.hpp"
+#include "perception/features/esf.hpp"
 
 namespace uwscan::bench {
 

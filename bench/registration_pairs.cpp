@@ -4,8 +4,8 @@
 #include <cmath>
 #include <random>
 
-#include "perception/cloud_io.hpp"
-#include "perception/cloud_neighbors.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 

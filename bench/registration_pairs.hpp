@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "perception/point_cloud.hpp"
+#include "perception/cloud/point_cloud.hpp"
 
 namespace uwscan::bench {
 

@@ -19,7 +19,7 @@
 
 #include "bench/reader_probes.hpp"
 #include "bench/reader_seeds.hpp"
-#include "mapping/dive_log.hpp"
+#include "mapping/log/dive_log.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/file_bytes.hpp"
 #include "scanner/lasers/scanner_file.hpp"

@@ -9,11 +9,11 @@
 #include <sstream>
 
 #include "bench/scratch_folder.hpp"
-#include "mapping/dive_simulation.hpp"
-#include "mapping/map_report.hpp"
-#include "mapping/reconstruction.hpp"
-#include "mapping/submap.hpp"
-#include "perception/voxel_filter.hpp"
+#include "mapping/log/dive_simulation.hpp"
+#include "mapping/reconstruction/reconstruction.hpp"
+#include "mapping/slam/map_report.hpp"
+#include "mapping/slam/submap.hpp"
+#include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"

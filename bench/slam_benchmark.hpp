@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "bench/progress.hpp"
-#include "mapping/dive_mapping.hpp"
+#include "mapping/slam/dive_mapping.hpp"
 
 namespace uwscan::bench {
 

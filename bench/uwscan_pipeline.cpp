@@ -1,7 +1,7 @@
 // uwscan's registration pipeline as the benchmark runs it, and the parameters every pipeline
 // shares (those of perception::RegistrationPipelineOptions::ForObjectSize).
 #include "bench/registration_pipelines.hpp"
-#include "perception/registration_pipeline.hpp"
+#include "perception/registration/registration_pipeline.hpp"
 
 namespace uwscan::bench {
 

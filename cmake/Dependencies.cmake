@@ -34,7 +34,7 @@ find_package(assimp REQUIRED)
 # Ray casting in the simulator (scanner/sim).
 find_package(embree 3 REQUIRED)
 
-# Dive logs (mapping/dive_log), with a checksum per column of every row (xxHash's XXH3).
+# Dive logs (mapping/log/dive_log), with a checksum per column of every row (xxHash's XXH3).
 find_package(SQLite3 REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(xxhash REQUIRED IMPORTED_TARGET libxxhash)

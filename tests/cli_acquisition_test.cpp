@@ -23,7 +23,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mapping/dive_log.hpp"
+#include "mapping/log/dive_log.hpp"
 #include "tests/cli_camera_support.hpp"
 #include "tests/cli_run.hpp"
 

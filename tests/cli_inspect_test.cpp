@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "mapping/dive_log.hpp"
+#include "mapping/log/dive_log.hpp"
 #include "tests/cli_camera_support.hpp"
 #include "tests/cli_run.hpp"
 

@@ -7,8 +7,8 @@
 #include <optional>
 #include <thread>
 
-#include "mapping/dive_log.hpp"
-#include "mapping/incremental_reconstruction.hpp"
+#include "mapping/log/dive_log.hpp"
+#include "mapping/reconstruction/incremental_reconstruction.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::viewer {

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "mapping/reconstruction.hpp"
+#include "mapping/reconstruction/reconstruction.hpp"
 #include "viewer/live_view.hpp"
 
 namespace uwscan::viewer {

@@ -10,9 +10,9 @@
 #include <filesystem>
 #include <thread>
 
-#include "mapping/dive_log.hpp"
-#include "mapping/dive_simulation.hpp"
-#include "mapping/reconstruction.hpp"
+#include "mapping/log/dive_log.hpp"
+#include "mapping/log/dive_simulation.hpp"
+#include "mapping/reconstruction/reconstruction.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 #include "viewer/dive_log_follower.hpp"

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "perception/cloud_io.hpp"
+#include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/json_fields.hpp"
 #include "viewer/scene_files.hpp"

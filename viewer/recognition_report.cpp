@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "mapping/scan_file.hpp"
-#include "perception/object_database.hpp"
+#include "mapping/reconstruction/scan_file.hpp"
+#include "perception/recognition/object_database.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/json_fields.hpp"
 

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "mapping/reconstruction.hpp"
+#include "mapping/reconstruction/reconstruction.hpp"
 #include "viewer/scene.hpp"
 
 // The recognition report that `uwscan recognize --json` writes (issue 11), read for drawing.

@@ -12,8 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "perception/cloud_io.hpp"
-#include "perception/object_database.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/recognition/object_database.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/png_image.hpp"
 #include "viewer/scene_files.hpp"

@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "mapping/dive_log.hpp"
-#include "perception/cloud_io.hpp"
+#include "mapping/log/dive_log.hpp"
+#include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "viewer/recognition_report.hpp"

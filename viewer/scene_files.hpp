@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "mapping/reconstruction.hpp"
+#include "mapping/reconstruction/reconstruction.hpp"
 #include "viewer/map_report.hpp"
 #include "viewer/scene.hpp"
 #include "viewer/tum_trajectory.hpp"

@@ -1,0 +1,106 @@
+#include "mapping/slam/dive_mapping.hpp"
+
+#include <chrono>
+#include <string>
+
+#include "mapping/slam/map_uncertainty.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+// Every this many points of each submap go into the expected map error: an RMS over tens of
+// thousands of points, not millions.
+constexpr std::size_t kExpectedErrorStride = 8;
+
+}  // namespace
+
+void DiveMappingOptions::Check() const {
+  mapper.Check();
+  if (!(map_voxel_m > 0.0)) throw Error("DiveMappingOptions.map_voxel_m: expected > 0 m");
+}
+
+NavigationNoise AssumedNavigationNoise() {
+  NavigationNoise noise;
+  noise.position_walk_m_per_sqrt_s = 0.005;
+  noise.heading_walk_rad_per_sqrt_s = 0.0005;
+  noise.speed_scale_sigma = 0.01;
+  noise.heading_bias_sigma_rad = 0.01;
+  noise.depth_sigma_m = 0.005;
+  noise.roll_pitch_sigma_rad = 0.002;
+  return noise;
+}
+
+DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
+                    const std::function<void(double)>& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::string name = "dive log '" + log.path().string() + "'";
+  const std::vector<NavigationRecord> navigation = log.ReadNavigation();
+  if (navigation.empty()) {
+    throw Error(name + " has no navigation: mapping places each frame with the vehicle's navigation");
+  }
+  const std::int64_t frame_count = log.frame_count();
+  if (frame_count < 2) {
+    throw Error(name + " has " + std::to_string(frame_count) + " frame" + (frame_count == 1 ? "" : "s") +
+                ": mapping needs at least a sweep of frames");
+  }
+  const DiveLogHeader& header = log.header();
+  DiveMapping result;
+  result.navigation_noise_assumed = !header.navigation_noise.has_value();
+  const Eigen::Isometry3d T_V_C = log.vehicle_mount().value_or(Eigen::Isometry3d::Identity());
+  Mapper mapper(header.scanner, header.scan_pattern, T_V_C, header.navigation_noise.value_or(AssumedNavigationNoise()),
+                options.mapper, options.table_cache);
+
+  // Replayed as the vehicle delivered it: each navigation sample before the frames it precedes.
+  std::size_t next_nav = 0;
+  std::int64_t done = 0;
+  double first_time = 0.0, last_time = 0.0;
+  log.ForEachFrame(
+      [&](const FrameRecord& frame, const GroundTruthRecord*) {
+        while (next_nav < navigation.size() && navigation[next_nav].time_s <= frame.time_s) {
+          mapper.AddNavigation(navigation[next_nav++]);
+        }
+        mapper.AddFrame(frame);
+        if (done == 0) first_time = frame.time_s;
+        last_time = frame.time_s;
+        ++done;
+        if (progress) progress(static_cast<double>(done) / static_cast<double>(frame_count));
+      },
+      /*with_truth=*/false);
+  while (next_nav < navigation.size()) mapper.AddNavigation(navigation[next_nav++]);
+  mapper.Finish();
+  if (mapper.submap_count() == 0) throw Error(name + ": no frame gave points to map");
+
+  result.submaps = mapper.submap_count();
+  const Eigen::Isometry3d T_C_V = T_V_C.inverse();
+  for (int i = 0; i < mapper.submap_count(); ++i) {
+    const Submap& s = mapper.submap(i);
+    result.slam.push_back({s.anchor_time_s, mapper.pose(i)});
+    result.dead_reckoning.push_back({s.anchor_time_s, s.T_W_V_nav});
+    if (options.keep_submaps) result.submap_clouds.push_back(s.cloud);
+    if (const std::optional<GroundTruthRecord> truth = log.ReadGroundTruth(s.anchor_frame)) {
+      result.truth.push_back({s.anchor_time_s, truth->T_W_C * T_C_V});
+    }
+  }
+  if (result.truth.size() != result.slam.size()) result.truth.clear();
+  if (const std::optional<Mapper::SubmapCovariances> covariances = mapper.Covariances()) {
+    result.covariances = covariances->anchors;
+    std::vector<const perception::PointCloud*> clouds;
+    std::vector<Eigen::Isometry3d> placed;
+    for (int i = 0; i < mapper.submap_count(); ++i) {
+      clouds.push_back(&mapper.submap(i).cloud);
+      placed.push_back(mapper.scan_pose(i));
+    }
+    result.expected_map_error_m = ExpectedSurfaceErrorRms(clouds, placed, covariances->scans, kExpectedErrorStride);
+  }
+  result.loops = mapper.loops();
+  result.map = mapper.Map(options.map_voxel_m);
+  result.stats = mapper.stats();
+  result.calibration = mapper.calibration();
+  result.dive_duration_s = last_time - first_time;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace uwscan::mapping

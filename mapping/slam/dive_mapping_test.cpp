@@ -1,0 +1,315 @@
+#include "mapping/slam/dive_mapping.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mapping/log/dive_log_test_support.hpp"
+#include "mapping/log/dive_simulation.hpp"
+#include "mapping/slam/map_report.hpp"
+#include "mapping/slam/navigation_uncertainty.hpp"
+#include "scanner/sim/ray_caster.hpp"
+#include "scanner/sim/scene.hpp"
+#include "scanner/sim/simulator.hpp"
+
+namespace uwscan::mapping::test {
+namespace {
+
+scanner::sim::Scene ShortScene() {
+  return scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_short.yaml");
+}
+
+class DiveMappingTest : public DiveLogTest {
+ protected:
+  fs::path Simulate(const scanner::sim::Scene& scene, const char* name) {
+    const fs::path path = dir_ / name;
+    const scanner::sim::Simulator simulator(scene);
+    DiveSimulationOptions options;
+    options.threads = 2;
+    SimulateDive(simulator, "", path, options);
+    return path;
+  }
+  DiveMapping Map(const fs::path& path, int threads = 2) {
+    DiveMappingOptions options;
+    options.mapper.threads = threads;
+    options.table_cache = dir_ / "tables";
+    return MapDive(DiveLogReader(path), options);
+  }
+};
+
+void ExpectSameBits(const DiveMapping& a, const DiveMapping& b) {
+  ASSERT_EQ(a.slam.size(), b.slam.size());
+  for (std::size_t i = 0; i < a.slam.size(); ++i) ExpectSamePose(a.slam[i].T_W_V, b.slam[i].T_W_V);
+  ASSERT_EQ(a.map.size(), b.map.size());
+  for (std::size_t i = 0; i < a.map.size(); ++i) {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(std::bit_cast<std::uint32_t>(a.map.points[i][k]),
+                                          std::bit_cast<std::uint32_t>(b.map.points[i][k]));
+  }
+  ASSERT_EQ(a.loops.size(), b.loops.size());
+  ASSERT_EQ(a.covariances.size(), b.covariances.size());
+  // The covariances come from a sparse QR (SuiteSparseQR through ceres::Covariance) whose
+  // rounding is not reproducible to the bit (2.6e-15 relative seen): equal to rounding.
+  for (std::size_t i = 0; i < a.covariances.size(); ++i) {
+    EXPECT_LT((a.covariances[i] - b.covariances[i]).norm(), 1e-12 * a.covariances[i].norm()) << "pose " << i;
+  }
+  ASSERT_TRUE(a.expected_map_error_m && b.expected_map_error_m);
+  EXPECT_NEAR(*a.expected_map_error_m, *b.expected_map_error_m, 1e-12 * *a.expected_map_error_m);
+}
+
+TEST_F(DiveMappingTest, WithoutDriftTheMapLiesOnTheTruth) {
+  scanner::sim::Scene scene = ShortScene();
+  scene.effects.navigation_drift.on = false;
+  scene.effects.peak_noise.on = false;
+  const DiveMapping m = Map(Simulate(scene, "exact.db"));
+  ASSERT_GT(m.submaps, 5);
+  ASSERT_EQ(m.truth.size(), m.slam.size());
+  EXPECT_LT(AbsoluteTrajectoryError(m.slam, m.truth), 5e-4);
+  EXPECT_LT(AbsoluteTrajectoryError(m.dead_reckoning, m.truth), 1e-9);
+  EXPECT_GT(m.map.size(), 10000u);
+}
+
+TEST_F(DiveMappingTest, SameBitsForOneAndTwoThreadsAndOnlineOrOffline) {
+  const fs::path log = Simulate(ShortScene(), "drift.db");
+  const DiveMapping one = Map(log, 1), two = Map(log, 2);
+  ExpectSameBits(one, two);
+
+  // Online: the same log fed as a live vehicle would, navigation far ahead of the frames.
+  const DiveLogReader reader(log);
+  MapperOptions options;
+  options.threads = 2;
+  Mapper mapper(reader.header().scanner, reader.header().scan_pattern, *reader.vehicle_mount(),
+                *reader.header().navigation_noise, options, dir_ / "tables");
+  for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
+  reader.ForEachFrame([&](const FrameRecord& frame, const GroundTruthRecord*) { mapper.AddFrame(frame); }, false);
+  mapper.Finish();
+  ASSERT_EQ(mapper.submap_count(), two.submaps);
+  for (int i = 0; i < mapper.submap_count(); ++i) ExpectSamePose(two.slam[static_cast<size_t>(i)].T_W_V, mapper.pose(i));
+}
+
+TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
+  const DiveMapping m = Map(Simulate(ShortScene(), "drift.db"));
+  const MapSummary s = Summarise(m);
+  ASSERT_TRUE(s.nees_mean.has_value());
+  EXPECT_GT(*s.nees_mean, 0.5 * 6.0);
+  EXPECT_LT(*s.nees_mean, 3.0 * 6.0);
+  EXPECT_EQ(s.loops_false.value_or(-1), 0);
+  for (const Matrix6d& c : m.covariances) EXPECT_GT(PoseStd(c).head<2>().minCoeff(), 0.0);
+}
+
+TEST_F(DiveMappingTest, TheMapsExpectedErrorIsWhatItsDistanceToTheTruthComesTo) {
+  const scanner::sim::Scene scene = ShortScene();
+  const DiveMapping m = Map(Simulate(scene, "drift.db"));
+  ASSERT_TRUE(m.expected_map_error_m.has_value());
+  // The map's distance to the scene's true surfaces, against what its poses' covariance says.
+  const scanner::sim::RayCaster caster(scene.objects);
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < m.map.size(); i += 7) {
+    const double d = caster.DistanceToSurface(m.map.Point(i), 0.5).value_or(0.5);
+    sum += d * d;
+    ++count;
+  }
+  const double measured = std::sqrt(sum / static_cast<double>(count));
+  EXPECT_GT(measured, 0.6 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
+  EXPECT_LT(measured, 1.5 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
+}
+
+TEST_F(DiveMappingTest, AlongASinglePipeTheMapFollowsTheNavigation) {
+  // Out along the pipe only: scan matching sees a pipe on a plane, free along the pipe (x).
+  scanner::sim::Scene scene =
+      scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_pipe.yaml");
+  scene.scanner.sweeps = 40;
+  const DiveMapping m = Map(Simulate(scene, "pipe.db"));
+  ASSERT_EQ(m.truth.size(), m.slam.size());
+  for (std::size_t i = 0; i < m.slam.size(); ++i) {
+    const double slam_x = std::abs(m.slam[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
+    const double dr_x = std::abs(m.dead_reckoning[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
+    EXPECT_LT(slam_x, dr_x + 0.01) << "submap " << i;
+  }
+  EXPECT_LE(AbsoluteTrajectoryError(m.slam, m.truth), AbsoluteTrajectoryError(m.dead_reckoning, m.truth) + 0.005);
+}
+
+TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {
+  // The pipe dive, out 3 m instead of 8 and back: coming back over the pipe closes loops that
+  // see it without its ends. They are kept in the five directions they pin and bring the
+  // sideways drift of the dead reckoning back onto the pipe; along it they claim nothing.
+  scanner::sim::Scene scene =
+      scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_pipe.yaml");
+  std::vector<scanner::sim::TrajectoryPose>& poses = scene.trajectory.poses;
+  ASSERT_EQ(poses.size(), 5u);  // out, turning (two), back
+  const double shift_s = 20.0;  // 8 m at 0.25 m/s is 32 s; 3 m is 12 s
+  for (std::size_t i = 1; i < poses.size(); ++i) poses[i].time_s -= i == 4 ? 2.0 * shift_s : shift_s;
+  for (std::size_t i = 1; i < 4; ++i) poses[i].T_W_V.translation().x() = 3.0;
+  scene.scanner.sweeps = static_cast<int>(poses.back().time_s / 70.0 * scene.scanner.sweeps);
+  const DiveMapping m = Map(Simulate(scene, "pipe_loop.db"));
+  ASSERT_EQ(m.truth.size(), m.slam.size());
+  int accepted = 0;
+  for (const LoopClosure& loop : m.loops) {
+    if (!loop.accepted) continue;
+    ++accepted;
+    EXPECT_GE(loop.constrained_directions, 5) << loop.from << " -> " << loop.to;
+    if (loop.constrained_directions == 6) continue;  // it saw the pipe's end
+    // What it leaves free is a slide along the pipe: x of the earlier submap, which flew along
+    // it, to within the heading error.
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(loop.information);
+    EXPECT_LT(eigen.eigenvalues()(0), 1e-9 * eigen.eigenvalues()(5));
+    const Vector6d free = eigen.eigenvectors().col(0);
+    EXPECT_LT(free.head<3>().norm(), 1e-6);
+    EXPECT_GT(std::abs(free(3)), std::cos(0.02)) << loop.from << " -> " << loop.to;
+  }
+  EXPECT_GT(accepted, 5);
+  EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 0);
+  double slam_sideways = 0.0, dr_sideways = 0.0;
+  for (std::size_t i = 0; i < m.slam.size(); ++i) {
+    const double y = m.truth[i].T_W_V.translation().y();
+    slam_sideways = std::max(slam_sideways, std::abs(m.slam[i].T_W_V.translation().y() - y));
+    dr_sideways = std::max(dr_sideways, std::abs(m.dead_reckoning[i].T_W_V.translation().y() - y));
+  }
+  EXPECT_LT(slam_sideways, 0.5 * dr_sideways);
+}
+
+TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
+  DiveMapping m;
+  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
+  far.translation().x() = 1.0;
+  m.truth = {{0.0, Eigen::Isometry3d::Identity()}, {1.0, far}};
+  m.slam = m.dead_reckoning = m.truth;
+  LoopClosure slid;  // off by 20 cm along the pipe it cannot see along
+  slid.from = 0;
+  slid.to = 1;
+  slid.accepted = true;
+  slid.T_from_to = far;
+  slid.T_from_to.translation().x() += 0.2;
+  slid.information.diagonal() << 1e6, 1e6, 1e6, 0.0, 1e6, 1e6;
+  m.loops = {slid};
+  EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 0);
+  LoopClosure sideways = slid;  // off by 20 cm across it: a wrong association
+  sideways.T_from_to = far;
+  sideways.T_from_to.translation().y() += 0.2;
+  m.loops = {slid, sideways};
+  EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 1);
+}
+
+TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {
+  // A recorder that died mid-sweep: every navigation sample, the frames up to the crash.
+  const scanner::sim::Simulator simulator(ShortScene());
+  const fs::path path = dir_ / "cut.db";
+  const std::int64_t kept = simulator.frame_count() / 2 + 7;
+  {
+    DiveLogHeader header;
+    header.scanner = simulator.scanner();
+    header.scan_pattern = simulator.scan_pattern();
+    header.navigation_noise = NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005};
+    DiveLogWriter writer(path, header);
+    writer.SetVehicleMount(simulator.scene().trajectory.T_V_C);
+    for (const scanner::sim::NavigationSample& n : simulator.Navigation(20.0)) writer.AppendNavigation({n.time_s, n.T_W_V});
+    for (std::int64_t i = 0; i < kept; ++i) {
+      const scanner::sim::SimulatedFrame f = simulator.Frame(i);
+      FrameRecord record;
+      record.time_s = f.time_s;
+      record.command = f.command;
+      record.sweep = f.sweep;
+      record.peaks_px = f.peaks_px;
+      writer.AppendFrame(record);
+    }
+  }
+  const DiveMapping m = Map(path);
+  EXPECT_TRUE(m.truth.empty());
+  ASSERT_GT(m.submaps, 2);
+  EXPECT_NEAR(m.dive_duration_s, static_cast<double>(kept - 1) * simulator.frame_period_s(), 1e-9);
+  EXPECT_GT(m.slam.back().time_s, m.dive_duration_s - 2.0);
+}
+
+TEST_F(DiveMappingTest, UnusableLogsGiveAClearError) {
+  const fs::path empty_nav = dir_ / "no_nav.db";
+  {
+    DiveLogWriter writer(empty_nav, TestHeader());
+    for (int i = 0; i < 3; ++i) writer.AppendFrame(TestFrame(i, 10));
+  }
+  EXPECT_NE(MessageOf([&] { Map(empty_nav); }).find("has no navigation"), std::string::npos);
+
+  const fs::path one = dir_ / "one.db";
+  {
+    DiveLogWriter writer(one, TestHeader());
+    writer.AppendFrame(TestFrame(0, 10));
+    writer.AppendNavigation({0.0, Eigen::Isometry3d::Identity()});
+  }
+  EXPECT_NE(MessageOf([&] { Map(one); }).find("has 1 frame"), std::string::npos);
+
+  const std::string next = std::to_string(kDiveLogSchemaVersion + 1);
+  RawExec(one, "UPDATE meta SET value = " + next + " WHERE key = 'schema_version'");
+  EXPECT_NE(MessageOf([&] { Map(one); })
+                .find("schema version " + next + ", this uwscan reads 1 to " + std::to_string(kDiveLogSchemaVersion)),
+            std::string::npos);
+}
+
+TEST_F(DiveMappingTest, VersionOneLogsOpenAndMapWithAnAssumedNoise) {
+  scanner::sim::Scene scene = ShortScene();
+  scene.scanner.sweeps = 12;
+  const fs::path path = Simulate(scene, "v1.db");
+  EXPECT_TRUE(DiveLogReader(path).header().navigation_noise.has_value());
+  RawExec(path, "DROP TABLE navigation_noise; UPDATE meta SET value = 1 WHERE key = 'schema_version'");
+  const DiveLogReader reader(path);
+  EXPECT_EQ(reader.header().schema_version, 1);
+  EXPECT_FALSE(reader.header().navigation_noise.has_value());
+  const DiveMapping m = Map(path);
+  EXPECT_TRUE(m.navigation_noise_assumed);
+  EXPECT_GT(m.submaps, 1);
+}
+
+TEST(PoseGraph, ACovarianceIsTheInverseOfItsOnlyPrior) {
+  PoseGraph graph;
+  const Eigen::Isometry3d T = TestPose(3);
+  graph.AddNode(T);
+  Matrix6d information = Matrix6d::Zero();
+  information.diagonal() << 1e4, 4e4, 9e4, 1e2, 4e2, 9e2;  // 0.01, 0.005, 0.0033 rad; 0.1, 0.05, 0.033 m
+  information(0, 3) = information(3, 0) = 50.0;
+  graph.AddPrior({0, T, information});
+  graph.Solve({});
+  const std::optional<std::vector<Matrix6d>> covariance = graph.Covariances();
+  ASSERT_TRUE(covariance.has_value());
+  EXPECT_LT(((*covariance)[0] - information.inverse()).norm(), 1e-9 * information.inverse().norm());
+}
+
+TEST(PoseGraph, RecoversAChainFromExactEdgesAndAPrior) {
+  PoseGraph graph;
+  std::vector<Eigen::Isometry3d> truth;
+  for (int i = 0; i < 5; ++i) truth.push_back(TestPose(10 + static_cast<std::uint64_t>(i)));
+  for (int i = 0; i < 5; ++i) graph.AddNode(i == 0 ? truth[0] : TestPose(100 + static_cast<std::uint64_t>(i)));
+  graph.AddPrior({0, truth[0], Matrix6d::Identity() * 1e6});
+  for (int i = 0; i + 1 < 5; ++i) {
+    graph.AddEdge({i, i + 1, truth[static_cast<size_t>(i)].inverse() * truth[static_cast<size_t>(i) + 1],
+                   Matrix6d::Identity() * 1e4, false, 3.0});
+  }
+  EXPECT_TRUE(graph.Solve({}).converged);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_LT(PoseError(graph.pose(i), truth[static_cast<size_t>(i)]).norm(), 1e-7) << "node " << i;
+  }
+}
+
+TEST(NavigationUncertainty, OdometryLeavesDepthRollAndPitchToThePriors) {
+  const NavigationUncertainty model(NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005});
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
+  a.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  b.translation() = Eigen::Vector3d(0.5, 0.1, 0.0);
+  const Matrix6d info = model.OdometryInformation(a, b, 2.0);
+  // In a's frame the world's down axis is still z (a turns about it): z, roll and pitch free.
+  Vector6d down = Vector6d::Zero();
+  down(5) = 1.0;
+  EXPECT_NEAR(down.dot(info * down), 0.0, 1e-9);
+  Vector6d roll = Vector6d::Zero();
+  roll(0) = 1.0;
+  EXPECT_NEAR(roll.dot(info * roll), 0.0, 1e-9);
+  Vector6d yaw = Vector6d::Zero();
+  yaw(2) = 1.0;
+  EXPECT_GT(yaw.dot(info * yaw), 1e5);
+}
+
+}  // namespace
+}  // namespace uwscan::mapping::test

@@ -1,0 +1,62 @@
+#include "mapping/slam/map_report.hpp"
+
+#include <algorithm>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+namespace uwscan::mapping {
+
+namespace {
+
+// The part of a loop's error [w, v] along what it measures: along a pipe a loop pins all but
+// the slide, where its pose is only the prediction and may be off by the drift.
+// Exact when the free direction is a pure translation (a slide, mapper.cpp); a loop without a
+// usable information is judged whole.
+Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& error, const Matrix6d& information) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (information + information.transpose()));
+  const double largest = eigen.eigenvalues()(5);
+  if (!information.allFinite() || !(largest > 0.0)) return error;
+  Eigen::Matrix<double, 6, 1> measured = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int k = 0; k < 6; ++k) {
+    if (!(eigen.eigenvalues()(k) > 1e-9 * largest)) continue;
+    measured += eigen.eigenvectors().col(k).dot(error) * eigen.eigenvectors().col(k);
+  }
+  return measured;
+}
+
+}  // namespace
+
+MapSummary Summarise(const DiveMapping& m) {
+  MapSummary s;
+  for (const LoopClosure& loop : m.loops) (loop.accepted ? s.loops_accepted : s.loops_rejected)++;
+  s.real_time_factor = m.seconds > 0.0 ? m.dive_duration_s / m.seconds : 0.0;
+  if (m.truth.empty()) return s;
+  s.ate_slam_m = AbsoluteTrajectoryError(m.slam, m.truth);
+  s.ate_dead_reckoning_m = AbsoluteTrajectoryError(m.dead_reckoning, m.truth);
+  s.rpe_slam_per_m = RelativeErrorPerMetre(m.slam, m.truth);
+  s.rpe_dead_reckoning_per_m = RelativeErrorPerMetre(m.dead_reckoning, m.truth);
+  if (!m.covariances.empty()) s.nees_mean = MeanNees(m.slam, m.truth, m.covariances);
+  int false_loops = 0;
+  for (const LoopClosure& loop : m.loops) {
+    if (!loop.accepted) continue;
+    const Eigen::Isometry3d truth = m.truth[static_cast<size_t>(loop.from)].T_W_V.inverse() *
+                                    m.truth[static_cast<size_t>(loop.to)].T_W_V;
+    const Eigen::Matrix<double, 6, 1> error = MeasuredPart(PoseError(loop.T_from_to, truth), loop.information);
+    if (error.tail<3>().norm() > kFalseLoopTranslation_m || error.head<3>().norm() > kFalseLoopRotation_rad) {
+      ++false_loops;
+    }
+  }
+  s.loops_false = false_loops;
+  return s;
+}
+
+Eigen::Matrix<double, 6, 1> PoseStd(const Matrix6d& covariance) {
+  Eigen::Matrix<double, 6, 1> std;
+  for (int k = 0; k < 3; ++k) {
+    std(k) = std::sqrt(std::max(0.0, covariance(3 + k, 3 + k)));
+    std(3 + k) = std::sqrt(std::max(0.0, covariance(k, k)));
+  }
+  return std;
+}
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,24 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <vector>
+
+#include "mapping/slam/pose_graph.hpp"
+#include "perception/cloud/point_cloud.hpp"
+
+namespace uwscan::mapping {
+
+// How far a map's points are expected to lie off the true surfaces from the uncertainty of the
+// poses that placed them alone: for each point, the standard deviation along its normal of its
+// displacement under its submap pose's covariance ([rotation, position] in the world,
+// pose_graph.hpp: the rotation turns about the pose's position), combined as an RMS over the
+// points. With a consistent covariance this is what the map's distance to the true surfaces
+// should come to, above the sensor's own error: the navigation and the scene's information
+// allow no better. Every `stride`-th point of each cloud is used (clouds need normals).
+// Throws uwscan::Error when the sizes differ, a cloud has no normals, or stride is 0.
+double ExpectedSurfaceErrorRms(const std::vector<const perception::PointCloud*>& clouds_V,
+                               const std::vector<Eigen::Isometry3d>& T_W_V, const std::vector<Matrix6d>& covariances,
+                               std::size_t stride = 1);
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,566 @@
+#include "mapping/slam/mapper.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+
+#include "mapping/slam/navigation_buffer.hpp"
+#include "mapping/slam/navigation_uncertainty.hpp"
+#include "mapping/slam/registration_information.hpp"
+#include "perception/preprocessing/voxel_filter.hpp"
+#include "perception/registration/icp.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/triangulation/triangulator_factory.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// Frames waiting for navigation beyond this many mean the navigation has stopped.
+constexpr std::size_t kMaxWaitingFrames = 20000;
+// The start fix: where the dive's dead reckoning starts is known to this much.
+constexpr double kStartSigma_m = 0.001;
+constexpr double kStartSigma_rad = 0.001;
+
+// Appends `cloud` (points and normals) moved by T to `out`, whose origin is 0.
+void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isometry3d& T, perception::PointCloud* out) {
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    out->points.push_back((T * cloud.Point(i)).cast<float>());
+    if (cloud.has_normals()) out->normals.push_back(R * cloud.normals[i]);
+  }
+}
+
+// Information along world axes [w_W, t_W] holding only heading, x and y: the start fix.
+Matrix6d StartInformation() {
+  Matrix6d info = Matrix6d::Zero();
+  info(2, 2) = 1.0 / (kStartSigma_rad * kStartSigma_rad);
+  info(3, 3) = info(4, 4) = 1.0 / (kStartSigma_m * kStartSigma_m);
+  return info;
+}
+
+// Covariance of the position of `to` seen from `from`'s frame, from the [w, v] covariance of
+// T_from_to: the rotation moves it by w x t.
+Eigen::Matrix3d PositionCovariance(const Matrix6d& covariance, const Eigen::Vector3d& t) {
+  Eigen::Matrix<double, 3, 6> J;
+  Eigen::Matrix3d minus_skew;
+  minus_skew << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;
+  J << minus_skew, Eigen::Matrix3d::Identity();
+  return J * covariance * J.transpose();
+}
+
+double LargestStd(const Eigen::Matrix3d& covariance) {
+  return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
+}
+
+}  // namespace
+
+void MapperOptions::Check() const {
+  const auto fail = [](const std::string& field, const std::string& expected) {
+    throw Error("MapperOptions." + field + ": expected " + expected);
+  };
+  clouds.Check();
+  if (sweeps_per_submap < 1) fail("sweeps_per_submap", "> 0");
+  if (local_map_submaps < 1) fail("local_map_submaps", "> 0");
+  if (!(point_sigma_floor_m > 0.0)) fail("point_sigma_floor_m", "> 0 m");
+  if (!(min_fitness >= 0.0 && min_fitness <= 1.0)) fail("min_fitness", "in [0, 1]");
+  if (!(loop_min_fitness >= 0.0 && loop_min_fitness <= 1.0)) fail("loop_min_fitness", "in [0, 1]");
+  if (loop_min_directions < 1 || loop_min_directions > 6) fail("loop_min_directions", "in [1, 6]");
+  if (loop_min_index_gap <= local_map_submaps) fail("loop_min_index_gap", "> local_map_submaps");
+  if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
+  if (loop_every_submaps < 1) fail("loop_every_submaps", "> 0");
+  if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
+  if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0)) fail("loop_overlap_ratio", "in (0, 1]");
+  if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
+  if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
+  if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
+  if (!(running_solve_tolerance > 0.0 && running_solve_tolerance < 1.0)) fail("running_solve_tolerance", "in (0, 1)");
+  if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
+  if (!(slide_sigma_m >= 0.0)) fail("slide_sigma_m", ">= 0 m");
+  if (threads < 0) fail("threads", ">= 0");
+  perception::IcpOptions icp;
+  icp.max_correspondence_distance_m = icp_distances_m;
+  icp.Check();
+  icp.max_correspondence_distance_m = loop_icp_distances_m;
+  icp.Check();
+}
+
+struct Mapper::Impl {
+  MapperOptions options;
+  Eigen::Isometry3d T_V_C;
+  NavigationUncertainty uncertainty;
+  std::unique_ptr<scanner::Triangulator> triangulator;
+  NavigationBuffer navigation;
+  std::deque<FrameRecord> waiting;
+  bool finished = false;
+  Mapper::FramePlacedCallback on_placed;
+
+  // The submap being filled: points in the navigation's world frame, and its frames. Its frames
+  // are placed with the navigation corrected by the calibration estimated when it opened, about
+  // the navigation's position at its first frame.
+  std::vector<Eigen::Vector3d> points_W;
+  DeadReckoningCalibration placement;
+  Eigen::Vector3d placement_origin_W = Eigen::Vector3d::Zero();
+  std::vector<std::pair<std::int64_t, double>> frames;  // index, time
+  int first_sweep = 0;
+  std::vector<scanner::TriangulatedPoint> triangulated;
+
+  // Submap i has two nodes in the graph: its anchor (the vehicle at its middle frame, which
+  // the navigation measures) and its scan (the pose at which its cloud, bent by the navigation
+  // that placed its frames, fits the scene best, which registration measures); a distortion
+  // edge ties them (SubmapDistortionCovariance). Bending is then a bounded offset per submap,
+  // not a step that accumulates along a chain of registrations.
+  std::vector<Submap> submaps;
+  std::vector<Matrix6d> increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
+  PoseGraph graph;
+  std::vector<LoopClosure> loops;
+  MapperStats stats;
+  int since_solve = 0;
+
+  Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
+      : options(o), T_V_C(mount), uncertainty(noise) {}
+
+  void Drain(bool hold_at_ends);
+  void Place(const FrameRecord& frame);
+  void CloseSubmap();
+  void AddToGraph(Submap submap);
+  perception::RegistrationResult Register(const Submap& source, const perception::PointCloud& target,
+                                          const Eigen::Isometry3d& T_init, const Matrix6d& prior_covariance,
+                                          const std::vector<double>& distances) const;
+  // The registration's own information (its pairs), weak directions removed. It relates the
+  // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
+  // `kept`, when given, receives what the pairs alone pin (KeptDirections).
+  Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
+                                   const Submap& source, KeptDirections* kept = nullptr) const;
+  // How far a submap's effective pose may sit from its anchor's navigation pose.
+  Matrix6d Distortion(const Submap& s, SystematicErrors systematic_errors) const;
+  // The navigation's motion between two submaps' effective poses (in a's frame).
+  // Everything it may be off by: the scale error and misalignment as noise, as the
+  // calibration may still be settling.
+  Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
+  Matrix6d ChainCovariance(int from, int to) const;
+  void TryLoopClosures(int k);
+  void Solve(bool last = false);  // last: the solve at Finish, to the full tolerance
+  static int AnchorNode(int submap) { return 2 * submap; }
+  static int ScanNode(int submap) { return 2 * submap + 1; }
+  Eigen::Isometry3d AnchorPose(int submap) const { return graph.pose(AnchorNode(submap)); }
+  Eigen::Isometry3d ScanPose(int submap) const { return graph.pose(ScanNode(submap)); }
+  SystematicErrors systematic() const {
+    return options.estimate_dead_reckoning_calibration ? SystematicErrors::kEstimated : SystematicErrors::kAsNoise;
+  }
+  // The navigation at t (held at its ends) with its motion since the submap's first frame
+  // corrected by the placement calibration.
+  Eigen::Isometry3d PlacementPose(double time_s) const {
+    Eigen::Isometry3d T_W_V =
+        navigation.T_W_V(std::clamp(time_s, navigation.first_time_s(), navigation.last_time_s()));
+    T_W_V.translation() = placement_origin_W + placement.Correct(T_W_V.translation() - placement_origin_W);
+    return T_W_V;
+  }
+};
+
+void Mapper::Impl::Drain(bool hold_at_ends) {
+  while (!waiting.empty()) {
+    const double t = waiting.front().time_s;
+    if (!hold_at_ends && !(navigation.Covers(t) || (!navigation.empty() && t < navigation.first_time_s()))) {
+      break;
+    }
+    Place(waiting.front());
+    waiting.pop_front();
+  }
+}
+
+void Mapper::Impl::Place(const FrameRecord& frame) {
+  if (!frames.empty() && frame.sweep >= first_sweep + options.sweeps_per_submap) CloseSubmap();
+  if (frames.empty()) {
+    first_sweep = frame.sweep;
+    placement = graph.calibration();
+    placement_origin_W = navigation
+                             .T_W_V(std::clamp(frame.time_s, navigation.first_time_s(), navigation.last_time_s()))
+                             .translation();
+  }
+  const Clock::time_point start = Clock::now();
+  triangulated.resize(frame.peaks_px.size());
+  triangulator->TriangulateFrame(frame.command, frame.peaks_px, triangulated);
+  // Held at the first or last sample outside the navigation's span.
+  const Eigen::Isometry3d T_W_C = PlacementPose(frame.time_s) * T_V_C;
+  const std::size_t first_point = points_W.size();
+  for (const scanner::TriangulatedPoint& p : triangulated) {
+    if (!p.ok()) continue;
+    points_W.push_back(T_W_C * p.p_C);
+    ++stats.points;
+  }
+  frames.emplace_back(frame.index, frame.time_s);
+  ++stats.frames;
+  stats.triangulation_s += Since(start);
+  if (on_placed) {
+    on_placed(frame, T_W_C, std::span<const Eigen::Vector3d>(points_W).subspan(first_point));
+  }
+}
+
+void Mapper::Impl::CloseSubmap() {
+  if (frames.empty()) return;
+  const Clock::time_point start = Clock::now();
+  Submap submap;
+  const auto& anchor = frames[frames.size() / 2];
+  submap.anchor_frame = anchor.first;
+  submap.anchor_time_s = anchor.second;
+  submap.first_frame = frames.front().first;
+  submap.last_frame = frames.back().first;
+  submap.start_s = frames.front().second;
+  submap.end_s = frames.back().second;
+  const double t = std::clamp(anchor.second, navigation.first_time_s(), navigation.last_time_s());
+  submap.T_W_V_nav = navigation.T_W_V(t);
+  const auto clamped = [&](double time) {
+    return navigation.T_W_V(std::clamp(time, navigation.first_time_s(), navigation.last_time_s()));
+  };
+  submap.T_W_V_start = clamped(submap.start_s);
+  submap.T_W_V_end = clamped(submap.end_s);
+  // The points in the anchor's frame as the corrected navigation placed it.
+  const Eigen::Isometry3d T_V_W = PlacementPose(anchor.second).inverse();
+  std::vector<Eigen::Vector3d> points_V;
+  points_V.reserve(points_W.size());
+  for (const Eigen::Vector3d& p : points_W) points_V.push_back(T_V_W * p);
+  SubmapCloudOptions cloud_options = options.clouds;
+  cloud_options.viewpoint_V = T_V_C.translation();
+  cloud_options.threads = options.threads;
+  BuildSubmapClouds(points_V, cloud_options, &submap);
+  const double last_time = frames.back().second;
+  points_W.clear();
+  frames.clear();
+  navigation.DropBefore(last_time);
+  stats.submap_s += Since(start);
+  // A submap that saw nothing (open water) adds no node: odometry bridges it.
+  if (submap.cloud.empty() || submap.sparse.size() < 10) return;
+  AddToGraph(std::move(submap));
+}
+
+perception::RegistrationResult Mapper::Impl::Register(const Submap& source, const perception::PointCloud& target,
+                                                      const Eigen::Isometry3d& T_init,
+                                                      const Matrix6d& prior_covariance,
+                                                      const std::vector<double>& distances) const {
+  perception::IcpOptions icp;
+  icp.method = perception::IcpMethod::kPointToPlane;
+  icp.max_correspondence_distance_m = distances;
+  icp.max_iterations = 120;
+  icp.max_iterations_per_stage = 30;
+  // Converged once a step moves the data less than a twentieth of the finest voxel: finer
+  // steps are the pairing flickering between neighbours, not progress.
+  icp.translation_tolerance_m = 0.05 * options.clouds.map_voxel_m;
+  icp.rotation_tolerance_rad = 2e-5;
+  icp.relative_rmse_tolerance = 1e-4;
+  icp.threads = options.threads;
+  perception::IcpPrior prior;
+  prior.T_target_source = T_init;
+  prior.information = prior_covariance.inverse();
+  prior.information = 0.5 * (prior.information + prior.information.transpose());
+  prior.point_sigma_m = 2.0 * options.point_sigma_floor_m;
+  icp.prior = prior;
+  return perception::AlignIcp(source.sparse, target, T_init, icp);
+}
+
+Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
+                                               const Submap& source, KeptDirections* kept) const {
+  const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
+  KeptDirections points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse, r.T_target_source,
+                                                 options.weak_direction_ratio);
+  // The pairs' residuals are not independent: what the navigation bent in each submap beyond a
+  // rigid offset stays in every pair. Both submaps' bending floors the registration's covariance.
+  const Matrix6d floor = uncertainty.BendingCovariance(target.end_s - target.start_s, target.rms_radius_m) +
+                         uncertainty.BendingCovariance(source.end_s - source.start_s, source.rms_radius_m);
+  const Matrix6d information = InformationOfSum(points.information, floor);
+  if (kept) *kept = std::move(points);
+  return information;
+}
+
+Matrix6d Mapper::Impl::Distortion(const Submap& s, SystematicErrors systematic_errors) const {
+  SweepPlacement sweep;
+  sweep.T_W_start = s.T_W_V_start;
+  sweep.T_W_anchor = s.T_W_V_nav;
+  sweep.T_W_end = s.T_W_V_end;
+  sweep.span_s = s.end_s - s.start_s;
+  sweep.footprint_radius_m = s.rms_radius_m;
+  sweep.footprint_centre_V = s.centroid_V;
+  return uncertainty.SubmapDistortionCovariance(sweep, systematic_errors);
+}
+
+Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b) const {
+  const SystematicErrors systematic_errors = SystematicErrors::kAsNoise;
+  const Eigen::Isometry3d T_a_b = a.T_W_V_nav.inverse() * b.T_W_V_nav;
+  const Matrix6d ad = Adjoint(T_a_b);
+  const Matrix6d covariance =
+      uncertainty.IncrementCovariance(a.T_W_V_nav, b.T_W_V_nav, b.anchor_time_s - a.anchor_time_s, systematic_errors) +
+      Distortion(a, systematic_errors) + ad * Distortion(b, systematic_errors) * ad.transpose();
+  return 0.5 * (covariance + covariance.transpose());
+}
+
+Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
+  Matrix6d covariance = Matrix6d::Zero();
+  const Eigen::Isometry3d T_from_W = ScanPose(from).inverse();
+  for (int i = from + 1; i <= to; ++i) {
+    const Matrix6d ad = Adjoint(T_from_W * ScanPose(i - 1));
+    covariance += ad * increment_covariance[static_cast<size_t>(i)] * ad.transpose();
+  }
+  return covariance;
+}
+
+void Mapper::Impl::AddToGraph(Submap submap) {
+  const int k = static_cast<int>(submaps.size());
+  submap.index = k;
+  const NavigationNoise& noise = uncertainty.noise();
+  Eigen::Isometry3d anchor_initial = submap.T_W_V_nav;
+  Eigen::Isometry3d scan_initial = submap.T_W_V_nav;
+  Matrix6d increment_cov = Matrix6d::Zero();
+  std::optional<RelativePoseEdge> registration;
+  Matrix6d slides = Matrix6d::Zero();
+  if (k > 0) {
+    const Submap& previous = submaps.back();
+    const Eigen::Isometry3d T_nav =
+        graph.calibration().CorrectMotion(previous.T_W_V_nav.inverse() * submap.T_W_V_nav);
+    // The registration starts from the corrected navigation, and is judged against it, with
+    // everything the navigation may be off by (the calibration may still be settling).
+    increment_cov = MotionCovariance(previous, submap);
+    // The scan's motion as the navigation predicts it, from the previous scan's offset.
+    const Eigen::Isometry3d T_predicted = ScanPose(k - 1).inverse() * AnchorPose(k - 1) * T_nav;
+    anchor_initial = AnchorPose(k - 1) * T_nav;
+    scan_initial = anchor_initial;
+
+    const Clock::time_point start = Clock::now();
+    perception::PointCloud local;
+    const Eigen::Isometry3d T_prev_W = ScanPose(k - 1).inverse();
+    for (int j = std::max(0, k - options.local_map_submaps); j < k; ++j) {
+      AppendMoved(submaps[static_cast<size_t>(j)].cloud, T_prev_W * ScanPose(j), &local);
+    }
+    const perception::RegistrationResult r =
+        Register(submap, local, T_predicted, increment_cov, options.icp_distances_m);
+    stats.registration_s += Since(start);
+    KeptDirections kept;
+    const Matrix6d information = RegistrationInformation(r, previous, submap, &kept);
+    const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
+    const double chi2 = innovation.dot(InformationOfSum(information, increment_cov) * innovation);
+    // Along a slide the registration measures nothing, so the test has as many degrees of
+    // freedom as directions it pins.
+    if (r.fitness >= options.min_fitness && chi2 <= Chi2Quantile999(kept.count)) {
+      registration = RelativePoseEdge{ScanNode(k - 1), ScanNode(k), r.T_target_source, information, false, 3.0};
+      slides = SlideCovariance(kept.slides, r.T_target_source, options.slide_sigma_m);
+      scan_initial = ScanPose(k - 1) * r.T_target_source;
+      const Matrix6d combined = (increment_cov.inverse() + information).inverse();
+      increment_cov = combined;
+      ++stats.registrations;
+    } else {
+      ++(r.fitness >= options.min_fitness ? stats.registrations_inconsistent : stats.registrations_failed);
+    }
+  }
+  const int anchor = graph.AddNode(anchor_initial);
+  const int scan = graph.AddNode(scan_initial);
+  if (anchor != AnchorNode(k) || scan != ScanNode(k)) throw Error("mapper: graph nodes out of step with submaps");
+  const Matrix6d distortion_information = (Distortion(submap, systematic()) + slides).inverse();
+  graph.AddEdge({anchor, scan, Eigen::Isometry3d::Identity(),
+                 0.5 * (distortion_information + distortion_information.transpose()), false, 3.0});
+  if (k == 0) {
+    graph.AddPrior({anchor, submap.T_W_V_nav, StartInformation()});
+  } else {
+    const Submap& previous = submaps.back();
+    graph.AddEdge({AnchorNode(k - 1), anchor, previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
+                   uncertainty.OdometryInformation(previous.T_W_V_nav, submap.T_W_V_nav,
+                                                   submap.anchor_time_s - previous.anchor_time_s, systematic()),
+                   false, 3.0, options.estimate_dead_reckoning_calibration});
+    if (registration) graph.AddEdge(*registration);
+  }
+  graph.AddDepth({anchor, submap.T_W_V_nav.translation().z(), noise.depth_sigma_m});
+  graph.AddGravity({anchor, submap.T_W_V_nav.linear().transpose() * Eigen::Vector3d::UnitZ(), noise.roll_pitch_sigma_rad});
+  submaps.push_back(std::move(submap));
+  increment_covariance.push_back(0.5 * (increment_cov + increment_cov.transpose()));
+
+  const std::size_t loops_before = std::count_if(loops.begin(), loops.end(), [](const LoopClosure& l) { return l.accepted; });
+  TryLoopClosures(k);
+  const std::size_t loops_after = std::count_if(loops.begin(), loops.end(), [](const LoopClosure& l) { return l.accepted; });
+  if (loops_after > loops_before || ++since_solve >= options.solve_every_submaps) Solve();
+}
+
+void Mapper::Impl::TryLoopClosures(int k) {
+  if (options.max_loop_candidates == 0 || k % options.loop_every_submaps != 0) return;
+  const Clock::time_point start = Clock::now();
+  const Submap& current = submaps[static_cast<size_t>(k)];
+  const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
+  struct Candidate {
+    int j;
+    double distance;
+    Matrix6d covariance;
+  };
+  std::vector<Candidate> candidates;
+  for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
+    const Submap& old = submaps[static_cast<size_t>(j)];
+    const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
+    const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
+    if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
+    const Matrix6d covariance = ChainCovariance(j, k);
+    const Eigen::Vector3d t = (ScanPose(j).inverse() * ScanPose(k)).translation();
+    const double sigma = LargestStd(PositionCovariance(covariance, t));
+    if (distance - overlap > options.gate_sigmas * sigma) continue;
+    candidates.push_back({j, distance, covariance});
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+  if (candidates.size() > static_cast<size_t>(options.max_loop_candidates)) {
+    candidates.resize(static_cast<size_t>(options.max_loop_candidates));
+  }
+  for (const Candidate& c : candidates) {
+    const int j = c.j;
+    perception::PointCloud target;
+    for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
+      AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i), &target);
+    }
+    const Eigen::Isometry3d T_pred = ScanPose(j).inverse() * ScanPose(k);
+    const Eigen::Vector3d t = T_pred.translation();
+    // The first stage reaches as far as the prediction may be off.
+    std::vector<double> distances = options.loop_icp_distances_m;
+    const double reach = options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, t));
+    if (reach > distances.front()) distances.insert(distances.begin(), reach);
+    const perception::RegistrationResult r = Register(current, target, T_pred, c.covariance, distances);
+
+    LoopClosure loop;
+    loop.from = j;
+    loop.to = k;
+    loop.fitness = r.fitness;
+    loop.T_from_to = r.T_target_source;
+    KeptDirections kept;
+    const Matrix6d information = RegistrationInformation(r, submaps[static_cast<size_t>(j)], current, &kept);
+    const int constrained = kept.count;
+    loop.constrained_directions = constrained;
+    loop.information = information;
+    // Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
+    // others, as for consecutive submaps, are left to the navigation), and the registration
+    // must be certain and consistent with the prediction in them.
+    const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
+    const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
+    if (r.fitness < options.loop_min_fitness) {
+      loop.reason = "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
+    } else if (constrained < options.loop_min_directions) {
+      loop.reason = "degenerate: the scans pin " + std::to_string(constrained) + " directions, fewer than " +
+                    std::to_string(options.loop_min_directions);
+    } else if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
+      loop.reason = "uncertain: registration std " + std::to_string(sigma_m) + " m, " + std::to_string(sigma_rad) +
+                    " rad";
+    } else {
+      const Vector6d innovation = PoseError(r.T_target_source, T_pred);
+      loop.chi2 = innovation.dot(InformationOfSum(information, c.covariance) * innovation);
+      if (!(loop.chi2 <= Chi2Quantile999(constrained))) {
+        loop.reason = "inconsistent with the prediction: chi2 " + std::to_string(loop.chi2) + " in " +
+                      std::to_string(constrained) + " directions";
+      } else {
+        loop.accepted = true;
+        graph.AddEdge({ScanNode(j), ScanNode(k), r.T_target_source, information, true, 3.0});
+      }
+    }
+    loops.push_back(loop);
+  }
+  stats.loop_s += Since(start);
+}
+
+void Mapper::Impl::Solve(bool last) {
+  const Clock::time_point start = Clock::now();
+  PoseGraphOptions solve;
+  if (!last) solve.function_tolerance = options.running_solve_tolerance;
+  graph.Solve(solve);
+  since_solve = 0;
+  stats.graph_s += Since(start);
+}
+
+Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern, const Eigen::Isometry3d& T_V_C,
+               const NavigationNoise& noise, const MapperOptions& options,
+               const std::filesystem::path& table_cache)
+    : impl_(std::make_unique<Impl>(options, T_V_C, noise)) {
+  options.Check();
+  if (impl_->options.estimate_dead_reckoning_calibration) {
+    const NavigationNoise& floored = impl_->uncertainty.noise();
+    impl_->graph.EstimateDeadReckoningCalibration(floored.speed_scale_sigma, floored.heading_bias_sigma_rad);
+  }
+  impl_->triangulator = scanner::MakeTriangulator(scanner, pattern, scanner::DefaultTriangulationMethod(pattern.kind),
+                                                  scanner::TriangulatorBuildOptions{table_cache});
+}
+
+Mapper::~Mapper() = default;
+
+void Mapper::SetFramePlacedCallback(FramePlacedCallback callback) { impl_->on_placed = std::move(callback); }
+
+void Mapper::AddNavigation(const NavigationRecord& record) {
+  if (impl_->finished) throw Error("mapper: navigation added after Finish");
+  impl_->navigation.Add(record);
+  impl_->Drain(false);
+}
+
+void Mapper::AddFrame(const FrameRecord& frame) {
+  Impl& m = *impl_;
+  if (m.finished) throw Error("mapper: frame added after Finish");
+  if (!m.waiting.empty() && frame.time_s < m.waiting.back().time_s) {
+    throw Error("mapper: frame " + std::to_string(frame.index) + " is older than the one before it");
+  }
+  if (m.waiting.size() >= kMaxWaitingFrames) {
+    throw Error("mapper: " + std::to_string(m.waiting.size()) +
+                " frames wait for navigation that does not come (last sample at " +
+                (m.navigation.empty() ? std::string("none") : std::to_string(m.navigation.last_time_s()) + " s") + ")");
+  }
+  FrameRecord copy;
+  copy.index = frame.index;
+  copy.time_s = frame.time_s;
+  copy.command = frame.command;
+  copy.sweep = frame.sweep;
+  copy.peaks_px = frame.peaks_px;  // the image is not needed once the peaks are found
+  m.waiting.push_back(std::move(copy));
+  m.Drain(false);
+}
+
+void Mapper::Finish() {
+  Impl& m = *impl_;
+  if (m.finished) return;
+  if (m.navigation.empty()) throw Error("mapper: no navigation: frames cannot be placed");
+  m.Drain(true);
+  m.CloseSubmap();
+  m.finished = true;
+  if (!m.submaps.empty()) m.Solve(/*last=*/true);
+}
+
+int Mapper::submap_count() const { return static_cast<int>(impl_->submaps.size()); }
+const Submap& Mapper::submap(int index) const { return impl_->submaps.at(static_cast<size_t>(index)); }
+Eigen::Isometry3d Mapper::pose(int index) const {
+  if (index < 0 || index >= submap_count()) throw Error("mapper: no submap " + std::to_string(index));
+  return impl_->AnchorPose(index);
+}
+Eigen::Isometry3d Mapper::scan_pose(int index) const {
+  if (index < 0 || index >= submap_count()) throw Error("mapper: no submap " + std::to_string(index));
+  return impl_->ScanPose(index);
+}
+const std::vector<LoopClosure>& Mapper::loops() const { return impl_->loops; }
+const MapperStats& Mapper::stats() const { return impl_->stats; }
+DeadReckoningCalibration Mapper::calibration() const { return impl_->graph.calibration(); }
+
+std::optional<Mapper::SubmapCovariances> Mapper::Covariances() const {
+  const int n = submap_count();
+  std::vector<int> nodes;
+  for (int i = 0; i < n; ++i) nodes.push_back(impl_->AnchorNode(i));
+  for (int i = 0; i < n; ++i) nodes.push_back(impl_->ScanNode(i));
+  std::optional<std::vector<Matrix6d>> all = impl_->graph.Covariances(nodes);
+  if (!all) return std::nullopt;
+  SubmapCovariances out;
+  out.anchors.assign(all->begin(), all->begin() + n);
+  out.scans.assign(all->begin() + n, all->end());
+  return out;
+}
+
+perception::PointCloud Mapper::Map(double voxel_m) const {
+  std::vector<const perception::PointCloud*> clouds;
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < submap_count(); ++i) {
+    const Submap& s = impl_->submaps[static_cast<size_t>(i)];
+    clouds.push_back(&s.cloud);
+    poses.push_back(scan_pose(i));
+  }
+  return MergeClouds(clouds, poses, voxel_m);
+}
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,165 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mapping/log/dive_log.hpp"
+#include "mapping/slam/pose_graph.hpp"
+#include "mapping/slam/submap.hpp"
+#include "perception/cloud/point_cloud.hpp"
+#include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/lasers/scanner.hpp"
+#include "scanner/triangulation/triangulator.hpp"
+
+// Scan-matching SLAM, frame by frame: the front end that `uwscan map` replays a log through and
+// that online inspection feeds live (mapping/README.md, "Scan-matching SLAM").
+namespace uwscan::mapping {
+
+struct MapperOptions {
+  int sweeps_per_submap = 1;            // sweeps grouped into one submap, > 0
+  SubmapCloudOptions clouds;            // voxel sizes, normals
+  int local_map_submaps = 3;            // previous submaps the new one is registered to, > 0
+  // ICP stages (metres, non-increasing) for consecutive submaps and for loop closures.
+  std::vector<double> icp_distances_m = {0.04, 0.02, 0.01};
+  std::vector<double> loop_icp_distances_m = {0.10, 0.04, 0.02, 0.01};
+  double point_sigma_floor_m = 0.0003;  // a point-to-plane residual is never trusted beyond this
+  // A registration edge is kept only above this fitness, and only if it agrees with the
+  // navigation's motion in the directions it pins (chi-square at 99.9 % for their number).
+  double min_fitness = 0.3;
+  // Loop closures: candidates at least this many submaps back, whose overlap is plausible
+  // within gate_sigmas of the relative uncertainty; at most max_loop_candidates tried per
+  // submap. Accepted only if the registration's fitness, its own uncertainty in the directions
+  // it pins and its consistency with the prediction there (chi-square) all agree.
+  int loop_min_index_gap = 6;
+  int max_loop_candidates = 1;
+  // Loop closures are tried at every this many submaps, > 0. A sweep's footprint is several
+  // times what the vehicle moves during it, so every other one still ties each stretch of a
+  // revisit: over five seeds per dive, the same map error at 0.75x the mapping time.
+  int loop_every_submaps = 2;
+  double gate_sigmas = 3.0;
+  // Two submaps overlap enough to match when their centres are closer than this fraction of
+  // the sum of their radii (1 = they just touch).
+  double loop_overlap_ratio = 0.6;
+  double loop_min_fitness = 0.5;
+  // A loop keeps the directions its pairs pin (weak_direction_ratio), at least this many: along
+  // a pipe on a flat seabed it pins all but the slide along the pipe (5), over a bare seabed
+  // only depth, roll and pitch (3), which the vehicle's own sensors already hold.
+  int loop_min_directions = 5;
+  double loop_max_sigma_m = 0.01;     // registration std along any kept direction
+  double loop_max_sigma_rad = 0.005;  // registration std about any kept axis
+                                      // (and chi-square at 99.9 % for the kept directions)
+  int solve_every_submaps = 2;        // whole-graph solve also without a loop closure, > 0
+  // The solves during the dive stop once an iteration lowers the cost by less than this
+  // fraction (they only have to predict the next registrations and loops); the last one, in
+  // Finish, goes to PoseGraphOptions' default. In (0, 1).
+  double running_solve_tolerance = 1e-6;
+  // Estimate the DVL's speed scale error and misalignment in the graph (odometry edges then
+  // carry only the random walks) and place new frames with the corrected navigation; false:
+  // both are treated as noise of each motion.
+  bool estimate_dead_reckoning_calibration = true;
+  // Registration directions whose normalised information is below this fraction of the
+  // strongest are left to the navigation (Conditioning in mapper.cpp).
+  double weak_direction_ratio = 0.02;
+  // A scan whose registration leaves a slide free (a pipe without its ends in view) is tied to
+  // its anchor along that slide only this loosely (metres): its place there is not measured,
+  // and what the pairs leak along it must not pull the vehicle (SlideCovariance, mapper.cpp).
+  double slide_sigma_m = 0.03;
+  int threads = 0;                    // OpenMP threads of ICP and normals, 0 = default
+  void Check() const;
+};
+
+struct LoopClosure {
+  int from = 0;  // the earlier submap
+  int to = 0;    // the new one
+  bool accepted = false;
+  std::string reason;  // why it was rejected ("" when accepted)
+  double fitness = 0.0;
+  double chi2 = 0.0;   // of the registration against the prediction
+  int constrained_directions = 0;  // directions the registration pins (the rest are left free)
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
+  // What it measures ([w, v] in `from`'s frame, pose_graph.hpp): zero along the directions it
+  // leaves free (the slide along a pipe), where T_from_to is only the prediction.
+  Matrix6d information = Matrix6d::Zero();
+};
+
+struct MapperStats {
+  std::int64_t frames = 0;
+  std::int64_t points = 0;
+  int registrations = 0;         // consecutive submaps registered (fitness above the floor)
+  int registrations_failed = 0;  // left to odometry alone: fitness below the floor
+  int registrations_inconsistent = 0;  // left to odometry alone: too far from the navigation
+  double triangulation_s = 0.0;
+  double submap_s = 0.0;  // voxels and normals
+  double registration_s = 0.0;
+  double loop_s = 0.0;
+  double graph_s = 0.0;
+};
+
+// Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until
+// the navigation covers their time, then triangulated and placed with the navigation
+// interpolated at their own time; every `sweeps_per_submap` sweeps close a submap, which is
+// registered (point-to-plane ICP with the navigation increment as start and prior) to the last
+// few submaps, added to the graph with its odometry and registration edges and its depth and
+// roll/pitch priors, and checked for loop closures against older submaps. The graph is
+// re-solved when a loop closes (and every few submaps). Memory: the voxelised submaps and the
+// graph, not the frames. Deterministic: the same inputs give the same bits for any thread count.
+class Mapper {
+ public:
+  // T_V_C: the camera on the vehicle. Throws uwscan::Error on invalid options.
+  Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern, const Eigen::Isometry3d& T_V_C,
+         const NavigationNoise& noise, const MapperOptions& options,
+         const std::filesystem::path& table_cache = {});
+  ~Mapper();
+  Mapper(const Mapper&) = delete;
+  Mapper& operator=(const Mapper&) = delete;
+
+  // Called for every frame as it is placed (inside AddFrame, AddNavigation or Finish, on the
+  // caller's thread), with the camera pose the navigation gave it and its triangulated points
+  // in the navigation's world frame: what a live view draws, and the moment a frame's points
+  // are in the map (the open submap). Set before the first frame.
+  using FramePlacedCallback =
+      std::function<void(const FrameRecord& frame, const Eigen::Isometry3d& T_W_C,
+                         std::span<const Eigen::Vector3d> points_W)>;
+  void SetFramePlacedCallback(FramePlacedCallback callback);
+
+  // Feed in time order (navigation may run ahead of frames; frames wait for it).
+  void AddNavigation(const NavigationRecord& record);
+  void AddFrame(const FrameRecord& frame);
+  // Processes every frame still waiting (past the last navigation sample: held at it), closes
+  // the last submap and solves the whole graph. Nothing may be added afterwards.
+  void Finish();
+
+  int submap_count() const;
+  const Submap& submap(int index) const;
+  Eigen::Isometry3d pose(int index) const;  // current estimate of T_W_V at the submap's anchor
+  // The pose its cloud is placed with: the anchor's, off by the bending of the navigation that
+  // placed its frames (SubmapDistortionCovariance in navigation_uncertainty.hpp).
+  Eigen::Isometry3d scan_pose(int index) const;
+  const std::vector<LoopClosure>& loops() const;
+  const MapperStats& stats() const;
+  // The dead reckoning's calibration as currently estimated (zero when not estimated).
+  DeadReckoningCalibration calibration() const;
+  // Per-submap marginal covariances ([rotation, position] in the world, pose_graph.hpp) of the
+  // anchors (the vehicle's poses) and of the scans (the poses the clouds are placed with), from
+  // one factorisation. std::nullopt when the graph leaves a direction unconstrained.
+  struct SubmapCovariances {
+    std::vector<Matrix6d> anchors, scans;
+  };
+  std::optional<SubmapCovariances> Covariances() const;
+  // Every submap's cloud placed with the current estimates, voxelised at `voxel_m`, origin at
+  // the first submap's position.
+  perception::PointCloud Map(double voxel_m) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,359 @@
+#include "mapping/slam/pose_graph.hpp"
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/covariance.h>
+#include <ceres/loss_function.h>
+#include <ceres/manifold.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <Eigen/Eigenvalues>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "scanner/common/error.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+// The left-perturbation error of a predicted relative pose against a measured one, for Jets.
+template <typename T>
+Eigen::Matrix<T, 6, 1> LeftError(const Eigen::Quaternion<T>& q_hat, const Eigen::Matrix<T, 3, 1>& t_hat,
+                                 const Eigen::Quaterniond& q_meas, const Eigen::Matrix<T, 3, 1>& t_meas) {
+  Eigen::Quaternion<T> q_delta = q_hat * q_meas.conjugate().cast<T>();
+  // q and -q are the same rotation: take the one with w >= 0, so the error is the short way.
+  if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
+  const Eigen::Matrix<T, 3, 1> t_delta = t_hat - q_delta * t_meas;
+  Eigen::Matrix<T, 6, 1> e;
+  e << T(2) * q_delta.vec(), t_delta;
+  return e;
+}
+
+// Residual sqrt(L) e of a relative pose measurement between two nodes.
+struct RelativeCost {
+  Eigen::Quaterniond q_meas;
+  Eigen::Vector3d t_meas;
+  Matrix6d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* q_a_raw, const T* p_a_raw, const T* q_b_raw, const T* p_b_raw,
+                  T* residual_raw) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_a_raw), q_b(q_b_raw);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_a_raw), p_b(p_b_raw);
+    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
+    const Eigen::Matrix<T, 6, 1> e =
+        LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_meas.cast<T>());
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
+    residual = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
+// A dead-reckoned motion: as RelativeCost, its measured translation corrected by the
+// calibration c = [scale error, misalignment] first.
+struct DeadReckonedCost {
+  Eigen::Quaterniond q_meas;
+  Eigen::Vector3d t_meas;
+  Matrix6d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* q_a_raw, const T* p_a_raw, const T* q_b_raw, const T* p_b_raw, const T* c,
+                  T* residual_raw) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_a_raw), q_b(q_b_raw);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_a_raw), p_b(p_b_raw);
+    const Eigen::Matrix<T, 3, 1> t_true =
+        DeadReckoningCalibration::Correct<T>(t_meas.cast<T>(), c[0], c[1]);
+    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
+    const Eigen::Matrix<T, 6, 1> e = LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_true);
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
+    residual = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
+// The calibration's zero-mean prior.
+struct CalibrationPriorCost {
+  double scale_sigma, misalignment_sigma_rad;
+  template <typename T>
+  bool operator()(const T* c, T* residual) const {
+    residual[0] = c[0] / T(scale_sigma);
+    residual[1] = c[1] / T(misalignment_sigma_rad);
+    return true;
+  }
+};
+
+struct PriorCost {
+  Eigen::Quaterniond q_meas;
+  Eigen::Vector3d t_meas;
+  Matrix6d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* q_raw, const T* p_raw, T* residual_raw) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_raw);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_raw);
+    // Rotation error as for the edges; the position error is the position's own (not about
+    // the world origin, which would tie it to the rotation through the vehicle's distance).
+    Eigen::Quaternion<T> q_delta = Eigen::Quaternion<T>(q) * q_meas.conjugate().cast<T>();
+    if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
+    Eigen::Matrix<T, 6, 1> e;
+    e << T(2) * q_delta.vec(), p - t_meas.cast<T>();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
+    residual = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
+struct DepthCost {
+  double z_m, sigma_m;
+  template <typename T>
+  bool operator()(const T* p, T* residual) const {
+    residual[0] = (p[2] - T(z_m)) / T(sigma_m);
+    return true;
+  }
+};
+
+struct GravityCost {
+  Eigen::Vector3d down_in_V;
+  double sigma_rad;
+  template <typename T>
+  bool operator()(const T* q_raw, T* residual_raw) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_raw);
+    const Eigen::Matrix<T, 3, 1> down = q.conjugate() * Eigen::Matrix<T, 3, 1>(T(0), T(0), T(1));
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> residual(residual_raw);
+    residual = (down - down_in_V.cast<T>()) / T(sigma_rad);
+    return true;
+  }
+};
+
+void RequireInformation(const Matrix6d& information, const std::string& what) {
+  if (!information.allFinite() || !information.isApprox(information.transpose(), 1e-9)) {
+    throw Error("pose graph: " + what + ": information must be finite and symmetric");
+  }
+}
+
+void RequireRigid(const Eigen::Isometry3d& T, const std::string& what) {
+  const Eigen::Matrix3d R = T.linear();
+  if (!T.matrix().allFinite() || (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-6) {
+    throw Error("pose graph: " + what + ": expected a finite rigid transform");
+  }
+}
+
+}  // namespace
+
+void PoseGraphOptions::Check() const {
+  if (max_iterations < 1) throw Error("PoseGraphOptions.max_iterations: expected > 0");
+  if (threads < 1) throw Error("PoseGraphOptions.threads: expected > 0");
+  if (!(function_tolerance > 0.0 && function_tolerance < 1.0)) {
+    throw Error("PoseGraphOptions.function_tolerance: expected in (0, 1)");
+  }
+}
+
+Vector6d PoseError(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) {
+  const Eigen::Matrix3d R = T_a.linear() * T_b.linear().transpose();
+  const Eigen::AngleAxisd rotation(R);
+  Vector6d e;
+  e << rotation.angle() * rotation.axis(), T_a.translation() - R * T_b.translation();
+  return e;
+}
+
+Matrix6d SqrtPsd(const Matrix6d& information) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(0.5 * (information + information.transpose()));
+  const Vector6d root = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  return solver.eigenvectors() * root.asDiagonal() * solver.eigenvectors().transpose();
+}
+
+struct PoseGraph::Impl {
+  // Parameter blocks: one quaternion (x, y, z, w as Eigen stores it) and one position per node,
+  // each in its own allocation so their addresses never move.
+  std::vector<std::unique_ptr<std::array<double, 4>>> rotations;
+  std::vector<std::unique_ptr<std::array<double, 3>>> positions;
+  std::unique_ptr<ceres::Problem> problem;
+  // The dead reckoning's [scale error, misalignment], a parameter block once estimated.
+  std::unique_ptr<std::array<double, 2>> calibration;
+
+  Impl() {
+    ceres::Problem::Options options;
+    options.manifold_ownership = ceres::TAKE_OWNERSHIP;
+    problem = std::make_unique<ceres::Problem>(options);
+  }
+
+  void RequireNode(int node, const std::string& what) const {
+    if (node < 0 || node >= static_cast<int>(rotations.size())) {
+      throw Error("pose graph: " + what + ": no node " + std::to_string(node));
+    }
+  }
+  double* q(int node) { return rotations[static_cast<size_t>(node)]->data(); }
+  double* p(int node) { return positions[static_cast<size_t>(node)]->data(); }
+};
+
+PoseGraph::PoseGraph() : impl_(std::make_unique<Impl>()) {}
+PoseGraph::~PoseGraph() = default;
+PoseGraph::PoseGraph(PoseGraph&&) noexcept = default;
+PoseGraph& PoseGraph::operator=(PoseGraph&&) noexcept = default;
+
+int PoseGraph::AddNode(const Eigen::Isometry3d& T_W_V) {
+  RequireRigid(T_W_V, "AddNode");
+  Impl& m = *impl_;
+  m.rotations.push_back(std::make_unique<std::array<double, 4>>());
+  m.positions.push_back(std::make_unique<std::array<double, 3>>());
+  const int node = static_cast<int>(m.rotations.size()) - 1;
+  set_pose(node, T_W_V);
+  m.problem->AddParameterBlock(m.q(node), 4, new ceres::EigenQuaternionManifold);
+  m.problem->AddParameterBlock(m.p(node), 3);
+  return node;
+}
+
+void PoseGraph::AddEdge(const RelativePoseEdge& edge) {
+  Impl& m = *impl_;
+  m.RequireNode(edge.from, "AddEdge");
+  m.RequireNode(edge.to, "AddEdge");
+  RequireRigid(edge.T_from_to, "AddEdge");
+  RequireInformation(edge.information, "AddEdge");
+  if (edge.robust && !(edge.huber_scale > 0.0)) throw Error("pose graph: AddEdge: huber_scale must be > 0");
+  if (edge.dead_reckoned && !m.calibration) {
+    throw Error("pose graph: AddEdge: a dead-reckoned edge needs EstimateDeadReckoningCalibration first");
+  }
+  // The problem owns each loss (one per edge: Ceres deletes them one by one).
+  ceres::LossFunction* loss = edge.robust ? new ceres::HuberLoss(edge.huber_scale) : nullptr;
+  const Eigen::Quaterniond q_meas(edge.T_from_to.linear());
+  if (edge.dead_reckoned) {
+    auto* cost = new ceres::AutoDiffCostFunction<DeadReckonedCost, 6, 4, 3, 4, 3, 2>(
+        new DeadReckonedCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
+    m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to), m.p(edge.to),
+                                m.calibration->data());
+    return;
+  }
+  auto* cost = new ceres::AutoDiffCostFunction<RelativeCost, 6, 4, 3, 4, 3>(
+      new RelativeCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
+  m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to), m.p(edge.to));
+}
+
+void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma, double misalignment_sigma_rad) {
+  Impl& m = *impl_;
+  if (m.calibration) throw Error("pose graph: EstimateDeadReckoningCalibration: called twice");
+  if (!(scale_sigma > 0.0 && std::isfinite(scale_sigma)) ||
+      !(misalignment_sigma_rad > 0.0 && std::isfinite(misalignment_sigma_rad))) {
+    throw Error("pose graph: EstimateDeadReckoningCalibration: expected finite sigmas > 0");
+  }
+  m.calibration = std::make_unique<std::array<double, 2>>(std::array<double, 2>{0.0, 0.0});
+  m.problem->AddParameterBlock(m.calibration->data(), 2);
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<CalibrationPriorCost, 2, 2>(
+                                  new CalibrationPriorCost{scale_sigma, misalignment_sigma_rad}),
+                              nullptr, m.calibration->data());
+}
+
+bool PoseGraph::estimates_calibration() const { return impl_->calibration != nullptr; }
+
+DeadReckoningCalibration PoseGraph::calibration() const {
+  if (!impl_->calibration) return {};
+  return {(*impl_->calibration)[0], (*impl_->calibration)[1]};
+}
+
+void PoseGraph::AddDepth(const DepthPrior& prior) {
+  Impl& m = *impl_;
+  m.RequireNode(prior.node, "AddDepth");
+  if (!std::isfinite(prior.z_m) || !(prior.sigma_m > 0.0)) {
+    throw Error("pose graph: AddDepth: expected a finite depth and sigma_m > 0");
+  }
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<DepthCost, 1, 3>(new DepthCost{prior.z_m, prior.sigma_m}),
+                              nullptr, m.p(prior.node));
+}
+
+void PoseGraph::AddGravity(const GravityPrior& prior) {
+  Impl& m = *impl_;
+  m.RequireNode(prior.node, "AddGravity");
+  if (!prior.down_in_V.allFinite() || std::abs(prior.down_in_V.norm() - 1.0) > 1e-6 || !(prior.sigma_rad > 0.0)) {
+    throw Error("pose graph: AddGravity: expected a unit down vector and sigma_rad > 0");
+  }
+  m.problem->AddResidualBlock(
+      new ceres::AutoDiffCostFunction<GravityCost, 3, 4>(new GravityCost{prior.down_in_V, prior.sigma_rad}), nullptr,
+      m.q(prior.node));
+}
+
+void PoseGraph::AddPrior(const PosePrior& prior) {
+  Impl& m = *impl_;
+  m.RequireNode(prior.node, "AddPrior");
+  RequireRigid(prior.T_W_V, "AddPrior");
+  RequireInformation(prior.information, "AddPrior");
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 6, 4, 3>(new PriorCost{
+                                  Eigen::Quaterniond(prior.T_W_V.linear()), prior.T_W_V.translation(),
+                                  SqrtPsd(prior.information)}),
+                              nullptr, m.q(prior.node), m.p(prior.node));
+}
+
+int PoseGraph::node_count() const { return static_cast<int>(impl_->rotations.size()); }
+
+Eigen::Isometry3d PoseGraph::pose(int node) const {
+  impl_->RequireNode(node, "pose");
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(impl_->q(node)).normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(impl_->p(node));
+  return T;
+}
+
+void PoseGraph::set_pose(int node, const Eigen::Isometry3d& T_W_V) {
+  impl_->RequireNode(node, "set_pose");
+  RequireRigid(T_W_V, "set_pose");
+  Eigen::Map<Eigen::Quaterniond>(impl_->q(node)) = Eigen::Quaterniond(T_W_V.linear()).normalized();
+  Eigen::Map<Eigen::Vector3d>(impl_->p(node)) = T_W_V.translation();
+}
+
+PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
+  options.Check();
+  Impl& m = *impl_;
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = options.threads;
+  solver.function_tolerance = options.function_tolerance;
+  solver.gradient_tolerance = 1e-12;
+  solver.parameter_tolerance = 1e-10;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, m.problem.get(), &summary);
+  PoseGraphSolve result;
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  result.iterations = static_cast<int>(summary.iterations.size());
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  return result;
+}
+
+std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(int threads) const {
+  std::vector<int> nodes(static_cast<size_t>(node_count()));
+  for (int i = 0; i < node_count(); ++i) nodes[static_cast<size_t>(i)] = i;
+  return Covariances(nodes, threads);
+}
+
+std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(const std::vector<int>& nodes, int threads) const {
+  Impl& m = *impl_;
+  for (const int node : nodes) m.RequireNode(node, "Covariances");
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = std::max(1, threads);
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const int i : nodes) {
+    blocks.emplace_back(m.q(i), m.q(i));
+    blocks.emplace_back(m.q(i), m.p(i));
+    blocks.emplace_back(m.p(i), m.p(i));
+  }
+  if (!covariance.Compute(blocks, m.problem.get())) return std::nullopt;
+  std::vector<Matrix6d> out(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const int i = nodes[k];
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> qq, qp, pp;
+    if (!covariance.GetCovarianceBlockInTangentSpace(m.q(i), m.q(i), qq.data()) ||
+        !covariance.GetCovarianceBlockInTangentSpace(m.q(i), m.p(i), qp.data()) ||
+        !covariance.GetCovarianceBlockInTangentSpace(m.p(i), m.p(i), pp.data())) {
+      return std::nullopt;
+    }
+    // Ceres's quaternion tangent is half the rotation vector (Plus = [cos|d|, sin|d| d/|d|] * q):
+    // scale to radians of rotation.
+    Matrix6d& c = out[k];
+    c << 4.0 * qq, 2.0 * qp, 2.0 * qp.transpose(), pp;
+  }
+  return out;
+}
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,44 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "perception/recognition/object_database.hpp"
+#include "scanner/common/triangle_mesh.hpp"
+
+namespace uwscan::perception {
+
+// An object to put in a database: its mesh (object frame), grasp frames and, when declared,
+// its symmetries (otherwise found from the mesh).
+struct ObjectSource {
+  std::string id;
+  std::string source;  // "procedural: valve_wheel" or the mesh file
+  scanner::TriangleMesh mesh;
+  std::vector<GraspFrame> grasps;
+  std::optional<std::vector<SymmetryAxis>> symmetries;
+};
+
+// The procedural IMR objects uwscan generates itself, with sensible grasp frames: pipe (its
+// body), elbow (mid-bend), tee (the run, clear of the branch), flange (its rim), valve_wheel
+// and valve_lever (the handle), and their symmetries declared by construction. Names in
+// CatalogueNames().
+std::vector<std::string> CatalogueNames();
+// Throws uwscan::Error listing the known names when `name` is not one.
+ObjectSource CatalogueObject(const std::string& name);
+
+// A mesh file (PLY/OFF/STL/OBJ, metres) with, when it exists, a sidecar MESH.grasps.yaml:
+//   uwscan_format: 1
+//   id: valve_dn100              # optional, default: the file's stem
+//   grasps:                      # optional
+//     - {name: handle, pose: {translation_m: [x, y, z], rotation_xyzw: [qx, qy, qz, qw]}}
+//   symmetries:                  # optional: declared, replacing detection from the mesh
+//     - {point_m: [0, 0, 0], axis: [0, 0, 1], order: 0}   # 0 continuous, N >= 2 N-fold
+// Throws uwscan::Error naming the file (and line) on anything missing or malformed.
+ObjectSource MeshObject(const std::filesystem::path& mesh_path);
+
+// The sidecar's path for a mesh: the mesh path with its extension replaced by ".grasps.yaml".
+std::filesystem::path GraspSidecarPath(const std::filesystem::path& mesh_path);
+
+}  // namespace uwscan::perception

@@ -1,0 +1,550 @@
+#include "perception/recognition/object_recognizer.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <tuple>
+
+#include "perception/cloud/cloud_neighbors.hpp"
+#include "perception/preprocessing/clustering.hpp"
+#include "perception/preprocessing/normals.hpp"
+#include "perception/preprocessing/plane_removal.hpp"
+#include "perception/preprocessing/voxel_filter.hpp"
+#include "perception/recognition/object_database_builder.hpp"
+#include "perception/recognition/object_pose_search.hpp"
+#include "perception/recognition/object_symmetry.hpp"
+#include "perception/recognition/recognition_verification.hpp"
+#include "perception/recognition/residual_patches.hpp"
+#include "perception/recognition/scan_segments.hpp"
+#include "perception/recognition/segment_pose.hpp"
+#include "perception/registration/coarse_alignment.hpp"
+#include "perception/registration/icp.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/common/parallel_tasks.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+using namespace recognition;
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+
+// The `count` nearest views of each object by chi-square, nearest first: (distance, view index).
+std::vector<std::vector<std::pair<double, int>>> NearestViews(const EsfDescriptor& esf,
+                                                              const ObjectDatabase& db,
+                                                              int count) {
+  std::vector<std::vector<std::pair<double, int>>> nearest;
+  for (const ObjectModel& o : db.objects) {
+    std::vector<std::pair<double, int>> views;
+    for (std::size_t v = 0; v < o.views.size(); ++v) {
+      views.emplace_back(ChiSquareDistance(esf.data(), o.views[v].esf.data(), 640), static_cast<int>(v));
+    }
+    const auto keep = views.begin() + std::min<std::ptrdiff_t>(count, std::ssize(views));
+    std::partial_sort(views.begin(), keep, views.end());
+    views.erase(keep, views.end());
+    if (views.empty()) views.emplace_back(std::numeric_limits<double>::infinity(), -1);
+    nearest.push_back(std::move(views));
+  }
+  return nearest;
+}
+
+
+// Whether a free rotation found in the data is one of the object's continuous symmetries, which
+// are reported as such: the same axis (within a degree) through the same line (within 2 mm).
+bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& model) {
+  for (const SymmetryAxis& s : model.symmetries) {
+    if (s.order != 0 || std::abs(s.axis_O.dot(rotation_O.axis_S)) < std::cos(kDegree)) continue;
+    const Eigen::Vector3d d = rotation_O.point_S - s.point_O;
+    if ((d - d.dot(s.axis_O) * s.axis_O).norm() < 0.002) return true;
+  }
+  return false;
+}
+
+// The directions the fine ICP on `fitted` leaves free (those the object's continuous symmetries
+// already name left out), in the scan frame, and the covariance over the others.
+void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
+                        const ScanContext& ctx, RecognizedObject& out) {
+  const double radius_m = 0.5 * model.diameter_m;
+  const double pair_distance_m =
+      FineIcp(model.diameter_m, ctx.db.parameters, 1).max_correspondence_distance_m.back();
+  const Eigen::Matrix<double, 6, 6> spread =
+      ResidualPatchSpread(fitted, posed.fine.T_target_source, model.model, ctx.cache.Model(posed.object).nearest(),
+                          pair_distance_m, model.model.origin, ctx.options.residual_patch_m);
+  const PoseConstraints c =
+      AnalysePoseConstraints(posed.fine.information, spread, model.model.origin,
+                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
+  const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
+  for (FreeDirection f : c.free_O) {
+    if (f.motion == "rotation" && IsContinuousSymmetry(f, model)) continue;
+    f.axis_S = T_S_O.linear() * f.axis_S;
+    f.point_S = T_S_O * f.point_S;
+    out.free_directions.push_back(f);
+  }
+  out.covariance = c.covariance;
+}
+
+// Verified candidates whose scores are within `tie` of the best one's are told apart by their
+// views' chi-square: the scores cannot, and the ESF says which the segment looks more like (a
+// pipe or a tee whose branch the sweep did not reach).
+void BreakTie(double tie, std::vector<PosedObject>& ranked) {
+  if (ranked.empty() || !ranked.front().candidate.verified) return;
+  std::size_t pick = 0;
+  for (std::size_t k = 1; k < ranked.size(); ++k) {
+    const RecognitionCandidate& c = ranked[k].candidate;
+    if (c.verified && c.score >= ranked.front().candidate.score - tie && c.chi_square < ranked[pick].candidate.chi_square) {
+      pick = k;
+    }
+  }
+  std::rotate(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(pick), ranked.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
+}
+
+// The other verified objects BreakTie chose among: scoring within `tie` of the best score.
+std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(const std::vector<PosedObject>& ranked,
+                                                                         double tie) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (const PosedObject& p : ranked) {
+    if (p.candidate.verified) top = std::max(top, p.candidate.score);
+  }
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent;
+  for (std::size_t k = 1; k < ranked.size(); ++k) {
+    const RecognitionCandidate& c = ranked[k].candidate;
+    if (c.verified && c.score >= top - tie) equivalent.emplace_back(c.object_id, c.T_S_O);
+  }
+  return equivalent;
+}
+
+// The objects worth posing on a segment: up to max_candidates whose nearest view is within
+// max_chi_square (and within max_chi_square_ratio of the best object's) and that are not smaller
+// than the segment's own cluster (a bounding-box diagonal can exceed it by up to sqrt(3); debris
+// that joined it may lie beyond the object), nearest first, with their nearest views.
+struct ChosenObjects {
+  std::vector<std::size_t> objects;
+  std::vector<std::vector<std::pair<double, int>>> nearest_views;  // of every object
+  std::vector<double> nearest_chi_square;                          // of every object
+};
+ChosenObjects ChooseObjects(const EsfDescriptor& esf, double extent_m, const ScanContext& ctx) {
+  const ObjectDatabase& db = ctx.db;
+  ChosenObjects c;
+  c.nearest_views = NearestViews(esf, db, std::max(1, ctx.options.pose_views));
+  for (const auto& views : c.nearest_views) c.nearest_chi_square.push_back(views.front().first);
+  std::vector<std::size_t> order(db.objects.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return c.nearest_chi_square[a] < c.nearest_chi_square[b];
+  });
+  const double best_chi_square = order.empty() ? 0.0 : c.nearest_chi_square[order.front()];
+  for (std::size_t i : order) {
+    const double chi_square = c.nearest_chi_square[i];
+    if (static_cast<int>(c.objects.size()) >= ctx.options.max_candidates) break;
+    if (chi_square > ctx.options.max_chi_square) break;
+    if (chi_square > ctx.options.max_chi_square_ratio * best_chi_square) break;
+    if (extent_m > 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m) continue;
+    c.objects.push_back(i);
+  }
+  return c;
+}
+
+// Object `i` posed on a segment from its starts (PoseStarts), with its chi-square and view.
+PosedObject PoseCandidate(const DescribedSegment& s, std::size_t i, const ChosenObjects& chosen,
+                          const SceneAround& around, const ScanContext& ctx) {
+  const std::vector<Eigen::Isometry3d> starts =
+      PoseStarts(s.cloud, s.features, i, chosen.nearest_views[i], ctx.cache, ctx.db, ctx.options);
+  ctx.clock.Lap("coarse");
+  PosedObject p = PoseOnSegment(s, i, starts, around, ctx);
+  p.candidate.object_id = ctx.db.objects[i].id;
+  p.candidate.chi_square = chosen.nearest_views[i].front().first;
+  p.candidate.view = chosen.nearest_views[i].front().second;
+  return p;
+}
+
+// The points of `segment` within `distance_m` (at most model_grid's radius) of the posed model's surface points.
+std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
+                                       const Eigen::Isometry3d& T_O_S, double distance_m) {
+  std::vector<std::size_t> on;
+  const float distance_sq = static_cast<float>(distance_m * distance_m);
+  for (std::size_t i = 0; i < segment.size(); ++i) {
+    const Eigen::Vector3d x = T_O_S * segment.Point(i);
+    if (model_grid.Nearest((x - model.model.origin).cast<float>(), distance_sq) >= 0) {
+      on.push_back(i);
+    }
+  }
+  return on;
+}
+
+// A part of a segment that one object explains, with the object posed on the part alone.
+struct ExplainedPart {
+  PosedObject posed;
+  std::vector<std::size_t> points;  // into the segment
+  double share = 0.0;               // of the segment's points
+};
+
+// The two halves of a cloud split across one of its principal axes (0 the longest) by 2-means,
+// started from its two extreme points along that axis: touching objects mostly end up one in
+// each, across the longest axis when they lie end to end, across the next when side by side.
+std::array<std::vector<std::size_t>, 2> Halves(const PointCloud& cloud, int principal_axis) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) mean += cloud.Point(i);
+  mean /= static_cast<double>(cloud.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) scatter += (cloud.Point(i) - mean) * (cloud.Point(i) - mean).transpose();
+  const Eigen::Vector3d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2 - principal_axis);
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (cloud.Point(i).dot(axis) < cloud.Point(lo).dot(axis)) lo = i;
+    if (cloud.Point(i).dot(axis) > cloud.Point(hi).dot(axis)) hi = i;
+  }
+  std::array<Eigen::Vector3d, 2> centre = {cloud.Point(lo), cloud.Point(hi)};
+  std::array<std::vector<std::size_t>, 2> halves;
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    std::array<std::vector<std::size_t>, 2> next;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const Eigen::Vector3d x = cloud.Point(i);
+      next[(x - centre[1]).squaredNorm() < (x - centre[0]).squaredNorm() ? 1 : 0].push_back(i);
+    }
+    if (next == halves) break;
+    halves = std::move(next);
+    for (int h = 0; h < 2; ++h) {
+      if (halves[h].empty()) continue;
+      centre[h].setZero();
+      for (std::size_t i : halves[h]) centre[h] += cloud.Point(i);
+      centre[h] /= static_cast<double>(halves[h].size());
+    }
+  }
+  return halves;
+}
+
+// A half of a segment recognised as a segment of its own, for pose candidates (ExplainPart).
+struct DescribedHalf {
+  DescribedSegment described;
+  SceneAround around;
+  ChosenObjects chosen;
+};
+
+// The halves of a segment worth recognising: Halves across its two longest principal axes,
+// distinct, with min_segment_points and an ESF.
+std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const ScanContext& ctx) {
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
+  std::vector<std::vector<std::size_t>> halves;
+  for (int axis = 0; axis < 2; ++axis) {
+    for (std::vector<std::size_t>& half : Halves(s.cloud, axis)) {
+      if (half.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) continue;
+      if (std::find(halves.begin(), halves.end(), half) == halves.end()) halves.push_back(std::move(half));
+    }
+  }
+  std::vector<std::optional<DescribedHalf>> described(halves.size());
+  RunParallelTasks(std::ssize(halves), ctx.options.threads, [&](std::ptrdiff_t h) {
+    const PointCloud half_cloud = Subset(s.cloud, halves[static_cast<std::size_t>(h)]);
+    const EsfResult esf = VoxelisedEsf(half_cloud, p.voxel_m, ctx.options.seed, 1);  // one task per thread
+    if (!esf.ok) return;
+    const OneThreadContext task(ctx);
+    described[static_cast<std::size_t>(h)].emplace(DescribedHalf{
+        {half_cloud, DescribeSegment(half_cloud, task.ctx()).features},
+        SceneAroundSegment(ctx.down, ctx.down_index, half_cloud, 2.0 * p.voxel_m),
+        ChooseObjects(esf.histogram, Diameter(half_cloud), task.ctx())});
+  });
+  std::vector<DescribedHalf> kept;
+  for (std::optional<DescribedHalf>& d : described) {
+    if (d) kept.push_back(std::move(*d));
+  }
+  return kept;
+}
+
+// Object `object`, posed on a half of segment `s`, as the part of `s` it explains: from its pose
+// the trimmed fine ICP of the whole segment leaves the other objects' points out, and the points
+// it puts on the model form the part, posed again and verified on its own. None when the part is
+// under min_part_share of the segment, or not verified.
+std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCloud& sample, const DescribedHalf& half,
+                                        std::size_t object, const ScanContext& ctx) {
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
+  const ObjectModel& model = ctx.db.objects[object];
+  const PosedObject posed = PoseCandidate(half.described, object, half.chosen, half.around, ctx);
+  const ModelIndexes& indexes = ctx.cache.Model(object);
+  const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
+  const RegistrationResult on_segment = AlignIcp(sample, indexes.target, posed.fine.T_target_source, fine);
+  std::vector<std::size_t> points =
+      PointsOnModel(s.cloud, model, indexes.nearest(), on_segment.T_target_source, 1.5 * p.voxel_m);
+  const double share = static_cast<double>(points.size()) / static_cast<double>(s.cloud.size());
+  if (share < ctx.options.min_part_share || points.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) {
+    return std::nullopt;
+  }
+  const PointCloud part = Subset(s.cloud, points);
+  const RegistrationResult refined = AlignIcp(part, indexes.target, on_segment.T_target_source, fine);
+  const SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, part, 2.0 * p.voxel_m);
+  ExplainedPart candidate{posed, std::move(points), share};
+  candidate.posed.fine = refined;
+  Verify(part, model, indexes.nearest(), around, refined, ctx, candidate.posed.candidate);
+  if (!candidate.posed.candidate.verified) return std::nullopt;
+  return candidate;
+}
+
+// The object explaining the largest share of a segment that no single object explains (objects
+// touching each other fall into one segment, whose outline resembles neither). The segment is
+// cut in two halves (Halves), each recognised as a segment of its own for pose candidates, and
+// each candidate gives the part it explains (PartOnHalf). The part must hold min_part_share of
+// the segment; parts are ranked by share x score, ties to the earlier half and candidate.
+// Parallel over (half, candidate), each on one thread: the same answer for any thread count.
+std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanContext& ctx) {
+  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
+  const std::vector<DescribedHalf> halves = DescribedHalves(s, ctx);
+  std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (half, object)
+  for (std::size_t h = 0; h < halves.size(); ++h) {
+    for (std::size_t object : halves[h].chosen.objects) tasks.emplace_back(h, object);
+  }
+  std::vector<std::optional<ExplainedPart>> parts(tasks.size());
+  RunParallelTasks(std::ssize(tasks), ctx.options.threads, [&](std::ptrdiff_t t) {
+    const auto [h, object] = tasks[static_cast<std::size_t>(t)];
+    const OneThreadContext task(ctx);
+    parts[static_cast<std::size_t>(t)] = PartOnHalf(s, sample, halves[h], object, task.ctx());
+  });
+  std::optional<ExplainedPart> best;
+  for (std::optional<ExplainedPart>& part : parts) {
+    if (!part) continue;
+    if (!best || part->share * part->posed.candidate.score > best->share * best->posed.candidate.score) {
+      best = std::move(part);
+    }
+  }
+  return best;
+}
+
+// The recognised object's identity, pose, free directions, covariance and grasps.
+void Accept(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model, double other_chi_square,
+            const ScanContext& ctx, RecognizedObject& object) {
+  const RecognitionCandidate& best = posed.candidate;
+  object.object_id = best.object_id;
+  object.score = best.score;
+  object.chi_square = best.chi_square;
+  object.T_S_O = best.T_S_O;
+  object.margin = std::isfinite(other_chi_square) && std::isfinite(best.chi_square) ? other_chi_square - best.chi_square : 0.0;
+  for (const SymmetryAxis& s : model.symmetries) {
+    FreeDirection f;
+    f.kind = "symmetry";
+    f.motion = "rotation";
+    f.axis_S = best.T_S_O.linear() * s.axis_O;
+    f.point_S = best.T_S_O * s.point_O;
+    f.order = s.order;
+    object.free_directions.push_back(f);
+  }
+  AddPoseConstraints(posed, fitted, model, ctx, object);
+  for (const GraspFrame& g : model.grasps) object.grasps_S.emplace_back(g.name, best.T_S_O * g.T_O_G);
+}
+
+// indices[i] for the positions i listed in `positions` (increasing), and for the others.
+std::pair<std::vector<std::size_t>, std::vector<std::size_t>> Partition(const std::vector<std::size_t>& indices,
+                                                                        const std::vector<std::size_t>& positions) {
+  std::pair<std::vector<std::size_t>, std::vector<std::size_t>> split;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const bool listed = k < positions.size() && positions[k] == i;
+    (listed ? split.first : split.second).push_back(indices[i]);
+    k += listed ? 1 : 0;
+  }
+  return split;
+}
+
+// The smallest of `chi_square` other than object `o`'s (infinity when there is none).
+double NearestOther(std::size_t o, const std::vector<double>& chi_square) {
+  double other = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < chi_square.size(); ++i) {
+    if (i != o) other = std::min(other, chi_square[i]);
+  }
+  return other;
+}
+
+Eigen::Vector3d Centroid(const PointCloud& cloud) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) sum += cloud.Point(i);
+  return sum / static_cast<double>(std::max<std::size_t>(cloud.size(), 1));
+}
+
+// A segment waiting to be recognised: indices into the scan's points left after plane removal.
+struct PendingSegment {
+  std::vector<std::size_t> indices;
+  double core_diameter_m = 0.0;
+  int objects_before = 0;  // objects already taken out of the segment it came from
+};
+
+// Clusters of `indices` (into `cloud`) with at least min_segment_points, as pending segments.
+void QueueClusters(const PointCloud& cloud, const std::vector<std::size_t>& indices, int objects_before,
+                   const RecognitionOptions& options, std::deque<PendingSegment>& pending) {
+  if (indices.size() < static_cast<std::size_t>(options.min_segment_points)) return;
+  const PointCloud rest = Subset(cloud, indices);
+  ClusteringOptions clustering;
+  clustering.tolerance_m = options.cluster_tolerance_m;
+  for (const std::vector<std::size_t>& c : EuclideanClusters(rest, clustering)) {
+    if (c.size() < static_cast<std::size_t>(options.min_segment_points)) continue;
+    PendingSegment next{{}, Diameter(Subset(rest, c)), objects_before};
+    for (std::size_t i : c) next.indices.push_back(indices[i]);
+    pending.push_back(std::move(next));
+  }
+}
+
+}  // namespace
+
+void RecognitionOptions::Check() const {
+  auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  if (!positive(plane_distance_m)) throw Error("recognition: plane_distance_m must be > 0");
+  if (!(plane_min_fraction > 0.0 && plane_min_fraction <= 1.0)) {
+    throw Error("recognition: plane_min_fraction must be in (0, 1]");
+  }
+  if (!positive(cluster_tolerance_m)) throw Error("recognition: cluster_tolerance_m must be > 0");
+  if (!(attach_distance_m >= 0.0 && std::isfinite(attach_distance_m))) {
+    throw Error("recognition: attach_distance_m must be >= 0");
+  }
+  if (min_segment_points < 10) throw Error("recognition: min_segment_points must be >= 10");
+  if (max_candidates < 1) throw Error("recognition: max_candidates must be >= 1, got " + std::to_string(max_candidates));
+  auto in_range = [](const char* field, int value, int lo, int hi) {
+    if (value < lo || value > hi) {
+      throw Error(std::string("recognition: ") + field + " must be in [" + std::to_string(lo) + ", " +
+                  std::to_string(hi) + "], got " + std::to_string(value));
+    }
+  };
+  in_range("pose_views", pose_views, 0, 64);
+  in_range("pose_rolls", pose_rolls, 1, 360);
+  in_range("sift_points", sift_points, 10, 100000);
+  in_range("refined_starts", refined_starts, 1, 64);
+  in_range("refine_points", refine_points, 10, 10000000);
+  if (!positive(max_chi_square)) throw Error("recognition: max_chi_square must be > 0");
+  if (!(max_chi_square_ratio >= 1.0)) throw Error("recognition: max_chi_square_ratio must be >= 1");
+  if (!(min_fitness >= 0.0 && min_fitness <= 1.0) || !(max_missing >= 0.0 && max_missing <= 1.0) ||
+      !(min_close >= 0.0 && min_close <= 1.0)) {
+    throw Error("recognition: min_fitness, min_close and max_missing must be in [0, 1]");
+  }
+  if (!(min_part_share >= 0.0 && min_part_share <= 1.0)) throw Error("recognition: min_part_share must be in [0, 1]");
+  if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
+  if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
+  if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
+  if (!positive(residual_patch_m)) throw Error("recognition: residual_patch_m must be > 0");
+  if (threads < 0) throw Error("recognition: threads must be >= 0");
+}
+
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
+                                   const RecognitionOptions& options) {
+  RecognitionCache cache(db);
+  return RecognizeObjects(scan, db, cache, options);
+}
+
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, RecognitionCache& cache,
+                                   const RecognitionOptions& options) {
+  options.Check();
+  if (&cache.db() != &db) throw Error("recognition: the RecognitionCache was made for another object database");
+  RequireValidCloud(scan, "scan", 1);
+  if (db.objects.empty()) throw Error("recognition: the object database is empty");
+  const ObjectDatabaseParameters& p = db.parameters;
+  RecognitionResult result;
+  StageClock clock(result.stage_seconds);
+
+  const PointCloud down = VoxelDownsample(scan, VoxelFilterOptions{p.voxel_m});
+  double largest_object_m = 0.0;
+  for (const ObjectModel& o : db.objects) largest_object_m = std::max(largest_object_m, o.diameter_m);
+  const PlaneRemovalResult removed = RemoveSupportPlanes(down, largest_object_m, options);
+  for (const DetectedPlane& plane : removed.planes) result.plane_points += plane.inliers.size();
+  clock.Lap("preprocess");
+
+  std::deque<PendingSegment> pending;
+  for (Segment& s : Segments(removed.remaining, largest_object_m, options)) pending.push_back({std::move(s.indices), s.core_diameter_m, 0});
+  clock.Lap("segment");
+
+  const KnnIndex down_index(down.points);
+  const ScanContext ctx{db, options, cache, down, down_index, clock};
+  std::vector<std::vector<std::size_t>> object_points;  // per object, into removed.remaining
+  while (!pending.empty()) {
+    const PendingSegment next = std::move(pending.front());
+    pending.pop_front();
+    RecognizedObject object;
+    object.object_id = "unknown";
+    std::vector<std::size_t> kept = next.indices;
+    const PointCloud segment = Subset(removed.remaining, next.indices);
+    object.centroid_S = Centroid(segment);
+    const SceneAround around = SceneAroundSegment(down, down_index, segment, 2.0 * p.voxel_m);
+    const DescribedSegment described = DescribeSegment(segment, ctx);
+    const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed, options.threads);
+    clock.Lap("describe");
+    if (esf.ok && described.cloud.size() >= 10) {
+      const ChosenObjects chosen = ChooseObjects(esf.histogram, next.core_diameter_m, ctx);
+      const std::vector<double>& nearest_chi_square = chosen.nearest_chi_square;
+      clock.Lap("match");
+      std::vector<PosedObject> posed;
+      for (std::size_t i : chosen.objects) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
+      std::stable_sort(posed.begin(), posed.end(),
+                       [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
+      BreakTie(options.score_tie, posed);
+      for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
+      const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
+      if (!posed.empty() && posed.front().candidate.verified) {
+        const PosedObject& best = posed.front();
+        const ObjectModel& model = db.objects[best.object];
+        Accept(best, described.cloud, model, NearestOther(best.object, nearest_chi_square), ctx, object);
+        object.equivalent_objects_S = EquivalentObjects(posed, options.score_tie);
+        object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
+        clock.Lap("equivalents");
+        if (split_allowed) {
+          // What the object leaves unexplained may be another one touching it.
+          const std::vector<std::size_t> rest =
+              Partition(next.indices, PointsOnModel(described.cloud, model, cache.Model(best.object).nearest(),
+                                                    best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m)).second;
+          const std::size_t queued = pending.size();
+          QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);
+          std::vector<std::size_t> taken;
+          for (std::size_t q = queued; q < pending.size(); ++q) {
+            taken.insert(taken.end(), pending[q].indices.begin(), pending[q].indices.end());
+          }
+          std::sort(taken.begin(), taken.end());
+          std::erase_if(kept, [&](std::size_t i) { return std::binary_search(taken.begin(), taken.end(), i); });
+        }
+      } else if (split_allowed && segment.size() >= 2 * static_cast<std::size_t>(options.min_segment_points)) {
+        std::optional<ExplainedPart> part = ExplainPart(described, ctx);
+        clock.Lap("split");
+        if (part) {
+          const PointCloud part_cloud = Subset(segment, part->points);
+          // The part's own ESF for its chi-square and margin.
+          const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed, options.threads);
+          std::vector<double> part_chi_square;
+          if (part_esf.ok) {
+            for (const auto& nearest : NearestViews(part_esf.histogram, db, 1)) {
+              part_chi_square.push_back(nearest.front().first);
+              if (part_chi_square.size() == part->posed.object + 1) part->posed.candidate.view = nearest.front().second;
+            }
+            part->posed.candidate.chi_square = part_chi_square[part->posed.object];
+          }
+          object.candidates.insert(object.candidates.begin(), part->posed.candidate);
+          Accept(part->posed, part_cloud, db.objects[part->posed.object],
+                 part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);
+          object.centroid_S = Centroid(part_cloud);
+          std::vector<std::size_t> rest;
+          std::tie(kept, rest) = Partition(next.indices, part->points);
+          QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);
+        }
+      }
+    }
+    clock.Lap("verify");
+    object_points.push_back(std::move(kept));
+    result.objects.push_back(std::move(object));
+  }
+
+  // Every scan point goes to the object of the voxel point nearest to it.
+  std::vector<int> object_of_down(down.size(), -1);
+  for (std::size_t k = 0; k < object_points.size(); ++k) {
+    for (std::size_t i : object_points[k]) object_of_down[removed.remaining_indices[i]] = static_cast<int>(k);
+  }
+  if (!object_points.empty()) {
+    std::vector<std::uint32_t> nearest;
+    std::vector<float> squared;
+    const Eigen::Vector3f shift = (scan.origin - down.origin).cast<float>();
+    for (std::size_t i = 0; i < scan.size(); ++i) {
+      down_index.Query(scan.points[i] + shift, 1, nearest, squared);
+      const int k = object_of_down[nearest[0]];
+      if (k >= 0) result.objects[static_cast<std::size_t>(k)].segment.push_back(i);
+    }
+  }
+  clock.Lap("segment");
+  return result;
+}
+
+}  // namespace uwscan::perception

@@ -1,0 +1,85 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "perception/cloud/cloud_neighbors.hpp"
+#include "perception/cloud/nearest_grid.hpp"
+#include "perception/cloud/point_cloud.hpp"
+#include "perception/recognition/object_database.hpp"
+
+namespace uwscan::perception {
+
+// How well a posed object model explains a scan segment, and what of the model the scan should
+// have seen but did not: the verification stage of RecognizeObjects.
+
+// Directions from the sensor (at the origin) as two angles about a mean line of sight, well
+// defined over the half space ahead of it whatever way the sensor's axes point.
+class SightAngles {
+ public:
+  explicit SightAngles(const Eigen::Vector3d& forward)
+      : w_(forward.normalized()), u_(w_.unitOrthogonal()), v_(w_.cross(u_)) {}
+  Eigen::Vector2d operator()(const Eigen::Vector3d& p) const {
+    const double z = p.dot(w_);
+    return {std::atan2(p.dot(u_), z), std::atan2(p.dot(v_), z)};
+  }
+
+ private:
+  Eigen::Vector3d w_, u_, v_;
+};
+
+// What the scan saw around one segment: all its points (scan frame, planes too) and their index,
+// the segment's window of directions (where the sweep is known to have looked) and, over
+// direction bins about `radius_m` wide at the segment, the nearest depth of any scan point.
+using Bin = std::pair<long, long>;
+struct SceneAround {
+  const PointCloud& points;
+  const KnnIndex& index;
+  SightAngles angles;
+  double bin_rad = 0.0;
+  Eigen::Vector2d lo, hi;  // the segment's angular window, one bin of margin
+  std::map<Bin, double> nearest_depth;
+
+  Bin BinOf(const Eigen::Vector2d& a) const { return {std::lround(a.x() / bin_rad), std::lround(a.y() / bin_rad)}; }
+  bool InWindow(const Eigen::Vector2d& a) const { return (a.array() >= lo.array()).all() && (a.array() <= hi.array()).all(); }
+  // Some scan point, of anything, within a bin of this direction: the sweep looked there.
+  bool Covered(const Bin& bin) const {
+    for (long du = -1; du <= 1; ++du) {
+      for (long dv = -1; dv <= 1; ++dv) {
+        if (nearest_depth.count({bin.first + du, bin.second + dv}) != 0) return true;
+      }
+    }
+    return false;
+  }
+};
+
+// The scene around `segment`: `whole_scan` (with its k-d index `index`) over the segment's
+// window of directions, binned about `radius_m` wide at the segment.
+SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
+                               double radius_m);
+
+// Share of the posed model's surface the sensor should have seen that has no scan point within
+// `radius_m`. Seen: facing the sensor (not grazing), within the segment's window of directions
+// (the sweep may have covered only part of the object), nearest to the sensor along its line of
+// sight among the model's own points (a depth buffer over the scene's direction bins), so parts
+// the object hides from itself are not expected, not behind anything else the scan saw nearer
+// in that direction (an object in front, a pipe lying across it), and where the scan has some
+// point, of anything, within a bin (a MEMS pattern or a fan covers a shape of its own, and
+// what it did not light is not evidence; a missing part in front of a seabed is). Any scan
+// point counts, not only the segment's: a valve's handle that occlusion cut off from its body
+// into a segment of its own still shows that the handle is there, and the seabed points
+// removed as a plane still show the object's lowest rim.
+double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
+                    double radius_m);
+
+// Share of the segment (object frame) within `distance_m` of the model's surface: the
+// point-to-plane distance to the nearest model point, when that point is within `reach_m` (about
+// the model's sample spacing, so that a point beside a thin part, on the part's tangent plane but
+// off its surface, does not count; at most model_grid's radius).
+double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const PointCloud& segment_O,
+                  double distance_m, double reach_m);
+
+}  // namespace uwscan::perception

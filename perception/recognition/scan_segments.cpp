@@ -1,0 +1,167 @@
+#include "perception/recognition/scan_segments.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
+#include <limits>
+
+#include "perception/cloud/cloud_neighbors.hpp"
+#include "perception/preprocessing/clustering.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+// The smaller of a point set's two spans across a plane's normal, metres (sqrt(12) standard
+// deviations: the width of a uniformly covered strip).
+double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t i : plane.inliers) mean += cloud.Point(i);
+  mean /= static_cast<double>(plane.inliers.size());
+  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - plane.normal * plane.normal.transpose();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (std::size_t i : plane.inliers) {
+    const Eigen::Vector3d d = across * (cloud.Point(i) - mean);
+    scatter += d * d.transpose();
+  }
+  scatter /= static_cast<double>(plane.inliers.size());
+  // Eigenvalues ascending: 0 along the normal, then the narrow and the wide in-plane variance.
+  const Eigen::Vector3d variances = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
+  return std::sqrt(12.0 * std::max(variances(1), 0.0));
+}
+
+// The segment nearest to `part` other than `skip` (its index, and the smallest point distance),
+// or (0, infinity) when there is none.
+std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std::vector<std::size_t>& part,
+                                              const std::vector<Segment>& segments, std::size_t skip) {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<std::size_t> owner;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    if (k == skip) continue;
+    for (std::size_t i : segments[k].indices) {
+      points.push_back(cloud.points[i]);
+      owner.push_back(k);
+    }
+  }
+  if (points.empty()) return {0, std::numeric_limits<double>::infinity()};
+  const KnnIndex index(points);
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared;
+  float best = std::numeric_limits<float>::infinity();
+  std::size_t to = 0;
+  for (std::size_t i : part) {
+    index.Query(cloud.points[i], 1, nearest, squared);
+    if (squared[0] < best) best = squared[0], to = owner[nearest[0]];
+  }
+  return {to, std::sqrt(static_cast<double>(best))};
+}
+
+// Each fragment joins the segment nearest to it when within `distance_m`.
+void AttachFragments(const PointCloud& cloud, const std::vector<std::vector<std::size_t>>& fragments,
+                     double distance_m, std::vector<Segment>& segments) {
+  if (segments.empty() || fragments.empty()) return;
+  std::vector<Eigen::Vector3f> points;
+  std::vector<std::size_t> owner;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    for (std::size_t i : segments[k].indices) {
+      points.push_back(cloud.points[i]);
+      owner.push_back(k);
+    }
+  }
+  const KnnIndex index(points);
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared;
+  for (const std::vector<std::size_t>& part : fragments) {
+    float best = std::numeric_limits<float>::infinity();
+    std::size_t to = 0;
+    for (std::size_t i : part) {
+      index.Query(cloud.points[i], 1, nearest, squared);
+      if (squared[0] < best) best = squared[0], to = owner[nearest[0]];
+    }
+    if (best <= distance_m * distance_m) {
+      segments[to].indices.insert(segments[to].indices.end(), part.begin(), part.end());
+    }
+  }
+}
+
+// Joins segments within `distance_m` of each other, the smallest first into its nearest, when
+// together they are no wider than `widest_m`.
+void JoinNearbySegments(const PointCloud& cloud, double widest_m, double distance_m, std::vector<Segment>& segments) {
+  bool joined = true;
+  while (joined && segments.size() > 1) {
+    joined = false;
+    std::vector<std::size_t> order(segments.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return segments[a].indices.size() < segments[b].indices.size();
+    });
+    for (std::size_t k : order) {
+      const auto [to, distance] = NearestSegment(cloud, segments[k].indices, segments, k);
+      if (distance > distance_m) continue;
+      std::vector<std::size_t> both = segments[to].indices;
+      both.insert(both.end(), segments[k].indices.begin(), segments[k].indices.end());
+      const double diameter = Diameter(Subset(cloud, both));
+      if (diameter > widest_m) continue;
+      segments[to] = {std::move(both), diameter};
+      segments.erase(segments.begin() + static_cast<std::ptrdiff_t>(k));
+      joined = true;
+      break;
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m, const RecognitionOptions& options) {
+  ClusteringOptions clustering;
+  clustering.tolerance_m = options.cluster_tolerance_m;
+  std::vector<Segment> segments;
+  std::vector<std::vector<std::size_t>> small;
+  for (std::vector<std::size_t>& c : EuclideanClusters(cloud, clustering)) {
+    if (c.size() < static_cast<std::size_t>(options.min_segment_points)) {
+      small.push_back(std::move(c));
+      continue;
+    }
+    const double diameter = Diameter(Subset(cloud, c));
+    segments.push_back({std::move(c), diameter});
+  }
+  AttachFragments(cloud, small, options.attach_distance_m, segments);
+  JoinNearbySegments(cloud, largest_object_m, options.attach_distance_m, segments);
+  for (Segment& segment : segments) std::sort(segment.indices.begin(), segment.indices.end());
+  std::stable_sort(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) {
+    return a.indices.size() > b.indices.size();
+  });
+  return segments;
+}
+
+PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_object_m,
+                                       const RecognitionOptions& options) {
+  PlaneRemovalOptions planes;
+  planes.distance_threshold_m = options.plane_distance_m;
+  planes.max_planes = 1;
+  planes.seed = options.seed;
+  planes.threads = options.threads;
+  PlaneRemovalResult result;
+  result.remaining = down;
+  for (std::size_t i = 0; i < down.size(); ++i) result.remaining_indices.push_back(i);
+  for (int k = 0; k < 3 && !result.remaining.empty(); ++k) {
+    // min_fraction is of the cloud handed over; keep it a share of the whole scan.
+    planes.min_fraction = std::min(1.0, options.plane_min_fraction * static_cast<double>(down.size()) /
+                                            static_cast<double>(result.remaining.size()));
+    PlaneRemovalResult step = RemovePlanes(result.remaining, planes);
+    if (step.planes.empty()) break;
+    DetectedPlane& plane = step.planes.front();
+    if (k > 0 && NarrowSpan(result.remaining, plane) < largest_object_m) break;
+    for (std::size_t& i : plane.inliers) i = result.remaining_indices[i];
+    std::vector<std::size_t> kept;
+    for (std::size_t i : step.remaining_indices) kept.push_back(result.remaining_indices[i]);
+    result.remaining_indices = std::move(kept);
+    result.remaining = std::move(step.remaining);
+    result.planes.push_back(std::move(plane));
+  }
+  return result;
+}
+
+}  // namespace uwscan::perception

@@ -1,0 +1,111 @@
+#pragma once
+// Internal to RecognizeObjects (object_recognizer.cpp), not the library's interface: one object
+// posed on a segment of a scan and verified there, and the other poses that fit it as well.
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "perception/cloud/cloud_neighbors.hpp"
+#include "perception/cloud/point_cloud.hpp"
+#include "perception/features/fpfh.hpp"
+#include "perception/recognition/object_database.hpp"
+#include "perception/recognition/object_pose_search.hpp"
+#include "perception/recognition/object_recognizer.hpp"
+#include "perception/recognition/recognition_verification.hpp"
+#include "perception/registration/icp.hpp"
+
+namespace uwscan::perception::recognition {
+
+// Seconds per stage, added up across calls.
+class StageClock {
+ public:
+  explicit StageClock(std::map<std::string, double>& seconds) : seconds_(seconds) {}
+  void Lap(const std::string& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    seconds_[stage] += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  std::map<std::string, double>& seconds_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// What every segment of one scan is recognised against.
+struct ScanContext {
+  const ObjectDatabase& db;
+  const RecognitionOptions& options;
+  RecognitionCache& cache;
+  const PointCloud& down;  // the voxelised scan, planes included
+  const KnnIndex& down_index;
+  StageClock& clock;
+};
+
+// The context of one task of a parallel loop over a scan's work: one thread, and a clock of its
+// own, untimed (the caller times the whole loop; a clock is not shared between threads).
+class OneThreadContext {
+ public:
+  explicit OneThreadContext(const ScanContext& outer)
+      : options_(OneThread(outer.options)),
+        clock_(untimed_),
+        ctx_{outer.db, options_, outer.cache, outer.down, outer.down_index, clock_} {}
+  OneThreadContext(const OneThreadContext&) = delete;  // ctx_ refers to the members beside it
+  OneThreadContext& operator=(const OneThreadContext&) = delete;
+  const ScanContext& ctx() const { return ctx_; }
+
+ private:
+  static RecognitionOptions OneThread(RecognitionOptions options) {
+    options.threads = 1;
+    return options;
+  }
+  RecognitionOptions options_;  // initialised in this order: each refers to those above it
+  std::map<std::string, double> untimed_;
+  StageClock clock_;
+  ScanContext ctx_;
+};
+
+// A segment's voxelised points with normals (scan frame) and FPFH at every one.
+struct DescribedSegment {
+  PointCloud cloud;
+  FpfhFeatures features;
+};
+DescribedSegment DescribeSegment(const PointCloud& segment, const ScanContext& ctx);
+
+// One object posed on (part of) a segment, with the fine ICP that placed it.
+struct PosedObject {
+  std::size_t object = 0;
+  RecognitionCandidate candidate;
+  RegistrationResult fine;
+};
+
+// The posed model verified on `segment`: fit, closeness and missing surface.
+void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
+            const SceneAround& around, const RegistrationResult& refined, const ScanContext& ctx,
+            RecognitionCandidate& c);
+
+// Verified beats unverified, then the higher score; ties keep the earlier.
+bool Better(const RecognitionCandidate& a, const RecognitionCandidate& b);
+
+// Every k-th point of a cloud, at most about `count` of them.
+PointCloud Strided(const PointCloud& cloud, std::size_t count);
+
+// An object's best pose on the whole segment from `starts`: sifted, the best few refined by the
+// fine ICP on refine_points of the segment's points and verified on all of them; the winner's
+// phase about any N-fold axis is searched, then it is refined once more on all its points (the
+// pose barely moves, but its information is that of every point) and verified again.
+PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const std::vector<Eigen::Isometry3d>& starts,
+                          const SceneAround& around, const ScanContext& ctx);
+
+// Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
+// equivalent_poses_S): its pose turned by each of DistinctHalfTurns (a nearly symmetric object,
+// a valve's body, fits either way; a tee seen as an L fits turned about the L's bisector), refined by the fine ICP and verified like it; kept when
+// verified, scoring within score_tie of it and more than 5 degrees or 2 voxels from it and from
+// each other modulo the object's symmetries. T_S_O each.
+std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const PosedObject& posed,
+                                               const SceneAround& around, const ScanContext& ctx);
+
+}  // namespace uwscan::perception::recognition

@@ -1,0 +1,477 @@
+#include "perception/registration/icp.hpp"
+
+#include <flann/algorithms/dist.h>
+#include <flann/algorithms/kdtree_single_index.h>
+#include <flann/util/matrix.h>
+#include <flann/util/result_set.h>
+#include <omp.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "perception/cloud/nearest_grid.hpp"
+#include "perception/registration/svd_alignment.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+constexpr std::ptrdiff_t kBlockSize = 256;  // points per partial sum
+constexpr double kEigenvalueFloor = 1e-10;  // relative: smaller eigenvalues of J^T J dropped
+constexpr int kNoMatch = -1;
+
+int ThreadCount(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
+
+// The nearest point within a radius: a FLANN result set of capacity 1 that starts with the
+// radius as its worst distance, so the tree prunes everything beyond it.
+// With a normal gate, only points whose normal is within the gate's angle of the query's count.
+class NearestWithin : public flann::ResultSet<float> {
+ public:
+  void Reset(float radius_sq) {
+    worst_ = radius_sq;
+    index_ = kNoMatch;
+  }
+  // Candidates must have normals[index] . normal >= min_cos; normals == nullptr: no gate.
+  void Gate(const std::vector<Eigen::Vector3f>* normals, const Eigen::Vector3f& normal, float min_cos) {
+    normals_ = normals;
+    normal_ = normal;
+    min_cos_ = min_cos;
+  }
+  bool full() const override { return true; }
+  // Whether target point `index` passes the gate.
+  bool Accepts(std::size_t index) const {
+    return normals_ == nullptr || (*normals_)[index].dot(normal_) >= min_cos_;
+  }
+  void addPoint(float dist, size_t index) override {
+    if (dist < worst_ && Accepts(index)) {
+      worst_ = dist;
+      index_ = static_cast<int>(index);
+    }
+  }
+  float worstDist() const override { return worst_; }
+  int index() const { return index_; }
+
+ private:
+  float worst_ = 0.0f;
+  int index_ = kNoMatch;
+  const std::vector<Eigen::Vector3f>* normals_ = nullptr;
+  Eigen::Vector3f normal_ = Eigen::Vector3f::Zero();
+  float min_cos_ = -1.0f;
+};
+
+// Exact nearest-neighbour search on the target points (relative to the target origin): FLANN's
+// kd-tree, and for radii up to grid_radius_m (when > 0) a NearestGrid of cells a quarter of it.
+class TargetTree {
+ public:
+  TargetTree(const PointCloud& target, double grid_radius_m)
+      : index_(flann::Matrix<float>(const_cast<float*>(target.points.front().data()), target.size(),
+                                    3),
+               flann::KDTreeSingleIndexParams(10)) {
+    index_.buildIndex();
+    if (grid_radius_m > 0.0) {
+      grid_.emplace(target.points, 0.25 * grid_radius_m, grid_radius_m);
+      grid_radius_sq_ = static_cast<float>(grid_radius_m * grid_radius_m);
+    }
+  }
+  // Index of the nearest target point within `radius` of p, or kNoMatch. Thread-safe.
+  int Nearest(const Eigen::Vector3d& p, float radius_sq, NearestWithin& result) const {
+    const Eigen::Vector3f query = p.cast<float>();
+    result.Reset(radius_sq);
+    if (grid_ && radius_sq <= grid_radius_sq_) {
+      return static_cast<int>(grid_->Nearest(query, radius_sq, [&](std::uint32_t j) { return result.Accepts(j); }));
+    }
+    index_.findNeighbors(result, query.data(), exact_);
+    return result.index();
+  }
+  const NearestGrid* grid() const { return grid_ ? &*grid_ : nullptr; }
+
+ private:
+  flann::KDTreeSingleIndex<flann::L2_3D<float>> index_;
+  flann::SearchParams exact_{-1, 0.0f};  // unlimited checks, eps = 0: exact
+  std::optional<NearestGrid> grid_;
+  float grid_radius_sq_ = 0.0f;
+};
+
+// -[p]x, so that w x p = MinusSkew(p) w.
+Eigen::Matrix3d MinusSkew(const Eigen::Vector3d& p) {
+  Eigen::Matrix3d m;
+  m << 0.0, p.z(), -p.y(), -p.z(), 0.0, p.x(), p.y(), -p.x(), 0.0;
+  return m;
+}
+
+// Sums of per-pair terms over fixed blocks of points, added in block order, so the rounding
+// does not depend on the thread count.
+struct Sums {
+  Matrix6d JtJ = Matrix6d::Zero();  // upper triangle until Pass() returns
+  Vector6d Jtr = Vector6d::Zero();
+  double squared_residual = 0.0;  // sum of r^2 (the method's residual)
+  double squared_distance = 0.0;  // sum of |p - q|^2
+  std::size_t count = 0;
+
+  void Add(const Sums& other) {
+    JtJ += other.JtJ;
+    Jtr += other.Jtr;
+    squared_residual += other.squared_residual;
+    squared_distance += other.squared_distance;
+    count += other.count;
+  }
+};
+
+// Unit normals of the source and target and the least cosine between paired ones, when
+// IcpOptions::max_normal_angle_rad gates the pairs.
+struct NormalGate {
+  const std::vector<Eigen::Vector3f>* source = nullptr;
+  const std::vector<Eigen::Vector3f>* target = nullptr;
+  float min_cos = -1.0f;
+};
+
+// One pass over the source: pairs every moved point p = T_rel s with its nearest target point q
+// within the radius (and the normal gate, when there is one; pairs[i] = target index or
+// kNoMatch) and, with `accumulate`, sums the Gauss-Newton terms with the rotation about `pivot`:
+// rows [(p - c) x n, n] for point-to-plane, [-[p - c]x, I] for point-to-point.
+Sums Pass(const std::vector<Eigen::Vector3d>& source_rel, const PointCloud& target,
+          const TargetTree& tree, const Eigen::Isometry3d& T_rel, double radius,
+          const Eigen::Vector3d& pivot, IcpMethod method, bool accumulate, int threads,
+          const NormalGate& gate, std::vector<int>& pairs) {
+  const auto n = static_cast<std::ptrdiff_t>(source_rel.size());
+  const auto radius_sq = static_cast<float>(radius * radius);
+  const std::ptrdiff_t blocks = (n + kBlockSize - 1) / kBlockSize;
+  std::vector<Sums> block_sums(static_cast<std::size_t>(blocks));
+  pairs.resize(source_rel.size());
+#pragma omp parallel num_threads(ThreadCount(threads))
+  {
+    NearestWithin result;
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t block = 0; block < blocks; ++block) {
+      Sums& sums = block_sums[static_cast<std::size_t>(block)];
+      const std::ptrdiff_t end = std::min(n, (block + 1) * kBlockSize);
+      for (std::ptrdiff_t i = block * kBlockSize; i < end; ++i) {
+        const Eigen::Vector3d p = T_rel * source_rel[static_cast<std::size_t>(i)];
+        if (gate.source != nullptr) {
+          const Eigen::Vector3d n = T_rel.linear() * (*gate.source)[static_cast<std::size_t>(i)].cast<double>();
+          result.Gate(gate.target, n.cast<float>(), gate.min_cos);
+        }
+        const int j = tree.Nearest(p, radius_sq, result);
+        pairs[static_cast<std::size_t>(i)] = j;
+        if (j == kNoMatch || !accumulate) continue;
+        const Eigen::Vector3d q = target.points[static_cast<std::size_t>(j)].cast<double>();
+        const Eigen::Vector3d d = p - q;
+        sums.squared_distance += d.squaredNorm();
+        ++sums.count;
+        if (method == IcpMethod::kPointToPlane) {
+          const Eigen::Vector3d normal =
+              target.normals[static_cast<std::size_t>(j)].cast<double>().normalized();
+          Vector6d J;
+          J << (p - pivot).cross(normal), normal;
+          const double r = normal.dot(d);
+          sums.JtJ.selfadjointView<Eigen::Upper>().rankUpdate(J);
+          sums.Jtr += J * r;
+          sums.squared_residual += r * r;
+        } else {
+          Eigen::Matrix<double, 3, 6> J;
+          J << MinusSkew(p - pivot), Eigen::Matrix3d::Identity();
+          sums.JtJ.selfadjointView<Eigen::Upper>().rankUpdate(J.transpose());
+          sums.Jtr += J.transpose() * d;
+          sums.squared_residual += d.squaredNorm();
+        }
+      }
+    }
+  }
+  Sums total;
+  for (const Sums& sums : block_sums) total.Add(sums);
+  total.JtJ.triangularView<Eigen::StrictlyLower>() = total.JtJ.transpose();
+  return total;
+}
+
+// Minimum-norm solution of JtJ x = -Jtr over the eigenvalues above the floor.
+Vector6d SolveTruncated(const Matrix6d& JtJ, const Vector6d& Jtr) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(JtJ);
+  const Vector6d& values = solver.eigenvalues();
+  const double floor = kEigenvalueFloor * values(5);
+  Vector6d x = Vector6d::Zero();
+  if (!(values(5) > 0.0)) return x;
+  for (int k = 0; k < 6; ++k) {
+    if (values(k) <= floor) continue;
+    const Vector6d u = solver.eigenvectors().col(k);
+    x -= (u.dot(Jtr) / values(k)) * u;
+  }
+  return x;
+}
+
+// The step with a prior: minimises |J x + r|^2 / sigma^2 + (e + x)^T L (e + x), where
+// e = [w, v] is the current pose's perturbation from the prior's (offset = current * prior^-1,
+// its rotation vector and translation) and L the prior's information.
+Vector6d SolveWithPrior(const Sums& sums, const IcpPrior& prior, const Eigen::Isometry3d& offset) {
+  const double weight = 1.0 / (prior.point_sigma_m * prior.point_sigma_m);
+  Vector6d e;
+  const Eigen::AngleAxisd rotation(offset.linear());
+  e << rotation.angle() * rotation.axis(), offset.translation();
+  const Matrix6d H = weight * sums.JtJ + prior.information;
+  const Vector6d g = weight * sums.Jtr + prior.information * e;
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(H);
+  const Vector6d& values = solver.eigenvalues();
+  Vector6d x = Vector6d::Zero();
+  if (!(values(5) > 0.0)) return x;
+  for (int k = 0; k < 6; ++k) {
+    if (values(k) <= kEigenvalueFloor * values(5)) continue;  // neither points nor prior: stay
+    const Vector6d u = solver.eigenvectors().col(k);
+    x -= (u.dot(g) / values(k)) * u;
+  }
+  return x;
+}
+
+// Rotation by w (rad) about `pivot`, then translation by v.
+Eigen::Isometry3d IncrementAbout(const Eigen::Vector3d& pivot, const Eigen::Vector3d& w,
+                                 const Eigen::Vector3d& v) {
+  Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
+  const double angle = w.norm();
+  if (angle > 0.0) increment.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  increment.translation() = pivot + v - increment.linear() * pivot;
+  return increment;
+}
+
+void RequireRigid(const Eigen::Isometry3d& T) {
+  const Eigen::Matrix3d R = T.linear();
+  if (!T.matrix().allFinite() ||
+      (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+      R.determinant() <= 0.0) {
+    throw Error(
+        "AlignIcp: T_target_source_init must be finite with a rotation (orthonormal, det +1) "
+        "as its linear part");
+  }
+}
+
+}  // namespace
+
+void IcpOptions::Check() const {
+  const auto fail = [](const std::string& field, const std::string& expected) {
+    throw Error("IcpOptions." + field + ": expected " + expected);
+  };
+  if (method != IcpMethod::kPointToPoint && method != IcpMethod::kPointToPlane) {
+    fail("method", "kPointToPoint or kPointToPlane");
+  }
+  if (max_iterations < 1) fail("max_iterations", "> 0, got " + std::to_string(max_iterations));
+  if (max_iterations_per_stage < 1) {
+    fail("max_iterations_per_stage", "> 0, got " + std::to_string(max_iterations_per_stage));
+  }
+  if (max_correspondence_distance_m.empty()) {
+    fail("max_correspondence_distance_m", "at least one distance");
+  }
+  for (std::size_t s = 0; s < max_correspondence_distance_m.size(); ++s) {
+    const double d = max_correspondence_distance_m[s];
+    const std::string field = "max_correspondence_distance_m[" + std::to_string(s) + "]";
+    if (!(std::isfinite(d) && d > 0.0)) fail(field, "a finite distance > 0 m");
+    if (s > 0 && d > max_correspondence_distance_m[s - 1]) {
+      fail(field, "a distance no larger than the previous stage's");
+    }
+  }
+  const auto require_tolerance = [&](const std::string& field, double value) {
+    if (!(std::isfinite(value) && value >= 0.0)) fail(field, "a finite value >= 0");
+  };
+  require_tolerance("rotation_tolerance_rad", rotation_tolerance_rad);
+  require_tolerance("translation_tolerance_m", translation_tolerance_m);
+  require_tolerance("relative_rmse_tolerance", relative_rmse_tolerance);
+  // A relative change of the whole residual is no tolerance (and would make every iteration a
+  // stall, stall_iterations counting a residual as lower only by this fraction).
+  if (!(relative_rmse_tolerance < 1.0)) fail("relative_rmse_tolerance", "a value below 1");
+  if (stall_iterations < 0) fail("stall_iterations", ">= 0 (0 = off), got " + std::to_string(stall_iterations));
+  if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
+  if (!(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi)) {
+    fail("max_normal_angle_rad", "an angle in [0, pi] rad");
+  }
+  if (prior) {
+    if (method != IcpMethod::kPointToPlane) fail("prior", "point-to-plane (method kPointToPlane)");
+    if (!(std::isfinite(prior->point_sigma_m) && prior->point_sigma_m > 0.0)) {
+      fail("prior.point_sigma_m", "a finite value > 0 m");
+    }
+    const Matrix6d& info = prior->information;
+    if (!info.allFinite() || !info.isApprox(info.transpose(), 1e-9) ||
+        Eigen::SelfAdjointEigenSolver<Matrix6d>(info).eigenvalues().minCoeff() <
+            -1e-9 * info.cwiseAbs().maxCoeff()) {
+      fail("prior.information", "a finite, symmetric, positive semi-definite 6x6 matrix");
+    }
+  }
+}
+
+struct IcpTarget::Tree {
+  Tree(const PointCloud& cloud, double grid_radius_m) : tree(cloud, grid_radius_m) {}
+  TargetTree tree;
+};
+
+IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m) : cloud_(cloud) {
+  RequireValidCloud(cloud, "AlignIcp: target", 3);
+  if (!(grid_radius_m >= 0.0 && std::isfinite(grid_radius_m))) {
+    throw Error("IcpTarget: grid_radius_m must be finite and >= 0, got " + std::to_string(grid_radius_m));
+  }
+  tree_ = std::make_unique<Tree>(cloud, grid_radius_m);
+  centroid_rel_.setZero();
+  for (const Eigen::Vector3f& q : cloud.points) centroid_rel_ += q.cast<double>();
+  centroid_rel_ /= static_cast<double>(cloud.size());
+}
+
+IcpTarget::~IcpTarget() = default;
+
+const NearestGrid* IcpTarget::grid() const { return tree_->tree.grid(); }
+
+RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
+                            const Eigen::Isometry3d& T_target_source_init,
+                            const IcpOptions& options) {
+  options.Check();
+  RequireValidCloud(source, "AlignIcp: source", 3);
+  return AlignIcp(source, IcpTarget(target), T_target_source_init, options);
+}
+
+RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
+                            const Eigen::Isometry3d& T_target_source_init,
+                            const IcpOptions& options) {
+  options.Check();
+  RequireValidCloud(source, "AlignIcp: source", 3);
+  const PointCloud& target = prepared.cloud_;
+  if (options.method == IcpMethod::kPointToPlane && !target.has_normals()) {
+    throw Error("AlignIcp: target has no normals; point-to-plane needs one per target point");
+  }
+  RequireRigid(T_target_source_init);
+  // Unit normals for the gate, computed once.
+  std::vector<Eigen::Vector3f> source_normals, target_normals;
+  NormalGate gate;
+  if (options.max_normal_angle_rad > 0.0) {
+    if (!source.has_normals() || !target.has_normals()) {
+      throw Error("AlignIcp: max_normal_angle_rad needs normals on both the source and the target");
+    }
+    for (const Eigen::Vector3f& n : source.normals) source_normals.push_back(n.normalized());
+    for (const Eigen::Vector3f& n : target.normals) target_normals.push_back(n.normalized());
+    gate = {&source_normals, &target_normals, static_cast<float>(std::cos(options.max_normal_angle_rad))};
+  }
+
+  // Everything below is relative to the target origin: T_rel maps source points relative to
+  // their origin to target points relative to theirs.
+  Eigen::Isometry3d T_rel = Eigen::Translation3d(-target.origin) * T_target_source_init *
+                            Eigen::Translation3d(source.origin);
+  std::vector<Eigen::Vector3d> source_rel(source.size());
+  for (std::size_t i = 0; i < source.size(); ++i) source_rel[i] = source.points[i].cast<double>();
+  const Eigen::Vector3d target_centroid = prepared.centroid_rel_;
+
+  // With a prior the linearisation is about the target origin, where the prior's information
+  // is expressed; without one about the centroid, which conditions the step best.
+  const std::optional<IcpPrior>& prior = options.prior;
+  const Eigen::Vector3d pivot = prior ? Eigen::Vector3d::Zero() : target_centroid;
+  const Eigen::Isometry3d prior_rel =
+      prior ? Eigen::Translation3d(-target.origin) * prior->T_target_source *
+                  Eigen::Translation3d(source.origin)
+            : Eigen::Isometry3d::Identity();
+  if (prior) RequireRigid(prior->T_target_source);
+
+  const TargetTree& tree = prepared.tree_->tree;
+  std::vector<int> pairs;
+  std::vector<Eigen::Vector3d> moved, matched;  // point-to-point pairs, reused
+  RegistrationResult result;
+  bool stopped = false;  // too few pairs or degenerate pairs
+  const std::size_t stages = options.max_correspondence_distance_m.size();
+  const bool point_to_plane = options.method == IcpMethod::kPointToPlane;
+  for (std::size_t stage = 0; stage < stages && !stopped; ++stage) {
+    const double radius = options.max_correspondence_distance_m[stage];
+    bool stage_converged = false;
+    double previous_rmse = std::numeric_limits<double>::quiet_NaN();
+    // The stage's lowest residual, the pose it was measured at, and iterations since.
+    double lowest_rmse = std::numeric_limits<double>::infinity();
+    Eigen::Isometry3d T_lowest = T_rel;
+    int since_lowest = 0;
+    for (int k = 0;
+         k < options.max_iterations_per_stage && result.iterations < options.max_iterations; ++k) {
+      const Sums sums = Pass(source_rel, target, tree, T_rel, radius, pivot,
+                             options.method, point_to_plane, options.threads, gate, pairs);
+      Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
+      double rmse = 0.0;
+      if (point_to_plane) {
+        if (sums.count < 3) {
+          if (prior) T_rel = prior_rel;  // nothing to match: the prior is the answer
+          stopped = true;
+          break;
+        }
+        rmse = std::sqrt(sums.squared_residual / static_cast<double>(sums.count));
+        const Vector6d x = prior ? SolveWithPrior(sums, *prior, T_rel * prior_rel.inverse())
+                                 : SolveTruncated(sums.JtJ, sums.Jtr);
+        increment = IncrementAbout(pivot, x.head<3>(), x.tail<3>());
+      } else {
+        moved.clear();
+        matched.clear();
+        for (std::size_t i = 0; i < source_rel.size(); ++i) {
+          if (pairs[i] == kNoMatch) continue;
+          moved.push_back(T_rel * source_rel[i]);
+          matched.push_back(target.points[static_cast<std::size_t>(pairs[i])].cast<double>());
+        }
+        if (moved.size() < 3) {
+          stopped = true;
+          break;
+        }
+        const SvdAlignment step = AlignSvd(moved, matched);
+        if (step.status != SvdAlignmentStatus::kSuccess) {
+          stopped = true;
+          break;
+        }
+        double squared = 0.0;
+        for (std::size_t i = 0; i < moved.size(); ++i) {
+          squared += (moved[i] - matched[i]).squaredNorm();
+        }
+        rmse = std::sqrt(squared / static_cast<double>(moved.size()));
+        increment = step.T_target_source;
+      }
+      if (rmse < lowest_rmse * (1.0 - options.relative_rmse_tolerance)) {
+        lowest_rmse = rmse;
+        T_lowest = T_rel;
+        since_lowest = 0;
+      } else if (options.stall_iterations > 0 && ++since_lowest >= options.stall_iterations) {
+        T_rel = T_lowest;
+        ++result.iterations;
+        break;
+      }
+      T_rel = increment * T_rel;
+      ++result.iterations;
+
+      const double rotation_step = Eigen::AngleAxisd(increment.linear()).angle();
+      const double translation_step = (increment * target_centroid - target_centroid).norm();
+      const bool small_step = rotation_step < options.rotation_tolerance_rad &&
+                              translation_step < options.translation_tolerance_m;
+      const bool flat_rmse =
+          std::isfinite(previous_rmse) &&
+          std::abs(previous_rmse - rmse) <= options.relative_rmse_tolerance * previous_rmse;
+      previous_rmse = rmse;
+      if (small_step || flat_rmse) {
+        stage_converged = true;
+        break;
+      }
+    }
+    if (stage + 1 == stages) result.converged = stage_converged && !stopped;
+  }
+
+  // Fitness, RMSE and information at the returned transform, with the last stage's distance;
+  // the information's rotation is about the target origin.
+  const Sums final_sums =
+      Pass(source_rel, target, tree, T_rel, options.max_correspondence_distance_m.back(),
+           Eigen::Vector3d::Zero(), options.method, true, options.threads, gate, pairs);
+  result.T_target_source =
+      Eigen::Translation3d(target.origin) * T_rel * Eigen::Translation3d(-source.origin);
+  result.fitness = static_cast<double>(final_sums.count) / static_cast<double>(source.size());
+  result.inlier_rmse =
+      final_sums.count == 0
+          ? 0.0
+          : std::sqrt(final_sums.squared_distance / static_cast<double>(final_sums.count));
+  if (point_to_plane && final_sums.count > 0) {
+    result.inlier_plane_rmse =
+        std::sqrt(final_sums.squared_residual / static_cast<double>(final_sums.count));
+  }
+  result.information = final_sums.JtJ;
+  return result;
+}
+
+}  // namespace uwscan::perception
