@@ -152,7 +152,8 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
   cmd->add_option("--only", a->options.only, "run only these scenes (indices below --scans), to look at a case");
   cmd->add_option("--scan-cache", a->options.scan_cache,
                   "keep the simulated scans in this folder and read them from it in later runs (for comparing "
-                  "versions of the recogniser; empty it after changing the simulator)");
+                  "versions of the recogniser; a scan is named by a hash of its scene and of the simulator's "
+                  "sources, so scans made by other simulator code are never read back)");
   cmd->add_flag("--details", a->details, "print every object's answer and the candidates weighed for it");
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { Run(*a); });

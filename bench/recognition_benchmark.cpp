@@ -252,10 +252,10 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
   return e;
 }
 
-// What decides scan `s` of the bench: its scene (objects, meshes, poses), the camera, the noise
-// seed and the rendering settings.
+// What decides scan `s` of the bench: the simulator's code, its scene (objects, meshes, poses),
+// the camera, the noise seed and the rendering settings.
 CachedScanKey KeyOf(const Scene& scene, int s, const RecognitionBenchOptions& options) {
-  std::string bytes;
+  std::string bytes = kSimulatorSourceHash;
   auto add = [&bytes](const auto* data, std::size_t count) {
     bytes.append(reinterpret_cast<const char*>(data), count * sizeof(*data));
   };
