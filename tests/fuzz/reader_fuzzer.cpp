@@ -1,4 +1,4 @@
-// One libFuzzer target for every reader of outside data (bench/reader_probes.hpp): the reader is
+// One libFuzzer target for every reader of outside data (bench/robustness/reader_probes.hpp): the reader is
 // chosen by the environment variable UWSCAN_FUZZ_READER, so one sanitized link serves them all.
 // An input may end in a clean uwscan::Error or be accepted; any other exception, a crash, a hang
 // or a leak is a finding (libFuzzer stops and keeps the input).
@@ -11,7 +11,7 @@
 #include <fstream>
 #include <string>
 
-#include "bench/reader_probes.hpp"
+#include "bench/robustness/reader_probes.hpp"
 #include "scanner/common/error.hpp"
 
 namespace {

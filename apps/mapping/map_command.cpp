@@ -1,0 +1,185 @@
+#include "apps/mapping/map_command.hpp"
+
+#include <omp.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "apps/cli/data_cache.hpp"
+#include "apps/cli/json_output.hpp"
+#include "apps/cli/output_path.hpp"
+#include "apps/cli/progress_bar.hpp"
+#include "mapping/slam/dive_mapping.hpp"
+#include "mapping/slam/map_report.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::app {
+namespace {
+
+struct MapArgs {
+  std::string log;
+  std::string output;
+  std::string trajectory;
+  std::string dead_reckoning;
+  std::string truth;
+  std::string json;
+  double voxel_m = 0.005;
+  int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
+  int threads = 0;
+};
+
+nlohmann::json TumRows(const std::vector<mapping::TimedPose>& poses) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const mapping::TimedPose& p : poses) {
+    const Eigen::Quaterniond q(p.T_W_V.linear());
+    const Eigen::Vector3d& t = p.T_W_V.translation();
+    rows.push_back({p.time_s, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()});
+  }
+  return rows;
+}
+
+template <typename T>
+nlohmann::json Optional(const std::optional<T>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+// The map report (format in mapping/README.md, "uwscan map"): what the viewer reads.
+nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& log, const std::string& map) {
+  const mapping::MapSummary s = mapping::Summarise(m);
+  nlohmann::json report = {{"uwscan_format", 1}, {"kind", "map_report"}, {"log", log}};
+  const std::filesystem::path map_path(map);
+  report["map"] = map_path.is_absolute() ? map : std::filesystem::absolute(map_path).string();
+  report["trajectories"] = {{"slam", TumRows(m.slam)}, {"dead_reckoning", TumRows(m.dead_reckoning)}};
+  if (!m.truth.empty()) report["trajectories"]["truth"] = TumRows(m.truth);
+  nlohmann::json covariance = nlohmann::json::array(), deviation = nlohmann::json::array();
+  for (std::size_t i = 0; i < m.covariances.size(); ++i) {
+    // Reordered to (x, y, z, roll, pitch, yaw): position first, as the report documents.
+    const Eigen::Matrix<double, 6, 6>& c = m.covariances[i];
+    Eigen::Matrix<double, 6, 6> ordered;
+    ordered << c.bottomRightCorner<3, 3>(), c.bottomLeftCorner<3, 3>(), c.topRightCorner<3, 3>(),
+        c.topLeftCorner<3, 3>();
+    nlohmann::json row = {m.slam[i].time_s};
+    for (int r = 0; r < 6; ++r) {
+      for (int k = 0; k < 6; ++k) row.push_back(ordered(r, k));
+    }
+    covariance.push_back(row);
+    const Eigen::Matrix<double, 6, 1> std = mapping::PoseStd(m.covariances[i]);
+    deviation.push_back({m.slam[i].time_s, std(0), std(1), std(2), std(3), std(4), std(5)});
+  }
+  report["pose_covariance"] = covariance;  // [t, 36 values, (x, y, z (m), roll, pitch, yaw (rad)) row-major]
+  report["pose_std"] = deviation;          // [t, x, y, z (m), roll, pitch, yaw (rad)]
+  nlohmann::json loops = nlohmann::json::array();
+  for (const mapping::LoopClosure& l : m.loops) {
+    const Eigen::Quaterniond q(l.T_from_to.linear());
+    const Eigen::Vector3d& t = l.T_from_to.translation();
+    loops.push_back({{"from_submap", l.from}, {"to_submap", l.to}, {"accepted", l.accepted},
+                     {"reason", l.reason}, {"fitness", l.fitness}, {"chi2", l.chi2},
+                     {"constrained_directions", l.constrained_directions},
+                     {"T_from_to", {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}}});
+  }
+  report["loops"] = loops;
+  report["figures"] = {{"submaps", m.submaps},
+                       {"map_points", m.map.size()},
+                       {"dive_duration_s", m.dive_duration_s},
+                       {"seconds", m.seconds},
+                       {"real_time_factor", s.real_time_factor},
+                       {"registrations", m.stats.registrations},
+                       {"registrations_left_to_navigation", m.stats.registrations_failed + m.stats.registrations_inconsistent},
+                       {"registrations_inconsistent", m.stats.registrations_inconsistent},
+                       {"dead_reckoning_scale_error", m.calibration.scale_error},
+                       {"dead_reckoning_misalignment_rad", m.calibration.misalignment_rad},
+                       {"loops_accepted", s.loops_accepted},
+                       {"loops_rejected", s.loops_rejected},
+                       {"loops_false", Optional(s.loops_false)},
+                       {"navigation_noise_assumed", m.navigation_noise_assumed},
+                       {"ate_slam_m", Optional(s.ate_slam_m)},
+                       {"ate_dead_reckoning_m", Optional(s.ate_dead_reckoning_m)},
+                       {"rpe_slam_per_m", Optional(s.rpe_slam_per_m)},
+                       {"rpe_dead_reckoning_per_m", Optional(s.rpe_dead_reckoning_per_m)},
+                       {"nees_mean", Optional(s.nees_mean)},
+                       {"expected_map_error_m", Optional(m.expected_map_error_m)}};
+  return report;
+}
+
+// Every output is checked before any work: a missing folder, or an output that is the input.
+void RequireOutput(const std::string& path, const char* option, const std::string& log) {
+  if (path.empty()) return;
+  CheckOutputPath(path, option, {log});
+}
+
+void RunMap(const MapArgs& a) {
+  for (const auto& [path, option] : {std::pair{a.output, "-o"}, {a.trajectory, "--trajectory"},
+                                     {a.dead_reckoning, "--dead-reckoning"}, {a.truth, "--truth"},
+                                     {a.json, "--json"}}) {
+    RequireOutput(path, option, a.log);
+  }
+  CheckCloudOutputPath(a.output, "-o", {a.log});
+  if (a.threads > 0) omp_set_num_threads(a.threads);
+  mapping::DiveMappingOptions options;
+  options.map_voxel_m = a.voxel_m;
+  options.mapper.sweeps_per_submap = a.sweeps_per_submap;
+  options.mapper.threads = a.threads;
+  options.table_cache = TableCache();
+  const mapping::DiveLogReader log(a.log);
+  mapping::DiveMapping m;
+  {
+    ProgressBar bar;
+    m = mapping::MapDive(log, options, [&bar](double f) { bar.Update("map", f); });
+  }
+  perception::WriteCloud(a.output, m.map);
+  if (!a.trajectory.empty()) mapping::WriteTum(a.trajectory, m.slam);
+  if (!a.dead_reckoning.empty()) mapping::WriteTum(a.dead_reckoning, m.dead_reckoning);
+  if (!a.truth.empty()) {
+    if (m.truth.empty()) throw Error("--truth " + a.truth + ": the log holds no ground truth (not simulated)");
+    mapping::WriteTum(a.truth, m.truth);
+  }
+  const mapping::MapSummary s = mapping::Summarise(m);
+  std::printf("%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
+              a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
+  std::printf("registrations %d (%d left to navigation, %d of them inconsistent with it), loops accepted %d, rejected %d\n",
+              m.stats.registrations, m.stats.registrations_failed + m.stats.registrations_inconsistent,
+              m.stats.registrations_inconsistent, s.loops_accepted, s.loops_rejected);
+  std::printf("dead reckoning as estimated: speed scale error %+.2f %%, misalignment %+.2f mrad\n",
+              100.0 * m.calibration.scale_error, 1000.0 * m.calibration.misalignment_rad);
+  std::printf("time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, graph %.2f s\n",
+              m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s, m.stats.graph_s);
+  if (m.expected_map_error_m) {
+    std::printf("expected map error from the poses' uncertainty: %.2f mm RMS along the normals\n",
+                *m.expected_map_error_m * 1e3);
+  }
+  if (m.navigation_noise_assumed) {
+    std::printf("navigation noise: not recorded in the log (schema 1), a typical AUV's assumed\n");
+  }
+  if (s.ate_slam_m) {
+    std::printf("against the truth: ATE dead reckoning %.4f m, SLAM %.4f m", *s.ate_dead_reckoning_m, *s.ate_slam_m);
+    if (s.nees_mean) std::printf(", NEES %.2f (6 for a consistent covariance)", *s.nees_mean);
+    std::printf("\n");
+  }
+  if (!a.json.empty()) WriteJsonFile(a.json, MapReportJson(m, a.log, a.output));
+}
+
+}  // namespace
+
+void AddMapCommand(CLI::App& app) {
+  auto args = std::make_shared<MapArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "map", "scan-matching SLAM over a dive log: map, trajectories, per-pose uncertainty, loop closures");
+  cmd->add_option("log", args->log, "dive log (.db)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "map to write (.ply or .pcd), voxelised")->required();
+  cmd->add_option("--trajectory", args->trajectory, "SLAM trajectory to write (TUM: t tx ty tz qx qy qz qw)");
+  cmd->add_option("--dead-reckoning", args->dead_reckoning, "the navigation at the same times (TUM)");
+  cmd->add_option("--truth", args->truth, "the true trajectory at the same times (TUM; simulated logs)");
+  cmd->add_option("--json", args->json,
+                  "report: trajectories, per-pose covariance and standard deviations, loops, figures");
+  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")->check(CLI::PositiveNumber);
+  cmd->add_option("--sweeps-per-submap", args->sweeps_per_submap, "sweeps grouped into one submap")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->threads, "threads (0: all cores); the output does not depend on it")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([args] { RunMap(*args); });
+}
+
+}  // namespace uwscan::app

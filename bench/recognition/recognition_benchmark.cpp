@@ -1,0 +1,430 @@
+#include "bench/recognition/recognition_benchmark.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <random>
+
+#include "bench/recognition/pose_nees.hpp"
+#include "bench/recognition/recognition_peers.hpp"
+#include "bench/recognition/recognition_scan_cache.hpp"
+#include "perception/preprocessing/normals.hpp"
+#include "perception/preprocessing/voxel_filter.hpp"
+#include "perception/recognition/object_database_builder.hpp"
+#include "perception/recognition/object_pose_search.hpp"
+#include "perception/recognition/object_recognizer.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/common/fnv1a.hpp"
+#include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/imr_objects.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+namespace sim = scanner::sim;
+using perception::ObjectDatabase;
+using perception::ObjectModel;
+using perception::PointCloud;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr const char* kForeignMeshes[] = {"bunny00", "rotor", "turbine", "anchor", "joint"};
+constexpr int kMinVisiblePoints = 300;  // an object with fewer scan points is not scored
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// The pose resting an object on the seabed (z = 0, up +z): its y_O up (valve stems), its z_O
+// axis horizontal at `yaw_rad`, at (x, y), lowest vertex on the seabed.
+Eigen::Isometry3d RestingPose(const scanner::TriangleMesh& mesh, double yaw_rad, double x, double y) {
+  Eigen::Matrix3d lay;
+  lay << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // x_O -> x, y_O -> z, z_O -> -y
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() * lay;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& v : mesh.vertices) lowest = std::min(lowest, (T.linear() * v).z());
+  T.translation() = Eigen::Vector3d(x, y, -lowest);
+  return T;
+}
+
+sim::SceneObject Object(const std::string& name, const scanner::TriangleMesh& mesh,
+                        const Eigen::Isometry3d& T_W_O) {
+  sim::SceneObject o;
+  o.name = name;
+  o.shape = sim::ObjectShape::kMesh;
+  o.mesh = mesh;
+  o.T_W_O = T_W_O;
+  o.reflectance = 0.5;
+  return o;
+}
+
+struct Scene {
+  std::vector<sim::SceneObject> objects;  // [0] seabed, then catalogue objects, then foreign
+  std::vector<std::string> classes;       // per object: catalogue id, "foreign" or "" (seabed)
+  Eigen::Isometry3d T_W_C;
+};
+
+Scene MakeScene(int index, const std::vector<perception::ObjectSource>& catalogue,
+                const std::vector<scanner::TriangleMesh>& foreign, std::uint64_t seed) {
+  std::mt19937_64 rng(seed * 7919 + static_cast<std::uint64_t>(index));
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Scene scene;
+  sim::SceneObject seabed;
+  seabed.name = "seabed";
+  seabed.shape = sim::ObjectShape::kPlane;
+  seabed.mesh = sim::MakeRectangle(4.0, 4.0);
+  seabed.reflectance = 0.3;
+  scene.objects.push_back(seabed);
+  scene.classes.push_back("");
+  // The target, in turn through the catalogue; a second catalogue object in half the scenes,
+  // touching the first in a third of those; a foreign mesh nearby.
+  const std::size_t first = static_cast<std::size_t>(index) % catalogue.size();
+  std::vector<std::pair<std::size_t, Eigen::Vector2d>> placed = {{first, {0.0, 0.0}}};
+  if (unit(rng) < 0.5) {
+    const std::size_t second = (first + 1 + static_cast<std::size_t>(unit(rng) * (catalogue.size() - 1))) % catalogue.size();
+    const double touching = unit(rng) < 0.33;
+    const double gap = 0.5 * (catalogue[first].mesh.BoundingBoxDiagonal() +
+                              catalogue[second].mesh.BoundingBoxDiagonal()) * (touching ? 0.55 : 1.0);
+    const double angle = 2.0 * std::numbers::pi * unit(rng);
+    placed.push_back({second, gap * Eigen::Vector2d(std::cos(angle), std::sin(angle))});
+  }
+  for (const auto& [k, xy] : placed) {
+    scene.objects.push_back(Object(catalogue[k].id, catalogue[k].mesh,
+                                   RestingPose(catalogue[k].mesh, 2.0 * std::numbers::pi * unit(rng), xy.x(), xy.y())));
+    scene.classes.push_back(catalogue[k].id);
+  }
+  if (!foreign.empty()) {
+    const scanner::TriangleMesh& mesh = foreign[static_cast<std::size_t>(index) % foreign.size()];
+    const double angle = 2.0 * std::numbers::pi * unit(rng);
+    const double distance = 0.25 + 0.5 * catalogue[first].mesh.BoundingBoxDiagonal();
+    scene.objects.push_back(Object("foreign", mesh,
+                                   RestingPose(mesh, 2.0 * std::numbers::pi * unit(rng),
+                                               distance * std::cos(angle), distance * std::sin(angle))));
+    scene.classes.push_back("foreign");
+  }
+  // The camera 0.5-1.5 m from the target, 35-90 degrees above the seabed.
+  const double range = 0.5 + unit(rng);
+  const double elevation = (35.0 + 55.0 * unit(rng)) * kDeg;
+  const double azimuth = 2.0 * std::numbers::pi * unit(rng);
+  const Eigen::Vector3d target = scene.objects[1].T_W_O.translation();
+  const Eigen::Vector3d eye =
+      target + range * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                                       std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+  const Eigen::Vector3d up = std::abs(std::sin(elevation)) > 0.99 ? Eigen::Vector3d::UnitX()
+                                                                  : Eigen::Vector3d::UnitZ();
+  scene.T_W_C = sim::LookAt(eye, target, up);
+  return scene;
+}
+
+// The database's models as the peers take them, with the views scanned again for their points.
+std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
+                                    const std::vector<perception::ObjectSource>& catalogue,
+                                    const sim::VirtualScanner& scanner, std::uint64_t seed, int threads) {
+  std::vector<PeerObject> peers(db.objects.size());
+  for (std::size_t k = 0; k < db.objects.size(); ++k) {
+    peers[k].id = db.objects[k].id;
+    peers[k].model = db.objects[k].model;
+    const std::vector<sim::SceneObject> scene = {
+        Object(catalogue[k].id, catalogue[k].mesh, Eigen::Isometry3d::Identity())};
+    std::vector<std::optional<PeerView>> views(db.objects[k].views.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int v = 0; v < static_cast<int>(views.size()); ++v) {
+      const Eigen::Isometry3d T_O_C = db.objects[k].views[static_cast<std::size_t>(v)].T_O_C;
+      const sim::VirtualScan scan = scanner.Scan(scene, T_O_C, seed + static_cast<std::uint64_t>(v));
+      const PointCloud cloud = perception::VoxelDownsample(
+          perception::MakeCloud(scan.points_C), perception::VoxelFilterOptions{db.parameters.voxel_m});
+      perception::EsfResult esf;
+#pragma omp critical(pcl_esf)
+      esf = perception::ComputePclEsf(cloud);  // PCL's ESF uses the global rand()
+      if (!esf.ok) continue;
+      PeerView view{esf.histogram, T_O_C, Eigen::Vector3d::Zero()};
+      for (std::size_t i = 0; i < cloud.size(); ++i) view.centroid_C += cloud.Point(i);
+      view.centroid_C /= static_cast<double>(cloud.size());
+      views[static_cast<std::size_t>(v)] = view;
+    }
+    for (const auto& v : views) {
+      if (v) peers[k].views.push_back(*v);
+    }
+  }
+  return peers;
+}
+
+// The offset left once the translation along the answer's reported free slides is taken out.
+Eigen::Vector3d OffsetAcrossFreeSlides(Eigen::Vector3d offset, const perception::RecognizedObject& reported) {
+  for (const perception::FreeDirection& f : reported.free_directions) {
+    if (f.kind == "unconstrained" && f.motion == "translation") offset -= offset.dot(f.axis_S) * f.axis_S;
+  }
+  return offset;
+}
+
+// Whether a pose is within 5 mm and 2 degrees of the truth (modulo symmetry) but for a slide
+// along the answer's reported free slides.
+bool PosedButForFreeSlides(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
+                           const perception::RecognizedObject& reported) {
+  return e.rotation_rad <= 2.0 * kDeg &&
+         OffsetAcrossFreeSlides(T_S_O.translation() - e.T_symmetric.translation(), reported).norm() <= 0.005;
+}
+
+// Whether a pose off the truth is right but for what its answer reports it cannot tell: one of
+// the equivalent poses is within 5 mm and 2 degrees (modulo symmetry), or the pose is once the
+// translation along its reported free slides is left out and it is turned about one of its
+// reported free rotation axes (searched by the degree over a full turn).
+bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
+                               const Eigen::Isometry3d& T_S_O_true, const std::vector<Eigen::Vector3d>& points,
+                               const ObjectModel& model, const perception::RecognizedObject* reported) {
+  if (reported == nullptr) return false;
+  for (const Eigen::Isometry3d& T : reported->equivalent_poses_S) {
+    const perception::SymmetricPoseError other =
+        perception::PoseErrorModuloSymmetry(T, T_S_O_true, points, model.symmetries);
+    if (other.rotation_rad <= 2.0 * kDeg && other.translation_m <= 0.005) return true;
+  }
+  if (PosedButForFreeSlides(e, T_S_O, *reported)) return true;
+  for (const perception::FreeDirection& f : reported->free_directions) {
+    if (f.kind != "unconstrained" || f.motion != "rotation") continue;
+    for (int degrees = -180; degrees < 180; ++degrees) {
+      const Eigen::Isometry3d turn = Eigen::Translation3d(f.point_S) *
+                                     Eigen::AngleAxisd(degrees * kDeg, f.axis_S) * Eigen::Translation3d(-f.point_S);
+      const Eigen::Isometry3d turned = turn * T_S_O;
+      const perception::SymmetricPoseError t =
+          perception::PoseErrorModuloSymmetry(turned, T_S_O_true, points, model.symmetries);
+      if (PosedButForFreeSlides(t, turned, *reported)) return true;
+    }
+  }
+  return false;
+}
+
+// Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
+// the pose error modulo symmetry when the answer is right.
+// `reported`: uwscan's answer, for its equivalent poses and free slides (none for the peers).
+std::optional<perception::SymmetricPoseError> Score(const std::string& truth, const std::string& answer,
+           const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
+           const ObjectDatabase& db, PipelineFigures& figures,
+           const perception::RecognizedObject* reported = nullptr) {
+  figures.confusion[truth][answer] += 1;
+  if (truth == "foreign") {
+    ++figures.foreign;
+    if (answer == "unknown") ++figures.foreign_unknown;
+    return std::nullopt;
+  }
+  ++figures.objects;
+  const bool reported_as_equivalent =
+      reported != nullptr && std::any_of(reported->equivalent_objects_S.begin(), reported->equivalent_objects_S.end(),
+                                         [&](const auto& e) { return e.first == truth; });
+  if (answer != truth || !T_S_O) {
+    figures.recognised_or_reported += reported_as_equivalent;
+    return std::nullopt;
+  }
+  ++figures.recognised;
+  ++figures.recognised_or_reported;
+  const ObjectModel& model = *std::find_if(db.objects.begin(), db.objects.end(),
+                                           [&](const ObjectModel& o) { return o.id == truth; });
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < model.model.size(); i += 4) points.push_back(model.model.Point(i));
+  const perception::SymmetricPoseError e =
+      perception::PoseErrorModuloSymmetry(*T_S_O, T_S_O_true, points, model.symmetries);
+  figures.rotation_errors_rad.push_back(e.rotation_rad);
+  figures.translation_errors_m.push_back(e.translation_m);
+  const bool posed = e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005;
+  figures.pose_success += posed;
+  figures.pose_or_reported += posed || PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, reported);
+  if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
+  if (reported != nullptr && e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
+    if (const auto nees = PoseNeesPerPinnedDirection(*T_S_O, e.T_symmetric, model.model.origin, reported->covariance)) {
+      figures.pose_nees_per_dimension.push_back(*nees);
+    }
+  }
+  if (model.grasps.empty()) return e;
+  const Eigen::Isometry3d& T_true = e.T_symmetric;
+  double worst_position = 0.0, worst_angle = 0.0;
+  for (const perception::GraspFrame& g : model.grasps) {
+    const Eigen::Isometry3d est = *T_S_O * g.T_O_G, truth_g = T_true * g.T_O_G;
+    worst_position = std::max(worst_position, (est.translation() - truth_g.translation()).norm());
+    const double c = std::clamp(est.linear().col(2).dot(truth_g.linear().col(2)), -1.0, 1.0);
+    worst_angle = std::max(worst_angle, std::acos(c));
+  }
+  figures.grasp_position_errors_m.push_back(worst_position);
+  figures.grasp_angle_errors_rad.push_back(worst_angle);
+  if (worst_position <= 0.005 && worst_angle <= 3.0 * kDeg) ++figures.grasp_success;
+  return e;
+}
+
+// What decides scan `s` of the bench: the simulator's code, its scene (objects, meshes, poses),
+// the camera, the noise seed and the rendering settings.
+CachedScanKey KeyOf(const Scene& scene, int s, const RecognitionBenchOptions& options) {
+  std::string bytes = kSimulatorSourceHash;
+  auto add = [&bytes](const auto* data, std::size_t count) {
+    bytes.append(reinterpret_cast<const char*>(data), count * sizeof(*data));
+  };
+  for (const sim::SceneObject& o : scene.objects) {
+    bytes += o.name;
+    add(o.T_W_O.matrix().data(), 16);
+    add(&o.reflectance, 1);
+    for (const Eigen::Vector3d& v : o.mesh.vertices) add(v.data(), 3);
+    for (const auto& t : o.mesh.triangles) add(t.data(), t.size());
+  }
+  add(scene.T_W_C.matrix().data(), 16);
+  const std::uint64_t seed = options.seed;
+  const int settings[] = {s, options.images ? 1 : 0, options.galvo_stride};
+  add(&seed, 1);
+  add(settings, 3);
+  return {s, Fnv1a64(bytes.data(), bytes.size())};
+}
+
+// Scan `s` of the bench, from the scan cache when it holds it (then saved there).
+sim::VirtualScan ScanOf(const Scene& scene, int s, const sim::VirtualScanner& scanner,
+                        const RecognitionBenchOptions& options) {
+  const CachedScanKey key = KeyOf(scene, s, options);
+  if (!options.scan_cache.empty()) {
+    if (std::optional<sim::VirtualScan> cached = LoadCachedScan(options.scan_cache, key)) return std::move(*cached);
+  }
+  sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, options.seed + 1000 + static_cast<std::uint64_t>(s));
+  if (!options.scan_cache.empty()) SaveCachedScan(options.scan_cache, key, scan);
+  return scan;
+}
+
+}  // namespace
+
+void RecognitionBenchOptions::Check() const {
+  if (scans < 1 || views < 1 || galvo_stride < 1 || threads < 1) {
+    throw Error("bench recognition: scans, views, stride and threads must be >= 1");
+  }
+}
+
+RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& options,
+                                           const Progress& progress) {
+  options.Check();
+  RecognitionBenchResult result;
+  std::vector<perception::ObjectSource> catalogue;
+  for (const std::string& name : perception::CatalogueNames()) {
+    catalogue.push_back(perception::CatalogueObject(name));
+  }
+  std::vector<scanner::TriangleMesh> foreign;
+  for (const char* name : kForeignMeshes) {
+    scanner::TriangleMesh mesh =
+        scanner::LoadMesh(options.data_cache / "meshes" / (std::string(name) + ".off"));
+    const double scale = 0.25 / mesh.BoundingBoxDiagonal();
+    for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
+    foreign.push_back(std::move(mesh));
+  }
+
+  sim::VirtualScannerOptions db_scan;
+  db_scan.pattern.kind = scanner::ScannerKind::kGalvo;
+  db_scan.pattern.galvo.step_stride = options.galvo_stride;
+  db_scan.table_cache = options.table_cache;
+  const scanner::Scanner galvo = scanner::DefaultScanner(scanner::ScannerKind::kGalvo);
+  const sim::VirtualScanner db_scanner(galvo, db_scan);
+  auto start = std::chrono::steady_clock::now();
+  perception::DatabaseBuildOptions build;
+  build.views = options.views;
+  build.seed = options.seed;
+  build.threads = options.threads;
+  const ObjectDatabase db = perception::BuildObjectDatabase(
+      catalogue, db_scanner, build,
+      [&](double f) { if (progress) progress("object database", f); });
+  result.database_seconds = Seconds(start);
+
+  sim::VirtualScannerOptions scene_scan = db_scan;
+  if (options.images) {
+    sim::SimulationEffects& e = scene_scan.effects;
+    e.peak_noise.on = false;
+    e.image.on = e.beam.on = e.sensor_noise.on = e.speckle.on = e.backscatter.on = e.ambient.on = true;
+    e.attenuation = true;
+  }
+  sim::Water water;
+  water.attenuation_per_m = 0.2;
+  scene_scan.water = water;
+  const sim::VirtualScanner scene_scanner(galvo, scene_scan);
+
+  std::optional<PclEsfPeer> pcl_peer;
+  std::optional<PpfPeer> ppf_peer;
+  if (options.run_peers) {
+    std::vector<PeerObject> peers = PeerObjects(db, catalogue, db_scanner, options.seed, options.threads);
+    if (options.run_ppf) {
+      ppf_peer.emplace(peers);
+      result.ppf_training_seconds = ppf_peer->training_seconds();
+    }
+    pcl_peer.emplace(std::move(peers));
+  }
+
+  perception::RecognitionCache cache(db);
+  perception::RecognitionOptions recognition;
+  recognition.seed = options.seed;
+  recognition.threads = options.threads;
+  for (int s = 0; s < options.scans; ++s) {
+    if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), s) == options.only.end()) continue;
+    ++result.scans;
+    const Scene scene = MakeScene(s, catalogue, foreign, options.seed);
+    start = std::chrono::steady_clock::now();
+    const sim::VirtualScan scan = ScanOf(scene, s, scene_scanner, options);
+    result.simulation_seconds += Seconds(start);
+    if (scan.points_C.empty()) continue;
+    const PointCloud cloud = perception::MakeCloud(scan.points_C);
+
+    start = std::chrono::steady_clock::now();
+    const perception::RecognitionResult answer = perception::RecognizeObjects(cloud, db, cache, recognition);
+    result.pipelines["uwscan"].seconds += Seconds(start);
+    for (const auto& [stage, seconds] : answer.stage_seconds) result.uwscan_stage_seconds[stage] += seconds;
+
+    // Each object of the scene with enough points, and the segment holding most of them.
+    for (std::size_t o = 1; o < scene.objects.size(); ++o) {
+      int visible = 0;
+      for (std::int32_t id : scan.object_index) visible += id == static_cast<int>(o);
+      if (visible < kMinVisiblePoints) continue;
+      int best_segment = -1, best_count = 0;
+      for (std::size_t k = 0; k < answer.objects.size(); ++k) {
+        int count = 0;
+        for (std::size_t i : answer.objects[k].segment) count += scan.object_index[i] == static_cast<int>(o);
+        if (count > best_count) best_count = count, best_segment = static_cast<int>(k);
+      }
+      const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
+      const std::string& truth = scene.classes[o];
+      if (best_segment < 0) {
+        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}, 0, 0});
+        Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
+        if (options.run_peers) {
+          Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
+          if (ppf_peer) Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["opencv_ppf"]);
+        }
+        continue;
+      }
+      const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
+      ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
+                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}, 0, 0};
+      for (const auto& [id, T] : ours.equivalent_objects_S) outcome.equivalent_objects.push_back(id);
+      for (const perception::FreeDirection& f : ours.free_directions) {
+        if (f.kind != "unconstrained") continue;
+        ++(f.motion == "translation" ? outcome.free_slides : outcome.free_turns);
+      }
+      if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"], &ours)) {
+        outcome.rotation_error_rad = e->rotation_rad;
+        outcome.translation_error_m = e->translation_m;
+      }
+      result.outcomes.push_back(std::move(outcome));
+      if (!options.run_peers) continue;
+      const PointCloud segment = perception::VoxelDownsample(
+          perception::Subset(cloud, ours.segment), perception::VoxelFilterOptions{db.parameters.voxel_m});
+      start = std::chrono::steady_clock::now();
+      const PeerAnswer pcl = pcl_peer->Recognize(segment);
+      result.pipelines["pcl_esf"].seconds += Seconds(start);
+      Score(truth, pcl.id, pcl.T_S_O, T_S_O_true, db, result.pipelines["pcl_esf"]);
+      if (!ppf_peer) continue;
+      start = std::chrono::steady_clock::now();
+      perception::NormalOptions normals;
+      normals.radius_m = db.parameters.normal_radius_m;
+      normals.threads = options.threads;
+      const perception::CloudWithNormals with_normals =
+          perception::AttachNormals(segment, perception::EstimateNormals(segment, normals));
+      const PeerAnswer ppf = ppf_peer->Recognize(with_normals.cloud);
+      result.pipelines["opencv_ppf"].seconds += Seconds(start);
+      Score(truth, ppf.id, ppf.T_S_O, T_S_O_true, db, result.pipelines["opencv_ppf"]);
+    }
+    if (progress) progress("scans", static_cast<double>(s + 1) / options.scans);
+  }
+  return result;
+}
+
+}  // namespace uwscan::bench

@@ -1,0 +1,91 @@
+#include "bench/registration/registration_benchmark.hpp"
+
+#include <functional>
+
+#include "bench/registration/registration_pipelines.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::bench {
+
+void RegistrationBenchOptions::Check() const {
+  if (threads < 1) throw Error("bench registration: threads must be >= 1");
+  if (!(max_rotation_error_rad > 0.0) || !(max_translation_fraction > 0.0)) {
+    throw Error("bench registration: success thresholds must be > 0");
+  }
+  pairs.Check();
+  for (const double f : sweep_voxel_fractions) {
+    if (!(f > 0.0 && f < 1.0)) throw Error("bench registration: a swept voxel fraction must be in (0, 1)");
+  }
+}
+
+namespace {
+
+using Runner = std::function<PipelineRun(const RegistrationPair&, const PipelineParameters&)>;
+
+// One pipeline over every pair; voxel_fraction > 0 sets the leaf to that fraction of each
+// object's size (0: the default, size / 50).
+PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
+                            const std::vector<RegistrationPair>& pairs, const RegistrationBenchOptions& o,
+                            double voxel_fraction, std::vector<PairOutcome>* outcomes, const Progress& progress) {
+  PipelineSummary summary;
+  double total_seconds = 0.0;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const RegistrationPair& pair = pairs[i];
+    const PipelineParameters parameters =
+        ParametersFor(pair.object_size_m, o.pairs.seed + i, o.threads, voxel_fraction * pair.object_size_m);
+    const PipelineRun run = run_pipeline(pair, parameters);
+    const PoseError error = ComparePoses(run.T_target_source, pair.T_target_source_true, pair.source.origin);
+    const double limit_m = o.max_translation_fraction * pair.object_size_m;
+    PairOutcome outcome;
+    outcome.pair = pair.name;
+    outcome.pipeline = name;
+    outcome.rotation_error_rad = error.rotation_rad;
+    outcome.translation_error_m = error.translation_m;
+    outcome.symmetric_error_m = SymmetricSurfaceError(pair.source, pair.surface, run.T_target_source,
+                                                     pair.T_target_source_true);
+    outcome.seconds = run.seconds;
+    outcome.success = error.rotation_rad < o.max_rotation_error_rad && error.translation_m < limit_m;
+    outcome.symmetric_success = outcome.symmetric_error_m < limit_m;
+    summary.successes += outcome.success ? 1 : 0;
+    summary.symmetric_successes += outcome.symmetric_success ? 1 : 0;
+    total_seconds += run.seconds;
+    for (const auto& [stage, seconds] : run.stage_seconds) {
+      summary.stage_seconds_per_pair[stage] += seconds / pairs.size();
+    }
+    if (outcomes) outcomes->push_back(outcome);
+    if (progress) progress(name + " pipeline", (i + 1.0) / pairs.size());
+  }
+  summary.pairs = static_cast<int>(pairs.size());
+  if (!pairs.empty()) {
+    summary.success_rate = summary.successes / double(pairs.size());
+    summary.symmetric_success_rate = summary.symmetric_successes / double(pairs.size());
+    summary.seconds_per_pair = total_seconds / pairs.size();
+  }
+  return summary;
+}
+
+}  // namespace
+
+RegistrationBenchResult RunRegistrationBenchmark(const RegistrationBenchOptions& o,
+                                                 const Progress& progress) {
+  o.Check();
+  if (progress) progress("loading and cutting the registration pairs", 0.0);
+  const std::vector<RegistrationPair> pairs = MakeRegistrationPairs(o.data_cache, o.pairs);
+  if (progress) progress("loading and cutting the registration pairs", 1.0);
+
+  std::vector<std::pair<std::string, Runner>> pipelines = {{"uwscan", RunUwscanPipeline}};
+  if (o.run_pcl) pipelines.emplace_back("pcl", RunPclPipeline);
+  if (o.run_open3d && Open3dAvailable()) pipelines.emplace_back("open3d", RunOpen3dPipeline);
+
+  RegistrationBenchResult result;
+  for (const auto& [name, run_pipeline] : pipelines) {
+    result.pipelines[name] = RunPipeline(name, run_pipeline, pairs, o, 0.0, &result.outcomes, progress);
+  }
+  for (const double fraction : o.sweep_voxel_fractions) {
+    const std::string what = "uwscan at voxel " + std::to_string(fraction) + " x size";
+    result.voxel_sweep.push_back({fraction, RunPipeline(what, RunUwscanPipeline, pairs, o, fraction, nullptr, progress)});
+  }
+  return result;
+}
+
+}  // namespace uwscan::bench

@@ -1,0 +1,66 @@
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bench/progress.hpp"
+#include "bench/registration/registration_pairs.hpp"
+
+namespace uwscan::bench {
+
+// uwscan's registration pipeline against PCL's stock one and Open3D's, on the same pairs, with
+// the same stage parameters, in one run.
+struct RegistrationBenchOptions {
+  std::filesystem::path data_cache;  // scripts/fetch_data.sh's folder
+  RegistrationPairOptions pairs;
+  int threads = 2;
+  double max_rotation_error_rad = 2.0 * 3.14159265358979323846 / 180.0;  // success: < 2 deg
+  double max_translation_fraction = 0.01;  // success: < 1 % of the object size
+  bool run_pcl = true;
+  bool run_open3d = true;
+  // uwscan's pipeline again at these voxel sizes (fractions of each object's size; the default
+  // is 1/50 = 0.02); empty: no sweep.
+  std::vector<double> sweep_voxel_fractions;
+
+  void Check() const;
+};
+
+struct PairOutcome {
+  std::string pair;
+  std::string pipeline;
+  double rotation_error_rad = 0.0;
+  double translation_error_m = 0.0;
+  double symmetric_error_m = 0.0;  // ADD-S (SymmetricSurfaceError)
+  double seconds = 0.0;
+  bool success = false;            // rotation and translation within the thresholds
+  bool symmetric_success = false;  // ADD-S within the translation threshold
+};
+
+struct PipelineSummary {
+  int pairs = 0;
+  int successes = 0;
+  double success_rate = 0.0;
+  int symmetric_successes = 0;  // judged by ADD-S: a symmetric object's equivalent poses pass
+  double symmetric_success_rate = 0.0;
+  double seconds_per_pair = 0.0;
+  std::map<std::string, double> stage_seconds_per_pair;
+};
+
+// uwscan's pipeline at one voxel size of the sweep.
+struct VoxelSweepRow {
+  double voxel_fraction = 0.0;  // of each object's size
+  PipelineSummary summary;
+};
+
+struct RegistrationBenchResult {
+  std::map<std::string, PipelineSummary> pipelines;  // "uwscan", "pcl", "open3d"
+  std::vector<PairOutcome> outcomes;
+  std::vector<VoxelSweepRow> voxel_sweep;
+};
+
+RegistrationBenchResult RunRegistrationBenchmark(const RegistrationBenchOptions& options,
+                                                 const Progress& progress = {});
+
+}  // namespace uwscan::bench

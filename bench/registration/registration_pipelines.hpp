@@ -1,0 +1,43 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "bench/registration/registration_pairs.hpp"
+
+namespace uwscan::bench {
+
+// The same stage parameters for every pipeline, scaled to the object: a fair comparison.
+struct PipelineParameters {
+  double voxel_m = 0.0;            // downsampling leaf
+  double normal_radius_m = 0.0;    // neighbourhood of the normals
+  double feature_radius_m = 0.0;   // FPFH support
+  double inlier_distance_m = 0.0;  // RANSAC inlier threshold
+  double icp_distance_m = 0.0;     // ICP correspondence distance
+  int ransac_iterations = 0;
+  std::uint64_t seed = 1;
+  int threads = 1;
+};
+// voxel_m > 0: that leaf (and the radii and distances scaled to it) instead of size / 50.
+PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads, double voxel_m = 0.0);
+
+// What one pipeline produced on one pair, and the time each stage took.
+struct PipelineRun {
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  std::map<std::string, double> stage_seconds;  // downsample, normals, features, coarse, icp
+  double seconds = 0.0;
+};
+
+// uwscan: voxel grid, normals, FPFH, seeded RANSAC with SVD and edge pre-rejection, ICP.
+PipelineRun RunUwscanPipeline(const RegistrationPair& pair, const PipelineParameters& p);
+// PCL's stock pipeline: VoxelGrid, NormalEstimationOMP, FPFHEstimationOMP,
+// SampleConsensusPrerejective, IterativeClosestPoint.
+PipelineRun RunPclPipeline(const RegistrationPair& pair, const PipelineParameters& p);
+// Open3D's: VoxelDownSample, EstimateNormals, ComputeFPFHFeature, RANSAC on feature matching,
+// RegistrationICP. Only when uwscan was built with Open3D (Open3dAvailable()).
+bool Open3dAvailable();
+PipelineRun RunOpen3dPipeline(const RegistrationPair& pair, const PipelineParameters& p);
+
+}  // namespace uwscan::bench

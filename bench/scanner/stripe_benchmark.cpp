@@ -1,0 +1,168 @@
+#include "bench/scanner/stripe_benchmark.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "scanner/common/error.hpp"
+#include "scanner/stripe/stripe_render.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Frames of one stripe, each with its own smooth curve crossing the middle of the image.
+std::vector<scanner::StripeFrame> MakeFrames(const StripeBenchOptions& o, double sigma_px,
+                                             double noise_sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<scanner::StripeFrame> frames;
+  for (int f = 0; f < o.frames; ++f) {
+    scanner::StripeRenderOptions render;
+    render.width_px = o.width_px;
+    render.height_px = o.height_px;
+    render.background = o.background;
+    render.noise_sigma = noise_sigma;
+    render.seed = seed + 1000 + f;
+    scanner::StripeSpec stripe;
+    stripe.sigma_px = sigma_px;
+    stripe.amplitude = o.amplitude;
+    stripe.centre.offset_px = o.height_px * (0.3 + 0.4 * unit(rng));
+    stripe.centre.pivot_px = 0.5 * o.width_px;
+    stripe.centre.slope = 0.08 * (unit(rng) - 0.5);
+    stripe.centre.wave_px = 0.05 * o.height_px * unit(rng);
+    stripe.centre.period_px = o.width_px * (0.3 + unit(rng));
+    stripe.centre.phase_rad = 6.283 * unit(rng);
+    frames.push_back(scanner::RenderStripes(render, {stripe}));
+  }
+  return frames;
+}
+
+struct Accuracy {
+  double rmse_px = 0.0;
+  double max_err_px = 0.0;
+  std::int64_t detected = 0;
+  std::int64_t lines = 0;
+};
+
+Accuracy MeasureAccuracy(scanner::StripeDetector& detector,
+                         const std::vector<scanner::StripeFrame>& frames) {
+  Accuracy a;
+  double sum2 = 0.0;
+  scanner::StripeDetection detection;
+  for (const scanner::StripeFrame& frame : frames) {
+    detector.Detect(frame.view(), &detection);
+    a.lines += detection.lines;
+    for (const scanner::StripePeak& peak : detection.peaks) {
+      const double e = peak.v_px - frame.truth_px[static_cast<size_t>(peak.u_px)];
+      sum2 += e * e;
+      a.max_err_px = std::max(a.max_err_px, std::abs(e));
+      ++a.detected;
+    }
+  }
+  a.rmse_px =
+      a.detected > 0 ? std::sqrt(sum2 / a.detected) : std::numeric_limits<double>::quiet_NaN();
+  return a;
+}
+
+// Frames per second of `process` over the frames: the fastest of o.repeats passes, each at
+// least o.min_seconds long, after one warm-up pass.
+template <typename Process>
+double MeasureSpeed(const std::vector<scanner::StripeFrame>& frames, const StripeBenchOptions& o,
+                    Process&& process) {
+  for (const scanner::StripeFrame& frame : frames) process(frame);
+  double best = 0.0;
+  for (int pass = 0; pass < o.repeats; ++pass) {
+    std::int64_t done = 0;
+    const Clock::time_point start = Clock::now();
+    double seconds = 0.0;
+    do {
+      for (const scanner::StripeFrame& frame : frames) process(frame);
+      done += std::ssize(frames);
+      seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    } while (seconds < o.min_seconds);
+    best = std::max(best, done / seconds);
+  }
+  return best;
+}
+
+// The limit pass: each column's running maximum over the rows, in row order. The sum of the
+// maxima goes to a sink the compiler cannot drop.
+class ColumnMaximumPass {
+ public:
+  explicit ColumnMaximumPass(int width_px) : max_(static_cast<size_t>(width_px)) {}
+  void operator()(const scanner::StripeFrame& frame) {
+    const scanner::StripeImage image = frame.view();
+    std::uint8_t* __restrict max = max_.data();
+    const int width = image.width_px;
+    std::fill(max, max + width, std::uint8_t{0});
+    for (int v = 0; v < image.height_px; ++v) {
+      const std::uint8_t* __restrict row = image.Row<std::uint8_t>(v);
+      for (int u = 0; u < width; ++u) max[u] = std::max(max[u], row[u]);
+    }
+    sink_ += max[static_cast<size_t>(width / 2)];
+  }
+  std::uint64_t sink() const { return sink_; }
+
+ private:
+  std::vector<std::uint8_t> max_;
+  std::uint64_t sink_ = 0;
+};
+
+}  // namespace
+
+void StripeBenchOptions::Check() const {
+  if (width_px < 16 || height_px < 16) throw Error("bench stripe: image must be at least 16x16");
+  if (height_px > 65535) throw Error("bench stripe: height_px must be <= 65535");
+  if (frames < 1) throw Error("bench stripe: --frames must be >= 1");
+  if (repeats < 1) throw Error("bench stripe: repeats must be >= 1");
+  if (!(min_seconds >= 0.0)) throw Error("bench stripe: min_seconds must be >= 0");
+  if (!(amplitude > 0.0) || !(background >= 0.0) || !(speed_noise_sigma >= 0.0)) {
+    throw Error("bench stripe: need amplitude > 0, background >= 0, speed_noise_sigma >= 0");
+  }
+}
+
+StripeBenchResult RunStripeBenchmark(const StripeBenchOptions& o, const Progress& progress) {
+  o.Check();
+  StripeBenchResult result;
+  result.default_method = scanner::ToString(scanner::StripeDetectorOptions{}.method);
+  if (progress) progress("rendering frames", 0.0);
+  const std::vector<scanner::StripeFrame> speed_frames =
+      MakeFrames(o, 1.5, o.speed_noise_sigma, o.seed);
+  if (progress) progress("rendering frames", 0.33);
+  const std::vector<scanner::StripeFrame> narrow = MakeFrames(o, 1.5, 0.0, o.seed + 1);
+  if (progress) progress("rendering frames", 0.67);
+  const std::vector<scanner::StripeFrame> wide = MakeFrames(o, 3.0, 0.0, o.seed + 2);
+  if (progress) progress("rendering frames", 1.0);
+
+  const std::span<const scanner::StripeMethod> methods = scanner::AllStripeMethods();
+  for (size_t i = 0; i < methods.size(); ++i) {
+    scanner::StripeDetectorOptions options;
+    options.method = methods[i];
+    scanner::StripeDetector detector(options);
+    StripeMethodFigures& f = result.methods[scanner::ToString(methods[i])];
+    const Accuracy a1 = MeasureAccuracy(detector, narrow);
+    const Accuracy a3 = MeasureAccuracy(detector, wide);
+    f.rmse_px_sigma1_5 = a1.rmse_px;
+    f.max_err_px_sigma1_5 = a1.max_err_px;
+    f.rmse_px_sigma3 = a3.rmse_px;
+    f.max_err_px_sigma3 = a3.max_err_px;
+    f.detected_fraction = static_cast<double>(a1.detected + a3.detected) / (a1.lines + a3.lines);
+    scanner::StripeDetection detection;
+    f.frames_per_s = MeasureSpeed(speed_frames, o, [&](const scanner::StripeFrame& frame) {
+      detector.Detect(frame.view(), &detection);
+    });
+    if (progress) progress("detecting", (i + 1.0) / methods.size());
+  }
+  ColumnMaximumPass limit(o.width_px);
+  result.limit_frames_per_s = MeasureSpeed(speed_frames, o, limit);
+  if (limit.sink() == 0) throw Error("bench stripe: the limit pass saw only black frames");
+  for (auto& [name, f] : result.methods) f.fraction_of_limit = f.frames_per_s / result.limit_frames_per_s;
+  return result;
+}
+
+}  // namespace uwscan::bench
