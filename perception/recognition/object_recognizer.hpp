@@ -32,8 +32,11 @@ struct RecognitionOptions {
   // Each start gets a short ICP on at most `sift_points` segment points; the `refined_starts`
   // best distinct ones by fit get the full ICP and the verification, and the best score wins
   // (poses the segment alone cannot tell apart, such as a valve body turned half a turn about
-  // its stem, differ in the surface they leave unseen, e.g. where the handle is).
-  int pose_views = 2;
+  // its stem, differ in the surface they leave unseen, e.g. where the handle is). On the
+  // recognition bench's 100 scans 2 views posed 80.6 % of the objects within 5 mm and 2 degrees,
+  // 3 80.8 %, 4 82.4 % (a lever valve no start had fitted, a flange 12 -> 1 degrees, a lever
+  // 50 -> 0.3 degrees), 6 the same as 4 in more time.
+  int pose_views = 4;
   int pose_rolls = 12;
   int sift_points = 200;
   int refined_starts = 3;
