@@ -21,6 +21,7 @@ struct SlamBenchArgs {
   std::string json;
   int seeds = 1;
   int threads = 2;
+  double walk_scale = 1.0;
   bool no_open3d = false;
 };
 
@@ -156,6 +157,7 @@ void RunSlamBench(const SlamBenchArgs& a) {
   for (const std::string& s : a.scenes) options.scenes.emplace_back(s);
   options.threads = a.threads;
   options.seeds = a.seeds;
+  options.walk_scale = a.walk_scale;
   options.run_open3d = !a.no_open3d;
   options.table_cache = TableCache();
   std::vector<bench::DiveFigures> dives;
@@ -179,6 +181,7 @@ void RunSlamBench(const SlamBenchArgs& a) {
                            {"duration_s", f.duration_s},
                            {"submaps", f.submaps},
                            {"threads", a.threads},
+                           {"walk_scale", a.walk_scale},
                            {"dr", TrajectoryJson(f.dead_reckoning)},
                            {"slam", slam},
                            {"true_poses_map", MapJson(f.true_poses_map)}};
@@ -203,6 +206,10 @@ void AddSlamBenchCommand(CLI::App& bench) {
   cmd->add_option("--seeds", a->seeds, "dives per scene: its own seed and the next ones (default 1)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", a->threads, "threads")->check(CLI::PositiveNumber);
+  cmd->add_option("--walk-scale", a->walk_scale,
+                  "multiply the navigation's random walks (position, heading) by this: what SLAM's error owes to "
+                  "the walk within each sweep (default 1)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { RunSlamBench(*a); });

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "bench/scratch_folder.hpp"
 #include "mapping/log/dive_simulation.hpp"
 #include "mapping/reconstruction/reconstruction.hpp"
@@ -168,7 +170,7 @@ DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t see
   DiveFigures f;
   f.name = scene_path.stem().string();
   f.seed = seed;
-  const std::string scene_text = WithSeed(ReadText(scene_path), f.seed);
+  const std::string scene_text = WithSeed(SceneWithWalkScale(ReadText(scene_path), options.walk_scale, scene_path), f.seed);
   const scanner::sim::Scene scene =
       scanner::sim::ParseScene(scene_text, scene_path.string(), scene_path.parent_path());
   if (scene.seed != f.seed) {
@@ -202,6 +204,24 @@ void SlamBenchOptions::Check() const {
   if (scenes.empty()) throw Error("bench slam: no scene");
   if (seeds < 1) throw Error("bench slam: seeds must be > 0");
   if (threads < 1) throw Error("bench slam: threads must be > 0");
+  if (!(std::isfinite(walk_scale) && walk_scale > 0.0)) {
+    throw Error("bench slam: walk scale must be a finite number > 0, got " + std::to_string(walk_scale));
+  }
+}
+
+std::string SceneWithWalkScale(const std::string& yaml_text, double scale, const std::filesystem::path& scene_path) {
+  if (scale == 1.0) return yaml_text;
+  YAML::Node root = YAML::Load(yaml_text);
+  YAML::Node drift = root["effects"] ? root["effects"]["navigation_drift"] : YAML::Node();
+  if (!drift || !drift.IsMap()) {
+    throw Error(scene_path.string() + ": a walk scale needs the scene's effects.navigation_drift");
+  }
+  for (const char* key : {"position_walk_m_per_sqrt_s", "yaw_walk_rad_per_sqrt_s"}) {
+    if (drift[key]) drift[key] = drift[key].as<double>() * scale;
+  }
+  YAML::Emitter out;
+  out << root;
+  return std::string(out.c_str()) + "\n";
 }
 
 std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Progress& progress) {

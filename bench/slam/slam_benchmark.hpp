@@ -19,6 +19,10 @@ struct SlamBenchOptions {
   // draw is luck, good or bad, as much as it is the mapper.
   int seeds = 1;
   int threads = 2;
+  // The scenes' navigation random walks (position and heading) multiplied by this, > 0: what
+  // SLAM's error owes to the walk within each sweep, which bends the sweep, against the DVL's
+  // scale error and misalignment, which this leaves as they are.
+  double walk_scale = 1.0;
   bool run_open3d = true;
   std::filesystem::path table_cache;
   void Check() const;
@@ -59,6 +63,11 @@ struct DiveFigures {
 };
 
 std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Progress& progress = {});
+
+// A scene's YAML text with its navigation's random walks (position and heading) multiplied by
+// `scale` (SlamBenchOptions::walk_scale), everything else as it was; the text itself when the
+// scale is 1. Throws naming `scene_path` when the scene has no navigation drift to scale.
+std::string SceneWithWalkScale(const std::string& yaml_text, double scale, const std::filesystem::path& scene_path);
 
 // Open3D's multiway registration (pairwise point-to-plane ICP of each submap with the three
 // before it and with the nearest older one its navigated position overlaps, about the pairs
