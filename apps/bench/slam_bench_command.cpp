@@ -60,6 +60,10 @@ void Print(const bench::DiveFigures& f) {
                 "allow)\n",
                 f.slam.map.rms_m * 1e3, *f.expected_map_error_m * 1e3);
   }
+  if (f.expected_ate_m) {
+    std::printf("SLAM ATE %.1f mm; its poses' covariance predicts %.1f mm\n", f.slam.ate_m * 1e3,
+                *f.expected_ate_m * 1e3);
+  }
   if (f.open3d) {
     std::printf("uwscan vs Open3D: ATE %.3f, time %.3f (uwscan's whole pipeline from the log vs Open3D's "
                 "registration and optimisation of the finished submaps)\n",
@@ -72,6 +76,7 @@ struct SceneSummary {
   std::string name;
   int seeds = 0;
   double ate_ratio_mean = 0.0, ate_ratio_max = 0.0;
+  double ate_mean_m = 0.0, expected_ate_mean_m = 0.0;  // SLAM's, measured and predicted
   double map_rms_mean_m = 0.0, map_ratio_mean = 0.0, expected_map_error_mean_m = 0.0;
   double nees_mean = 0.0, real_time_factor_mean = 0.0, real_time_factor_min = 0.0;
   int loops_false = 0;
@@ -92,6 +97,8 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
     ++it->seeds;
     it->ate_ratio_mean += ate_ratio;
     it->ate_ratio_max = std::max(it->ate_ratio_max, ate_ratio);
+    it->ate_mean_m += f.slam.ate_m;
+    it->expected_ate_mean_m += f.expected_ate_m.value_or(NAN);
     it->map_rms_mean_m += f.slam.map.rms_m;
     it->map_ratio_mean += f.slam.map.rms_m / f.dead_reckoning.map.rms_m;
     it->expected_map_error_mean_m += f.expected_map_error_m.value_or(NAN);
@@ -107,7 +114,7 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
   }
   for (SceneSummary& s : scenes) {
     const double n = s.seeds;
-    for (double* v : {&s.ate_ratio_mean, &s.map_rms_mean_m, &s.map_ratio_mean, &s.expected_map_error_mean_m,
+    for (double* v : {&s.ate_ratio_mean, &s.ate_mean_m, &s.expected_ate_mean_m, &s.map_rms_mean_m, &s.map_ratio_mean, &s.expected_map_error_mean_m,
                       &s.nees_mean, &s.real_time_factor_mean}) {
       *v /= n;
     }
@@ -119,11 +126,13 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
 
 void Print(const std::vector<SceneSummary>& scenes) {
   std::printf("\nOver the seeds (means; SLAM/DR ratios; the worst ATE ratio and real-time factor):\n");
-  std::printf("| dive | seeds | ATE ratio (worst) | map rms | map ratio | predicted map rms | NEES | real time (worst) "
-              "| false loops | uwscan/Open3D ATE, time |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf("| dive | seeds | ATE ratio (worst) | SLAM ATE | predicted ATE | map rms | map ratio | predicted map rms "
+              "| NEES | real time (worst) | false loops | uwscan/Open3D ATE, time |\n"
+              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const SceneSummary& s : scenes) {
-    std::printf("| %s | %d | %.3f (%.3f) | %.2f mm | %.3f | %.2f mm | %.2f | %.1fx (%.1fx) | %d | ", s.name.c_str(),
-                s.seeds, s.ate_ratio_mean, s.ate_ratio_max, s.map_rms_mean_m * 1e3, s.map_ratio_mean,
+    std::printf("| %s | %d | %.3f (%.3f) | %.1f mm | %.1f mm | %.2f mm | %.3f | %.2f mm | %.2f | %.1fx (%.1fx) | %d | ",
+                s.name.c_str(), s.seeds, s.ate_ratio_mean, s.ate_ratio_max, s.ate_mean_m * 1e3,
+                s.expected_ate_mean_m * 1e3, s.map_rms_mean_m * 1e3, s.map_ratio_mean,
                 s.expected_map_error_mean_m * 1e3, s.nees_mean, s.real_time_factor_mean, s.real_time_factor_min,
                 s.loops_false);
     if (s.open3d_ate_ratio_mean) {
@@ -139,6 +148,8 @@ nlohmann::json SummaryJson(const SceneSummary& s) {
           {"seeds", s.seeds},
           {"ate_ratio_mean", s.ate_ratio_mean},
           {"ate_ratio_max", s.ate_ratio_max},
+          {"ate_mean_m", s.ate_mean_m},
+          {"expected_ate_mean_m", s.expected_ate_mean_m},
           {"map_rms_mean_m", s.map_rms_mean_m},
           {"map_ratio_mean", s.map_ratio_mean},
           {"expected_map_error_mean_m", s.expected_map_error_mean_m},
@@ -176,6 +187,7 @@ void RunSlamBench(const SlamBenchArgs& a) {
     slam["real_time_factor"] = f.real_time_factor;
     slam["expected_map_error_m"] =
         f.expected_map_error_m ? nlohmann::json(*f.expected_map_error_m) : nlohmann::json(nullptr);
+    slam["expected_ate_m"] = f.expected_ate_m ? nlohmann::json(*f.expected_ate_m) : nlohmann::json(nullptr);
     nlohmann::json dive = {{"name", f.name},
                            {"seed", f.seed},
                            {"duration_s", f.duration_s},

@@ -100,7 +100,8 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
                        {"rpe_slam_per_m", Optional(s.rpe_slam_per_m)},
                        {"rpe_dead_reckoning_per_m", Optional(s.rpe_dead_reckoning_per_m)},
                        {"nees_mean", Optional(s.nees_mean)},
-                       {"expected_map_error_m", Optional(m.expected_map_error_m)}};
+                       {"expected_map_error_m", Optional(m.expected_map_error_m)},
+                       {"expected_position_error_m", Optional(m.expected_position_error_m)}};
   return report;
 }
 
@@ -149,6 +150,10 @@ void RunMap(const MapArgs& a) {
   if (m.expected_map_error_m) {
     std::printf("expected map error from the poses' uncertainty: %.2f mm RMS along the normals\n",
                 *m.expected_map_error_m * 1e3);
+  }
+  if (m.expected_position_error_m) {
+    std::printf("expected position error from the poses' uncertainty: %.2f mm RMS (what the ATE should come to)\n",
+                *m.expected_position_error_m * 1e3);
   }
   if (m.navigation_noise_assumed) {
     std::printf("navigation noise: not recorded in the log (schema 1), a typical AUV's assumed\n");

@@ -139,6 +139,7 @@ void MapAndMeasure(const std::filesystem::path& log_path, const scanner::sim::Sc
   f.nees_mean = s.nees_mean;
   f.real_time_factor = s.real_time_factor;
   f.expected_map_error_m = m.expected_map_error_m;
+  f.expected_ate_m = m.expected_position_error_m;
 
   const scanner::sim::RayCaster caster(scene.objects);
   if (progress) progress("surface distances " + label, 0.0);

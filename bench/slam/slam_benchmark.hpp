@@ -58,6 +58,9 @@ struct DiveFigures {
   // alone (mapping::ExpectedSurfaceErrorRms): with a consistent covariance, what the
   // navigation and the scene allow.
   std::optional<double> expected_map_error_m;
+  // The SLAM trajectory's RMS position error as its covariance predicts it (what the ATE should
+  // come to: ExpectedPositionErrorRms).
+  std::optional<double> expected_ate_m;
   double real_time_factor = 0.0;
   double simulate_seconds = 0.0;
 };

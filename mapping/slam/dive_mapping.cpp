@@ -86,6 +86,7 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
   if (result.truth.size() != result.slam.size()) result.truth.clear();
   if (const std::optional<Mapper::SubmapCovariances> covariances = mapper.Covariances()) {
     result.covariances = covariances->anchors;
+    result.expected_position_error_m = ExpectedPositionErrorRms(covariances->anchors);
     std::vector<const perception::PointCloud*> clouds;
     std::vector<Eigen::Isometry3d> placed;
     for (int i = 0; i < mapper.submap_count(); ++i) {

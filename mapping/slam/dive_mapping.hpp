@@ -33,6 +33,9 @@ struct DiveMapping {
   // The map's expected distance to the true surfaces from its poses' uncertainty alone (RMS
   // along the normals, ExpectedSurfaceErrorRms); empty with the covariances.
   std::optional<double> expected_map_error_m;
+  // The trajectory's expected RMS position error from the same covariances (what the ATE should
+  // come to, ExpectedPositionErrorRms); empty with them.
+  std::optional<double> expected_position_error_m;
   std::vector<LoopClosure> loops;
   perception::PointCloud map;             // voxelised, world frame (SLAM poses)
   // Each submap's cloud in its own frame (normals attached), for peers that take the same

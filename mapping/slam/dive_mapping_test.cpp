@@ -100,6 +100,10 @@ TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
   EXPECT_LT(*s.nees_mean, 3.0 * 6.0);
   EXPECT_EQ(s.loops_false.value_or(-1), 0);
   for (const Matrix6d& c : m.covariances) EXPECT_GT(PoseStd(c).head<2>().minCoeff(), 0.0);
+  // The ATE is what the covariance predicts for it (one dive: one draw of the errors).
+  ASSERT_TRUE(m.expected_position_error_m.has_value() && s.ate_slam_m.has_value());
+  EXPECT_GT(*s.ate_slam_m, 0.5 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
+  EXPECT_LT(*s.ate_slam_m, 2.0 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
 }
 
 TEST_F(DiveMappingTest, TheMapsExpectedErrorIsWhatItsDistanceToTheTruthComesTo) {

@@ -36,4 +36,18 @@ double ExpectedSurfaceErrorRms(const std::vector<const perception::PointCloud*>&
   return count == 0 ? 0.0 : std::sqrt(sum / static_cast<double>(count));
 }
 
+double ExpectedPositionErrorRms(const std::vector<Matrix6d>& covariances) {
+  if (covariances.empty()) throw Error("expected position error: no pose covariances");
+  double sum = 0.0;
+  for (std::size_t i = 0; i < covariances.size(); ++i) {
+    const double variance = covariances[i].bottomRightCorner<3, 3>().trace();
+    if (!(variance >= 0.0 && std::isfinite(variance))) {
+      throw Error("expected position error: pose " + std::to_string(i) + " has position variance " +
+                  std::to_string(variance) + ", expected finite and >= 0");
+    }
+    sum += variance;
+  }
+  return std::sqrt(sum / static_cast<double>(covariances.size()));
+}
+
 }  // namespace uwscan::mapping

@@ -21,4 +21,12 @@ double ExpectedSurfaceErrorRms(const std::vector<const perception::PointCloud*>&
                                const std::vector<Eigen::Isometry3d>& T_W_V, const std::vector<Matrix6d>& covariances,
                                std::size_t stride = 1);
 
+// How far the poses are expected to lie from the true ones from their covariance alone: the
+// square root of the mean over the poses of their position variance (the trace of the position
+// block of each [rotation, position] covariance). With a consistent covariance this is what the
+// ATE (RMS position error, no alignment) should come to: the navigation and the scene's
+// information allow no better. Throws uwscan::Error when `covariances` is empty or a position
+// variance is negative or not finite.
+double ExpectedPositionErrorRms(const std::vector<Matrix6d>& covariances);
+
 }  // namespace uwscan::mapping

@@ -98,5 +98,47 @@ TEST(ExpectedSurfaceError, MismatchedInputsGiveAClearError) {
   says(ErrorOf([&] { ExpectedSurfaceErrorRms({&seabed}, {pose}, {Matrix6d::Identity()}, 0); }), "stride must be > 0");
 }
 
+TEST(ExpectedPositionError, IsTheRmsOfPositionErrorsDrawnFromTheCovariancesAndIgnoresRotation) {
+  // Two poses: one uncertain in x and y, one in depth and with a large, correlated rotation
+  // (a turn about the pose's own position does not move it).
+  Matrix6d sideways = Matrix6d::Zero();
+  sideways(3, 3) = 0.004 * 0.004;
+  sideways(4, 4) = 0.002 * 0.002;
+  sideways(3, 4) = sideways(4, 3) = 0.5 * 0.004 * 0.002;
+  Matrix6d turned = Matrix6d::Zero();
+  turned.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * 0.05 * 0.05;
+  turned(5, 5) = 0.001 * 0.001;
+  turned(2, 5) = turned(5, 2) = 0.5 * 0.05 * 0.001;
+  const double expected = ExpectedPositionErrorRms({sideways, turned});
+  EXPECT_NEAR(expected, std::sqrt((16e-6 + 4e-6 + 1e-6) / 2.0), 1e-15);
+
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal;
+  double sum = 0.0;
+  const int draws = 20000;
+  for (const Matrix6d& covariance : {sideways, turned}) {
+    const Eigen::LDLT<Matrix6d> ldlt(covariance);  // semi-definite: LDLT, not LLT
+    const Matrix6d L = ldlt.transpositionsP().transpose() * Matrix6d(ldlt.matrixL()) *
+                       ldlt.vectorD().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    for (int draw = 0; draw < draws; ++draw) {
+      Eigen::Matrix<double, 6, 1> z;
+      for (int k = 0; k < 6; ++k) z(k) = normal(rng);
+      sum += (L * z).tail<3>().squaredNorm();
+    }
+  }
+  const double sampled = std::sqrt(sum / (2.0 * draws));
+  EXPECT_NEAR(expected / sampled, 1.0, 0.02) << expected << " m predicted, " << sampled << " m sampled";
+}
+
+TEST(ExpectedPositionError, NoCovarianceOrABrokenOneGivesAClearError) {
+  const auto says = [](const std::string& message, const char* what) {
+    EXPECT_NE(message.find(what), std::string::npos) << "'" << message << "' does not say '" << what << "'";
+  };
+  says(ErrorOf([] { ExpectedPositionErrorRms({}); }), "no pose covariances");
+  Matrix6d broken = Matrix6d::Identity();
+  broken(4, 4) = std::nan("");
+  says(ErrorOf([&] { ExpectedPositionErrorRms({Matrix6d::Identity(), broken}); }), "pose 1 has position variance");
+}
+
 }  // namespace
 }  // namespace uwscan::mapping::test
