@@ -32,6 +32,13 @@ mkdir -p docs
 "$UWSCAN" view "$work/map.json" --camera top --ellipsoid-every 2 --screenshot docs/map_inspection_short.png \
   --size 1280x800
 
+# The looping dive's SLAM map from above, coloured by its distance to the scene's true surfaces
+# (README, "What limits it"): the error sits on the faces that look along the track.
+"$UWSCAN" simulate data/scenes/inspection_loop.yaml -o "$work/loop.db" >/dev/null
+"$UWSCAN" map "$work/loop.db" -o "$work/loop.ply" >/dev/null
+"$UWSCAN" view "$work/loop.ply" --scene data/scenes/inspection_loop.yaml --camera top --range 0 0.01 --point-size 1 \
+  --screenshot docs/map_inspection_loop_error.png --size 560x1280
+
 # Trade-offs: triangulation methods (and their tables' resolutions) and stripe detectors,
 # accuracy against time.
 "$UWSCAN" bench triangulation --points 1000000 --sweep-grid-px 1 2 4 8 16 --sweep-rays-per-fan 9 17 35 70 \

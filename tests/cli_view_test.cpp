@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -103,6 +105,38 @@ TEST(CliView, BadInputGivesOneLineNamingIt) {
   EXPECT_NE(error.output.find("no ground truth"), std::string::npos) << error.output;
   fs::remove(unknown);
   fs::remove(cloud);
+}
+
+// A cloud of a simulated scene, coloured by its distance to the scene's true surfaces: points
+// 3 to 9 mm outside a sphere of the scene give a colour range within those distances.
+TEST(CliView, ACloudIsColouredByItsDistanceToTheScenesSurfaces) {
+  const fs::path scene = TempPath("ball.yaml"), cloud = TempPath("ball.xyz"), png = TempPath("ball.png");
+  std::ofstream(scene) << "uwscan_format: 1\nscanner: {file: " << SourcePath("data/scanners/galvo_default.yaml")
+                       << "}\nobjects:\n  - {name: ball, shape: sphere, radius_m: 0.2,\n"
+                          "     pose: {translation_m: [0, 0, 1], rotation_xyzw: [0, 0, 0, 1]}}\n";
+  {
+    std::ofstream out(cloud);
+    for (int i = 0; i < 100; ++i) {
+      const double r = 0.203 + 0.006 * i / 99.0, a = 0.0628 * i;
+      out << r * std::cos(a) << " " << r * std::sin(a) << " 1\n";
+    }
+  }
+  const CommandRun run =
+      RunUwscan("view " + cloud.string() + " --scene " + scene.string() + " --screenshot " + png.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("1 cloud coloured by the distance to its surfaces"), std::string::npos) << run.output;
+  double lo = 0.0, hi = 0.0;
+  const std::size_t at = run.output.find("colour by error (");
+  ASSERT_NE(at, std::string::npos) << run.output;
+  ASSERT_EQ(std::sscanf(run.output.c_str() + at, "colour by error (%lf .. %lf)", &lo, &hi), 2) << run.output;
+  EXPECT_GE(lo, 0.0029) << run.output;
+  EXPECT_LE(hi, 0.0091) << run.output;
+  EXPECT_GT(hi - lo, 0.005) << run.output;
+  // Without a scene a plain cloud has no error to show, and says how to give it one.
+  const CommandRun bare = RunUwscan("view " + cloud.string() + " --colour error --screenshot " + png.string());
+  EXPECT_EQ(bare.exit_code, 1);
+  EXPECT_NE(bare.output.find("--scene"), std::string::npos) << bare.output;
+  for (const fs::path& p : {scene, cloud, png}) fs::remove(p);
 }
 
 // A hand-made map report in the format `uwscan map --json` writes: its map, three trajectories

@@ -14,7 +14,10 @@
 #include "viewer/render/interactive_view.hpp"
 #include "viewer/render/live_view.hpp"
 #include "viewer/render/screenshot.hpp"
+#include "scanner/sim/ray_caster.hpp"
+#include "scanner/sim/scene.hpp"
 #include "viewer/scene/scene_files.hpp"
+#include "viewer/scene/surface_error.hpp"
 
 namespace uwscan::app {
 namespace {
@@ -37,7 +40,11 @@ struct ViewArgs {
   std::int64_t frames = 0;
   double timeout_s = 0.0;
   double decay_s = 0.0;
+  std::string scene;  // a simulated scene: clouds coloured by their distance to its surfaces
 };
+
+// How far from the scene's surfaces a point still gets a distance (beyond: no value).
+constexpr double kSurfaceSearch_m = 0.5;
 
 // "WxH" -> width, height in pixels.
 std::pair<int, int> ParseSize(const std::string& text) {
@@ -69,7 +76,10 @@ viewer::RenderOptions RenderOptionsFrom(const ViewArgs& a) {
   // A recognition report's scan is in the sensor's frame (y down): by default it is coloured by
   // object (a segment and its model share a colour) and shown upright as the sensor saw it.
   const bool recognition = ShowsARecognitionReport(a);
-  const std::string colour_name = !a.colour.empty() ? a.colour : recognition ? "object" : "height";
+  const std::string colour_name = !a.colour.empty()     ? a.colour
+                                  : recognition         ? "object"
+                                  : !a.scene.empty()    ? "error"
+                                                        : "height";
   const std::optional<viewer::ColourMode> colour = viewer::ParseColourMode(colour_name);
   if (!colour) throw Error("--colour " + colour_name + ": use height, error, intensity or object");
   o.colour = *colour;
@@ -138,7 +148,10 @@ void RunFollow(const ViewArgs& a, const viewer::RenderOptions& render) {
 void RunView(const ViewArgs& a) {
   const viewer::RenderOptions render = RenderOptionsFrom(a);
   viewer::RequireDisplay();  // before minutes of reading and reconstructing, not after
-  if (a.follow) return RunFollow(a, render);
+  if (a.follow) {
+    if (!a.scene.empty()) throw Error("--scene: not with --follow (a followed log carries its own truth)");
+    return RunFollow(a, render);
+  }
   viewer::Scene scene;
   viewer::MapReportDrawing map_drawing;
   map_drawing.ellipsoid_every = a.ellipsoid_every;
@@ -153,6 +166,12 @@ void RunView(const ViewArgs& a) {
     } else {
       viewer::AddFile(file, log_options, map_drawing, scene);
     }
+  }
+  if (!a.scene.empty()) {
+    const scanner::sim::RayCaster truth(scanner::sim::LoadScene(a.scene).objects);
+    const std::size_t filled = viewer::SetSurfaceError(truth, kSurfaceSearch_m, scene);
+    std::printf("%s: %zu cloud%s coloured by the distance to its surfaces\n", a.scene.c_str(), filled,
+                filled == 1 ? "" : "s");
   }
   if (a.screenshot.empty()) {
     viewer::ShowScene(scene, render, "uwscan view");
@@ -174,8 +193,8 @@ void AddViewCommand(CLI::App& app) {
                           "(.txt .tum), dive logs (.db), map and recognition reports (.json); keys: ") + viewer::kViewKeys);
   cmd->add_option("files", a->files, "files to show")->required();
   cmd->add_option("--colour,--color", a->colour,
-                  "height, error (simulated dive logs), intensity or object (default: object with a recognition "
-                  "report, else height)");
+                  "height, error (simulated dive logs, or clouds given --scene), intensity or object (default: "
+                  "object with a recognition report, error with --scene, else height)");
   cmd->add_option("--range", a->range, "fixed colour range LOW HIGH (metres for height and error)")->expected(2);
   cmd->add_option("--point-size", a->point_size_px, "point size in pixels");
   cmd->add_flag("--edl", a->edl, "Eye-Dome Lighting: shades points by depth so shapes read without colour");
@@ -188,6 +207,10 @@ void AddViewCommand(CLI::App& app) {
                   "whose scan is in the sensor's frame)")
       ->expected(3);
   cmd->add_option("--method", a->method, "dive logs: plane, cone or ray (default: the scanner's)");
+  cmd->add_option("--scene", a->scene,
+                  "a simulated scene (.yaml): colour the clouds (e.g. a map of a dive simulated from it) by their "
+                  "distance to its true surfaces")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
   cmd->add_flag("--no-colour-bar", a->no_colour_bar, "no colour bar");
   cmd->add_option("--ellipsoid-every", a->ellipsoid_every, "map reports: a 3-sigma ellipsoid every N poses")

@@ -17,7 +17,8 @@ std::vector<float> PointScalars(const CloudLayer& layer, ColourMode mode, const 
   if (mode == ColourMode::kError) {
     if (layer.error_m.size() != layer.size()) {
       throw Error("colour by error: " + layer.name +
-                  " has no ground truth (only simulated dive logs have it)");
+                  " has no ground truth (simulated dive logs have it; give any other cloud of a simulated "
+                  "scene its scene with --scene)");
     }
     values = &layer.error_m;
   } else if (mode == ColourMode::kIntensity) {
