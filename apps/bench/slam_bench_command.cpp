@@ -114,8 +114,8 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
   }
   for (SceneSummary& s : scenes) {
     const double n = s.seeds;
-    for (double* v : {&s.ate_ratio_mean, &s.ate_mean_m, &s.expected_ate_mean_m, &s.map_rms_mean_m, &s.map_ratio_mean, &s.expected_map_error_mean_m,
-                      &s.nees_mean, &s.real_time_factor_mean}) {
+    for (double* v : {&s.ate_ratio_mean, &s.ate_mean_m, &s.expected_ate_mean_m, &s.map_rms_mean_m,
+                      &s.map_ratio_mean, &s.expected_map_error_mean_m, &s.nees_mean, &s.real_time_factor_mean}) {
       *v /= n;
     }
     if (s.open3d_ate_ratio_mean) *s.open3d_ate_ratio_mean /= n;

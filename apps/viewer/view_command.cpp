@@ -9,13 +9,13 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/sim/ray_caster.hpp"
+#include "scanner/sim/scene.hpp"
 #include "viewer/render/display.hpp"
 #include "viewer/render/dive_log_follower.hpp"
 #include "viewer/render/interactive_view.hpp"
 #include "viewer/render/live_view.hpp"
 #include "viewer/render/screenshot.hpp"
-#include "scanner/sim/ray_caster.hpp"
-#include "scanner/sim/scene.hpp"
 #include "viewer/scene/scene_files.hpp"
 #include "viewer/scene/surface_error.hpp"
 
@@ -76,10 +76,10 @@ viewer::RenderOptions RenderOptionsFrom(const ViewArgs& a) {
   // A recognition report's scan is in the sensor's frame (y down): by default it is coloured by
   // object (a segment and its model share a colour) and shown upright as the sensor saw it.
   const bool recognition = ShowsARecognitionReport(a);
-  const std::string colour_name = !a.colour.empty()     ? a.colour
-                                  : recognition         ? "object"
-                                  : !a.scene.empty()    ? "error"
-                                                        : "height";
+  const std::string colour_name = !a.colour.empty() ? a.colour
+                                  : recognition     ? "object"
+                                  : !a.scene.empty() ? "error"
+                                                     : "height";
   const std::optional<viewer::ColourMode> colour = viewer::ParseColourMode(colour_name);
   if (!colour) throw Error("--colour " + colour_name + ": use height, error, intensity or object");
   o.colour = *colour;

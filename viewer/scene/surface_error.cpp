@@ -23,7 +23,8 @@ std::size_t SetSurfaceError(const scanner::sim::RayCaster& truth, double max_dis
 #pragma omp parallel for schedule(dynamic, 4096)
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(layer.size()); ++i) {
       try {
-        const std::optional<double> d = truth.DistanceToSurface(layer.Point(static_cast<std::size_t>(i)), max_distance_m);
+        const std::optional<double> d =
+            truth.DistanceToSurface(layer.Point(static_cast<std::size_t>(i)), max_distance_m);
         if (d) error[static_cast<std::size_t>(i)] = static_cast<float>(*d);
       } catch (...) {
 #pragma omp critical
