@@ -220,7 +220,7 @@ void AddSlamBenchCommand(CLI::App& bench) {
   cmd->add_option("--threads", a->threads, "threads")->check(CLI::PositiveNumber);
   cmd->add_option("--walk-scale", a->walk_scale,
                   "multiply the navigation's random walks (position, heading) by this: what SLAM's error owes to "
-                  "the walk within each sweep (default 1)")
+                  "them (default 1)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
   cmd->add_option("--json", a->json, "write the figures as JSON");

@@ -171,7 +171,8 @@ DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t see
   DiveFigures f;
   f.name = scene_path.stem().string();
   f.seed = seed;
-  const std::string scene_text = WithSeed(SceneWithWalkScale(ReadText(scene_path), options.walk_scale, scene_path), f.seed);
+  const std::string scene_text =
+      WithSeed(SceneWithWalkScale(ReadText(scene_path), options.walk_scale, scene_path), f.seed);
   const scanner::sim::Scene scene =
       scanner::sim::ParseScene(scene_text, scene_path.string(), scene_path.parent_path());
   if (scene.seed != f.seed) {
@@ -212,7 +213,12 @@ void SlamBenchOptions::Check() const {
 
 std::string SceneWithWalkScale(const std::string& yaml_text, double scale, const std::filesystem::path& scene_path) {
   if (scale == 1.0) return yaml_text;
-  YAML::Node root = YAML::Load(yaml_text);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw Error(scene_path.string() + ": not YAML (" + e.what() + ")");
+  }
   YAML::Node drift = root["effects"] ? root["effects"]["navigation_drift"] : YAML::Node();
   if (!drift || !drift.IsMap()) {
     throw Error(scene_path.string() + ": a walk scale needs the scene's effects.navigation_drift");

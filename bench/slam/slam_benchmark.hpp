@@ -20,8 +20,8 @@ struct SlamBenchOptions {
   int seeds = 1;
   int threads = 2;
   // The scenes' navigation random walks (position and heading) multiplied by this, > 0: what
-  // SLAM's error owes to the walk within each sweep, which bends the sweep, against the DVL's
-  // scale error and misalignment, which this leaves as they are.
+  // SLAM's error owes to the walk (within each sweep and between the places the scans pin),
+  // against the DVL's scale error and misalignment, which this leaves as they are.
   double walk_scale = 1.0;
   bool run_open3d = true;
   std::filesystem::path table_cache;
@@ -69,7 +69,8 @@ std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Pro
 
 // A scene's YAML text with its navigation's random walks (position and heading) multiplied by
 // `scale` (SlamBenchOptions::walk_scale), everything else as it was; the text itself when the
-// scale is 1. Throws naming `scene_path` when the scene has no navigation drift to scale.
+// scale is 1. Throws naming `scene_path` when the text is not YAML or the scene has no navigation
+// drift to scale.
 std::string SceneWithWalkScale(const std::string& yaml_text, double scale, const std::filesystem::path& scene_path);
 
 // Open3D's multiway registration (pairwise point-to-plane ICP of each submap with the three

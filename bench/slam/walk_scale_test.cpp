@@ -52,6 +52,7 @@ TEST(SlamBenchWalkScale, ASceneWithoutNavigationDriftIsRefusedByName) {
     EXPECT_NE(std::string(e.what()).find("default.yaml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("navigation_drift"), std::string::npos) << e.what();
   }
+  EXPECT_THROW(SceneWithWalkScale("effects: [unclosed", 0.5, path), Error);
 }
 
 }  // namespace
