@@ -72,6 +72,7 @@ void WriteReport(const InspectArgs& a, const ReadSummary& r, const mapping::Insp
                          {"frames_logged", s.frames_logged},
                          {"frames_mapped", s.frames_mapped},
                          {"frames_skipped", s.frames_skipped},
+                         {"frames_without_navigation", s.frames_without_navigation},
                          {"frames_out_of_order", s.frames_out_of_order},
                          {"clock_restarts", s.clock_restarts},
                          {"lost_frames", r.source.lost_frames},
@@ -187,6 +188,10 @@ void RunInspect(const InspectArgs& a) {
               read.seconds > 0 ? read.frames / read.seconds : 0.0, static_cast<long long>(read.source.lost_frames),
               static_cast<long long>(read.undecodable), static_cast<long long>(s.frames_logged),
               static_cast<long long>(s.frames_mapped), static_cast<long long>(s.frames_skipped), a.live_queue);
+  if (s.frames_without_navigation > 0) {
+    std::printf("inspect: %lld frames logged but not mapped: no navigation around their time\n",
+                static_cast<long long>(s.frames_without_navigation));
+  }
   std::printf("inspect: latency to the map, receive -> map median %.2f ms (p95 %.2f, max %.2f)", s.receive_to_map.median_s * 1e3,
               s.receive_to_map.p95_s * 1e3, s.receive_to_map.max_s * 1e3);
   if (s.capture_to_map.frames > 0) {

@@ -28,6 +28,7 @@ struct MapArgs {
   std::string json;
   double voxel_m = 0.005;
   int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
+  double max_navigation_gap_s = mapping::MapperOptions{}.max_navigation_gap_s;
   int threads = 0;
 };
 
@@ -82,6 +83,8 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
   }
   report["loops"] = loops;
   report["figures"] = {{"submaps", m.submaps},
+                       {"frames_mapped", m.stats.frames},
+                       {"frames_without_navigation", m.stats.frames_without_navigation},
                        {"map_points", m.map.size()},
                        {"dive_duration_s", m.dive_duration_s},
                        {"seconds", m.seconds},
@@ -123,6 +126,7 @@ void RunMap(const MapArgs& a) {
   options.map_voxel_m = a.voxel_m;
   options.mapper.sweeps_per_submap = a.sweeps_per_submap;
   options.mapper.threads = a.threads;
+  options.mapper.max_navigation_gap_s = a.max_navigation_gap_s;
   options.table_cache = TableCache();
   const mapping::DiveLogReader log(a.log);
   mapping::DiveMapping m;
@@ -140,6 +144,11 @@ void RunMap(const MapArgs& a) {
   const mapping::MapSummary s = mapping::Summarise(m);
   std::printf("%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
               a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
+  if (m.stats.frames_without_navigation > 0) {
+    std::printf("%lld of %lld frames left out: not between navigation samples at most %g s apart (--max-navigation-gap)\n",
+                static_cast<long long>(m.stats.frames_without_navigation),
+                static_cast<long long>(m.stats.frames_without_navigation + m.stats.frames), a.max_navigation_gap_s);
+  }
   std::printf("registrations %d (%d left to navigation, %d of them inconsistent with it), loops accepted %d, rejected %d\n",
               m.stats.registrations, m.stats.registrations_failed + m.stats.registrations_inconsistent,
               m.stats.registrations_inconsistent, s.loops_accepted, s.loops_rejected);
@@ -179,8 +188,14 @@ void AddMapCommand(CLI::App& app) {
   cmd->add_option("--truth", args->truth, "the true trajectory at the same times (TUM; simulated logs)");
   cmd->add_option("--json", args->json,
                   "report: trajectories, per-pose covariance and standard deviations, loops, figures");
-  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")->check(CLI::PositiveNumber);
+  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--sweeps-per-submap", args->sweeps_per_submap, "sweeps grouped into one submap")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-navigation-gap", args->max_navigation_gap_s,
+                  "seconds: frames between navigation samples farther apart, or outside them, are left out "
+                  "(and counted)")
+      ->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->threads, "threads (0: all cores); the output does not depend on it")
       ->check(CLI::NonNegativeNumber);

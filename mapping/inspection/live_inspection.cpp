@@ -120,6 +120,13 @@ struct LiveInspection::Impl {
     receive_latency.Add(now - times.receive_time_s);
   }
 
+  void OnLeftOut(const FrameRecord& frame) {
+    in_mapper.erase(frame.index);
+    std::lock_guard<std::mutex> lock(mutex);
+    ++stats.frames_without_navigation;
+    --stats.frames_waiting;
+  }
+
   // Gives one frame to the mapper. Fixed scanner: the vehicle is at the origin at the frame's
   // time, and a camera whose clock or sweep count went back (it was restarted) is renumbered
   // on, so that the mapper's time and sweeps keep increasing. False when the frame is out of
@@ -211,6 +218,7 @@ LiveInspection::LiveInspection(const DiveLogHeader& header, const std::filesyste
       [m](const FrameRecord& f, const Eigen::Isometry3d& T_W_C, std::span<const Eigen::Vector3d> points) {
         m->OnPlaced(f, T_W_C, points);
       });
+  m->mapper.SetFrameLeftOutCallback([m](const FrameRecord& f) { m->OnLeftOut(f); });
   m->thread = std::thread([m] { m->Run(); });
 }
 

@@ -73,6 +73,9 @@ struct InspectionStatistics {
   std::int64_t frames_logged = 0;    // committed to the dive log (when there is one)
   std::int64_t frames_mapped = 0;    // placed in the map
   std::int64_t frames_skipped = 0;   // pushed out of the live queue by newer frames
+  // Navigation mode: no navigation around their time (MapperOptions::max_navigation_gap_s);
+  // logged, not mapped.
+  std::int64_t frames_without_navigation = 0;
   // Navigation mode: older than a frame already mapped (a camera that restarted its clock);
   // logged, not mapped. Fixed scanner: frames are renumbered on instead (clock_restarts).
   std::int64_t frames_out_of_order = 0;

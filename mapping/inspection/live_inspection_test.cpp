@@ -112,7 +112,8 @@ class LiveInspectionTest : public ::testing::Test {
 };
 
 void ExpectBalanced(const InspectionStatistics& s) {
-  EXPECT_EQ(s.frames_received, s.frames_mapped + s.frames_skipped + s.frames_out_of_order + s.frames_waiting);
+  EXPECT_EQ(s.frames_received, s.frames_mapped + s.frames_skipped + s.frames_out_of_order +
+                                   s.frames_without_navigation + s.frames_waiting);
 }
 
 // A mapper that keeps up (a queue that never fills): every frame logged and mapped, each
@@ -274,6 +275,31 @@ TEST_F(LiveInspectionTest, WithNavigationFramesWaitForItAndOldOnesAreRefused) {
   inspection.AddNavigation({1.0, Eigen::Isometry3d::Identity()});
   s = inspection.Finish().statistics;
   EXPECT_EQ(s.frames_mapped, 20);
+  EXPECT_EQ(s.frames_waiting, 0);
+  ExpectBalanced(s);
+}
+
+// A navigation dropout longer than MapperOptions::max_navigation_gap_s: the frames inside it are
+// logged and counted, not placed with a pose bridged across it.
+TEST_F(LiveInspectionTest, FramesInANavigationDropoutAreCountedNotMapped) {
+  InspectionOptions options = Options();
+  options.fixed_scanner = false;
+  options.live_queue_frames = 100000;
+  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  const double last_sample_s = Frame(6).record.time_s;
+  std::int64_t after = 0;
+  for (std::int64_t k = 0; k < 20; ++k) {
+    InspectionFrame f = Frame(k);
+    after += f.record.time_s > last_sample_s ? 1 : 0;
+    inspection.Push(std::move(f));
+  }
+  ASSERT_GT(after, 5);
+  inspection.AddNavigation({0.0, Eigen::Isometry3d::Identity()});
+  inspection.AddNavigation({last_sample_s, Eigen::Isometry3d::Identity()});
+  inspection.AddNavigation({last_sample_s + 2.0, Eigen::Isometry3d::Identity()});
+  const InspectionStatistics s = inspection.Finish().statistics;
+  EXPECT_EQ(s.frames_without_navigation, after);
+  EXPECT_EQ(s.frames_mapped, 20 - after);
   EXPECT_EQ(s.frames_waiting, 0);
   ExpectBalanced(s);
 }

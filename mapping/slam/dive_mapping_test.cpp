@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -228,6 +229,69 @@ TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {
   ASSERT_GT(m.submaps, 2);
   EXPECT_NEAR(m.dive_duration_s, static_cast<double>(kept - 1) * simulator.frame_period_s(), 1e-9);
   EXPECT_GT(m.slam.back().time_s, m.dive_duration_s - 2.0);
+}
+
+// A log of the short dive's first `frames` frames, with the navigation samples `keep` accepts.
+fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const fs::path& path, std::int64_t frames,
+                                const std::function<bool(double)>& keep) {
+  DiveLogHeader header;
+  header.scanner = simulator.scanner();
+  header.scan_pattern = simulator.scan_pattern();
+  header.navigation_noise = NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005};
+  DiveLogWriter writer(path, header);
+  writer.SetVehicleMount(simulator.scene().trajectory.T_V_C);
+  for (const scanner::sim::NavigationSample& n : simulator.Navigation(20.0)) {
+    if (keep(n.time_s)) writer.AppendNavigation({n.time_s, n.T_W_V});
+  }
+  for (std::int64_t i = 0; i < frames; ++i) {
+    const scanner::sim::SimulatedFrame f = simulator.Frame(i);
+    FrameRecord record;
+    record.time_s = f.time_s;
+    record.command = f.command;
+    record.sweep = f.sweep;
+    record.peaks_px = f.peaks_px;
+    writer.AppendFrame(record);
+  }
+  return path;
+}
+
+TEST_F(DiveMappingTest, FramesTheNavigationDoesNotCoverAreLeftOutAndCounted) {
+  // The navigation drops out for 3 s (a DVL that lost the bottom) and stops 3 s before the
+  // recorder: those frames have no pose to be placed with, and holding or bridging one would
+  // smear the map without a word.
+  const scanner::sim::Simulator simulator(ShortScene());
+  const double period = simulator.frame_period_s();
+  const std::int64_t frames = static_cast<std::int64_t>(12.0 / period);
+  const auto kept = [](double t) { return t <= 9.0 && !(t > 3.0 && t < 6.0); };
+  const fs::path path = WriteLogWithNavigation(simulator, dir_ / "dropout.db", frames, kept);
+  // Covered: a sample at or before the frame and one at or after it, at most 1 s apart.
+  std::vector<double> samples;
+  for (const scanner::sim::NavigationSample& n : simulator.Navigation(20.0)) {
+    if (kept(n.time_s)) samples.push_back(n.time_s);
+  }
+  std::int64_t uncovered = 0;
+  for (std::int64_t i = 0; i < frames; ++i) {
+    const double t = simulator.Frame(i).time_s;
+    const auto after = std::lower_bound(samples.begin(), samples.end(), t);
+    const bool covered = after != samples.end() && (*after == t || (after != samples.begin() && *after - *(after - 1) <= 1.0));
+    uncovered += covered ? 0 : 1;
+  }
+  ASSERT_GT(uncovered, frames / 3);
+
+  const DiveMapping m = Map(path);
+  EXPECT_EQ(m.stats.frames_without_navigation, uncovered);
+  EXPECT_EQ(m.stats.frames + m.stats.frames_without_navigation, frames);
+  for (const TimedPose& p : m.slam) {
+    EXPECT_LE(p.time_s, 9.0);
+    EXPECT_FALSE(p.time_s > 3.0 && p.time_s < 6.0) << "a submap anchored in the dropout, at " << p.time_s << " s";
+  }
+
+  // With every frame after the navigation's end nothing can be placed, and the error says why.
+  const fs::path late = WriteLogWithNavigation(simulator, dir_ / "late.db", static_cast<std::int64_t>(2.0 / period),
+                                               [](double t) { return t >= 5.0; });
+  EXPECT_NE(MessageOf([&] { Map(late); }).find("no frame lies within its navigation (samples from 5.0"),
+            std::string::npos)
+      << MessageOf([&] { Map(late); });
 }
 
 TEST_F(DiveMappingTest, UnusableLogsGiveAClearError) {

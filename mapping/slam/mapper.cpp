@@ -82,6 +82,7 @@ void MapperOptions::Check() const {
   if (!(running_solve_tolerance > 0.0 && running_solve_tolerance < 1.0)) fail("running_solve_tolerance", "in (0, 1)");
   if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
   if (!(slide_sigma_m >= 0.0)) fail("slide_sigma_m", ">= 0 m");
+  if (!(max_navigation_gap_s > 0.0 && std::isfinite(max_navigation_gap_s))) fail("max_navigation_gap_s", "> 0 s");
   if (threads < 0) fail("threads", ">= 0");
   perception::IcpOptions icp;
   icp.max_correspondence_distance_m = icp_distances_m;
@@ -99,6 +100,7 @@ struct Mapper::Impl {
   std::deque<FrameRecord> waiting;
   bool finished = false;
   Mapper::FramePlacedCallback on_placed;
+  Mapper::FrameLeftOutCallback on_left_out;
 
   // The submap being filled: points in the navigation's world frame, and its frames. Its frames
   // are placed with the navigation corrected by the calibration estimated when it opened, about
@@ -125,7 +127,9 @@ struct Mapper::Impl {
   Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
       : options(o), T_V_C(mount), uncertainty(noise) {}
 
-  void Drain(bool hold_at_ends);
+  // Places the waiting frames the navigation covers, leaves out those it never will; at the
+  // end of the dive (`finishing`) also those after its last sample.
+  void Drain(bool finishing);
   void Place(const FrameRecord& frame);
   void CloseSubmap();
   void AddToGraph(Submap submap);
@@ -163,13 +167,21 @@ struct Mapper::Impl {
   }
 };
 
-void Mapper::Impl::Drain(bool hold_at_ends) {
+void Mapper::Impl::Drain(bool finishing) {
   while (!waiting.empty()) {
     const double t = waiting.front().time_s;
-    if (!hold_at_ends && !(navigation.Covers(t) || (!navigation.empty() && t < navigation.first_time_s()))) {
-      break;
+    bool place = false;
+    if (navigation.Covers(t)) {
+      place = navigation.GapAround(t) <= options.max_navigation_gap_s;
+    } else if (navigation.empty() || t > navigation.last_time_s()) {
+      if (!finishing) break;  // waits for the navigation to reach it; at the end none will
+    }  // else: before the first sample, never covered
+    if (place) {
+      Place(waiting.front());
+    } else {
+      ++stats.frames_without_navigation;
+      if (on_left_out) on_left_out(waiting.front());
     }
-    Place(waiting.front());
     waiting.pop_front();
   }
 }
@@ -186,7 +198,6 @@ void Mapper::Impl::Place(const FrameRecord& frame) {
   const Clock::time_point start = Clock::now();
   triangulated.resize(frame.peaks_px.size());
   triangulator->TriangulateFrame(frame.command, frame.peaks_px, triangulated);
-  // Held at the first or last sample outside the navigation's span.
   const Eigen::Isometry3d T_W_C = PlacementPose(frame.time_s) * T_V_C;
   const std::size_t first_point = points_W.size();
   for (const scanner::TriangulatedPoint& p : triangulated) {
@@ -487,6 +498,7 @@ Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& patt
 Mapper::~Mapper() = default;
 
 void Mapper::SetFramePlacedCallback(FramePlacedCallback callback) { impl_->on_placed = std::move(callback); }
+void Mapper::SetFrameLeftOutCallback(FrameLeftOutCallback callback) { impl_->on_left_out = std::move(callback); }
 
 void Mapper::AddNavigation(const NavigationRecord& record) {
   if (impl_->finished) throw Error("mapper: navigation added after Finish");

@@ -71,6 +71,11 @@ struct MapperOptions {
   // its anchor along that slide only this loosely (metres): its place there is not measured,
   // and what the pairs leak along it must not pull the vehicle (SlideCovariance, mapper.cpp).
   double slide_sigma_m = 0.03;
+  // A frame is placed only between navigation samples at most this far apart (seconds, > 0):
+  // across a longer gap (a DVL that lost the bottom, a navigation that stopped) the
+  // interpolated pose is a guess, so such a frame is left out and counted, as is one before the
+  // first sample or, at Finish, after the last (MapperStats::frames_without_navigation).
+  double max_navigation_gap_s = 1.0;
   int threads = 0;                    // OpenMP threads of ICP and normals, 0 = default
   void Check() const;
 };
@@ -90,7 +95,8 @@ struct LoopClosure {
 };
 
 struct MapperStats {
-  std::int64_t frames = 0;
+  std::int64_t frames = 0;                     // placed
+  std::int64_t frames_without_navigation = 0;  // left out: no navigation around their time
   std::int64_t points = 0;
   int registrations = 0;         // consecutive submaps registered (fitness above the floor)
   int registrations_failed = 0;  // left to odometry alone: fitness below the floor
@@ -104,7 +110,8 @@ struct MapperStats {
 
 // Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until
 // the navigation covers their time, then triangulated and placed with the navigation
-// interpolated at their own time; every `sweeps_per_submap` sweeps close a submap, which is
+// interpolated at their own time (frames the navigation does not cover are left out and
+// counted, MapperOptions::max_navigation_gap_s); every `sweeps_per_submap` sweeps close a submap, which is
 // registered (point-to-plane ICP with the navigation increment as start and prior) to the last
 // few submaps, added to the graph with its odometry and registration edges and its depth and
 // roll/pitch priors, and checked for loop closures against older submaps. The graph is
@@ -128,12 +135,16 @@ class Mapper {
       std::function<void(const FrameRecord& frame, const Eigen::Isometry3d& T_W_C,
                          std::span<const Eigen::Vector3d> points_W)>;
   void SetFramePlacedCallback(FramePlacedCallback callback);
+  // Called for every frame left out for want of navigation around its time (where and when
+  // FramePlacedCallback would have been): every frame given is either placed or left out.
+  using FrameLeftOutCallback = std::function<void(const FrameRecord& frame)>;
+  void SetFrameLeftOutCallback(FrameLeftOutCallback callback);
 
   // Feed in time order (navigation may run ahead of frames; frames wait for it).
   void AddNavigation(const NavigationRecord& record);
   void AddFrame(const FrameRecord& frame);
-  // Processes every frame still waiting (past the last navigation sample: held at it), closes
-  // the last submap and solves the whole graph. Nothing may be added afterwards.
+  // Processes every frame still waiting (past the last navigation sample: left out and counted),
+  // closes the last submap and solves the whole graph. Nothing may be added afterwards.
   void Finish();
 
   int submap_count() const;

@@ -37,13 +37,24 @@ bool NavigationBuffer::Covers(double time_s) const {
   return !samples_.empty() && time_s >= samples_.front().time_s && time_s <= samples_.back().time_s;
 }
 
+void NavigationBuffer::RequireCovered(double time_s) const {
+  if (Covers(time_s)) return;
+  throw Error("navigation: no sample brackets time " + std::to_string(time_s) + " s" +
+              (samples_.empty() ? std::string(" (no navigation)")
+                                : " (navigation spans " + std::to_string(first_time_s()) + " to " +
+                                      std::to_string(last_time_s()) + " s)"));
+}
+
+double NavigationBuffer::GapAround(double time_s) const {
+  RequireCovered(time_s);
+  const auto after = std::lower_bound(samples_.begin(), samples_.end(), time_s,
+                                      [](const NavigationRecord& r, double t) { return r.time_s < t; });
+  if (after->time_s == time_s) return 0.0;
+  return after->time_s - (after - 1)->time_s;
+}
+
 Eigen::Isometry3d NavigationBuffer::T_W_V(double time_s) const {
-  if (!Covers(time_s)) {
-    throw Error("navigation: no sample brackets time " + std::to_string(time_s) + " s" +
-                (samples_.empty() ? std::string(" (no navigation)")
-                                  : " (navigation spans " + std::to_string(first_time_s()) + " to " +
-                                        std::to_string(last_time_s()) + " s)"));
-  }
+  RequireCovered(time_s);
   const auto after = std::lower_bound(samples_.begin(), samples_.end(), time_s,
                                       [](const NavigationRecord& r, double t) { return r.time_s < t; });
   if (after->time_s == time_s || after == samples_.begin()) return after->T_W_V;

@@ -21,12 +21,16 @@ class NavigationBuffer {
   double last_time_s() const;
   // True when t lies within [first, last] sample time.
   bool Covers(double time_s) const;
+  // The time between the samples either side of time_s (0 at a sample's own time): how far
+  // the interpolation has to reach. Throws uwscan::Error outside [first, last] or when empty.
+  double GapAround(double time_s) const;
   // T_W_V at time_s; throws uwscan::Error outside [first, last] or when empty.
   Eigen::Isometry3d T_W_V(double time_s) const;
   // Forgets samples that no time >= time_s needs (keeps the one at or before it).
   void DropBefore(double time_s);
 
  private:
+  void RequireCovered(double time_s) const;  // throws uwscan::Error naming the span
   std::deque<NavigationRecord> samples_;
 };
 
