@@ -210,6 +210,60 @@ TEST(CliView, RecognitionReportOfTheDemoSceneIsDrawn) {
   fs::remove_all(dir);
 }
 
+// A scan from another sensor with invalid rows (NaN, as organised clouds mark missing returns):
+// the report's segments give rows of the file, never an invalid one, and the viewer reads the
+// report back onto the same rows.
+TEST(CliView, ARecognitionReportIndexesTheRowsOfItsScanFile) {
+  const fs::path dir = TempPath("rows");
+  fs::create_directories(dir);
+  const fs::path scan = dir / "holes.xyz", db = dir / "objects.db", report = dir / "r.json";
+  std::size_t rows = 0;
+  {
+    std::ofstream out(scan);
+    const auto row = [&](double x, double y, double z) {
+      if (rows % 7 == 3) out << "nan nan nan\n", ++rows;  // a hole every seventh row
+      out << x << ' ' << y << ' ' << z << '\n';
+      ++rows;
+    };
+    for (int i = 0; i < 120; ++i) {
+      for (int j = 0; j < 120; ++j) row(-0.3 + 0.005 * i, -0.3 + 0.005 * j, 1.0);  // a seabed
+    }
+    for (int i = 0; i < 30; ++i) {  // a 15 cm box standing on it, its top and two sides
+      for (int j = 0; j < 30; ++j) {
+        const double a = -0.075 + 0.005 * i, b = -0.075 + 0.005 * j;
+        row(a, b, 0.85);
+        row(a, -0.075, 0.85 + 0.005 * j);
+        row(-0.075, a, 0.85 + 0.005 * j);
+      }
+    }
+  }
+  ASSERT_EQ(RunUwscan("build-db pipe --views 4 -o " + db.string()).exit_code, 0);
+  const CommandRun run = RunUwscan("recognize " + scan.string() + " --db " + db.string() + " --json " + report.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::size_t holes = (rows + 3) / 7;
+  EXPECT_NE(run.output.find(std::to_string(holes) + " of the file's " + std::to_string(rows) + " points dropped"),
+            std::string::npos)
+      << run.output;
+  const std::string json = Bytes(report);
+  EXPECT_NE(json.find("\"scan_points\": " + std::to_string(rows)), std::string::npos);
+  std::size_t listed = 0;
+  for (std::size_t at = json.find("\"segment\": ["); at != std::string::npos; at = json.find("\"segment\": [", at + 1)) {
+    std::istringstream in(json.substr(at + 12, json.find(']', at) - at - 12));
+    std::string number;
+    while (std::getline(in, number, ',')) {
+      const std::size_t row = std::stoul(number);
+      EXPECT_LT(row, rows);
+      EXPECT_NE(row % 7, 3u) << "row " << row << " is a hole";
+      ++listed;
+    }
+  }
+  EXPECT_GT(listed, 1000u) << json.substr(0, 400);
+  const fs::path png = dir / "r.png";
+  const CommandRun view = RunUwscan("view " + report.string() + " --screenshot " + png.string() + " --size 320x240");
+  EXPECT_EQ(view.exit_code, 0) << view.output;
+  fs::remove_all(dir);
+}
+
 // `view --follow` started before the log exists shows every frame `simulate` then writes.
 TEST(CliView, FollowPicksUpADiveWrittenAfterItStarted) {
   const fs::path log = TempPath("follow.db"), png = TempPath("follow.png"), out = TempPath("follow.txt");

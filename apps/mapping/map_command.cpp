@@ -50,9 +50,12 @@ nlohmann::json Optional(const std::optional<T>& value) {
 // The map report (format in mapping/README.md, "uwscan map"): what the viewer reads.
 nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& log, const std::string& map) {
   const mapping::MapSummary s = mapping::Summarise(m);
-  nlohmann::json report = {{"uwscan_format", 1}, {"kind", "map_report"}, {"log", log}};
-  const std::filesystem::path map_path(map);
-  report["map"] = map_path.is_absolute() ? map : std::filesystem::absolute(map_path).string();
+  // Both absolute: the report may be read from anywhere.
+  const auto absolute = [](const std::string& path) {
+    return std::filesystem::absolute(path).lexically_normal().string();
+  };
+  nlohmann::json report = {{"uwscan_format", 1}, {"kind", "map_report"}, {"log", absolute(log)}};
+  report["map"] = absolute(map);
   report["trajectories"] = {{"slam", TumRows(m.slam)}, {"dead_reckoning", TumRows(m.dead_reckoning)}};
   if (!m.truth.empty()) report["trajectories"]["truth"] = TumRows(m.truth);
   nlohmann::json covariance = nlohmann::json::array(), deviation = nlohmann::json::array();

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,7 @@ struct RecognizeArgs {
   std::string scan, db, json;
   std::uint64_t seed = 1;
   int threads = 0;
+  std::optional<int> sweep;
 };
 
 // `path` as seen from the folder `file` is in.
@@ -94,11 +96,17 @@ void RunRecognize(const RecognizeArgs& a) {
   const perception::ObjectDatabase db = perception::ObjectDatabase::Load(a.db);
   mapping::ReconstructionOptions log_options;
   log_options.table_cache = TableCache();
-  const perception::PointCloud scan = mapping::ReadScanFile(a.scan, log_options);
+  log_options.sweep = a.sweep;
+  const mapping::ScanFile file = mapping::ReadScanFile(a.scan, log_options);
+  const perception::PointCloud& scan = file.cloud;
   perception::RecognitionOptions options;
   options.seed = a.seed;
   options.threads = a.threads;
   const perception::RecognitionResult result = perception::RecognizeObjects(scan, db, options);
+  if (file.rows_in_file != scan.size()) {
+    std::printf("%zu of the file's %zu points dropped: a NaN or infinite coordinate or normal\n",
+                file.rows_in_file - scan.size(), file.rows_in_file);
+  }
   std::printf("%zu points, %zu on planes, %zu segments\n", scan.size(), result.plane_points,
               result.objects.size());
   for (const perception::RecognizedObject& o : result.objects) {
@@ -121,7 +129,8 @@ void RunRecognize(const RecognizeArgs& a) {
     }
   }
   if (!a.json.empty()) {
-    nlohmann::json j = RecognitionJson(result, scan.size());
+    nlohmann::json j = RecognitionJson(result, file.rows, file.rows_in_file);
+    if (a.sweep) j["scan_sweep"] = *a.sweep;
     // Relative to the report's folder, so the viewer finds them from anywhere.
     j["scan"] = RelativeToFolderOf(a.scan, a.json);
     j["database"] = RelativeToFolderOf(a.db, a.json);
@@ -161,9 +170,11 @@ void AddRecognizeCommand(CLI::App& app) {
       "recognize",
       "find the database's objects in a scan (sensor frame): id, pose, free directions, "
       "covariance, grasp poses");
-  cmd->add_option("scan", a->scan, "PLY, PCD or XYZ cloud, or a dive log of one static sweep")
+  cmd->add_option("scan", a->scan,
+                  "PLY, PCD or XYZ cloud, or a dive log (one sweep, placed with its navigation when it has some)")
       ->required()
       ->check(CLI::ExistingFile);
+  cmd->add_option("--sweep", a->sweep, "the sweep of a dive log of several to recognise objects in");
   cmd->add_option("--db", a->db, "object database from `uwscan build-db`")->required();
   cmd->add_option("--json", a->json, "write every object, candidate and grasp as JSON");
   cmd->add_option("--seed", a->seed, "RANSAC and ESF seed");

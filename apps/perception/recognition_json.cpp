@@ -20,10 +20,13 @@ nlohmann::json Pose(const Eigen::Isometry3d& T) {
           {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
-nlohmann::json ObjectJson(const perception::RecognizedObject& o) {
+nlohmann::json ObjectJson(const perception::RecognizedObject& o, const std::vector<std::size_t>& rows) {
+  std::vector<std::size_t> segment_rows;
+  segment_rows.reserve(o.segment.size());
+  for (std::size_t i : o.segment) segment_rows.push_back(rows.at(i));
   nlohmann::json j = {{"id", o.object_id},
                       {"points", o.segment.size()},
-                      {"segment", o.segment},
+                      {"segment", segment_rows},
                       {"centroid_m", Vector(o.centroid_S)}};
   nlohmann::json candidates = nlohmann::json::array();
   for (const perception::RecognitionCandidate& c : o.candidates) {
@@ -85,12 +88,13 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o) {
 
 }  // namespace
 
-nlohmann::json RecognitionJson(const perception::RecognitionResult& result, std::size_t scan_points) {
+nlohmann::json RecognitionJson(const perception::RecognitionResult& result, const std::vector<std::size_t>& rows,
+                               std::size_t rows_in_file) {
   nlohmann::json objects = nlohmann::json::array();
-  for (const perception::RecognizedObject& o : result.objects) objects.push_back(ObjectJson(o));
+  for (const perception::RecognizedObject& o : result.objects) objects.push_back(ObjectJson(o, rows));
   return {{"uwscan_format", 1},
           {"kind", "recognition_report"},
-          {"scan_points", scan_points},
+          {"scan_points", rows_in_file},
           {"objects", objects},
           {"plane_points", result.plane_points},
           {"stage_seconds", result.stage_seconds}};

@@ -2,16 +2,23 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstddef>
+#include <vector>
+
 #include "perception/recognition/object_recognizer.hpp"
 
 namespace uwscan::app {
 
 // The recognition report `uwscan recognize --json` writes ({"uwscan_format": 1, "kind":
-// "recognition_report"}): the scan's point count, then per segment the id ("unknown" when none
-// was verified), its points (indices into the scan), score, chi-square and margin, pose T_S_O
-// (4x4, position, quaternion xyzw), covariance and standard deviations over [w (rad), v (m)]
-// in the object frame, free directions, grasp poses and the candidates. The caller adds
-// "scan" and "database" (paths relative to the report's folder), which `uwscan view` reads.
-nlohmann::json RecognitionJson(const perception::RecognitionResult& result, std::size_t scan_points);
+// "recognition_report"}): the scan file's row count ("scan_points"), then per segment the id
+// ("unknown" when none was verified), its points (rows of the scan file: `rows[i]` is the row of
+// the scan's point i, so points dropped on reading, e.g. NaN, leave no hole), score, chi-square
+// and margin, pose T_S_O (4x4, position, quaternion xyzw), covariance and standard deviations
+// over [w (rad), v (m)] in the object frame, free directions, grasp poses and the candidates.
+// The caller adds "scan" and "database" (paths relative to the report's folder) and, for a
+// sweep of a dive log, "scan_sweep", which `uwscan view` reads. Documented in
+// perception/README.md.
+nlohmann::json RecognitionJson(const perception::RecognitionResult& result, const std::vector<std::size_t>& rows,
+                               std::size_t rows_in_file);
 
 }  // namespace uwscan::app

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
@@ -60,8 +61,17 @@ Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions
   const std::int64_t frame_count = log.frame_count();
   std::vector<scanner::TriangulatedPoint> triangulated;
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::set<int> sweeps;
+  double first_time_s = 0.0, last_time_s = 0.0;
+  std::int64_t visited = 0;
   log.ForEachFrame(
       [&](const FrameRecord& frame, const GroundTruthRecord* truth) {
+        sweeps.insert(frame.sweep);
+        ++visited;
+        if (progress && frame_count > 0) progress(static_cast<double>(visited) / frame_count);
+        if (options.sweep && frame.sweep != *options.sweep) return;
+        if (result.frames == 0) first_time_s = frame.time_s;
+        last_time_s = frame.time_s;
         triangulated.resize(frame.peaks_px.size());
         const Clock::time_point start = Clock::now();
         triangulator->TriangulateFrame(frame.command, frame.peaks_px, triangulated);
@@ -84,9 +94,15 @@ Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions
         }
         result.peaks += static_cast<std::int64_t>(frame.peaks_px.size());
         ++result.frames;
-        if (progress && frame_count > 0) progress(static_cast<double>(result.frames) / frame_count);
       },
       /*with_truth=*/true);
+  result.sweeps.assign(sweeps.begin(), sweeps.end());
+  if (options.relative_to_middle && navigation && result.frames > 0) {
+    const Eigen::Isometry3d T_C_W = navigation->T_W_C(0.5 * (first_time_s + last_time_s)).inverse();
+    for (Eigen::Vector3d& p : result.points) p = T_C_W * p;
+    for (Eigen::Vector3d& p : result.truth) p = T_C_W * p;  // NaN stays NaN
+    result.world_frame = false;
+  }
   // A log without ground truth has none for any point; one with it has it for every point.
   if (result.truth.size() != result.points.size()) result.truth.clear();
   return result;

@@ -25,6 +25,13 @@ struct ReconstructionOptions {
   std::optional<scanner::Scanner> calibration;
   // Folder keeping per-calibration tables between runs; empty: computed every time.
   std::filesystem::path table_cache;
+  // Only the frames of this sweep; std::nullopt: every frame.
+  std::optional<int> sweep;
+  // With use_navigation and navigation in the log: each frame still placed with the navigation
+  // at its own time, but the points given in the camera frame at the middle of the frames
+  // reconstructed instead of the world frame: a sweep taken while the vehicle moved, as a
+  // sensor at rest at that moment would have seen it.
+  bool relative_to_middle = false;
 };
 
 // A dive's point cloud, point by point with the frame it came from, and the truth of each point
@@ -35,7 +42,8 @@ struct Reconstruction {
   std::vector<Eigen::Vector3d> points;
   std::vector<std::int64_t> frame_of_point;
   std::vector<Eigen::Vector3d> truth;  // empty when the log holds no ground truth
-  std::int64_t frames = 0;
+  std::int64_t frames = 0;                // reconstructed (of the sweep chosen, if one is)
+  std::vector<int> sweeps;                // every sweep of the log, ascending, chosen or not
   std::int64_t peaks = 0;                 // peaks read; peaks - points.size() had no point
   double table_seconds = 0.0;             // building the per-calibration tables, once
   double triangulation_seconds = 0.0;     // the triangulation itself, all frames

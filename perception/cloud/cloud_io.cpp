@@ -250,6 +250,7 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
                         (raw.normals.empty() ||
                          (raw.normals[i].allFinite() && raw.normals[i].norm() > 1e-6));
     if (!usable) continue;
+    if (stats) local.rows.push_back(i);
     points.push_back(raw.points[i]);
     if (local.has_normals) normals.push_back(raw.normals[i].normalized().cast<float>());
     if (!raw.intensity.empty()) intensity.push_back(static_cast<float>(raw.intensity[i]));
@@ -263,7 +264,7 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   PointCloud cloud = MakeCloud(points);
   cloud.normals = std::move(normals);
   cloud.intensity = std::move(intensity);
-  if (stats) *stats = local;
+  if (stats) *stats = std::move(local);
   return cloud;
 }
 

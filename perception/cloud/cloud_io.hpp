@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <vector>
 
 #include "perception/cloud/point_cloud.hpp"
 
@@ -13,6 +14,9 @@ struct CloudReadStats {
   std::size_t num_dropped_non_finite = 0;  // dropped: a NaN or infinite coordinate, or a normal
                                            // that is not finite or has zero length
   bool has_normals = false;                // normals were read (PCD normal_x.., PLY nx..)
+  // The file's row (0-based point or vertex) of each point of the cloud: what an index into the
+  // cloud is in the file once points were dropped.
+  std::vector<std::size_t> rows;
 };
 
 // Reads a point cloud from .pcd (uwscan's bounded reader; ascii, binary and binary_compressed),

@@ -93,6 +93,11 @@ RecognitionReport ReadRecognitionReport(const std::filesystem::path& path) {
   const json& scan_points = Require(j, "scan_points", root);
   if (!scan_points.is_number_unsigned()) root["scan_points"].Fail("expected a point count");
   report.scan_points = scan_points.get<std::size_t>();
+  if (j.contains("scan_sweep")) {
+    const json& sweep = j["scan_sweep"];
+    if (!sweep.is_number_integer()) root["scan_sweep"].Fail("expected a sweep number");
+    report.scan_sweep = sweep.get<int>();
+  }
   const json& objects = Require(j, "objects", root);
   if (!objects.is_array()) root["objects"].Fail("expected an array");
   for (std::size_t i = 0; i < objects.size(); ++i) {
@@ -107,11 +112,18 @@ void AddRecognitionReport(const RecognitionReport& report, const mapping::Recons
   // or the segments' indices would fall on other points.
   mapping::ReconstructionOptions scan_options = log_options;
   scan_options.method = std::nullopt;
-  const perception::PointCloud scan = mapping::ReadScanFile(report.scan, scan_options);
-  if (scan.size() != report.scan_points) {
-    throw Error(report.scan.string() + ": has " + std::to_string(scan.size()) + " points, the recognition report " +
-                std::to_string(report.scan_points) + "; was it changed after `uwscan recognize`?");
+  scan_options.sweep = report.scan_sweep;
+  const mapping::ScanFile file = mapping::ReadScanFile(report.scan, scan_options);
+  const perception::PointCloud& scan = file.cloud;
+  if (file.rows_in_file != report.scan_points) {
+    throw Error(report.scan.string() + ": has " + std::to_string(file.rows_in_file) +
+                " points, the recognition report " + std::to_string(report.scan_points) +
+                "; was it changed after `uwscan recognize`?");
   }
+  // The report gives the file's rows; the cloud drops the rows that are not finite points.
+  constexpr std::size_t kDropped = static_cast<std::size_t>(-1);
+  std::vector<std::size_t> index_of_row(file.rows_in_file, kDropped);
+  for (std::size_t i = 0; i < file.rows.size(); ++i) index_of_row[file.rows[i]] = i;
   CloudLayer scan_layer;
   scan_layer.name = report.scan.filename().string();
   scan_layer.origin = scan.origin;
@@ -120,7 +132,13 @@ void AddRecognitionReport(const RecognitionReport& report, const mapping::Recons
   scan_layer.object_ids.assign(scan.size(), -1);
   for (std::size_t k = 0; k < report.objects.size(); ++k) {
     if (!report.objects[k].recognised()) continue;
-    for (const std::size_t i : report.objects[k].segment) scan_layer.object_ids[i] = static_cast<std::int32_t>(k);
+    for (const std::size_t row : report.objects[k].segment) {
+      if (index_of_row[row] == kDropped) {
+        throw Error(report.scan.string() + ": row " + std::to_string(row) +
+                    " is not a finite point, yet the recognition report puts it in a segment");
+      }
+      scan_layer.object_ids[index_of_row[row]] = static_cast<std::int32_t>(k);
+    }
   }
   scene.clouds.push_back(std::move(scan_layer));
 

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,12 +27,13 @@ struct ReportedObject {
 struct RecognitionReport {
   std::filesystem::path scan;      // resolved against the report's folder
   std::filesystem::path database;  // resolved against the report's folder
-  std::size_t scan_points = 0;     // what the segments index
+  std::size_t scan_points = 0;     // rows of the scan file, what the segments index
+  std::optional<int> scan_sweep;   // the sweep of a dive log recognised
   std::vector<ReportedObject> objects;
 };
 
 // Reads {"uwscan_format": 1, "kind": "recognition_report", "scan", "database", "scan_points",
-// "objects": [{"id", "segment", "centroid_m", and for a recognised object "score", "T_S_O":
+// optionally "scan_sweep", "objects": [{"id", "segment", "centroid_m", and for a recognised object "score", "T_S_O":
 // {"matrix"}, "grasps": [{"name", "matrix"}]}]}. Throws uwscan::Error naming the file and the
 // field when the JSON does not parse, the format or kind differs, or a value has the wrong
 // type or count, is not finite, a pose is not rigid, or an index is beyond scan_points.
