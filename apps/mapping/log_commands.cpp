@@ -56,7 +56,7 @@ void PrintCheck(const std::string& log, const mapping::DiveLogCheck& check) {
 
 void RunCheck(const CheckArgs& a) {
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.log});
-  const mapping::DiveLogReader reader(a.log);
+  const mapping::DiveLogReader reader(a.log, mapping::DiveLogOpening::kDamaged);
   const mapping::DiveLogCheck check = reader.Check({}, {});
   PrintCheck(a.log, check);
   if (!a.json.empty()) WriteJsonFile(a.json, ToJson(check));
@@ -70,7 +70,7 @@ void RunSalvage(const SalvageArgs& a) {
   CheckOutputPath(a.output, "-o", {a.log});
   if (fs::exists(a.output)) throw Error("-o " + a.output + ": exists (a dive log is never overwritten)");
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.log, a.output});
-  const mapping::DiveLogReader reader(a.log);
+  const mapping::DiveLogReader reader(a.log, mapping::DiveLogOpening::kDamaged);
   mapping::DiveLogHeader header = reader.header();
   header.producer += " (salvaged by uwscan log salvage from " + fs::path(a.log).filename().string() + ")";
 

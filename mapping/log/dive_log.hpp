@@ -144,14 +144,23 @@ struct DiveLogCheck {
   bool ok() const { return integrity.empty() && damage.empty(); }
 };
 
+// How DiveLogReader opens a log.
+enum class DiveLogOpening {
+  kIntact,   // a truncated file is refused, naming what it lacks
+  kDamaged,  // for Check and salvage: a truncated file is read as far as it goes (a file being
+             // written may show as truncated to Check while its writer checkpoints)
+};
+
 // Reads a dive log, read-only. Works on a log whose writer is still appending (in this or
 // another process: each call sees what was committed when it starts) and on a log whose writer
 // was killed (every committed frame is there). Not thread-safe: one thread at a time.
 class DiveLogReader {
  public:
   // Throws uwscan::Error naming the file when it is missing, not a SQLite database, not a dive
-  // log (no `meta` table), of another or a newer schema version, or lacks a table or column.
-  explicit DiveLogReader(const std::filesystem::path& path);
+  // log (no `meta` table), of another or a newer schema version, or lacks a table or column;
+  // and, when opened as kIntact, when the file is shorter than its own header says (a copy or
+  // transfer cut short: `uwscan log salvage` recovers what it holds).
+  explicit DiveLogReader(const std::filesystem::path& path, DiveLogOpening opening = DiveLogOpening::kIntact);
   ~DiveLogReader();
   DiveLogReader(DiveLogReader&&) noexcept;
   DiveLogReader& operator=(DiveLogReader&&) noexcept;
@@ -185,7 +194,9 @@ class DiveLogReader {
   // Reads every row of the log, going on past damaged ones, and runs SQLite's quick_check:
   // `frame` is called for each intact frame in index order (with its ground truth, or nullptr),
   // `navigation` for each intact sample in nav_id order; either may be empty. A frame whose
-  // ground truth is damaged counts as damaged. Throws only when the file cannot be read at all.
+  // ground truth is damaged counts as damaged. A truncated file (opened as kDamaged) is an
+  // integrity finding naming how much of it is missing. Throws only when the file cannot be
+  // read at all.
   DiveLogCheck Check(const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
                      const std::function<void(const NavigationRecord&)>& navigation) const;
 

@@ -8,6 +8,45 @@
 namespace uwscan::mapping::test {
 namespace {
 
+// A log cut short (a copy or transfer interrupted): SQLite calls it malformed and reads nothing;
+// the reader says it is truncated and by how much, and read as damaged it gives the frames that
+// the pages left still hold, each one as written.
+TEST_F(DiveLogTest, ATruncatedLogIsNamedAsSuchAndItsFramesCanBeRecovered) {
+  const fs::path whole = WriteLog("whole.db", 200, 100);
+  const fs::path cut = dir_ / "cut.db";
+  fs::copy_file(whole, cut);
+  const std::uintmax_t size = fs::file_size(whole);
+  fs::resize_file(cut, size / 2);
+
+  const std::string message = MessageOf([&] { DiveLogReader reader(cut); });
+  EXPECT_NE(message.find("dive log '" + cut.string() + "' is truncated: " + std::to_string(size / 2) + " bytes of the " +
+                         std::to_string(size) + " its header gives"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("uwscan log salvage"), std::string::npos) << message;
+
+  const DiveLogReader reader(cut, DiveLogOpening::kDamaged);
+  std::int64_t recovered = 0;
+  const DiveLogCheck check = reader.Check(
+      [&](const FrameRecord& frame, const GroundTruthRecord* truth) {
+        ExpectSameFrame(TestFrame(frame.index, 100), frame);
+        EXPECT_EQ(truth != nullptr, frame.index % 2 == 0);
+        ++recovered;
+      },
+      {});
+  EXPECT_FALSE(check.ok());
+  ASSERT_FALSE(check.integrity.empty());
+  EXPECT_EQ(check.integrity.front().rfind("the file is truncated: ", 0), 0u) << check.integrity.front();
+  EXPECT_EQ(recovered, check.frames_intact);
+  EXPECT_GT(recovered, 20);
+  EXPECT_LT(recovered, 200);
+
+  // An intact log opens the same either way.
+  const DiveLogCheck intact = DiveLogReader(whole, DiveLogOpening::kDamaged).Check({}, {});
+  EXPECT_TRUE(intact.ok());
+  EXPECT_EQ(intact.frames_intact, 200);
+}
+
 TEST_F(DiveLogTest, ReaderNamesTheFileAndWhatIsWrong) {
   auto expect = [](const fs::path& path, const std::string& expected) {
     const std::string message = MessageOf([&] { DiveLogReader reader(path); });

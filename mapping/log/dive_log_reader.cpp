@@ -1,5 +1,9 @@
 #include <bit>
+#include <cstdint>
+#include <fstream>
+#include <optional>
 #include <set>
+#include <string>
 #include <utility>
 
 #include "mapping/log/dive_log.hpp"
@@ -78,6 +82,30 @@ std::optional<GroundTruthRecord> DecodeTruth(const Row& row, int first, std::siz
   return truth;
 }
 
+// What is missing from a SQLite file shorter than its header says it is (an interrupted copy
+// or transfer), or nullopt. The header's page count is only valid when its "version-valid-for"
+// number equals the change counter (SQLite's file format, section 1.3); a file too short to
+// hold a header is left to SQLite to refuse.
+std::optional<std::string> Truncation(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char h[100];
+  if (!in.read(reinterpret_cast<char*>(h), sizeof(h))) return std::nullopt;
+  const auto be32 = [&h](int at) {
+    return (std::uint32_t(h[at]) << 24) | (std::uint32_t(h[at + 1]) << 16) | (std::uint32_t(h[at + 2]) << 8) |
+           std::uint32_t(h[at + 3]);
+  };
+  const std::uint32_t raw_page = (std::uint32_t(h[16]) << 8) | h[17];
+  const std::uint64_t page_bytes = raw_page == 1 ? 65536 : raw_page;
+  const std::uint64_t pages = be32(28);
+  if (be32(92) != be32(24) || pages == 0 || page_bytes < 512) return std::nullopt;
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec || size >= pages * page_bytes) return std::nullopt;
+  return "truncated: " + std::to_string(size) + " bytes of the " + std::to_string(pages * page_bytes) +
+         " its header gives (" + std::to_string(pages - size / page_bytes) + " of " + std::to_string(pages) +
+         " pages missing)";
+}
+
 }  // namespace
 
 struct DiveLogReader::Impl {
@@ -109,6 +137,11 @@ struct DiveLogReader::Impl {
     auto fail = [&] {
       if (sqlite3_errcode(db.get()) == SQLITE_NOTADB) {
         throw Error(name + " is not a SQLite database");
+      }
+      // Looked at only once SQLite has failed: a raw read of a log whose writer is checkpointing
+      // can see the header's new page count before the pages that extend the file.
+      if (const std::optional<std::string> truncation = Truncation(path)) {
+        throw Error(name + " is " + *truncation + "; `uwscan log salvage` copies what it holds into a new log");
       }
       sqlite::Fail(name, "cannot read the list of tables", db.get());
     };
@@ -197,7 +230,8 @@ struct DiveLogReader::Impl {
   }
 };
 
-DiveLogReader::DiveLogReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+DiveLogReader::DiveLogReader(const std::filesystem::path& path, DiveLogOpening opening)
+    : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.path = path;
   r.name = LogName(path);
@@ -208,6 +242,11 @@ DiveLogReader::DiveLogReader(const std::filesystem::path& path) : impl_(std::mak
   r.db = sqlite::Open(path, SQLITE_OPEN_READONLY, kBusyTimeout_ms, r.name);
   // Checks each b-tree cell against its page as it is read: damage fails cleanly and early.
   sqlite::Exec(r.db.get(), "PRAGMA cell_size_check = ON", r.name, "cannot enable cell checks");
+  if (opening == DiveLogOpening::kDamaged) {
+    // SQLite refuses a file shorter than its header's page count unless the schema is writable;
+    // then it reads the pages there are (the connection stays read-only: nothing is written).
+    sqlite::Exec(r.db.get(), "PRAGMA writable_schema = ON", r.name, "cannot read a damaged file");
+  }
 
   const std::set<std::string> tables = r.Tables();
   if (!tables.contains("meta")) {
@@ -380,6 +419,9 @@ DiveLogCheck DiveLogReader::Check(
   DiveLogCheck check;
   check.schema_version = r.header.schema_version;
   check.checksummed = r.checksummed();
+  if (const std::optional<std::string> truncation = Truncation(r.path)) {
+    check.integrity.push_back("the file is " + *truncation);
+  }
 
   // SQLite's own check of the file's structure (pages, b-trees), without the index cross-checks.
   {
