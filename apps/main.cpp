@@ -82,13 +82,16 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version print as CLI11 prints them; a usage error is one line, as any error.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    std::fprintf(stderr, "uwscan: error: %s (--help lists the options)\n", e.what());
+    return 2;
   } catch (const uwscan::Error& e) {
     std::fprintf(stderr, "uwscan: error: %s\n", e.what());
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "uwscan: internal error: %s\n", e.what());
-    return 2;
+    return 3;
   }
   return 0;
 }

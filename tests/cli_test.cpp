@@ -49,6 +49,17 @@ TEST(Cli, BadInputEndsWithOneLineReason) {
   EXPECT_NE(missing.output.find("/nonexistent/scanner.yaml"), std::string::npos);
   const CommandRun negative = RunUwscan("bench triangulation --points -5");
   EXPECT_NE(negative.exit_code, 0);
+  // Usage errors as any error: one line naming the option, exit 2.
+  for (const CommandRun& usage : {no_command, unknown, missing, negative}) {
+    EXPECT_EQ(usage.exit_code, 2) << usage.output;
+    EXPECT_EQ(std::count(usage.output.begin(), usage.output.end(), '\n'), 1) << usage.output;
+    EXPECT_EQ(usage.output.rfind("uwscan: error: ", 0), 0u) << usage.output;
+  }
+  const CommandRun zero_voxel = RunUwscan("map " + std::string(UWSCAN_BIN) + " -o m.ply --voxel 0");
+  EXPECT_EQ(zero_voxel.output, "uwscan: error: --voxel: expected a number > 0, got '0' (--help lists the options)\n");
+  const CommandRun word = RunUwscan("map " + std::string(UWSCAN_BIN) + " -o m.ply --max-navigation-gap soon");
+  EXPECT_NE(word.output.find("--max-navigation-gap: expected a number > 0, got 'soon'"), std::string::npos)
+      << word.output;
 }
 
 TEST(Cli, MalformedScannerFileNamesTheField) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/scanner/accuracy_benchmark.hpp"
 #include "scanner/common/error.hpp"
@@ -114,7 +115,7 @@ void AddAccuracyBenchCommand(CLI::App& bench) {
   cmd->add_flag("--quick", args->quick, "a few positions per experiment (smoke test)");
   cmd->add_option("--seed", args->seed, "noise seed");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->callback([args] { RunAccuracy(*args); });
 }
 

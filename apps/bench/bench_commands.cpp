@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/cpu_model.hpp"
 #include "bench/scanner/deformation_experiment.hpp"
@@ -161,7 +162,7 @@ void RunTriangulation(const TriangulationArgs& args) {
 
 void AddTriangulationOptions(CLI::App& command, TriangulationArgs& args) {
   command.add_option("--points", args.points, "stripe pixels to triangulate")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   command.add_option("--seed", args.seed, "random seed of the generated pixels");
   command.add_option("--sweep-grid-px", args.sweep_grid_px,
                      "also measure camera-ray tables of these grid spacings, px (e.g. 1 2 4 8 16)");

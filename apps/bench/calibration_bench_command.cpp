@@ -7,6 +7,7 @@
 #include <string>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/scanner/calibration_benchmark.hpp"
 #include "scanner/common/error.hpp"
@@ -97,7 +98,7 @@ void AddCalibrationBenchCommand(CLI::App& bench) {
   cmd->add_option("--data", args->data_dir, "data folder holding scenes/ and scanners/ (default: data)");
   cmd->add_flag("--quick", args->quick, "3 gauge positions instead of 29 (smoke test)");
   cmd->add_option("--seed", args->seed, "noise seed of the gauge experiment");
-  cmd->add_option("--threads", args->threads, "threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", args->threads, "threads (0: all cores)")->check(kNonNegativeNumber);
   cmd->callback([args] { RunCalibrationBench(*args); });
 }
 

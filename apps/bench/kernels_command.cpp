@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "apps/cli/number_validators.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
 #include "scanner/stripe/stripe_render.hpp"
@@ -86,8 +87,8 @@ void AddKernelsCommand(CLI::App& bench) {
   auto args = std::make_shared<KernelsArgs>();
   CLI::App* cmd = bench.add_subcommand(
       "kernels", "fixed work for each hot kernel, once (for bench/instructions.sh under callgrind)");
-  cmd->add_option("--frames", args->frames, "stripe frames to detect")->check(CLI::PositiveNumber);
-  cmd->add_option("--points", args->points, "stripe pixels per triangulation method")->check(CLI::PositiveNumber);
+  cmd->add_option("--frames", args->frames, "stripe frames to detect")->check(kPositiveNumber);
+  cmd->add_option("--points", args->points, "stripe pixels per triangulation method")->check(kPositiveNumber);
   cmd->callback([args] {
     RunStripe(args->frames);
     RunTriangulators(args->points);

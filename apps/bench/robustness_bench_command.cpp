@@ -4,6 +4,7 @@
 #include <string>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/robustness/reader_seeds.hpp"
@@ -77,12 +78,12 @@ void AddRobustnessBenchCommand(CLI::App& bench) {
                     "wrong types) and damage dive logs; exits 1 on any crash or hang");
   cmd->add_option("--json", args->json, "write the outcomes as JSON");
   cmd->add_option("--mutants", args->options.mutants_per_kind, "mutants per seed file and kind of mutation")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--trials", args->options.dive_log_trials, "damaged dive logs")->check(CLI::NonNegativeNumber);
+      ->check(kPositiveNumber);
+  cmd->add_option("--trials", args->options.dive_log_trials, "damaged dive logs")->check(kNonNegativeNumber);
   cmd->add_option("--damaged-bytes", args->options.damaged_bytes, "random bytes changed per dive log")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   cmd->add_option("--timeout", args->options.timeout_s, "seconds after which a read counts as a hang")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   cmd->add_option("--seed", args->options.seed, "random seed of the mutations");
   cmd->add_option("--data", args->options.data_dir, "the data folder (scenes/, scanners/)");
   cmd->add_option("--write-seeds", args->write_seeds, "only write the seed files into this folder and stop");

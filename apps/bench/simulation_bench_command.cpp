@@ -6,6 +6,7 @@
 #include <string>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/cpu_model.hpp"
 #include "bench/scanner/simulation_benchmark.hpp"
@@ -64,7 +65,7 @@ void AddSimulationBenchCommand(CLI::App& bench) {
   CLI::App* cmd = bench.add_subcommand("simulation", "time per frame of each simulation effect, alone and all on");
   cmd->add_option("--json", args->json_path, "write the figures as JSON");
   cmd->add_option("--data", args->data_dir, "data folder holding scenes/ (default: data)");
-  cmd->add_option("--frames", args->frames, "frames timed per row")->check(CLI::PositiveNumber);
+  cmd->add_option("--frames", args->frames, "frames timed per row")->check(kPositiveNumber);
   cmd->callback([args] { RunSimulationBench(*args); });
 }
 

@@ -10,6 +10,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/slam/slam_benchmark.hpp"
 
@@ -216,12 +217,12 @@ void AddSlamBenchCommand(CLI::App& bench) {
   cmd->add_option("--scene", a->scenes, "dive scenes (default: data/scenes/inspection_loop.yaml and inspection_pipe.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--seeds", a->seeds, "dives per scene: its own seed and the next ones (default 1)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", a->threads, "threads")->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
+  cmd->add_option("--threads", a->threads, "threads")->check(kPositiveNumber);
   cmd->add_option("--walk-scale", a->walk_scale,
                   "multiply the navigation's random walks (position, heading) by this: what SLAM's error owes to "
                   "them (default 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   cmd->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { RunSlamBench(*a); });

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/cpu_model.hpp"
 #include "bench/scanner/stripe_benchmark.hpp"
@@ -103,7 +104,7 @@ void AddStripeBenchCommand(CLI::App& bench) {
   CLI::App* stripe = bench.add_subcommand(
       "stripe", "stripe detectors: frames/s on 2048x1088 Mono8 and sub-pixel RMSE per method");
   stripe->add_option("--frames", args->frames, "distinct frames per measurement")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   stripe->add_option("--seed", args->seed, "random seed of the rendered stripes");
   stripe->add_option("--json", args->json_path, "write the figures as JSON");
   stripe->callback([args] { RunStripe(*args); });

@@ -12,6 +12,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/stop_signal.hpp"
 #include "apps/scanner/camera_frames.hpp"
@@ -228,8 +229,8 @@ void AddInspectCommand(CLI::App& app) {
   cmd->add_option("-o,--map", a->map, "map to write at the end (.ply or .pcd), voxelised");
   cmd->add_flag("--ascii", a->ascii, "write the map as ASCII instead of binary");
   cmd->add_option("--json", a->json, "figures as JSON: frames received, logged, mapped, skipped, latency");
-  cmd->add_option("--frames", a->frames, "stop after this many frames")->check(CLI::PositiveNumber);
-  cmd->add_option("--seconds", a->seconds, "stop after this long")->check(CLI::PositiveNumber);
+  cmd->add_option("--frames", a->frames, "stop after this many frames")->check(kPositiveNumber);
+  cmd->add_option("--seconds", a->seconds, "stop after this long")->check(kPositiveNumber);
   cmd->add_flag("--images", a->images, "image mode: log the images as well as the detected peaks");
   cmd->add_flag("--view", a->view, "show the map live (needs an X display)");
   cmd->add_option("--screenshot", a->screenshot,
@@ -241,13 +242,13 @@ void AddInspectCommand(CLI::App& app) {
   cmd->add_option("--live-queue", a->live_queue,
                   "frames waiting for the mapper; a newer frame skips the oldest")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--voxel", a->voxel_m, "map voxel, metres")->capture_default_str()->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
+  cmd->add_option("--voxel", a->voxel_m, "map voxel, metres")->capture_default_str()->check(kPositiveNumber);
   cmd->add_option("--sweeps-per-submap", a->sweeps_per_submap, "sweeps grouped into one submap")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   cmd->add_option("--threads", a->threads, "threads of the mapper's ICP and normals (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->add_flag("--force", a->force, "replace an existing log at the --log path");
   cmd->callback([a] { RunInspect(*a); });
 }

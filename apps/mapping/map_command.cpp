@@ -9,6 +9,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "mapping/slam/dive_mapping.hpp"
@@ -191,17 +192,17 @@ void AddMapCommand(CLI::App& app) {
   cmd->add_option("--truth", args->truth, "the true trajectory at the same times (TUM; simulated logs)");
   cmd->add_option("--json", args->json,
                   "report: trajectories, per-pose covariance and standard deviations, loops, figures");
-  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")->capture_default_str()->check(kPositiveNumber);
   cmd->add_option("--sweeps-per-submap", args->sweeps_per_submap, "sweeps grouped into one submap")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   cmd->add_option("--max-navigation-gap", args->max_navigation_gap_s,
                   "seconds: frames between navigation samples farther apart, or outside them, are left out "
                   "(and counted)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   cmd->add_option("--threads", args->threads, "threads (0: all cores); the output does not depend on it")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->callback([args] { RunMap(*args); });
 }
 

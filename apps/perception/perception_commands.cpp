@@ -9,6 +9,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/registration/features_benchmark.hpp"
@@ -238,8 +239,8 @@ void AddPerceptionBenchCommands(CLI::App& bench) {
   CLI::App* reg = bench.add_subcommand(
       "registration", "uwscan's registration against PCL's and Open3D's on real data");
   reg->add_option("--pairs-per-mesh", a->pairs_per_mesh, "partial-view pairs per CGAL mesh")
-      ->check(CLI::PositiveNumber);
-  reg->add_option("--threads", a->threads, "threads for every pipeline")->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
+  reg->add_option("--threads", a->threads, "threads for every pipeline")->check(kPositiveNumber);
   reg->add_option("--seed", a->seed, "seed of the pairs and of every RANSAC");
   reg->add_flag("--no-pcl", a->no_pcl, "skip PCL's pipeline");
   reg->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
@@ -253,7 +254,7 @@ void AddPerceptionBenchCommands(CLI::App& bench) {
   auto threads = std::make_shared<int>(2);
   CLI::App* features = bench.add_subcommand("features", "FPFH and ESF against PCL's");
   features->add_option("--json", *json, "write the figures as JSON");
-  features->add_option("--threads", *threads, "threads")->check(CLI::PositiveNumber);
+  features->add_option("--threads", *threads, "threads")->check(kPositiveNumber);
   features->callback([json, threads] { RunFeaturesBench(*json, *threads); });
 }
 

@@ -10,6 +10,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "apps/perception/recognition_json.hpp"
@@ -152,15 +153,15 @@ void AddBuildDbCommand(CLI::App& app) {
                   "valve_wheel, valve_lever")
       ->required();
   cmd->add_option("-o,--output", a->output, "object database to write")->required();
-  cmd->add_option("--views", a->views, "views per object over the sphere of directions")
+  cmd->add_option("--views", a->views, "views per object over the sphere of directions")->capture_default_str()
       ->check(CLI::Range(1, 10000));
-  cmd->add_option("--standoff-m", a->standoffs_m, "camera distances used in turn, metres");
+  cmd->add_option("--standoff-m", a->standoffs_m, "camera distances used in turn, metres")->capture_default_str();
   cmd->add_option("--scanner", a->scanner, "scanner file (default: the galvanometer scanner)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--voxel", a->voxel_m, "voxel of views, models and scans, metres")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--seed", a->seed, "scan noise and ESF sampling seed");
-  cmd->add_option("--threads", a->threads, "threads (0: all)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--voxel", a->voxel_m, "voxel of views, models and scans, metres")->capture_default_str()
+      ->check(kPositiveNumber);
+  cmd->add_option("--seed", a->seed, "scan noise and ESF sampling seed")->capture_default_str();
+  cmd->add_option("--threads", a->threads, "threads (0: all)")->check(kNonNegativeNumber);
   cmd->callback([a] { RunBuildDb(*a); });
 }
 
@@ -178,7 +179,7 @@ void AddRecognizeCommand(CLI::App& app) {
   cmd->add_option("--db", a->db, "object database from `uwscan build-db`")->required();
   cmd->add_option("--json", a->json, "write every object, candidate and grasp as JSON");
   cmd->add_option("--seed", a->seed, "RANSAC and ESF seed");
-  cmd->add_option("--threads", a->threads, "threads (0: all)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", a->threads, "threads (0: all)")->check(kNonNegativeNumber);
   cmd->callback([a] { RunRecognize(*a); });
 }
 

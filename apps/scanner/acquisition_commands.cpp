@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "apps/cli/stop_signal.hpp"
 #include "apps/scanner/camera_frames.hpp"
@@ -192,8 +193,8 @@ void AddAcquireCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("acquire", "record a GigE Vision camera's frames into a new dive log");
   AddCameraOptions(*cmd, args->camera);
   cmd->add_option("-o,--output", args->output, "dive log to create (.db)")->required();
-  cmd->add_option("--frames", args->frames, "stop after this many frames")->check(CLI::PositiveNumber);
-  cmd->add_option("--seconds", args->seconds, "stop after this long")->check(CLI::PositiveNumber);
+  cmd->add_option("--frames", args->frames, "stop after this many frames")->check(kPositiveNumber);
+  cmd->add_option("--seconds", args->seconds, "stop after this long")->check(kPositiveNumber);
   cmd->add_flag("--images", args->images, "image mode: store the images as well as the detected peaks");
   cmd->add_option("--queue-mb", args->queue_mb,
                   "frames waiting for the disk before the reader waits, MB (then the buffers fill and "

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "apps/cli/data_cache.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "apps/cli/text_file.hpp"
 #include "bench/scratch_folder.hpp"
@@ -101,7 +102,7 @@ void AddDemoCommand(CLI::App& app) {
       "demo", "simulate the default scene, reconstruct it with every method, compare to truth");
   cmd->add_option("--scene", args->scene, "scene YAML (default data/scenes/default.yaml)");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->add_option("--screenshot", args->screenshot,
                   "also write a PNG of the reconstructed scene coloured by error (needs an X display)");
   cmd->callback([args] { RunDemo(*args); });

@@ -8,6 +8,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "apps/cli/text_file.hpp"
@@ -179,7 +180,7 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_flag("--images", args->images, "store the rendered frames in the log (image effects on)");
   cmd->add_flag("--force", args->force, "replace an existing log at the output path");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->callback([args] { RunSimulate(*args); });
 }
 

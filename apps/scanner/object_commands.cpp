@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli/number_validators.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/sim/imr_objects.hpp"
@@ -179,7 +180,7 @@ void AddMakeObjectCommand(CLI::App& app) {
   cmd->add_option("--flange-radius-m", a->flange_radius_m, "flange: outer radius of the disc");
   cmd->add_option("--flange-thickness-m", a->flange_thickness_m, "flange: thickness of the disc");
   cmd->add_option("--bolts", a->bolts, "flange: number of bolt heads")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->add_option("--handle", a->handle, "valve: wheel or lever")
       ->check(CLI::IsMember({"wheel", "lever"}));
   cmd->add_option("--handle-radius-m", a->handle_radius_m, "valve: wheel radius or lever reach");

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/plots/bench_plots.hpp"
@@ -212,7 +213,7 @@ void AddViewerBenchCommand(CLI::App& bench) {
   CLI::App* cmd = bench.add_subcommand(
       "viewer", "time to the first picture and per frame, and memory, for big clouds (needs an X display)");
   cmd->add_option("--points", a->points, "point counts (default 1000000 5000000)");
-  cmd->add_option("--frames", a->frames, "frames timed per count")->check(CLI::PositiveNumber);
+  cmd->add_option("--frames", a->frames, "frames timed per count")->check(kPositiveNumber);
   cmd->add_flag("--edl", a->edl, "with Eye-Dome Lighting");
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { RunViewerBench(*a); });

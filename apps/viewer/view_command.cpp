@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "apps/cli/data_cache.hpp"
+#include "apps/cli/number_validators.hpp"
+#include "apps/cli/output_path.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
@@ -147,7 +149,12 @@ void RunFollow(const ViewArgs& a, const viewer::RenderOptions& render) {
 
 void RunView(const ViewArgs& a) {
   const viewer::RenderOptions render = RenderOptionsFrom(a);
-  viewer::RequireDisplay();  // before minutes of reading and reconstructing, not after
+  if (!a.screenshot.empty()) {  // before minutes of reading and reconstructing, not after
+    std::vector<std::filesystem::path> inputs(a.files.begin(), a.files.end());
+    if (!a.scene.empty()) inputs.emplace_back(a.scene);
+    CheckOutputPath(a.screenshot, "--screenshot", inputs);
+  }
+  viewer::RequireDisplay();  // so is the display
   if (a.follow) {
     if (!a.scene.empty()) throw Error("--scene: not with --follow (a followed log carries its own truth)");
     return RunFollow(a, render);
@@ -170,8 +177,11 @@ void RunView(const ViewArgs& a) {
   if (!a.scene.empty()) {
     const scanner::sim::RayCaster truth(scanner::sim::LoadScene(a.scene).objects);
     const std::size_t filled = viewer::SetSurfaceError(truth, kSurfaceSearch_m, scene);
-    std::printf("%s: %zu cloud%s coloured by the distance to its surfaces\n", a.scene.c_str(), filled,
-                filled == 1 ? "" : "s");
+    const std::size_t own = scene.clouds.size() - filled;
+    const std::string kept =
+        own == 0 ? "" : ", " + std::to_string(own) + " keep the error they carry (a simulated log's, from its truth)";
+    std::printf("%s: %zu cloud%s coloured by the distance to its surfaces%s\n", a.scene.c_str(), filled,
+                filled == 1 ? "" : "s", kept.c_str());
   }
   if (a.screenshot.empty()) {
     viewer::ShowScene(scene, render, "uwscan view");
@@ -214,13 +224,13 @@ void AddViewCommand(CLI::App& app) {
   cmd->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
   cmd->add_flag("--no-colour-bar", a->no_colour_bar, "no colour bar");
   cmd->add_option("--ellipsoid-every", a->ellipsoid_every, "map reports: a 3-sigma ellipsoid every N poses")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   cmd->add_flag("--follow", a->follow, "show a dive log while it is written (waits for it to appear)");
-  cmd->add_option("--frames", a->frames, "--follow: stop once the log holds N frames")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--frames", a->frames, "--follow: stop once the log holds N frames")->check(kNonNegativeNumber);
   cmd->add_option("--timeout", a->timeout_s, "--follow: fail after S seconds without the log or a new frame")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->add_option("--decay", a->decay_s, "--follow: drop points older than S seconds (0: keep)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   cmd->callback([a] { RunView(*a); });
 }
 
