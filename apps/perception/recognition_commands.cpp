@@ -16,6 +16,7 @@
 #include "apps/perception/recognition_json.hpp"
 #include "mapping/reconstruction/scan_file.hpp"
 #include "perception/cloud/cloud_io.hpp"
+#include "perception/recognition/object_catalogue.hpp"
 #include "perception/recognition/object_database_builder.hpp"
 #include "perception/recognition/object_recognizer.hpp"
 #include "scanner/common/error.hpp"
@@ -66,6 +67,13 @@ void RunBuildDb(const BuildDbArgs& a) {
       [&](double fraction) { progress.Update("scanning views", fraction); });
   db.Save(a.output);
   std::printf("%s: %zu objects\n", a.output.c_str(), db.objects.size());
+  for (const std::string& name : a.objects) {
+    const std::filesystem::path sidecar = perception::GraspSidecarPath(name);
+    if (std::filesystem::exists(name) && !std::filesystem::exists(sidecar)) {
+      std::printf("  %s: no %s beside it, so no grasp frames (recognize gives its pose only)\n", name.c_str(),
+                  sidecar.filename().c_str());
+    }
+  }
   for (const perception::ObjectModel& o : db.objects) {
     std::string symmetries;
     for (const perception::SymmetryAxis& s : o.symmetries) {

@@ -188,9 +188,12 @@ void RunView(const ViewArgs& a) {
     return;
   }
   const viewer::PictureInfo info = viewer::SaveScreenshot(scene, render, a.screenshot);
-  std::printf("%s: %dx%d, %zu of %zu points drawn, colour by %s", a.screenshot.c_str(), info.width_px,
-              info.height_px, info.points_drawn, info.points_total, viewer::ToString(render.colour));
-  if (info.range) std::printf(" (%.4g .. %.4g)", info.range->lo, info.range->hi);
+  std::printf("%s: %dx%d", a.screenshot.c_str(), info.width_px, info.height_px);
+  if (info.points_total > 0) {  // meshes and trajectories alone have no points to colour
+    std::printf(", %zu of %zu points drawn, colour by %s", info.points_drawn, info.points_total,
+                viewer::ToString(render.colour));
+    if (info.range) std::printf(" (%.4g .. %.4g)", info.range->lo, info.range->hi);
+  }
   std::printf("\n");
 }
 
