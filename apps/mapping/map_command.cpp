@@ -149,7 +149,8 @@ void RunMap(const MapArgs& a) {
   std::printf("%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
               a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
   if (m.stats.frames_without_navigation > 0) {
-    std::printf("%lld of %lld frames left out: not between navigation samples at most %g s apart (--max-navigation-gap)\n",
+    std::printf("%lld of %lld frames left out: not between navigation samples at most %g s apart "
+                "(--max-navigation-gap)\n",
                 static_cast<long long>(m.stats.frames_without_navigation),
                 static_cast<long long>(m.stats.frames_without_navigation + m.stats.frames), a.max_navigation_gap_s);
   }

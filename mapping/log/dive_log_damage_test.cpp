@@ -19,8 +19,8 @@ TEST_F(DiveLogTest, ATruncatedLogIsNamedAsSuchAndItsFramesCanBeRecovered) {
   fs::resize_file(cut, size / 2);
 
   const std::string message = MessageOf([&] { DiveLogReader reader(cut); });
-  EXPECT_NE(message.find("dive log '" + cut.string() + "' is truncated: " + std::to_string(size / 2) + " bytes of the " +
-                         std::to_string(size) + " its header gives"),
+  EXPECT_NE(message.find("dive log '" + cut.string() + "' is truncated: " + std::to_string(size / 2) +
+                         " bytes of the " + std::to_string(size) + " its header gives"),
             std::string::npos)
       << message;
   EXPECT_NE(message.find("uwscan log salvage"), std::string::npos) << message;

@@ -45,9 +45,9 @@ ScanFile ReadScanFile(const std::filesystem::path& path, ReconstructionOptions o
                 SweepRange(r.sweeps) + ")");
   }
   if (r.points.empty()) {
-    throw Error(path.string() + ": " +
-                (options.sweep ? "sweep " + std::to_string(*options.sweep) + " of the dive log" : std::string("the dive log")) +
-                " holds no triangulated point");
+    const std::string what =
+        options.sweep ? "sweep " + std::to_string(*options.sweep) + " of the dive log" : std::string("the dive log");
+    throw Error(path.string() + ": " + what + " holds no triangulated point");
   }
   scan.cloud = perception::MakeCloud(r.points);
   scan.rows.resize(r.points.size());

@@ -55,7 +55,8 @@ TEST_F(ScanFileTest, ACloudFileSaysWhichRowEachFinitePointCameFrom) {
 // would be smeared by the motion.
 TEST_F(ScanFileTest, ASweepOfAMovingDiveIsPlacedWithItsNavigation) {
   const fs::path path = MovingDive();
-  EXPECT_NE(MessageOf([&] { ReadScanFile(path); }).find("holds 4 sweeps, 0 to 3; recognition takes one: choose it with --sweep"),
+  EXPECT_NE(MessageOf([&] { ReadScanFile(path); })
+                .find("holds 4 sweeps, 0 to 3; recognition takes one: choose it with --sweep"),
             std::string::npos)
       << MessageOf([&] { ReadScanFile(path); });
   ReconstructionOptions options;

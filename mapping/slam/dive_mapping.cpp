@@ -71,9 +71,9 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
   while (next_nav < navigation.size()) mapper.AddNavigation(navigation[next_nav++]);
   mapper.Finish();
   if (mapper.stats().frames == 0) {
-    throw Error(name + ": no frame lies within its navigation (samples from " + std::to_string(navigation.front().time_s) +
-                " to " + std::to_string(navigation.back().time_s) + " s, at most " +
-                std::to_string(options.mapper.max_navigation_gap_s) + " s apart; frames from " +
+    throw Error(name + ": no frame lies within its navigation (samples from " +
+                std::to_string(navigation.front().time_s) + " to " + std::to_string(navigation.back().time_s) +
+                " s, at most " + std::to_string(options.mapper.max_navigation_gap_s) + " s apart; frames from " +
                 std::to_string(first_time) + " to " + std::to_string(last_time) + " s)");
   }
   if (mapper.submap_count() == 0) throw Error(name + ": no frame gave points to map");

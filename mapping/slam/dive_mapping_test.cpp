@@ -273,7 +273,8 @@ TEST_F(DiveMappingTest, FramesTheNavigationDoesNotCoverAreLeftOutAndCounted) {
   for (std::int64_t i = 0; i < frames; ++i) {
     const double t = simulator.Frame(i).time_s;
     const auto after = std::lower_bound(samples.begin(), samples.end(), t);
-    const bool covered = after != samples.end() && (*after == t || (after != samples.begin() && *after - *(after - 1) <= 1.0));
+    const bool covered =
+        after != samples.end() && (*after == t || (after != samples.begin() && *after - *(after - 1) <= 1.0));
     uncovered += covered ? 0 : 1;
   }
   ASSERT_GT(uncovered, frames / 3);
