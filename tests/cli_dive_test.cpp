@@ -184,6 +184,19 @@ TEST(CliDive, ImportIntrinsicsFromOpenCv) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("fx_px: 1700.5"), std::string::npos) << text;
   EXPECT_NE(text.find("intrinsics:"), std::string::npos) << text;
+  // Intrinsics of another image size (a binned camera) are refused; so is writing over an input.
+  std::ofstream(ocv) << "%YAML:1.0\n---\nimage_width: 1024\nimage_height: 544\n"
+                        "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                        "   data: [ 850.25, 0., 510.125, 0., 850.75, 270.375, 0., 0., 1. ]\n"
+                        "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+                        "   data: [ -0.1, 0.05, 0.001, -0.002, 0.01 ]\n";
+  const CommandRun binned = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                                      SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
+  EXPECT_EQ(binned.exit_code, 1) << binned.output;
+  EXPECT_NE(binned.output.find("calibrated on 1024x544 images, the camera of"), std::string::npos) << binned.output;
+  const CommandRun over = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                                    SourcePath("data/scanners/galvo_default.yaml") + " -o " + ocv.string());
+  EXPECT_NE(over.output.find("is also an input"), std::string::npos) << over.output;
   std::ofstream(ocv) << "%YAML:1.0\n---\nimage_width: 2048\n";
   const CommandRun bad = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
                                    SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());

@@ -77,6 +77,7 @@ TEST_F(CliFaults, OutputsThatCannotBeWrittenAreRefusedBeforeAnyWork) {
       {"acquire --camera 127.0.0.1 -o " + missing + "/a.db --frames 1", "does not exist"},
       {"log salvage " + dive + " -o " + dive, "is also an input"},
       {"view " + dive + " --screenshot " + missing + "/v.png", "does not exist"},
+      {"plot " + dive + " -o " + dive, "is also an input"},
       {"recognize " + cloud + " --db " + dive + " --json " + missing + "/r.json", "does not exist"},
       {"reconstruct " + dive + " -o " + (dir_ / "c.xyz").string(), "a point cloud is written as .ply or .pcd"},
       {"map " + dive + " -o " + (dir_ / "m.xyz").string(), "a point cloud is written as .ply or .pcd"},

@@ -63,8 +63,18 @@ struct ImportArgs {
 };
 
 void RunImportIntrinsics(const ImportArgs& a) {
+  CheckOutputPath(a.output, "-o", {a.opencv_yaml, a.into});
   const PinholeCamera camera = scanner::calibration::ImportOpenCvCalibration(a.opencv_yaml);
   scanner::Scanner calibrated = scanner::LoadScanner(a.into);
+  const PinholeCamera& current = calibrated.camera().camera;
+  if (camera.width_px != current.width_px || camera.height_px != current.height_px) {
+    // Intrinsics belong to one image size: those of a binned or cropped image would place every
+    // stripe peak of the scanner's full frames wrongly.
+    throw Error(a.opencv_yaml + ": calibrated on " + std::to_string(camera.width_px) + "x" +
+                std::to_string(camera.height_px) + " images, the camera of " + a.into + " gives " +
+                std::to_string(current.width_px) + "x" + std::to_string(current.height_px) +
+                " (calibrate at the camera's own resolution)");
+  }
   calibrated.camera().camera = camera;
   scanner::StepRecord record;
   record.step = "intrinsics";

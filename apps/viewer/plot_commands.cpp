@@ -15,6 +15,7 @@
 
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
+#include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/plots/bench_plots.hpp"
@@ -30,13 +31,6 @@ namespace fs = std::filesystem;
 constexpr int kPanelWidthPx = 760;
 constexpr int kPanelHeightPx = 560;
 
-void RequireFolderOf(const std::string& path, const char* option) {
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty() && !fs::is_directory(parent)) {
-    throw Error(std::string(option) + " " + path + ": folder '" + parent.string() + "' does not exist");
-  }
-}
-
 // Writes the charts of a bench JSON; returns which bench it was.
 std::string PlotFile(const fs::path& json, const fs::path& png) {
   const viewer::BenchPlots plots = viewer::ReadBenchPlots(json);
@@ -50,7 +44,7 @@ struct PlotArgs {
 };
 
 void RunPlot(const PlotArgs& a) {
-  RequireFolderOf(a.output, "-o");
+  CheckOutputPath(a.output, "-o", {a.report});
   viewer::RequireDisplay();
   const std::string bench = PlotFile(a.report, a.output);
   std::printf("%s: %s bench plotted\n", a.output.c_str(), bench.c_str());
@@ -153,7 +147,7 @@ struct ViewerBenchArgs {
 };
 
 void RunViewerBench(const ViewerBenchArgs& a) {
-  if (!a.json.empty()) RequireFolderOf(a.json, "--json");
+  if (!a.json.empty()) CheckOutputPath(a.json, "--json");
   viewer::ViewerBenchOptions o;
   o.point_counts = a.points;
   o.frames = a.frames;

@@ -1,5 +1,6 @@
 #include "scanner/acquisition/frame_source.hpp"
 
+#include <arpa/inet.h>
 #include <arv.h>
 
 #include <atomic>
@@ -58,6 +59,12 @@ std::optional<ReceivePath> ReceivePathFromString(const std::string& name) {
 
 void CameraSettings::Check() const {
   if (address.empty()) throw Error("camera settings: address is empty (expected an IPv4 address)");
+  in_addr parsed{};
+  if (inet_pton(AF_INET, address.c_str(), &parsed) != 1) {
+    // Aravis takes anything else for a device name and looks for it on every interface.
+    throw Error("camera settings: address '" + address +
+                "' is not an IPv4 address (a.b.c.d): cameras are opened by address, never searched for by name");
+  }
   if (roi_x_px < 0 || roi_y_px < 0 || roi_width_px < 0 || roi_height_px < 0 ||
       (roi_width_px > 0) != (roi_height_px > 0)) {
     throw Error("camera settings: roi must be non-negative, width and height both set or both 0");
