@@ -284,6 +284,25 @@ TEST_F(DetectPatternTest, NoPatternIsNullopt) {
   EXPECT_FALSE(DetectPattern(Save("board.png", board), Charuco()));
 }
 
+// A manifest whose board size is off by a column finds no pattern (and quickly: OpenCV's
+// classic detector alone searched such a view for minutes), while the right size still does.
+TEST_F(DetectPatternTest, ABoardOfAnotherSizeIsNotFound) {
+  const PatternSpec spec = Chessboard();
+  const Eigen::Matrix3d H = PlaneToImage(
+      Pose((spec.columns - 1) * spec.square_m, (spec.rows - 1) * spec.square_m, 0.6, 0.2, -0.1, 0.1));
+  cv::Mat image = Render(H, ChessboardShade(spec));
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.7);
+  const std::filesystem::path path = Save("board.png", image);
+  for (const int columns : {8, 10}) {
+    PatternSpec other = spec;
+    other.columns = columns;
+    EXPECT_FALSE(DetectPattern(path, other)) << columns << " columns";
+  }
+  const std::optional<PatternObservation> right = DetectPattern(path, spec);
+  ASSERT_TRUE(right);
+  EXPECT_LT(WorstCornerError(*right, spec, H), 0.1);
+}
+
 TEST_F(DetectPatternTest, UnreadableImageThrowsNamingTheFile) {
   const std::filesystem::path missing = dir_ / "missing.png";
   try {
