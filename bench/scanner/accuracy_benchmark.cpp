@@ -85,7 +85,12 @@ class TriangulatorCache {
                             (pattern.kind == scanner::ScannerKind::kMems ? scanner::ScanPatternToYaml(pattern) : "galvo");
     std::unique_ptr<scanner::Triangulator>& slot = cache_[key];
     if (!slot) {
-      slot = scanner::MakeTriangulator(used, pattern, scanner::DefaultTriangulationMethod(pattern.kind));
+      // A MEMS calibration triangulates on the lines the simulated scanner designed and drove.
+      scanner::TriangulatorBuildOptions build;
+      if (calibration && pattern.kind == scanner::ScannerKind::kMems) {
+        build.driven_with = simulator.scanner().mems().functions;
+      }
+      slot = scanner::MakeTriangulator(used, pattern, scanner::DefaultTriangulationMethod(pattern.kind), build);
     }
     return *slot;
   }

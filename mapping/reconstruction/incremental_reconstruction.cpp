@@ -9,15 +9,7 @@ namespace uwscan::mapping {
 
 IncrementalReconstructor::IncrementalReconstructor(const DiveLogReader& log, const ReconstructionOptions& options)
     : log_(log), options_(options) {
-  const DiveLogHeader& header = log.header();
-  const scanner::TriangulationMethod method =
-      options.method.value_or(scanner::DefaultTriangulationMethod(header.scan_pattern.kind));
-  try {
-    triangulator_ = scanner::MakeTriangulator(options.calibration.value_or(header.scanner), header.scan_pattern,
-                                              method, scanner::TriangulatorBuildOptions{options.table_cache});
-  } catch (const Error& e) {
-    throw Error(log.path().string() + (options.calibration ? " with the calibration given" : "") + ": " + e.what());
-  }
+  triangulator_ = MakeLogTriangulator(log, options);
 }
 
 IncrementalReconstructor::~IncrementalReconstructor() = default;

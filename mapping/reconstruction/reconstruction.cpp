@@ -36,6 +36,24 @@ std::optional<scanner::sim::Trajectory> NavigationTrajectory(const DiveLogReader
 
 }  // namespace
 
+std::unique_ptr<scanner::Triangulator> MakeLogTriangulator(const DiveLogReader& log,
+                                                           const ReconstructionOptions& options) {
+  const DiveLogHeader& header = log.header();
+  const scanner::ScanPattern& pattern = header.scan_pattern;
+  scanner::TriangulatorBuildOptions build;
+  build.table_cache = options.table_cache;
+  if (options.calibration && pattern.kind == scanner::ScannerKind::kMems) {
+    build.driven_with = header.scanner.mems().functions;
+  }
+  try {
+    return scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern,
+                                     options.method.value_or(scanner::DefaultTriangulationMethod(pattern.kind)),
+                                     build);
+  } catch (const Error& e) {
+    throw Error(log.path().string() + (options.calibration ? " with the calibration given" : "") + ": " + e.what());
+  }
+}
+
 Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions& options,
                            const std::function<void(double)>& progress) {
   const DiveLogHeader& header = log.header();
@@ -44,14 +62,7 @@ Reconstruction Reconstruct(const DiveLogReader& log, const ReconstructionOptions
   result.method = options.method.value_or(scanner::DefaultTriangulationMethod(pattern.kind));
 
   const Clock::time_point tables_start = Clock::now();
-  std::unique_ptr<scanner::Triangulator> triangulator;
-  try {
-    triangulator = scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern,
-                                             result.method, scanner::TriangulatorBuildOptions{options.table_cache});
-  } catch (const Error& e) {
-    throw Error(log.path().string() + (options.calibration ? " with the calibration given" : "") + ": " +
-                e.what());
-  }
+  const std::unique_ptr<scanner::Triangulator> triangulator = MakeLogTriangulator(log, options);
   result.table_seconds = Seconds(tables_start);
 
   const std::optional<scanner::sim::Trajectory> navigation =

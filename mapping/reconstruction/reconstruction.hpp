@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,6 +60,13 @@ struct TruthError {
 };
 // std::nullopt when the reconstruction has no truth for any point.
 std::optional<TruthError> CompareToTruth(const Reconstruction& reconstruction);
+
+// The triangulator of a log's frames: with the log's own scanner, or with options.calibration
+// (for a MEMS scanner, on the lines the log's own scanner designed and drove: a calibration
+// changes where their voltages send the beam, not the voltages). Throws uwscan::Error naming
+// the log.
+std::unique_ptr<scanner::Triangulator> MakeLogTriangulator(const DiveLogReader& log,
+                                                           const ReconstructionOptions& options);
 
 // Triangulates every frame of a dive log with the scanner configuration and scan pattern it
 // stores (tables built once), then places each point with the navigation interpolated at its

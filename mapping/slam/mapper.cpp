@@ -491,8 +491,10 @@ Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& patt
     const NavigationNoise& floored = impl_->uncertainty.noise();
     impl_->graph.EstimateDeadReckoningCalibration(floored.speed_scale_sigma, floored.heading_bias_sigma_rad);
   }
-  impl_->triangulator = scanner::MakeTriangulator(scanner, pattern, scanner::DefaultTriangulationMethod(pattern.kind),
-                                                  scanner::TriangulatorBuildOptions{table_cache});
+  scanner::TriangulatorBuildOptions build;
+  build.table_cache = table_cache;
+  impl_->triangulator =
+      scanner::MakeTriangulator(scanner, pattern, scanner::DefaultTriangulationMethod(pattern.kind), build);
 }
 
 Mapper::~Mapper() = default;

@@ -88,4 +88,32 @@ std::vector<MemsLine> DesignMemsScanPattern(const ProjectionFunctions& functions
   return lines;
 }
 
+Plane MemsLinePlaneAt(const ProjectionFunctions& functions, const std::vector<Eigen::Vector2d>& volts,
+                      double plane_extension_m, int line) {
+  functions.Check();
+  const double slack = kDriveRangeSlack * (functions.volts_max - functions.volts_min).maxCoeff();
+  std::vector<Eigen::Vector3d> points_C;
+  points_C.reserve(2 * volts.size());
+  for (std::size_t j = 0; j < volts.size(); ++j) {
+    const RayTrace beam = functions.RayInWater_C(volts[j]);
+    if (!functions.InDriveRange(volts[j], slack) || !beam.ok()) {
+      std::ostringstream message;
+      message << "scan pattern: line " << line << ", waypoint " << j << " is driven at ("
+              << volts[j].transpose() << ") V, outside the range [" << functions.volts_min.transpose()
+              << "] .. [" << functions.volts_max.transpose()
+              << "] V the projection functions were calibrated on (they would be extrapolated)";
+      throw Error(message.str());
+    }
+    const Eigen::Vector2d p = functions.PointAt(volts[j]);
+    const Eigen::Vector3d p_C = functions.T_C_P * Eigen::Vector3d(p.x(), p.y(), 0.0);
+    points_C.push_back(p_C);
+    points_C.push_back(p_C + plane_extension_m * beam.ray.direction);
+  }
+  try {
+    return FitPlane(points_C).plane;
+  } catch (const Error& e) {
+    throw Error("scan pattern: line " + std::to_string(line) + ": " + e.what());
+  }
+}
+
 }  // namespace uwscan::scanner

@@ -40,4 +40,13 @@ struct MemsLine {
 std::vector<MemsLine> DesignMemsScanPattern(const ProjectionFunctions& functions,
                                             const MemsScanPatternOptions& options);
 
+// The light plane of a line the mirror is driven along at `volts` (its waypoints' voltage pairs),
+// as `functions` say those voltages send the beam: each beam from its point on the projection
+// plane (f1, f2) along its direction in water, fitted by one plane. What a later calibration
+// makes of lines designed and driven with an earlier one. Throws uwscan::Error naming the line
+// (`line` in messages) when a voltage pair lies outside the range `functions` were fitted on
+// (they would be extrapolated) or its beam does not leave the viewport.
+Plane MemsLinePlaneAt(const ProjectionFunctions& functions, const std::vector<Eigen::Vector2d>& volts,
+                      double plane_extension_m, int line);
+
 }  // namespace uwscan::scanner

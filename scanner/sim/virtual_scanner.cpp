@@ -48,8 +48,9 @@ VirtualScanner::VirtualScanner(const Scanner& scanner, const VirtualScannerOptio
   impl_->effective = EffectiveScanner(scene);
   const TriangulationMethod method =
       options.method.value_or(DefaultTriangulationMethod(options.pattern.kind));
-  impl_->triangulator = MakeTriangulator(impl_->effective, options.pattern, method,
-                                         TriangulatorBuildOptions{options.table_cache});
+  TriangulatorBuildOptions build;
+  build.table_cache = options.table_cache;
+  impl_->triangulator = MakeTriangulator(impl_->effective, options.pattern, method, build);
 }
 
 VirtualScanner::~VirtualScanner() = default;

@@ -27,7 +27,8 @@ std::unique_ptr<Triangulator> MakeGalvoTriangulator(const GalvoScannerModel& mod
 }
 
 std::unique_ptr<Triangulator> MakeMemsTriangulator(const MemsScannerModel& model, const MemsScan& scan,
-                                                   TriangulationMethod method) {
+                                                   TriangulationMethod method,
+                                                   const std::optional<ProjectionFunctions>& driven_with) {
   if (method != TriangulationMethod::kRayPlane) {
     throw Error("the MEMS scanner triangulates with the planes of its lines only (seed 001); method '" +
                 std::string(ToString(method)) + "' needs a galvanometer scanner");
@@ -38,8 +39,11 @@ std::unique_ptr<Triangulator> MakeMemsTriangulator(const MemsScannerModel& model
   pattern.fov_fraction_x = scan.fov_fraction_x;
   pattern.fov_fraction_y = scan.fov_fraction_y;
   std::vector<Plane> planes;
-  for (const MemsLine& line : DesignMemsScanPattern(model.functions, pattern)) {
-    planes.push_back(line.plane_C);
+  const std::vector<MemsLine> lines = DesignMemsScanPattern(driven_with.value_or(model.functions), pattern);
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    planes.push_back(driven_with ? MemsLinePlaneAt(model.functions, lines[i].volts, pattern.plane_extension_m,
+                                                   static_cast<int>(i))
+                                 : lines[i].plane_C);
   }
   return std::make_unique<PlaneTableTriangulator>(std::make_shared<const CameraRayTable>(model.camera),
                                                   std::move(planes));
@@ -59,7 +63,7 @@ std::unique_ptr<Triangulator> MakeTriangulator(const Scanner& scanner, const Sca
                 ToString(scanner.kind()));
   }
   if (pattern.kind == ScannerKind::kGalvo) return MakeGalvoTriangulator(scanner.galvo(), method, options);
-  return MakeMemsTriangulator(scanner.mems(), pattern.mems, method);
+  return MakeMemsTriangulator(scanner.mems(), pattern.mems, method, options.driven_with);
 }
 
 }  // namespace uwscan::scanner

@@ -2,8 +2,10 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "scanner/lasers/projection_functions.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/lasers/scanner.hpp"
 #include "scanner/triangulation/triangulator.hpp"
@@ -14,6 +16,11 @@ struct TriangulatorBuildOptions {
   // Folder where the galvanometer's cone table is kept between runs (light_surface_cache.hpp);
   // empty: fitted every time. Ray-plane fits planes only, which takes milliseconds.
   std::filesystem::path table_cache;
+  // MEMS: the projection functions the scan pattern was designed and driven with when the frames
+  // were taken (a dive log's own scanner), when the scanner given is another calibration of it.
+  // Its lines are where those put them, at their voltages; the scanner given says where those
+  // voltages send the beam. std::nullopt: the scanner given designed them.
+  std::optional<ProjectionFunctions> driven_with;
 };
 
 // Builds the triangulator of `method` for a scanner (galvanometer or MEMS) and its scan
