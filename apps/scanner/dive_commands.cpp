@@ -188,7 +188,7 @@ void AddReconstructCommand(CLI::App& app) {
   auto args = std::make_shared<ReconstructArgs>();
   CLI::App* cmd = app.add_subcommand("reconstruct", "triangulate a dive log into a point cloud");
   cmd->add_option("log", args->log, "dive log (.db)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", args->output, "point cloud to write (.ply, .pcd, .xyz)")->required();
+  cmd->add_option("-o,--output", args->output, "point cloud to write (.ply or .pcd)")->required();
   cmd->add_option("--method", args->method,
                   "plane, cone or ray (default: cone for the galvanometer, plane for MEMS)");
   cmd->add_option("--json", args->json, "also write the figures as JSON");
