@@ -63,8 +63,14 @@ struct RegisterArgs {
 void RunRegister(const RegisterArgs& a) {
   if (!a.output.empty()) CheckCloudOutputPath(a.output, "-o", {a.source, a.target});
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.source, a.target, a.output});
-  const perception::PointCloud source = perception::ReadCloud(a.source);
-  const perception::PointCloud target = perception::ReadCloud(a.target);
+  perception::CloudReadStats source_stats, target_stats;
+  const perception::PointCloud source = perception::ReadCloud(a.source, &source_stats);
+  const perception::PointCloud target = perception::ReadCloud(a.target, &target_stats);
+  for (const auto& [file, stats] : {std::pair{&a.source, &source_stats}, {&a.target, &target_stats}}) {
+    if (stats->num_dropped_non_finite == 0) continue;
+    std::printf("%s: %zu of its %zu points dropped (a NaN or infinite coordinate or normal)\n", file->c_str(),
+                stats->num_dropped_non_finite, stats->num_in_file);
+  }
   const double size = perception::BoundingBoxDiagonal(target);
   if (a.voxel_set && !(a.voxel_m > 0.0)) throw Error("--voxel: must be > 0 metres");
   if (!a.voxel_set && !(size > 0.0)) {
@@ -75,8 +81,13 @@ void RunRegister(const RegisterArgs& a) {
       size > 0.0 ? size : 50.0 * a.voxel_m, a.seed, a.threads, a.voxel_set ? a.voxel_m : 0.0);
   std::optional<Eigen::Isometry3d> init;
   if (!a.init.empty()) init = ParsePose(a.init);
-  const perception::RegistrationPipelineResult r =
-      perception::RegisterClouds(source, target, options, init);
+  perception::RegistrationPipelineResult r;
+  try {
+    r = perception::RegisterClouds(source, target, options, init);
+  } catch (const Error& e) {
+    throw Error("register " + a.source + " onto " + a.target + " (" + std::to_string(source.size()) + " and " +
+                std::to_string(target.size()) + " points): " + e.what());
+  }
   const Eigen::Matrix4d T = r.fine.T_target_source.matrix();
   std::printf("T_target_source =\n");
   for (int i = 0; i < 4; ++i) {
