@@ -201,36 +201,6 @@ TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
   EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 1);
 }
 
-TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {
-  // A recorder that died mid-sweep: every navigation sample, the frames up to the crash.
-  const scanner::sim::Simulator simulator(ShortScene());
-  const fs::path path = dir_ / "cut.db";
-  const std::int64_t kept = simulator.frame_count() / 2 + 7;
-  {
-    DiveLogHeader header;
-    header.scanner = simulator.scanner();
-    header.scan_pattern = simulator.scan_pattern();
-    header.navigation_noise = NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005};
-    DiveLogWriter writer(path, header);
-    writer.SetVehicleMount(simulator.scene().trajectory.T_V_C);
-    for (const scanner::sim::NavigationSample& n : simulator.Navigation(20.0)) writer.AppendNavigation({n.time_s, n.T_W_V});
-    for (std::int64_t i = 0; i < kept; ++i) {
-      const scanner::sim::SimulatedFrame f = simulator.Frame(i);
-      FrameRecord record;
-      record.time_s = f.time_s;
-      record.command = f.command;
-      record.sweep = f.sweep;
-      record.peaks_px = f.peaks_px;
-      writer.AppendFrame(record);
-    }
-  }
-  const DiveMapping m = Map(path);
-  EXPECT_TRUE(m.truth.empty());
-  ASSERT_GT(m.submaps, 2);
-  EXPECT_NEAR(m.dive_duration_s, static_cast<double>(kept - 1) * simulator.frame_period_s(), 1e-9);
-  EXPECT_GT(m.slam.back().time_s, m.dive_duration_s - 2.0);
-}
-
 // A log of the short dive's first `frames` frames, with the navigation samples `keep` accepts.
 fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const fs::path& path, std::int64_t frames,
                                 const std::function<bool(double)>& keep) {
@@ -253,6 +223,18 @@ fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const 
     writer.AppendFrame(record);
   }
   return path;
+}
+
+TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {
+  // A recorder that died mid-sweep: every navigation sample, the frames up to the crash.
+  const scanner::sim::Simulator simulator(ShortScene());
+  const std::int64_t kept = simulator.frame_count() / 2 + 7;
+  const fs::path path = WriteLogWithNavigation(simulator, dir_ / "cut.db", kept, [](double) { return true; });
+  const DiveMapping m = Map(path);
+  EXPECT_TRUE(m.truth.empty());
+  ASSERT_GT(m.submaps, 2);
+  EXPECT_NEAR(m.dive_duration_s, static_cast<double>(kept - 1) * simulator.frame_period_s(), 1e-9);
+  EXPECT_GT(m.slam.back().time_s, m.dive_duration_s - 2.0);
 }
 
 TEST_F(DiveMappingTest, FramesTheNavigationDoesNotCoverAreLeftOutAndCounted) {
