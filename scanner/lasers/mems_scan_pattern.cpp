@@ -95,14 +95,18 @@ Plane MemsLinePlaneAt(const ProjectionFunctions& functions, const std::vector<Ei
   std::vector<Eigen::Vector3d> points_C;
   points_C.reserve(2 * volts.size());
   for (std::size_t j = 0; j < volts.size(); ++j) {
-    const RayTrace beam = functions.RayInWater_C(volts[j]);
-    if (!functions.InDriveRange(volts[j], slack) || !beam.ok()) {
+    if (!functions.InDriveRange(volts[j], slack)) {
       std::ostringstream message;
       message << "scan pattern: line " << line << ", waypoint " << j << " is driven at ("
               << volts[j].transpose() << ") V, outside the range [" << functions.volts_min.transpose()
               << "] .. [" << functions.volts_max.transpose()
               << "] V the projection functions were calibrated on (they would be extrapolated)";
       throw Error(message.str());
+    }
+    const RayTrace beam = functions.RayInWater_C(volts[j]);
+    if (!beam.ok()) {
+      throw Error("scan pattern: line " + std::to_string(line) + ", waypoint " + std::to_string(j) +
+                  ": the calibrated beam does not leave the viewport");
     }
     const Eigen::Vector2d p = functions.PointAt(volts[j]);
     const Eigen::Vector3d p_C = functions.T_C_P * Eigen::Vector3d(p.x(), p.y(), 0.0);
