@@ -3,8 +3,10 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <utility>
+#include <vector>
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/cloud/nearest_grid.hpp"
@@ -33,7 +35,8 @@ class SightAngles {
 
 // What the scan saw around one segment: all its points (scan frame, planes too) and their index,
 // the segment's window of directions (where the sweep is known to have looked) and, over
-// direction bins about `radius_m` wide at the segment, the nearest depth of any scan point.
+// direction bins about `radius_m` wide at the segment, the scan points and the nearest depth of
+// any of them.
 using Bin = std::pair<long, long>;
 struct SceneAround {
   const PointCloud& points;
@@ -42,18 +45,14 @@ struct SceneAround {
   double bin_rad = 0.0;
   Eigen::Vector2d lo, hi;  // the segment's angular window, one bin of margin
   std::map<Bin, double> nearest_depth;
+  std::map<Bin, std::vector<std::uint32_t>> points_in_bin;  // the scan points in each bin
 
   Bin BinOf(const Eigen::Vector2d& a) const { return {std::lround(a.x() / bin_rad), std::lround(a.y() / bin_rad)}; }
   bool InWindow(const Eigen::Vector2d& a) const { return (a.array() >= lo.array()).all() && (a.array() <= hi.array()).all(); }
-  // Some scan point, of anything, within a bin of this direction: the sweep looked there.
-  bool Covered(const Bin& bin) const {
-    for (long du = -1; du <= 1; ++du) {
-      for (long dv = -1; dv <= 1; ++dv) {
-        if (nearest_depth.count({bin.first + du, bin.second + dv}) != 0) return true;
-      }
-    }
-    return false;
-  }
+  // Some scan point lies more than `beyond_m` behind the plane through x normal to `normal`, on
+  // a line of sight passing within `lateral_m` (at most a bin) of x: the sensor saw through a
+  // surface there.
+  bool SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& normal, double lateral_m, double beyond_m) const;
 };
 
 // The scene around `segment`: `whole_scan` (with its k-d index `index`) over the segment's
@@ -61,17 +60,22 @@ struct SceneAround {
 SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
                                double radius_m);
 
-// Share of the posed model's surface the sensor should have seen that has no scan point within
-// `radius_m`. Seen: facing the sensor (not grazing), within the segment's window of directions
+// Share of the posed model's surface the sensor should have seen where it saw past it instead.
+// Should have seen: facing the sensor (not grazing), within the segment's window of directions
 // (the sweep may have covered only part of the object), nearest to the sensor along its line of
 // sight among the model's own points (a depth buffer over the scene's direction bins), so parts
-// the object hides from itself are not expected, not behind anything else the scan saw nearer
-// in that direction (an object in front, a pipe lying across it), and where the scan has some
-// point, of anything, within a bin (a MEMS pattern or a fan covers a shape of its own, and
-// what it did not light is not evidence; a missing part in front of a seabed is). Any scan
-// point counts, not only the segment's: a valve's handle that occlusion cut off from its body
-// into a segment of its own still shows that the handle is there, and the seabed points
-// removed as a plane still show the object's lowest rim.
+// the object hides from itself are not expected, and not behind anything else the scan saw
+// nearer in that direction (an object in front, a pipe lying across it). Of that surface, a model
+// point is seen when a scan point lies within `radius_m` of it, and missing when a line of sight
+// passes within half of `radius_m` of it and ends, on a scan point, more than that beyond the
+// model's surface there (the sensor saw through where the model claims surface). Model points
+// no line of sight came near, such as a handwheel's thin rim between two laser lines, or what a
+// MEMS pattern did not light, are no evidence either way and count for neither: the former
+// measure, no scan point near a point the sweep looked around, took those for missing and
+// scored a handwheel in its true pose below the same wheel turned off it. Any scan point counts,
+// not only the segment's: a valve's handle that occlusion cut off from its body into a segment
+// of its own still shows that the handle is there, and the seabed points removed as a plane
+// still show the object's lowest rim. 1 when nothing is expected.
 double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
                     double radius_m);
 
