@@ -226,6 +226,11 @@ TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   EXPECT_GT(j["fitness"].get<double>(), 0.9);
+  // An exact copy, judged on every point rather than on the voxels ICP aligned (whose RMSE is
+  // the spread of voxel centroids, millimetres here).
+  EXPECT_EQ(j["whole_clouds"]["fitness"].get<double>(), 1.0);
+  EXPECT_LT(j["whole_clouds"]["inlier_rmse_m"].get<double>(), 2e-4);
+  EXPECT_GT(j["inlier_rmse_m"].get<double>(), 10.0 * j["whole_clouds"]["inlier_rmse_m"].get<double>());
   Eigen::Matrix4d T;
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) T(r, c) = j["T_target_source"][r][c].get<double>();

@@ -36,6 +36,7 @@ nlohmann::json ToJson(const mapping::DiveLogCheck& check) {
           {"integrity", check.integrity},
           {"frames", check.frames},
           {"frames_intact", check.frames_intact},
+          {"frames_without_damaged_truth", check.frames_without_damaged_truth},
           {"navigation", check.navigation},
           {"navigation_intact", check.navigation_intact},
           {"damage", damage},
@@ -46,9 +47,13 @@ void PrintCheck(const std::string& log, const mapping::DiveLogCheck& check) {
   std::printf("%s: schema version %d, %s\n", log.c_str(), check.schema_version,
               check.checksummed ? "every row checksummed"
                                 : "no checksums (schema before 3): structure and values' types only");
-  std::printf("frames: %lld intact of %lld; navigation: %lld intact of %lld\n",
-              static_cast<long long>(check.frames_intact), static_cast<long long>(check.frames),
-              static_cast<long long>(check.navigation_intact), static_cast<long long>(check.navigation));
+  std::printf("frames: %lld intact of %lld", static_cast<long long>(check.frames_intact),
+              static_cast<long long>(check.frames));
+  if (check.frames_without_damaged_truth > 0) {
+    std::printf(" (%lld of them with damaged ground truth)", static_cast<long long>(check.frames_without_damaged_truth));
+  }
+  std::printf("; navigation: %lld intact of %lld\n", static_cast<long long>(check.navigation_intact),
+              static_cast<long long>(check.navigation));
   for (const std::string& line : check.integrity) std::printf("sqlite quick_check: %s\n", line.c_str());
   for (const mapping::DiveLogDamage& d : check.damage) std::printf("damaged: %s\n", d.message.c_str());
   std::printf("%s\n", check.ok() ? "ok" : "DAMAGED");
@@ -104,14 +109,18 @@ void RunSalvage(const SalvageArgs& a) {
     throw;
   }
   PrintCheck(a.log, check);
-  std::printf("salvaged into %s: %lld frames, %lld navigation samples%s (frames renumbered from 0)\n",
-              a.output.c_str(), static_cast<long long>(check.frames_intact),
-              static_cast<long long>(check.navigation_intact),
-              mount_copied ? ", the vehicle mount" : "");
+  const std::string without_truth =
+      check.frames_without_damaged_truth == 0
+          ? ""
+          : " (" + std::to_string(check.frames_without_damaged_truth) + " without their damaged ground truth)";
+  std::printf("salvaged into %s: %lld frames%s, %lld navigation samples%s (frames renumbered from 0)\n",
+              a.output.c_str(), static_cast<long long>(check.frames_intact), without_truth.c_str(),
+              static_cast<long long>(check.navigation_intact), mount_copied ? ", the vehicle mount" : "");
   if (!a.json.empty()) {
     nlohmann::json json = ToJson(check);
     json["salvaged"] = {{"output", a.output},
                         {"frames", check.frames_intact},
+                        {"frames_without_ground_truth", check.frames_without_damaged_truth},
                         {"navigation", check.navigation_intact},
                         {"vehicle_mount", mount_copied}};
     WriteJsonFile(a.json, json);
@@ -134,7 +143,7 @@ void AddLogCommands(CLI::App& app) {
 
   auto salvage = std::make_shared<SalvageArgs>();
   CLI::App* salvage_cmd = log->add_subcommand(
-      "salvage", "copy every intact frame (with its ground truth) and navigation sample of a "
+      "salvage", "copy every intact frame (with its ground truth when that is intact) and navigation sample of a "
                  "damaged log into a new one");
   salvage_cmd->add_option("log", salvage->log, "damaged dive log (.db)")->required()->check(CLI::ExistingFile);
   salvage_cmd->add_option("-o,--output", salvage->output, "new dive log to write (.db)")->required();

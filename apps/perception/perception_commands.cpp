@@ -15,6 +15,7 @@
 #include "bench/registration/features_benchmark.hpp"
 #include "bench/registration/registration_benchmark.hpp"
 #include "perception/cloud/cloud_io.hpp"
+#include "perception/registration/cloud_fit.hpp"
 #include "perception/registration/registration_pipeline.hpp"
 #include "scanner/common/error.hpp"
 
@@ -93,13 +94,19 @@ void RunRegister(const RegisterArgs& a) {
   for (int i = 0; i < 4; ++i) {
     std::printf("  %12.8f %12.8f %12.8f %12.8f\n", T(i, 0), T(i, 1), T(i, 2), T(i, 3));
   }
-  std::printf("fitness %.4f, inlier RMSE %.6f m, %d ICP iterations, %s\n", r.fine.fitness,
-              r.fine.inlier_rmse, r.fine.iterations, r.fine.converged ? "converged" : "NOT converged");
+  // ICP's figures are over the voxelised clouds; the user's clouds are judged whole.
+  const double within_m = options.icp.max_correspondence_distance_m.back();
+  const perception::CloudFit whole = perception::FitOnTarget(source, target, r.fine.T_target_source, within_m);
+  std::printf("%.1f %% of the source within %.6f m of the target, RMS %.6f m (every point of both clouds)\n",
+              100.0 * whole.fitness, within_m, whole.inlier_rmse_m);
+  std::printf("ICP on the %.6f m voxels: fitness %.4f, inlier RMSE %.6f m, %d iterations, %s\n", options.voxel_m,
+              r.fine.fitness, r.fine.inlier_rmse, r.fine.iterations, r.fine.converged ? "converged" : "NOT converged");
   if (!a.output.empty()) {
     perception::WriteCloud(a.output, perception::Transformed(source, r.fine.T_target_source));
   }
   if (!a.json.empty()) {
     nlohmann::json j = ResultJson(r.fine);
+    j["whole_clouds"] = {{"within_m", within_m}, {"fitness", whole.fitness}, {"inlier_rmse_m", whole.inlier_rmse_m}};
     if (!init) j["coarse"] = ResultJson(r.coarse);
     j["stage_seconds"] = r.stage_seconds;
     WriteJsonFile(a.json, j);

@@ -137,7 +137,8 @@ struct DiveLogCheck {
   bool checksummed = false;            // schema version 3 on: every value verified
   std::vector<std::string> integrity;  // SQLite's quick_check findings (empty: none)
   std::int64_t frames = 0;             // rows of the frames table, and how many are intact
-  std::int64_t frames_intact = 0;      // (with their ground truth, when they have one)
+  std::int64_t frames_intact = 0;
+  std::int64_t frames_without_damaged_truth = 0;  // of those, whose ground truth is damaged
   std::int64_t navigation = 0;
   std::int64_t navigation_intact = 0;
   std::vector<DiveLogDamage> damage;
@@ -194,7 +195,8 @@ class DiveLogReader {
   // Reads every row of the log, going on past damaged ones, and runs SQLite's quick_check:
   // `frame` is called for each intact frame in index order (with its ground truth, or nullptr),
   // `navigation` for each intact sample in nav_id order; either may be empty. A frame whose
-  // ground truth is damaged counts as damaged. A truncated file (opened as kDamaged) is an
+  // ground truth is damaged is intact, handed over without it (nullptr), and its ground truth
+  // is a damaged row of table ground_truth. A truncated file (opened as kDamaged) is an
   // integrity finding naming how much of it is missing. Throws only when the file cannot be
   // read at all.
   DiveLogCheck Check(const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,

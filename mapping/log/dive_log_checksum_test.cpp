@@ -131,7 +131,7 @@ TEST_F(DiveLogTest, CheckFindsEveryDamagedRowAndHandsOverEveryIntactOne) {
   const DiveLogCheck check = reader.Check(
       [&](const FrameRecord& frame, const GroundTruthRecord* truth) {
         ExpectSameFrame(TestFrame(frame.index, 10), frame);
-        ASSERT_NE(truth, nullptr);
+        EXPECT_EQ(truth == nullptr, frame.index == 7);  // its ground truth is damaged
         intact_frames.push_back(frame.index);
       },
       [&](const NavigationRecord&) { ++intact_navigation; });
@@ -139,14 +139,15 @@ TEST_F(DiveLogTest, CheckFindsEveryDamagedRowAndHandsOverEveryIntactOne) {
   EXPECT_FALSE(check.ok());
   EXPECT_TRUE(check.integrity.empty());  // SQLite's structure is fine: only values changed
   EXPECT_EQ(check.frames, 11);
-  EXPECT_EQ(check.frames_intact, 9);
-  EXPECT_EQ(intact_frames, (std::vector<std::int64_t>{0, 1, 2, 4, 5, 6, 8, 10, 11}));
+  EXPECT_EQ(check.frames_intact, 10);
+  EXPECT_EQ(check.frames_without_damaged_truth, 1);
+  EXPECT_EQ(intact_frames, (std::vector<std::int64_t>{0, 1, 2, 4, 5, 6, 7, 8, 10, 11}));
   EXPECT_EQ(check.navigation, 12);
   EXPECT_EQ(check.navigation_intact, 11);
   EXPECT_EQ(intact_navigation, 11);
   ASSERT_EQ(check.damage.size(), 4u);
   const std::vector<std::pair<std::string, std::int64_t>> expected = {
-      {"frames", 3}, {"frames", 7}, {"frames", 9}, {"navigation", 5}};
+      {"frames", 3}, {"ground_truth", 7}, {"frames", 9}, {"navigation", 5}};
   for (std::size_t k = 0; k < expected.size(); ++k) {
     EXPECT_EQ(check.damage[k].table, expected[k].first) << check.damage[k].message;
     EXPECT_EQ(check.damage[k].row, expected[k].second) << check.damage[k].message;

@@ -464,14 +464,23 @@ DiveLogCheck DiveLogReader::Check(
       damaged("frames", expected, r.name + ": " + FrameName(expected) + " is missing");
     }
     expected = index + 1;
+    std::optional<FrameRecord> record;
     try {
-      const FrameRecord record = ReadFrame(index);
-      const std::optional<GroundTruthRecord> truth = ReadGroundTruth(index);
-      ++check.frames_intact;
-      if (frame) frame(record, truth ? &*truth : nullptr);
+      record = ReadFrame(index);
     } catch (const Error& e) {
       damaged("frames", index, e.what());
+      continue;
     }
+    // A frame is worth keeping without its ground truth: a real dive has none.
+    std::optional<GroundTruthRecord> truth;
+    try {
+      truth = ReadGroundTruth(index);
+    } catch (const Error& e) {
+      damaged("ground_truth", index, e.what());
+      ++check.frames_without_damaged_truth;
+    }
+    ++check.frames_intact;
+    if (frame) frame(*record, truth ? &*truth : nullptr);
   }
 
   // Navigation: row by row, in the order it was appended.

@@ -246,7 +246,7 @@ std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const Scan
     const OneThreadContext task(ctx);
     described[static_cast<std::size_t>(h)].emplace(DescribedHalf{
         {half_cloud, DescribeSegment(half_cloud, task.ctx()).features},
-        SceneAroundSegment(ctx.down, ctx.down_index, half_cloud, 2.0 * p.voxel_m),
+        SceneAroundOf(half_cloud, task.ctx()),
         ChooseObjects(esf.histogram, Diameter(half_cloud), task.ctx())});
   });
   std::vector<DescribedHalf> kept;
@@ -276,7 +276,7 @@ std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCl
   }
   const PointCloud part = Subset(s.cloud, points);
   const RegistrationResult refined = AlignIcp(part, indexes.target, on_segment.T_target_source, fine);
-  const SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, part, 2.0 * p.voxel_m);
+  const SceneAround around = SceneAroundOf(part, ctx);
   ExplainedPart candidate{posed, std::move(points), share};
   candidate.posed.fine = refined;
   Verify(part, model, indexes.nearest(), around, refined, ctx, candidate.posed.candidate);
@@ -462,7 +462,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
     std::vector<std::size_t> kept = next.indices;
     const PointCloud segment = Subset(removed.remaining, next.indices);
     object.centroid_S = Centroid(segment);
-    const SceneAround around = SceneAroundSegment(down, down_index, segment, 2.0 * p.voxel_m);
+    const SceneAround around = SceneAroundOf(segment, ctx);
     const DescribedSegment described = DescribeSegment(segment, ctx);
     const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed, options.threads);
     clock.Lap("describe");

@@ -2,47 +2,70 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <numbers>
 #include <vector>
 
 namespace uwscan::perception {
 
+SceneAround::SceneAround(const PointCloud& points_in, const KnnIndex& index_in, const Eigen::Vector3d& forward,
+                         double bin_rad_in)
+    : points(points_in), index(index_in), angles(forward), bin_rad(bin_rad_in) {}
+
 SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
-                               double radius_m) {
+                               double radius_m, double margin_m) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < segment.size(); ++i) centroid += segment.Point(i);
   centroid /= static_cast<double>(segment.size());
-  SceneAround around{whole_scan, index, SightAngles(centroid.norm() > 0.0 ? centroid : Eigen::Vector3d::UnitZ()),
-                     std::max(radius_m / std::max(centroid.norm(), 1e-3), 1e-4),
-                     Eigen::Vector2d::Constant(1e9), Eigen::Vector2d::Constant(-1e9), {}, {}};
+  const double range = std::max(centroid.norm(), 1e-3);
+  SceneAround around(whole_scan, index, centroid.norm() > 0.0 ? centroid : Eigen::Vector3d::UnitZ(),
+                     std::max(radius_m / range, 1e-4));
+  around.lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  around.hi = -around.lo;
   for (std::size_t i = 0; i < segment.size(); ++i) {
     const Eigen::Vector2d a = around.angles(segment.Point(i));
     around.lo = around.lo.cwiseMin(a);
     around.hi = around.hi.cwiseMax(a);
   }
-  around.lo.array() -= around.bin_rad;
-  around.hi.array() += around.bin_rad;
+  // The angles are atan2s, within (-pi, pi]: so is the window.
+  const double margin_rad = around.bin_rad + margin_m / range;
+  around.lo = (around.lo.array() - margin_rad).cwiseMax(-std::numbers::pi);
+  around.hi = (around.hi.array() + margin_rad).cwiseMin(std::numbers::pi);
+  around.columns = static_cast<long>((around.hi.x() - around.lo.x()) / around.bin_rad) + 1;
+  around.rows = static_cast<long>((around.hi.y() - around.lo.y()) / around.bin_rad) + 1;
+  const std::size_t bins = static_cast<std::size_t>(around.columns * around.rows);
+  around.nearest_depth.assign(bins, std::numeric_limits<double>::infinity());
+  // The scan points of each bin, counted, then placed (one array, no allocation per bin).
+  std::vector<long> bin_of(whole_scan.size());
+  around.bin_start.assign(bins + 1, 0);
   for (std::size_t i = 0; i < whole_scan.size(); ++i) {
     const Eigen::Vector3d x = whole_scan.Point(i);
-    const Eigen::Vector2d a = around.angles(x);
-    if (!around.InWindow(a)) continue;
-    const Bin bin = around.BinOf(a);
-    auto [it, inserted] = around.nearest_depth.emplace(bin, x.norm());
-    if (!inserted) it->second = std::min(it->second, x.norm());
-    around.points_in_bin[bin].push_back(static_cast<std::uint32_t>(i));
+    bin_of[i] = around.BinOf(around.angles(x));
+    if (bin_of[i] < 0) continue;
+    const std::size_t b = static_cast<std::size_t>(bin_of[i]);
+    around.nearest_depth[b] = std::min(around.nearest_depth[b], x.norm());
+    ++around.bin_start[b + 1];
+  }
+  for (std::size_t b = 0; b < bins; ++b) around.bin_start[b + 1] += around.bin_start[b];
+  around.bin_points.resize(around.bin_start[bins]);
+  std::vector<std::uint32_t> filled(around.bin_start.begin(), around.bin_start.end() - 1);
+  for (std::size_t i = 0; i < whole_scan.size(); ++i) {
+    if (bin_of[i] >= 0) around.bin_points[filled[static_cast<std::size_t>(bin_of[i])]++] = static_cast<std::uint32_t>(i);
   }
   return around;
 }
 
 bool SceneAround::SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& normal, double lateral_m,
                               double beyond_m) const {
-  const Bin bin = BinOf(angles(x));
+  const long bin = BinOf(angles(x));
+  if (bin < 0) return false;
+  const long u0 = bin % columns, v0 = bin / columns;
   const double offset = normal.dot(x);
-  for (long du = -1; du <= 1; ++du) {
-    for (long dv = -1; dv <= 1; ++dv) {
-      const auto cell = points_in_bin.find({bin.first + du, bin.second + dv});
-      if (cell == points_in_bin.end()) continue;
-      for (const std::uint32_t i : cell->second) {
-        const Eigen::Vector3d p = points.Point(i);
+  for (long v = std::max(v0 - 1, 0L); v <= std::min(v0 + 1, rows - 1); ++v) {
+    for (long u = std::max(u0 - 1, 0L); u <= std::min(u0 + 1, columns - 1); ++u) {
+      const std::size_t b = static_cast<std::size_t>(v * columns + u);
+      for (std::uint32_t k = bin_start[b]; k < bin_start[b + 1]; ++k) {
+        const Eigen::Vector3d p = points.Point(bin_points[k]);
         const double range = p.norm();
         const Eigen::Vector3d sight = p / range;
         if ((x - x.dot(sight) * sight).squaredNorm() > lateral_m * lateral_m) continue;
@@ -57,10 +80,10 @@ bool SceneAround::SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& n
 
 double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
                     double radius_m) {
-  std::map<Bin, double> model_depth;
+  std::vector<double> model_depth(scene.nearest_depth.size(), std::numeric_limits<double>::infinity());
   struct Facing {
     Eigen::Vector3d x, normal;
-    Bin bin;
+    std::size_t bin;
   };
   std::vector<Facing> facing;
   const Eigen::Matrix3d R = T_S_O.linear();
@@ -69,21 +92,19 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
     const double depth = x.norm();
     const Eigen::Vector3d normal = R * o.model.normals[i].cast<double>().normalized();
     if (normal.dot(-x / depth) < 0.3) continue;  // grazing or back
-    const Eigen::Vector2d a = scene.angles(x);
-    if (!scene.InWindow(a)) continue;  // not swept
-    const Bin bin = scene.BinOf(a);
-    auto [it, inserted] = model_depth.emplace(bin, depth);
-    if (!inserted) it->second = std::min(it->second, depth);
-    facing.push_back({x, normal, bin});
+    const long bin = scene.BinOf(scene.angles(x));
+    if (bin < 0) continue;  // out of the window
+    const std::size_t b = static_cast<std::size_t>(bin);
+    model_depth[b] = std::min(model_depth[b], depth);
+    facing.push_back({x, normal, b});
   }
   std::vector<std::uint32_t> nearest;
   std::vector<float> squared;
   std::size_t expected = 0, missing = 0;
   for (const auto& [x, normal, bin] : facing) {
     const double depth = x.norm();
-    if (depth > model_depth[bin] + radius_m) continue;  // hidden by the object itself
-    const auto in_front = scene.nearest_depth.find(bin);
-    if (in_front != scene.nearest_depth.end() && in_front->second < depth - radius_m) continue;  // occluded
+    if (depth > model_depth[bin] + radius_m) continue;               // hidden by the object itself
+    if (scene.nearest_depth[bin] < depth - radius_m) continue;       // behind something the scan saw
     scene.index.Query((x - scene.points.origin).cast<float>(), 1, nearest, squared);
     if (!nearest.empty() && squared[0] <= radius_m * radius_m) {
       ++expected;  // seen

@@ -2,10 +2,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <map>
-#include <utility>
 #include <vector>
 
 #include "perception/cloud/cloud_neighbors.hpp"
@@ -34,21 +33,29 @@ class SightAngles {
 };
 
 // What the scan saw around one segment: all its points (scan frame, planes too) and their index,
-// the segment's window of directions (where the sweep is known to have looked) and, over
-// direction bins about `radius_m` wide at the segment, the scan points and the nearest depth of
+// the segment's window of directions, and over a grid of direction bins about `radius_m` wide
+// at the segment covering that window, the scan points in each bin and the nearest depth of
 // any of them.
-using Bin = std::pair<long, long>;
 struct SceneAround {
+  SceneAround(const PointCloud& points, const KnnIndex& index, const Eigen::Vector3d& forward, double bin_rad);
+
   const PointCloud& points;
   const KnnIndex& index;
   SightAngles angles;
   double bin_rad = 0.0;
-  Eigen::Vector2d lo, hi;  // the segment's angular window, one bin of margin
-  std::map<Bin, double> nearest_depth;
-  std::map<Bin, std::vector<std::uint32_t>> points_in_bin;  // the scan points in each bin
+  Eigen::Vector2d lo, hi;  // the window: the segment's directions, widened by the margin and a bin
+  long columns = 0, rows = 0;
+  std::vector<double> nearest_depth;       // per bin, infinity where the scan has no point
+  std::vector<std::uint32_t> bin_start;    // bin b's scan points are bin_points[bin_start[b] ..
+  std::vector<std::uint32_t> bin_points;   // bin_start[b + 1]), indices into points
 
-  Bin BinOf(const Eigen::Vector2d& a) const { return {std::lround(a.x() / bin_rad), std::lround(a.y() / bin_rad)}; }
-  bool InWindow(const Eigen::Vector2d& a) const { return (a.array() >= lo.array()).all() && (a.array() <= hi.array()).all(); }
+  // The bin of direction a, or -1 outside the window.
+  long BinOf(const Eigen::Vector2d& a) const {
+    if (!((a.array() >= lo.array()).all() && (a.array() <= hi.array()).all())) return -1;
+    const long u = std::min(static_cast<long>((a.x() - lo.x()) / bin_rad), columns - 1);
+    const long v = std::min(static_cast<long>((a.y() - lo.y()) / bin_rad), rows - 1);
+    return v * columns + u;
+  }
   // Some scan point lies more than `beyond_m` behind the plane through x normal to `normal`, on
   // a line of sight passing within `lateral_m` (at most a bin) of x: the sensor saw through a
   // surface there.
@@ -56,9 +63,9 @@ struct SceneAround {
 };
 
 // The scene around `segment`: `whole_scan` (with its k-d index `index`) over the segment's
-// window of directions, binned about `radius_m` wide at the segment.
+// window of directions widened by `margin_m` at the segment, binned about `radius_m` wide there.
 SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
-                               double radius_m);
+                               double radius_m, double margin_m = 0.0);
 
 // Share of the posed model's surface the sensor should have seen where it saw past it instead.
 // Should have seen: facing the sensor (not grazing), within the segment's window of directions

@@ -82,6 +82,11 @@ struct PosedObject {
   RegistrationResult fine;
 };
 
+// What the scan saw around `segment`, for the verification: over its window of directions widened
+// by half the database's largest object, so that a posed model reaching out of its segment (a
+// tee's branch, a flange's rim, a handwheel cut off by its own shadow) is checked there too.
+SceneAround SceneAroundOf(const PointCloud& segment, const ScanContext& ctx);
+
 // The posed model verified on `segment`: fit, closeness and missing surface.
 void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
             const SceneAround& around, const RegistrationResult& refined, const ScanContext& ctx,
