@@ -139,6 +139,28 @@ TEST(CliView, ACloudIsColouredByItsDistanceToTheScenesSurfaces) {
   for (const fs::path& p : {scene, cloud, png}) fs::remove(p);
 }
 
+// A scene alone shows its objects (but a sphere, which has no triangles), and without files or a
+// scene the command says what it needs.
+TEST(CliView, AScenesObjectsAreDrawnWithoutAnyCloud) {
+  const fs::path scene = TempPath("objects.yaml"), png = TempPath("objects.png");
+  std::ofstream(scene) << "uwscan_format: 1\nscanner: {file: " << SourcePath("data/scanners/galvo_default.yaml")
+                       << "}\nobjects:\n"
+                          "  - {name: seabed, shape: plane, size_m: [2, 2],\n"
+                          "     pose: {translation_m: [0, 0, 1.2], rotation_xyzw: [0, 0, 0, 1]}}\n"
+                          "  - {name: pipe, shape: pipe, outer_radius_m: 0.1, length_m: 1.0,\n"
+                          "     pose: {translation_m: [0, 0, 1.0], rotation_xyzw: [0, 0.7071068, 0, 0.7071068]}}\n"
+                          "  - {name: ball, shape: sphere, radius_m: 0.1,\n"
+                          "     pose: {translation_m: [0.5, 0, 1], rotation_xyzw: [0, 0, 0, 1]}}\n";
+  const CommandRun run = RunUwscan("view --scene " + scene.string() + " --screenshot " + png.string() + " --size 320x240");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("2 objects drawn (1 sphere not drawn)"), std::string::npos) << run.output;
+  EXPECT_EQ(PngSize(png), std::make_pair(320, 240));
+  const CommandRun nothing = RunUwscan("view --screenshot " + png.string());
+  EXPECT_EQ(nothing.exit_code, 2) << nothing.output;
+  EXPECT_NE(nothing.output.find("--scene"), std::string::npos) << nothing.output;
+  for (const fs::path& p : {scene, png}) fs::remove(p);
+}
+
 // A hand-made map report in the format `uwscan map --json` writes: its map, three trajectories
 // and uncertainty ellipsoids.
 TEST(CliView, MapReportIsDrawnWithItsMapTrajectoriesAndEllipsoids) {

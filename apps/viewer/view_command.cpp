@@ -147,7 +147,26 @@ void RunFollow(const ViewArgs& a, const viewer::RenderOptions& render) {
   if (!a.screenshot.empty()) std::printf("%s: written\n", a.screenshot.c_str());
 }
 
+// A scene alone: its objects' surfaces, each where the scene places it.
+void AddSceneObjects(const scanner::sim::Scene& loaded, const std::string& file, viewer::Scene& scene) {
+  std::size_t spheres = 0;
+  for (const scanner::sim::SceneObject& object : loaded.objects) {
+    if (object.shape == scanner::sim::ObjectShape::kSphere) {  // ray cast exactly: it has no triangles
+      ++spheres;
+      continue;
+    }
+    scene.meshes.push_back({object.name, object.mesh, object.T_W_O});
+  }
+  if (scene.meshes.empty()) throw Error(file + ": no object with a surface to draw (spheres are not drawn)");
+  std::printf("%s: %zu object%s drawn", file.c_str(), scene.meshes.size(), scene.meshes.size() == 1 ? "" : "s");
+  if (spheres > 0) std::printf(" (%zu sphere%s not drawn)", spheres, spheres == 1 ? "" : "s");
+  std::printf("\n");
+}
+
 void RunView(const ViewArgs& a) {
+  if (a.files.empty() && a.scene.empty()) {
+    throw CLI::RequiredError("files to show (or --scene SCENE.yaml alone, to show a scene's objects)");
+  }
   const viewer::RenderOptions render = RenderOptionsFrom(a);
   if (!a.screenshot.empty()) {  // before minutes of reading and reconstructing, not after
     std::vector<std::filesystem::path> inputs(a.files.begin(), a.files.end());
@@ -174,7 +193,9 @@ void RunView(const ViewArgs& a) {
       viewer::AddFile(file, log_options, map_drawing, scene);
     }
   }
-  if (!a.scene.empty()) {
+  if (a.files.empty()) {
+    AddSceneObjects(scanner::sim::LoadScene(a.scene), a.scene, scene);
+  } else if (!a.scene.empty()) {
     const scanner::sim::RayCaster truth(scanner::sim::LoadScene(a.scene).objects);
     const std::size_t filled = viewer::SetSurfaceError(truth, kSurfaceSearch_m, scene);
     const std::size_t own = scene.clouds.size() - filled;
@@ -204,7 +225,7 @@ void AddViewCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "view", std::string("show clouds (.ply .pcd .xyz), meshes (.ply .off .stl .obj), TUM trajectories "
                           "(.txt .tum), dive logs (.db), map and recognition reports (.json); keys: ") + viewer::kViewKeys);
-  cmd->add_option("files", a->files, "files to show")->required();
+  cmd->add_option("files", a->files, "files to show (none with --scene: the scene's objects)");
   cmd->add_option("--colour,--color", a->colour,
                   "height, error (simulated dive logs, or clouds given --scene), intensity or object (default: "
                   "object with a recognition report, error with --scene, else height)");
@@ -222,7 +243,7 @@ void AddViewCommand(CLI::App& app) {
   cmd->add_option("--method", a->method, "dive logs: plane, cone or ray (default: the scanner's)");
   cmd->add_option("--scene", a->scene,
                   "a simulated scene (.yaml): colour the clouds (e.g. a map of a dive simulated from it) by their "
-                  "distance to its true surfaces")
+                  "distance to its true surfaces; alone, draw its objects")
       ->check(CLI::ExistingFile);
   cmd->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
   cmd->add_flag("--no-colour-bar", a->no_colour_bar, "no colour bar");
