@@ -22,6 +22,7 @@
 #include <limits>
 
 #include "scanner/common/error.hpp"
+#include "viewer/plots/legend_place.hpp"
 #include "viewer/render/display.hpp"
 #include "viewer/render/vtk_scene.hpp"
 
@@ -108,9 +109,15 @@ void FillChart(vtkChartXY& chart, const PlotSpec& spec) {
   }
   chart.SetShowLegend(true);
   chart.GetLegend()->SetLabelSize(12);
-  // Top centre: the fast-and-coarse and slow-and-exact corners hold the points.
-  chart.GetLegend()->SetHorizontalAlignment(vtkChartLegend::CENTER);
-  chart.GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
+  // Where it hides least of the data (the fast-and-coarse and slow-and-exact corners of a
+  // trade-off plot hold the points; a rate plot's bars fill its bottom).
+  const LegendPlace place = PlaceLegend(spec);
+  const bool left = place == LegendPlace::kTopLeft || place == LegendPlace::kBottomLeft;
+  const bool top = place != LegendPlace::kBottomLeft && place != LegendPlace::kBottomRight;
+  chart.GetLegend()->SetHorizontalAlignment(place == LegendPlace::kTopCentre ? vtkChartLegend::CENTER
+                                            : left                           ? vtkChartLegend::LEFT
+                                                                             : vtkChartLegend::RIGHT);
+  chart.GetLegend()->SetVerticalAlignment(top ? vtkChartLegend::TOP : vtkChartLegend::BOTTOM);
 }
 
 }  // namespace
@@ -130,6 +137,8 @@ void SavePlotsPng(const std::vector<PlotSpec>& plots, const std::filesystem::pat
   window->SetSize(width_px, height_px);
   vtkNew<vtkChartMatrix> matrix;
   matrix->SetSize(vtkVector2i(static_cast<int>(plots.size()), 1));
+  // Room at the left for the y axis's title beside its tick labels (VTK's default cut it off).
+  matrix->SetBorders(90, 50, 20, 30);
   for (std::size_t i = 0; i < plots.size(); ++i) {
     vtkNew<vtkChartXY> chart;
     matrix->SetChart(vtkVector2i(static_cast<int>(i), 0), chart);
