@@ -229,7 +229,7 @@ TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
   // An exact copy, judged on every point rather than on the voxels ICP aligned (whose RMSE is
   // the spread of voxel centroids, millimetres here).
   EXPECT_EQ(j["whole_clouds"]["fitness"].get<double>(), 1.0);
-  EXPECT_LT(j["whole_clouds"]["inlier_rmse_m"].get<double>(), 2e-4);
+  EXPECT_LT(j["whole_clouds"]["inlier_rmse_m"].get<double>(), 1e-3);  // 0.06 mm measured
   EXPECT_GT(j["inlier_rmse_m"].get<double>(), 10.0 * j["whole_clouds"]["inlier_rmse_m"].get<double>());
   Eigen::Matrix4d T;
   for (int r = 0; r < 4; ++r) {

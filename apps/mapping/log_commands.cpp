@@ -36,7 +36,7 @@ nlohmann::json ToJson(const mapping::DiveLogCheck& check) {
           {"integrity", check.integrity},
           {"frames", check.frames},
           {"frames_intact", check.frames_intact},
-          {"frames_without_damaged_truth", check.frames_without_damaged_truth},
+          {"frames_with_damaged_truth", check.frames_with_damaged_truth},
           {"navigation", check.navigation},
           {"navigation_intact", check.navigation_intact},
           {"damage", damage},
@@ -49,8 +49,9 @@ void PrintCheck(const std::string& log, const mapping::DiveLogCheck& check) {
                                 : "no checksums (schema before 3): structure and values' types only");
   std::printf("frames: %lld intact of %lld", static_cast<long long>(check.frames_intact),
               static_cast<long long>(check.frames));
-  if (check.frames_without_damaged_truth > 0) {
-    std::printf(" (%lld of them with damaged ground truth)", static_cast<long long>(check.frames_without_damaged_truth));
+  if (check.frames_with_damaged_truth > 0) {
+    std::printf(" (%lld of them with ground truth that could not be read)",
+                static_cast<long long>(check.frames_with_damaged_truth));
   }
   std::printf("; navigation: %lld intact of %lld\n", static_cast<long long>(check.navigation_intact),
               static_cast<long long>(check.navigation));
@@ -110,9 +111,9 @@ void RunSalvage(const SalvageArgs& a) {
   }
   PrintCheck(a.log, check);
   const std::string without_truth =
-      check.frames_without_damaged_truth == 0
+      check.frames_with_damaged_truth == 0
           ? ""
-          : " (" + std::to_string(check.frames_without_damaged_truth) + " without their damaged ground truth)";
+          : " (" + std::to_string(check.frames_with_damaged_truth) + " without ground truth, which could not be read)";
   std::printf("salvaged into %s: %lld frames%s, %lld navigation samples%s (frames renumbered from 0)\n",
               a.output.c_str(), static_cast<long long>(check.frames_intact), without_truth.c_str(),
               static_cast<long long>(check.navigation_intact), mount_copied ? ", the vehicle mount" : "");
@@ -120,7 +121,7 @@ void RunSalvage(const SalvageArgs& a) {
     nlohmann::json json = ToJson(check);
     json["salvaged"] = {{"output", a.output},
                         {"frames", check.frames_intact},
-                        {"frames_without_ground_truth", check.frames_without_damaged_truth},
+                        {"frames_with_damaged_truth", check.frames_with_damaged_truth},
                         {"navigation", check.navigation_intact},
                         {"vehicle_mount", mount_copied}};
     WriteJsonFile(a.json, json);

@@ -138,7 +138,9 @@ struct DiveLogCheck {
   std::vector<std::string> integrity;  // SQLite's quick_check findings (empty: none)
   std::int64_t frames = 0;             // rows of the frames table, and how many are intact
   std::int64_t frames_intact = 0;
-  std::int64_t frames_without_damaged_truth = 0;  // of those, whose ground truth is damaged
+  // Of those, the frames whose ground truth could not be read: damaged, or in a truncated file
+  // the pages where a frame's row (or its absence) would be; such a frame may have had none.
+  std::int64_t frames_with_damaged_truth = 0;
   std::int64_t navigation = 0;
   std::int64_t navigation_intact = 0;
   std::vector<DiveLogDamage> damage;

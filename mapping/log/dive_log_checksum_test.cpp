@@ -140,7 +140,7 @@ TEST_F(DiveLogTest, CheckFindsEveryDamagedRowAndHandsOverEveryIntactOne) {
   EXPECT_TRUE(check.integrity.empty());  // SQLite's structure is fine: only values changed
   EXPECT_EQ(check.frames, 11);
   EXPECT_EQ(check.frames_intact, 10);
-  EXPECT_EQ(check.frames_without_damaged_truth, 1);
+  EXPECT_EQ(check.frames_with_damaged_truth, 1);
   EXPECT_EQ(intact_frames, (std::vector<std::int64_t>{0, 1, 2, 4, 5, 6, 7, 8, 10, 11}));
   EXPECT_EQ(check.navigation, 12);
   EXPECT_EQ(check.navigation_intact, 11);

@@ -477,7 +477,7 @@ DiveLogCheck DiveLogReader::Check(
       truth = ReadGroundTruth(index);
     } catch (const Error& e) {
       damaged("ground_truth", index, e.what());
-      ++check.frames_without_damaged_truth;
+      ++check.frames_with_damaged_truth;
     }
     ++check.frames_intact;
     if (frame) frame(*record, truth ? &*truth : nullptr);

@@ -51,8 +51,10 @@ struct RecognitionOptions {
   // answers under 0.85 in the bench's 100 scans were wrong (foreign meshes taken for a tee).
   double min_close = 0.85;
   double close_distance_m = 0.002;
-  // ...and at most this share of the model surface facing the sensor (within the segment's
-  // extent along the view) left without a scan point within 2 voxels.
+  // ...and at most this share of the model surface the sensor should have seen where it saw
+  // through it instead (MissingShare; only surface a line of sight came near counts). Set for the
+  // former measure, which counted all unseen surface; on the bench's 100 scans with the present
+  // one, 0.3 gave 123 recognised (124 at 0.45) and 0.2 the same answers as 0.45.
   double max_missing = 0.45;
   // Verified candidates scoring within this of the best are ranked by chi-square instead.
   double score_tie = 0.02;
@@ -85,7 +87,7 @@ struct RecognitionCandidate {
   int view = -1;            // that view's index in the object's views
   double fitness = 0.0;     // share of the segment on the posed model
   double close = 0.0;       // share of the segment within close_distance_m of its surface
-  double missing = 1.0;     // share of the expected visible model surface not seen
+  double missing = 1.0;     // share of the surface it should have seen that the sensor saw through
   double rmse_m = 0.0;      // point-to-plane RMS of the final ICP
   double score = 0.0;       // close x (1 - missing); the best verified one wins (score_tie)
   bool verified = false;

@@ -1,10 +1,13 @@
 #include "perception/recognition/recognition_verification.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numbers>
 #include <vector>
+
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 
@@ -14,9 +17,11 @@ SceneAround::SceneAround(const PointCloud& points_in, const KnnIndex& index_in, 
 
 SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
                                double radius_m, double margin_m) {
+  if (segment.empty()) throw Error("verification: the segment is empty");
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < segment.size(); ++i) centroid += segment.Point(i);
   centroid /= static_cast<double>(segment.size());
+  if (!centroid.allFinite()) throw Error("verification: the segment has a non-finite point");
   const double range = std::max(centroid.norm(), 1e-3);
   SceneAround around(whole_scan, index, centroid.norm() > 0.0 ? centroid : Eigen::Vector3d::UnitZ(),
                      std::max(radius_m / range, 1e-4));
@@ -31,8 +36,13 @@ SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& ind
   const double margin_rad = around.bin_rad + margin_m / range;
   around.lo = (around.lo.array() - margin_rad).cwiseMax(-std::numbers::pi);
   around.hi = (around.hi.array() + margin_rad).cwiseMin(std::numbers::pi);
-  around.columns = static_cast<long>((around.hi.x() - around.lo.x()) / around.bin_rad) + 1;
-  around.rows = static_cast<long>((around.hi.y() - around.lo.y()) / around.bin_rad) + 1;
+  // Bins about radius_m wide, but at most kMaxBins of them (a segment near the sensor and a wide
+  // margin): wider bins only make the depth buffers coarser.
+  constexpr double kMaxBins = 4e6;
+  const Eigen::Vector2d extent = around.hi - around.lo;
+  around.bin_rad = std::max(around.bin_rad, std::sqrt(extent.x() * extent.y() / kMaxBins));
+  around.columns = static_cast<long>(extent.x() / around.bin_rad) + 1;
+  around.rows = static_cast<long>(extent.y() / around.bin_rad) + 1;
   const std::size_t bins = static_cast<std::size_t>(around.columns * around.rows);
   around.nearest_depth.assign(bins, std::numeric_limits<double>::infinity());
   // The scan points of each bin, counted, then placed (one array, no allocation per bin).
@@ -68,7 +78,8 @@ bool SceneAround::SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& n
         const Eigen::Vector3d p = points.Point(bin_points[k]);
         const double range = p.norm();
         const Eigen::Vector3d sight = p / range;
-        if ((x - x.dot(sight) * sight).squaredNorm() > lateral_m * lateral_m) continue;
+        const double along = x.dot(sight);
+        if (along <= 0.0 || (x - along * sight).squaredNorm() > lateral_m * lateral_m) continue;
         // Where the line of sight meets the surface's plane at x (the caller's x faces the sensor).
         const double surface = offset / normal.dot(sight);
         if (range > surface + beyond_m) return true;

@@ -64,6 +64,7 @@ struct SceneAround {
 
 // The scene around `segment`: `whole_scan` (with its k-d index `index`) over the segment's
 // window of directions widened by `margin_m` at the segment, binned about `radius_m` wide there.
+// Throws uwscan::Error on an empty segment or a non-finite point in it.
 SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
                                double radius_m, double margin_m = 0.0);
 

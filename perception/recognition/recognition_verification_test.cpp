@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include "scanner/common/error.hpp"
+
 #include <cmath>
+#include <vector>
 #include <vector>
 
 namespace uwscan::perception {
@@ -45,42 +48,81 @@ ObjectModel Plate() {
   return o;
 }
 
-double Missing(const PointCloud& scan, const Eigen::Isometry3d& T_S_O) {
-  const ObjectModel plate = Plate();
-  const KnnIndex index(scan.points);
+SceneAround Around(const PointCloud& scan, const KnnIndex& index, const Eigen::Isometry3d& T_S_O) {
   // The segment's window: where the plate would be.
-  const SceneAround around = SceneAroundSegment(scan, index, Transformed(plate.model, T_S_O), kRadius);
-  return MissingShare(plate, T_S_O, around, kRadius);
+  return SceneAroundSegment(scan, index, Transformed(Plate().model, T_S_O), kRadius);
+}
+
+double Missing(const PointCloud& scan, const Eigen::Isometry3d& T_S_O) {
+  const KnnIndex index(scan.points);
+  return MissingShare(Plate(), T_S_O, Around(scan, index, T_S_O), kRadius);
 }
 
 const Eigen::Isometry3d kOnPlate(Eigen::Translation3d(0.0, 0.0, kPlateZ));
+const Eigen::Vector3d kTowardsSensor(0.0, 0.0, -1.0);
+
+// Whether the scan saw through the plate's surface at (x, y) of the plate.
+bool SeenThrough(const PointCloud& scan, double x, double y) {
+  const KnnIndex index(scan.points);
+  return Around(scan, index, kOnPlate).SeenThrough(Eigen::Vector3d(x, y, kPlateZ), kTowardsSensor, 0.5 * kRadius,
+                                                   0.5 * kRadius);
+}
 
 TEST(MissingShareTest, APlateTheScanSawIsNotMissing) {
   EXPECT_EQ(Missing(Scan(true, 0.004), kOnPlate), 0.0);
+  EXPECT_FALSE(SeenThrough(Scan(true, 0.004), 0.0, 0.0));
 }
 
 TEST(MissingShareTest, APlateTheSensorSawThroughIsMissing) {
+  EXPECT_TRUE(SeenThrough(Scan(false, 0.004), 0.0, 0.0));
   EXPECT_GT(Missing(Scan(false, 0.004), kOnPlate), 0.95);
 }
 
-// Laser lines 30 mm apart leave most of the plate between them, unseen but not seen through:
-// that is no evidence against it. Where the lines cross an absent plate, it is missing.
+// Laser lines 30 mm apart (27 mm at the plate) leave most of the plate between them, unseen but
+// not seen through: that is no evidence against it. Where the lines cross an absent plate, it is
+// missing.
 TEST(MissingShareTest, SurfaceBetweenLaserLinesIsNoEvidence) {
   EXPECT_EQ(Missing(Scan(true, 0.03), kOnPlate), 0.0);
-  EXPECT_GT(Missing(Scan(false, 0.03), kOnPlate), 0.95);
-}
-
-// Posed 5 mm in front of the seabed the plate is on what the sensor saw (within the seen
-// radius), not seen through; posed 50 mm in front of the seabed, it is.
-TEST(MissingShareTest, SeeingThroughNeedsTheLineOfSightToEndBeyondTheSurface) {
-  const PointCloud seabed_only = Scan(false, 0.004);
-  EXPECT_EQ(Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.005))), 0.0);
-  EXPECT_GT(Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.05))), 0.95);
+  const PointCloud no_plate = Scan(false, 0.03);
+  EXPECT_TRUE(SeenThrough(no_plate, 0.0, 0.009));    // on the line v = 0.01 (y = 0.9 v there)
+  EXPECT_FALSE(SeenThrough(no_plate, 0.0, 0.0225));  // half-way to the next, v = 0.04
+  EXPECT_GT(Missing(no_plate, kOnPlate), 0.95);
 }
 
 // Half the plate seen, the sensor seeing the seabed where the other half should be.
 TEST(MissingShareTest, HalfAPlateIsHalfMissing) {
   EXPECT_NEAR(Missing(Scan(true, 0.004, 0.0), kOnPlate), 0.5, 0.1);
+}
+
+// A plate posed 5 mm in front of the seabed lies on what the sensor saw (within the seen radius);
+// posed 50 mm in front of it, the sensor saw through it.
+TEST(MissingShareTest, APlateJustInFrontOfWhatTheScanSawIsSeen) {
+  const PointCloud seabed_only = Scan(false, 0.004);
+  EXPECT_EQ(Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.005))), 0.0);
+  EXPECT_GT(Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.05))), 0.95);
+}
+
+// Seen through means the line of sight ends more than `beyond_m` past the surface's plane (along
+// the line, not the normal), and passes within `lateral_m` of the point.
+TEST(MissingShareTest, SeenThroughNeedsTheLineOfSightToEndBeyondTheSurfaceNearThePoint) {
+  const Eigen::Vector3d p(0.02, 0.0, 1.0);  // the one scan point, 1 m away
+  const PointCloud scan = MakeCloud(std::vector<Eigen::Vector3d>{p});
+  const KnnIndex index(scan.points);
+  const SceneAround around = SceneAroundSegment(scan, index, scan, kRadius, 0.05);
+  // A surface facing the sensor, 30 mm (along the line of sight) in front of the point.
+  const Eigen::Vector3d x = (1.0 - 0.03) * p;
+  EXPECT_TRUE(around.SeenThrough(x, kTowardsSensor, 0.001, 0.02));
+  EXPECT_FALSE(around.SeenThrough(x, kTowardsSensor, 0.001, 0.04));
+  // 3 mm beside the line of sight.
+  const Eigen::Vector3d beside = x + Eigen::Vector3d(0.0, 0.003, 0.0);
+  EXPECT_TRUE(around.SeenThrough(beside, kTowardsSensor, 0.005, 0.02));
+  EXPECT_FALSE(around.SeenThrough(beside, kTowardsSensor, 0.002, 0.02));
+}
+
+TEST(MissingShareTest, AnEmptySegmentIsRefused) {
+  const PointCloud scan = Scan(true, 0.004);
+  const KnnIndex index(scan.points);
+  EXPECT_THROW(SceneAroundSegment(scan, index, PointCloud{}, kRadius), Error);
 }
 
 }  // namespace
