@@ -1,5 +1,6 @@
 #include "perception/recognition/object_database.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -165,6 +166,12 @@ ObjectModel GetObject(ByteReader& in) {
 }
 
 }  // namespace
+
+double ObjectDatabase::LargestDiameter() const {
+  double largest_m = 0.0;
+  for (const ObjectModel& o : objects) largest_m = std::max(largest_m, o.diameter_m);
+  return largest_m;
+}
 
 void ObjectDatabase::Save(const std::filesystem::path& path) const {
   ByteWriter out;

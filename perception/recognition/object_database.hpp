@@ -64,6 +64,9 @@ struct ObjectDatabase {
   // database (foreign file), a newer or older format version, truncated, corrupt (checksum or
   // a value out of range).
   static ObjectDatabase Load(const std::filesystem::path& path);
+
+  // The largest diameter of its objects, metres (0 when it has none).
+  double LargestDiameter() const;
 };
 
 inline constexpr std::uint32_t kObjectDatabaseVersion = 1;

@@ -441,8 +441,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   StageClock clock(result.stage_seconds);
 
   const PointCloud down = VoxelDownsample(scan, VoxelFilterOptions{p.voxel_m});
-  double largest_object_m = 0.0;
-  for (const ObjectModel& o : db.objects) largest_object_m = std::max(largest_object_m, o.diameter_m);
+  const double largest_object_m = db.LargestDiameter();
   const PlaneRemovalResult removed = RemoveSupportPlanes(down, largest_object_m, options);
   for (const DetectedPlane& plane : removed.planes) result.plane_points += plane.inliers.size();
   clock.Lap("preprocess");

@@ -98,9 +98,8 @@ DescribedSegment DescribeSegment(const PointCloud& segment, const ScanContext& c
 }
 
 SceneAround SceneAroundOf(const PointCloud& segment, const ScanContext& ctx) {
-  double largest_m = 0.0;
-  for (const ObjectModel& o : ctx.db.objects) largest_m = std::max(largest_m, o.diameter_m);
-  return SceneAroundSegment(ctx.down, ctx.down_index, segment, 2.0 * ctx.db.parameters.voxel_m, 0.5 * largest_m);
+  return SceneAroundSegment(ctx.down, ctx.down_index, segment, 2.0 * ctx.db.parameters.voxel_m,
+                            0.5 * ctx.db.LargestDiameter());
 }
 
 // The posed model verified on `segment`: fit, closeness and missing surface.
