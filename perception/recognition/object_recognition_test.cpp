@@ -246,6 +246,59 @@ TEST(ObjectRecognition, TwoTouchingObjectsAreBothRecognised) {
   }
 }
 
+// The same pipe and valve, the valve's stem left out of its mesh: its handwheel floats 4 cm above
+// the body and forms a segment of its own, which cannot join the body's (pipe and body together are
+// already wider than any object of the database) and which alone is no object. The segment of the
+// body, split off the pipe's, is joined with it and the whole valve comes out, posed.
+TEST(ObjectRecognition, AHandwheelCutOffItsValveIsJoinedToIt) {
+  TouchingObjects t = PipeAgainstValve();
+  const sim::ValveShape shape;
+  scanner::TriangleMesh& valve = t.scene[2].mesh;
+  std::erase_if(valve.triangles, [&](const Eigen::Vector3i& triangle) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& v = valve.vertices[triangle[k]];
+      if (std::hypot(v.x(), v.z()) > shape.stem_radius_m + 1e-4) return false;
+    }
+    return true;  // the stem's side and caps
+  });
+  t.scan = Scanner().Scan(t.scene, t.T_W_C, 11);
+  t.cloud = MakeCloud(t.scan.points_C);
+  // The wheel's own points: the valve's above the body.
+  const Eigen::Isometry3d T_S_O = t.T_W_C.inverse() * t.scene[2].T_W_O;
+  std::vector<std::size_t> wheel;
+  for (std::size_t i = 0; i < t.cloud.size(); ++i) {
+    const double height_O = (T_S_O.inverse() * t.cloud.Point(i)).y();
+    if (t.scan.object_index[i] == 2 && height_O > shape.body_radius_m + 0.02) wheel.push_back(i);
+  }
+  ASSERT_GT(wheel.size(), 300u);
+  ClusteringOptions clustering;
+  clustering.tolerance_m = RecognitionOptions{}.cluster_tolerance_m;
+  std::vector<std::size_t> valve_points;
+  for (std::size_t i = 0; i < t.cloud.size(); ++i) {
+    if (t.scan.object_index[i] == 2) valve_points.push_back(i);
+  }
+  EXPECT_GE(EuclideanClusters(Subset(t.cloud, valve_points), clustering).size(), 2u) << "the wheel is not cut off";
+
+  const RecognitionResult r = RecognizeObjects(t.cloud, PipeFlangeValveDb());
+  const RecognizedObject* holder = nullptr;
+  for (const RecognizedObject& found : r.objects) {
+    if (std::binary_search(found.segment.begin(), found.segment.end(), wheel.front())) holder = &found;
+  }
+  ASSERT_NE(holder, nullptr);
+  ASSERT_EQ(holder->object_id, "valve_wheel");
+  const std::size_t held = static_cast<std::size_t>(std::count_if(wheel.begin(), wheel.end(), [&](std::size_t i) {
+    return std::binary_search(holder->segment.begin(), holder->segment.end(), i);
+  }));
+  EXPECT_GT(held, 0.95 * static_cast<double>(wheel.size()));
+  const ObjectModel& model = PipeFlangeValveDb().objects[2];
+  ASSERT_EQ(model.id, "valve_wheel");
+  std::vector<Eigen::Vector3d> model_points;
+  for (std::size_t i = 0; i < model.model.size(); ++i) model_points.push_back(model.model.Point(i));
+  const SymmetricPoseError e = PoseErrorModuloSymmetry(holder->T_S_O, T_S_O, model_points, model.symmetries);
+  EXPECT_LT(e.translation_m, 0.005);
+  EXPECT_LT(e.rotation_rad, 2.0 * std::numbers::pi / 180.0);
+}
+
 // The segment split into the objects it holds (in parallel over halves and candidates) gives
 // the same objects, points and poses for one thread and two.
 TEST(ObjectRecognition, ASplitSegmentIsTheSameForOneAndTwoThreads) {

@@ -385,6 +385,190 @@ void QueueClusters(const PointCloud& cloud, const std::vector<std::size_t>& indi
   }
 }
 
+// What recognising one segment gives: its object (or "unknown"), the segment's points it keeps,
+// and what it leaves unexplained, queued as segments of their own.
+struct SegmentOutcome {
+  RecognizedObject object;
+  std::vector<std::size_t> kept;  // into the plane-free cloud
+  std::deque<PendingSegment> queued;
+};
+
+// One segment of the plane-free cloud `remaining` recognised: its candidates posed and verified,
+// the best accepted, or, when none is verified, the part one object explains split off it.
+SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& remaining, const ScanContext& ctx) {
+  const ObjectDatabase& db = ctx.db;
+  const RecognitionOptions& options = ctx.options;
+  const ObjectDatabaseParameters& p = db.parameters;
+  RecognitionCache& cache = ctx.cache;
+  StageClock& clock = ctx.clock;
+  SegmentOutcome out;
+  RecognizedObject& object = out.object;
+  object.object_id = "unknown";
+  std::vector<std::size_t>& kept = out.kept;
+  kept = next.indices;
+  const PointCloud segment = Subset(remaining, next.indices);
+  object.centroid_S = Centroid(segment);
+  const SceneAround around = SceneAroundOf(segment, ctx);
+  const DescribedSegment described = DescribeSegment(segment, ctx);
+  const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed, options.threads);
+  clock.Lap("describe");
+  if (esf.ok && described.cloud.size() >= 10) {
+    const ChosenObjects chosen = ChooseObjects(esf.histogram, next.core_diameter_m, ctx);
+    const std::vector<double>& nearest_chi_square = chosen.nearest_chi_square;
+    clock.Lap("match");
+    std::vector<PosedObject> posed;
+    for (std::size_t i : chosen.objects) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
+    std::stable_sort(posed.begin(), posed.end(),
+                     [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
+    BreakTie(options.score_tie, posed);
+    for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
+    const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
+    if (!posed.empty() && posed.front().candidate.verified) {
+      const PosedObject& best = posed.front();
+      const ObjectModel& model = db.objects[best.object];
+      Accept(best, described.cloud, model, NearestOther(best.object, nearest_chi_square), ctx, object);
+      object.equivalent_objects_S = EquivalentObjects(posed, options.score_tie);
+      object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
+      clock.Lap("equivalents");
+      if (split_allowed) {
+        // What the object leaves unexplained may be another one touching it.
+        const std::vector<std::size_t> rest =
+            Partition(next.indices, PointsOnModel(described.cloud, model, cache.Model(best.object).nearest(),
+                                                  best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m)).second;
+        QueueClusters(remaining, rest, next.objects_before + 1, options, out.queued);
+        std::vector<std::size_t> taken;
+        for (const PendingSegment& q : out.queued) taken.insert(taken.end(), q.indices.begin(), q.indices.end());
+        std::sort(taken.begin(), taken.end());
+        std::erase_if(kept, [&](std::size_t i) { return std::binary_search(taken.begin(), taken.end(), i); });
+      }
+    } else if (split_allowed && segment.size() >= 2 * static_cast<std::size_t>(options.min_segment_points)) {
+      std::optional<ExplainedPart> part = ExplainPart(described, ctx);
+      clock.Lap("split");
+      if (part) {
+        const PointCloud part_cloud = Subset(segment, part->points);
+        // The part's own ESF for its chi-square and margin.
+        const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed, options.threads);
+        std::vector<double> part_chi_square;
+        if (part_esf.ok) {
+          for (const auto& nearest : NearestViews(part_esf.histogram, db, 1)) {
+            part_chi_square.push_back(nearest.front().first);
+            if (part_chi_square.size() == part->posed.object + 1) part->posed.candidate.view = nearest.front().second;
+          }
+          part->posed.candidate.chi_square = part_chi_square[part->posed.object];
+        }
+        object.candidates.insert(object.candidates.begin(), part->posed.candidate);
+        Accept(part->posed, part_cloud, db.objects[part->posed.object],
+               part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);
+        object.centroid_S = Centroid(part_cloud);
+        std::vector<std::size_t> rest;
+        std::tie(kept, rest) = Partition(next.indices, part->points);
+        QueueClusters(remaining, rest, next.objects_before + 1, options, out.queued);
+      }
+    }
+  }
+  clock.Lap("verify");
+  return out;
+}
+
+// The database index of the object named `id`.
+std::size_t ObjectIndex(const ObjectDatabase& db, const std::string& id) {
+  for (std::size_t i = 0; i < db.objects.size(); ++i) {
+    if (db.objects[i].id == id) return i;
+  }
+  throw Error("recognition: no object '" + id + "' in the database");  // answers come from it
+}
+
+// Whether `object` (posed as `T_S_O`) has at least `share` of `part`'s points (indices into
+// `remaining`) within 1.5 voxels of its model.
+bool ExplainsPart(const PointCloud& remaining, const std::vector<std::size_t>& part, std::size_t object,
+                  const Eigen::Isometry3d& T_S_O, double share, const ScanContext& ctx) {
+  const PointCloud cloud = Subset(remaining, part);
+  const std::size_t on = PointsOnModel(cloud, ctx.db.objects[object], ctx.cache.Model(object).nearest(),
+                                       T_S_O.inverse(), 1.5 * ctx.db.parameters.voxel_m).size();
+  return static_cast<double>(on) >= share * static_cast<double>(cloud.size());
+}
+
+// Whether segments `a` and `b` are worth recognising as one: a segment no object explains next to
+// a recognised one (a handwheel its own shadow cut off from its valve's body, when the body also
+// touched another object and so could not join it in Segments), or two answered as the same
+// object (the handwheel alone fits the wheel valve too, badly). Pairs of recognised segments are
+// taken once (a < b).
+bool WorthJoining(const RecognizedObject& a, const RecognizedObject& b, std::size_t ia, std::size_t ib) {
+  if (a.object_id == "unknown") return b.object_id != "unknown";
+  return ib > ia && b.object_id == a.object_id;
+}
+
+// Segment `k` joined with the nearest other WorthJoining it (see JoinSegmentsOneObjectExplains):
+// the entry that holds the union (the pair's first; the second is dropped), or none.
+std::optional<std::size_t> JoinNearest(const PointCloud& remaining, double largest_object_m, const ScanContext& ctx,
+                                       std::size_t k, std::vector<bool>& dropped, std::vector<RecognizedObject>& objects,
+                                       std::vector<std::vector<std::size_t>>& points) {
+  if (dropped[k] || points[k].empty()) return std::nullopt;
+  std::vector<Segment> others(objects.size());
+  for (std::size_t j = 0; j < objects.size(); ++j) {
+    if (j != k && !dropped[j] && WorthJoining(objects[k], objects[j], k, j)) others[j].indices = points[j];
+  }
+  const auto [to, distance] = NearestSegment(remaining, points[k], others, k);
+  if (distance > ctx.options.attach_distance_m) return std::nullopt;
+  std::vector<std::size_t> both = points[k];
+  both.insert(both.end(), points[to].begin(), points[to].end());
+  std::sort(both.begin(), both.end());
+  const double diameter = Diameter(Subset(remaining, both));
+  if (diameter > largest_object_m) return std::nullopt;
+  SegmentOutcome joined = RecognizeSegment({both, diameter, ctx.options.max_objects_per_segment - 1}, remaining, ctx);
+  if (joined.object.object_id == "unknown") return std::nullopt;
+  const double apart = (objects[k].score * static_cast<double>(points[k].size()) +
+                        objects[to].score * static_cast<double>(points[to].size())) /
+                       static_cast<double>(both.size());
+  if (joined.object.score < apart) return std::nullopt;
+  const std::size_t object = ObjectIndex(ctx.db, joined.object.object_id);
+  const double share = ctx.options.min_fitness;
+  if (!ExplainsPart(remaining, points[k], object, joined.object.T_S_O, share, ctx) ||
+      !ExplainsPart(remaining, points[to], object, joined.object.T_S_O, share, ctx)) {
+    return std::nullopt;
+  }
+  const std::size_t first = std::min(k, to), second = std::max(k, to);
+  objects[first] = std::move(joined.object);
+  points[first] = std::move(joined.kept);
+  points[second].clear();
+  dropped[second] = true;
+  return first;
+}
+
+// Segments that one object explains better together than apart, joined after the per-segment
+// pass: for each segment, the nearest other within attach_distance_m WorthJoining it is
+// recognised with it as one segment (not split again) when together they are no wider than the
+// largest object. The union replaces the pair when it is verified, its object puts min_fitness
+// of each one's points on its model, and it scores at least their scores' mean weighted by points
+// (an unknown one's counting 0): a wheel valve whose handwheel was cut off then comes out whole
+// and posed where its body alone fitted the lever valve as well. `objects` and `points` (indices
+// into `remaining`) stay in order, the pair's second entry dropped.
+void JoinSegmentsOneObjectExplains(const PointCloud& remaining, double largest_object_m, const ScanContext& ctx,
+                                   std::vector<RecognizedObject>& objects,
+                                   std::vector<std::vector<std::size_t>>& points) {
+  // The stages of the segments recognised here are timed as one, "join".
+  std::map<std::string, double> untimed;
+  StageClock clock(untimed);
+  const ScanContext join_ctx{ctx.db, ctx.options, ctx.cache, ctx.down, ctx.down_index, clock};
+  std::vector<bool> dropped(objects.size(), false);
+  std::size_t k = 0;
+  while (k < objects.size()) {
+    const std::optional<std::size_t> into = JoinNearest(remaining, largest_object_m, join_ctx, k, dropped, objects, points);
+    if (into != k) ++k;  // else the grown segment may join another
+  }
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    if (dropped[i]) continue;
+    if (kept != i) {  // a self-move would empty them
+      objects[kept] = std::move(objects[i]);
+      points[kept] = std::move(points[i]);
+    }
+    ++kept;
+  }
+  objects.resize(kept);
+  points.resize(kept);
+}
+
 }  // namespace
 
 void RecognitionOptions::Check() const {
@@ -454,78 +638,14 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   const ScanContext ctx{db, options, cache, down, down_index, clock};
   std::vector<std::vector<std::size_t>> object_points;  // per object, into removed.remaining
   while (!pending.empty()) {
-    const PendingSegment next = std::move(pending.front());
+    SegmentOutcome outcome = RecognizeSegment(pending.front(), removed.remaining, ctx);
     pending.pop_front();
-    RecognizedObject object;
-    object.object_id = "unknown";
-    std::vector<std::size_t> kept = next.indices;
-    const PointCloud segment = Subset(removed.remaining, next.indices);
-    object.centroid_S = Centroid(segment);
-    const SceneAround around = SceneAroundOf(segment, ctx);
-    const DescribedSegment described = DescribeSegment(segment, ctx);
-    const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed, options.threads);
-    clock.Lap("describe");
-    if (esf.ok && described.cloud.size() >= 10) {
-      const ChosenObjects chosen = ChooseObjects(esf.histogram, next.core_diameter_m, ctx);
-      const std::vector<double>& nearest_chi_square = chosen.nearest_chi_square;
-      clock.Lap("match");
-      std::vector<PosedObject> posed;
-      for (std::size_t i : chosen.objects) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
-      std::stable_sort(posed.begin(), posed.end(),
-                       [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
-      BreakTie(options.score_tie, posed);
-      for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
-      const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
-      if (!posed.empty() && posed.front().candidate.verified) {
-        const PosedObject& best = posed.front();
-        const ObjectModel& model = db.objects[best.object];
-        Accept(best, described.cloud, model, NearestOther(best.object, nearest_chi_square), ctx, object);
-        object.equivalent_objects_S = EquivalentObjects(posed, options.score_tie);
-        object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
-        clock.Lap("equivalents");
-        if (split_allowed) {
-          // What the object leaves unexplained may be another one touching it.
-          const std::vector<std::size_t> rest =
-              Partition(next.indices, PointsOnModel(described.cloud, model, cache.Model(best.object).nearest(),
-                                                    best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m)).second;
-          const std::size_t queued = pending.size();
-          QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);
-          std::vector<std::size_t> taken;
-          for (std::size_t q = queued; q < pending.size(); ++q) {
-            taken.insert(taken.end(), pending[q].indices.begin(), pending[q].indices.end());
-          }
-          std::sort(taken.begin(), taken.end());
-          std::erase_if(kept, [&](std::size_t i) { return std::binary_search(taken.begin(), taken.end(), i); });
-        }
-      } else if (split_allowed && segment.size() >= 2 * static_cast<std::size_t>(options.min_segment_points)) {
-        std::optional<ExplainedPart> part = ExplainPart(described, ctx);
-        clock.Lap("split");
-        if (part) {
-          const PointCloud part_cloud = Subset(segment, part->points);
-          // The part's own ESF for its chi-square and margin.
-          const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed, options.threads);
-          std::vector<double> part_chi_square;
-          if (part_esf.ok) {
-            for (const auto& nearest : NearestViews(part_esf.histogram, db, 1)) {
-              part_chi_square.push_back(nearest.front().first);
-              if (part_chi_square.size() == part->posed.object + 1) part->posed.candidate.view = nearest.front().second;
-            }
-            part->posed.candidate.chi_square = part_chi_square[part->posed.object];
-          }
-          object.candidates.insert(object.candidates.begin(), part->posed.candidate);
-          Accept(part->posed, part_cloud, db.objects[part->posed.object],
-                 part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);
-          object.centroid_S = Centroid(part_cloud);
-          std::vector<std::size_t> rest;
-          std::tie(kept, rest) = Partition(next.indices, part->points);
-          QueueClusters(removed.remaining, rest, next.objects_before + 1, options, pending);
-        }
-      }
-    }
-    clock.Lap("verify");
-    object_points.push_back(std::move(kept));
-    result.objects.push_back(std::move(object));
+    for (PendingSegment& q : outcome.queued) pending.push_back(std::move(q));
+    object_points.push_back(std::move(outcome.kept));
+    result.objects.push_back(std::move(outcome.object));
   }
+  JoinSegmentsOneObjectExplains(removed.remaining, largest_object_m, ctx, result.objects, object_points);
+  clock.Lap("join");
 
   // Every scan point goes to the object of the voxel point nearest to it.
   std::vector<int> object_of_down(down.size(), -1);

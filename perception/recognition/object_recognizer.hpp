@@ -129,7 +129,8 @@ struct RecognitionResult {
   std::size_t plane_points = 0;           // removed as planes
   // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine, final;
   // equivalents (other poses that fit as well); split (a segment no object explains searched
-  // for the objects it holds: its own poses are not counted in coarse to final); verify
+  // for the objects it holds: its own poses are not counted in coarse to final); verify; join
+  // (neighbouring segments one object may explain together, each stage of theirs included)
   std::map<std::string, double> stage_seconds;
 };
 

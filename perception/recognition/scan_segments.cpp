@@ -32,32 +32,6 @@ double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
   return std::sqrt(12.0 * std::max(variances(1), 0.0));
 }
 
-// The segment nearest to `part` other than `skip` (its index, and the smallest point distance),
-// or (0, infinity) when there is none.
-std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std::vector<std::size_t>& part,
-                                              const std::vector<Segment>& segments, std::size_t skip) {
-  std::vector<Eigen::Vector3f> points;
-  std::vector<std::size_t> owner;
-  for (std::size_t k = 0; k < segments.size(); ++k) {
-    if (k == skip) continue;
-    for (std::size_t i : segments[k].indices) {
-      points.push_back(cloud.points[i]);
-      owner.push_back(k);
-    }
-  }
-  if (points.empty()) return {0, std::numeric_limits<double>::infinity()};
-  const KnnIndex index(points);
-  std::vector<std::uint32_t> nearest;
-  std::vector<float> squared;
-  float best = std::numeric_limits<float>::infinity();
-  std::size_t to = 0;
-  for (std::size_t i : part) {
-    index.Query(cloud.points[i], 1, nearest, squared);
-    if (squared[0] < best) best = squared[0], to = owner[nearest[0]];
-  }
-  return {to, std::sqrt(static_cast<double>(best))};
-}
-
 // Each fragment joins the segment nearest to it when within `distance_m`.
 void AttachFragments(const PointCloud& cloud, const std::vector<std::vector<std::size_t>>& fragments,
                      double distance_m, std::vector<Segment>& segments) {
@@ -113,6 +87,30 @@ void JoinNearbySegments(const PointCloud& cloud, double widest_m, double distanc
 }
 
 }  // namespace
+
+std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std::vector<std::size_t>& part,
+                                              const std::vector<Segment>& segments, std::size_t skip) {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<std::size_t> owner;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    if (k == skip) continue;
+    for (std::size_t i : segments[k].indices) {
+      points.push_back(cloud.points[i]);
+      owner.push_back(k);
+    }
+  }
+  if (points.empty()) return {0, std::numeric_limits<double>::infinity()};
+  const KnnIndex index(points);
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared;
+  float best = std::numeric_limits<float>::infinity();
+  std::size_t to = 0;
+  for (std::size_t i : part) {
+    index.Query(cloud.points[i], 1, nearest, squared);
+    if (squared[0] < best) best = squared[0], to = owner[nearest[0]];
+  }
+  return {to, std::sqrt(static_cast<double>(best))};
+}
 
 std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m, const RecognitionOptions& options) {
   ClusteringOptions clustering;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "perception/cloud/point_cloud.hpp"
@@ -36,5 +37,10 @@ PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_ob
 // database. (Two objects joined by mistake are split again by recognition.) Largest first
 // (equal sizes in cluster order).
 std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m, const RecognitionOptions& options);
+
+// The segment nearest to `part` (indices into `cloud`) other than segment `skip`: its index and
+// the smallest point-to-point distance, or (0, infinity) when no other segment has a point.
+std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std::vector<std::size_t>& part,
+                                              const std::vector<Segment>& segments, std::size_t skip);
 
 }  // namespace uwscan::perception
