@@ -466,6 +466,30 @@ TEST(ObjectPoseSearch, TheBoltsPhaseIsFound) {
   EXPECT_TRUE(SymmetryPhaseStarts(sample, *flange, index, half_turn, off, voxel_m).empty());
 }
 
+// A pipe whose scan shows one of its ends (the sweep reaches 0.13 m past it), the rest cut off
+// 0.12 m short of its middle as by the sweep's other edge (seabed included): the fit of its wall
+// leaves the slide along the axis free (it ended 5 cm off), and the end places it. Slid past the
+// end, the model would lie where lines of sight went on to the seabed; slid short of it, the
+// scan's last points would leave the model. (Cut at the middle, the piece is a flange's neck as
+// much as a pipe.)
+TEST(ObjectRecognition, APipeSeenWithOneEndIsPlacedByThatEnd) {
+  const Scan full = ScanOnSeabed(CatalogueObject("pipe").mesh, Eigen::Vector3d(0.3, 0.2, 0.8), 4);
+  const Eigen::Isometry3d T_O_S = full.T_S_O.inverse();
+  std::vector<Eigen::Vector3d> kept;
+  for (std::size_t i = 0; i < full.cloud.size(); ++i) {
+    if ((T_O_S * full.cloud.Point(i)).z() > -0.12) kept.push_back(full.cloud.Point(i));
+  }
+  const PointCloud cloud = MakeCloud(kept);
+  const RecognitionResult r = RecognizeObjects(cloud, PipeFlangeValveDb());
+  const RecognizedObject* pipe = Nearest(r, full);
+  ASSERT_NE(pipe, nullptr);
+  ASSERT_EQ(pipe->object_id, "pipe");
+  const Eigen::Vector3d axis_S = full.T_S_O.linear() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d offset = pipe->T_S_O.translation() - full.T_S_O.translation();
+  EXPECT_LT(std::abs(offset.dot(axis_S)), 0.005) << "along the axis";
+  EXPECT_LT((offset - offset.dot(axis_S) * axis_S).norm(), 0.003) << "across the axis";
+}
+
 // A lever valve whose lever the scan does not hold (cut off the mesh scanned, as when it lies
 // out of the sweep): its body fits the model turned half a turn about the stem as well, and the
 // answer says so with an equivalent pose turned about the stem.

@@ -421,13 +421,20 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
     std::stable_sort(posed.begin(), posed.end(),
                      [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
     BreakTie(options.score_tie, posed);
+    // The others that fit as well, as posed by the same search (none of them is slid).
+    const std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent_objects =
+        EquivalentObjects(posed, options.score_tie);
+    if (!posed.empty() && posed.front().candidate.verified) {
+      PlaceFreeSlides(described.cloud, around, ctx, posed.front());
+      clock.Lap("slide");
+    }
     for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
     const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
     if (!posed.empty() && posed.front().candidate.verified) {
       const PosedObject& best = posed.front();
       const ObjectModel& model = db.objects[best.object];
       Accept(best, described.cloud, model, NearestOther(best.object, nearest_chi_square), ctx, object);
-      object.equivalent_objects_S = EquivalentObjects(posed, options.score_tie);
+      object.equivalent_objects_S = equivalent_objects;
       object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
       clock.Lap("equivalents");
       if (split_allowed) {

@@ -127,7 +127,8 @@ struct RecognitionResult {
   // One per segment, largest segment first, then the parts split off segments in that order.
   std::vector<RecognizedObject> objects;
   std::size_t plane_points = 0;           // removed as planes
-  // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine, final;
+  // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine, final,
+  // slide (the accepted pose along a free slide);
   // equivalents (other poses that fit as well); split (a segment no object explains searched
   // for the objects it holds: its own poses are not counted in coarse to final); verify; join
   // (neighbouring segments one object may explain together, each stage of theirs included)

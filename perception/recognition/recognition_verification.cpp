@@ -89,8 +89,8 @@ bool SceneAround::SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& n
   return false;
 }
 
-double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
-                    double radius_m) {
+SurfaceEvidence ExpectedSurface(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
+                                double radius_m) {
   std::vector<double> model_depth(scene.nearest_depth.size(), std::numeric_limits<double>::infinity());
   struct Facing {
     Eigen::Vector3d x, normal;
@@ -111,7 +111,9 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
   }
   std::vector<std::uint32_t> nearest;
   std::vector<float> squared;
-  std::size_t expected = 0, missing = 0;
+  SurfaceEvidence evidence;
+  std::size_t& expected = evidence.expected;
+  std::size_t& missing = evidence.missing;
   for (const auto& [x, normal, bin] : facing) {
     const double depth = x.norm();
     if (depth > model_depth[bin] + radius_m) continue;               // hidden by the object itself
@@ -126,7 +128,13 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
     // Otherwise no line of sight came near it (between two laser lines, outside the pattern):
     // no evidence either way.
   }
-  return expected == 0 ? 1.0 : static_cast<double>(missing) / static_cast<double>(expected);
+  return evidence;
+}
+
+double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
+                    double radius_m) {
+  const SurfaceEvidence e = ExpectedSurface(o, T_S_O, scene, radius_m);
+  return e.expected == 0 ? 1.0 : static_cast<double>(e.missing) / static_cast<double>(e.expected);
 }
 
 double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const PointCloud& segment_O,

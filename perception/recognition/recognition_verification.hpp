@@ -87,6 +87,15 @@ SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& ind
 double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
                     double radius_m);
 
+// The counts MissingShare divides: model points the sensor should have seen and has evidence
+// about (seen, or seen through), and of those the ones it saw through.
+struct SurfaceEvidence {
+  std::size_t expected = 0;
+  std::size_t missing = 0;
+};
+SurfaceEvidence ExpectedSurface(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
+                                double radius_m);
+
 // Share of the segment (object frame) within `distance_m` of the model's surface: the
 // point-to-plane distance to the nearest model point, when that point is within `reach_m` (about
 // the model's sample spacing, so that a point beside a thin part, on the part's tangent plane but

@@ -1,9 +1,11 @@
 #include "perception/recognition/segment_pose.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 #include "perception/preprocessing/normals.hpp"
+#include "perception/recognition/free_directions.hpp"
 #include "perception/recognition/object_symmetry.hpp"
 #include "scanner/common/parallel_tasks.hpp"
 
@@ -179,6 +181,80 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
   }
   ctx.clock.Lap("final");
   return best;
+}
+
+// What a posed model leaves unexplained, in points: model surface the sensor saw through, and
+// segment points off the model's surface (CloseShare's test).
+double Unexplained(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
+                   const SceneAround& around, const Eigen::Isometry3d& T_O_S, const ScanContext& ctx) {
+  const double voxel_m = ctx.db.parameters.voxel_m;
+  const SurfaceEvidence surface = ExpectedSurface(model, T_O_S.inverse(), around, 2.0 * voxel_m);
+  const double close =
+      CloseShare(model.model, model_grid, Transformed(segment, T_O_S), ctx.options.close_distance_m, voxel_m);
+  return static_cast<double>(surface.missing) + (1.0 - close) * static_cast<double>(segment.size());
+}
+
+// The offset (metres) minimising `cost` over centre_m +- reach_m at steps of `step_m`, the
+// profile smoothed over three neighbouring steps (a single offset can dip by chance, where a slide
+// is really pinned the cost rises on both sides over several steps) and refined by a parabola
+// through the smoothed minimum and its neighbours; with the smoothed gain over the centre. Ties go
+// to the offset nearest the centre.
+struct SlideMinimum {
+  double offset_m = 0.0;
+  double gain = 0.0;
+};
+template <typename Cost>
+SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, double reach_m) {
+  const int steps = static_cast<int>(std::ceil(reach_m / step_m));
+  std::vector<double> raw;
+  for (int k = -steps; k <= steps; ++k) raw.push_back(cost(centre_m + k * step_m));
+  const int n = static_cast<int>(raw.size());
+  std::vector<double> smooth(raw.size());
+  for (int k = 0; k < n; ++k) {
+    double sum = 0.0;
+    int count = 0;
+    for (int j = std::max(0, k - 1); j <= std::min(n - 1, k + 1); ++j) sum += raw[static_cast<std::size_t>(j)], ++count;
+    smooth[static_cast<std::size_t>(k)] = sum / count;
+  }
+  int best = steps;
+  for (int k = 0; k < n; ++k) {
+    const double value = smooth[static_cast<std::size_t>(k)], held = smooth[static_cast<std::size_t>(best)];
+    if (value < held || (value == held && std::abs(k - steps) < std::abs(best - steps))) best = k;
+  }
+  SlideMinimum m{centre_m + (best - steps) * step_m, smooth[static_cast<std::size_t>(steps)] - smooth[static_cast<std::size_t>(best)]};
+  if (best > 0 && best < n - 1) {
+    const double below = smooth[static_cast<std::size_t>(best - 1)], at = smooth[static_cast<std::size_t>(best)],
+                 above = smooth[static_cast<std::size_t>(best + 1)];
+    const double curvature = below - 2.0 * at + above;
+    if (curvature > 0.0) m.offset_m += 0.5 * step_m * (below - above) / curvature;
+  }
+  return m;
+}
+
+void PlaceFreeSlides(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed) {
+  const ObjectModel& model = ctx.db.objects[posed.object];
+  const ModelIndexes& indexes = ctx.cache.Model(posed.object);
+  const NearestGrid& model_grid = indexes.nearest();
+  const double voxel_m = ctx.db.parameters.voxel_m, radius_m = 0.5 * model.diameter_m;
+  const PoseConstraints constraints =
+      AnalysePoseConstraints(posed.fine.information, Eigen::Matrix<double, 6, 6>::Zero(), model.model.origin,
+                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
+  IcpOptions last = FineIcp(model.diameter_m, ctx.db.parameters, ctx.options.threads);
+  last.max_correspondence_distance_m = {last.max_correspondence_distance_m.back()};
+  const double min_gain = std::max(10.0, 0.02 * static_cast<double>(segment.size()));
+  for (const FreeDirection& free : constraints.free_O) {
+    if (free.motion != "translation") continue;
+    const Eigen::Isometry3d T_O_S = posed.fine.T_target_source;
+    auto slid = [&](double offset_m) { return Eigen::Translation3d(-offset_m * free.axis_S) * T_O_S; };
+    auto cost = [&](double offset_m) { return Unexplained(segment, model, model_grid, around, slid(offset_m), ctx); };
+    const SlideMinimum coarse = SmoothedMinimum(cost, 0.0, 2.0 * voxel_m, radius_m);
+    if (coarse.gain < min_gain) continue;
+    const SlideMinimum m = SmoothedMinimum(cost, std::round(coarse.offset_m / voxel_m) * voxel_m, 0.5 * voxel_m, 3.0 * voxel_m);
+    PosedObject moved = posed;
+    moved.fine = AlignIcp(segment, indexes.target, slid(m.offset_m), last);
+    Verify(segment, model, model_grid, around, moved.fine, ctx, moved.candidate);
+    if (moved.candidate.verified) posed = std::move(moved);
+  }
 }
 
 // Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
