@@ -425,8 +425,8 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
     const std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent_objects =
         EquivalentObjects(posed, options.score_tie);
     if (!posed.empty() && posed.front().candidate.verified) {
-      PlaceFreeSlides(described.cloud, around, ctx, posed.front());
-      clock.Lap("slide");
+      PlaceAlongFreeDirections(described.cloud, around, ctx, posed.front());
+      clock.Lap("free");
     }
     for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
     const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
@@ -463,6 +463,7 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
           }
           part->posed.candidate.chi_square = part_chi_square[part->posed.object];
         }
+        PlaceAlongFreeDirections(part_cloud, SceneAroundOf(part_cloud, ctx), ctx, part->posed);
         object.candidates.insert(object.candidates.begin(), part->posed.candidate);
         Accept(part->posed, part_cloud, db.objects[part->posed.object],
                part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);

@@ -128,7 +128,7 @@ struct RecognitionResult {
   std::vector<RecognizedObject> objects;
   std::size_t plane_points = 0;           // removed as planes
   // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine, final,
-  // slide (the accepted pose along a free slide);
+  // free (the accepted pose along the directions its fit leaves free);
   // equivalents (other poses that fit as well); split (a segment no object explains searched
   // for the objects it holds: its own poses are not counted in coarse to final); verify; join
   // (neighbouring segments one object may explain together, each stage of theirs included)

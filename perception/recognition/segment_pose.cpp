@@ -231,7 +231,7 @@ SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, d
   return m;
 }
 
-void PlaceFreeSlides(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed) {
+void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed) {
   const ObjectModel& model = ctx.db.objects[posed.object];
   const ModelIndexes& indexes = ctx.cache.Model(posed.object);
   const NearestGrid& model_grid = indexes.nearest();
@@ -243,11 +243,18 @@ void PlaceFreeSlides(const PointCloud& segment, const SceneAround& around, const
   last.max_correspondence_distance_m = {last.max_correspondence_distance_m.back()};
   const double min_gain = std::max(10.0, 0.02 * static_cast<double>(segment.size()));
   for (const FreeDirection& free : constraints.free_O) {
-    if (free.motion != "translation") continue;
+    const bool slide = free.motion == "translation";
+    // The model moved by `offset_m` along the free direction (a turn's arc at the radius), in its frame.
+    auto motion_O = [&](double offset_m) -> Eigen::Isometry3d {
+      if (slide) return Eigen::Isometry3d(Eigen::Translation3d(offset_m * free.axis_S));
+      return Eigen::Translation3d(free.point_S) * Eigen::AngleAxisd(offset_m / radius_m, free.axis_S) *
+             Eigen::Translation3d(-free.point_S);
+    };
+    const double reach_m = slide ? radius_m : 0.25 * std::numbers::pi * radius_m;
     const Eigen::Isometry3d T_O_S = posed.fine.T_target_source;
-    auto slid = [&](double offset_m) { return Eigen::Translation3d(-offset_m * free.axis_S) * T_O_S; };
+    auto slid = [&](double offset_m) { return motion_O(offset_m).inverse() * T_O_S; };
     auto cost = [&](double offset_m) { return Unexplained(segment, model, model_grid, around, slid(offset_m), ctx); };
-    const SlideMinimum coarse = SmoothedMinimum(cost, 0.0, 2.0 * voxel_m, radius_m);
+    const SlideMinimum coarse = SmoothedMinimum(cost, 0.0, 2.0 * voxel_m, reach_m);
     if (coarse.gain < min_gain) continue;
     const SlideMinimum m = SmoothedMinimum(cost, std::round(coarse.offset_m / voxel_m) * voxel_m, 0.5 * voxel_m, 3.0 * voxel_m);
     PosedObject moved = posed;

@@ -105,20 +105,22 @@ PointCloud Strided(const PointCloud& cloud, std::size_t count);
 PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const std::vector<Eigen::Isometry3d>& starts,
                           const SceneAround& around, const ScanContext& ctx);
 
-// The accepted pose slid along each direction its fit leaves free (a pipe seen without one of
-// its ends slides along its axis: point-to-plane pairs on its wall do not pin it) to where the
-// model leaves the fewest points unexplained: surface the sensor saw through plus segment points
-// off its surface. An end the scan shows pins the slide: slid past it, the model lies where lines
+// The accepted pose moved along each direction its fit leaves free to where the model leaves the
+// fewest points unexplained: surface the sensor saw through plus segment points off its surface.
+// A pipe seen without one of its ends slides along its axis (point-to-plane pairs on its wall do
+// not pin it), and the end the scan shows pins the slide: slid past it, the model lies where lines
 // of sight went on to the seabed; slid short of it, the segment's last points leave the model.
-// Offsets over the model's radius each way every 2 voxels, then every half voxel over 3 voxels
-// each way about the best, the count smoothed over three of them (SmoothedMinimum); the pose
-// moves only when that explains at least 10 points (and 2 % of the
-// segment) more than where the fit left it (with neither end in view a pipe explains as much all
-// along, give or take a few points), then is refined by the last stage of the fine ICP and stands
-// if still verified. Only for the accepted
-// pose, after the candidates were ranked: slid, a wrong object (a pipe on a flange's neck) fits
-// better too.
-void PlaceFreeSlides(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed);
+// An elbow seen without its ends turns about its bend axis alike. Offsets (a turn's as its arc at
+// the model's radius) over the radius each way for a slide and an eighth of a turn each way for a
+// turn, every 2 voxels, then every half voxel over 3 voxels each way about the best, the count
+// smoothed over three of them (SmoothedMinimum); the pose moves only when that explains at least
+// 10 points (and 2 % of the segment) more than where the fit left it (with neither end in view a
+// pipe explains as much all along, give or take a few points), then is refined by the last stage
+// of the fine ICP and stands if still verified. Only for the accepted pose, after the candidates
+// were ranked: moved so, a wrong object (a pipe on a flange's neck) fits better too. The
+// directions stay reported free: the fit does not pin them, the verification's counts do, to
+// about a voxel.
+void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed);
 
 // Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
 // equivalent_poses_S): its pose turned by each of DistinctHalfTurns (a nearly symmetric object,
