@@ -126,6 +126,9 @@ std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(const s
 // that joined it may lie beyond the object), nearest first, with their nearest views.
 struct ChosenObjects {
   std::vector<std::size_t> objects;
+  // The others within max_chi_square, nearest first, whatever their size: posed only when the
+  // chosen explain the segment poorly (it may hold one of them and something else).
+  std::vector<std::size_t> others;
   std::vector<std::vector<std::pair<double, int>>> nearest_views;  // of every object
   std::vector<double> nearest_chi_square;                          // of every object
 };
@@ -142,11 +145,11 @@ ChosenObjects ChooseObjects(const EsfDescriptor& esf, double extent_m, const Sca
   const double best_chi_square = order.empty() ? 0.0 : c.nearest_chi_square[order.front()];
   for (std::size_t i : order) {
     const double chi_square = c.nearest_chi_square[i];
-    if (static_cast<int>(c.objects.size()) >= ctx.options.max_candidates) break;
     if (chi_square > ctx.options.max_chi_square) break;
-    if (chi_square > ctx.options.max_chi_square_ratio * best_chi_square) break;
-    if (extent_m > 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m) continue;
-    c.objects.push_back(i);
+    const bool chosen = static_cast<int>(c.objects.size()) < ctx.options.max_candidates &&
+                        chi_square <= ctx.options.max_chi_square_ratio * best_chi_square &&
+                        extent_m <= 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m;
+    (chosen ? c.objects : c.others).push_back(i);
   }
   return c;
 }
@@ -418,6 +421,16 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
     clock.Lap("match");
     std::vector<PosedObject> posed;
     for (std::size_t i : chosen.objects) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
+    auto best_verified_score = [&] {
+      double best = -1.0;
+      for (const PosedObject& q : posed) {
+        if (q.candidate.verified) best = std::max(best, q.candidate.score);
+      }
+      return best;
+    };
+    if (const double weak = best_verified_score(); weak >= 0.0 && weak < options.weak_score) {
+      for (std::size_t i : chosen.others) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
+    }
     std::stable_sort(posed.begin(), posed.end(),
                      [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
     BreakTie(options.score_tie, posed);
@@ -609,6 +622,7 @@ void RecognitionOptions::Check() const {
     throw Error("recognition: min_fitness, min_close and max_missing must be in [0, 1]");
   }
   if (!(min_part_share >= 0.0 && min_part_share <= 1.0)) throw Error("recognition: min_part_share must be in [0, 1]");
+  if (!(weak_score >= 0.0 && weak_score <= 1.0)) throw Error("recognition: weak_score must be in [0, 1]");
   if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
   if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
