@@ -476,7 +476,9 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
           }
           part->posed.candidate.chi_square = part_chi_square[part->posed.object];
         }
-        PlaceAlongFreeDirections(part_cloud, SceneAroundOf(part_cloud, ctx), ctx, part->posed);
+        // On the part's points with their normals (the fine ICP's normal gate needs them).
+        PlaceAlongFreeDirections(Subset(described.cloud, part->points), SceneAroundOf(part_cloud, ctx), ctx,
+                                 part->posed);
         object.candidates.insert(object.candidates.begin(), part->posed.candidate);
         Accept(part->posed, part_cloud, db.objects[part->posed.object],
                part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);
