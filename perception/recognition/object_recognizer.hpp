@@ -58,9 +58,10 @@ struct RecognitionOptions {
   double max_missing = 0.45;
   // Verified candidates scoring within this of the best are ranked by chi-square instead.
   double score_tie = 0.02;
-  // When the best verified candidate scores below this, the segment may hold another object and
-  // something touching it: the other objects within max_chi_square are posed too, whatever their
-  // size and chi-square rank.
+  // When the best verified candidate scores below this, the segment may hold a smaller object
+  // and something touching it: the other objects within max_chi_square are posed too, whatever
+  // their size and chi-square rank. In the recognition bench's 100 scans one answer scored under
+  // 0.85 (a tee, 0.65, on a pipe and a flange touching end to end: the pipe is now recognised).
   double weak_score = 0.85;
   // A segment no single object explains may be several touching each other: the object that
   // explains the largest part of it (at least this share of its points) is taken out and the

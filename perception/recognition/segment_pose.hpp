@@ -119,7 +119,7 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
 // of the fine ICP and stands if still verified. Only for the accepted pose, after the candidates
 // were ranked: moved so, a wrong object (a pipe on a flange's neck) fits better too. The
 // directions stay reported free: the fit does not pin them, the verification's counts do, to
-// about a voxel.
+// about a voxel. `segment` needs its normals (the fine ICP's normal gate).
 void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed);
 
 // Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
