@@ -1,8 +1,6 @@
 #include "perception/recognition/object_recognizer.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -22,7 +20,9 @@
 #include "perception/recognition/recognition_verification.hpp"
 #include "perception/recognition/residual_patches.hpp"
 #include "perception/recognition/scan_segments.hpp"
+#include "perception/recognition/segment_candidates.hpp"
 #include "perception/recognition/segment_pose.hpp"
+#include "perception/recognition/segment_split.hpp"
 #include "perception/registration/coarse_alignment.hpp"
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
@@ -35,25 +35,6 @@ using namespace recognition;
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
-
-// The `count` nearest views of each object by chi-square, nearest first: (distance, view index).
-std::vector<std::vector<std::pair<double, int>>> NearestViews(const EsfDescriptor& esf,
-                                                              const ObjectDatabase& db,
-                                                              int count) {
-  std::vector<std::vector<std::pair<double, int>>> nearest;
-  for (const ObjectModel& o : db.objects) {
-    std::vector<std::pair<double, int>> views;
-    for (std::size_t v = 0; v < o.views.size(); ++v) {
-      views.emplace_back(ChiSquareDistance(esf.data(), o.views[v].esf.data(), 640), static_cast<int>(v));
-    }
-    const auto keep = views.begin() + std::min<std::ptrdiff_t>(count, std::ssize(views));
-    std::partial_sort(views.begin(), keep, views.end());
-    views.erase(keep, views.end());
-    if (views.empty()) views.emplace_back(std::numeric_limits<double>::infinity(), -1);
-    nearest.push_back(std::move(views));
-  }
-  return nearest;
-}
 
 
 // Whether a free rotation found in the data is one of the object's continuous symmetries, which
@@ -118,202 +99,6 @@ std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(const s
     if (c.verified && c.score >= top - tie) equivalent.emplace_back(c.object_id, c.T_S_O);
   }
   return equivalent;
-}
-
-// The objects worth posing on a segment: up to max_candidates whose nearest view is within
-// max_chi_square (and within max_chi_square_ratio of the best object's) and that are not smaller
-// than the segment's own cluster (a bounding-box diagonal can exceed it by up to sqrt(3); debris
-// that joined it may lie beyond the object), nearest first, with their nearest views.
-struct ChosenObjects {
-  std::vector<std::size_t> objects;
-  // The others within max_chi_square, nearest first, whatever their size: posed only when the
-  // chosen explain the segment poorly (it may hold one of them and something else).
-  std::vector<std::size_t> others;
-  std::vector<std::vector<std::pair<double, int>>> nearest_views;  // of every object
-  std::vector<double> nearest_chi_square;                          // of every object
-};
-ChosenObjects ChooseObjects(const EsfDescriptor& esf, double extent_m, const ScanContext& ctx) {
-  const ObjectDatabase& db = ctx.db;
-  ChosenObjects c;
-  c.nearest_views = NearestViews(esf, db, std::max(1, ctx.options.pose_views));
-  for (const auto& views : c.nearest_views) c.nearest_chi_square.push_back(views.front().first);
-  std::vector<std::size_t> order(db.objects.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return c.nearest_chi_square[a] < c.nearest_chi_square[b];
-  });
-  const double best_chi_square = order.empty() ? 0.0 : c.nearest_chi_square[order.front()];
-  for (std::size_t i : order) {
-    const double chi_square = c.nearest_chi_square[i];
-    if (chi_square > ctx.options.max_chi_square) break;
-    const bool chosen = static_cast<int>(c.objects.size()) < ctx.options.max_candidates &&
-                        chi_square <= ctx.options.max_chi_square_ratio * best_chi_square &&
-                        extent_m <= 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m;
-    (chosen ? c.objects : c.others).push_back(i);
-  }
-  return c;
-}
-
-// Object `i` posed on a segment from its starts (PoseStarts), with its chi-square and view.
-PosedObject PoseCandidate(const DescribedSegment& s, std::size_t i, const ChosenObjects& chosen,
-                          const SceneAround& around, const ScanContext& ctx) {
-  const std::vector<Eigen::Isometry3d> starts =
-      PoseStarts(s.cloud, s.features, i, chosen.nearest_views[i], ctx.cache, ctx.db, ctx.options);
-  ctx.clock.Lap("coarse");
-  PosedObject p = PoseOnSegment(s, i, starts, around, ctx);
-  p.candidate.object_id = ctx.db.objects[i].id;
-  p.candidate.chi_square = chosen.nearest_views[i].front().first;
-  p.candidate.view = chosen.nearest_views[i].front().second;
-  return p;
-}
-
-// The points of `segment` within `distance_m` (at most model_grid's radius) of the posed model's surface points.
-std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
-                                       const Eigen::Isometry3d& T_O_S, double distance_m) {
-  std::vector<std::size_t> on;
-  const float distance_sq = static_cast<float>(distance_m * distance_m);
-  for (std::size_t i = 0; i < segment.size(); ++i) {
-    const Eigen::Vector3d x = T_O_S * segment.Point(i);
-    if (model_grid.Nearest((x - model.model.origin).cast<float>(), distance_sq) >= 0) {
-      on.push_back(i);
-    }
-  }
-  return on;
-}
-
-// A part of a segment that one object explains, with the object posed on the part alone.
-struct ExplainedPart {
-  PosedObject posed;
-  std::vector<std::size_t> points;  // into the segment
-  double share = 0.0;               // of the segment's points
-};
-
-// The two halves of a cloud split across one of its principal axes (0 the longest) by 2-means,
-// started from its two extreme points along that axis: touching objects mostly end up one in
-// each, across the longest axis when they lie end to end, across the next when side by side.
-std::array<std::vector<std::size_t>, 2> Halves(const PointCloud& cloud, int principal_axis) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i) mean += cloud.Point(i);
-  mean /= static_cast<double>(cloud.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i) scatter += (cloud.Point(i) - mean) * (cloud.Point(i) - mean).transpose();
-  const Eigen::Vector3d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2 - principal_axis);
-  std::size_t lo = 0, hi = 0;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (cloud.Point(i).dot(axis) < cloud.Point(lo).dot(axis)) lo = i;
-    if (cloud.Point(i).dot(axis) > cloud.Point(hi).dot(axis)) hi = i;
-  }
-  std::array<Eigen::Vector3d, 2> centre = {cloud.Point(lo), cloud.Point(hi)};
-  std::array<std::vector<std::size_t>, 2> halves;
-  for (int iteration = 0; iteration < 20; ++iteration) {
-    std::array<std::vector<std::size_t>, 2> next;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      const Eigen::Vector3d x = cloud.Point(i);
-      next[(x - centre[1]).squaredNorm() < (x - centre[0]).squaredNorm() ? 1 : 0].push_back(i);
-    }
-    if (next == halves) break;
-    halves = std::move(next);
-    for (int h = 0; h < 2; ++h) {
-      if (halves[h].empty()) continue;
-      centre[h].setZero();
-      for (std::size_t i : halves[h]) centre[h] += cloud.Point(i);
-      centre[h] /= static_cast<double>(halves[h].size());
-    }
-  }
-  return halves;
-}
-
-// A half of a segment recognised as a segment of its own, for pose candidates (ExplainPart).
-struct DescribedHalf {
-  DescribedSegment described;
-  SceneAround around;
-  ChosenObjects chosen;
-};
-
-// The halves of a segment worth recognising: Halves across its two longest principal axes,
-// distinct, with min_segment_points and an ESF.
-std::vector<DescribedHalf> DescribedHalves(const DescribedSegment& s, const ScanContext& ctx) {
-  const ObjectDatabaseParameters& p = ctx.db.parameters;
-  std::vector<std::vector<std::size_t>> halves;
-  for (int axis = 0; axis < 2; ++axis) {
-    for (std::vector<std::size_t>& half : Halves(s.cloud, axis)) {
-      if (half.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) continue;
-      if (std::find(halves.begin(), halves.end(), half) == halves.end()) halves.push_back(std::move(half));
-    }
-  }
-  std::vector<std::optional<DescribedHalf>> described(halves.size());
-  RunParallelTasks(std::ssize(halves), ctx.options.threads, [&](std::ptrdiff_t h) {
-    const PointCloud half_cloud = Subset(s.cloud, halves[static_cast<std::size_t>(h)]);
-    const EsfResult esf = VoxelisedEsf(half_cloud, p.voxel_m, ctx.options.seed, 1);  // one task per thread
-    if (!esf.ok) return;
-    const OneThreadContext task(ctx);
-    described[static_cast<std::size_t>(h)].emplace(DescribedHalf{
-        {half_cloud, DescribeSegment(half_cloud, task.ctx()).features},
-        SceneAroundOf(half_cloud, task.ctx()),
-        ChooseObjects(esf.histogram, Diameter(half_cloud), task.ctx())});
-  });
-  std::vector<DescribedHalf> kept;
-  for (std::optional<DescribedHalf>& d : described) {
-    if (d) kept.push_back(std::move(*d));
-  }
-  return kept;
-}
-
-// Object `object`, posed on a half of segment `s`, as the part of `s` it explains: from its pose
-// the trimmed fine ICP of the whole segment leaves the other objects' points out, and the points
-// it puts on the model form the part, posed again and verified on its own. None when the part is
-// under min_part_share of the segment, or not verified.
-std::optional<ExplainedPart> PartOnHalf(const DescribedSegment& s, const PointCloud& sample, const DescribedHalf& half,
-                                        std::size_t object, const ScanContext& ctx) {
-  const ObjectDatabaseParameters& p = ctx.db.parameters;
-  const ObjectModel& model = ctx.db.objects[object];
-  const PosedObject posed = PoseCandidate(half.described, object, half.chosen, half.around, ctx);
-  const ModelIndexes& indexes = ctx.cache.Model(object);
-  const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
-  const RegistrationResult on_segment = AlignIcp(sample, indexes.target, posed.fine.T_target_source, fine);
-  std::vector<std::size_t> points =
-      PointsOnModel(s.cloud, model, indexes.nearest(), on_segment.T_target_source, 1.5 * p.voxel_m);
-  const double share = static_cast<double>(points.size()) / static_cast<double>(s.cloud.size());
-  if (share < ctx.options.min_part_share || points.size() < static_cast<std::size_t>(ctx.options.min_segment_points)) {
-    return std::nullopt;
-  }
-  const PointCloud part = Subset(s.cloud, points);
-  const RegistrationResult refined = AlignIcp(part, indexes.target, on_segment.T_target_source, fine);
-  const SceneAround around = SceneAroundOf(part, ctx);
-  ExplainedPart candidate{posed, std::move(points), share};
-  candidate.posed.fine = refined;
-  Verify(part, model, indexes.nearest(), around, refined, ctx, candidate.posed.candidate);
-  if (!candidate.posed.candidate.verified) return std::nullopt;
-  return candidate;
-}
-
-// The object explaining the largest share of a segment that no single object explains (objects
-// touching each other fall into one segment, whose outline resembles neither). The segment is
-// cut in two halves (Halves), each recognised as a segment of its own for pose candidates, and
-// each candidate gives the part it explains (PartOnHalf). The part must hold min_part_share of
-// the segment; parts are ranked by share x score, ties to the earlier half and candidate.
-// Parallel over (half, candidate), each on one thread: the same answer for any thread count.
-std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanContext& ctx) {
-  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
-  const std::vector<DescribedHalf> halves = DescribedHalves(s, ctx);
-  std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (half, object)
-  for (std::size_t h = 0; h < halves.size(); ++h) {
-    for (std::size_t object : halves[h].chosen.objects) tasks.emplace_back(h, object);
-  }
-  std::vector<std::optional<ExplainedPart>> parts(tasks.size());
-  RunParallelTasks(std::ssize(tasks), ctx.options.threads, [&](std::ptrdiff_t t) {
-    const auto [h, object] = tasks[static_cast<std::size_t>(t)];
-    const OneThreadContext task(ctx);
-    parts[static_cast<std::size_t>(t)] = PartOnHalf(s, sample, halves[h], object, task.ctx());
-  });
-  std::optional<ExplainedPart> best;
-  for (std::optional<ExplainedPart>& part : parts) {
-    if (!part) continue;
-    if (!best || part->share * part->posed.candidate.score > best->share * best->posed.candidate.score) {
-      best = std::move(part);
-    }
-  }
-  return best;
 }
 
 // The recognised object's identity, pose, free directions, covariance and grasps.
