@@ -192,32 +192,68 @@ double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, con
   return sum;
 }
 
+namespace {
+
+// TruncatedResidual of `sample` with the pose T_O_S turned about `axis` (of order >= 3) in steps
+// of about half a voxel at the object's rim, over half a period either way: residual[k] is at
+// turn (k - steps) x step.
+struct PhaseProfile {
+  double step_rad = 0.0;
+  int steps = 0;
+  std::vector<double> residual;
+};
+
+Eigen::Isometry3d TurnedAbout(const SymmetryAxis& axis, double angle_rad, const Eigen::Isometry3d& T_O_S) {
+  return Eigen::Translation3d(axis.point_O) * Eigen::AngleAxisd(angle_rad, axis.axis_O.normalized()) *
+         Eigen::Translation3d(-axis.point_O) * T_O_S;
+}
+
+PhaseProfile SymmetryPhaseProfile(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
+                                  const SymmetryAxis& axis, const Eigen::Isometry3d& T_O_S, double voxel_m) {
+  PhaseProfile profile;
+  const double period = 2.0 * std::numbers::pi / axis.order;
+  profile.step_rad = std::min(period / 8.0, 0.5 * voxel_m / std::max(0.5 * model.diameter_m, voxel_m));
+  profile.steps = static_cast<int>(std::ceil(0.5 * period / profile.step_rad));
+  for (int k = -profile.steps; k <= profile.steps; ++k) {
+    profile.residual.push_back(
+        TruncatedResidual(sample, model, model_grid, TurnedAbout(axis, k * profile.step_rad, T_O_S), voxel_m));
+  }
+  return profile;
+}
+
+bool HasPhase(const PointCloud& sample, const ObjectModel& model, const SymmetryAxis& axis) {
+  return axis.order >= 3 && sample.size() > 0 && model.model.has_normals();
+}
+
+}  // namespace
+
 std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, const ObjectModel& model,
                                                    const NearestGrid& model_grid, const SymmetryAxis& axis,
                                                    const Eigen::Isometry3d& T_O_S, double voxel_m) {
-  if (axis.order < 3 || sample.size() == 0 || !model.model.has_normals()) return {};
-  const double period = 2.0 * std::numbers::pi / axis.order;
-  const double step = std::min(period / 8.0, 0.5 * voxel_m / std::max(0.5 * model.diameter_m, voxel_m));
-  const int steps = static_cast<int>(std::ceil(0.5 * period / step));
-  auto turned = [&](double angle) {
-    return Eigen::Translation3d(axis.point_O) * Eigen::AngleAxisd(angle, axis.axis_O.normalized()) *
-           Eigen::Translation3d(-axis.point_O) * T_O_S;
-  };
-  std::vector<double> residual;
-  for (int k = -steps; k <= steps; ++k) {
-    residual.push_back(TruncatedResidual(sample, model, model_grid, turned(k * step), voxel_m));
-  }
+  if (!HasPhase(sample, model, axis)) return {};
+  const PhaseProfile profile = SymmetryPhaseProfile(sample, model, model_grid, axis, T_O_S, voxel_m);
+  const std::vector<double>& residual = profile.residual;
   const std::size_t lowest = static_cast<std::size_t>(std::min_element(residual.begin(), residual.end()) - residual.begin());
   const double near = residual[lowest] + 0.5 * voxel_m * voxel_m;
   std::size_t first = lowest, last = lowest;
   while (first > 0 && residual[first - 1] <= near) --first;
   while (last + 1 < residual.size() && residual[last + 1] <= near) ++last;
   std::vector<Eigen::Isometry3d> starts;
-  const double lowest_turn = static_cast<double>(lowest) - steps;
-  const double middle_turn = std::round(0.5 * static_cast<double>(first + last)) - steps;
-  if (lowest_turn != 0.0) starts.push_back(turned(lowest_turn * step));
-  if (middle_turn != 0.0 && middle_turn != lowest_turn) starts.push_back(turned(middle_turn * step));
+  const double lowest_turn = static_cast<double>(lowest) - profile.steps;
+  const double middle_turn = std::round(0.5 * static_cast<double>(first + last)) - profile.steps;
+  if (lowest_turn != 0.0) starts.push_back(TurnedAbout(axis, lowest_turn * profile.step_rad, T_O_S));
+  if (middle_turn != 0.0 && middle_turn != lowest_turn) {
+    starts.push_back(TurnedAbout(axis, middle_turn * profile.step_rad, T_O_S));
+  }
   return starts;
+}
+
+bool SymmetryPhasePinned(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
+                         const SymmetryAxis& axis, const Eigen::Isometry3d& T_O_S, double voxel_m, double min_points) {
+  if (!HasPhase(sample, model, axis)) return true;
+  const std::vector<double> residual = SymmetryPhaseProfile(sample, model, model_grid, axis, T_O_S, voxel_m).residual;
+  const auto [low, high] = std::minmax_element(residual.begin(), residual.end());
+  return *high - *low >= min_points * voxel_m * voxel_m;
 }
 
 }  // namespace uwscan::perception

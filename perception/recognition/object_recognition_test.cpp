@@ -427,6 +427,27 @@ TEST(ObjectRecognition, AFlangeIsPosedToItsBoltsPhase) {
   EXPECT_EQ(posed, 4);
 }
 
+// Seen from its face, a flange is a surface of revolution: its bolt heads are behind the face,
+// every phase about its axis fits alike, and its answer reports that turn free (which the ICP's
+// information alone did not). Seen from behind, the bolts pin it and it is not reported.
+TEST(ObjectRecognition, AFlangeSeenFromItsFaceReportsItsTurnFree) {
+  const ObjectSource flange = CatalogueObject("flange");
+  auto turn_about_axis_free = [&](const Eigen::Vector3d& eye) {
+    const Scan scan = ScanOnSeabed(flange.mesh, eye, 5);
+    const RecognitionResult r = RecognizeObjects(scan.cloud, PipeFlangeValveDb());
+    const RecognizedObject* found = Nearest(r, scan);
+    EXPECT_TRUE(found != nullptr && found->object_id == "flange");
+    if (found == nullptr) return false;
+    const Eigen::Vector3d axis_S = scan.T_S_O.linear() * Eigen::Vector3d::UnitZ();
+    return std::any_of(found->free_directions.begin(), found->free_directions.end(), [&](const FreeDirection& f) {
+      return f.kind == "unconstrained" && f.motion == "rotation" && std::abs(f.axis_S.dot(axis_S)) > 0.999;
+    });
+  };
+  // The flange's face is at +z_O, which OnSeabed lays along -y; its neck and bolts face +y.
+  EXPECT_TRUE(turn_about_axis_free(Eigen::Vector3d(0.3, -0.6, 0.5)));
+  EXPECT_FALSE(turn_about_axis_free(Eigen::Vector3d(0.3, 0.9, 0.5)));
+}
+
 // The phase search alone, on the flange's own model: its surface (every third point, 0.5 mm of
 // noise) turned 15 degrees about the axis comes back within a degree of the bolts' phase, with
 // a residual less than half the turned one; an axis of order 2 has no phase to search.

@@ -48,8 +48,46 @@ bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& mo
   return false;
 }
 
+// Whether `rotation_O` turns about the same axis (within a degree) through the same line (within
+// 2 mm) as a rotation among `free_O`.
+bool AlreadyFree(const FreeDirection& rotation_O, const std::vector<FreeDirection>& free_O) {
+  for (const FreeDirection& f : free_O) {
+    if (f.motion != "rotation" || std::abs(f.axis_S.dot(rotation_O.axis_S)) < std::cos(kDegree)) continue;
+    const Eigen::Vector3d d = rotation_O.point_S - f.point_S;
+    if ((d - d.dot(f.axis_S) * f.axis_S).norm() < 0.002) return true;
+  }
+  return false;
+}
+
+// The turn about each N-fold symmetry axis (N >= 3) whose phase the data does not pin
+// (SymmetryPhasePinned), added to `c` as a free rotation (in the object frame), and the
+// covariance left without it: projected onto the twists orthogonal to the turn's.
+void AddUnpinnedPhases(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
+                       const ScanContext& ctx, PoseConstraints& c) {
+  for (const SymmetryAxis& axis : model.symmetries) {
+    if (SymmetryPhasePinned(fitted, model, ctx.cache.Model(posed.object).nearest(), axis, posed.fine.T_target_source,
+                            ctx.db.parameters.voxel_m, ctx.options.min_phase_points)) {
+      continue;
+    }
+    FreeDirection turn;
+    turn.kind = "unconstrained";
+    turn.motion = "rotation";
+    turn.axis_S = axis.axis_O.normalized();
+    turn.point_S = axis.point_O;
+    if (AlreadyFree(turn, c.free_O)) continue;
+    c.free_O.push_back(turn);
+    // The twist [w, v] of that turn about the covariance's centre (x -> x + w x (x - c) + v).
+    Eigen::Matrix<double, 6, 1> twist;
+    twist << turn.axis_S, turn.axis_S.cross(model.model.origin - turn.point_S);
+    const Eigen::Matrix<double, 6, 6> project =
+        Eigen::Matrix<double, 6, 6>::Identity() - twist * twist.transpose() / twist.squaredNorm();
+    c.covariance = project * c.covariance * project.transpose();
+  }
+}
+
 // The directions the fine ICP on `fitted` leaves free (those the object's continuous symmetries
-// already name left out), in the scan frame, and the covariance over the others.
+// already name left out), and the phases the data leaves free about its N-fold axes, in the scan
+// frame, and the covariance over the others.
 void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
                         const ScanContext& ctx, RecognizedObject& out) {
   const double radius_m = 0.5 * model.diameter_m;
@@ -58,9 +96,10 @@ void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, cons
   const Eigen::Matrix<double, 6, 6> spread =
       ResidualPatchSpread(fitted, posed.fine.T_target_source, model.model, ctx.cache.Model(posed.object).nearest(),
                           pair_distance_m, model.model.origin, ctx.options.residual_patch_m);
-  const PoseConstraints c =
+  PoseConstraints c =
       AnalysePoseConstraints(posed.fine.information, spread, model.model.origin,
                              std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
+  AddUnpinnedPhases(posed, fitted, model, ctx, c);
   const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
   for (FreeDirection f : c.free_O) {
     if (f.motion == "rotation" && IsContinuousSymmetry(f, model)) continue;
@@ -414,6 +453,9 @@ void RecognitionOptions::Check() const {
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
   if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
   if (!positive(residual_patch_m)) throw Error("recognition: residual_patch_m must be > 0");
+  if (!(min_phase_points >= 0.0 && std::isfinite(min_phase_points))) {
+    throw Error("recognition: min_phase_points must be finite and >= 0");
+  }
   if (threads < 0) throw Error("recognition: threads must be >= 0");
 }
 

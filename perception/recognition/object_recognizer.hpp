@@ -74,6 +74,11 @@ struct RecognitionOptions {
   // deviation (its point-to-plane residual over the square root of its information; a
   // rotation's at the object's radius), metres: what a grasp cannot take as known.
   double free_direction_std_m = 0.002;
+  // The phase about an N-fold symmetry axis (N >= 3) is free when no turn over a period puts this
+  // many more points' worth of truncated residual off the model (SymmetryPhasePinned), points.
+  // On the recognition bench's 18 flanges the spread was 1-4 where the bolts were not in view
+  // (two of them posed 14 and 19 degrees off) and 6-112 where they were.
+  double min_phase_points = 5.0;
   // Residuals within a cube of this side are taken as correlated (one misfit: a bolt head, a
   // facet), independent from cube to cube, for the pose covariance (ResidualPatchSpread), metres.
   // On the recognition bench's 109 poses within 10 degrees, the median NEES per pinned direction
