@@ -96,6 +96,18 @@ TEST(CliDive, DemoPrintsEveryMethodAgainstTruth) {
   }
 }
 
+// Without --scene, from a folder that is not the repository root, demo finds the default scene
+// in the source tree it was built from.
+TEST(CliDive, DemoWithoutASceneRunsFromAnyFolder) {
+  const std::filesystem::path elsewhere = TempPath("demo_elsewhere");
+  std::filesystem::create_directories(elsewhere);
+  const CommandRun run = uwscan::test::RunCommand("cd " + elsewhere.string() + " && " + std::string(UWSCAN_BIN) + " demo");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("default.yaml"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("ray_ray"), std::string::npos) << run.output;
+  std::filesystem::remove_all(elsewhere);
+}
+
 TEST(CliDive, MakeObjectWritesAReadableMesh) {
   const std::filesystem::path mesh = TempPath("valve.ply");
   const CommandRun run = RunUwscan("make-object valve -o " + mesh.string());
@@ -103,6 +115,24 @@ TEST(CliDive, MakeObjectWritesAReadableMesh) {
   EXPECT_GT(std::filesystem::file_size(mesh), 1000u);
   const CommandRun bad = RunUwscan("make-object teapot -o " + mesh.string());
   EXPECT_NE(bad.exit_code, 0);
+  std::filesystem::remove(mesh);
+}
+
+// A size in millimetres where metres are expected (a 300 m pipe) is refused, naming the option,
+// and nothing is written.
+TEST(CliDive, MakeObjectRefusesASizeInMillimetres) {
+  const std::filesystem::path mesh = TempPath("pipe.ply");
+  std::filesystem::remove(mesh);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"pipe --length-m 300", "--length-m"}, {"box --size-m 0.1 0.2 150", "--size-m"}, {"valve --handle-radius-m 0", "--handle-radius-m"}};
+  for (const auto& [options, option] : cases) {
+    const CommandRun run = RunUwscan("make-object " + options + " -o " + mesh.string());
+    EXPECT_NE(run.exit_code, 0) << options;
+    EXPECT_NE(run.output.find(option), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("metres"), std::string::npos) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(mesh)) << options;
+  }
+  ASSERT_EQ(RunUwscan("make-object pipe --length-m 0.3 -o " + mesh.string()).exit_code, 0);
   std::filesystem::remove(mesh);
 }
 

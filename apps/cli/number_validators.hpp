@@ -33,4 +33,15 @@ inline const CLI::Validator kNonNegativeNumber(
     [](std::string& text) { return internal::CheckNumber(text, ">= 0", [](double v) { return v >= 0.0; }); },
     "NONNEGATIVE", "NONNEGATIVE");
 
+// A length in metres that an object a vehicle inspects or grasps can have: over 0.1 mm and at
+// most 50 m. A size given in millimetres (--length-m 300 for a 0.3 m pipe) is refused instead of
+// building an object a thousand times too large.
+inline const CLI::Validator kObjectLengthMetres(
+    [](std::string& text) {
+      const std::string wrong = internal::CheckNumber(
+          text, "of metres in (0.0001, 50]", [](double v) { return v > 1e-4 && v <= 50.0; });
+      return wrong.empty() ? wrong : wrong + " (lengths are in metres)";
+    },
+    "METRES", "METRES");
+
 }  // namespace uwscan::app

@@ -26,7 +26,7 @@ namespace uwscan::app {
 namespace {
 
 struct DemoArgs {
-  std::string scene = "data/scenes/default.yaml";
+  std::string scene;  // empty: the default scene (DefaultScene)
   int threads = 0;
   std::string screenshot;  // PNG of the reconstructed scene coloured by error; empty: none
 };
@@ -44,10 +44,20 @@ void WriteDemoScreenshot(const std::filesystem::path& log, const std::string& pn
               png.c_str(), info.points_drawn, info.range->lo * 1e3, info.range->hi * 1e3);
 }
 
-void RunDemo(const DemoArgs& a) {
-  if (!std::filesystem::is_regular_file(a.scene)) {
-    throw Error("--scene " + a.scene + ": no such file (run from the repository root, or give --scene)");
-  }
+// data/scenes/default.yaml below the working folder (a repository root), else in the data/ folder
+// of the source tree this program was built from.
+std::string DefaultScene() {
+  const std::filesystem::path relative = "data/scenes/default.yaml";
+  if (std::filesystem::is_regular_file(relative)) return relative.string();
+  const std::filesystem::path built = std::filesystem::path(UWSCAN_SOURCE_DATA_DIR) / "scenes/default.yaml";
+  if (std::filesystem::is_regular_file(built)) return built.string();
+  throw Error("no default scene: neither " + relative.string() + " nor " + built.string() +
+              " exists (give --scene)");
+}
+
+void RunDemo(DemoArgs a) {
+  if (a.scene.empty()) a.scene = DefaultScene();
+  if (!std::filesystem::is_regular_file(a.scene)) throw Error("--scene " + a.scene + ": no such file");
   if (!a.screenshot.empty()) viewer::RequireDisplay();  // before the run, not after it
   const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
   const scanner::sim::Simulator simulator(scene);
@@ -100,7 +110,7 @@ void AddDemoCommand(CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
   CLI::App* cmd = app.add_subcommand(
       "demo", "simulate the default scene, reconstruct it with every method, compare to truth");
-  cmd->add_option("--scene", args->scene, "scene YAML (default data/scenes/default.yaml)");
+  cmd->add_option("--scene", args->scene, "scene YAML (default data/scenes/default.yaml here, else in the source tree uwscan was built from)");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
       ->check(kNonNegativeNumber);
   cmd->add_option("--screenshot", args->screenshot,

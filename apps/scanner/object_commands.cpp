@@ -169,23 +169,35 @@ void AddMakeObjectCommand(CLI::App& app) {
       ->check(CLI::IsMember(shapes));
   cmd->add_option("-o,--output", a->output, "PLY file to write")->required();
   cmd->add_option("--length-m", a->length_m,
-                  "cylinder, pipe or flange length along z; tee run length; gauge length along y");
-  cmd->add_option("--radius-m", a->radius_m, "sphere or cylinder radius; pipe outer radius");
-  cmd->add_option("--wall-m", a->wall_m, "pipe wall thickness");
-  cmd->add_option("--size-m", a->size_m, "plane: X Y; box: X Y Z")->expected(2, 3);
-  cmd->add_option("--bend-radius-m", a->bend_radius_m, "elbow: radius of the centre line's bend");
+                  "cylinder, pipe or flange length along z; tee run length; gauge length along y")
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--radius-m", a->radius_m, "sphere or cylinder radius; pipe outer radius")
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--wall-m", a->wall_m, "pipe wall thickness")
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--size-m", a->size_m, "plane: X Y; box: X Y Z")
+      ->expected(2, 3)
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--bend-radius-m", a->bend_radius_m, "elbow: radius of the centre line's bend")
+      ->check(kObjectLengthMetres);
   cmd->add_option("--bend-angle-rad", a->bend_angle_rad, "elbow: bend angle");
   cmd->add_option("--branch-length-m", a->branch_length_m,
-                  "tee: branch length from the run's axis");
-  cmd->add_option("--flange-radius-m", a->flange_radius_m, "flange: outer radius of the disc");
-  cmd->add_option("--flange-thickness-m", a->flange_thickness_m, "flange: thickness of the disc");
+                  "tee: branch length from the run's axis")
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--flange-radius-m", a->flange_radius_m, "flange: outer radius of the disc")
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--flange-thickness-m", a->flange_thickness_m, "flange: thickness of the disc")
+      ->check(kObjectLengthMetres);
   cmd->add_option("--bolts", a->bolts, "flange: number of bolt heads")
       ->check(kNonNegativeNumber);
   cmd->add_option("--handle", a->handle, "valve: wheel or lever")
       ->check(CLI::IsMember({"wheel", "lever"}));
-  cmd->add_option("--handle-radius-m", a->handle_radius_m, "valve: wheel radius or lever reach");
-  cmd->add_option("--body-radius-m", a->body_radius_m, "valve: body radius");
-  cmd->add_option("--stem-length-m", a->stem_length_m, "valve: stem top above the pipe axis");
+  cmd->add_option("--handle-radius-m", a->handle_radius_m, "valve: wheel radius or lever reach")
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--body-radius-m", a->body_radius_m, "valve: body radius")
+      ->check(kObjectLengthMetres);
+  cmd->add_option("--stem-length-m", a->stem_length_m, "valve: stem top above the pipe axis")
+      ->check(kObjectLengthMetres);
   cmd->add_option("--chord-error-m", a->chord_error_m,
                   "largest distance of a chord from the true curved surface (default 1e-4)");
   cmd->callback([a, cmd] { RunMakeObject(*a, *cmd); });
