@@ -450,6 +450,7 @@ void RecognitionOptions::Check() const {
   if (!(min_part_share >= 0.0 && min_part_share <= 1.0)) throw Error("recognition: min_part_share must be in [0, 1]");
   if (!(weak_score >= 0.0 && weak_score <= 1.0)) throw Error("recognition: weak_score must be in [0, 1]");
   if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
+  if (split_candidates < 1) throw Error("recognition: split_candidates must be >= 1");
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
   if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
   if (!positive(residual_patch_m)) throw Error("recognition: residual_patch_m must be > 0");

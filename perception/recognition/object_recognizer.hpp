@@ -70,6 +70,11 @@ struct RecognitionOptions {
   // candidate is.
   double min_part_share = 0.25;
   int max_objects_per_segment = 3;
+  // Objects posed on each half of such a segment, nearest by chi-square first (at most
+  // max_candidates). In the recognition bench's 100 scans, of 26 segments split, the part came
+  // from a half's nearest object 11 times, its second 4 times, its third never: 2 gives the same
+  // answers in two thirds of the time (0.04 s per scan less).
+  int split_candidates = 2;
   // A pose direction is free when the final ICP pins it to no better than this standard
   // deviation (its point-to-plane residual over the square root of its information; a
   // rotation's at the object's radius), metres: what a grasp cannot take as known.

@@ -118,7 +118,9 @@ std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanCo
   const std::vector<DescribedHalf> halves = DescribedHalves(s, ctx);
   std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (half, object)
   for (std::size_t h = 0; h < halves.size(); ++h) {
-    for (std::size_t object : halves[h].chosen.objects) tasks.emplace_back(h, object);
+    const std::vector<std::size_t>& objects = halves[h].chosen.objects;
+    const std::size_t count = std::min(objects.size(), static_cast<std::size_t>(ctx.options.split_candidates));
+    for (std::size_t k = 0; k < count; ++k) tasks.emplace_back(h, objects[k]);
   }
   std::vector<std::optional<ExplainedPart>> parts(tasks.size());
   RunParallelTasks(std::ssize(tasks), ctx.options.threads, [&](std::ptrdiff_t t) {

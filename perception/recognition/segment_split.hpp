@@ -19,8 +19,9 @@ struct ExplainedPart {
 
 // The object explaining the largest share of a segment that no single object explains (objects
 // touching each other fall into one segment, whose outline resembles neither). The segment is
-// cut in two halves (Halves), each recognised as a segment of its own for pose candidates, and
-// each candidate gives the part it explains (PartOnHalf). The part must hold min_part_share of
+// cut in two halves (Halves), each recognised as a segment of its own for pose candidates (its
+// split_candidates nearest by chi-square), and each candidate gives the part it explains
+// (PartOnHalf). The part must hold min_part_share of
 // the segment; parts are ranked by share x score, ties to the earlier half and candidate.
 // Parallel over (half, candidate), each on one thread: the same answer for any thread count.
 std::optional<ExplainedPart> ExplainPart(const DescribedSegment& s, const ScanContext& ctx);
