@@ -99,6 +99,9 @@ void Run(Args a) {
       pipelines[name]["pose_nees_per_dimension_mean"] = Mean(f.pose_nees_per_dimension);
       pipelines[name]["pose_nees_per_dimension_median"] = Median(f.pose_nees_per_dimension);
       pipelines[name]["pose_nees_poses"] = f.pose_nees_per_dimension.size();
+      for (const auto& [truth, nees] : f.pose_nees_by_class) {
+        pipelines[name]["pose_nees_per_dimension_median_by_class"][truth] = Median(nees);
+      }
     }
     confusion[name] = f.confusion;
   }
@@ -110,6 +113,11 @@ void Run(Args a) {
     std::printf("uwscan pose covariance: NEES per pinned direction mean %.2f, median %.2f over %zu poses within "
                 "10 deg and 5 cm (1 when consistent)\n",
                 Mean(nees), Median(nees), nees.size());
+    std::printf("  median by class:");
+    for (const auto& [truth, by_class] : r.pipelines.at("uwscan").pose_nees_by_class) {
+      std::printf(" %s %.1f (%zu)", truth.c_str(), Median(by_class), by_class.size());
+    }
+    std::printf("\n");
   }
   if (r.pipelines.count("uwscan")) {
     std::printf("uwscan confusion (true -> answers):\n");

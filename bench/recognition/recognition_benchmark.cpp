@@ -235,6 +235,7 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
   if (reported != nullptr && e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
     if (const auto nees = PoseNeesPerPinnedDirection(*T_S_O, e.T_symmetric, model.model.origin, reported->covariance)) {
       figures.pose_nees_per_dimension.push_back(*nees);
+      figures.pose_nees_by_class[truth].push_back(*nees);
     }
   }
   if (model.grasps.empty()) return e;

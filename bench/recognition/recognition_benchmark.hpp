@@ -59,6 +59,7 @@ struct PipelineFigures {
   // each recognised object within 10 degrees and 5 cm (gross errors, such as a half turn of a
   // valve whose handle is out of view, are no covariance's business). Peers report none.
   std::vector<double> pose_nees_per_dimension;
+  std::map<std::string, std::vector<double>> pose_nees_by_class;  // the same, by true class
   // true class (or "foreign") -> answer -> count
   std::map<std::string, std::map<std::string, int>> confusion;
 };

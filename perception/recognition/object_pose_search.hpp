@@ -105,8 +105,9 @@ std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, con
 // some turn over the period (as SymmetryPhaseStarts turns it) puts at least `min_points` points'
 // worth of TruncatedResidual (voxel_m^2 each) more off the model than another. A flange seen
 // from its face shows a surface of revolution, its bolt heads behind it: every phase fits alike,
-// which the ICP's information does not show (the model's normals, a little off the surface's,
-// seem to pin the turn). True for an axis of lower order, which has no phase.
+// which the ICP's information does not show (the faceted model and its estimated normals are not
+// quite a surface of revolution, which makes the turn look pinned). True for an axis of lower
+// order, which has no phase.
 bool SymmetryPhasePinned(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
                          const SymmetryAxis& axis, const Eigen::Isometry3d& T_O_S, double voxel_m, double min_points);
 
