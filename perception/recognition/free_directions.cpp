@@ -77,8 +77,9 @@ std::pair<Vector6d, Vector6d> PureRotations(const Vector6d& a, const Vector6d& b
 
 PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix6d& patch_spread,
                                        const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
-                                       double tolerance_m) {
+                                       double tolerance_m, double floor_std_m) {
   Check(information, patch_spread, centre_O, sigma_m, radius_m, tolerance_m);
+  if (!(floor_std_m >= 0.0 && std::isfinite(floor_std_m))) throw Error("free directions: floor_std_m must be >= 0");
   // Rotations scaled by the radius: both halves in metres, so one tolerance judges both.
   Matrix6d D = Matrix6d::Identity();
   D.topLeftCorner<3, 3>() *= 1.0 / radius_m;
@@ -87,6 +88,7 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(scaled);
   PoseConstraints out;
   Matrix6d inverse = Matrix6d::Zero();  // over the pinned directions, scaled
+  Matrix6d pinned = Matrix6d::Zero();   // projector onto them
   Eigen::Matrix<double, 6, Eigen::Dynamic> free(6, 0);
   for (int k = 0; k < 6; ++k) {
     const Vector6d u = eigen.eigenvectors().col(k);
@@ -96,12 +98,14 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
                                          : std::numeric_limits<double>::infinity();
     if (variance <= tolerance_m * tolerance_m) {
       inverse += u * u.transpose() / lambda;
+      pinned += u * u.transpose();
     } else {
       free.conservativeResize(Eigen::NoChange, free.cols() + 1);
       free.col(free.cols() - 1) = u;
     }
   }
-  out.covariance = D * (sigma_m * sigma_m * inverse + inverse * spread * inverse) * D;
+  out.covariance =
+      D * (sigma_m * sigma_m * inverse + inverse * spread * inverse + floor_std_m * floor_std_m * pinned) * D;
   if (free.cols() == 0) return out;
 
   // Combinations of the free directions by how much they turn: the right singular vectors of

@@ -42,10 +42,13 @@ struct PoseConstraints {
 // and when two rotations are free, the two pure rotations they combine into (a screw system of
 // two free rotations holds exactly two zero-pitch screws, e.g. an elbow's bend axis and its
 // tube's tangent) rather than an arbitrary mixture of them.
-// Throws uwscan::Error when a matrix is not finite and symmetric or a scalar is not positive.
+// floor_std_m adds a variance of floor_std_m^2 along every pinned direction (a rotation's at
+// radius_m): the error of the model and of the segment's sampling, which no residual shows.
+// Throws uwscan::Error when a matrix is not finite and symmetric, a scalar is not positive or the
+// floor is negative.
 PoseConstraints AnalysePoseConstraints(const Eigen::Matrix<double, 6, 6>& information,
                                        const Eigen::Matrix<double, 6, 6>& patch_spread,
                                        const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
-                                       double tolerance_m);
+                                       double tolerance_m, double floor_std_m = 0.0);
 
 }  // namespace uwscan::perception

@@ -77,6 +77,23 @@ TEST(FreeDirections, APipeWithoutEndsSlidesAndRollsAboutItsOwnAxis) {
   EXPECT_LT(DistanceToLine(rolls[0].point_S, on_axis, axis), 1e-9);
   // Nothing else is loose, and the free directions carry no covariance.
   EXPECT_EQ((c.covariance.bottomRightCorner<3, 3>() * axis).norm() < 1e-12, true);
+
+  // A floor adds its variance along every pinned direction, a rotation's at the radius, and
+  // nothing along the free ones. (The roll, about the axis off the centre, moves the centre along
+  // `across`; the shift along `third` and the tilt about `across` are pinned and apart from it.)
+  const double floor_m = 1e-4, radius_m = 0.2;
+  const PoseConstraints floored =
+      AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, radius_m, 1e-3, floor_m);
+  ASSERT_EQ(floored.free_O.size(), 2u);
+  const Matrix6d added = floored.covariance - c.covariance;
+  Vector6d shift, tilt, slide;
+  shift << 0, 0, 0, third;
+  tilt << across, 0, 0, 0;
+  slide << 0, 0, 0, axis;
+  EXPECT_NEAR(shift.dot(added * shift), floor_m * floor_m, 1e-15);
+  EXPECT_NEAR(tilt.dot(added * tilt), floor_m * floor_m / (radius_m * radius_m), 1e-15);
+  EXPECT_LT(std::abs(slide.dot(floored.covariance * slide)), 1e-15);
+  EXPECT_THROW(AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, radius_m, 1e-3, -1e-4), Error);
 }
 
 // A 90-degree elbow seen without its ends turns about its bend axis, and only about it: the

@@ -98,7 +98,8 @@ void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, cons
                           pair_distance_m, model.model.origin, ctx.options.residual_patch_m);
   PoseConstraints c =
       AnalysePoseConstraints(posed.fine.information, spread, model.model.origin,
-                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
+                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m,
+                             ctx.options.pose_floor_std_m);
   AddUnpinnedPhases(posed, fitted, model, ctx, c);
   const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
   for (FreeDirection f : c.free_O) {
@@ -454,6 +455,9 @@ void RecognitionOptions::Check() const {
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
   if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
   if (!positive(residual_patch_m)) throw Error("recognition: residual_patch_m must be > 0");
+  if (!(pose_floor_std_m >= 0.0 && std::isfinite(pose_floor_std_m))) {
+    throw Error("recognition: pose_floor_std_m must be finite and >= 0");
+  }
   if (!(min_phase_points >= 0.0 && std::isfinite(min_phase_points))) {
     throw Error("recognition: min_phase_points must be finite and >= 0");
   }
