@@ -35,28 +35,28 @@ using namespace recognition;
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
-
-
-// Whether a free rotation found in the data is one of the object's continuous symmetries, which
-// are reported as such: the same axis (within a degree) through the same line (within 2 mm).
-bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& model) {
-  for (const SymmetryAxis& s : model.symmetries) {
-    if (s.order != 0 || std::abs(s.axis_O.dot(rotation_O.axis_S)) < std::cos(kDegree)) continue;
-    const Eigen::Vector3d d = rotation_O.point_S - s.point_O;
-    if ((d - d.dot(s.axis_O) * s.axis_O).norm() < 0.002) return true;
-  }
-  return false;
+// Whether two rotation axes are the same line: the same direction (within a degree) through the
+// same points (within 2 mm), both given in one frame.
+bool SameAxis(const Eigen::Vector3d& axis_a, const Eigen::Vector3d& point_a, const Eigen::Vector3d& axis_b,
+              const Eigen::Vector3d& point_b) {
+  if (std::abs(axis_a.dot(axis_b)) < std::cos(kDegree)) return false;
+  const Eigen::Vector3d d = point_a - point_b;
+  return (d - d.dot(axis_b) * axis_b).norm() < 0.002;
 }
 
-// Whether `rotation_O` turns about the same axis (within a degree) through the same line (within
-// 2 mm) as a rotation among `free_O`.
+// Whether a free rotation found in the data is one of the object's continuous symmetries, which
+// are reported as such.
+bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& model) {
+  return std::any_of(model.symmetries.begin(), model.symmetries.end(), [&](const SymmetryAxis& s) {
+    return s.order == 0 && SameAxis(rotation_O.axis_S, rotation_O.point_S, s.axis_O, s.point_O);
+  });
+}
+
+// Whether `rotation_O` turns about the same axis as a rotation among `free_O`.
 bool AlreadyFree(const FreeDirection& rotation_O, const std::vector<FreeDirection>& free_O) {
-  for (const FreeDirection& f : free_O) {
-    if (f.motion != "rotation" || std::abs(f.axis_S.dot(rotation_O.axis_S)) < std::cos(kDegree)) continue;
-    const Eigen::Vector3d d = rotation_O.point_S - f.point_S;
-    if ((d - d.dot(f.axis_S) * f.axis_S).norm() < 0.002) return true;
-  }
-  return false;
+  return std::any_of(free_O.begin(), free_O.end(), [&](const FreeDirection& f) {
+    return f.motion == "rotation" && SameAxis(rotation_O.axis_S, rotation_O.point_S, f.axis_S, f.point_S);
+  });
 }
 
 // The turn about each N-fold symmetry axis (N >= 3) whose phase the data does not pin
