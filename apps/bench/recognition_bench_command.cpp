@@ -45,8 +45,8 @@ void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
     if (o.free_slides + o.free_turns > 0) std::printf(", free: %d slide, %d turn", o.free_slides, o.free_turns);
     std::printf("\n");
     for (const perception::RecognitionCandidate& c : o.candidates) {
-      std::printf("      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f rmse %.2f mm%s\n",
-                  c.object_id.c_str(), c.chi_square, c.view, c.fitness, c.close, c.missing, c.rmse_m * 1e3,
+      std::printf("      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f buried %.2f rmse %.2f mm%s\n",
+                  c.object_id.c_str(), c.chi_square, c.view, c.fitness, c.close, c.missing, c.buried, c.rmse_m * 1e3,
                   c.verified ? " verified" : "");
     }
   }

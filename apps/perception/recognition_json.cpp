@@ -36,6 +36,7 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o, const std::vect
                           {"fitness", c.fitness},
                           {"close", c.close},
                           {"missing", c.missing},
+                          {"buried", c.buried},
                           {"rmse_m", c.rmse_m},
                           {"score", c.score},
                           {"verified", c.verified}});

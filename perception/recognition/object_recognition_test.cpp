@@ -511,6 +511,36 @@ TEST(ObjectRecognition, APipeSeenWithOneEndIsPlacedByThatEnd) {
   EXPECT_LT((offset - offset.dot(axis_S) * axis_S).norm(), 0.003) << "across the axis";
 }
 
+// A flange lying on its rim, its scan cut 5 cm short of the rim as by the sweep's edge (seabed
+// included): its neck, 4.5 cm over the seabed, fits the database's pipe as well as the flange,
+// and the answer says so. But the pipe would hang in the water (its clearance over the seabed is
+// the rim's radius less the neck's); the flange rests on the seabed, and is the answer. (Seen
+// from other sides, the flange's fit can come out end for end, its rim where the scan shows the
+// neck's open end; then the pipe is the better fit.)
+TEST(ObjectRecognition, AFlangeNeckOverTheSeabedIsAFlangeNotAFloatingPipe) {
+  const Scan full = ScanOnSeabed(CatalogueObject("flange").mesh, Eigen::Vector3d(-0.3, 0.0, 0.8), 4);
+  const Eigen::Isometry3d T_O_S = full.T_S_O.inverse();
+  std::vector<Eigen::Vector3d> kept;
+  for (std::size_t i = 0; i < full.cloud.size(); ++i) {
+    if ((T_O_S * full.cloud.Point(i)).z() < 0.08) kept.push_back(full.cloud.Point(i));
+  }
+  const RecognitionResult r = RecognizeObjects(MakeCloud(kept), PipeFlangeValveDb());
+  const RecognizedObject* found = Nearest(r, full);
+  ASSERT_NE(found, nullptr);
+  EXPECT_EQ(found->object_id, "flange");
+  bool pipe_fits = false;
+  for (const auto& [id, T_S_other] : found->equivalent_objects_S) pipe_fits |= id == "pipe";
+  EXPECT_TRUE(pipe_fits) << "the pipe fits the neck as well";
+  for (const RecognitionCandidate& c : found->candidates) {
+    if (c.object_id == "pipe" && c.verified) {
+      EXPECT_GT(c.clearance_m, 0.03) << "the pipe hangs over the seabed";
+    }
+    if (c.object_id == "flange") {
+      EXPECT_LT(std::abs(c.clearance_m), 0.005) << "the flange rests on it";
+    }
+  }
+}
+
 // A lever valve whose lever the scan does not hold (cut off the mesh scanned, as when it lies
 // out of the sweep): its body fits the model turned half a turn about the stem as well, and the
 // answer says so with an equivalent pose turned about the stem.
@@ -745,3 +775,4 @@ TEST(ObjectSymmetry, ARollAboutAContinuousAxisIsNoError) {
 
 }  // namespace
 }  // namespace uwscan::perception
+

@@ -111,19 +111,39 @@ void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, cons
   out.covariance = c.covariance;
 }
 
-// Verified candidates whose scores are within `tie` of the best one's are told apart by their
-// views' chi-square: the scores cannot, and the ESF says which the segment looks more like (a
-// pipe or a tee whose branch the sweep did not reach).
-void BreakTie(double tie, std::vector<PosedObject>& ranked) {
+// Verified candidates whose scores are within `tie` of the best one's are told apart by whether
+// they rest on a support plane within `resting_m`, then by their views' chi-square: the scores
+// cannot, an object floating over the seabed needs a support the scan does not show, and the ESF
+// says which the segment looks more like (a pipe or a tee whose branch the sweep did not reach).
+void BreakTie(double tie, double resting_m, std::vector<PosedObject>& ranked) {
   if (ranked.empty() || !ranked.front().candidate.verified) return;
+  auto key = [&](const RecognitionCandidate& c) { return std::make_pair(c.clearance_m > resting_m, c.chi_square); };
   std::size_t pick = 0;
   for (std::size_t k = 1; k < ranked.size(); ++k) {
     const RecognitionCandidate& c = ranked[k].candidate;
-    if (c.verified && c.score >= ranked.front().candidate.score - tie && c.chi_square < ranked[pick].candidate.chi_square) {
+    if (c.verified && c.score >= ranked.front().candidate.score - tie && key(c) < key(ranked[pick].candidate)) {
       pick = k;
     }
   }
   std::rotate(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(pick), ranked.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
+}
+
+// The verified candidates of `posed` that could still rank first placed along the directions their
+// fits leave free (PlaceAlongFreeDirections), before they are ranked: a pipe seen with one end
+// and left by its fit with the other end in view misses surface the scan saw through, and a wrong
+// object that fits the same stretch would win. A candidate can rank first when it would score
+// within score_tie of the best with nothing missing: placing it changes that share, not the
+// others much.
+void PlaceContendersAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
+                                        std::vector<PosedObject>& posed) {
+  double best = 0.0;
+  for (const PosedObject& q : posed) best = std::max(best, q.candidate.verified ? q.candidate.score : 0.0);
+  for (PosedObject& q : posed) {
+    const RecognitionCandidate& c = q.candidate;
+    if (c.verified && c.close * (1.0 - c.buried) >= best - ctx.options.score_tie) {
+      PlaceAlongFreeDirections(segment, around, ctx, q);
+    }
+  }
 }
 
 // The other verified objects BreakTie chose among: scoring within `tie` of the best score.
@@ -256,16 +276,14 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
     if (const double weak = best_verified_score(); weak >= 0.0 && weak < options.weak_score) {
       for (std::size_t i : chosen.others) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
     }
+    PlaceContendersAlongFreeDirections(described.cloud, around, ctx, posed);
+    clock.Lap("free");
     std::stable_sort(posed.begin(), posed.end(),
                      [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
-    BreakTie(options.score_tie, posed);
+    BreakTie(options.score_tie, options.buried_depth_m, posed);
     // The others that fit as well, as posed by the same search (none of them is slid).
     const std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent_objects =
         EquivalentObjects(posed, options.score_tie);
-    if (!posed.empty() && posed.front().candidate.verified) {
-      PlaceAlongFreeDirections(described.cloud, around, ctx, posed.front());
-      clock.Lap("free");
-    }
     for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
     const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
     if (!posed.empty() && posed.front().candidate.verified) {
@@ -397,7 +415,7 @@ void JoinSegmentsOneObjectExplains(const PointCloud& remaining, double largest_o
   // The stages of the segments recognised here are timed as one, "join".
   std::map<std::string, double> untimed;
   StageClock clock(untimed);
-  const ScanContext join_ctx{ctx.db, ctx.options, ctx.cache, ctx.down, ctx.down_index, clock};
+  const ScanContext join_ctx{ctx.db, ctx.options, ctx.cache, ctx.down, ctx.down_index, ctx.planes, clock};
   std::vector<bool> dropped(objects.size(), false);
   std::size_t k = 0;
   while (k < objects.size()) {
@@ -455,6 +473,9 @@ void RecognitionOptions::Check() const {
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
   if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
   if (!positive(residual_patch_m)) throw Error("recognition: residual_patch_m must be > 0");
+  if (!(buried_depth_m >= 0.0 && std::isfinite(buried_depth_m))) {
+    throw Error("recognition: buried_depth_m must be finite and >= 0");
+  }
   if (!(pose_floor_std_m >= 0.0 && std::isfinite(pose_floor_std_m))) {
     throw Error("recognition: pose_floor_std_m must be finite and >= 0");
   }
@@ -491,7 +512,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   clock.Lap("segment");
 
   const KnnIndex down_index(down.points);
-  const ScanContext ctx{db, options, cache, down, down_index, clock};
+  const ScanContext ctx{db, options, cache, down, down_index, removed.planes, clock};
   std::vector<std::vector<std::size_t>> object_points;  // per object, into removed.remaining
   while (!pending.empty()) {
     SegmentOutcome outcome = RecognizeSegment(pending.front(), removed.remaining, ctx);

@@ -56,7 +56,14 @@ struct RecognitionOptions {
   // former measure, which counted all unseen surface; on the bench's 100 scans with the present
   // one, 0.3 gave 123 recognised (124 at 0.45) and 0.2 the same answers as 0.45.
   double max_missing = 0.45;
-  // Verified candidates scoring within this of the best are ranked by chi-square instead.
+  // A posed model's points deeper than this beyond a support plane removed from the scan (the
+  // seabed) count as buried, and its score is scaled by the share of its points not buried
+  // (SupportContact): objects rest on the seabed, they are not sunk into it.
+  double buried_depth_m = 0.01;
+  // Verified candidates scoring within this of the best are ranked by chi-square instead, those
+  // resting on a support plane (their clearance within buried_depth_m) before those floating
+  // over it: a flange's neck seen without its rim fits a pipe as well, but the pipe would hang
+  // in the water over the seabed.
   double score_tie = 0.02;
   // When the best verified candidate scores below this, the segment may hold a smaller object
   // and something touching it: the other objects within max_chi_square are posed too, whatever
@@ -109,8 +116,10 @@ struct RecognitionCandidate {
   double fitness = 0.0;     // share of the segment on the posed model
   double close = 0.0;       // share of the segment within close_distance_m of its surface
   double missing = 1.0;     // share of the surface it should have seen that the sensor saw through
+  double buried = 0.0;      // share of the model beyond a support plane (SupportContact)
+  double clearance_m = std::numeric_limits<double>::infinity();  // over the support planes (SupportContact)
   double rmse_m = 0.0;      // point-to-plane RMS of the final ICP
-  double score = 0.0;       // close x (1 - missing); the best verified one wins (score_tie)
+  double score = 0.0;       // close x (1 - missing) x (1 - buried); the best verified one wins (score_tie)
   bool verified = false;
   Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();
 };

@@ -137,6 +137,36 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
   return e.expected == 0 ? 1.0 : static_cast<double>(e.missing) / static_cast<double>(e.expected);
 }
 
+std::vector<SupportPlane> SupportPlanesAround(const PointCloud& scan, const std::vector<DetectedPlane>& planes,
+                                              const Eigen::Vector3d& centre, double radius_m, std::size_t min_points) {
+  std::vector<SupportPlane> around;
+  for (const DetectedPlane& plane : planes) {
+    std::size_t near = 0;
+    for (std::size_t i : plane.inliers) near += (scan.Point(i) - centre).squaredNorm() <= radius_m * radius_m ? 1 : 0;
+    if (near < min_points) continue;
+    // The sensor, at the origin, is at signed distance offset_m: make it positive.
+    const double side = plane.offset_m >= 0.0 ? 1.0 : -1.0;
+    around.push_back({side * plane.normal, side * plane.offset_m});
+  }
+  return around;
+}
+
+SupportContact SupportContactOf(const ObjectModel& o, const Eigen::Isometry3d& T_S_O,
+                                const std::vector<SupportPlane>& planes, double depth_m) {
+  SupportContact contact;
+  if (planes.empty() || o.model.empty()) return contact;
+  std::size_t buried = 0;
+  for (std::size_t i = 0; i < o.model.size(); ++i) {
+    const Eigen::Vector3d x = T_S_O * o.model.Point(i);
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const SupportPlane& p : planes) lowest = std::min(lowest, p.normal.dot(x) + p.offset_m);
+    contact.clearance_m = std::min(contact.clearance_m, lowest);
+    buried += lowest < -depth_m ? 1 : 0;
+  }
+  contact.buried = static_cast<double>(buried) / static_cast<double>(o.model.size());
+  return contact;
+}
+
 double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const PointCloud& segment_O,
                   double distance_m, double reach_m) {
   const float reach_sq = static_cast<float>(reach_m * reach_m);

@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/cloud/nearest_grid.hpp"
 #include "perception/cloud/point_cloud.hpp"
+#include "perception/preprocessing/plane_removal.hpp"
 #include "perception/recognition/object_database.hpp"
 
 namespace uwscan::perception {
@@ -32,6 +34,13 @@ class SightAngles {
   Eigen::Vector3d w_, u_, v_;
 };
 
+// A plane removed from the scan (the seabed, a wall) that an object rests on or stands against,
+// oriented so that the sensor (at the origin) is on its positive side: n . x + offset_m > 0 there.
+struct SupportPlane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit
+  double offset_m = 0.0;
+};
+
 // What the scan saw around one segment: all its points (scan frame, planes too) and their index,
 // the segment's window of directions, and over a grid of direction bins about `radius_m` wide
 // at the segment covering that window, the scan points in each bin and the nearest depth of
@@ -48,6 +57,7 @@ struct SceneAround {
   std::vector<double> nearest_depth;       // per bin, infinity where the scan has no point
   std::vector<std::uint32_t> bin_start;    // bin b's scan points are bin_points[bin_start[b] ..
   std::vector<std::uint32_t> bin_points;   // bin_start[b + 1]), indices into points
+  std::vector<SupportPlane> support_planes;  // the caller's: planes seen around the segment
 
   // The bin of direction a, or -1 outside the window.
   long BinOf(const Eigen::Vector2d& a) const {
@@ -67,6 +77,26 @@ struct SceneAround {
 // Throws uwscan::Error on an empty segment or a non-finite point in it.
 SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
                                double radius_m, double margin_m = 0.0);
+
+// The planes of `planes` (removed from `scan`, their inliers indices into it) with at least
+// `min_points` inliers within `radius_m` of `centre`: those an object there may rest on.
+std::vector<SupportPlane> SupportPlanesAround(const PointCloud& scan, const std::vector<DetectedPlane>& planes,
+                                              const Eigen::Vector3d& centre, double radius_m, std::size_t min_points);
+
+// How a posed model meets the support planes around it.
+struct SupportContact {
+  // Share of its points more than the caller's depth beyond a plane, inside the seabed or a wall:
+  // what the sensor cannot see there is not missing, but a solid object cannot be there either. A
+  // pipe lying on the seabed fits a tee with its branch pointing down into it, or a flange with
+  // the lower half of its rim in it, as well as it fits a pipe.
+  double buried = 0.0;
+  // Distance of its point nearest to a plane's far side, negative beyond it: about 0 for an
+  // object resting on the seabed, a flange's neck 4.5 cm over the seabed its rim rests on.
+  // Infinity without planes.
+  double clearance_m = std::numeric_limits<double>::infinity();
+};
+SupportContact SupportContactOf(const ObjectModel& o, const Eigen::Isometry3d& T_S_O,
+                                const std::vector<SupportPlane>& planes, double depth_m);
 
 // Share of the posed model's surface the sensor should have seen where it saw past it instead.
 // Should have seen: facing the sensor (not grazing), within the segment's window of directions

@@ -125,5 +125,51 @@ TEST(MissingShareTest, AnEmptySegmentIsRefused) {
   EXPECT_THROW(SceneAroundSegment(scan, index, PointCloud{}, kRadius), Error);
 }
 
+// The seabed plane of the scan above, as plane removal gives it (its normal away from the sensor,
+// n . x + offset = 0), with every seabed point of a scan without the plate as its inliers.
+DetectedPlane Seabed(const PointCloud& scan) {
+  DetectedPlane seabed{Eigen::Vector3d::UnitZ(), -kSeabedZ, {}};
+  for (std::size_t i = 0; i < scan.size(); ++i) seabed.inliers.push_back(i);
+  return seabed;
+}
+
+// The plane is turned to face the sensor; a plane with too few inliers near the segment is not
+// its support.
+TEST(SupportContact, TheSeabedAroundASegmentFacesTheSensor) {
+  const PointCloud scan = Scan(false, 0.01);
+  const std::vector<SupportPlane> around =
+      SupportPlanesAround(scan, {Seabed(scan)}, Eigen::Vector3d(0.0, 0.0, kSeabedZ), 0.05, 20);
+  ASSERT_EQ(around.size(), 1u);
+  EXPECT_NEAR(around[0].normal.z(), -1.0, 1e-12);
+  EXPECT_NEAR(around[0].offset_m, kSeabedZ, 1e-12);
+  EXPECT_GT(around[0].normal.dot(Eigen::Vector3d::Zero()) + around[0].offset_m, 0.0) << "the sensor's side";
+  EXPECT_TRUE(SupportPlanesAround(scan, {Seabed(scan)}, Eigen::Vector3d(2.0, 0.0, kSeabedZ), 0.05, 20).empty());
+}
+
+// The plate stood on its edge across the seabed, sunk by `sunk_m`: its buried share is the share
+// of its points deeper than the tolerance (counted here from their z), and its clearance the
+// depth of its deepest point, negated.
+TEST(SupportContact, APlateSunkIntoTheSeabedIsBuriedByItsShareBelowIt) {
+  const PointCloud scan = Scan(false, 0.01);
+  const std::vector<SupportPlane> planes =
+      SupportPlanesAround(scan, {Seabed(scan)}, Eigen::Vector3d(0.0, 0.0, kSeabedZ), 0.1, 20);
+  const ObjectModel plate = Plate();
+  for (const double sunk_m : {-0.02, 0.0, 0.03, kPlateHalf}) {
+    // Plate y -> sensor z: its edge at y = +kPlateHalf is the lowest, sunk_m below the seabed.
+    Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();
+    T_S_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+    T_S_O.translation() = Eigen::Vector3d(0.0, 0.0, kSeabedZ + sunk_m - kPlateHalf);
+    std::size_t deeper = 0;
+    for (std::size_t i = 0; i < plate.model.size(); ++i) deeper += (T_S_O * plate.model.Point(i)).z() > kSeabedZ + 0.01 ? 1 : 0;
+    const SupportContact contact = SupportContactOf(plate, T_S_O, planes, 0.01);
+    EXPECT_DOUBLE_EQ(contact.buried, static_cast<double>(deeper) / static_cast<double>(plate.model.size())) << sunk_m;
+    EXPECT_NEAR(contact.clearance_m, -sunk_m, 1e-9) << sunk_m;
+  }
+  EXPECT_GT(SupportContactOf(plate, Eigen::Isometry3d(Eigen::Translation3d(0, 0, kSeabedZ + 0.04)), planes, 0.01).buried, 0.99);
+  const SupportContact no_plane = SupportContactOf(plate, Eigen::Isometry3d::Identity(), {}, 0.01);
+  EXPECT_EQ(no_plane.buried, 0.0);
+  EXPECT_TRUE(std::isinf(no_plane.clearance_m));
+}
+
 }  // namespace
 }  // namespace uwscan::perception

@@ -12,6 +12,10 @@
 namespace uwscan::perception::recognition {
 namespace {
 
+// Inliers a removed plane needs within the largest object's diameter of a segment to count as
+// its support: a few voxels' worth of seabed or wall beside it.
+constexpr std::size_t kSupportPoints = 20;
+
 // The pose's phase about each N-fold axis of the model (SymmetryPhaseStarts): details repeating
 // about an axis (a flange's bolts) are out of the ICP's reach when off, and the verification's
 // score barely sees them, so a phase the search found stands unless it scores clearly worse than
@@ -100,8 +104,13 @@ DescribedSegment DescribeSegment(const PointCloud& segment, const ScanContext& c
 }
 
 SceneAround SceneAroundOf(const PointCloud& segment, const ScanContext& ctx) {
-  return SceneAroundSegment(ctx.down, ctx.down_index, segment, 2.0 * ctx.db.parameters.voxel_m,
-                            0.5 * ctx.db.LargestDiameter());
+  SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, segment, 2.0 * ctx.db.parameters.voxel_m,
+                                          0.5 * ctx.db.LargestDiameter());
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < segment.size(); ++i) centroid += segment.Point(i);
+  centroid /= static_cast<double>(segment.size());  // SceneAroundSegment refused an empty one
+  around.support_planes = SupportPlanesAround(ctx.down, ctx.planes, centroid, ctx.db.LargestDiameter(), kSupportPoints);
+  return around;
 }
 
 // The posed model verified on `segment`: fit, closeness and missing surface.
@@ -115,7 +124,10 @@ void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGr
   c.rmse_m = refined.inlier_plane_rmse;
   c.missing = MissingShare(model, c.T_S_O, around, 2.0 * p.voxel_m);
   c.close = CloseShare(model.model, model_grid, Transformed(segment, T_O_S), ctx.options.close_distance_m, p.voxel_m);
-  c.score = c.close * (1.0 - c.missing);
+  const SupportContact contact = SupportContactOf(model, c.T_S_O, around.support_planes, ctx.options.buried_depth_m);
+  c.buried = contact.buried;
+  c.clearance_m = contact.clearance_m;
+  c.score = c.close * (1.0 - c.missing) * (1.0 - c.buried);
   c.verified = c.fitness >= ctx.options.min_fitness && c.close >= ctx.options.min_close &&
                c.missing <= ctx.options.max_missing;
 }

@@ -42,6 +42,7 @@ struct ScanContext {
   RecognitionCache& cache;
   const PointCloud& down;  // the voxelised scan, planes included
   const KnnIndex& down_index;
+  const std::vector<DetectedPlane>& planes;  // removed from `down` (the seabed), inliers into it
   StageClock& clock;
 };
 
@@ -52,7 +53,7 @@ class OneThreadContext {
   explicit OneThreadContext(const ScanContext& outer)
       : options_(OneThread(outer.options)),
         clock_(untimed_),
-        ctx_{outer.db, options_, outer.cache, outer.down, outer.down_index, clock_} {}
+        ctx_{outer.db, options_, outer.cache, outer.down, outer.down_index, outer.planes, clock_} {}
   OneThreadContext(const OneThreadContext&) = delete;  // ctx_ refers to the members beside it
   OneThreadContext& operator=(const OneThreadContext&) = delete;
   const ScanContext& ctx() const { return ctx_; }
