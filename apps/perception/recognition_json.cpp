@@ -37,6 +37,7 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o, const std::vect
                           {"close", c.close},
                           {"missing", c.missing},
                           {"buried", c.buried},
+                          {"clearance_m", std::isfinite(c.clearance_m) ? nlohmann::json(c.clearance_m) : nlohmann::json()},
                           {"rmse_m", c.rmse_m},
                           {"score", c.score},
                           {"verified", c.verified}});

@@ -281,7 +281,7 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
     std::stable_sort(posed.begin(), posed.end(),
                      [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
     BreakTie(options.score_tie, options.buried_depth_m, posed);
-    // The others that fit as well, as posed by the same search (none of them is slid).
+    // The others that fit as well, as posed by the same search and placed as the answer is.
     const std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent_objects =
         EquivalentObjects(posed, options.score_tie);
     for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);

@@ -113,7 +113,7 @@ SceneAround SceneAroundOf(const PointCloud& segment, const ScanContext& ctx) {
   return around;
 }
 
-// The posed model verified on `segment`: fit, closeness and missing surface.
+// The posed model verified on `segment`: fit, closeness, missing surface and support contact.
 void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
             const SceneAround& around, const RegistrationResult& refined, const ScanContext& ctx,
             RecognitionCandidate& c) {

@@ -88,7 +88,8 @@ struct PosedObject {
 // tee's branch, a flange's rim, a handwheel cut off by its own shadow) is checked there too.
 SceneAround SceneAroundOf(const PointCloud& segment, const ScanContext& ctx);
 
-// The posed model verified on `segment`: fit, closeness and missing surface.
+// The posed model verified on `segment`: fit, closeness, missing surface, and how it meets the
+// support planes around it (buried share, clearance).
 void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
             const SceneAround& around, const RegistrationResult& refined, const ScanContext& ctx,
             RecognitionCandidate& c);
@@ -117,9 +118,9 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
 // smoothed over three of them (SmoothedMinimum); the pose moves only when that explains at least
 // 10 points (and 2 % of the segment) more than where the fit left it (with neither end in view a
 // pipe explains as much all along, give or take a few points), then is refined by the last stage
-// of the fine ICP and stands if still verified. Only for the accepted pose, after the candidates
-// were ranked: moved so, a wrong object (a pipe on a flange's neck) fits better too. The
-// directions stay reported free: the fit does not pin them, the verification's counts do, to
+// of the fine ICP and stands if still verified. For every candidate that could still rank first,
+// before they are ranked (RecognizeSegment): left unplaced, a pipe seen with one end lost to a
+// tee or flange fitting the same stretch. The directions stay reported free: the fit does not pin them, the verification's counts do, to
 // about a voxel. `segment` needs its normals (the fine ICP's normal gate).
 void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed);
 
