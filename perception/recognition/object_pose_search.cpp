@@ -37,7 +37,7 @@ const ViewFeatures& RecognitionCache::View(std::size_t object, std::size_t view,
 const ModelIndexes& RecognitionCache::Model(std::size_t object) {
   const std::lock_guard<std::mutex> lock(mutex_);
   std::unique_ptr<ModelIndexes>& slot = models_[object];
-  if (!slot) slot = std::make_unique<ModelIndexes>(db_.objects.at(object).model, db_.parameters.voxel_m);
+  if (!slot) slot = std::make_unique<ModelIndexes>(db_.objects.at(object), db_.parameters.voxel_m);
   return *slot;
 }
 
@@ -112,6 +112,8 @@ std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhF
   return starts;
 }
 
+double SiftReach(double diameter_m, double voxel_m) { return std::max(0.1 * diameter_m, 8.0 * voxel_m); }
+
 std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTarget& target,
                                           const std::vector<Eigen::Isometry3d>& starts, double diameter_m,
                                           const ObjectDatabaseParameters& p,
@@ -125,9 +127,8 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
   const PointCloud subset = Subset(segment, every);
   IcpOptions icp;
   icp.method = IcpMethod::kPointToPlane;
-  // From a tenth of the object's size (a roll step off at its rim) down to the fine ICP's start.
-  icp.max_correspondence_distance_m = {std::max(0.1 * diameter_m, 8.0 * p.voxel_m), 4.0 * p.voxel_m,
-                                       2.0 * p.voxel_m};
+  // From the sift's reach down to the fine ICP's start.
+  icp.max_correspondence_distance_m = {SiftReach(diameter_m, p.voxel_m), 4.0 * p.voxel_m, 2.0 * p.voxel_m};
   icp.max_iterations_per_stage = 8;
   icp.max_iterations = 20;
   icp.translation_tolerance_m = 0.1 * p.voxel_m;

@@ -70,16 +70,17 @@ class NearestWithin : public flann::ResultSet<float> {
 };
 
 // Exact nearest-neighbour search on the target points (relative to the target origin): FLANN's
-// kd-tree, and for radii up to grid_radius_m (when > 0) a NearestGrid of cells a quarter of it.
+// kd-tree, and for radii up to grid_radius_m (when > 0) a NearestGrid of cells of grid_cell_m (0: a
+// quarter of the radius).
 class TargetTree {
  public:
-  TargetTree(const PointCloud& target, double grid_radius_m)
+  TargetTree(const PointCloud& target, double grid_radius_m, double grid_cell_m)
       : index_(flann::Matrix<float>(const_cast<float*>(target.points.front().data()), target.size(),
                                     3),
                flann::KDTreeSingleIndexParams(10)) {
     index_.buildIndex();
     if (grid_radius_m > 0.0) {
-      grid_.emplace(target.points, 0.25 * grid_radius_m, grid_radius_m);
+      grid_.emplace(target.points, grid_cell_m > 0.0 ? grid_cell_m : 0.25 * grid_radius_m, grid_radius_m);
       grid_radius_sq_ = static_cast<float>(grid_radius_m * grid_radius_m);
     }
   }
@@ -304,16 +305,19 @@ void IcpOptions::Check() const {
 }
 
 struct IcpTarget::Tree {
-  Tree(const PointCloud& cloud, double grid_radius_m) : tree(cloud, grid_radius_m) {}
+  Tree(const PointCloud& cloud, double grid_radius_m, double grid_cell_m) : tree(cloud, grid_radius_m, grid_cell_m) {}
   TargetTree tree;
 };
 
-IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m) : cloud_(cloud) {
+IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m, double grid_cell_m) : cloud_(cloud) {
   RequireValidCloud(cloud, "AlignIcp: target", 3);
   if (!(grid_radius_m >= 0.0 && std::isfinite(grid_radius_m))) {
     throw Error("IcpTarget: grid_radius_m must be finite and >= 0, got " + std::to_string(grid_radius_m));
   }
-  tree_ = std::make_unique<Tree>(cloud, grid_radius_m);
+  if (!(grid_cell_m >= 0.0 && grid_cell_m <= grid_radius_m)) {
+    throw Error("IcpTarget: grid_cell_m must be in [0, grid_radius_m], got " + std::to_string(grid_cell_m));
+  }
+  tree_ = std::make_unique<Tree>(cloud, grid_radius_m, grid_cell_m);
   centroid_rel_.setZero();
   for (const Eigen::Vector3f& q : cloud.points) centroid_rel_ += q.cast<double>();
   centroid_rel_ /= static_cast<double>(cloud.size());

@@ -110,11 +110,12 @@ class NearestGrid;
 // uwscan::Error when the cloud has fewer than 3 points or a non-finite point or normal.
 class IcpTarget {
  public:
-  // grid_radius_m > 0: searches within up to that radius use a grid of cells a quarter of it
-  // (NearestGrid), faster than the tree when the target's points are about a cell apart; the
-  // same pairs either way (of equally near points the grid takes the lowest index).
-  explicit IcpTarget(const PointCloud& cloud, double grid_radius_m = 0.0);
-  IcpTarget(const PointCloud&&, double = 0.0) = delete;
+  // grid_radius_m > 0: searches within up to that radius use a grid (NearestGrid) of cells of
+  // grid_cell_m (0: a quarter of the radius), faster than the tree when the target's points are
+  // about a cell apart; the same pairs either way (of equally near points the grid takes the
+  // lowest index). grid_cell_m in [0, grid_radius_m].
+  explicit IcpTarget(const PointCloud& cloud, double grid_radius_m = 0.0, double grid_cell_m = 0.0);
+  IcpTarget(const PointCloud&&, double = 0.0, double = 0.0) = delete;
   ~IcpTarget();
   IcpTarget(const IcpTarget&) = delete;
   IcpTarget& operator=(const IcpTarget&) = delete;

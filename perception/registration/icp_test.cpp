@@ -197,15 +197,18 @@ TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
   const PointCloud source = Transformed(BumpySurface(3000, 5, -0.1, 0.0005), KnownMotion().inverse());
   const IcpTarget prepared(target);
   const IcpTarget gridded(target, 0.02);  // the last two of the three stages
+  const IcpTarget fine_gridded(target, 0.05, 0.002);  // every stage, on small cells
   EXPECT_EQ(prepared.grid(), nullptr);
   ASSERT_NE(gridded.grid(), nullptr);
   EXPECT_EQ(gridded.grid()->max_radius_m(), 0.02);
+  ASSERT_NE(fine_gridded.grid(), nullptr);
+  EXPECT_EQ(fine_gridded.grid()->max_radius_m(), 0.05);
   const IcpOptions options = Options(GetParam());
   for (const double angle_deg : {0.0, 3.0, -4.0}) {
     Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
     start.linear() = Eigen::AngleAxisd(angle_deg * kDeg, Eigen::Vector3d::UnitZ()).matrix();
     const RegistrationResult plain = AlignIcp(source, target, start, options);
-    for (const IcpTarget* reused_target : {&prepared, &gridded}) {
+    for (const IcpTarget* reused_target : {&prepared, &gridded, &fine_gridded}) {
       const RegistrationResult reused = AlignIcp(source, *reused_target, start, options);
       EXPECT_TRUE(plain.T_target_source.matrix() == reused.T_target_source.matrix());
       EXPECT_EQ(plain.fitness, reused.fitness);
@@ -215,6 +218,7 @@ TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
     }
   }
   EXPECT_THROW(IcpTarget(target, -0.01), Error);
+  EXPECT_THROW(IcpTarget(target, 0.01, 0.02), Error);  // cells wider than the radius
   PointCloud two_points;
   two_points.points = {Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX()};
   EXPECT_THROW(IcpTarget target(two_points), Error);
