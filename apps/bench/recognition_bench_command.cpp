@@ -44,10 +44,15 @@ void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
     for (const std::string& id : o.equivalent_objects) std::printf(", or %s", id.c_str());
     if (o.free_slides + o.free_turns > 0) std::printf(", free: %d slide, %d turn", o.free_slides, o.free_turns);
     std::printf("\n");
-    for (const perception::RecognitionCandidate& c : o.candidates) {
-      std::printf("      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f buried %.2f rmse %.2f mm%s\n",
+    for (std::size_t k = 0; k < o.candidates.size(); ++k) {
+      const perception::RecognitionCandidate& c = o.candidates[k];
+      std::printf("      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f buried %.2f rmse %.2f mm%s",
                   c.object_id.c_str(), c.chi_square, c.view, c.fitness, c.close, c.missing, c.buried, c.rmse_m * 1e3,
                   c.verified ? " verified" : "");
+      if (k < o.candidate_errors.size() && o.candidate_errors[k].first >= 0.0) {
+        std::printf(", off by %.2f deg %.1f mm", o.candidate_errors[k].first * kRadToDeg, o.candidate_errors[k].second * 1e3);
+      }
+      std::printf("\n");
     }
   }
 }

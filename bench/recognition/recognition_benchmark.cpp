@@ -200,6 +200,24 @@ bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Ei
 // Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
 // the pose error modulo symmetry when the answer is right.
 // `reported`: uwscan's answer, for its equivalent poses and free slides (none for the peers).
+// The pose error modulo symmetry (rotation rad, translation m) of a candidate of object
+// `truth`, (-1, -1) for a candidate of another object or one never posed.
+std::pair<double, double> CandidateError(const perception::RecognitionCandidate& c, const std::string& truth,
+                                         const Eigen::Isometry3d& T_S_O_true, const ObjectModel& model) {
+  if (c.object_id != truth || c.fitness <= 0.0) return {-1.0, -1.0};
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < model.model.size(); i += 4) points.push_back(model.model.Point(i));
+  const perception::SymmetricPoseError e = perception::PoseErrorModuloSymmetry(c.T_S_O, T_S_O_true, points, model.symmetries);
+  return {e.rotation_rad, e.translation_m};
+}
+
+std::pair<double, double> CandidateError(const perception::RecognitionCandidate& c, const std::string& truth,
+                                         const Eigen::Isometry3d& T_S_O_true, const ObjectDatabase& db) {
+  const auto model = std::find_if(db.objects.begin(), db.objects.end(), [&](const ObjectModel& o) { return o.id == truth; });
+  if (model == db.objects.end()) return {-1.0, -1.0};  // a foreign mesh
+  return CandidateError(c, truth, T_S_O_true, *model);
+}
+
 std::optional<perception::SymmetricPoseError> Score(const std::string& truth, const std::string& answer,
            const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
            const ObjectDatabase& db, PipelineFigures& figures,
@@ -384,7 +402,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
       const std::string& truth = scene.classes[o];
       if (best_segment < 0) {
-        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}, 0, 0});
+        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}, 0, 0, {}});
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
@@ -394,8 +412,11 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       }
       const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
       ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
-                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}, 0, 0};
+                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}, 0, 0, {}};
       for (const auto& [id, T] : ours.equivalent_objects_S) outcome.equivalent_objects.push_back(id);
+      for (const perception::RecognitionCandidate& c : ours.candidates) {
+        outcome.candidate_errors.push_back(CandidateError(c, truth, T_S_O_true, db));
+      }
       for (const perception::FreeDirection& f : ours.free_directions) {
         if (f.kind != "unconstrained") continue;
         ++(f.motion == "translation" ? outcome.free_slides : outcome.free_turns);

@@ -77,6 +77,9 @@ struct ObjectOutcome {
   int equivalent_poses = 0;   // other poses uwscan reported as fitting as well
   std::vector<std::string> equivalent_objects;  // other objects uwscan reported as fitting as well
   int free_slides = 0, free_turns = 0;  // directions uwscan reported unconstrained by the scan
+  // Per candidate of the true object, its pose error modulo symmetry (rotation rad, translation
+  // m): a pose search that missed tells apart from a verification that refused; -1 for others.
+  std::vector<std::pair<double, double>> candidate_errors;
 };
 
 struct RecognitionBenchResult {
