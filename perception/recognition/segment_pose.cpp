@@ -210,17 +210,19 @@ double Unexplained(const PointCloud& segment, const ObjectModel& model, const Ne
 // profile smoothed over three neighbouring steps (a single offset can dip by chance, where a slide
 // is really pinned the cost rises on both sides over several steps) and refined by a parabola
 // through the smoothed minimum and its neighbours; with the smoothed gain over the centre. Ties go
-// to the offset nearest the centre.
+// to the offset nearest the centre. The offsets are costed on `threads` threads.
 struct SlideMinimum {
   double offset_m = 0.0;
   double gain = 0.0;
 };
 template <typename Cost>
-SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, double reach_m) {
+SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, double reach_m, int threads) {
   const int steps = static_cast<int>(std::ceil(reach_m / step_m));
-  std::vector<double> raw;
-  for (int k = -steps; k <= steps; ++k) raw.push_back(cost(centre_m + k * step_m));
-  const int n = static_cast<int>(raw.size());
+  const int n = 2 * steps + 1;
+  std::vector<double> raw(static_cast<std::size_t>(n));
+  RunParallelTasks(n, threads, [&](std::ptrdiff_t k) {
+    raw[static_cast<std::size_t>(k)] = cost(centre_m + static_cast<double>(k - steps) * step_m);
+  });
   std::vector<double> smooth(raw.size());
   for (int k = 0; k < n; ++k) {
     double sum = 0.0;
@@ -266,9 +268,11 @@ void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& arou
     const Eigen::Isometry3d T_O_S = posed.fine.T_target_source;
     auto slid = [&](double offset_m) { return motion_O(offset_m).inverse() * T_O_S; };
     auto cost = [&](double offset_m) { return Unexplained(segment, model, model_grid, around, slid(offset_m), ctx); };
-    const SlideMinimum coarse = SmoothedMinimum(cost, 0.0, 2.0 * voxel_m, reach_m);
+    const int threads = ctx.options.threads;
+    const SlideMinimum coarse = SmoothedMinimum(cost, 0.0, 2.0 * voxel_m, reach_m, threads);
     if (coarse.gain < min_gain) continue;
-    const SlideMinimum m = SmoothedMinimum(cost, std::round(coarse.offset_m / voxel_m) * voxel_m, 0.5 * voxel_m, 3.0 * voxel_m);
+    const SlideMinimum m =
+        SmoothedMinimum(cost, std::round(coarse.offset_m / voxel_m) * voxel_m, 0.5 * voxel_m, 3.0 * voxel_m, threads);
     PosedObject moved = posed;
     moved.fine = AlignIcp(segment, indexes.target, slid(m.offset_m), last);
     Verify(segment, model, model_grid, around, moved.fine, ctx, moved.candidate);
