@@ -197,27 +197,23 @@ bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Ei
   return false;
 }
 
-// Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
-// the pose error modulo symmetry when the answer is right.
-// `reported`: uwscan's answer, for its equivalent poses and free slides (none for the peers).
-// The pose error modulo symmetry (rotation rad, translation m) of a candidate of object
-// `truth`, (-1, -1) for a candidate of another object or one never posed.
-std::pair<double, double> CandidateError(const perception::RecognitionCandidate& c, const std::string& truth,
-                                         const Eigen::Isometry3d& T_S_O_true, const ObjectModel& model) {
-  if (c.object_id != truth || c.fitness <= 0.0) return {-1.0, -1.0};
-  std::vector<Eigen::Vector3d> points;
-  for (std::size_t i = 0; i < model.model.size(); i += 4) points.push_back(model.model.Point(i));
-  const perception::SymmetricPoseError e = perception::PoseErrorModuloSymmetry(c.T_S_O, T_S_O_true, points, model.symmetries);
-  return {e.rotation_rad, e.translation_m};
-}
-
+// The pose error modulo symmetry (rotation rad, translation m) of a candidate for a true object
+// `truth`; (-1, -1) when the candidate is another object's, was never posed, or `truth` is not
+// in the database (a foreign mesh).
 std::pair<double, double> CandidateError(const perception::RecognitionCandidate& c, const std::string& truth,
                                          const Eigen::Isometry3d& T_S_O_true, const ObjectDatabase& db) {
   const auto model = std::find_if(db.objects.begin(), db.objects.end(), [&](const ObjectModel& o) { return o.id == truth; });
-  if (model == db.objects.end()) return {-1.0, -1.0};  // a foreign mesh
-  return CandidateError(c, truth, T_S_O_true, *model);
+  if (model == db.objects.end() || c.object_id != truth || c.fitness <= 0.0) return {-1.0, -1.0};
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < model->model.size(); i += 4) points.push_back(model->model.Point(i));
+  const perception::SymmetricPoseError e =
+      perception::PoseErrorModuloSymmetry(c.T_S_O, T_S_O_true, points, model->symmetries);
+  return {e.rotation_rad, e.translation_m};
 }
 
+// Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
+// the pose error modulo symmetry when the answer is right.
+// `reported`: uwscan's answer, for its equivalent poses and free slides (none for the peers).
 std::optional<perception::SymmetricPoseError> Score(const std::string& truth, const std::string& answer,
            const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
            const ObjectDatabase& db, PipelineFigures& figures,

@@ -1,8 +1,7 @@
 #pragma once
 
-#include <algorithm>
-
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstddef>
 #include <map>
 #include <memory>
