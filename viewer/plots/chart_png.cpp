@@ -137,8 +137,10 @@ void SavePlotsPng(const std::vector<PlotSpec>& plots, const std::filesystem::pat
   window->SetSize(width_px, height_px);
   vtkNew<vtkChartMatrix> matrix;
   matrix->SetSize(vtkVector2i(static_cast<int>(plots.size()), 1));
-  // Room at the left for the y axis's title beside its tick labels (VTK's default cut it off).
+  // Room at the left for the y axis's title beside its tick labels (VTK's default cut it off),
+  // and as much between charts side by side: the right one's y labels met the left one's x labels.
   matrix->SetBorders(90, 50, 20, 30);
+  matrix->SetGutterX(90.0f);
   for (std::size_t i = 0; i < plots.size(); ++i) {
     vtkNew<vtkChartXY> chart;
     matrix->SetChart(vtkVector2i(static_cast<int>(i), 0), chart);
