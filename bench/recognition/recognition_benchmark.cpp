@@ -197,17 +197,28 @@ bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Ei
   return false;
 }
 
+// The database's model named `id`, or none (a foreign mesh).
+const ObjectModel* ModelNamed(const ObjectDatabase& db, const std::string& id) {
+  const auto model = std::find_if(db.objects.begin(), db.objects.end(), [&](const ObjectModel& o) { return o.id == id; });
+  return model == db.objects.end() ? nullptr : &*model;
+}
+
+// The model points pose errors are measured on (every 4th).
+std::vector<Eigen::Vector3d> ErrorPoints(const ObjectModel& model) {
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < model.model.size(); i += 4) points.push_back(model.model.Point(i));
+  return points;
+}
+
 // The pose error modulo symmetry (rotation rad, translation m) of a candidate for a true object
 // `truth`; (-1, -1) when the candidate is another object's, was never posed, or `truth` is not
 // in the database (a foreign mesh).
 std::pair<double, double> CandidateError(const perception::RecognitionCandidate& c, const std::string& truth,
                                          const Eigen::Isometry3d& T_S_O_true, const ObjectDatabase& db) {
-  const auto model = std::find_if(db.objects.begin(), db.objects.end(), [&](const ObjectModel& o) { return o.id == truth; });
-  if (model == db.objects.end() || c.object_id != truth || c.fitness <= 0.0) return {-1.0, -1.0};
-  std::vector<Eigen::Vector3d> points;
-  for (std::size_t i = 0; i < model->model.size(); i += 4) points.push_back(model->model.Point(i));
+  const ObjectModel* model = ModelNamed(db, truth);
+  if (model == nullptr || c.object_id != truth || c.fitness <= 0.0) return {-1.0, -1.0};
   const perception::SymmetricPoseError e =
-      perception::PoseErrorModuloSymmetry(c.T_S_O, T_S_O_true, points, model->symmetries);
+      perception::PoseErrorModuloSymmetry(c.T_S_O, T_S_O_true, ErrorPoints(*model), model->symmetries);
   return {e.rotation_rad, e.translation_m};
 }
 
@@ -234,10 +245,8 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
   }
   ++figures.recognised;
   ++figures.recognised_or_reported;
-  const ObjectModel& model = *std::find_if(db.objects.begin(), db.objects.end(),
-                                           [&](const ObjectModel& o) { return o.id == truth; });
-  std::vector<Eigen::Vector3d> points;
-  for (std::size_t i = 0; i < model.model.size(); i += 4) points.push_back(model.model.Point(i));
+  const ObjectModel& model = *ModelNamed(db, truth);  // answers come from the database
+  const std::vector<Eigen::Vector3d> points = ErrorPoints(model);
   const perception::SymmetricPoseError e =
       perception::PoseErrorModuloSymmetry(*T_S_O, T_S_O_true, points, model.symmetries);
   figures.rotation_errors_rad.push_back(e.rotation_rad);

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <algorithm>
 #include <cstddef>
 #include <map>
 #include <memory>
@@ -35,12 +34,12 @@ double SiftReach(double diameter_m, double voxel_m);
 
 // A model's search structures: its ICP target, whose grid of one-voxel cells (the model's points
 // are about a voxel apart) answers every pair search of the pose search, out to the sift's reach
-// and at least 4 voxels, and the nearest model points for verification, parts and symmetry
-// phases. Searched through the grid the sift took 12 % less time than through the k-d tree
-// (recognition bench, seed 2), with the same pairs.
+// (beyond the fine ICP's 4 voxels), and the nearest model points for verification, parts and
+// symmetry phases. Searched through the grid the sift took 12 % less time than through the k-d
+// tree (recognition bench, seed 2), with the same pairs.
 struct ModelIndexes {
   ModelIndexes(const ObjectModel& model, double voxel_m)
-      : target(model.model, std::max(4.0 * voxel_m, SiftReach(model.diameter_m, voxel_m)), voxel_m) {}
+      : target(model.model, SiftReach(model.diameter_m, voxel_m), voxel_m) {}
   IcpTarget target;
   const NearestGrid& nearest() const { return *target.grid(); }
 };
