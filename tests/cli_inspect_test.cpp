@@ -4,6 +4,7 @@
 // private network namespace with only `lo` up (cmake/run_in_netns.sh).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -32,6 +33,28 @@ void ExpectEveryFrameAccountedFor(const nlohmann::json& j, const fs::path& log) 
   EXPECT_GT(j["frames_mapped"].get<std::int64_t>(), 0);
 }
 
+// The frames the camera sent and inspect never logged are counted exactly: each logged frame
+// carries the camera's frame counter as its sweep and mirror step (201 steps a sweep), so the
+// counter's gaps are the lost frames. A shared machine can starve the receiver long enough for
+// Aravis to drop a few frames (a CI run lost 3 of 606); more than 1 % is a receiver that does
+// not keep up with 200 frames/s.
+void ExpectLossCountedAndSmall(const nlohmann::json& j, const fs::path& log) {
+  std::vector<std::int64_t> counters;
+  uwscan::mapping::DiveLogReader(log).ForEachFrame(
+      [&](const uwscan::mapping::FrameRecord& f, const uwscan::mapping::GroundTruthRecord*) {
+        counters.push_back(static_cast<std::int64_t>(f.sweep) * 201 + (f.command + 100));
+      },
+      false);
+  ASSERT_FALSE(counters.empty());
+  ASSERT_TRUE(std::is_sorted(counters.begin(), counters.end()));
+  const std::int64_t missing = counters.back() - counters.front() + 1 - static_cast<std::int64_t>(counters.size());
+  const std::int64_t lost = j["lost_frames"].get<std::int64_t>();
+  std::printf("profile mode: %lld of %zu frames lost (%lld incomplete)\n", static_cast<long long>(lost),
+              counters.size(), static_cast<long long>(j["incomplete_frames"].get<std::int64_t>()));
+  EXPECT_EQ(lost, missing);
+  EXPECT_LE(lost, static_cast<std::int64_t>(counters.size()) / 100);
+}
+
 // Profile mode: 3 sweeps of the default scene (a fixed scanner, world = camera frame). Every
 // frame is in the log; the map lies on the cloud `simulate` + `reconstruct` make of the scene
 // (a map point is a voxel's centroid: within the voxel's diagonal of a point it averages).
@@ -49,7 +72,7 @@ TEST(CliInspect, ProfileModeLogsEveryFrameAndMapsTheScene) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   EXPECT_EQ(j["frames_received"].get<std::int64_t>(), 603) << run.output;
-  EXPECT_EQ(j["lost_frames"].get<std::int64_t>(), 0);
+  ExpectLossCountedAndSmall(j, log);
   ExpectEveryFrameAccountedFor(j, log);
   // The fake camera's clock is the host's: both latencies are known, and short.
   const nlohmann::json& latency = j["latency_s"];

@@ -77,6 +77,7 @@ void WriteReport(const InspectArgs& a, const ReadSummary& r, const mapping::Insp
                          {"frames_out_of_order", s.frames_out_of_order},
                          {"clock_restarts", s.clock_restarts},
                          {"lost_frames", r.source.lost_frames},
+                         {"incomplete_frames", r.source.incomplete_frames},
                          {"undecodable_frames", r.undecodable},
                          {"seconds", r.seconds},
                          {"frames_per_s", r.seconds > 0 ? r.frames / r.seconds : 0.0},
