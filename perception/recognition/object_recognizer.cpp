@@ -273,9 +273,16 @@ SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& re
       }
       return best;
     };
-    if (const double weak = best_verified_score(); weak >= 0.0 && weak < options.weak_score) {
-      for (std::size_t i : chosen.others) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
-    }
+    // When the chosen explain the segment poorly or not at all, the others may (weak_score).
+    const double weak = best_verified_score();
+    const std::vector<std::size_t> no_others;
+    const std::vector<std::size_t>& others = weak < 0.0                  ? chosen.others_that_fit
+                                             : weak < options.weak_score ? chosen.others
+                                                                         : no_others;
+    RecognitionOptions others_options = options;
+    if (weak < 0.0) others_options.pose_views = options.unverified_pose_views;
+    const ScanContext others_ctx{ctx.db, others_options, ctx.cache, ctx.down, ctx.down_index, ctx.planes, ctx.clock};
+    for (std::size_t i : others) posed.push_back(PoseCandidate(described, i, chosen, around, others_ctx));
     PlaceContendersAlongFreeDirections(described.cloud, around, ctx, posed);
     clock.Lap("free");
     std::stable_sort(posed.begin(), posed.end(),
@@ -456,6 +463,7 @@ void RecognitionOptions::Check() const {
     }
   };
   in_range("pose_views", pose_views, 0, 64);
+  in_range("unverified_pose_views", unverified_pose_views, 0, 64);
   in_range("pose_rolls", pose_rolls, 1, 360);
   in_range("sift_points", sift_points, 10, 100000);
   in_range("refined_starts", refined_starts, 1, 64);

@@ -39,10 +39,11 @@ ChosenObjects ChooseObjects(const EsfDescriptor& esf, double extent_m, const Sca
   for (std::size_t i : order) {
     const double chi_square = c.nearest_chi_square[i];
     if (chi_square > ctx.options.max_chi_square) break;
+    const bool fits = extent_m <= 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m;
     const bool chosen = static_cast<int>(c.objects.size()) < ctx.options.max_candidates &&
-                        chi_square <= ctx.options.max_chi_square_ratio * best_chi_square &&
-                        extent_m <= 1.1 * db.objects[i].diameter_m + 4.0 * db.parameters.voxel_m;
+                        chi_square <= ctx.options.max_chi_square_ratio * best_chi_square && fits;
     (chosen ? c.objects : c.others).push_back(i);
+    if (!chosen && fits) c.others_that_fit.push_back(i);
   }
   return c;
 }

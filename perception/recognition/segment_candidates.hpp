@@ -26,8 +26,10 @@ std::vector<std::vector<std::pair<double, int>>> NearestViews(const EsfDescripto
 struct ChosenObjects {
   std::vector<std::size_t> objects;
   // The others within max_chi_square, nearest first, whatever their size: posed only when the
-  // chosen explain the segment poorly (it may hold one of them and something else).
+  // chosen explain the segment poorly (it may hold one of them and something else)...
   std::vector<std::size_t> others;
+  // ...and those of them the segment's size fits: posed when none of the chosen is verified.
+  std::vector<std::size_t> others_that_fit;
   std::vector<std::vector<std::pair<double, int>>> nearest_views;  // of every object
   std::vector<double> nearest_chi_square;                          // of every object
 };
