@@ -1,6 +1,6 @@
 #pragma once
 // What the camera tests (cli_acquisition_test, cli_inspect_test) share: `uwscan` processes in
-// the background (the fake camera), temporary files, JSON, and cloud comparisons.
+// the background (the fake camera), temporary files, JSON, cloud comparisons and lost frames.
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -22,6 +22,8 @@
 #include <thread>
 #include <unordered_map>
 #include <vector>
+
+#include "mapping/log/dive_log.hpp"
 
 extern char** environ;
 
@@ -141,6 +143,28 @@ inline double MaxNearestDistance(const std::vector<Eigen::Vector3d>& a, const st
     worst = std::max(worst, best);
   }
   return worst;
+}
+
+// What a log of the fake camera's default scene says of the frames it sent: each frame carries
+// the camera's frame counter as its sweep and mirror step (201 steps a sweep), so the counter's
+// gaps between the first and the last logged frame are the frames lost on the way.
+struct CounterGaps {
+  std::int64_t logged = 0;
+  std::int64_t missing = 0;
+  bool in_order = true;  // the counter never runs backwards
+};
+inline CounterGaps CounterGapsOf(const fs::path& log) {
+  std::vector<std::int64_t> counters;
+  mapping::DiveLogReader(log).ForEachFrame(
+      [&](const mapping::FrameRecord& f, const mapping::GroundTruthRecord*) {
+        counters.push_back(static_cast<std::int64_t>(f.sweep) * 201 + (f.command + 100));
+      },
+      false);
+  CounterGaps g;
+  g.logged = static_cast<std::int64_t>(counters.size());
+  g.in_order = std::is_sorted(counters.begin(), counters.end());
+  if (!counters.empty()) g.missing = counters.back() - counters.front() + 1 - g.logged;
+  return g;
 }
 
 }  // namespace uwscan::test
