@@ -86,6 +86,34 @@ void JoinNearbySegments(const PointCloud& cloud, double widest_m, double distanc
   }
 }
 
+// Fragments within `attach_distance_m` of each other that together hold min_segment_points
+// (and are no wider than `widest_m`) become a segment: an object that occlusion cut into pieces
+// each too small to count, with no segment near enough to take them (a lever valve whose own
+// handle's shadow split it in two halves of 110 points). The rest stay fragments.
+void PromoteFragmentGroups(const PointCloud& cloud, double widest_m, const RecognitionOptions& options,
+                           std::vector<std::vector<std::size_t>>& fragments, std::vector<Segment>& segments) {
+  std::vector<std::size_t> points;  // into cloud
+  for (const std::vector<std::size_t>& part : fragments) points.insert(points.end(), part.begin(), part.end());
+  if (points.size() < static_cast<std::size_t>(options.min_segment_points)) return;
+  ClusteringOptions grouping;
+  grouping.tolerance_m = options.attach_distance_m;
+  std::vector<std::vector<std::size_t>> rest;
+  for (const std::vector<std::size_t>& group : EuclideanClusters(Subset(cloud, points), grouping)) {
+    std::vector<std::size_t> members;
+    for (std::size_t i : group) members.push_back(points[i]);
+    std::sort(members.begin(), members.end());
+    if (members.size() >= static_cast<std::size_t>(options.min_segment_points)) {
+      const double diameter = Diameter(Subset(cloud, members));
+      if (diameter <= widest_m) {
+        segments.push_back({std::move(members), diameter});
+        continue;
+      }
+    }
+    rest.push_back(std::move(members));
+  }
+  fragments = std::move(rest);
+}
+
 }  // namespace
 
 std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std::vector<std::size_t>& part,
@@ -125,6 +153,7 @@ std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m, 
     const double diameter = Diameter(Subset(cloud, c));
     segments.push_back({std::move(c), diameter});
   }
+  PromoteFragmentGroups(cloud, largest_object_m, options, small, segments);
   AttachFragments(cloud, small, options.attach_distance_m, segments);
   JoinNearbySegments(cloud, largest_object_m, options.attach_distance_m, segments);
   for (Segment& segment : segments) std::sort(segment.indices.begin(), segment.indices.end());
