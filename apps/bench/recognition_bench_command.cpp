@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -43,6 +44,13 @@ void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
     if (o.equivalent_poses > 0) std::printf(", %d equivalent pose%s", o.equivalent_poses, o.equivalent_poses > 1 ? "s" : "");
     for (const std::string& id : o.equivalent_objects) std::printf(", or %s", id.c_str());
     if (o.free_slides + o.free_turns > 0) std::printf(", free: %d slide, %d turn", o.free_slides, o.free_turns);
+    if (!o.why_wrong.empty()) {
+      std::printf(", why: %s", o.why_wrong.c_str());
+      if (const auto& t = o.truth_check) {
+        std::printf(" (the truth at its pose: fitness %.2f close %.2f missing %.2f score %.3f)", t->fitness, t->close,
+                    t->missing, t->score);
+      }
+    }
     std::printf("\n");
     for (std::size_t k = 0; k < o.candidates.size(); ++k) {
       const perception::RecognitionCandidate& c = o.candidates[k];
@@ -132,6 +140,17 @@ void Run(Args a) {
       std::printf("\n");
     }
   }
+  // Why catalogue objects were not recognised (ObjectOutcome::why_wrong).
+  std::map<std::string, int> why_wrong;
+  for (const bench::ObjectOutcome& o : r.outcomes) {
+    if (!o.why_wrong.empty()) ++why_wrong[o.why_wrong];
+  }
+  if (r.pipelines.count("uwscan")) {
+    std::printf("uwscan wrong answers, the true object checked at its true pose on the segment answered for it:");
+    for (const auto& [why, n] : why_wrong) std::printf(" %s %d", why.c_str(), n);
+    if (why_wrong.empty()) std::printf(" none");
+    std::printf("\n");
+  }
   if (a.details) PrintOutcomes(r.outcomes);
   if (!a.json.empty()) {
     nlohmann::json stages(r.uwscan_stage_seconds);
@@ -143,6 +162,7 @@ void Run(Args a) {
                            {"ppf_training_seconds", r.ppf_training_seconds},
                            {"pipelines", pipelines},
                            {"confusion", confusion},
+                           {"uwscan_wrong_answers", why_wrong},
                            {"uwscan_stage_seconds_per_scan", stages}});
   }
 }

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <optional>
 #include <random>
+#include <string>
 
 #include "bench/recognition/pose_nees.hpp"
 #include "bench/recognition/recognition_peers.hpp"
@@ -17,6 +18,7 @@
 #include "perception/recognition/object_database_builder.hpp"
 #include "perception/recognition/object_pose_search.hpp"
 #include "perception/recognition/object_recognizer.hpp"
+#include "perception/recognition/pose_check.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/fnv1a.hpp"
 #include "scanner/lasers/scanner_file.hpp"
@@ -222,6 +224,16 @@ std::pair<double, double> CandidateError(const perception::RecognitionCandidate&
   return {e.rotation_rad, e.translation_m};
 }
 
+// ObjectOutcome::why_wrong of a wrong answer `ours`, given the true object checked at its true
+// pose on the same segment.
+std::string WhyWrong(const perception::RecognitionCandidate& truth, const perception::RecognizedObject& ours,
+                     double score_tie) {
+  if (!truth.verified) return "unverified";
+  if (ours.object_id == "unknown" || truth.score > ours.score + score_tie) return "missed";
+  if (truth.score < ours.score - score_tie) return "outscored";
+  return "tie";
+}
+
 // Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
 // the pose error modulo symmetry when the answer is right.
 // `reported`: uwscan's answer, for its equivalent poses and free slides (none for the peers).
@@ -407,7 +419,8 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
       const std::string& truth = scene.classes[o];
       if (best_segment < 0) {
-        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}, 0, 0, {}});
+        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}, 0, 0, {},
+                                   truth == "foreign" ? "" : "no segment", std::nullopt});
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
@@ -417,7 +430,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       }
       const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
       ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
-                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}, 0, 0, {}};
+                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}, 0, 0, {}, "", std::nullopt};
       for (const auto& [id, T] : ours.equivalent_objects_S) outcome.equivalent_objects.push_back(id);
       for (const perception::RecognitionCandidate& c : ours.candidates) {
         outcome.candidate_errors.push_back(CandidateError(c, truth, T_S_O_true, db));
@@ -429,6 +442,12 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"], &ours)) {
         outcome.rotation_error_rad = e->rotation_rad;
         outcome.translation_error_m = e->translation_m;
+      }
+      if (ours.object_id != truth && truth != "foreign") {
+        const perception::RecognitionCandidate checked =
+            perception::CheckObjectPose(cloud, ours.segment, db, cache, truth, T_S_O_true, recognition);
+        outcome.why_wrong = WhyWrong(checked, ours, recognition.score_tie);
+        outcome.truth_check = checked;
       }
       result.outcomes.push_back(std::move(outcome));
       if (!options.run_peers) continue;

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,15 @@ struct ObjectOutcome {
   // Per candidate of the true object, its pose error modulo symmetry (rotation rad, translation
   // m): a pose search that missed tells apart from a verification that refused; -1 for others.
   std::vector<std::pair<double, double>> candidate_errors;
+  // Why a catalogue object was not recognised, from the true object posed at its true pose on the
+  // segment answered for it (CheckObjectPose, refined and verified as recognition's candidates
+  // are): "tie" (it verifies and scores within score_tie of the answer: the scan cannot tell the
+  // two apart, and the answer went by chi-square), "missed" (it verifies and scores above the
+  // answer, or the answer is "unknown": the pose search did not find it), "outscored" (it
+  // verifies, the answer scores higher), "unverified" (it does not verify on that segment),
+  // "no segment" (no segment holds its points); empty when recognised, and for foreign meshes.
+  std::string why_wrong;
+  std::optional<perception::RecognitionCandidate> truth_check;  // that check, when made
 };
 
 struct RecognitionBenchResult {
