@@ -363,12 +363,16 @@ bool ExplainsPart(const PointCloud& remaining, const std::vector<std::size_t>& p
 
 // Whether segments `a` and `b` are worth recognising as one: a segment no object explains next to
 // a recognised one (a handwheel its own shadow cut off from its valve's body, when the body also
-// touched another object and so could not join it in Segments), or two answered as the same
-// object (the handwheel alone fits the wheel valve too, badly). Pairs of recognised segments are
+// touched another object and so could not join it in Segments), two answered as the same object
+// (the handwheel alone fits the wheel valve too, badly), or two of which one is explained poorly
+// (scoring under `weak_score`: a split that gave most of a flange to a tee, which fit it with a
+// sixth of its model in the seabed, and the rest to the flange). Pairs of recognised segments are
 // taken once (a < b).
-bool WorthJoining(const RecognizedObject& a, const RecognizedObject& b, std::size_t ia, std::size_t ib) {
+bool WorthJoining(const RecognizedObject& a, const RecognizedObject& b, std::size_t ia, std::size_t ib,
+                  double weak_score) {
   if (a.object_id == "unknown") return b.object_id != "unknown";
-  return ib > ia && b.object_id == a.object_id;
+  if (b.object_id == "unknown" || ib < ia) return false;
+  return b.object_id == a.object_id || a.score < weak_score || b.score < weak_score;
 }
 
 // Segment `k` joined with the nearest other WorthJoining it (see JoinSegmentsOneObjectExplains):
@@ -379,7 +383,9 @@ std::optional<std::size_t> JoinNearest(const PointCloud& remaining, double large
   if (dropped[k] || points[k].empty()) return std::nullopt;
   std::vector<Segment> others(objects.size());
   for (std::size_t j = 0; j < objects.size(); ++j) {
-    if (j != k && !dropped[j] && WorthJoining(objects[k], objects[j], k, j)) others[j].indices = points[j];
+    if (j != k && !dropped[j] && WorthJoining(objects[k], objects[j], k, j, ctx.options.weak_score)) {
+      others[j].indices = points[j];
+    }
   }
   const auto [to, distance] = NearestSegment(remaining, points[k], others, k);
   if (distance > ctx.options.attach_distance_m) return std::nullopt;
