@@ -71,6 +71,10 @@ RecognitionCandidate CheckObjectPose(const PointCloud& scan, const std::vector<s
   for (std::size_t i : segment) {
     if (i >= scan.size()) throw Error("pose check: a segment index is past the scan's " + std::to_string(scan.size()) + " points");
   }
+  const Eigen::Matrix3d R = T_S_O.linear();
+  if (!T_S_O.matrix().allFinite() || !(R.transpose() * R).isIdentity(1e-9) || !(R.determinant() > 0.0)) {
+    throw Error("pose check: T_S_O must be finite, a rotation (orthonormal, det +1) and a translation");
+  }
   const std::size_t object = static_cast<std::size_t>(found - db.objects.begin());
 
   const PointCloud down = VoxelDownsample(scan, VoxelFilterOptions{db.parameters.voxel_m});

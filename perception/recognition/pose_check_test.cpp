@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -60,9 +61,10 @@ TEST(PoseCheck, BadRequestsAreRefusedNamingWhatIsWrong) {
   const FlangeScan& f = Flange();
   const ObjectDatabase& db = PipeFlangeValveDb();
   RecognitionCache cache(db);
-  auto message = [&](const std::vector<std::size_t>& segment, const std::string& id) {
+  auto message = [&](const std::vector<std::size_t>& segment, const std::string& id,
+                     const Eigen::Isometry3d& T_S_O = Flange().scan.T_S_O) {
     try {
-      CheckObjectPose(f.scan.cloud, segment, db, cache, id, f.scan.T_S_O);
+      CheckObjectPose(f.scan.cloud, segment, db, cache, id, T_S_O);
     } catch (const Error& e) {
       return std::string(e.what());
     }
@@ -71,6 +73,12 @@ TEST(PoseCheck, BadRequestsAreRefusedNamingWhatIsWrong) {
   EXPECT_NE(message(f.segment, "elbow").find("'elbow' is not in the database"), std::string::npos);
   EXPECT_NE(message({}, "flange").find("segment is empty"), std::string::npos);
   EXPECT_NE(message({f.scan.cloud.size()}, "flange").find("past the scan"), std::string::npos);
+  Eigen::Isometry3d scaled = f.scan.T_S_O;
+  scaled.linear() *= 1.1;
+  EXPECT_NE(message(f.segment, "flange", scaled).find("must be finite, a rotation"), std::string::npos);
+  Eigen::Isometry3d nan = f.scan.T_S_O;
+  nan.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message(f.segment, "flange", nan).find("must be finite, a rotation"), std::string::npos);
 }
 
 }  // namespace
