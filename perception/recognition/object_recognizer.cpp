@@ -141,6 +141,10 @@ void PlaceContendersAlongFreeDirections(const PointCloud& segment, const SceneAr
   for (PosedObject& q : posed) {
     const RecognitionCandidate& c = q.candidate;
     if (c.verified && c.close * (1.0 - c.buried) >= best - ctx.options.score_tie) {
+      // Losing on surface it should have shown: perhaps posed a half turn off.
+      if (c.missing > ctx.options.score_tie) {
+        TurnToBetterHalfTurn(segment, around, ctx, q);
+      }
       PlaceAlongFreeDirections(segment, around, ctx, q);
     }
   }

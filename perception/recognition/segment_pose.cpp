@@ -280,6 +280,35 @@ void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& arou
   }
 }
 
+void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
+                          PosedObject& posed) {
+  const ObjectModel& model = ctx.db.objects[posed.object];
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
+  const ModelIndexes& indexes = ctx.cache.Model(posed.object);
+  const NearestGrid& model_grid = indexes.nearest();
+  const PointCloud sample = Strided(segment, static_cast<std::size_t>(ctx.options.refine_points));
+  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, model_grid, p.voxel_m);
+  std::vector<RegistrationResult> refined(turns.size());
+  std::vector<RecognitionCandidate> turned(turns.size(), posed.candidate);
+  RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
+    const std::size_t i = static_cast<std::size_t>(k);
+    refined[i] = AlignIcp(sample, indexes.target, turns[i] * posed.fine.T_target_source, FineIcp(model.diameter_m, p, 1));
+    Verify(segment, model, model_grid, around, refined[i], ctx, turned[i]);
+  });
+  std::size_t best = turns.size();
+  for (std::size_t i = 0; i < turns.size(); ++i) {
+    if (Better(turned[i], best < turns.size() ? turned[best] : posed.candidate)) best = i;
+  }
+  if (best == turns.size()) return;
+  // On every point, as PoseOnSegment ends.
+  IcpOptions last = FineIcp(model.diameter_m, p, ctx.options.threads);
+  last.max_correspondence_distance_m = {last.max_correspondence_distance_m.back()};
+  PosedObject moved = posed;
+  moved.fine = AlignIcp(segment, indexes.target, refined[best].T_target_source, last);
+  Verify(segment, model, model_grid, around, moved.fine, ctx, moved.candidate);
+  if (Better(moved.candidate, posed.candidate)) posed = std::move(moved);
+}
+
 // Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
 // equivalent_poses_S): its pose turned by each of DistinctHalfTurns (a nearly symmetric object,
 // a valve's body, fits either way), refined by the fine ICP and verified like it; kept when

@@ -124,6 +124,14 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
 // about a voxel. `segment` needs its normals (the fine ICP's normal gate).
 void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed);
 
+// The posed object turned by each of DistinctHalfTurns, refined by the fine ICP and verified, and
+// moved to the best of them when that scores better (Better): a candidate that fits the segment
+// but leaves model surface where the sensor saw through may be posed a half turn off (a tee seen
+// as an L, turned about the L's bisector, its branch out where the seabed was seen). `segment`
+// needs its normals (the fine ICP's normal gate).
+void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
+                          PosedObject& posed);
+
 // Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
 // equivalent_poses_S): its pose turned by each of DistinctHalfTurns (a nearly symmetric object,
 // a valve's body, fits either way; a tee seen as an L fits turned about the L's bisector), refined by the fine ICP and verified like it; kept when
