@@ -133,7 +133,8 @@ void BreakTie(double tie, double resting_m, std::vector<PosedObject>& ranked) {
 // and left by its fit with the other end in view misses surface the scan saw through, and a wrong
 // object that fits the same stretch would win. A candidate can rank first when it would score
 // within score_tie of the best with nothing missing: placing it changes that share, not the
-// others much.
+// others much. One that misses surface is first tried turned by its model's half turns
+// (TurnToBetterHalfTurn): a flange posed end for end misses its rim where the scan shows its neck.
 void PlaceContendersAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
                                         std::vector<PosedObject>& posed) {
   double best = 0.0;
@@ -141,7 +142,7 @@ void PlaceContendersAlongFreeDirections(const PointCloud& segment, const SceneAr
   for (PosedObject& q : posed) {
     const RecognitionCandidate& c = q.candidate;
     if (c.verified && c.close * (1.0 - c.buried) >= best - ctx.options.score_tie) {
-      // Losing on surface it should have shown: perhaps posed a half turn off.
+      // Missing surface it should have shown: perhaps posed a half turn off.
       if (c.missing > ctx.options.score_tie) {
         TurnToBetterHalfTurn(segment, around, ctx, q);
       }
