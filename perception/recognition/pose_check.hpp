@@ -15,9 +15,9 @@ class RecognitionCache;
 
 // A pose of a database object, given from outside (a layout drawing, the previous scan, a
 // simulation's truth), checked on part of a scan as recognition checks its own candidates: the
-// same voxel grid and support planes, the pose refined from `T_S_O` by the pose search's fine ICP
-// (and its phase about any N-fold axis searched), then verified by fit, closeness, missing surface
-// and support contact (RecognitionCandidate: verified, score). It answers whether the scan
+// same voxel grid and support planes; the pose as given and as refined from it by the pose
+// search's fine ICP, each verified by fit, closeness, missing surface and support contact, and the
+// better of the two returned (RecognitionCandidate: verified, score). It answers whether the scan
 // supports that object there as well as it supports what recognition answered: a recognition
 // bench uses it to tell a scan that cannot decide between two objects from a search that missed.
 //

@@ -89,6 +89,25 @@ std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, const
   return turns;
 }
 
+// `posed` turned by each of DistinctHalfTurns, each refined by the fine ICP on a sample of
+// `segment` (one turn per thread) and verified on all of it.
+std::vector<PosedObject> HalfTurnedPoses(const PointCloud& segment, const PosedObject& posed, const SceneAround& around,
+                                         const ScanContext& ctx) {
+  const ObjectModel& model = ctx.db.objects[posed.object];
+  const ObjectDatabaseParameters& p = ctx.db.parameters;
+  const ModelIndexes& indexes = ctx.cache.Model(posed.object);
+  const PointCloud sample = Strided(segment, static_cast<std::size_t>(ctx.options.refine_points));
+  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, indexes.nearest(), p.voxel_m);
+  std::vector<PosedObject> turned(turns.size(), posed);
+  RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
+    PosedObject& t = turned[static_cast<std::size_t>(k)];
+    t.fine = AlignIcp(sample, indexes.target, turns[static_cast<std::size_t>(k)] * posed.fine.T_target_source,
+                      FineIcp(model.diameter_m, p, 1));
+    Verify(segment, model, indexes.nearest(), around, t.fine, ctx, t.candidate);
+  });
+  return turned;
+}
+
 }  // namespace
 
 DescribedSegment DescribeSegment(const PointCloud& segment, const ScanContext& ctx) {
@@ -282,30 +301,20 @@ void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& arou
 
 void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
                           PosedObject& posed) {
-  const ObjectModel& model = ctx.db.objects[posed.object];
-  const ObjectDatabaseParameters& p = ctx.db.parameters;
-  const ModelIndexes& indexes = ctx.cache.Model(posed.object);
-  const NearestGrid& model_grid = indexes.nearest();
-  const PointCloud sample = Strided(segment, static_cast<std::size_t>(ctx.options.refine_points));
-  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, model_grid, p.voxel_m);
-  std::vector<RegistrationResult> refined(turns.size());
-  std::vector<RecognitionCandidate> turned(turns.size(), posed.candidate);
-  RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
-    const std::size_t i = static_cast<std::size_t>(k);
-    refined[i] = AlignIcp(sample, indexes.target, turns[i] * posed.fine.T_target_source, FineIcp(model.diameter_m, p, 1));
-    Verify(segment, model, model_grid, around, refined[i], ctx, turned[i]);
-  });
-  std::size_t best = turns.size();
-  for (std::size_t i = 0; i < turns.size(); ++i) {
-    if (Better(turned[i], best < turns.size() ? turned[best] : posed.candidate)) best = i;
+  const std::vector<PosedObject> turned = HalfTurnedPoses(segment, posed, around, ctx);
+  const PosedObject* best = &posed;
+  for (const PosedObject& t : turned) {
+    if (Better(t.candidate, best->candidate)) best = &t;
   }
-  if (best == turns.size()) return;
+  if (best == &posed) return;
   // On every point, as PoseOnSegment ends.
-  IcpOptions last = FineIcp(model.diameter_m, p, ctx.options.threads);
+  const ObjectModel& model = ctx.db.objects[posed.object];
+  const ModelIndexes& indexes = ctx.cache.Model(posed.object);
+  IcpOptions last = FineIcp(model.diameter_m, ctx.db.parameters, ctx.options.threads);
   last.max_correspondence_distance_m = {last.max_correspondence_distance_m.back()};
-  PosedObject moved = posed;
-  moved.fine = AlignIcp(segment, indexes.target, refined[best].T_target_source, last);
-  Verify(segment, model, model_grid, around, moved.fine, ctx, moved.candidate);
+  PosedObject moved = *best;
+  moved.fine = AlignIcp(segment, indexes.target, best->fine.T_target_source, last);
+  Verify(segment, model, indexes.nearest(), around, moved.fine, ctx, moved.candidate);
   if (Better(moved.candidate, posed.candidate)) posed = std::move(moved);
 }
 
@@ -318,23 +327,12 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
                                                const SceneAround& around, const ScanContext& ctx) {
   const ObjectModel& model = ctx.db.objects[posed.object];
   const ObjectDatabaseParameters& p = ctx.db.parameters;
-  const ModelIndexes& indexes = ctx.cache.Model(posed.object);
-  const IcpTarget& target = indexes.target;
-  const NearestGrid& model_grid = indexes.nearest();
-  const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
-  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, model_grid, p.voxel_m);
-  std::vector<RecognitionCandidate> turned(turns.size());
-  RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
-    const std::size_t i = static_cast<std::size_t>(k);
-    const RegistrationResult refined = AlignIcp(sample, target, turns[i] * posed.fine.T_target_source,
-                                                FineIcp(model.diameter_m, p, 1));
-    Verify(s.cloud, model, model_grid, around, refined, ctx, turned[i]);
-  });
   std::vector<Eigen::Vector3d> points_O;
   for (std::size_t i = 0; i < model.model.size(); i += 4) points_O.push_back(model.model.Point(i));
   const double same_rad = 5.0 * std::numbers::pi / 180.0, same_m = 2.0 * p.voxel_m;
   std::vector<Eigen::Isometry3d> equivalent;
-  for (const RecognitionCandidate& c : turned) {
+  for (const PosedObject& t : HalfTurnedPoses(s.cloud, posed, around, ctx)) {
+    const RecognitionCandidate& c = t.candidate;
     if (!c.verified || c.score < posed.candidate.score - ctx.options.score_tie) continue;
     bool seen = false;
     for (const Eigen::Isometry3d& other : equivalent) {
