@@ -70,6 +70,13 @@ double Diameter(const PointCloud& cloud, std::size_t max_points) {
   return std::sqrt(static_cast<double>(best));
 }
 
+Eigen::Vector3d Centroid(const PointCloud& cloud) {
+  if (cloud.empty()) throw Error("Centroid: the cloud is empty");
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) sum += cloud.Point(i);
+  return sum / static_cast<double>(cloud.size());
+}
+
 double BoundingBoxDiagonal(const PointCloud& cloud) {
   if (cloud.size() < 2) return 0.0;
   Eigen::Vector3f lo = cloud.points.front(), hi = cloud.points.front();

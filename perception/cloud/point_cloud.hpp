@@ -38,6 +38,9 @@ void RequireValidCloud(const PointCloud& cloud, const std::string& what,
 // rotate, so no precision is lost to large translations.
 PointCloud Transformed(const PointCloud& cloud, const Eigen::Isometry3d& T);
 
+// Mean of the points, metres. Throws uwscan::Error for an empty cloud.
+Eigen::Vector3d Centroid(const PointCloud& cloud);
+
 // Axis-aligned bounding box diagonal, metres (0 for fewer than 2 points).
 double BoundingBoxDiagonal(const PointCloud& cloud);
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "scanner/common/error.hpp"
+
 namespace uwscan::perception {
 namespace {
 
@@ -33,6 +35,17 @@ TEST(Diameter, ExactBelowTheCapAndNeverAboveTheTruthBeyondIt) {
   EXPECT_NEAR(Diameter(disc), 0.2, 1e-6);
   EXPECT_GT(BoundingBoxDiagonal(disc), 0.28);
   EXPECT_EQ(Diameter(PointCloud{}), 0.0);
+}
+
+// The mean of the points, in the cloud's frame (its origin added), also far from the frame's
+// origin where the offsets are float; an empty cloud has none.
+TEST(Centroid, IsTheMeanOfThePointsAndRefusesAnEmptyCloud) {
+  PointCloud cloud;
+  cloud.origin = Eigen::Vector3d(5000.0, -3000.0, 120.0);
+  cloud.points = {{0.1f, 0.0f, 0.0f}, {-0.1f, 0.2f, 0.0f}, {0.3f, 0.1f, -0.6f}};
+  const Eigen::Vector3d expected = cloud.origin + Eigen::Vector3d(0.3, 0.3, -0.6) / 3.0;
+  EXPECT_LT((Centroid(cloud) - expected).norm(), 1e-7);
+  EXPECT_THROW(Centroid(PointCloud{}), Error);
 }
 
 }  // namespace

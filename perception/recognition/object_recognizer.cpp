@@ -210,12 +210,6 @@ double NearestOther(std::size_t o, const std::vector<double>& chi_square) {
   return other;
 }
 
-Eigen::Vector3d Centroid(const PointCloud& cloud) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i) sum += cloud.Point(i);
-  return sum / static_cast<double>(std::max<std::size_t>(cloud.size(), 1));
-}
-
 // A segment waiting to be recognised: indices into the scan's points left after plane removal.
 struct PendingSegment {
   std::vector<std::size_t> indices;

@@ -18,9 +18,7 @@ SceneAround::SceneAround(const PointCloud& points_in, const KnnIndex& index_in, 
 SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
                                double radius_m, double margin_m) {
   if (segment.empty()) throw Error("verification: the segment is empty");
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < segment.size(); ++i) centroid += segment.Point(i);
-  centroid /= static_cast<double>(segment.size());
+  const Eigen::Vector3d centroid = Centroid(segment);
   if (!centroid.allFinite()) throw Error("verification: the segment has a non-finite point");
   const double range = std::max(centroid.norm(), 1e-3);
   SceneAround around(whole_scan, index, centroid.norm() > 0.0 ? centroid : Eigen::Vector3d::UnitZ(),

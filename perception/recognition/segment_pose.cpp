@@ -125,10 +125,9 @@ DescribedSegment DescribeSegment(const PointCloud& segment, const ScanContext& c
 SceneAround SceneAroundOf(const PointCloud& segment, const ScanContext& ctx) {
   SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, segment, 2.0 * ctx.db.parameters.voxel_m,
                                           0.5 * ctx.db.LargestDiameter());
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < segment.size(); ++i) centroid += segment.Point(i);
-  centroid /= static_cast<double>(segment.size());  // SceneAroundSegment refused an empty one
-  around.support_planes = SupportPlanesAround(ctx.down, ctx.planes, centroid, ctx.db.LargestDiameter(), kSupportPoints);
+  // SceneAroundSegment refused an empty segment.
+  around.support_planes =
+      SupportPlanesAround(ctx.down, ctx.planes, Centroid(segment), ctx.db.LargestDiameter(), kSupportPoints);
   return around;
 }
 

@@ -16,9 +16,7 @@ namespace {
 // started from its two extreme points along that axis: touching objects mostly end up one in
 // each, across the longest axis when they lie end to end, across the next when side by side.
 std::array<std::vector<std::size_t>, 2> Halves(const PointCloud& cloud, int principal_axis) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i) mean += cloud.Point(i);
-  mean /= static_cast<double>(cloud.size());
+  const Eigen::Vector3d mean = Centroid(cloud);
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < cloud.size(); ++i) scatter += (cloud.Point(i) - mean) * (cloud.Point(i) - mean).transpose();
   const Eigen::Vector3d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2 - principal_axis);
