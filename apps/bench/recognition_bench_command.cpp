@@ -32,6 +32,45 @@ double Mean(const std::vector<double>& v) {
 
 double Ratio(int a, int b) { return b == 0 ? 0.0 : static_cast<double>(a) / b; }
 
+// Every pipeline's confusion counts over the same rows and columns, zeros included: a row for
+// each database object and for "foreign" (the meshes not in it), a column for each database
+// object and "unknown".
+using Confusion = std::map<std::string, std::map<std::string, int>>;
+struct ConfusionShape {
+  std::vector<std::string> rows, columns;
+};
+ConfusionShape ShapeOf(const std::vector<std::string>& object_ids) {
+  ConfusionShape shape{object_ids, object_ids};
+  shape.rows.push_back("foreign");
+  shape.columns.push_back("unknown");
+  return shape;
+}
+int Count(const Confusion& c, const std::string& truth, const std::string& answer) {
+  const auto row = c.find(truth);
+  if (row == c.end()) return 0;
+  const auto n = row->second.find(answer);
+  return n == row->second.end() ? 0 : n->second;
+}
+nlohmann::json DenseConfusion(const Confusion& c, const ConfusionShape& shape) {
+  nlohmann::json dense = nlohmann::json::object();
+  for (const std::string& truth : shape.rows) {
+    for (const std::string& answer : shape.columns) dense[truth][answer] = Count(c, truth, answer);
+  }
+  return dense;
+}
+void PrintConfusion(const Confusion& c, const ConfusionShape& shape) {
+  std::printf("| true \\ answer |");
+  for (const std::string& answer : shape.columns) std::printf(" %s |", answer.c_str());
+  std::printf("\n|---|");
+  for (std::size_t k = 0; k < shape.columns.size(); ++k) std::printf("---:|");
+  std::printf("\n");
+  for (const std::string& truth : shape.rows) {
+    std::printf("| %s |", truth.c_str());
+    for (const std::string& answer : shape.columns) std::printf(" %d |", Count(c, truth, answer));
+    std::printf("\n");
+  }
+}
+
 // One line per object, then one per candidate uwscan weighed for it.
 void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
   std::printf("uwscan per object (scan, truth -> answer, its points, pose error):\n");
@@ -86,6 +125,7 @@ void Run(Args a) {
               "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json pipelines = nlohmann::json::object();
   nlohmann::json confusion = nlohmann::json::object();
+  const ConfusionShape shape = ShapeOf(r.object_ids);
   for (const auto& [name, f] : r.pipelines) {
     const double per_scan = f.seconds / r.scans;
     std::printf("| %s | %d/%d (%.1f %%) | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %d/%d | %.2f deg / %.1f mm | %.3f |\n",
@@ -116,7 +156,7 @@ void Run(Args a) {
         pipelines[name]["pose_nees_per_dimension_median_by_class"][truth] = Median(nees);
       }
     }
-    confusion[name] = f.confusion;
+    confusion[name] = DenseConfusion(f.confusion, shape);
   }
   std::printf("uwscan stages (s per scan):");
   for (const auto& [stage, s] : r.uwscan_stage_seconds) std::printf(" %s %.3f", stage.c_str(), s / r.scans);
@@ -133,12 +173,8 @@ void Run(Args a) {
     std::printf("\n");
   }
   if (r.pipelines.count("uwscan")) {
-    std::printf("uwscan confusion (true -> answers):\n");
-    for (const auto& [truth, row] : r.pipelines.at("uwscan").confusion) {
-      std::printf("  %-12s", truth.c_str());
-      for (const auto& [answer, n] : row) std::printf(" %s:%d", answer.c_str(), n);
-      std::printf("\n");
-    }
+    std::printf("uwscan confusion (rows: the true object, columns: uwscan's answer):\n");
+    PrintConfusion(r.pipelines.at("uwscan").confusion, shape);
   }
   // Why catalogue objects were not recognised (ObjectOutcome::why_wrong).
   std::map<std::string, int> why_wrong;

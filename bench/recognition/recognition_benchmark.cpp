@@ -362,6 +362,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       catalogue, db_scanner, build,
       [&](double f) { if (progress) progress("object database", f); });
   result.database_seconds = Seconds(start);
+  for (const perception::ObjectModel& o : db.objects) result.object_ids.push_back(o.id);
 
   sim::VirtualScannerOptions scene_scan = db_scan;
   if (options.images) {

@@ -96,6 +96,7 @@ struct RecognitionBenchResult {
   int scans = 0;
   double database_seconds = 0.0;
   double simulation_seconds = 0.0;
+  std::vector<std::string> object_ids;  // the database's objects, the answers a pipeline can give
   std::map<std::string, PipelineFigures> pipelines;  // uwscan, pcl_esf, opencv_ppf
   std::map<std::string, double> uwscan_stage_seconds;  // summed over scans
   double ppf_training_seconds = 0.0;
