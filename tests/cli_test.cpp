@@ -199,6 +199,33 @@ TEST(Cli, RegistrationBenchComparesThePipelines) {
   std::filesystem::remove(json);
 }
 
+// The confusion matrix has a row for every database object and the foreign meshes and a column
+// for every object and "unknown", zeros included; its diagonal is the recognition rate.
+TEST(Cli, RecognitionBenchWritesAFullConfusionMatrix) {
+  const std::filesystem::path json = TempPath("recognition.json");
+  const CommandRun run = RunUwscan("bench recognition --scans 3 --views 4 --no-peers --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("| true \\ answer |"), std::string::npos) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  const nlohmann::json& confusion = j.at("confusion").at("uwscan");
+  const std::vector<std::string> objects = {"elbow", "flange", "pipe", "tee", "valve_lever", "valve_wheel"};
+  ASSERT_EQ(confusion.size(), objects.size() + 1);  // and "foreign"
+  int total = 0, diagonal = 0;
+  for (const auto& [truth, row] : confusion.items()) {
+    ASSERT_EQ(row.size(), objects.size() + 1) << truth;  // and "unknown"
+    EXPECT_TRUE(row.contains("unknown")) << truth;
+    for (const std::string& o : objects) EXPECT_TRUE(row.contains(o)) << truth << " -> " << o;
+    if (truth == "foreign") continue;
+    for (const auto& [answer, n] : row.items()) total += n.get<int>();
+    diagonal += row.at(truth).get<int>();
+  }
+  const nlohmann::json& uwscan = j.at("pipelines").at("uwscan");
+  EXPECT_EQ(total, uwscan.at("objects").get<int>());
+  ASSERT_GT(total, 0);
+  EXPECT_DOUBLE_EQ(static_cast<double>(diagonal) / total, uwscan.at("recognition_rate").get<double>());
+  std::filesystem::remove(json);
+}
+
 TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
   // A surface with three different bumps (no symmetry) and a moved copy of it, as XYZ text.
   const std::filesystem::path target = TempPath("target.xyz"), source = TempPath("source.xyz");
@@ -246,6 +273,32 @@ TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
   EXPECT_LT((T.topLeftCorner<3, 3>() * centre + T.topRightCorner<3, 1>() - truth * centre).norm(),
             2e-3);
   for (const auto& f : {target, source, json}) std::filesystem::remove(f);
+}
+
+// A flat square onto a sphere: no pose lays one on the other, coarse alignment finds none, and
+// the output says so rather than reporting an ICP that never ran (it printed RANSAC's iterations
+// as ICP's).
+TEST(Cli, RegisterSaysWhenCoarseAlignmentFindsNoPose) {
+  const std::filesystem::path square = TempPath("square.xyz"), sphere = TempPath("sphere.xyz");
+  {
+    std::ofstream out(square);
+    for (int i = 0; i < 20; ++i) {
+      for (int j = 0; j < 20; ++j) out << 0.05 * i << " " << 0.05 * j << " 0\n";
+    }
+    std::ofstream round(sphere);
+    const int n = 400;
+    for (int k = 0; k < n; ++k) {  // a Fibonacci lattice of radius 0.5 m
+      const double z = 1.0 - 2.0 * (k + 0.5) / n, r = std::sqrt(1.0 - z * z), a = 2.399963 * k;
+      round << 0.5 * r * std::cos(a) << " " << 0.5 * r * std::sin(a) << " " << 0.5 * z << "\n";
+    }
+  }
+  const CommandRun run = RunUwscan("register " + square.string() + " " + sphere.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("no convincing pose"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("ICP not run"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("ICP on the"), std::string::npos) << run.output;
+  std::filesystem::remove(square);
+  std::filesystem::remove(sphere);
 }
 
 TEST(Cli, RegisterRejectsMissingAndEmptyClouds) {

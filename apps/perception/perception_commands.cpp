@@ -99,8 +99,16 @@ void RunRegister(const RegisterArgs& a) {
   const perception::CloudFit whole = perception::FitOnTarget(source, target, r.fine.T_target_source, within_m);
   std::printf("%.1f %% of the source within %.6f m of the target, RMS %.6f m (every point of both clouds)\n",
               100.0 * whole.fitness, within_m, whole.inlier_rmse_m);
-  std::printf("ICP on the %.6f m voxels: fitness %.4f, inlier RMSE %.6f m, %d iterations, %s\n", options.voxel_m,
-              r.fine.fitness, r.fine.inlier_rmse, r.fine.iterations, r.fine.converged ? "converged" : "NOT converged");
+  const bool coarse_failed = !init && !r.coarse.converged;
+  if (coarse_failed) {
+    // RegisterClouds returns the coarse result as the fine one then: ICP never ran.
+    std::printf("coarse alignment on the %.6f m voxels: no convincing pose (fitness %.4f after %d RANSAC iterations), "
+                "ICP not run\n",
+                options.voxel_m, r.coarse.fitness, r.coarse.iterations);
+  } else {
+    std::printf("ICP on the %.6f m voxels: fitness %.4f, inlier RMSE %.6f m, %d iterations, %s\n", options.voxel_m,
+                r.fine.fitness, r.fine.inlier_rmse, r.fine.iterations, r.fine.converged ? "converged" : "NOT converged");
+  }
   if (!a.output.empty()) {
     perception::WriteCloud(a.output, perception::Transformed(source, r.fine.T_target_source));
   }
@@ -111,7 +119,7 @@ void RunRegister(const RegisterArgs& a) {
     j["stage_seconds"] = r.stage_seconds;
     WriteJsonFile(a.json, j);
   }
-  if (!init && !r.coarse.converged) {
+  if (coarse_failed) {
     throw Error("coarse alignment found no convincing pose (fitness " +
                 std::to_string(r.coarse.fitness) + "); give --init or check the overlap");
   }
