@@ -91,6 +91,20 @@ TEST_F(DiveMappingTest, SameBitsForOneAndTwoThreadsAndOnlineOrOffline) {
   mapper.Finish();
   ASSERT_EQ(mapper.submap_count(), two.submaps);
   for (int i = 0; i < mapper.submap_count(); ++i) ExpectSamePose(two.slam[static_cast<size_t>(i)].T_W_V, mapper.pose(i));
+  // The same loops and the same map, point for point.
+  ASSERT_EQ(mapper.loops().size(), two.loops.size());
+  for (std::size_t k = 0; k < two.loops.size(); ++k) {
+    EXPECT_EQ(mapper.loops()[k].accepted, two.loops[k].accepted) << "loop " << k;
+  }
+  const perception::PointCloud online_map = mapper.Map(DiveMappingOptions{}.map_voxel_m);
+  EXPECT_EQ(online_map.origin, two.map.origin);
+  ASSERT_EQ(online_map.size(), two.map.size());
+  for (std::size_t i = 0; i < online_map.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(online_map.points[i][k]), std::bit_cast<std::uint32_t>(two.map.points[i][k]))
+          << "map point " << i;
+    }
+  }
 }
 
 TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
