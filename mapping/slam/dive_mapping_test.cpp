@@ -4,6 +4,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -216,13 +220,10 @@ TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
 }
 
 // A log of the short dive's first `frames` frames, with the navigation samples `keep` accepts.
-fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const fs::path& path, std::int64_t frames,
-                                const std::function<bool(double)>& keep) {
-  DiveLogHeader header;
-  header.scanner = simulator.scanner();
-  header.scan_pattern = simulator.scan_pattern();
-  header.navigation_noise = NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005};
-  DiveLogWriter writer(path, header);
+// The navigation the simulator gives at 20 Hz (the samples `keep` passes) and its first
+// `frames` frames, appended to `writer` as a recorder would.
+void AppendDive(const scanner::sim::Simulator& simulator, DiveLogWriter& writer, std::int64_t frames,
+                const std::function<bool(double)>& keep) {
   writer.SetVehicleMount(simulator.scene().trajectory.T_V_C);
   for (const scanner::sim::NavigationSample& n : simulator.Navigation(20.0)) {
     if (keep(n.time_s)) writer.AppendNavigation({n.time_s, n.T_W_V});
@@ -236,6 +237,20 @@ fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const 
     record.peaks_px = f.peaks_px;
     writer.AppendFrame(record);
   }
+}
+
+DiveLogHeader HeaderWithNavigationNoise(const scanner::sim::Simulator& simulator) {
+  DiveLogHeader header;
+  header.scanner = simulator.scanner();
+  header.scan_pattern = simulator.scan_pattern();
+  header.navigation_noise = NavigationNoise{0.003, 0.0005, 0.01, 0.01, 0.001, 0.0005};
+  return header;
+}
+
+fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const fs::path& path, std::int64_t frames,
+                                const std::function<bool(double)>& keep) {
+  DiveLogWriter writer(path, HeaderWithNavigationNoise(simulator));
+  AppendDive(simulator, writer, frames, keep);
   return path;
 }
 
@@ -246,6 +261,45 @@ TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {
   const fs::path path = WriteLogWithNavigation(simulator, dir_ / "cut.db", kept, [](double) { return true; });
   const DiveMapping m = Map(path);
   EXPECT_TRUE(m.truth.empty());
+  ASSERT_GT(m.submaps, 2);
+  EXPECT_NEAR(m.dive_duration_s, static_cast<double>(kept - 1) * simulator.frame_period_s(), 1e-9);
+  EXPECT_GT(m.slam.back().time_s, m.dive_duration_s - 2.0);
+}
+
+// The recorder's process killed (SIGKILL) mid-dive: it never closed the log, whose last frames
+// are still in SQLite's write-ahead log. The map goes up to the last frame it committed.
+TEST_F(DiveMappingTest, ALogWhoseRecorderWasKilledMapsUpToItsLastFrame) {
+  const scanner::sim::Simulator simulator(ShortScene());
+  const std::int64_t kept = simulator.frame_count() / 2 + 7;
+  const fs::path path = dir_ / "killed.db";
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {  // the recorder: writes, says so, and waits to be killed
+    ::close(fds[0]);
+    try {
+      DiveLogWriter writer(path, HeaderWithNavigationNoise(simulator));
+      AppendDive(simulator, writer, kept, [](double) { return true; });
+      const char written = 1;
+      if (::write(fds[1], &written, 1) != 1) ::_exit(1);
+      for (;;) ::pause();
+    } catch (...) {
+      ::_exit(1);
+    }
+  }
+  ::close(fds[1]);
+  char written = 0;
+  const bool reported = ::read(fds[0], &written, 1) == 1;
+  ::close(fds[0]);
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(reported) << "the recorder process stopped before writing its frames";
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "the recorder exited " << status;
+  ASSERT_TRUE(fs::exists(path.string() + "-wal"));  // never closed: its frames are in the WAL
+
+  const DiveMapping m = Map(path);
   ASSERT_GT(m.submaps, 2);
   EXPECT_NEAR(m.dive_duration_s, static_cast<double>(kept - 1) * simulator.frame_period_s(), 1e-9);
   EXPECT_GT(m.slam.back().time_s, m.dive_duration_s - 2.0);
