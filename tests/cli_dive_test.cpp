@@ -2,9 +2,11 @@
 #include <gtest/gtest.h>
 
 #include "tests/cli_run.hpp"
+#include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +14,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -58,6 +62,35 @@ TEST(CliDive, SimulateThenReconstructRecoversTheSceneWithEveryMethod) {
   const CommandRun again = RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_NE(again.output.find("exists"), std::string::npos) << again.output;
+  std::filesystem::remove(log);
+}
+
+// A dive log `map` cannot use: the reason on one line, exit 1, no map written.
+TEST(CliDive, MapRefusesAnUnusableLogWithOneLine) {
+  const std::filesystem::path log = TempPath("short.db"), map = TempPath("map.ply");
+  const CommandRun simulated =
+      RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " + log.string() + " --force");
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  // Each damage applied to a fresh copy of the log.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"DELETE FROM navigation", "has no navigation"},
+      {"DELETE FROM ground_truth WHERE frame_index > 0; DELETE FROM frames WHERE frame_index > 0", "has 1 frame"},
+      {"UPDATE meta SET value = 99 WHERE key = 'schema_version'", "has schema version 99, this uwscan reads 1 to"}};
+  for (const auto& [sql, reason] : cases) {
+    const std::filesystem::path copy = TempPath("damaged.db");
+    std::filesystem::copy_file(log, copy, std::filesystem::copy_options::overwrite_existing);
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(copy.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+    sqlite3_close(db);
+    const CommandRun run = RunUwscan("map " + copy.string() + " -o " + map.string());
+    EXPECT_EQ(run.exit_code, 1) << sql << "\n" << run.output;
+    EXPECT_NE(run.output.find(reason), std::string::npos) << sql << "\n" << run.output;
+    EXPECT_NE(run.output.find(copy.string()), std::string::npos) << "the log is named: " << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << "one line: " << run.output;
+    EXPECT_FALSE(std::filesystem::exists(map)) << sql;
+    std::filesystem::remove(copy);
+  }
   std::filesystem::remove(log);
 }
 
