@@ -8,11 +8,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -224,6 +226,42 @@ TEST(Cli, RecognitionBenchWritesAFullConfusionMatrix) {
   ASSERT_GT(total, 0);
   EXPECT_DOUBLE_EQ(static_cast<double>(diagonal) / total, uwscan.at("recognition_rate").get<double>());
   std::filesystem::remove(json);
+}
+
+// Separate runs of the program give the same database and the same answers, for 1 and 2
+// threads: bytes for the database, every field but the stage times for the answers.
+TEST(Cli, BuildDbAndRecognizeGiveTheSameAnswerAcrossRunsAndThreads) {
+  const std::filesystem::path dive = TempPath("objects_dive.db");
+  const CommandRun simulated = RunUwscan("simulate " + std::string(UWSCAN_SOURCE_DIR) +
+                                         "/data/scenes/default.yaml -o " + dive.string() + " --force");
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  std::array<std::filesystem::path, 2> db = {TempPath("objects_1.db"), TempPath("objects_2.db")};
+  for (int t = 0; t < 2; ++t) {
+    const CommandRun built = RunUwscan("build-db pipe flange valve_lever --views 4 --threads " + std::to_string(t + 1) +
+                                       " -o " + db[static_cast<std::size_t>(t)].string());
+    ASSERT_EQ(built.exit_code, 0) << built.output;
+  }
+  auto bytes = [](const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes(db[0]), bytes(db[1]));
+  std::vector<nlohmann::json> answers;
+  for (const int threads : {1, 2, 2}) {
+    const std::filesystem::path json = TempPath("answer.json");
+    const CommandRun run = RunUwscan("recognize " + dive.string() + " --db " + db[0].string() + " --threads " +
+                                     std::to_string(threads) + " --json " + json.string());
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    nlohmann::json j = ReadJson(json);
+    ASSERT_TRUE(j.contains("objects"));
+    ASSERT_FALSE(j.at("objects").empty());
+    j.erase("stage_seconds");
+    answers.push_back(j);
+    std::filesystem::remove(json);
+  }
+  EXPECT_EQ(answers[0], answers[1]) << "1 and 2 threads";
+  EXPECT_EQ(answers[1], answers[2]) << "two runs on 2 threads";
+  for (const std::filesystem::path& path : {dive, db[0], db[1]}) std::filesystem::remove(path);
 }
 
 TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
