@@ -36,7 +36,7 @@ using namespace recognition_test;
 TEST(ObjectRecognition, SameDatabaseAndAnswerForOneAndTwoThreads) {
   const ObjectDatabase one = Build({"elbow", "tee"}, 1);
   const ObjectDatabase two = Build({"elbow", "tee"}, 2);
-  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const std::filesystem::path dir = TestDir();
   one.Save(dir / "uwscan_db_1.db");
   two.Save(dir / "uwscan_db_2.db");
   auto bytes = [](const std::filesystem::path& p) {
@@ -516,7 +516,7 @@ TEST(ObjectRecognition, APlainPlyFromAnotherSensorIsRecognised) {
   const Scan truth = ScanOnSeabed(valve, Eigen::Vector3d(0.3, -0.35, 0.6), 3);  // for its pose
   const std::vector<sim::SceneObject> scene = OnSeabed(valve);
   const sim::VirtualScan scan = mems.Scan(scene, scene[1].T_W_O * truth.T_S_O.inverse(), 3);
-  const std::filesystem::path ply = std::filesystem::temp_directory_path() / "uwscan_mems_valve.ply";
+  const std::filesystem::path ply = TestDir() / "uwscan_mems_valve.ply";
   WriteCloud(ply, MakeCloud(scan.points_C));
   const Scan from_file{ReadCloud(ply), truth.T_S_O};
   const RecognitionResult r = RecognizeObjects(from_file.cloud, PipeFlangeValveDb());
@@ -527,7 +527,7 @@ TEST(ObjectRecognition, APlainPlyFromAnotherSensorIsRecognised) {
 }
 
 TEST(ObjectDatabaseFile, TruncatedForeignAndNewerFilesGiveOneLineErrors) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const std::filesystem::path dir = TestDir();
   const std::filesystem::path good = dir / "uwscan_db_good.db";
   PipeFlangeValveDb().Save(good);
   std::ifstream in(good, std::ios::binary);

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "perception/cloud/point_cloud.hpp"
@@ -26,6 +27,22 @@
 namespace uwscan::perception::recognition_test {
 
 namespace sim = scanner::sim;
+
+// A folder of this test process's own for the files the tests write (two test programs, or the
+// same one built twice, may run at once), removed when the process ends.
+struct OwnTestDir {
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("uwscan_recognition_test_" + std::to_string(::getpid()));
+  OwnTestDir() { std::filesystem::create_directories(path); }
+  ~OwnTestDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+};
+inline std::filesystem::path TestDir() {
+  static const OwnTestDir dir;
+  return dir.path;
+}
 
 inline const sim::VirtualScanner& Scanner() {
   static const sim::VirtualScanner scanner = [] {
