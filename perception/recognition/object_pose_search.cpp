@@ -81,6 +81,12 @@ IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int thr
   return icp;
 }
 
+IcpOptions FineIcpLastStage(double diameter_m, const ObjectDatabaseParameters& p, int threads) {
+  IcpOptions last = FineIcp(diameter_m, p, threads);
+  last.max_correspondence_distance_m = {last.max_correspondence_distance_m.back()};
+  return last;
+}
+
 // Starting poses T_O_S of a segment on one object: FPFH + RANSAC onto its nearest view (when
 // RANSAC finds one), then each of its nearest views rolled about the line of sight.
 std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhFeatures& segment_features,

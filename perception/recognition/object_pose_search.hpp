@@ -68,6 +68,9 @@ std::vector<Eigen::Isometry3d> HalfTurns(const PointCloud& cloud);
 // Point-to-plane ICP of a segment onto a model, to the scale of the data, pairing only points
 // whose normals agree within 60 degrees (the segment's facing the sensor, the model's outwards).
 IcpOptions FineIcp(double diameter_m, const ObjectDatabaseParameters& p, int threads);
+// FineIcp's last stage alone: the pass on every point of a segment once a pose has converged on
+// a sample (the pose barely moves; its information is that of every point).
+IcpOptions FineIcpLastStage(double diameter_m, const ObjectDatabaseParameters& p, int threads);
 
 // Starting poses T_O_S of a segment on one object: FPFH + RANSAC onto its nearest view (when
 // RANSAC finds one), then each of its nearest `options.pose_views` views rolled about the line

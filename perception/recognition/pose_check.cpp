@@ -103,9 +103,8 @@ RecognitionCandidate CheckObjectPose(const PointCloud& scan, const std::vector<s
   const IcpOptions fine = FineIcp(model.diameter_m, db.parameters, options.threads);
   const PointCloud sample = recognition::Strided(described.cloud, static_cast<std::size_t>(options.refine_points));
   RegistrationResult refined = AlignIcp(sample, indexes.target, T_S_O.inverse(), fine);
-  IcpOptions last = fine;
-  last.max_correspondence_distance_m = {fine.max_correspondence_distance_m.back()};
-  refined = AlignIcp(described.cloud, indexes.target, refined.T_target_source, last);
+  refined = AlignIcp(described.cloud, indexes.target, refined.T_target_source,
+                     FineIcpLastStage(model.diameter_m, db.parameters, options.threads));
   RecognitionCandidate checked = unverified;
   recognition::Verify(described.cloud, model, indexes.nearest(), around, refined, ctx, checked);
   RegistrationResult as_given;

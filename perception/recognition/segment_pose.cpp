@@ -204,9 +204,8 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
     ctx.clock.Lap("refine");
     // The pose has converged on the sample: the last stage alone, on every point, for the
     // information of them all (the coarser stages took 34 iterations on average to get back).
-    IcpOptions last = fine;
-    last.max_correspondence_distance_m = {fine.max_correspondence_distance_m.back()};
-    best.fine = AlignIcp(s.cloud, target, best.fine.T_target_source, last);
+    best.fine = AlignIcp(s.cloud, target, best.fine.T_target_source,
+                         FineIcpLastStage(model.diameter_m, p, ctx.options.threads));
     Verify(s.cloud, model, model_grid, around, best.fine, ctx, best.candidate);
   }
   ctx.clock.Lap("final");
@@ -271,8 +270,7 @@ void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& arou
   const PoseConstraints constraints =
       AnalysePoseConstraints(posed.fine.information, Eigen::Matrix<double, 6, 6>::Zero(), model.model.origin,
                              std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
-  IcpOptions last = FineIcp(model.diameter_m, ctx.db.parameters, ctx.options.threads);
-  last.max_correspondence_distance_m = {last.max_correspondence_distance_m.back()};
+  const IcpOptions last = FineIcpLastStage(model.diameter_m, ctx.db.parameters, ctx.options.threads);
   const double min_gain = std::max(10.0, 0.02 * static_cast<double>(segment.size()));
   for (const FreeDirection& free : constraints.free_O) {
     const bool slide = free.motion == "translation";
@@ -309,10 +307,9 @@ void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around, 
   // On every point, as PoseOnSegment ends.
   const ObjectModel& model = ctx.db.objects[posed.object];
   const ModelIndexes& indexes = ctx.cache.Model(posed.object);
-  IcpOptions last = FineIcp(model.diameter_m, ctx.db.parameters, ctx.options.threads);
-  last.max_correspondence_distance_m = {last.max_correspondence_distance_m.back()};
   PosedObject moved = *best;
-  moved.fine = AlignIcp(segment, indexes.target, best->fine.T_target_source, last);
+  moved.fine = AlignIcp(segment, indexes.target, best->fine.T_target_source,
+                        FineIcpLastStage(model.diameter_m, ctx.db.parameters, ctx.options.threads));
   Verify(segment, model, indexes.nearest(), around, moved.fine, ctx, moved.candidate);
   if (Better(moved.candidate, posed.candidate)) posed = std::move(moved);
 }
