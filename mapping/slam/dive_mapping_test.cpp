@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -58,13 +59,14 @@ void ExpectSameBits(const DiveMapping& a, const DiveMapping& b) {
   }
   ASSERT_EQ(a.loops.size(), b.loops.size());
   ASSERT_EQ(a.covariances.size(), b.covariances.size());
-  // The covariances come from a sparse QR (SuiteSparseQR through ceres::Covariance) whose
-  // rounding is not reproducible to the bit (2.6e-15 relative seen): equal to rounding.
   for (std::size_t i = 0; i < a.covariances.size(); ++i) {
-    EXPECT_LT((a.covariances[i] - b.covariances[i]).norm(), 1e-12 * a.covariances[i].norm()) << "pose " << i;
+    for (int k = 0; k < 36; ++k) {
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(a.covariances[i](k)), std::bit_cast<std::uint64_t>(b.covariances[i](k)))
+          << "pose " << i;
+    }
   }
   ASSERT_TRUE(a.expected_map_error_m && b.expected_map_error_m);
-  EXPECT_NEAR(*a.expected_map_error_m, *b.expected_map_error_m, 1e-12 * *a.expected_map_error_m);
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(*a.expected_map_error_m), std::bit_cast<std::uint64_t>(*b.expected_map_error_m));
 }
 
 TEST_F(DiveMappingTest, WithoutDriftTheMapLiesOnTheTruth) {

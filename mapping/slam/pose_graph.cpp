@@ -1,7 +1,6 @@
 #include "mapping/slam/pose_graph.hpp"
 
 #include <ceres/autodiff_cost_function.h>
-#include <ceres/covariance.h>
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 #include <ceres/problem.h>
@@ -12,6 +11,7 @@
 #include <cmath>
 #include <string>
 
+#include "mapping/slam/inverse_blocks.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
@@ -319,40 +319,49 @@ PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
   return result;
 }
 
-std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(int threads) const {
+std::optional<std::vector<Matrix6d>> PoseGraph::Covariances() const {
   std::vector<int> nodes(static_cast<size_t>(node_count()));
   for (int i = 0; i < node_count(); ++i) nodes[static_cast<size_t>(i)] = i;
-  return Covariances(nodes, threads);
+  return Covariances(nodes);
 }
 
-std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(const std::vector<int>& nodes, int threads) const {
+// The information J^T J at the current estimate, J the whitened residuals' Jacobian (robust
+// losses applied) in the tangent spaces, columns ordered [q_0, p_0, q_1, p_1, ..., calibration]:
+// node i at 6 i, its rotation (Ceres's quaternion tangent) then its position.
+Eigen::SparseMatrix<double> PoseGraph::Information() const {
   Impl& m = *impl_;
-  for (const int node : nodes) m.RequireNode(node, "Covariances");
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = std::max(1, threads);
-  ceres::Covariance covariance(options);
-  std::vector<std::pair<const double*, const double*>> blocks;
-  for (const int i : nodes) {
-    blocks.emplace_back(m.q(i), m.q(i));
-    blocks.emplace_back(m.q(i), m.p(i));
-    blocks.emplace_back(m.p(i), m.p(i));
+  ceres::Problem::EvaluateOptions options;
+  for (int i = 0; i < node_count(); ++i) {
+    options.parameter_blocks.push_back(m.q(i));
+    options.parameter_blocks.push_back(m.p(i));
   }
-  if (!covariance.Compute(blocks, m.problem.get())) return std::nullopt;
-  std::vector<Matrix6d> out(nodes.size());
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    const int i = nodes[k];
-    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> qq, qp, pp;
-    if (!covariance.GetCovarianceBlockInTangentSpace(m.q(i), m.q(i), qq.data()) ||
-        !covariance.GetCovarianceBlockInTangentSpace(m.q(i), m.p(i), qp.data()) ||
-        !covariance.GetCovarianceBlockInTangentSpace(m.p(i), m.p(i), pp.data())) {
-      return std::nullopt;
-    }
-    // Ceres's quaternion tangent is half the rotation vector (Plus = [cos|d|, sin|d| d/|d|] * q):
-    // scale to radians of rotation.
-    Matrix6d& c = out[k];
-    c << 4.0 * qq, 2.0 * qp, 2.0 * qp.transpose(), pp;
+  if (m.calibration) options.parameter_blocks.push_back(m.calibration->data());
+  options.num_threads = 1;
+  ceres::CRSMatrix crs;
+  double cost = 0.0;
+  if (!m.problem->Evaluate(options, &cost, nullptr, nullptr, &crs)) {
+    throw Error("pose graph: the residuals could not be evaluated at the current estimate");
   }
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
+      crs.values.data());
+  const Eigen::SparseMatrix<double> J = jacobian;
+  return Eigen::SparseMatrix<double>(J.transpose()) * J;
+}
+
+std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(const std::vector<int>& nodes) const {
+  for (const int node : nodes) impl_->RequireNode(node, "Covariances");
+  std::vector<IndexRange> blocks;
+  for (const int i : nodes) blocks.push_back({6 * i, 6});
+  const std::optional<std::vector<Eigen::MatrixXd>> tangent = InverseBlocks(Information(), blocks);
+  if (!tangent) return std::nullopt;
+  // Ceres's quaternion tangent is half the rotation vector (Plus = [cos|d|, sin|d| d/|d|] * q):
+  // scale to radians of rotation.
+  Vector6d to_radians;
+  to_radians << 2.0, 2.0, 2.0, 1.0, 1.0, 1.0;
+  std::vector<Matrix6d> out;
+  out.reserve(nodes.size());
+  for (const Eigen::MatrixXd& c : *tangent) out.push_back(to_radians.asDiagonal() * c * to_radians.asDiagonal());
   return out;
 }
 

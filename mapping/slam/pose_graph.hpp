@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <Eigen/SparseCore>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -98,12 +99,14 @@ class PoseGraph {
 
   // Marginal covariance of every node at the current estimate, ordered [rotation (rad),
   // position (m)], both in the world frame: T_W_V = exp([w, 0]) applied to the rotation,
-  // position + v. std::nullopt when the graph leaves a direction unconstrained (rank deficient).
-  std::optional<std::vector<Matrix6d>> Covariances(int threads = 1) const;
+  // position + v. From the inverse of the information J^T J (InverseBlocks): the same bits on
+  // every run. std::nullopt when the graph leaves a direction unconstrained (rank deficient).
+  std::optional<std::vector<Matrix6d>> Covariances() const;
   // The same for the given nodes only, in their order.
-  std::optional<std::vector<Matrix6d>> Covariances(const std::vector<int>& nodes, int threads = 1) const;
+  std::optional<std::vector<Matrix6d>> Covariances(const std::vector<int>& nodes) const;
 
  private:
+  Eigen::SparseMatrix<double> Information() const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,0 +1,119 @@
+#include "mapping/slam/inverse_blocks.hpp"
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cassert>
+#include <string>
+
+#include "scanner/common/error.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+// The strictly lower factor L in compressed columns, rows ascending within each column, and
+// the inverse Z on the same pattern (plus its diagonal).
+struct SelectedInverse {
+  std::vector<int> column_start;  // n + 1
+  std::vector<int> rows;
+  std::vector<double> l;
+  std::vector<double> z;
+  Eigen::VectorXd z_diagonal;
+
+  // Z(i, k) for i, k on the pattern (Z is symmetric: stored in the column of the smaller index).
+  double At(int i, int k) const {
+    if (i == k) return z_diagonal[i];
+    if (i < k) std::swap(i, k);
+    const auto begin = rows.begin() + column_start[static_cast<size_t>(k)];
+    const auto end = rows.begin() + column_start[static_cast<size_t>(k) + 1];
+    const auto it = std::lower_bound(begin, end, i);
+    assert(it != end && *it == i);
+    return z[static_cast<size_t>(it - rows.begin())];
+  }
+};
+
+SelectedInverse CopyFactor(const Eigen::SparseMatrix<double>& L) {
+  SelectedInverse s;
+  const int n = static_cast<int>(L.cols());
+  s.column_start.assign(static_cast<size_t>(n) + 1, 0);
+  std::vector<std::pair<int, double>> column;
+  for (int j = 0; j < n; ++j) {
+    column.clear();
+    for (Eigen::SparseMatrix<double>::InnerIterator it(L, j); it; ++it) {
+      if (it.row() > j) column.emplace_back(static_cast<int>(it.row()), it.value());
+    }
+    std::sort(column.begin(), column.end());
+    for (const auto& [row, value] : column) {
+      s.rows.push_back(row);
+      s.l.push_back(value);
+    }
+    s.column_start[static_cast<size_t>(j) + 1] = static_cast<int>(s.rows.size());
+  }
+  s.z.assign(s.rows.size(), 0.0);
+  s.z_diagonal = Eigen::VectorXd::Zero(n);
+  return s;
+}
+
+// Z(i, j) = delta_ij / d_j - sum_{k > j, L(k, j) != 0} Z(i, k) L(k, j), for i >= j on the pattern.
+// The rows of column j form a clique of the factor's graph, so every Z(i, k) it reads lies on
+// the pattern, in a column already done.
+void FillInverseOnPattern(SelectedInverse& s, const Eigen::VectorXd& d) {
+  const int n = static_cast<int>(d.size());
+  for (int j = n - 1; j >= 0; --j) {
+    const int begin = s.column_start[static_cast<size_t>(j)];
+    const int end = s.column_start[static_cast<size_t>(j) + 1];
+    for (int p = begin; p < end; ++p) {
+      double sum = 0.0;
+      for (int q = begin; q < end; ++q) sum += s.At(s.rows[static_cast<size_t>(p)], s.rows[static_cast<size_t>(q)]) * s.l[static_cast<size_t>(q)];
+      s.z[static_cast<size_t>(p)] = -sum;
+    }
+    double sum = 0.0;
+    for (int p = begin; p < end; ++p) sum += s.z[static_cast<size_t>(p)] * s.l[static_cast<size_t>(p)];
+    s.z_diagonal[j] = 1.0 / d[j] - sum;
+  }
+}
+
+}  // namespace
+
+std::optional<std::vector<Eigen::MatrixXd>> InverseBlocks(Eigen::SparseMatrix<double> information,
+                                                          const std::vector<IndexRange>& blocks,
+                                                          double min_pivot_ratio) {
+  const int n = static_cast<int>(information.rows());
+  if (information.cols() != n) throw Error("InverseBlocks: the information must be square");
+  std::vector<Eigen::Triplet<double>> structural;
+  for (const IndexRange& b : blocks) {
+    if (b.start < 0 || b.size < 1 || b.start + b.size > n) {
+      throw Error("InverseBlocks: block [" + std::to_string(b.start) + ", +" + std::to_string(b.size) +
+                  ") outside a " + std::to_string(n) + "-row matrix");
+    }
+    for (int a = b.start; a < b.start + b.size; ++a) {
+      for (int c = b.start; c < b.start + b.size; ++c) structural.emplace_back(a, c, 0.0);
+    }
+  }
+  Eigen::SparseMatrix<double> zeros(n, n);
+  zeros.setFromTriplets(structural.begin(), structural.end());
+  information += zeros;  // explicit zeros stay stored: the blocks' entries are on L's pattern
+
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(information);
+  if (ldlt.info() != Eigen::Success) return std::nullopt;
+  const Eigen::VectorXd d = ldlt.vectorD();
+  if (n > 0 && !(d.minCoeff() > min_pivot_ratio * d.maxCoeff())) return std::nullopt;
+
+  SelectedInverse inverse = CopyFactor(ldlt.matrixL().nestedExpression());
+  FillInverseOnPattern(inverse, d);
+
+  // P H P^T = L D L^T with (P x)[perm[a]] = x[a]: H^-1(a, c) = Z(perm[a], perm[c]).
+  const auto& perm = ldlt.permutationP().indices();
+  std::vector<Eigen::MatrixXd> out;
+  out.reserve(blocks.size());
+  for (const IndexRange& b : blocks) {
+    Eigen::MatrixXd block(b.size, b.size);
+    for (int a = 0; a < b.size; ++a) {
+      for (int c = 0; c < b.size; ++c) block(a, c) = inverse.At(perm[b.start + a], perm[b.start + c]);
+    }
+    out.push_back(std::move(block));
+  }
+  return out;
+}
+
+}  // namespace uwscan::mapping
