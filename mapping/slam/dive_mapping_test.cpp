@@ -398,6 +398,34 @@ TEST(PoseGraph, ACovarianceIsTheInverseOfItsOnlyPrior) {
   EXPECT_LT(((*covariance)[0] - information.inverse()).norm(), 1e-9 * information.inverse().norm());
 }
 
+// Node 0 at the origin held by a prior, node 1 measured from it by one edge: to first order
+// node 1's [w, v] is A (e_0 + e_edge) with A = [[I, 0], [-[t]x, I]] (a turn of node 0 swings
+// node 1 about it), so its covariance is A (C_0 + C_edge) A^T.
+TEST(PoseGraph, ACovarianceCarriesThePriorAndTheEdgeAlongTheLever) {
+  const Eigen::Vector3d t(2.0, -1.0, 0.5);
+  Eigen::Isometry3d T_0_1 = Eigen::Isometry3d::Identity();
+  T_0_1.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  T_0_1.translation() = t;
+  Matrix6d prior = Matrix6d::Zero(), edge = Matrix6d::Zero();
+  prior.diagonal() << 1e4, 2e4, 3e4, 1e3, 2e3, 5e3;
+  prior(1, 4) = prior(4, 1) = 300.0;
+  edge.diagonal() << 4e4, 1e4, 2e4, 3e3, 1e3, 2e3;
+  edge(0, 5) = edge(5, 0) = -500.0;
+  PoseGraph graph;
+  graph.AddNode(Eigen::Isometry3d::Identity());
+  graph.AddNode(T_0_1);
+  graph.AddPrior({0, Eigen::Isometry3d::Identity(), prior});
+  graph.AddEdge({0, 1, T_0_1, edge, false, 3.0});
+  graph.Solve({});
+  const std::optional<std::vector<Matrix6d>> covariance = graph.Covariances();
+  ASSERT_TRUE(covariance.has_value());
+  Matrix6d A = Matrix6d::Identity();
+  A.block<3, 3>(3, 0) << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;  // -[t]x
+  const Matrix6d expected = A * (prior.inverse() + edge.inverse()) * A.transpose();
+  EXPECT_LT(((*covariance)[0] - prior.inverse()).norm(), 1e-9 * prior.inverse().norm());
+  EXPECT_LT(((*covariance)[1] - expected).norm(), 1e-9 * expected.norm()) << (*covariance)[1] << "\n\n" << expected;
+}
+
 TEST(PoseGraph, RecoversAChainFromExactEdgesAndAPrior) {
   PoseGraph graph;
   std::vector<Eigen::Isometry3d> truth;
