@@ -8,6 +8,7 @@
 
 #include "mapping/slam/navigation_buffer.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
+#include "mapping/slam/overlap_gate.hpp"
 #include "mapping/slam/registration_information.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "perception/registration/icp.hpp"
@@ -409,10 +410,13 @@ void Mapper::Impl::TryLoopClosures(int k) {
     const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
     const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
     if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
+    // In j's frame: how far k's centre is predicted from j's, and how uncertain that is.
     const Matrix6d covariance = ChainCovariance(j, k);
-    const Eigen::Vector3d t = (ScanPose(j).inverse() * ScanPose(k)).translation();
-    const double sigma = LargestStd(PositionCovariance(covariance, t));
-    if (distance - overlap > options.gate_sigmas * sigma) continue;
+    const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
+    const Eigen::Vector3d gap = centre_k_in_j - old.centroid_V;
+    if (MahalanobisGapToOverlap(gap, overlap, PositionCovariance(covariance, centre_k_in_j)) > options.gate_sigmas) {
+      continue;
+    }
     candidates.push_back({j, distance, covariance});
   }
   std::stable_sort(candidates.begin(), candidates.end(),

@@ -34,7 +34,8 @@ struct MapperOptions {
   // navigation's motion in the directions it pins (chi-square at 99.9 % for their number).
   double min_fitness = 0.3;
   // Loop closures: candidates at least this many submaps back, whose overlap is plausible
-  // within gate_sigmas of the relative uncertainty; at most max_loop_candidates tried per
+  // under the relative uncertainty (an error of Mahalanobis norm at most gate_sigmas brings
+  // their centres within the overlap distance); at most max_loop_candidates tried per
   // submap. Accepted only if the registration's fitness, its own uncertainty in the directions
   // it pins and its consistency with the prediction there (chi-square) all agree.
   int loop_min_index_gap = 6;
