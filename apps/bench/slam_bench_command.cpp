@@ -19,7 +19,7 @@ namespace {
 
 struct SlamBenchArgs {
   std::vector<std::string> scenes = {"data/scenes/inspection_loop.yaml", "data/scenes/inspection_pipe.yaml",
-                                     "data/scenes/inspection_long.yaml"};
+                                     "data/scenes/inspection_long.yaml", "data/scenes/inspection_loop_mems.yaml"};
   std::string json;
   int seeds = 1;
   int threads = 2;
@@ -215,7 +215,7 @@ void AddSlamBenchCommand(CLI::App& bench) {
   auto a = std::make_shared<SlamBenchArgs>();
   CLI::App* cmd = bench.add_subcommand(
       "slam", "scan-matching SLAM against dead reckoning and Open3D's multiway registration on simulated dives");
-  cmd->add_option("--scene", a->scenes, "dive scenes (default: data/scenes/inspection_loop.yaml, inspection_pipe.yaml and inspection_long.yaml)")
+  cmd->add_option("--scene", a->scenes, "dive scenes (default: data/scenes/inspection_loop.yaml, inspection_pipe.yaml, inspection_long.yaml and inspection_loop_mems.yaml, the loop dive with the MEMS scanner)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--seeds", a->seeds, "dives per scene: its own seed and the next ones (default 1)")
       ->check(kPositiveNumber);
