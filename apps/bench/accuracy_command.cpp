@@ -27,6 +27,11 @@ nlohmann::json GaugeJson(const bench::GaugeFigures& g) {
           {"bias_m", g.bias_m}, {"missed", g.missed}};
 }
 
+nlohmann::json PeakJson(const bench::PeakErrorFigures& f) {
+  return {{"std_px", f.std_px}, {"rms_px", f.rms_px}, {"bias_px", f.bias_px}, {"p95_abs_px", f.p95_abs_px},
+          {"peaks", f.peaks}};
+}
+
 void RunAccuracy(const AccuracyArgs& a) {
   if (!a.json_path.empty()) {
     const std::filesystem::path parent = std::filesystem::path(a.json_path).parent_path();
@@ -91,6 +96,14 @@ void RunAccuracy(const AccuracyArgs& a) {
                          {"rms_noise_free_m", row.rms_noise_free_m}, {"lines_per_s", row.lines_per_s},
                          {"points_per_s", row.points_per_s}});
   }
+  std::printf("\nThe detector on the rendered stripes (detected peak minus the exact crossing of its image line):\n\n");
+  std::printf("| stripes | std px | rms px | bias px | p95 abs px | peaks |\n|---|---:|---:|---:|---:|---:|\n");
+  const auto peak_row = [](const char* what, const bench::PeakErrorFigures& f) {
+    std::printf("| %s | %.3f | %.3f | %+.3f | %.3f | %lld |\n", what, f.std_px, f.rms_px, f.bias_px, f.p95_abs_px,
+                static_cast<long long>(f.peaks));
+  };
+  peak_row("galvanometer, gauges in water", r.peak_errors_gauges_water);
+  peak_row("MEMS, plane", r.peak_errors_plane);
   std::printf("\n%.1f s. The accuracy-versus-time plot (PNG) is left to the viewer issue.\n", r.seconds);
   if (!a.json_path.empty()) {
     WriteJsonFile(a.json_path, {{"gauges", {{"air", GaugeJson(r.gauges_air)},
@@ -100,6 +113,8 @@ void RunAccuracy(const AccuracyArgs& a) {
                                 {"plane", plane},
                                 {"sphere", sphere},
                                 {"waypoints", waypoints},
+                                {"peak_errors", {{"gauges_water", PeakJson(r.peak_errors_gauges_water)},
+                                                 {"plane", PeakJson(r.peak_errors_plane)}}},
                                 {"seconds", r.seconds}});
   }
 }

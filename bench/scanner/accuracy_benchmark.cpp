@@ -35,21 +35,6 @@ constexpr double kWaterIndex = 1.33;
 constexpr double kRunBreakM = 0.003;
 constexpr int kMinRunPoints = 8;
 
-// The image stages a real dive has. Under water the beam is also attenuated and scattered back.
-SimulationEffects RealisticEffects(bool underwater) {
-  SimulationEffects e;
-  e.image.on = true;
-  e.image.peak_level = 220.0;
-  e.beam.on = true;
-  e.sensor_noise.on = true;
-  e.speckle.on = true;
-  e.speckle.contrast = 0.3;
-  e.ambient.on = true;
-  e.attenuation = underwater;
-  e.backscatter.on = underwater;
-  return e;
-}
-
 Scene BaseScene(const std::filesystem::path& scanner_path, const scanner::Scanner& model,
                 double water_index, double attenuation_per_m, std::uint64_t seed) {
   Scene scene;
@@ -100,12 +85,14 @@ class TriangulatorCache {
 };
 
 // Every frame simulated (in parallel) and triangulated: points per frame, in peak order, world
-// frame.
+// frame. The peaks' errors are appended to `peak_errors_px` in frame order when it is given.
 std::vector<std::vector<Eigen::Vector3d>> SimulateAndTriangulate(const Simulator& simulator,
                                                                  const scanner::Triangulator& triangulator,
-                                                                 int threads) {
+                                                                 int threads,
+                                                                 std::vector<double>* peak_errors_px = nullptr) {
   const std::int64_t count = simulator.frame_count();
   std::vector<std::vector<Eigen::Vector3d>> points(static_cast<size_t>(count));
+  std::vector<std::vector<double>> errors(static_cast<size_t>(count));
   RunParallelTasks(count, threads, [&](std::ptrdiff_t i) {
     const scanner::sim::SimulatedFrame frame = simulator.Frame(i);
     std::vector<scanner::TriangulatedPoint> out(frame.peaks_px.size());
@@ -113,8 +100,32 @@ std::vector<std::vector<Eigen::Vector3d>> SimulateAndTriangulate(const Simulator
     for (const scanner::TriangulatedPoint& p : out) {
       if (p.ok()) points[static_cast<size_t>(i)].push_back(frame.T_W_C * p.p_C);
     }
+    if (peak_errors_px) errors[static_cast<size_t>(i)] = scanner::sim::PeakErrorsPx(frame, simulator.scene().detector.axis);
   });
+  if (peak_errors_px) {
+    for (const std::vector<double>& e : errors) peak_errors_px->insert(peak_errors_px->end(), e.begin(), e.end());
+  }
   return points;
+}
+
+PeakErrorFigures SummarisePeakErrors(std::vector<double> errors) {
+  PeakErrorFigures f;
+  f.peaks = static_cast<std::int64_t>(errors.size());
+  if (errors.empty()) return f;
+  double sum = 0.0, sum2 = 0.0;
+  for (const double e : errors) {
+    sum += e;
+    sum2 += e * e;
+  }
+  const double n = static_cast<double>(errors.size());
+  f.bias_px = sum / n;
+  f.rms_px = std::sqrt(sum2 / n);
+  f.std_px = std::sqrt(std::max(0.0, sum2 / n - f.bias_px * f.bias_px));
+  for (double& e : errors) e = std::abs(e);
+  const std::size_t at = static_cast<std::size_t>(0.95 * (n - 1));
+  std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(at), errors.end());
+  f.p95_abs_px = errors[at];
+  return f;
 }
 
 std::vector<Eigen::Vector3d> Flatten(const std::vector<std::vector<Eigen::Vector3d>>& frames) {
@@ -247,10 +258,10 @@ class AccuracyRun {
         std::optional<double> measured;
         if (steps) {
           scene.scanner.galvo = *steps;
-          if (realistic) scene.effects = RealisticEffects(underwater);
+          if (realistic) scene.effects = scanner::sim::RealisticImageEffects(underwater);
           const Simulator simulator(scene);
-          measured = MeasureGaugeLength(
-              SimulateAndTriangulate(simulator, cache_.For(simulator, calibration), threads_));
+          measured = MeasureGaugeLength(SimulateAndTriangulate(simulator, cache_.For(simulator, calibration), threads_,
+                                                               realistic ? &gauge_peak_errors_px_ : nullptr));
         }
         if (measured) {
           errors.push_back(*measured - length);
@@ -268,7 +279,7 @@ class AccuracyRun {
                             o_.water_attenuation_per_m, seed);
     scene.scanner.mems.lines = o_.mems_lines;
     scene.scanner.mems.waypoints_per_line = waypoints;
-    if (realistic) scene.effects = RealisticEffects(true);
+    if (realistic) scene.effects = scanner::sim::RealisticImageEffects(true);
     scene.effects.mirror_dynamics = true;
     return scene;
   }
@@ -290,8 +301,10 @@ class AccuracyRun {
       Scene scene = MemsScene(50, o_.seed + 7 * k, true);
       scene.objects.push_back(PlaneAt(d));
       const Simulator simulator(scene);
+      std::vector<double> peak_errors_px;
       const std::vector<Eigen::Vector3d> points =
-          Flatten(SimulateAndTriangulate(simulator, cache_.For(simulator), threads_));
+          Flatten(SimulateAndTriangulate(simulator, cache_.For(simulator), threads_, &peak_errors_px));
+      plane_peak_errors_px_.insert(plane_peak_errors_px_.end(), peak_errors_px.begin(), peak_errors_px.end());
       PlaneRow row;
       row.distance_m = d;
       row.points = static_cast<std::int64_t>(points.size());
@@ -357,6 +370,10 @@ class AccuracyRun {
     return rows;
   }
 
+  // The realistic runs' peak errors so far (Gauges in water or air, Planes).
+  PeakErrorFigures GaugePeakErrors() const { return SummarisePeakErrors(gauge_peak_errors_px_); }
+  PeakErrorFigures PlanePeakErrors() const { return SummarisePeakErrors(plane_peak_errors_px_); }
+
  private:
   const AccuracyBenchOptions& o_;
   const Progress& progress_;
@@ -364,6 +381,8 @@ class AccuracyRun {
   scanner::Scanner galvo_;
   scanner::Scanner mems_;
   TriangulatorCache cache_;
+  std::vector<double> gauge_peak_errors_px_;
+  std::vector<double> plane_peak_errors_px_;
 };
 
 }  // namespace
@@ -405,9 +424,11 @@ AccuracyBenchResult RunAccuracyBenchmark(const AccuracyBenchOptions& options,
   AccuracyBenchResult result;
   result.gauges_air = run.Gauges(false, true, "gauges in air");
   result.gauges_water = run.Gauges(true, true, "gauges in water");
+  result.peak_errors_gauges_water = run.GaugePeakErrors();
   result.gauges_air_exact = run.Gauges(false, false, "gauges in air, exact peaks");
   result.gauges_water_exact = run.Gauges(true, false, "gauges in water, exact peaks");
   result.plane = run.Planes();
+  result.peak_errors_plane = run.PlanePeakErrors();
   result.sphere = run.Spheres();
   result.waypoints = run.Waypoints();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -67,6 +67,16 @@ struct WaypointRow {
   double points_per_s = 0.0;
 };
 
+// The detector's error on the rendered stripes: each detected peak minus the exact crossing
+// of its image line, along the detection axis. What a dive's `peak_noise` stands for.
+struct PeakErrorFigures {
+  double std_px = 0.0;
+  double rms_px = 0.0;
+  double bias_px = 0.0;
+  double p95_abs_px = 0.0;
+  std::int64_t peaks = 0;  // detected peaks matched to a crossing
+};
+
 struct AccuracyBenchResult {
   GaugeFigures gauges_air;
   GaugeFigures gauges_water;
@@ -76,6 +86,8 @@ struct AccuracyBenchResult {
   std::vector<PlaneRow> plane;
   std::vector<SphereRow> sphere;
   std::vector<WaypointRow> waypoints;
+  PeakErrorFigures peak_errors_gauges_water;  // galvanometer, gauges under water (all positions)
+  PeakErrorFigures peak_errors_plane;         // MEMS, the plane at every distance
   double seconds = 0.0;
 };
 

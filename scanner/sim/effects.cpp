@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "scanner/common/error.hpp"
 
@@ -61,6 +62,20 @@ void SimulationEffects::Check() const {
   Require(NonNegative(backscatter.level), "backscatter.level", backscatter.level,
           ">= 0 image units");
   Require(NonNegative(ambient.level), "ambient.level", ambient.level, ">= 0 image units");
+}
+
+SimulationEffects RealisticImageEffects(bool underwater, SimulationEffects base) {
+  SimulationEffects e = std::move(base);
+  e.image.on = true;
+  e.image.peak_level = 220.0;
+  e.beam.on = true;
+  e.sensor_noise.on = true;
+  e.speckle.on = true;
+  e.speckle.contrast = 0.3;
+  e.ambient.on = true;
+  e.attenuation = underwater;
+  e.backscatter.on = underwater;
+  return e;
 }
 
 }  // namespace uwscan::scanner::sim

@@ -80,4 +80,10 @@ struct SimulationEffects {
   void Check() const;
 };
 
+// The image stages a real dive's frames have (the seeds' accuracy experiments): stripes
+// rendered at peak level 220 with the beam's footprint, speckle (contrast 0.3), shot and read
+// noise and ambient light; under water also attenuation and backscatter. The other stages are
+// base's.
+SimulationEffects RealisticImageEffects(bool underwater, SimulationEffects base = {});
+
 }  // namespace uwscan::scanner::sim

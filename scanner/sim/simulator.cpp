@@ -147,6 +147,7 @@ void Simulator::Impl::DetectInImage(const std::vector<TracedPeak>& exact,
     frame->peaks_px.push_back(px);
     frame->truth_W.push_back(best ? best->p_W : Eigen::Vector3d::Constant(nan));
     frame->object_ids.push_back(best ? best->object_index : -1);
+    frame->truth_px.push_back(best ? best->px : Eigen::Vector2d::Constant(nan));
   }
 }
 
@@ -180,6 +181,7 @@ SimulatedFrame Simulator::Frame(std::int64_t index) const {
       frame.peaks_px.push_back(px);
       frame.truth_W.push_back(peak.p_W);
       frame.object_ids.push_back(peak.object_index);
+      frame.truth_px.push_back(peak.px);
     }
     return frame;
   }
@@ -272,6 +274,15 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
     samples.push_back(sample);
   }
   return samples;
+}
+
+std::vector<double> PeakErrorsPx(const SimulatedFrame& frame, StripeAxis axis) {
+  const int along = axis == StripeAxis::kRows ? 0 : 1;
+  std::vector<double> errors;
+  for (std::size_t k = 0; k < frame.peaks_px.size(); ++k) {
+    if (std::isfinite(frame.truth_px[k][along])) errors.push_back(frame.peaks_px[k][along] - frame.truth_px[k][along]);
+  }
+  return errors;
 }
 
 }  // namespace uwscan::scanner::sim

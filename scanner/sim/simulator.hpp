@@ -25,9 +25,16 @@ struct SimulatedFrame {
   // e.g. noise) and the scene object it lies on (-1 for none).
   std::vector<Eigen::Vector3d> truth_W;
   std::vector<std::int32_t> object_ids;
+  // The exact crossing of the stripe with the peak's image line (NaN for no match): what the
+  // peak would be without noise, to measure a detector's error against.
+  std::vector<Eigen::Vector2d> truth_px;
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();  // true camera pose used
   std::optional<StripeFrame> image;  // when an image stage is on
 };
+
+// Each peak's error along the detection axis (x for kRows), px: detected minus truth_px, for
+// the peaks that match a crossing.
+std::vector<double> PeakErrorsPx(const SimulatedFrame& frame, StripeAxis axis);
 
 // What the vehicle's navigation reports (the truth, plus drift when that effect is on).
 struct NavigationSample {
