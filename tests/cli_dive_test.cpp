@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -248,6 +249,15 @@ TEST(CliDive, AccuracyBenchWritesEveryTable) {
   ASSERT_EQ(j["waypoints"].size(), 2u);
   // More waypoints per line: slower lines.
   EXPECT_GT(j["waypoints"][0]["lines_per_s"].get<double>(), j["waypoints"][1]["lines_per_s"].get<double>());
+  // The detector's error on the rendered stripes: sub-pixel and centred.
+  for (const char* stripes : {"gauges_water", "plane"}) {
+    const nlohmann::json& p = j["peak_errors"][stripes];
+    EXPECT_GT(p["peaks"].get<long long>(), 1000) << stripes;
+    EXPECT_GT(p["std_px"].get<double>(), 0.02) << stripes;
+    EXPECT_LT(p["std_px"].get<double>(), 0.5) << stripes;
+    EXPECT_LT(std::abs(p["bias_px"].get<double>()), 0.2 * p["std_px"].get<double>()) << stripes;
+    EXPECT_GT(p["p95_abs_px"].get<double>(), p["std_px"].get<double>()) << stripes;
+  }
   std::filesystem::remove(json);
 }
 

@@ -261,7 +261,7 @@ class AccuracyRun {
           if (realistic) scene.effects = scanner::sim::RealisticImageEffects(underwater);
           const Simulator simulator(scene);
           measured = MeasureGaugeLength(SimulateAndTriangulate(simulator, cache_.For(simulator, calibration), threads_,
-                                                               realistic ? &gauge_peak_errors_px_ : nullptr));
+                                                               realistic && underwater ? &gauge_peak_errors_px_ : nullptr));
         }
         if (measured) {
           errors.push_back(*measured - length);
@@ -370,7 +370,7 @@ class AccuracyRun {
     return rows;
   }
 
-  // The realistic runs' peak errors so far (Gauges in water or air, Planes).
+  // The realistic runs' peak errors so far (Gauges under water, Planes).
   PeakErrorFigures GaugePeakErrors() const { return SummarisePeakErrors(gauge_peak_errors_px_); }
   PeakErrorFigures PlanePeakErrors() const { return SummarisePeakErrors(plane_peak_errors_px_); }
 

@@ -129,7 +129,8 @@ TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
 
 // The MEMS scanner's dive (the same lap, pre-curved lines instead of a galvanometer's fan):
 // without drift the map lies on the truth; with drift and peak noise the registrations agree
-// with the navigation, SLAM beats dead reckoning and the covariance is honest.
+// with the navigation and the covariance is honest. (One lap has no loop to beat dead
+// reckoning with: the looping MEMS dive is in bench slam.)
 TEST_F(DiveMappingTest, AMemsDiveMapsAsAGalvanometerDiveDoes) {
   scanner::sim::Scene scene =
       scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_mems.yaml");
@@ -146,8 +147,9 @@ TEST_F(DiveMappingTest, AMemsDiveMapsAsAGalvanometerDiveDoes) {
   const MapSummary s = Summarise(m);
   EXPECT_LE(m.stats.registrations_inconsistent, m.submaps / 10);
   EXPECT_GE(m.stats.registrations, 3 * m.submaps / 4);
-  ASSERT_TRUE(s.ate_slam_m && s.ate_dead_reckoning_m && s.nees_mean);
-  EXPECT_LT(*s.ate_slam_m, *s.ate_dead_reckoning_m);
+  ASSERT_TRUE(s.ate_slam_m && s.nees_mean && m.expected_position_error_m);
+  EXPECT_GT(*s.ate_slam_m, 0.5 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
+  EXPECT_LT(*s.ate_slam_m, 2.0 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
   EXPECT_EQ(s.loops_false.value_or(-1), 0);
   EXPECT_GT(*s.nees_mean, 0.5 * 6.0);
   EXPECT_LT(*s.nees_mean, 3.0 * 6.0);

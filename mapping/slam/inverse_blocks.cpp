@@ -3,7 +3,7 @@
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
-#include <cassert>
+#include <stdexcept>
 #include <string>
 
 #include "scanner/common/error.hpp"
@@ -27,7 +27,9 @@ struct SelectedInverse {
     const auto begin = rows.begin() + column_start[static_cast<size_t>(k)];
     const auto end = rows.begin() + column_start[static_cast<size_t>(k) + 1];
     const auto it = std::lower_bound(begin, end, i);
-    assert(it != end && *it == i);
+    // Every entry read lies on the pattern (a column's rows are a clique of the factor's graph;
+    // the blocks were made structural): a miss is a broken invariant, never wrong numbers.
+    if (it == end || *it != i) throw std::logic_error("InverseBlocks: an entry off the factor's pattern");
     return z[static_cast<size_t>(it - rows.begin())];
   }
 };
@@ -82,7 +84,7 @@ std::optional<std::vector<Eigen::MatrixXd>> InverseBlocks(Eigen::SparseMatrix<do
   if (information.cols() != n) throw Error("InverseBlocks: the information must be square");
   std::vector<Eigen::Triplet<double>> structural;
   for (const IndexRange& b : blocks) {
-    if (b.start < 0 || b.size < 1 || b.start + b.size > n) {
+    if (b.start < 0 || b.size < 1 || b.start > n || b.size > n - b.start) {
       throw Error("InverseBlocks: block [" + std::to_string(b.start) + ", +" + std::to_string(b.size) +
                   ") outside a " + std::to_string(n) + "-row matrix");
     }
@@ -97,13 +99,20 @@ std::optional<std::vector<Eigen::MatrixXd>> InverseBlocks(Eigen::SparseMatrix<do
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(information);
   if (ldlt.info() != Eigen::Success) return std::nullopt;
   const Eigen::VectorXd d = ldlt.vectorD();
-  if (n > 0 && !(d.minCoeff() > min_pivot_ratio * d.maxCoeff())) return std::nullopt;
+  // P H P^T = L D L^T with (P x)[perm[a]] = x[a]: H^-1(a, c) = Z(perm[a], perm[c]).
+  const auto& perm = ldlt.permutationP().indices();
+  if (perm.size() != n) throw std::logic_error("InverseBlocks: the ordering gave no permutation");
+  // Each pivot is what is left of its row's diagonal once the rows before it are eliminated:
+  // a vanishing fraction means the row is (numerically) a combination of them. Relative to its
+  // own diagonal, the test does not depend on the units of the row (radians, metres).
+  for (int a = 0; a < n; ++a) {
+    const double diagonal = information.coeff(a, a);
+    if (!(diagonal > 0.0) || !(d[perm[a]] > min_pivot_ratio * diagonal)) return std::nullopt;
+  }
 
   SelectedInverse inverse = CopyFactor(ldlt.matrixL().nestedExpression());
   FillInverseOnPattern(inverse, d);
 
-  // P H P^T = L D L^T with (P x)[perm[a]] = x[a]: H^-1(a, c) = Z(perm[a], perm[c]).
-  const auto& perm = ldlt.permutationP().indices();
   std::vector<Eigen::MatrixXd> out;
   out.reserve(blocks.size());
   for (const IndexRange& b : blocks) {

@@ -25,9 +25,10 @@ struct IndexRange {
 // fixed order, so the bits do not depend on threads or on where memory was allocated.
 //
 // std::nullopt when the matrix is not positive definite or a pivot falls below
-// min_pivot_ratio times the largest (a direction nothing constrains).
+// min_pivot_ratio times its row's diagonal (a direction nothing constrains, to rounding).
+// Throws uwscan::Error for a block outside the matrix.
 std::optional<std::vector<Eigen::MatrixXd>> InverseBlocks(Eigen::SparseMatrix<double> information,
                                                           const std::vector<IndexRange>& blocks,
-                                                          double min_pivot_ratio = 1e-14);
+                                                          double min_pivot_ratio = 1e-12);
 
 }  // namespace uwscan::mapping

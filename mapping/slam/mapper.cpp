@@ -413,8 +413,8 @@ void Mapper::Impl::TryLoopClosures(int k) {
     // In j's frame: how far k's centre is predicted from j's, and how uncertain that is.
     const Matrix6d covariance = ChainCovariance(j, k);
     const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
-    const Eigen::Vector3d gap = centre_k_in_j - old.centroid_V;
-    if (MahalanobisGapToOverlap(gap, overlap, PositionCovariance(covariance, centre_k_in_j)) > options.gate_sigmas) {
+    const Eigen::Vector3d gap_m = centre_k_in_j - old.centroid_V;
+    if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <= options.gate_sigmas)) {
       continue;
     }
     candidates.push_back({j, distance, covariance});
@@ -432,7 +432,9 @@ void Mapper::Impl::TryLoopClosures(int k) {
     }
     const Eigen::Isometry3d T_pred = ScanPose(j).inverse() * ScanPose(k);
     const Eigen::Vector3d t = T_pred.translation();
-    // The first stage reaches as far as the prediction may be off.
+    // The first stage reaches as far as the prediction may be off: three times the largest
+    // position std of the scan's origin (the gate above asked the narrower question, whether
+    // the two centres can meet at all).
     std::vector<double> distances = options.loop_icp_distances_m;
     const double reach = options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, t));
     if (reach > distances.front()) distances.insert(distances.begin(), reach);

@@ -35,7 +35,7 @@ TEST(MahalanobisGapToOverlap, IsTheGapBeyondTheOverlapInSigmasWhenTheUncertainty
   EXPECT_EQ(MahalanobisGapToOverlap({0.1, 0.0, 0.0}, 0.2, C), 0.0);
 }
 
-TEST(MahalanobisGapToOverlap, AGapAcrossTheLongAxisIsMorePlausible) {
+TEST(MahalanobisGapToOverlap, AGapAlongTheLongAxisIsMorePlausible) {
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
   C.diagonal() << 0.1 * 0.1, 0.01 * 0.01, 0.01 * 0.01;  // 10 cm along x, 1 cm across
   EXPECT_NEAR(MahalanobisGapToOverlap({0.5, 0.0, 0.0}, 0.2, C), 3.0, 1e-9);
@@ -65,6 +65,15 @@ TEST(MahalanobisGapToOverlap, ADirectionWithoutVarianceCannotCloseTheGap) {
   EXPECT_EQ(MahalanobisGapToOverlap({0.0, 0.0, 0.5}, 0.2, C), std::numeric_limits<double>::infinity());
   // Within the overlap along z, the rest closes through x: (0.5 - sqrt(0.2^2 - 0.1^2)) / 0.05.
   EXPECT_NEAR(MahalanobisGapToOverlap({0.5, 0.0, 0.1}, 0.2, C), (0.5 - std::sqrt(0.03)) / 0.05, 1e-6);
+}
+
+TEST(MahalanobisGapToOverlap, FailsClosedOnWhatIsNotANumberAndClosesAGapOfTinyVariance) {
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(MahalanobisGapToOverlap({0.5, 0.0, 0.0}, 0.2, Eigen::Matrix3d::Constant(nan)), inf);
+  EXPECT_EQ(MahalanobisGapToOverlap({nan, 0.0, 0.0}, 0.2, Eigen::Matrix3d::Identity()), inf);
+  // Variances of 1e-200 m^2 still measure: 0.3 m is 3e99 sigmas.
+  const double m = MahalanobisGapToOverlap({0.5, 0.0, 0.0}, 0.2, Eigen::Matrix3d::Identity() * 1e-200);
+  EXPECT_NEAR(m / 3e99, 1.0, 1e-9);
 }
 
 }  // namespace

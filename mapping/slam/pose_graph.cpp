@@ -185,6 +185,28 @@ struct PoseGraph::Impl {
   }
   double* q(int node) { return rotations[static_cast<size_t>(node)]->data(); }
   double* p(int node) { return positions[static_cast<size_t>(node)]->data(); }
+
+  // The information J^T J at the current estimate, J the whitened residuals' Jacobian (robust
+  // losses applied) in the tangent spaces, columns ordered [q_0, p_0, q_1, p_1, ...,
+  // calibration]: node i at 6 i, its rotation (Ceres's quaternion tangent) then its position.
+  // std::nullopt when a residual cannot be evaluated there.
+  std::optional<Eigen::SparseMatrix<double>> Information() {
+    ceres::Problem::EvaluateOptions options;
+    for (int i = 0; i < static_cast<int>(rotations.size()); ++i) {
+      options.parameter_blocks.push_back(q(i));
+      options.parameter_blocks.push_back(p(i));
+    }
+    if (calibration) options.parameter_blocks.push_back(calibration->data());
+    options.num_threads = 1;
+    ceres::CRSMatrix crs;
+    double cost = 0.0;
+    if (!problem->Evaluate(options, &cost, nullptr, nullptr, &crs)) return std::nullopt;
+    const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
+        crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
+        crs.values.data());
+    const Eigen::SparseMatrix<double> J = jacobian;
+    return Eigen::SparseMatrix<double>(J.transpose()) * J;
+  }
 };
 
 PoseGraph::PoseGraph() : impl_(std::make_unique<Impl>()) {}
@@ -325,35 +347,13 @@ std::optional<std::vector<Matrix6d>> PoseGraph::Covariances() const {
   return Covariances(nodes);
 }
 
-// The information J^T J at the current estimate, J the whitened residuals' Jacobian (robust
-// losses applied) in the tangent spaces, columns ordered [q_0, p_0, q_1, p_1, ..., calibration]:
-// node i at 6 i, its rotation (Ceres's quaternion tangent) then its position.
-Eigen::SparseMatrix<double> PoseGraph::Information() const {
-  Impl& m = *impl_;
-  ceres::Problem::EvaluateOptions options;
-  for (int i = 0; i < node_count(); ++i) {
-    options.parameter_blocks.push_back(m.q(i));
-    options.parameter_blocks.push_back(m.p(i));
-  }
-  if (m.calibration) options.parameter_blocks.push_back(m.calibration->data());
-  options.num_threads = 1;
-  ceres::CRSMatrix crs;
-  double cost = 0.0;
-  if (!m.problem->Evaluate(options, &cost, nullptr, nullptr, &crs)) {
-    throw Error("pose graph: the residuals could not be evaluated at the current estimate");
-  }
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
-      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
-      crs.values.data());
-  const Eigen::SparseMatrix<double> J = jacobian;
-  return Eigen::SparseMatrix<double>(J.transpose()) * J;
-}
-
 std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(const std::vector<int>& nodes) const {
   for (const int node : nodes) impl_->RequireNode(node, "Covariances");
   std::vector<IndexRange> blocks;
   for (const int i : nodes) blocks.push_back({6 * i, 6});
-  const std::optional<std::vector<Eigen::MatrixXd>> tangent = InverseBlocks(Information(), blocks);
+  const std::optional<Eigen::SparseMatrix<double>> information = impl_->Information();
+  if (!information) return std::nullopt;
+  const std::optional<std::vector<Eigen::MatrixXd>> tangent = InverseBlocks(*information, blocks);
   if (!tangent) return std::nullopt;
   // Ceres's quaternion tangent is half the rotation vector (Plus = [cos|d|, sin|d| d/|d|] * q):
   // scale to radians of rotation.

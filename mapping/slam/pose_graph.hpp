@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <Eigen/SparseCore>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -106,7 +105,6 @@ class PoseGraph {
   std::optional<std::vector<Matrix6d>> Covariances(const std::vector<int>& nodes) const;
 
  private:
-  Eigen::SparseMatrix<double> Information() const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

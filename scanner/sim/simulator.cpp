@@ -147,7 +147,7 @@ void Simulator::Impl::DetectInImage(const std::vector<TracedPeak>& exact,
     frame->peaks_px.push_back(px);
     frame->truth_W.push_back(best ? best->p_W : Eigen::Vector3d::Constant(nan));
     frame->object_ids.push_back(best ? best->object_index : -1);
-    frame->truth_px.push_back(best ? best->px : Eigen::Vector2d::Constant(nan));
+    frame->crossing_px.push_back(best ? best->px : Eigen::Vector2d::Constant(nan));
   }
 }
 
@@ -181,7 +181,7 @@ SimulatedFrame Simulator::Frame(std::int64_t index) const {
       frame.peaks_px.push_back(px);
       frame.truth_W.push_back(peak.p_W);
       frame.object_ids.push_back(peak.object_index);
-      frame.truth_px.push_back(peak.px);
+      frame.crossing_px.push_back(peak.px);
     }
     return frame;
   }
@@ -277,10 +277,14 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
 }
 
 std::vector<double> PeakErrorsPx(const SimulatedFrame& frame, StripeAxis axis) {
+  if (frame.crossing_px.size() != frame.peaks_px.size()) {
+    throw Error("PeakErrorsPx: frame " + std::to_string(frame.index) + " has " + std::to_string(frame.peaks_px.size()) +
+                " peaks but " + std::to_string(frame.crossing_px.size()) + " crossings");
+  }
   const int along = axis == StripeAxis::kRows ? 0 : 1;
   std::vector<double> errors;
   for (std::size_t k = 0; k < frame.peaks_px.size(); ++k) {
-    if (std::isfinite(frame.truth_px[k][along])) errors.push_back(frame.peaks_px[k][along] - frame.truth_px[k][along]);
+    if (std::isfinite(frame.crossing_px[k][along])) errors.push_back(frame.peaks_px[k][along] - frame.crossing_px[k][along]);
   }
   return errors;
 }

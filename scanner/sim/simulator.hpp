@@ -27,12 +27,12 @@ struct SimulatedFrame {
   std::vector<std::int32_t> object_ids;
   // The exact crossing of the stripe with the peak's image line (NaN for no match): what the
   // peak would be without noise, to measure a detector's error against.
-  std::vector<Eigen::Vector2d> truth_px;
+  std::vector<Eigen::Vector2d> crossing_px;
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();  // true camera pose used
   std::optional<StripeFrame> image;  // when an image stage is on
 };
 
-// Each peak's error along the detection axis (x for kRows), px: detected minus truth_px, for
+// Each peak's error along the detection axis (x for kRows), px: detected minus crossing_px, for
 // the peaks that match a crossing.
 std::vector<double> PeakErrorsPx(const SimulatedFrame& frame, StripeAxis axis);
 

@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "scanner/common/error.hpp"
@@ -185,6 +186,45 @@ TEST(Simulator, CleanRenderedStripesAreDetectedAtTheExactCrossings) {
   EXPECT_LT(std::sqrt(sum2 / matched), 0.05);
   const Recovery r = Reconstruct(simulator, TriangulationMethod::kRayRay);
   EXPECT_LT(r.max_error_m, 2e-3);
+}
+
+// Peak noise moves each exact peak along the detection axis only, by the scene's sigma; the
+// frame keeps the exact crossing beside it.
+TEST(Simulator, PeakNoiseIsGaussianAlongTheDetectionAxisAroundTheExactCrossing) {
+  Scene scene = GalvoScene();
+  scene.effects.peak_noise.on = true;
+  scene.effects.peak_noise.sigma_px = 0.2;
+  const Simulator simulator(scene);
+  std::vector<double> errors;
+  for (std::int64_t i = 0; i < simulator.frame_count(); ++i) {
+    const SimulatedFrame frame = simulator.Frame(i);
+    ASSERT_EQ(frame.crossing_px.size(), frame.peaks_px.size());
+    for (std::size_t k = 0; k < frame.peaks_px.size(); ++k) {
+      EXPECT_EQ(frame.peaks_px[k].y(), frame.crossing_px[k].y());  // the same image row
+    }
+    const std::vector<double> e = PeakErrorsPx(frame, StripeAxis::kRows);
+    errors.insert(errors.end(), e.begin(), e.end());
+  }
+  ASSERT_GT(errors.size(), 5000u);
+  double sum = 0.0, sum2 = 0.0;
+  for (const double e : errors) {
+    sum += e;
+    sum2 += e * e;
+  }
+  const double n = static_cast<double>(errors.size());
+  EXPECT_NEAR(sum / n, 0.0, 4.0 * 0.2 / std::sqrt(n));
+  EXPECT_NEAR(std::sqrt(sum2 / n), 0.2, 0.01);
+  // Gaussian: 68.3 % within one sigma, 95.4 % within two.
+  const auto within = [&](double k) {
+    return static_cast<double>(std::count_if(errors.begin(), errors.end(), [&](double e) { return std::abs(e) <= k * 0.2; })) / n;
+  };
+  EXPECT_NEAR(within(1.0), 0.683, 0.02);
+  EXPECT_NEAR(within(2.0), 0.954, 0.01);
+
+  scene.effects.peak_noise.on = false;
+  const SimulatedFrame exact = Simulator(scene).Frame(simulator.frame_count() / 2);
+  ASSERT_FALSE(exact.peaks_px.empty());
+  for (std::size_t k = 0; k < exact.peaks_px.size(); ++k) EXPECT_EQ(exact.peaks_px[k], exact.crossing_px[k]);
 }
 
 TEST(Simulator, EffectsThatAreOffChangeNothingWhateverTheirParameters) {

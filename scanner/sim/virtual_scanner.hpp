@@ -20,9 +20,10 @@ namespace uwscan::scanner::sim {
 struct VirtualScannerOptions {
   ScanPattern pattern;  // one sweep: the galvanometer steps or the MEMS lines
   Water water;          // 1.33 by default: the scanner under water
-  // Refraction, distortion and occlusion, and the peaks moved by the detector's measured noise
-  // (0.1 px): what a real scan carries, without the cost of rendering every frame. Turn image
-  // stages on to render and detect frames instead.
+  // Refraction, distortion and occlusion, and the peaks moved by 0.1 px of noise (the default
+  // peak_noise), without the cost of rendering every frame. The detector errs by more on
+  // realistically rendered stripes (0.15-0.23 px, bench accuracy): turn image stages on to
+  // render and detect frames instead, as bench recognition does by default.
   SimulationEffects effects = [] {
     SimulationEffects e;
     e.peak_noise.on = true;
