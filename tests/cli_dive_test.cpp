@@ -93,7 +93,55 @@ TEST(CliDive, MapRefusesAnUnusableLogWithOneLine) {
     EXPECT_FALSE(std::filesystem::exists(map)) << sql;
     std::filesystem::remove(copy);
   }
+  // A real log (no ground truth) asked for the true trajectory: refused before any output.
+  const std::filesystem::path copy = TempPath("real.db"), truth = TempPath("truth.tum");
+  std::filesystem::copy_file(log, copy, std::filesystem::copy_options::overwrite_existing);
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(copy.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "DELETE FROM ground_truth", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+  const CommandRun run = RunUwscan("map " + copy.string() + " -o " + map.string() + " --truth " + truth.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("holds no ground truth"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(map));
+  EXPECT_FALSE(std::filesystem::exists(truth));
+  std::filesystem::remove(copy);
   std::filesystem::remove(log);
+}
+
+// bench slam on the short test lap: every figure issue 10 asks of a dive is in the JSON, and
+// the ones with a ground truth to hold them to are sane.
+TEST(CliDive, SlamBenchWritesEveryFigureOfADive) {
+  const std::filesystem::path json = TempPath("slam.json");
+  const CommandRun run = RunUwscan("bench slam --scene " + SourcePath("data/scenes/inspection_short.yaml") +
+                                   " --seeds 1 --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  ASSERT_EQ(j["dives"].size(), 1u);
+  const nlohmann::json& d = j["dives"][0];
+  EXPECT_EQ(d["name"], "inspection_short");
+  EXPECT_NEAR(d["duration_s"].get<double>(), 20.0, 0.5);
+  for (const char* part : {"dr", "slam", "open3d"}) {
+    ASSERT_TRUE(d[part].is_object()) << part << " (Open3D is a build dependency)";
+    for (const char* figure : {"ate_m", "rpe_per_m", "map_rms_m", "seconds"}) {
+      ASSERT_TRUE(d[part][figure].is_number()) << part << "." << figure;
+      EXPECT_GE(d[part][figure].get<double>(), 0.0) << part << "." << figure;
+    }
+  }
+  const nlohmann::json& slam = d["slam"];
+  EXPECT_EQ(slam["loops_false"].get<int>(), 0);
+  EXPECT_GE(slam["loops_accepted"].get<int>(), 0);
+  EXPECT_GT(slam["nees_mean"].get<double>(), 0.0);
+  EXPECT_GT(slam["real_time_factor"].get<double>(), 0.0);
+  // The drift is millimetres to centimetres on a 20 s lap; the map lies within millimetres of
+  // the true surfaces, and above the floor of the frames placed at their true poses.
+  EXPECT_GT(d["dr"]["ate_m"].get<double>(), 1e-3);
+  EXPECT_LT(slam["ate_m"].get<double>(), 0.05);
+  EXPECT_LT(slam["map_rms_m"].get<double>(), 0.01);
+  EXPECT_GT(slam["map_rms_m"].get<double>(), d["true_poses_map"]["rms_m"].get<double>());
+  ASSERT_EQ(j["summary"].size(), 1u);
+  EXPECT_EQ(j["summary"][0]["seeds"].get<int>(), 1);
+  std::filesystem::remove(json);
 }
 
 std::string FileBytes(const std::filesystem::path& path) {

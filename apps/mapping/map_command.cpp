@@ -133,6 +133,10 @@ void RunMap(const MapArgs& a) {
   options.mapper.max_navigation_gap_s = a.max_navigation_gap_s;
   options.table_cache = TableCache();
   const mapping::DiveLogReader log(a.log);
+  // Refused before anything is mapped or written: a real log has no truth to write.
+  if (!a.truth.empty() && log.frame_count() > 0 && !log.ReadGroundTruth(0)) {
+    throw Error("--truth " + a.truth + ": the log " + a.log + " holds no ground truth (not simulated)");
+  }
   mapping::DiveMapping m;
   {
     ProgressBar bar;
