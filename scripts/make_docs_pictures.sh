@@ -33,7 +33,7 @@ mkdir -p docs
   --size 1280x800
 
 # The looping dive's SLAM map from above, coloured by its distance to the scene's true surfaces
-# (README, "What limits it"): the error sits on the faces that look along the track.
+# (bench/slam/RESULTS.md, "What limits it"): the error sits on the faces that look along the track.
 "$UWSCAN" simulate data/scenes/inspection_loop.yaml -o "$work/loop.db" >/dev/null
 "$UWSCAN" map "$work/loop.db" -o "$work/loop.ply" >/dev/null
 "$UWSCAN" view "$work/loop.ply" --scene data/scenes/inspection_loop.yaml --camera top --range 0 0.01 --point-size 1 \

@@ -48,7 +48,7 @@ nlohmann::json Optional(const std::optional<T>& value) {
   return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
 }
 
-// The map report (format in mapping/README.md, "uwscan map"): what the viewer reads.
+// The map report (format in docs/formats.md, "Map report"): what the viewer reads.
 nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& log, const std::string& map) {
   const mapping::MapSummary s = mapping::Summarise(m);
   // Both absolute: the report may be read from anywhere.
