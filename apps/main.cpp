@@ -26,13 +26,15 @@
 #include "apps/scanner/demo_command.hpp"
 #include "apps/scanner/dive_commands.hpp"
 #include "apps/scanner/object_commands.hpp"
+#include "apps/ros/bag_commands.hpp"
+#include "apps/ros/ros_inspect_command.hpp"
 #include "apps/viewer/plot_commands.hpp"
 #include "apps/viewer/view_command.hpp"
 #include "scanner/common/error.hpp"
 
 // OpenMP's threads wait for work by sleeping, not spinning, unless the user asks otherwise:
 // libgomp's default spin-wait made 2 threads slower than 1 whenever the other core was busy
-// (a vehicle's computer always runs something else; README, "Threads under load"). libgomp reads
+// (a vehicle's computer always runs something else; docs/reliability.md, "Threads under load"). libgomp reads
 // OMP_WAIT_POLICY in its own constructor, before main; an entry in the program's .preinit_array
 // runs before any shared library's constructor, so the default is set there.
 namespace {
@@ -63,6 +65,8 @@ int main(int argc, char** argv) {
   uwscan::app::AddAcquireCommand(app);
   uwscan::app::AddInspectCommand(app);
   uwscan::app::AddLogCommands(app);
+  uwscan::app::AddBagCommands(app);
+  uwscan::app::AddRosCommands(app);
   CLI::App* bench = app.add_subcommand("bench", "benchmarks and the seeds' experiments");
   bench->require_subcommand(1);
   uwscan::app::AddBenchCommands(*bench);

@@ -52,3 +52,26 @@ find_package(Threads REQUIRED)
 # GenICam cameras (scanner/acquisition, the one part that links Aravis): Debian's aravis-0.8.
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(Aravis REQUIRED IMPORTED_TARGET aravis-0.8)
+
+# ROS 1 (ros/, the one module that links it). roscpp by its CMake config, which works without
+# catkin. rosbag's config is not used: through pluginlib it loads ament_cmake_core, which runs a
+# Python module (ament_package) that a non-Debian python3 first on the PATH lacks; rosbag's
+# libraries and the nested include folders its bag.h needs (pluginlib, class_loader, ament,
+# rcpputils, rcutils) are found directly. The message packages are header-only, in the system
+# include path: find_package of them would pull catkin in (DESIGN.md, "Known traps").
+if(NOT UWSCAN_LIBRARIES_ONLY)
+  find_package(roscpp REQUIRED)
+  add_library(uwscan_rosbag INTERFACE)
+  foreach(library rosbag rosbag_storage class_loader ament_index_cpp console_bridge)
+    find_library(UWSCAN_ROS_${library} ${library} REQUIRED)
+    target_link_libraries(uwscan_rosbag INTERFACE ${UWSCAN_ROS_${library}})
+  endforeach()
+  foreach(header pluginlib/class_loader.hpp class_loader/class_loader.hpp
+                 ament_index_cpp/get_package_prefix.hpp rcpputils/shared_library.hpp rcutils/types.h)
+    get_filename_component(package ${header} DIRECTORY)
+    find_path(UWSCAN_ROS_INCLUDE_${package} ${header} PATH_SUFFIXES ${package} REQUIRED)
+    target_include_directories(uwscan_rosbag SYSTEM INTERFACE ${UWSCAN_ROS_INCLUDE_${package}})
+  endforeach()
+  target_include_directories(uwscan_rosbag SYSTEM INTERFACE ${roscpp_INCLUDE_DIRS})
+  target_link_libraries(uwscan_rosbag INTERFACE ${roscpp_LIBRARIES})
+endif()

@@ -6,15 +6,22 @@
 #include <exception>
 #include <mutex>
 #include <thread>
+#include <variant>
 
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
 namespace {
 
+using Record = std::variant<FrameRecord, NavigationRecord>;
+
 std::size_t FrameBytes(const FrameRecord& f) {
   return sizeof(FrameRecord) + f.peaks_px.size() * sizeof(Eigen::Vector2d) +
          (f.image ? f.image->bytes.size() : 0);
+}
+
+std::size_t RecordBytes(const Record& r) {
+  return std::holds_alternative<FrameRecord>(r) ? FrameBytes(std::get<FrameRecord>(r)) : sizeof(NavigationRecord);
 }
 
 }  // namespace
@@ -24,7 +31,7 @@ struct FrameRecorder::Impl {
   std::size_t capacity;
   mutable std::mutex mutex;
   std::condition_variable changed;
-  std::deque<FrameRecord> queue;
+  std::deque<Record> queue;  // frames and navigation samples, in the order they came
   FrameRecorderStatistics stats;
   bool finishing = false;
   std::exception_ptr failure;
@@ -37,13 +44,18 @@ struct FrameRecorder::Impl {
     while (true) {
       changed.wait(lock, [this] { return !queue.empty() || finishing; });
       if (queue.empty()) return;
-      FrameRecord frame = std::move(queue.front());
+      Record record = std::move(queue.front());
       queue.pop_front();
-      const std::size_t bytes = FrameBytes(frame);
+      const std::size_t bytes = RecordBytes(record);
+      const bool is_frame = std::holds_alternative<FrameRecord>(record);
       lock.unlock();
       std::exception_ptr error;
       try {
-        writer.AppendFrame(frame);
+        if (is_frame) {
+          writer.AppendFrame(std::get<FrameRecord>(record));
+        } else {
+          writer.AppendNavigation(std::get<NavigationRecord>(record));
+        }
       } catch (...) {
         error = std::current_exception();
       }
@@ -56,7 +68,7 @@ struct FrameRecorder::Impl {
         changed.notify_all();
         return;
       }
-      ++stats.frames_written;
+      ++(is_frame ? stats.frames_written : stats.navigation_written);
       changed.notify_all();
     }
   }
@@ -92,6 +104,17 @@ void FrameRecorder::Push(FrameRecord frame) {
   if (m.failure) std::rethrow_exception(m.failure);
   m.queue.push_back(std::move(frame));
   m.stats.queued_bytes += bytes;
+  m.stats.max_queued_bytes = std::max(m.stats.max_queued_bytes, m.stats.queued_bytes);
+  m.changed.notify_all();
+}
+
+void FrameRecorder::PushNavigation(const NavigationRecord& record) {
+  Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.mutex);
+  if (m.failure) std::rethrow_exception(m.failure);
+  if (m.finishing) throw Error("frame recorder: PushNavigation() after Finish()");
+  m.queue.push_back(record);
+  m.stats.queued_bytes += sizeof(NavigationRecord);
   m.stats.max_queued_bytes = std::max(m.stats.max_queued_bytes, m.stats.queued_bytes);
   m.changed.notify_all();
 }

@@ -10,6 +10,7 @@ namespace uwscan::mapping {
 
 struct FrameRecorderStatistics {
   std::int64_t frames_written = 0;
+  std::int64_t navigation_written = 0;
   std::size_t queued_bytes = 0;      // frames waiting for the disk now
   std::size_t max_queued_bytes = 0;  // the most that ever waited
   double blocked_s = 0.0;            // time Push() waited for room (the disk was behind)
@@ -33,6 +34,8 @@ class FrameRecorder {
   // Queues a frame (waits while the queue is full). Throws the writer's uwscan::Error when an
   // earlier frame could not be written.
   void Push(FrameRecord frame);
+  // Queues a navigation sample (small: it never waits for room). Throws like Push().
+  void PushNavigation(const NavigationRecord& record);
   // Writes every queued frame, stops the writer thread and returns. Throws like Push().
   void Finish();
   FrameRecorderStatistics statistics() const;

@@ -78,6 +78,7 @@ void InspectionOptions::Check() const {
 struct LiveInspection::Impl {
   InspectionOptions options;
   std::function<void(const MappedFrame&)> on_mapped;
+  std::function<void(const Mapper&)> on_submap_closed;
   std::unique_ptr<FrameRecorder> recorder;  // null without a log
   Mapper mapper;                            // mapping thread only (and Finish after it ended)
 
@@ -111,7 +112,7 @@ struct LiveInspection::Impl {
       times = it->second;
       in_mapper.erase(it);
     }
-    if (on_mapped) on_mapped(MappedFrame{frame.index, frame.time_s, T_W_C, points});
+    if (on_mapped) on_mapped(MappedFrame{frame.index, frame.time_s, frame.sweep, T_W_C, points});
     std::lock_guard<std::mutex> lock(mutex);
     ++stats.frames_mapped;
     --stats.frames_waiting;
@@ -174,8 +175,10 @@ struct LiveInspection::Impl {
       }
       lock.unlock();
       try {
+        const int submaps_before = mapper.submap_count();
         for (const NavigationRecord& r : records) mapper.AddNavigation(r);
         const bool mapped = !frame || Map(*frame);
+        if (on_submap_closed && mapper.submap_count() > submaps_before) on_submap_closed(mapper);
         lock.lock();
         if (!mapped) {
           ++stats.frames_out_of_order;
@@ -212,7 +215,11 @@ LiveInspection::LiveInspection(const DiveLogHeader& header, const std::filesyste
   effective.mapper.clouds.map_voxel_m = options.map_voxel_m;
   impl_ = std::make_unique<Impl>(effective, header, T_V_C, noise);
   impl_->on_mapped = std::move(on_mapped);
-  if (!log.empty()) impl_->recorder = std::make_unique<FrameRecorder>(DiveLogWriter(log, header), options.log_queue_bytes);
+  if (!log.empty()) {
+    DiveLogWriter writer(log, header);
+    writer.SetVehicleMount(T_V_C);
+    impl_->recorder = std::make_unique<FrameRecorder>(std::move(writer), options.log_queue_bytes);
+  }
   Impl* m = impl_.get();
   m->mapper.SetFramePlacedCallback(
       [m](const FrameRecord& f, const Eigen::Isometry3d& T_W_C, std::span<const Eigen::Vector3d> points) {
@@ -266,9 +273,21 @@ void LiveInspection::Push(InspectionFrame frame) {
 }
 
 void LiveInspection::AddNavigation(const NavigationRecord& record) {
+  Impl& m = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(m.mutex);
+    if (m.finishing) throw Error("live inspection: AddNavigation() after Finish()");
+    m.RethrowFailure();
+  }
+  if (m.recorder && !m.options.fixed_scanner) m.recorder->PushNavigation(record);
+  std::lock_guard<std::mutex> lock(m.mutex);
+  m.navigation.push_back(record);
+  m.changed.notify_all();
+}
+
+void LiveInspection::SetSubmapClosedCallback(std::function<void(const Mapper&)> callback) {
   std::lock_guard<std::mutex> lock(impl_->mutex);
-  impl_->navigation.push_back(record);
-  impl_->changed.notify_all();
+  impl_->on_submap_closed = std::move(callback);
 }
 
 InspectionResult LiveInspection::Finish() {
@@ -289,6 +308,7 @@ InspectionResult LiveInspection::Finish() {
     m.mapper.Finish();
     for (int i = 0; i < m.mapper.submap_count(); ++i) {
       result.slam.push_back({m.mapper.submap(i).anchor_time_s, m.mapper.pose(i)});
+      result.navigation.push_back({m.mapper.submap(i).anchor_time_s, m.mapper.submap(i).T_W_V_nav});
     }
     result.map = m.mapper.Map(m.options.map_voxel_m);
   }

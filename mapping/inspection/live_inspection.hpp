@@ -92,12 +92,14 @@ struct InspectionResult {
   InspectionStatistics statistics;
   perception::PointCloud map;  // voxelised at map_voxel_m, world frame (SLAM poses)
   std::vector<TimedPose> slam;  // T_W_V at each submap's anchor, estimated
+  std::vector<TimedPose> navigation;  // T_W_V at each submap's anchor, as the navigation gave it
 };
 
 // A frame just placed in the map, for a live view (called on the mapping thread).
 struct MappedFrame {
   std::int64_t index = 0;  // the frame's index in the log (push order)
   double time_s = 0.0;     // its capture time (the camera's clock, as logged)
+  int sweep = 0;           // its sweep, as given
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::span<const Eigen::Vector3d> points_W;  // valid during the call
 };
@@ -126,8 +128,13 @@ class LiveInspection {
   // when the log writer or the mapping thread failed (the message says which), or after
   // Finish().
   void Push(InspectionFrame frame);
-  // The vehicle's navigation (options.fixed_scanner false), in time order; thread-safe.
+  // The vehicle's navigation (options.fixed_scanner false), in time order; thread-safe. Logged
+  // with the frames (when there is a log). Throws like Push().
   void AddNavigation(const NavigationRecord& record);
+  // Called on the mapping thread each time a submap closes (the mapper holds it, registered and
+  // in the graph), with the mapper to read poses, covariances and the map from; nothing may be
+  // added to the mapper there. Set it before the first Push().
+  void SetSubmapClosedCallback(std::function<void(const Mapper&)> callback);
   // Maps the frames still queued, closes the log (every frame committed), finishes the mapper
   // (last submap, whole-graph solve) and returns the map. Throws like Push(), and when frames
   // were given to the mapper but no navigation ever covered them.

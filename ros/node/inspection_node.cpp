@@ -1,0 +1,477 @@
+#include "ros/node/inspection_node.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "mapping/slam/dive_mapping.hpp"
+#include "mapping/slam/mapper.hpp"
+#include "ros/conversions/dive_description.hpp"
+#include "ros/conversions/frame_image.hpp"
+#include "ros/conversions/static_transforms.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::ros {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+double UnixNow() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// The first failure of any callback thread, rethrown on the node's thread.
+class Failure {
+ public:
+  void Set(std::exception_ptr e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!failure_) failure_ = std::move(e);
+  }
+  bool IsSet() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return failure_ != nullptr;
+  }
+  void Rethrow() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (failure_) std::rethrow_exception(failure_);
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::exception_ptr failure_;
+};
+
+// What the node learns from its latched topics before frames are taken: the scanner (dive
+// description) and the camera's mount (/tf_static).
+struct DiveSetup {
+  mapping::DiveLogHeader header;
+  double time_origin_s = 0.0;
+  bool described = false;
+  Eigen::Isometry3d T_V_C = Eigen::Isometry3d::Identity();
+  std::string mount;
+};
+
+class SetupListener {
+ public:
+  SetupListener(RosConnection& ros, const InspectionNodeOptions& o, Failure& failure) : options_(o) {
+    if (!o.header) {
+      ros.SubscribeText(o.topics.dive, [this, &failure, topic = o.topics.dive](StringMessage&& m) {
+        try {
+          DiveDescription d = ParseDiveDescription(m.data, "topic " + topic);
+          std::lock_guard<std::mutex> lock(mutex_);
+          if (!description_) description_ = std::move(d);
+        } catch (...) {
+          failure.Set(std::current_exception());
+        }
+      });
+    }
+    ros.SubscribeTransforms(o.topics.tf_static, [this](std::vector<TransformMessage>&& transforms) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const TransformMessage& t : transforms) statics_.Add(t);
+    });
+  }
+
+  // Waits for the scanner, then for the mount (or gives up on it). Throws when the scanner
+  // does not come in time.
+  DiveSetup Wait(const Failure& failure, const std::function<bool()>& stop_requested) {
+    DiveSetup setup;
+    const Clock::time_point start = Clock::now();
+    while (!options_.header && !Described()) {
+      failure.Rethrow();
+      if (stop_requested()) throw Error("stopped while waiting for the dive description");
+      if (SecondsSince(start) > options_.description_wait_s) {
+        throw Error("no dive description on " + options_.topics.dive + " within " +
+                    std::to_string(options_.description_wait_s) + " s: give the scanner (--scanner, or ~scanner)");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (options_.header) {
+      setup.header = *options_.header;
+    } else {
+      std::lock_guard<std::mutex> lock(mutex_);
+      setup.header = description_->header;
+      setup.time_origin_s = description_->time_origin_s;
+      setup.described = true;
+    }
+    const Clock::time_point mount_start = Clock::now();
+    std::optional<Eigen::Isometry3d> T_V_C;
+    while (!(T_V_C = Mount()) && SecondsSince(mount_start) < options_.mount_wait_s && !stop_requested()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    const RosFrames& f = options_.frames;
+    setup.T_V_C = T_V_C.value_or(Eigen::Isometry3d::Identity());
+    setup.mount = T_V_C ? options_.topics.tf_static + " " + f.base_link + " -> " + f.camera
+                        : "none on " + options_.topics.tf_static + " from " + f.base_link + " to " + f.camera +
+                              ": the camera is taken at the vehicle's origin";
+    return setup;
+  }
+
+ private:
+  bool Described() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return description_.has_value();
+  }
+  std::optional<Eigen::Isometry3d> Mount() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return statics_.Find(options_.frames.base_link, options_.frames.camera);
+  }
+
+  const InspectionNodeOptions& options_;
+  std::mutex mutex_;
+  std::optional<DiveDescription> description_;
+  StaticTransforms statics_;
+};
+
+// Frames and navigation from their topics into the inspection. Callbacks run on roscpp's
+// spinner threads. Until Begin() (the scanner is not known yet) messages wait here, up to
+// `capacity` frames; after Close() none reaches the inspection any more.
+class Intake {
+ public:
+  Intake(const InspectionNodeOptions& o, Failure& failure)
+      : options_(o), failure_(failure), capacity_(static_cast<std::size_t>(o.frame_queue)) {}
+
+  void Begin(const DiveSetup& setup, mapping::LiveInspection& inspection) {
+    std::scoped_lock lock(frames_mutex_, navigation_mutex_);
+    decoder_.emplace(setup.header.scanner.camera().camera, options_.detector, options_.keep_images);
+    time_origin_s_ = setup.time_origin_s;
+    inspection_ = &inspection;
+    for (OdometryMessage& m : pending_navigation_) AddNavigation(m);
+    for (ImageMessage& m : pending_frames_) AddFrame(m);
+    pending_navigation_.clear();
+    pending_frames_.clear();
+  }
+
+  void OnImage(ImageMessage&& m) {
+    std::lock_guard<std::mutex> lock(frames_mutex_);
+    if (closed_) return;
+    ++frames_;
+    if (inspection_ != nullptr) {
+      AddFrame(m);
+    } else if (pending_frames_.size() < capacity_) {
+      pending_frames_.push_back(std::move(m));
+    } else {
+      ++dropped_;
+    }
+  }
+
+  void OnOdometry(OdometryMessage&& m) {
+    std::lock_guard<std::mutex> lock(navigation_mutex_);
+    if (closed_) return;
+    if (inspection_ != nullptr) {
+      AddNavigation(m);
+    } else {
+      pending_navigation_.push_back(std::move(m));
+    }
+  }
+
+  void Close() {
+    std::scoped_lock lock(frames_mutex_, navigation_mutex_);
+    closed_ = true;
+  }
+
+  std::int64_t frames() const { return frames_.load(); }
+  std::int64_t undecodable() const { return undecodable_.load(); }
+  std::int64_t dropped() const { return dropped_.load(); }
+  std::int64_t navigation() const { return navigation_.load(); }
+
+ private:
+  // With frames_mutex_ held.
+  void AddFrame(const ImageMessage& m) {
+    if (closed_) return;
+    try {
+      std::optional<mapping::FrameRecord> frame = decoder_->Decode(m, m.header.stamp_s - time_origin_s_, options_.topics.frames);
+      if (!frame) {
+        ++undecodable_;
+        return;
+      }
+      mapping::InspectionFrame f;
+      f.record = std::move(*frame);
+      f.receive_time_s = UnixNow();
+      // The stamp is the host's clock when it is within a second of it (a live camera), not in
+      // a replayed bag.
+      if (std::abs(m.header.stamp_s - f.receive_time_s) < 1.0) f.capture_time_s = m.header.stamp_s;
+      inspection_->Push(std::move(f));
+    } catch (...) {
+      closed_ = true;
+      failure_.Set(std::current_exception());
+    }
+  }
+
+  // With navigation_mutex_ held.
+  void AddNavigation(const OdometryMessage& m) {
+    if (closed_) return;
+    try {
+      inspection_->AddNavigation({m.header.stamp_s - time_origin_s_, m.pose});
+      ++navigation_;
+    } catch (...) {
+      closed_ = true;
+      failure_.Set(std::current_exception());
+    }
+  }
+
+  const InspectionNodeOptions& options_;
+  Failure& failure_;
+  std::size_t capacity_;
+  std::mutex frames_mutex_, navigation_mutex_;
+  std::optional<FrameImageDecoder> decoder_;
+  double time_origin_s_ = 0.0;
+  mapping::LiveInspection* inspection_ = nullptr;
+  std::deque<ImageMessage> pending_frames_;
+  std::deque<OdometryMessage> pending_navigation_;
+  bool closed_ = false;
+  std::atomic<std::int64_t> frames_{0}, undecodable_{0}, dropped_{0}, navigation_{0};
+};
+
+// ROS's covariance order (position, rotation) from uwscan's [rotation, position].
+Covariance6d RosCovariance(const mapping::Matrix6d& c) {
+  Covariance6d out;
+  out << c.bottomRightCorner<3, 3>(), c.bottomLeftCorner<3, 3>(), c.topRightCorner<3, 3>(), c.topLeftCorner<3, 3>();
+  return out;
+}
+
+CloudMessage MapMessage(const perception::PointCloud& map, const Header& header) {
+  CloudMessage c;
+  c.header = header;
+  c.points.reserve(map.size());
+  for (std::size_t i = 0; i < map.size(); ++i) c.points.push_back(map.Point(i).cast<float>());
+  return c;
+}
+
+// Publishes what the mapper makes: sweeps, paths, pose, TF and map.
+class Outlet {
+ public:
+  Outlet(RosConnection& ros, const InspectionNodeOptions& o, double time_origin_s)
+      : ros_(ros), options_(o), origin_s_(time_origin_s) {
+    const RosTopics& t = o.topics;
+    sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
+    map_id_ = ros.Advertise(t.map, RosConnection::Kind::kCloud, true);
+    slam_path_id_ = ros.Advertise(t.slam_path, RosConnection::Kind::kPath, true);
+    navigation_path_id_ = ros.Advertise(t.navigation_path, RosConnection::Kind::kPath, true);
+    pose_id_ = ros.Advertise(t.pose, RosConnection::Kind::kPose, true);
+    tf_id_ = ros.Advertise(t.tf, RosConnection::Kind::kTransforms, false);
+  }
+
+  // Mapping thread: a frame placed. A sweep is published when the next one starts, in the
+  // camera frame at its last frame (each point placed with the navigation at its own frame).
+  void OnMapped(const mapping::MappedFrame& f) {
+    if (sweep_ && f.sweep != *sweep_) PublishSweep();
+    sweep_ = f.sweep;
+    sweep_time_s_ = f.time_s;
+    T_W_C_last_ = f.T_W_C;
+    sweep_points_W_.insert(sweep_points_W_.end(), f.points_W.begin(), f.points_W.end());
+  }
+
+  // Mapping thread: a submap closed.
+  void OnSubmapClosed(const mapping::Mapper& m) {
+    std::vector<mapping::TimedPose> slam, navigation;
+    for (int i = 0; i < m.submap_count(); ++i) {
+      slam.push_back({m.submap(i).anchor_time_s, m.pose(i)});
+      navigation.push_back({m.submap(i).anchor_time_s, m.submap(i).T_W_V_nav});
+    }
+    PublishTrajectory(slam, navigation);
+    const int last = m.submap_count() - 1;
+    if (const std::optional<mapping::Mapper::SubmapCovariances> c = m.Covariances()) {
+      ros_.Publish(pose_id_, PoseMessage{Stamp(slam.back().time_s, options_.frames.map), slam.back().T_W_V,
+                                         RosCovariance(c->anchors[static_cast<std::size_t>(last)])});
+    }
+    if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
+      ros_.Publish(map_id_, MapMessage(m.Map(options_.inspection.map_voxel_m),
+                                       Stamp(slam.back().time_s, options_.frames.map)));
+      last_map_ = Clock::now();
+      ++maps_;
+    }
+  }
+
+  // After the inspection finished: the last sweep, the final map and paths.
+  void Finish(const mapping::InspectionResult& r) {
+    if (!sweep_points_W_.empty()) PublishSweep();
+    if (r.slam.empty()) return;
+    PublishTrajectory(r.slam, r.navigation);
+    ros_.Publish(map_id_, MapMessage(r.map, Stamp(r.slam.back().time_s, options_.frames.map)));
+    ++maps_;
+  }
+
+  std::int64_t sweeps() const { return sweeps_; }
+  std::int64_t maps() const { return maps_; }
+
+ private:
+  Header Stamp(double time_s, const std::string& frame) const { return {origin_s_ + time_s, frame}; }
+
+  void PublishSweep() {
+    CloudMessage c;
+    c.header = Stamp(sweep_time_s_, options_.frames.camera);
+    const Eigen::Isometry3d T_C_W = T_W_C_last_.inverse();
+    c.points.reserve(sweep_points_W_.size());
+    for (const Eigen::Vector3d& p : sweep_points_W_) c.points.push_back((T_C_W * p).cast<float>());
+    ros_.Publish(sweep_id_, c);
+    sweep_points_W_.clear();
+    ++sweeps_;
+  }
+
+  // Both paths in the map frame (uwscan's world: the navigation's, corrected), and the
+  // correction at the latest anchor as map -> odom.
+  void PublishTrajectory(const std::vector<mapping::TimedPose>& slam, const std::vector<mapping::TimedPose>& navigation) {
+    const RosFrames& f = options_.frames;
+    ros_.Publish(slam_path_id_, Path(slam));
+    ros_.Publish(navigation_path_id_, Path(navigation));
+    const Eigen::Isometry3d T_map_odom = slam.back().T_W_V * navigation.back().T_W_V.inverse();
+    ros_.Publish(tf_id_, std::vector<TransformMessage>{{Stamp(slam.back().time_s, f.map), f.odom, T_map_odom}});
+  }
+
+  PathMessage Path(const std::vector<mapping::TimedPose>& poses) const {
+    PathMessage p;
+    p.header = Stamp(poses.back().time_s, options_.frames.map);
+    for (const mapping::TimedPose& pose : poses) {
+      p.stamps_s.push_back(origin_s_ + pose.time_s);
+      p.poses.push_back(pose.T_W_V);
+    }
+    return p;
+  }
+
+  RosConnection& ros_;
+  const InspectionNodeOptions& options_;
+  double origin_s_;
+  int sweep_id_ = 0, map_id_ = 0, slam_path_id_ = 0, navigation_path_id_ = 0, pose_id_ = 0, tf_id_ = 0;
+  std::optional<int> sweep_;
+  double sweep_time_s_ = 0.0;
+  Eigen::Isometry3d T_W_C_last_ = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> sweep_points_W_;
+  std::optional<Clock::time_point> last_map_;
+  std::atomic<std::int64_t> sweeps_{0}, maps_{0};
+};
+
+// Why the node stops now, "" to go on.
+std::string StopReason(const InspectionNodeOptions& o, RosConnection& ros, const Intake& intake,
+                       const std::function<bool()>& stop_requested, double idle_s) {
+  if (stop_requested()) return "stop requested";
+  if (!ros.Ok()) return "ROS shut the node down";
+  if (o.max_frames > 0 && intake.frames() >= o.max_frames) return std::to_string(o.max_frames) + " frames received";
+  if (o.idle_stop_s > 0.0 && intake.frames() > 0 && idle_s >= o.idle_stop_s) {
+    return "no frame for " + std::to_string(o.idle_stop_s) + " s";
+  }
+  return "";
+}
+
+}  // namespace
+
+void InspectionNodeOptions::Check() const {
+  const auto fail = [](const std::string& field, const std::string& expected) {
+    throw Error("InspectionNodeOptions." + field + ": expected " + expected);
+  };
+  if (!(description_wait_s > 0.0)) fail("description_wait_s", "> 0 s");
+  if (!(mount_wait_s >= 0.0)) fail("mount_wait_s", ">= 0 s");
+  if (!(map_period_s > 0.0)) fail("map_period_s", "> 0 s");
+  if (frame_queue < 1) fail("frame_queue", ">= 1");
+  if (max_frames < 0) fail("max_frames", ">= 0");
+  if (!(idle_stop_s >= 0.0)) fail("idle_stop_s", ">= 0 s");
+  inspection.Check();
+}
+
+namespace {
+
+// Everything a running node holds. The subscriptions end first (no callback runs after), then
+// the parts go in the reverse of their order here: the inspection (its mapping thread calls the
+// outlet), the outlet, the intake, the listener.
+struct Node {
+  explicit Node(RosConnection& r) : ros(r) {}
+  ~Node() { ros.Unsubscribe(); }
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+
+  RosConnection& ros;
+  Failure failure;
+  std::unique_ptr<SetupListener> listener;
+  std::unique_ptr<Intake> intake;  // holds no inspection after Close()
+  std::unique_ptr<Outlet> outlet;
+  std::unique_ptr<mapping::LiveInspection> inspection;
+};
+
+// Frames and navigation are taken from the start (they wait in the intake), so that none is
+// lost while the scanner's description and mount arrive.
+void Subscribe(Node& node, const InspectionNodeOptions& o) {
+  node.listener = std::make_unique<SetupListener>(node.ros, o, node.failure);
+  node.intake = std::make_unique<Intake>(o, node.failure);
+  Intake* intake = node.intake.get();
+  node.ros.SubscribeOdometry(o.topics.odometry, o.frame_queue,
+                             [intake](OdometryMessage&& m) { intake->OnOdometry(std::move(m)); });
+  node.ros.SubscribeImages(o.topics.frames, o.frame_queue, [intake](ImageMessage&& m) { intake->OnImage(std::move(m)); });
+}
+
+void StartInspection(Node& node, const InspectionNodeOptions& o, const DiveSetup& setup) {
+  mapping::DiveLogHeader header = setup.header;
+  header.producer = o.producer;
+  mapping::InspectionOptions options = o.inspection;
+  options.fixed_scanner = false;
+  node.outlet = std::make_unique<Outlet>(node.ros, o, setup.time_origin_s);
+  Outlet* outlet = node.outlet.get();
+  node.inspection = std::make_unique<mapping::LiveInspection>(
+      header, o.log, setup.T_V_C, header.navigation_noise.value_or(mapping::AssumedNavigationNoise()), options,
+      [outlet](const mapping::MappedFrame& f) { outlet->OnMapped(f); });
+  node.inspection->SetSubmapClosedCallback([outlet](const mapping::Mapper& m) { outlet->OnSubmapClosed(m); });
+  node.intake->Begin(setup, *node.inspection);
+}
+
+// Until a reason to stop; reports about once a second and keeps the node registered.
+std::string Watch(Node& node, const InspectionNodeOptions& o, const std::function<bool()>& stop_requested,
+                  const std::function<void(const InspectionNodeStatus&)>& status) {
+  const Clock::time_point start = Clock::now();
+  Clock::time_point last_frame_change = start, last_status = start;
+  std::int64_t last_frames = 0;
+  while (!node.failure.IsSet()) {
+    if (node.intake->frames() != last_frames) {
+      last_frames = node.intake->frames();
+      last_frame_change = Clock::now();
+    }
+    const std::string reason = StopReason(o, node.ros, *node.intake, stop_requested, SecondsSince(last_frame_change));
+    if (!reason.empty()) return reason;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (SecondsSince(last_status) >= 1.0) {
+      last_status = Clock::now();
+      const bool master = node.ros.KeepRegistered();
+      if (status) status({node.inspection->statistics(), master, SecondsSince(start)});
+    }
+  }
+  return "failed";
+}
+
+}  // namespace
+
+InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNodeOptions& o,
+                                        const std::function<bool()>& stop_requested,
+                                        const std::function<void(const InspectionNodeStatus&)>& status) {
+  o.Check();
+  Node node(ros);
+  Subscribe(node, o);
+  ros.Start(2);
+  const DiveSetup setup = node.listener->Wait(node.failure, stop_requested);
+  StartInspection(node, o, setup);
+
+  InspectionNodeSummary summary;
+  summary.stop_reason = Watch(node, o, stop_requested, status);
+  node.intake->Close();
+  node.failure.Rethrow();
+  if (node.intake->dropped() > 0) {
+    throw Error(std::to_string(node.intake->dropped()) + " frames on " + o.topics.frames +
+                " came before the scanner was known and beyond ~frame_queue; they are not in the log");
+  }
+  summary.result = node.inspection->Finish();
+  node.outlet->Finish(summary.result);
+  summary.frames_undecodable = node.intake->undecodable();
+  summary.navigation_samples = node.intake->navigation();
+  summary.sweeps_published = node.outlet->sweeps();
+  summary.maps_published = node.outlet->maps();
+  summary.reregistrations = ros.reregistrations();
+  summary.described = setup.described;
+  summary.mount = setup.mount;
+  summary.time_origin_s = setup.time_origin_s;
+  return summary;
+}
+
+}  // namespace uwscan::ros

@@ -1,0 +1,77 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "mapping/inspection/live_inspection.hpp"
+#include "ros/bridge/ros_connection.hpp"
+#include "ros/conversions/ros_names.hpp"
+#include "scanner/stripe/stripe_detector.hpp"
+
+// Online inspection on the vehicle (`uwscan ros inspect`): the same LiveInspection as
+// `uwscan inspect`, fed by ROS. Frames come from an image topic (frame_image.hpp), the
+// navigation from nav_msgs/Odometry; every frame and navigation sample is logged, and each frame
+// is placed with the navigation interpolated at its own stamp (frames wait for it). Publishes
+// each sweep (PointCloud2 in the camera frame at its last frame), the map (PointCloud2, latched,
+// at most every map_period_s), the SLAM and the navigation's paths at the submaps' anchors
+// (nav_msgs/Path, both in the map frame, which is the navigation's world corrected), the
+// correction map -> odom on /tf and the latest anchor's pose with its covariance.
+namespace uwscan::ros {
+
+struct InspectionNodeOptions {
+  RosTopics topics;
+  RosFrames frames;
+  std::filesystem::path log;  // dive log to create ("" = none)
+  // The scanner and scan pattern when given by the user; else the dive description on
+  // topics.dive (a bag uwscan wrote, played) is waited for, up to description_wait_s.
+  std::optional<mapping::DiveLogHeader> header;
+  double description_wait_s = 30.0;  // seconds, > 0
+  // The camera's mount is looked up on /tf_static (frames.base_link -> frames.camera) for up to
+  // this long before the camera is taken at the vehicle's origin, seconds, >= 0.
+  double mount_wait_s = 3.0;
+  double map_period_s = 2.0;  // the map is published at most this often, seconds, > 0
+  int frame_queue = 4096;     // frames roscpp holds while the node is busy, > 0
+  scanner::StripeDetectorOptions detector;  // how image-mode frames are searched
+  bool keep_images = false;                 // image-mode frames: log the images with the peaks
+  mapping::InspectionOptions inspection;    // fixed_scanner is set false (navigation comes)
+  std::string producer;                     // the log's producer
+  // Stop once this many frames were received (0: no limit), or once frames stopped coming for
+  // idle_stop_s after the first (0: never): for replays and tests.
+  std::int64_t max_frames = 0;
+  double idle_stop_s = 0.0;
+  void Check() const;  // throws uwscan::Error naming the field
+};
+
+struct InspectionNodeSummary {
+  mapping::InspectionResult result;
+  std::int64_t frames_undecodable = 0;  // metadata row failed its checksum: not logged
+  std::int64_t navigation_samples = 0;
+  std::int64_t sweeps_published = 0;
+  std::int64_t maps_published = 0;
+  int reregistrations = 0;     // times the node registered again with a restarted master
+  bool described = false;      // the scanner came from the dive topic
+  std::string mount;           // where the camera's mount came from
+  double time_origin_s = 0.0;  // ROS time of the log's time 0
+  std::string stop_reason;
+};
+
+// What the node reports about once a second.
+struct InspectionNodeStatus {
+  mapping::InspectionStatistics statistics;
+  bool master_reachable = true;
+  double seconds = 0.0;  // since frames were first subscribed
+};
+
+// Runs the node on `ros` until `stop_requested` says so, roscpp shuts down, or a limit in
+// `options` is reached; then maps what is queued, closes the log and publishes the final map
+// and paths. Throws uwscan::Error on a scanner that never came, a frame of the wrong encoding
+// or size (naming the topic), a log that cannot be written, or mapping that failed; the log
+// then holds every frame received before.
+InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNodeOptions& options,
+                                        const std::function<bool()>& stop_requested,
+                                        const std::function<void(const InspectionNodeStatus&)>& status);
+
+}  // namespace uwscan::ros

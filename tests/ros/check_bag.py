@@ -1,0 +1,43 @@
+#!/usr/bin/python3
+"""Reads a bag with ROS's own Python reader (python3-rosbag), independently of uwscan's C++ one,
+and prints one JSON line per topic: type, message count, first and last header stamp, frame ids
+seen, and whether header stamps never go back. Used by tests/cli_ros_test.cpp."""
+import json
+import sys
+
+import rosbag
+
+
+def main():
+    bag = rosbag.Bag(sys.argv[1])
+    topics = {}
+    for topic, message, _ in bag.read_messages():
+        entry = topics.setdefault(topic, {"type": message._type, "count": 0, "frame_ids": [],
+                                          "first_stamp": None, "last_stamp": None, "ordered": True,
+                                          "children": []})
+        entry["count"] += 1
+        header = getattr(message, "header", None)
+        if header is not None:
+            stamp = header.stamp.to_sec()
+            if entry["last_stamp"] is not None and stamp < entry["last_stamp"]:
+                entry["ordered"] = False
+            if entry["first_stamp"] is None:
+                entry["first_stamp"] = stamp
+            entry["last_stamp"] = stamp
+            if header.frame_id not in entry["frame_ids"]:
+                entry["frame_ids"].append(header.frame_id)
+        for transform in getattr(message, "transforms", []):
+            pair = transform.header.frame_id + " " + transform.child_frame_id
+            if pair not in entry["children"]:
+                entry["children"].append(pair)
+        if hasattr(message, "child_frame_id") and message.child_frame_id not in entry["children"]:
+            entry["children"].append(message.child_frame_id)
+        if topic.endswith("/path") and hasattr(message, "poses"):
+            entry["last_path"] = [[p.header.stamp.to_sec(), p.pose.position.x, p.pose.position.y,
+                                   p.pose.position.z] for p in message.poses]
+    bag.close()
+    print(json.dumps(topics))
+
+
+if __name__ == "__main__":
+    main()
