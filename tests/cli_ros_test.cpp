@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mapping/log/dive_log.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "tests/cli_run.hpp"
 
@@ -293,4 +294,197 @@ TEST(CliRos, NodeMapsAPlayedBagAsMapDoesOffline) {
     const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(), path[i][3].get<double>());
     EXPECT_LT((p - online[i].p).norm(), 1e-6) << "anchor " << i;
   }
+}
+
+namespace {
+
+struct NodeRun {
+  CommandRun run;
+  nlohmann::json report;  // node.json, empty when the node wrote none
+  std::string log;        // the node's output
+};
+
+// Plays `bag` into the node (tests/ros/replay_dive.sh) with `environment` (fault settings).
+NodeRun ReplayIntoNode(const std::filesystem::path& bag, const std::string& name, const std::string& environment,
+                       const std::string& node_options = "--idle-stop-s 3") {
+  const std::filesystem::path out = TempPath(name);
+  NodeRun r;
+  r.run = RunCommand(environment + " " + SourcePath("tests/ros/replay_dive.sh") + " " + UWSCAN_BIN + " " +
+                     bag.string() + " " + out.string() + " " + node_options);
+  std::ifstream log_file(out / "node.log");
+  r.log.assign(std::istreambuf_iterator<char>(log_file), std::istreambuf_iterator<char>());
+  std::ifstream json_file(out / "node.json");
+  if (json_file) r.report = nlohmann::json::parse(json_file);
+  return r;
+}
+
+std::int64_t LogFrames(const std::filesystem::path& log) {
+  const CommandRun check = RunUwscan("log check " + log.string());
+  EXPECT_EQ(check.exit_code, 0) << check.output;
+  const std::size_t at = check.output.find("frames: ");
+  return at == std::string::npos ? -1 : std::stoll(check.output.substr(at + 8));
+}
+
+}  // namespace
+
+// The ROS master dies five seconds into the dive and a new one starts two seconds later: the
+// node keeps receiving from the player it is connected to, registers again, and loses no frame.
+TEST(CliRos, NodeLosesNoFrameWhenTheMasterRestarts) {
+  const NodeRun r = ReplayIntoNode(ShortBag(), "master_restart", "MASTER_DOWN_AT=5");
+  ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
+  EXPECT_EQ(Dump(r.report["frames_received"]), Dump(1989)) << r.report.dump();
+  EXPECT_EQ(Dump(r.report["frames_logged"]), Dump(1989));
+  EXPECT_GE(r.report["reregistrations"].get<int>(), 1) << r.log;
+  EXPECT_EQ(LogFrames(TempPath("master_restart") / "node.db"), 1989);
+}
+
+// SIGINT mid-dive: the node stops, every frame it received is in its log, and it says why.
+TEST(CliRos, SigintStopsTheNodeWithEveryReceivedFrameLogged) {
+  const NodeRun r = ReplayIntoNode(ShortBag(), "sigint", "SIGINT_AT=6");
+  ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
+  const std::int64_t received = r.report["frames_received"].get<std::int64_t>();
+  EXPECT_GT(received, 100) << r.report.dump();
+  EXPECT_LT(received, 1989);
+  EXPECT_EQ(r.report["frames_logged"].get<std::int64_t>(), received);
+  EXPECT_EQ(r.report["stop_reason"].get<std::string>(), "stop requested");
+  EXPECT_EQ(LogFrames(TempPath("sigint") / "node.db"), received);
+}
+
+// The navigation stops half-way: the frames after it are logged but not mapped, counted and
+// said so, and they do not pile up (MapperOptions::navigation_latency_s); the node ends cleanly.
+TEST(CliRos, FramesAfterTheNavigationStoppedAreLoggedNotMapped) {
+  const nlohmann::json topics = CheckBag(ShortBag());
+  const double stop_s = topics["/uwscan/frames"]["first_stamp"].get<double>() + 10.0;
+  const std::filesystem::path bag = TempPath("navigation_stops.bag");
+  ASSERT_EQ(RunCommand("rosbag filter " + ShortBag().string() + " " + bag.string() +
+                       " \"topic != '/navigation/odometry' or m.header.stamp.to_sec() < " + std::to_string(stop_s) +
+                       "\"")
+                .exit_code,
+            0);
+  const NodeRun r = ReplayIntoNode(bag, "navigation_stops", "");
+  ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
+  EXPECT_EQ(Dump(r.report["frames_logged"]), Dump(1989)) << r.report.dump();
+  const std::int64_t left_out = r.report["frames_without_navigation"].get<std::int64_t>();
+  EXPECT_GT(left_out, 900);  // the last ten seconds, at 100 frames/s
+  EXPECT_LT(left_out, 1100);
+  EXPECT_EQ(r.report["frames_mapped"].get<std::int64_t>() + left_out, 1989);
+  EXPECT_NE(r.log.find(std::to_string(left_out) + " frames logged but not mapped: no navigation"), std::string::npos)
+      << r.log;
+}
+
+// A dive and its map report in one bag: RViz replays the frames and navigation, the map, and the
+// SLAM, navigation and true paths growing anchor by anchor, on the node's topics and stamps.
+TEST(CliRos, ADiveAndItsMapReportExportTogether) {
+  const MapOutput mapped = Map(ShortDive(), "for_export");
+  const std::filesystem::path bag = TempPath("dive_and_map.bag");
+  const CommandRun run = RunUwscan("bag export " + ShortDive().string() + " " + TempPath("for_export.json").string() +
+                                   " -o " + bag.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json topics = CheckBag(bag);
+  const std::size_t anchors = mapped.trajectory.size();
+  EXPECT_EQ(Dump(topics["/uwscan/map"]["count"]), Dump(1));
+  EXPECT_EQ(Dump(topics["/uwscan/path"]["count"]), Dump(anchors));
+  EXPECT_EQ(Dump(topics["/uwscan/truth_path"]["count"]), Dump(anchors));
+  EXPECT_EQ(Dump(topics["/uwscan/pose"]["count"]), Dump(anchors));
+  EXPECT_EQ(Dump(topics["/uwscan/frames"]["count"]), Dump(1989));
+  // The map's anchors at the frames' stamps: one clock for the dive and its map.
+  const double origin_s = topics["/uwscan/frames"]["first_stamp"].get<double>();
+  const nlohmann::json& path = topics["/uwscan/path"]["last_path"];
+  ASSERT_EQ(path.size(), anchors);
+  for (std::size_t i = 0; i < anchors; ++i) {
+    EXPECT_NEAR(path[i][0].get<double>() - origin_s, mapped.trajectory[i].time_s, 1e-6);
+    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(), path[i][3].get<double>());
+    EXPECT_LT((p - mapped.trajectory[i].p).norm(), 1e-9);
+  }
+  const CommandRun recognition = RunUwscan("bag export " + TempPath("for_export.tum").string() + " -o " +
+                                           TempPath("refused.bag").string());
+  EXPECT_EQ(recognition.exit_code, 1) << recognition.output;
+  EXPECT_FALSE(std::filesystem::exists(TempPath("refused.bag")));
+}
+
+// Recognition on the vehicle: the node's published sweep of the demo scene (a valve, a flanged
+// pipe) searched by `uwscan ros recognize`, which finds what `uwscan recognize` finds in the
+// same sweep offline, at the same place, and publishes it with standard messages.
+TEST(CliRos, RecognitionNodeFindsWhatRecognizeFindsOffline) {
+  const std::filesystem::path db = TempPath("objects.db");
+  CommandRun run = RunUwscan("build-db valve_wheel flange pipe --views 16 -o " + db.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::filesystem::path log = TempPath("demo.db"), bag = TempPath("demo.bag"), offline = TempPath("offline.json");
+  ASSERT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string()).exit_code, 0);
+  run = RunUwscan("recognize " + log.string() + " --db " + db.string() + " --json " + offline.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ASSERT_EQ(RunUwscan("bag export " + log.string() + " -o " + bag.string()).exit_code, 0);
+  const NodeRun r = ReplayIntoNode(bag, "recognition", "RECOGNIZE_DB=" + db.string());
+  ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
+
+  std::ifstream offline_file(offline), online_file(TempPath("recognition") / "recognition.json");
+  const nlohmann::json expected = nlohmann::json::parse(offline_file);
+  const nlohmann::json online = nlohmann::json::parse(online_file);
+  EXPECT_EQ(online["sweeps_recognised"].get<int>(), 1) << online.dump();
+  std::vector<std::string> expected_ids;
+  std::vector<Eigen::Vector3d> expected_positions;
+  for (const nlohmann::json& o : expected["objects"]) {
+    if (o["id"] == "unknown") continue;
+    expected_ids.push_back(o["id"].get<std::string>());
+    const nlohmann::json& p = o["T_S_O"]["position_m"];
+    expected_positions.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  }
+  ASSERT_GE(expected_ids.size(), 2u) << expected.dump().substr(0, 2000);
+  for (const std::string& id : expected_ids) EXPECT_TRUE(online["objects"].contains(id)) << id << online.dump();
+
+  const nlohmann::json published = CheckBag(TempPath("recognition") / "published.bag");
+  const nlohmann::json& labels = published["/uwscan/objects"]["last_labels"];
+  EXPECT_EQ(labels.size(), expected_ids.size()) << labels.dump();
+  const nlohmann::json& positions = published["/uwscan/object_poses"]["positions"];
+  ASSERT_EQ(positions.size(), expected_positions.size()) << positions.dump();
+  for (const Eigen::Vector3d& e : expected_positions) {
+    double nearest = 1e9;
+    for (const nlohmann::json& p : positions) {
+      nearest = std::min(nearest, (Eigen::Vector3d(p[0].get<double>(), p[1].get<double>(), p[2].get<double>()) - e).norm());
+    }
+    EXPECT_LT(nearest, 0.005) << "an object offline at " << e.transpose();
+  }
+  EXPECT_EQ(Dump(published["/uwscan/object_poses"]["frame_ids"]), Dump(nlohmann::json::array({"uwscan_camera"})));
+}
+
+// A vehicle's own bag (tests/ros/vehicle_bag.py): its topic and frame names, frames and
+// navigation recorded out of stamp order, TF at 50 Hz, the mount as a chain of static transforms,
+// other topics, no dive description. Imported with the scanner's file and the topic names, it
+// gives the dive's frames and navigation back, the camera where the chain puts it, and maps.
+TEST(CliRos, AVehiclesOwnBagImportsWithItsScannerAndTopicNames) {
+  const std::filesystem::path vehicle = TempPath("vehicle.bag");
+  const CommandRun rewrite = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/vehicle_bag.py") + " " +
+                                        ShortBag().string() + " " + vehicle.string());
+  ASSERT_EQ(rewrite.exit_code, 0) << rewrite.output;
+  const std::filesystem::path log = TempPath("vehicle.db");
+  const std::string topics = " --frames-topic /girona500/camera/profile --odometry-topic /girona500/navigator/odometry";
+  CommandRun run = RunUwscan("bag import " + vehicle.string() + " -o " + log.string() + topics);
+  EXPECT_EQ(run.exit_code, 1) << run.output;  // no dive description: the scanner must be given
+  EXPECT_NE(run.output.find("--scanner"), std::string::npos) << run.output;
+  run = RunUwscan("bag import " + vehicle.string() + " -o " + log.string() + topics + " --scanner " +
+                  SourcePath("data/scanners/galvo_binned.yaml"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("girona500/base_link -> girona500/laser_camera"), std::string::npos) << run.output;
+
+  const uwscan::mapping::DiveLogReader original(ShortDive()), imported(log);
+  ASSERT_EQ(imported.frame_count(), original.frame_count());
+  for (std::int64_t i = 0; i < original.frame_count(); i += 97) {
+    const uwscan::mapping::FrameRecord a = original.ReadFrame(i), b = imported.ReadFrame(i);
+    EXPECT_EQ(a.command, b.command);
+    EXPECT_EQ(a.sweep, b.sweep);
+    EXPECT_EQ(a.peaks_px.size(), b.peaks_px.size());
+  }
+  const std::vector<uwscan::mapping::NavigationRecord> nav_a = original.ReadNavigation(), nav_b = imported.ReadNavigation();
+  ASSERT_EQ(nav_a.size(), nav_b.size());
+  // The vehicle's stamps are ROS time: the dive's clock plus the bag's origin, kept as they are.
+  const double origin_s = imported.ReadFrame(0).time_s - original.ReadFrame(0).time_s;
+  EXPECT_GT(origin_s, 1.6e9);
+  for (std::size_t i = 0; i < nav_a.size(); ++i) {
+    EXPECT_NEAR(nav_b[i].time_s - origin_s, nav_a[i].time_s, 1e-6);
+    EXPECT_TRUE(nav_b[i].T_W_V.isApprox(nav_a[i].T_W_V, 1e-9));
+  }
+  ASSERT_TRUE(imported.vehicle_mount() && original.vehicle_mount());
+  EXPECT_TRUE(imported.vehicle_mount()->isApprox(*original.vehicle_mount(), 1e-9));
+  const MapOutput mapped = Map(log, "vehicle");
+  EXPECT_EQ(Dump(mapped.report["figures"]["frames_mapped"]), Dump(original.frame_count()));
 }

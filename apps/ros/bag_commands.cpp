@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "apps/cli/output_path.hpp"
 #include "ros/bag/bag_export.hpp"
@@ -23,7 +24,7 @@ struct ImportArgs {
 };
 
 struct ExportArgs {
-  std::string log;
+  std::vector<std::string> inputs;
   std::string bag;
   ros::RosTopics topics;
   ros::RosFrames frames;
@@ -58,18 +59,26 @@ void RunImport(const ImportArgs& a) {
 }
 
 void RunExport(const ExportArgs& a) {
-  CheckOutputPath(a.bag, "-o", {a.log});
+  const std::vector<std::filesystem::path> inputs(a.inputs.begin(), a.inputs.end());
+  CheckOutputPath(a.bag, "-o", inputs);
   if (std::filesystem::exists(a.bag)) throw Error("-o " + a.bag + ": exists (a bag is never overwritten)");
   ros::BagExportOptions options;
   options.topics = a.topics;
   options.frames = a.frames;
   options.producer = std::string("uwscan bag export ") + UWSCAN_VERSION;
-  const ros::BagExportSummary s = ros::ExportDiveLog(a.log, a.bag, options);
-  std::printf("bag export: %lld frames (%lld as images, the rest as %d-row profiles) on %s, %lld navigation "
-              "samples on %s and %s -> %s\n",
-              static_cast<long long>(s.frames), static_cast<long long>(s.images), s.layout.peak_rows,
-              a.topics.frames.c_str(), static_cast<long long>(s.navigation), a.topics.odometry.c_str(),
-              a.topics.tf.c_str(), a.bag.c_str());
+  const ros::BagExportSummary s = ros::ExportToBag(inputs, a.bag, options);
+  if (s.frames > 0) {
+    std::printf("bag export: %lld frames (%lld as images, the rest as %d-row profiles) on %s, %lld navigation "
+                "samples on %s and %s\n",
+                static_cast<long long>(s.frames), static_cast<long long>(s.images), s.layout.peak_rows,
+                a.topics.frames.c_str(), static_cast<long long>(s.navigation), a.topics.odometry.c_str(),
+                a.topics.tf.c_str());
+  }
+  if (s.anchors > 0) {
+    std::printf("bag export: a map of %lld points on %s; paths, poses and map -> odom at %lld anchors\n",
+                static_cast<long long>(s.map_points), a.topics.map.c_str(), static_cast<long long>(s.anchors));
+  }
+  std::printf("bag export: written to %s\n", a.bag.c_str());
   if (s.time_origin_s != 0.0) std::printf("bag export: log time 0 is ROS time %.0f s\n", s.time_origin_s);
 }
 
@@ -107,8 +116,12 @@ void AddBagCommands(CLI::App& app) {
 
   auto out = std::make_shared<ExportArgs>();
   CLI::App* exp = bag->add_subcommand(
-      "export", "a dive log -> a ROS 1 bag (frames, odometry, TF, dive description) for rosbag play and RViz");
-  exp->add_option("log", out->log, "the dive log (.db)")->required()->check(CLI::ExistingFile);
+      "export",
+      "dive logs and map reports -> a ROS 1 bag for rosbag play and RViz: a log's frames, odometry, TF and "
+      "dive description; a map report's map, paths, poses and map -> odom");
+  exp->add_option("inputs", out->inputs, "dive logs (.db) and map reports (map --json)")
+      ->required()
+      ->check(CLI::ExistingFile);
   exp->add_option("-o,--output", out->bag, "bag to create (.bag)")->required();
   AddTopicOptions(*exp, out->topics);
   exp->add_option("--odom-frame", out->frames.odom, "the navigation's world frame")->capture_default_str();

@@ -13,6 +13,7 @@
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/stop_signal.hpp"
+#include "apps/ros/ros_recognize_command.hpp"
 #include "apps/scanner/camera_frames.hpp"
 #include "mapping/slam/trajectory_metrics.hpp"
 #include "perception/cloud/cloud_io.hpp"
@@ -97,10 +98,13 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
 
 void PrintStatus(const ros::InspectionNodeStatus& s) {
   const mapping::InspectionStatistics& i = s.statistics;
-  std::fprintf(stderr, "%sros inspect: %lld frames, logged %lld, mapped %lld, skipped %lld, waiting %lld; %d submaps%s%s",
+  std::fprintf(stderr,
+               "%sros inspect: %lld frames, logged %lld, mapped %lld, skipped %lld, waiting %lld, without navigation "
+               "%lld; %d submaps%s%s",
                isatty(2) ? "\r" : "", static_cast<long long>(i.frames_received),
                static_cast<long long>(i.frames_logged), static_cast<long long>(i.frames_mapped),
-               static_cast<long long>(i.frames_skipped), static_cast<long long>(i.frames_waiting), i.submaps,
+               static_cast<long long>(i.frames_skipped), static_cast<long long>(i.frames_waiting),
+               static_cast<long long>(i.frames_without_navigation), i.submaps,
                s.master_reachable ? "" : "; ROS master lost", isatty(2) ? "   " : "\n");
 }
 
@@ -154,6 +158,10 @@ void RunRosInspect(const RosInspectArgs& a) {
               static_cast<long long>(i.frames_without_navigation), static_cast<long long>(s.frames_undecodable),
               static_cast<long long>(s.navigation_samples), static_cast<long long>(s.sweeps_published),
               static_cast<long long>(s.maps_published), i.submaps, s.stop_reason.c_str());
+  if (i.frames_without_navigation > 0) {
+    std::printf("ros inspect: %lld frames logged but not mapped: no navigation around their time\n",
+                static_cast<long long>(i.frames_without_navigation));
+  }
   std::printf("ros inspect: scanner from %s; camera mount from %s\n",
               s.described ? "the dive description" : "the scanner file", s.mount.c_str());
   if (!a.map.empty()) perception::WriteCloud(a.map, s.result.map, true);
@@ -190,6 +198,7 @@ void AddRosCommands(CLI::App& app) {
     a->ros_arguments = cmd->remaining();
     RunRosInspect(*a);
   });
+  AddRosRecognizeCommand(*ros);
 }
 
 }  // namespace uwscan::app

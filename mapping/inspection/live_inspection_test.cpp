@@ -304,6 +304,45 @@ TEST_F(LiveInspectionTest, FramesInANavigationDropoutAreCountedNotMapped) {
   ExpectBalanced(s);
 }
 
+// Navigation that stops: the frames after it do not pile up in the mapper (memory bounded by
+// the frames of max_navigation_gap_s + navigation_latency_s); they are left out and counted as
+// they would be at the end anyway, and every one is logged.
+TEST_F(LiveInspectionTest, FramesAfterTheNavigationStoppedAreLeftOutWithoutPilingUp) {
+  InspectionOptions options = Options();
+  options.fixed_scanner = false;
+  options.live_queue_frames = 100000;
+  const fs::path log = dir_ / "stopped.db";
+  LiveInspection inspection(*header_, log, Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  const double stop_s = 0.5;
+  inspection.AddNavigation({0.0, Eigen::Isometry3d::Identity()});
+  inspection.AddNavigation({stop_s, Eigen::Isometry3d::Identity()});
+  const std::int64_t n = 4000;  // 11.8 s at 339 frames/s
+  std::int64_t before_stop = 0;
+  for (std::int64_t k = 0; k < n; ++k) {
+    InspectionFrame f = Frame(k);
+    before_stop += f.record.time_s <= stop_s ? 1 : 0;
+    inspection.Push(std::move(f));
+  }
+  // The frames of the last 2 s (gap + latency) may still wait; all older ones are decided.
+  const MapperOptions mapper;
+  const double window_s = mapper.max_navigation_gap_s + mapper.navigation_latency_s;
+  const std::int64_t last_window = static_cast<std::int64_t>(std::ceil(window_s * 339.0)) + 2;
+  InspectionStatistics s = inspection.statistics();
+  for (int i = 0; i < 3000 && s.frames_waiting > last_window; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    s = inspection.statistics();
+  }
+  EXPECT_LE(s.frames_waiting, last_window);
+  EXPECT_GE(s.frames_without_navigation, n - before_stop - last_window);
+  ExpectBalanced(s);
+  s = inspection.Finish().statistics;
+  EXPECT_EQ(s.frames_mapped, before_stop);
+  EXPECT_EQ(s.frames_without_navigation, n - before_stop);
+  EXPECT_EQ(s.frames_logged, n);
+  EXPECT_EQ(DiveLogReader(log).ReadNavigation().size(), 2u);  // the navigation is logged too
+  ExpectBalanced(s);
+}
+
 TEST_F(LiveInspectionTest, FramesWithoutAnyNavigationFailClearly) {
   InspectionOptions options = Options();
   options.fixed_scanner = false;

@@ -84,6 +84,7 @@ void MapperOptions::Check() const {
   if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
   if (!(slide_sigma_m >= 0.0)) fail("slide_sigma_m", ">= 0 m");
   if (!(max_navigation_gap_s > 0.0 && std::isfinite(max_navigation_gap_s))) fail("max_navigation_gap_s", "> 0 s");
+  if (!(navigation_latency_s >= 0.0 && std::isfinite(navigation_latency_s))) fail("navigation_latency_s", ">= 0 s");
   if (threads < 0) fail("threads", ">= 0");
   perception::IcpOptions icp;
   icp.max_correspondence_distance_m = icp_distances_m;
@@ -175,7 +176,10 @@ void Mapper::Impl::Drain(bool finishing) {
     if (navigation.Covers(t)) {
       place = navigation.GapAround(t) <= options.max_navigation_gap_s;
     } else if (navigation.empty() || t > navigation.last_time_s()) {
-      if (!finishing) break;  // waits for the navigation to reach it; at the end none will
+      // Waits for the navigation to reach it, unless it cannot be placed whatever comes: at the
+      // end, or when frames much newer arrived (MapperOptions::navigation_latency_s).
+      const bool hopeless = waiting.back().time_s - t > options.max_navigation_gap_s + options.navigation_latency_s;
+      if (!finishing && !hopeless) break;
     }  // else: before the first sample, never covered
     if (place) {
       Place(waiting.front());

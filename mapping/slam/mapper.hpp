@@ -77,6 +77,12 @@ struct MapperOptions {
   // interpolated pose is a guess, so such a frame is left out and counted, as is one before the
   // first sample or, at Finish, after the last (MapperStats::frames_without_navigation).
   double max_navigation_gap_s = 1.0;
+  // How far behind the frames the navigation may arrive (seconds, >= 0). A frame the
+  // navigation has not reached once frames this much plus max_navigation_gap_s newer have come
+  // is left out at once: the next sample, when it comes, is more than the gap away from the
+  // last one before the frame, so the frame would be left out anyway. Frames then never pile up
+  // waiting for a navigation that stopped.
+  double navigation_latency_s = 1.0;
   int threads = 0;                    // OpenMP threads of ICP and normals, 0 = default
   void Check() const;
 };

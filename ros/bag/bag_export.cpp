@@ -1,9 +1,13 @@
 #include "ros/bag/bag_export.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <ctime>
+#include <fstream>
 
 #include "mapping/log/dive_log.hpp"
+#include "ros/bag/report_export.hpp"
 #include "ros/bridge/bag_file.hpp"
 #include "ros/conversions/dive_description.hpp"
 #include "ros/conversions/frame_image.hpp"
@@ -22,10 +26,46 @@ double UnixSeconds(const std::string& utc) {
   return static_cast<double>(::timegm(&tm));
 }
 
-double TimeOrigin(const mapping::DiveLogReader& reader, double first_time_s) {
-  if (first_time_s >= kUnixTimeFloor_s) return 0.0;
+// 0 for a log in Unix time, else its creation time (whole seconds).
+double TimeOrigin(const mapping::DiveLogReader& reader) {
+  double first_s = reader.frame_count() > 0 ? reader.ReadFrame(0).time_s : kUnixTimeFloor_s;
+  const std::vector<mapping::NavigationRecord> navigation = reader.ReadNavigation();
+  if (!navigation.empty()) first_s = std::min(first_s, navigation.front().time_s);
+  if (first_s >= kUnixTimeFloor_s) return 0.0;
   const double created = UnixSeconds(reader.header().created_utc);
   return created > 0.0 ? created : kUnixTimeFloor_s;
+}
+
+bool IsSqlite(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[16] = {};
+  in.read(magic, sizeof(magic));
+  return in.gcount() == 16 && std::string(magic, 15) == "SQLite format 3";
+}
+
+std::string ReportKind(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  try {
+    return nlohmann::json::parse(in).value("kind", "");
+  } catch (const nlohmann::json::exception&) {
+    throw Error(path.string() + ": neither a dive log (SQLite) nor a JSON report");
+  }
+}
+
+// The origin of the first dive log, else of the log the first map report names.
+double TimeOriginOf(const std::vector<std::filesystem::path>& inputs) {
+  for (const std::filesystem::path& input : inputs) {
+    if (IsSqlite(input)) return TimeOrigin(mapping::DiveLogReader(input));
+  }
+  for (const std::filesystem::path& input : inputs) {
+    std::ifstream in(input);
+    const nlohmann::json report = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (report.is_object() && report.contains("log") && report["log"].is_string() &&
+        std::filesystem::is_regular_file(report["log"].get<std::string>())) {
+      return TimeOrigin(mapping::DiveLogReader(report["log"].get<std::string>()));
+    }
+  }
+  return kUnixTimeFloor_s;
 }
 
 ImageMessage FrameMessage(const mapping::FrameRecord& frame, const scanner::acquisition::ProfileLayout& layout,
@@ -44,24 +84,24 @@ void WriteNavigation(const mapping::NavigationRecord& nav, double origin_s, cons
   bag.Write(o.topics.tf, std::vector<TransformMessage>{{header, o.frames.base_link, nav.T_W_V}}, header.stamp_s);
 }
 
-BagExportSummary Export(const mapping::DiveLogReader& reader, BagWriter& bag, const BagExportOptions& o) {
-  BagExportSummary summary;
+// The profile layout that carries every frame of the log whole.
+scanner::acquisition::ProfileLayout LayoutOf(const mapping::DiveLogReader& reader) {
   ProfileLayoutFinder finder;
-  std::optional<double> first_time_s;
   reader.ForEachFrame(
       [&](const mapping::FrameRecord& f, const mapping::GroundTruthRecord*) {
-        if (!first_time_s) first_time_s = f.time_s;
         if (!f.image) finder.Add(f);
       },
       false);
-  const std::vector<mapping::NavigationRecord> navigation = reader.ReadNavigation();
-  if (!first_time_s) throw Error(reader.path().string() + ": the log holds no frames");
-  summary.layout = finder.Layout(reader.header().scanner.camera().camera);
-  summary.time_origin_s = TimeOrigin(reader, std::min(*first_time_s, navigation.empty() ? *first_time_s
-                                                                                        : navigation.front().time_s));
-  const double start_s = summary.time_origin_s + *first_time_s;
+  return finder.Layout(reader.header().scanner.camera().camera);
+}
 
-  DiveDescription description{reader.header(), summary.time_origin_s};
+void ExportDive(const std::filesystem::path& log, double origin_s, const BagExportOptions& o, BagWriter& bag,
+                BagExportSummary& summary) {
+  const mapping::DiveLogReader reader(log);
+  if (reader.frame_count() == 0) throw Error(log.string() + ": the log holds no frames");
+  summary.layout = LayoutOf(reader);
+  const double start_s = origin_s + reader.ReadFrame(0).time_s;
+  DiveDescription description{reader.header(), origin_s};
   description.header.producer = o.producer;
   bag.Write(o.topics.dive, StringMessage{DiveDescriptionToYaml(description)}, start_s, true);
   const Eigen::Isometry3d T_V_C = reader.vehicle_mount().value_or(Eigen::Isometry3d::Identity());
@@ -69,24 +109,43 @@ BagExportSummary Export(const mapping::DiveLogReader& reader, BagWriter& bag, co
             start_s);
   reader.ForEachFrame(
       [&](const mapping::FrameRecord& f, const mapping::GroundTruthRecord*) {
-        bag.Write(o.topics.frames, FrameMessage(f, summary.layout, summary.time_origin_s, o.frames));
+        bag.Write(o.topics.frames, FrameMessage(f, summary.layout, origin_s, o.frames));
         ++summary.frames;
         if (f.image) ++summary.images;
       },
       false);
-  for (const mapping::NavigationRecord& nav : navigation) WriteNavigation(nav, summary.time_origin_s, o, bag);
-  summary.navigation = static_cast<std::int64_t>(navigation.size());
-  return summary;
+  const std::vector<mapping::NavigationRecord> navigation = reader.ReadNavigation();
+  for (const mapping::NavigationRecord& nav : navigation) WriteNavigation(nav, origin_s, o, bag);
+  summary.navigation += static_cast<std::int64_t>(navigation.size());
+}
+
+void ExportInput(const std::filesystem::path& input, const BagExportOptions& o, BagWriter& bag,
+                 BagExportSummary& summary) {
+  if (IsSqlite(input)) return ExportDive(input, summary.time_origin_s, o, bag, summary);
+  const std::string kind = ReportKind(input);
+  if (kind == "map_report") {
+    const ReportExportSummary r = ExportMapReport(input, summary.time_origin_s, o, bag);
+    summary.anchors += r.anchors;
+    summary.map_points += r.map_points;
+  } else if (kind == "recognition_report") {
+    throw Error(input.string() + ": recognition reports are not exported to bags yet");
+  } else {
+    throw Error(input.string() + ": a JSON file that is not a map report (kind '" + kind + "')");
+  }
 }
 
 }  // namespace
 
-BagExportSummary ExportDiveLog(const std::filesystem::path& log, const std::filesystem::path& bag_path,
-                               const BagExportOptions& options) {
-  const mapping::DiveLogReader reader(log);
+BagExportSummary ExportToBag(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& bag_path,
+                             const BagExportOptions& options) {
+  for (const std::filesystem::path& input : inputs) {
+    if (!std::filesystem::is_regular_file(input)) throw Error(input.string() + ": no such file");
+  }
+  BagExportSummary summary;
+  summary.time_origin_s = TimeOriginOf(inputs);
   BagWriter bag(bag_path.string());
   try {
-    BagExportSummary summary = Export(reader, bag, options);
+    for (const std::filesystem::path& input : inputs) ExportInput(input, options, bag, summary);
     bag.Close();
     return summary;
   } catch (...) {

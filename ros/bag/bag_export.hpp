@@ -3,14 +3,17 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "ros/conversions/ros_names.hpp"
 #include "scanner/acquisition/frame_encoding.hpp"
 
-// A dive log written as a ROS 1 bag, as the vehicle would have recorded it: the camera's frames
-// as images (frame_image.hpp), the navigation as nav_msgs/Odometry and on /tf, the camera's
-// mount on /tf_static and the scanner in the dive description (dive_description.hpp), so that
-// `uwscan bag import` needs no --scanner and `rosbag play` feeds `uwscan ros inspect`.
+// Dive logs and map reports written as one ROS 1 bag. A dive log goes in as the vehicle would
+// have recorded it: the camera's frames as images (frame_image.hpp), the navigation as
+// nav_msgs/Odometry and on /tf, the camera's mount on /tf_static and the scanner in the dive
+// description (dive_description.hpp), so that `uwscan bag import` needs no --scanner and
+// `rosbag play` feeds `uwscan ros inspect`. A map report goes in as the node would have published
+// it (report_export.hpp), so that a mapped dive replays in RViz.
 namespace uwscan::ros {
 
 struct BagExportOptions {
@@ -23,14 +26,19 @@ struct BagExportSummary {
   std::int64_t frames = 0;
   std::int64_t images = 0;  // of them, sent as images (the log kept them); the rest as profiles
   std::int64_t navigation = 0;
-  double time_origin_s = 0.0;  // ROS time of the log's time 0
+  std::int64_t anchors = 0;     // map reports' submap anchors
+  std::int64_t map_points = 0;  // map reports' maps
+  double time_origin_s = 0.0;   // ROS time of the logs' time 0
   scanner::acquisition::ProfileLayout layout;
 };
 
-// Writes `bag` (which must not exist) from `log`. A log whose times are not Unix times (a
-// simulated dive counts from 0) is placed at its creation time: ROS time = log time +
-// time_origin_s. Throws uwscan::Error naming the file on any failure; the bag is then removed.
-BagExportSummary ExportDiveLog(const std::filesystem::path& log, const std::filesystem::path& bag,
-                               const BagExportOptions& options);
+// Writes `bag` (which must not exist) from `inputs`: dive logs (SQLite) and map reports (JSON),
+// told apart by their content. Times: ROS time = log time + time_origin_s, where the origin is
+// 0 for a log whose times are Unix times and its creation time for one that counts from 0 (a
+// simulated dive): the first dive log's, else that of the log a map report names. Throws
+// uwscan::Error naming the file on any failure (a recognition report: not exported yet); the bag
+// is then removed.
+BagExportSummary ExportToBag(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& bag,
+                             const BagExportOptions& options);
 
 }  // namespace uwscan::ros

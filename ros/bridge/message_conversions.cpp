@@ -191,6 +191,53 @@ sensor_msgs::PointCloud2 ToRos(const CloudMessage& m) {
   return out;
 }
 
+CloudMessage FromRos(const sensor_msgs::PointCloud2& m) {
+  CloudMessage out;
+  out.header = FromRos(m.header);
+  const std::string what = "sensor_msgs/PointCloud2 in " + m.header.frame_id;
+  if (m.is_bigendian != 0) throw Error(what + ": big-endian clouds are not read");
+  std::uint32_t offsets[3] = {};
+  bool doubles[3] = {};
+  const char* names[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    bool found = false;
+    for (const sensor_msgs::PointField& f : m.fields) {
+      if (f.name != names[k]) continue;
+      if (f.datatype != sensor_msgs::PointField::FLOAT32 && f.datatype != sensor_msgs::PointField::FLOAT64) {
+        throw Error(what + ": field " + f.name + " is neither float32 nor float64");
+      }
+      offsets[k] = f.offset;
+      doubles[k] = f.datatype == sensor_msgs::PointField::FLOAT64;
+      found = true;
+    }
+    if (!found) throw Error(what + ": no field " + names[k]);
+  }
+  const std::size_t points = static_cast<std::size_t>(m.width) * m.height;
+  if (m.data.size() < static_cast<std::size_t>(m.row_step) * m.height || m.row_step < m.point_step * m.width ||
+      (points > 0 && m.point_step < 12)) {
+    throw Error(what + ": data of " + std::to_string(m.data.size()) + " bytes does not hold " +
+                std::to_string(points) + " points");
+  }
+  for (std::uint32_t row = 0; row < m.height; ++row) {
+    for (std::uint32_t col = 0; col < m.width; ++col) {
+      const std::uint8_t* p = m.data.data() + static_cast<std::size_t>(row) * m.row_step +
+                              static_cast<std::size_t>(col) * m.point_step;
+      Eigen::Vector3f v;
+      for (int k = 0; k < 3; ++k) {
+        if (doubles[k]) {
+          double d = 0.0;
+          std::memcpy(&d, p + offsets[k], 8);
+          v[k] = static_cast<float>(d);
+        } else {
+          std::memcpy(&v[k], p + offsets[k], 4);
+        }
+      }
+      if (v.allFinite()) out.points.push_back(v);
+    }
+  }
+  return out;
+}
+
 nav_msgs::Path ToRos(const PathMessage& m) {
   nav_msgs::Path out;
   out.header = ToRos(m.header);

@@ -35,6 +35,10 @@ std::vector<TransformMessage> FromRos(const tf2_msgs::TFMessage& message);
 tf2_msgs::TFMessage ToRos(const std::vector<TransformMessage>& transforms);
 
 sensor_msgs::PointCloud2 ToRos(const CloudMessage& message);
+// Fields x, y, z (float32 or float64); points with a non-finite coordinate are left out.
+// Throws uwscan::Error when a coordinate field is missing, of another type, or the data is
+// shorter than its shape says.
+CloudMessage FromRos(const sensor_msgs::PointCloud2& message);
 nav_msgs::Path ToRos(const PathMessage& message);
 geometry_msgs::PoseWithCovarianceStamped ToRos(const PoseMessage& message);
 geometry_msgs::PoseArray ToRos(const PoseArrayMessage& message);

@@ -63,11 +63,17 @@ struct RosConnection::Impl {
   std::vector<Registration> published, subscribed;
   bool master_lost = false;
   int reregistrations = 0;
+  std::function<void(std::exception_ptr)> on_error;  // set before Start
 
   template <typename RosMessage, typename Message>
   void Subscribe(const std::string& topic, int queue, std::function<void(Message&&)> callback) {
-    auto handler = [callback = std::move(callback)](const boost::shared_ptr<const RosMessage>& m) {
-      callback(FromRos(*m));
+    auto handler = [this, topic, callback = std::move(callback)](const boost::shared_ptr<const RosMessage>& m) {
+      // An exception must not reach roscpp's spinner thread (it would end the process).
+      try {
+        callback(FromRos(*m));
+      } catch (const std::exception& e) {
+        if (on_error) on_error(std::make_exception_ptr(Error("topic " + topic + ": " + e.what())));
+      }
     };
     subscribers.push_back(node->subscribe<RosMessage>(topic, static_cast<std::uint32_t>(queue), handler,
                                                       ::ros::VoidConstPtr(), ::ros::TransportHints().tcpNoDelay()));
@@ -142,6 +148,10 @@ bool RosConnection::Param(const std::string& name, bool fallback) const {
   return GetParam(*impl_->private_node, name, fallback);
 }
 
+void RosConnection::SetErrorHandler(std::function<void(std::exception_ptr)> handler) {
+  impl_->on_error = std::move(handler);
+}
+
 void RosConnection::SubscribeImages(const std::string& topic, int queue, std::function<void(ImageMessage&&)> callback) {
   impl_->Subscribe<sensor_msgs::Image>(topic, queue, std::move(callback));
 }
@@ -151,6 +161,9 @@ void RosConnection::SubscribeOdometry(const std::string& topic, int queue,
 }
 void RosConnection::SubscribeText(const std::string& topic, std::function<void(StringMessage&&)> callback) {
   impl_->Subscribe<std_msgs::String>(topic, 10, std::move(callback));
+}
+void RosConnection::SubscribeClouds(const std::string& topic, int queue, std::function<void(CloudMessage&&)> callback) {
+  impl_->Subscribe<sensor_msgs::PointCloud2>(topic, queue, std::move(callback));
 }
 void RosConnection::SubscribeTransforms(const std::string& topic,
                                         std::function<void(std::vector<TransformMessage>&&)> callback) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <exception>
 #include <functional>
 #include <memory>
 #include <string>
@@ -34,10 +35,14 @@ class RosConnection {
   bool Param(const std::string& name, bool fallback) const;
 
   // Callbacks run on the connection's spinner threads (Start), one message at a time per
-  // topic, in arrival order. `queue`: messages roscpp holds while a callback runs.
+  // topic, in arrival order. `queue`: messages roscpp holds while a callback runs. A message
+  // that does not convert (a NaN pose, a cloud without x) goes to the error handler instead,
+  // as a uwscan::Error naming the topic; without a handler it is dropped.
+  void SetErrorHandler(std::function<void(std::exception_ptr)> handler);
   void SubscribeImages(const std::string& topic, int queue, std::function<void(ImageMessage&&)> callback);
   void SubscribeOdometry(const std::string& topic, int queue, std::function<void(OdometryMessage&&)> callback);
   void SubscribeText(const std::string& topic, std::function<void(StringMessage&&)> callback);
+  void SubscribeClouds(const std::string& topic, int queue, std::function<void(CloudMessage&&)> callback);
   void SubscribeTransforms(const std::string& topic, std::function<void(std::vector<TransformMessage>&&)> callback);
 
   // Ends every subscription; when it returns, no callback runs or will run (a callback in

@@ -20,7 +20,8 @@ struct RosTopics {
   std::string sweeps = "/uwscan/sweep";             // sensor_msgs/PointCloud2, camera frame
   std::string map = "/uwscan/map";                  // sensor_msgs/PointCloud2, map frame, latched
   std::string slam_path = "/uwscan/path";           // nav_msgs/Path, map frame
-  std::string navigation_path = "/uwscan/navigation_path";  // nav_msgs/Path, odom frame
+  std::string navigation_path = "/uwscan/navigation_path";  // nav_msgs/Path, map frame
+  std::string truth_path = "/uwscan/truth_path";            // nav_msgs/Path, map frame (simulated dives)
   std::string pose = "/uwscan/pose";  // geometry_msgs/PoseWithCovarianceStamped, map frame
 };
 

@@ -381,7 +381,10 @@ namespace {
 // outlet), the outlet, the intake, the listener.
 struct Node {
   explicit Node(RosConnection& r) : ros(r) {}
-  ~Node() { ros.Unsubscribe(); }
+  ~Node() {
+    ros.Unsubscribe();
+    ros.SetErrorHandler({});
+  }
   Node(const Node&) = delete;
   Node& operator=(const Node&) = delete;
 
@@ -448,6 +451,7 @@ InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNode
                                         const std::function<void(const InspectionNodeStatus&)>& status) {
   o.Check();
   Node node(ros);
+  ros.SetErrorHandler([&node](std::exception_ptr e) { node.failure.Set(std::move(e)); });
   Subscribe(node, o);
   ros.Start(2);
   const DiveSetup setup = node.listener->Wait(node.failure, stop_requested);

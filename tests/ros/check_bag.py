@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Reads a bag with ROS's own Python reader (python3-rosbag), independently of uwscan's C++ one,
 and prints one JSON line per topic: type, message count, first and last header stamp, frame ids
-seen, and whether header stamps never go back. Used by tests/cli_ros_test.cpp."""
+seen, whether header stamps never go back, and for some types what they hold (the last path's
+positions, the last marker array's labels, every pose's position). Used by tests/cli_ros_test.cpp."""
 import json
 import sys
 
@@ -32,6 +33,11 @@ def main():
                 entry["children"].append(pair)
         if hasattr(message, "child_frame_id") and message.child_frame_id not in entry["children"]:
             entry["children"].append(message.child_frame_id)
+        if hasattr(message, "markers"):
+            entry["last_labels"] = [m.text for m in message.markers if m.text]
+        if message._type == "geometry_msgs/PoseWithCovarianceStamped":
+            p = message.pose.pose.position
+            entry.setdefault("positions", []).append([p.x, p.y, p.z])
         if topic.endswith("/path") and hasattr(message, "poses"):
             entry["last_path"] = [[p.header.stamp.to_sec(), p.pose.position.x, p.pose.position.y,
                                    p.pose.position.z] for p in message.poses]
