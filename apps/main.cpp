@@ -16,6 +16,7 @@
 #include "apps/bench/slam_bench_command.hpp"
 #include "apps/bench/stripe_commands.hpp"
 #include "apps/bench/thread_bench_command.hpp"
+#include "apps/cli/data_folder.hpp"
 #include "apps/mapping/inspect_command.hpp"
 #include "apps/mapping/log_commands.hpp"
 #include "apps/mapping/map_command.hpp"
@@ -46,6 +47,16 @@ __attribute__((section(".preinit_array"), used)) static void (*const kPreinit)(i
 int main(int argc, char** argv) {
   CLI::App app{"uwscan: underwater laser scanner perception toolkit"};
   app.set_version_flag("--version", std::string("uwscan ") + UWSCAN_VERSION);
+  // For paths to the shipped scenes and scanners in scripts: "$(uwscan --data-dir)/scenes/...".
+  app.add_flag_callback(
+      "--data-dir",
+      [] {
+        std::printf("%s\n", uwscan::app::DataFolder().c_str());
+        throw CLI::Success();
+      },
+      "Print the folder of uwscan's data (scanners, scenes, GenICam XML, RViz configuration) and "
+      "exit: $UWSCAN_DATA_DIR, else share/uwscan of the installed program, else the source "
+      "tree's data/");
   app.require_subcommand(1);
 
   uwscan::app::AddDemoCommand(app);

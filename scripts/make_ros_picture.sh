@@ -26,5 +26,6 @@ until rostopic info /uwscan/frames 2>/dev/null | grep -q uwscan_inspection; do s
 sleep 8  # RViz's first frames
 rosbag play --quiet "$tmp/dive.bag" >/dev/null 2>&1
 sleep 3
-xwd -root -silent | xwdtopnm 2>/dev/null | pnmtopng > docs/ros_rviz.png
+# The 3-D view only, without RViz's panels.
+xwd -root -silent | xwdtopnm 2>/dev/null | pnmcut -left 366 -top 64 -width 1016 -height 800 | pnmtopng > docs/ros_rviz.png
 echo "docs/ros_rviz.png: written"

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
@@ -16,7 +17,7 @@ namespace {
 
 struct AccuracyArgs {
   std::string json_path;
-  std::string data_dir = "data";
+  std::string data_dir;  // empty: DataFolder()
   bool quick = false;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -40,8 +41,9 @@ void RunAccuracy(const AccuracyArgs& a) {
     }
   }
   bench::AccuracyBenchOptions o;
-  o.galvo_scanner = std::filesystem::path(a.data_dir) / "scanners" / "galvo_default.yaml";
-  o.mems_scanner = std::filesystem::path(a.data_dir) / "scanners" / "mems_default.yaml";
+  const std::filesystem::path data = DataFolderOr(a.data_dir);
+  o.galvo_scanner = data / "scanners" / "galvo_default.yaml";
+  o.mems_scanner = data / "scanners" / "mems_default.yaml";
   o.seed = a.seed;
   o.threads = a.threads;
   if (a.quick) {  // a smoke run: every experiment, a few positions each
@@ -126,7 +128,8 @@ void AddAccuracyBenchCommand(CLI::App& bench) {
   CLI::App* cmd = bench.add_subcommand(
       "accuracy", "the seeds' accuracy experiments in simulation: gauges, plane, sphere, waypoints");
   cmd->add_option("--json", args->json_path, "write the figures as JSON");
-  cmd->add_option("--data", args->data_dir, "data folder holding scanners/ (default: data)");
+  cmd->add_option("--data", args->data_dir,
+                  "data folder holding scanners/ (default: `uwscan --data-dir`)");
   cmd->add_flag("--quick", args->quick, "a few positions per experiment (smoke test)");
   cmd->add_option("--seed", args->seed, "noise seed");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <regex>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "apps/cli/data_cache.hpp"
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/scanner/camera_frames.hpp"
 #include "mapping/inspection/live_inspection.hpp"
@@ -34,8 +36,8 @@ namespace acq = scanner::acquisition;
 struct AcquisitionBenchArgs {
   std::string json;
   double seconds = 4.0;
-  std::string profile_scene = "data/scenes/default.yaml";
-  std::string image_scene = "data/scenes/camera_image.yaml";
+  std::string profile_scene;  // empty: scenes/default.yaml in DataFolder()
+  std::string image_scene;    // empty: scenes/camera_image.yaml in DataFolder()
 };
 
 struct StreamFigures {
@@ -203,7 +205,11 @@ void Print(const char* name, const StreamFigures& f) {
   std::printf("\n");
 }
 
-void RunAcquisitionBench(const AcquisitionBenchArgs& a) {
+void RunAcquisitionBench(AcquisitionBenchArgs a) {
+  if (a.profile_scene.empty())
+    a.profile_scene = (DataFolder() / "scenes" / "default.yaml").string();
+  if (a.image_scene.empty())
+    a.image_scene = (DataFolder() / "scenes" / "camera_image.yaml").string();
   if (!(a.seconds >= 2.0 && a.seconds <= 600.0)) throw Error("--seconds must be in [2, 600]");
   // A private network namespace (root only): nothing leaves the machine and nothing else on
   // this host's loopback competes. Must come before any thread is started.
@@ -273,10 +279,14 @@ void AddAcquisitionBenchCommand(CLI::App& bench) {
                      "profile and image mode, with arv-camera-test-0.8 as the peer");
   cmd->add_option("--json", args->json, "write the figures as JSON");
   cmd->add_option("--seconds", args->seconds, "seconds per run")->capture_default_str();
-  cmd->add_option("--profile-scene", args->profile_scene, "scene served in profile mode")
-      ->capture_default_str()->check(CLI::ExistingFile);
-  cmd->add_option("--image-scene", args->image_scene, "scene served in image mode (renders frames)")
-      ->capture_default_str()->check(CLI::ExistingFile);
+  cmd->add_option("--profile-scene", args->profile_scene,
+                  "scene served in profile mode (default: scenes/default.yaml in the data folder, "
+                  "`uwscan --data-dir`)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--image-scene", args->image_scene,
+                  "scene served in image mode, which renders frames (default: "
+                  "scenes/camera_image.yaml in the data folder)")
+      ->check(CLI::ExistingFile);
   cmd->callback([args] { RunAcquisitionBench(*args); });
 }
 

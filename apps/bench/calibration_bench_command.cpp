@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
@@ -21,7 +22,7 @@ constexpr double kGaugeRatioTarget = 1.5;
 
 struct CalibrationBenchArgs {
   std::string json_path;
-  std::string data_dir = "data";
+  std::string data_dir;  // empty: DataFolder()
   bool quick = false;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -39,7 +40,7 @@ void RunCalibrationBench(const CalibrationBenchArgs& a) {
     }
   }
   bench::CalibrationBenchOptions o;
-  o.data_dir = a.data_dir;
+  o.data_dir = DataFolderOr(a.data_dir);
   o.seed = a.seed;
   o.threads = a.threads;
   if (a.quick) o.gauge_positions = 3;
@@ -95,7 +96,8 @@ void AddCalibrationBenchCommand(CLI::App& bench) {
   CLI::App* cmd = bench.add_subcommand(
       "calibration", "every calibration step on simulated datasets: recovered vs true, and gauges");
   cmd->add_option("--json", args->json_path, "write the figures as JSON");
-  cmd->add_option("--data", args->data_dir, "data folder holding scenes/ and scanners/ (default: data)");
+  cmd->add_option("--data", args->data_dir,
+                  "data folder holding scenes/ and scanners/ (default: `uwscan --data-dir`)");
   cmd->add_flag("--quick", args->quick, "3 gauge positions instead of 29 (smoke test)");
   cmd->add_option("--seed", args->seed, "noise seed of the gauge experiment");
   cmd->add_option("--threads", args->threads, "threads (0: all cores)")->check(kNonNegativeNumber);

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
@@ -18,10 +19,12 @@ namespace {
 struct RobustnessArgs {
   std::string json;
   std::string write_seeds;
+  std::string data;  // empty: DataFolder()
   bench::RobustnessOptions options;
 };
 
-void Run(const RobustnessArgs& a) {
+void Run(RobustnessArgs a) {
+  a.options.data_dir = DataFolderOr(a.data);
   if (!a.write_seeds.empty()) {
     bench::WriteReaderSeeds(a.options.data_dir, a.write_seeds);
     std::printf("seeds written to %s\n", a.write_seeds.c_str());
@@ -85,7 +88,8 @@ void AddRobustnessBenchCommand(CLI::App& bench) {
   cmd->add_option("--timeout", args->options.timeout_s, "seconds after which a read counts as a hang")
       ->check(kPositiveNumber);
   cmd->add_option("--seed", args->options.seed, "random seed of the mutations");
-  cmd->add_option("--data", args->options.data_dir, "the data folder (scenes/, scanners/)");
+  cmd->add_option("--data", args->data,
+                  "the data folder (scenes/, scanners/; default: `uwscan --data-dir`)");
   cmd->add_option("--write-seeds", args->write_seeds, "only write the seed files into this folder and stop");
   cmd->callback([args] { Run(*args); });
 }

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
@@ -17,7 +18,7 @@ namespace {
 
 struct SimulationBenchArgs {
   std::string json_path;
-  std::string data_dir = "data";
+  std::string data_dir;  // empty: DataFolder()
   int frames = 12;
 };
 
@@ -29,16 +30,18 @@ void RunSimulationBench(const SimulationBenchArgs& a) {
     }
   }
   bench::SimulationBenchOptions o;
-  o.data_dir = a.data_dir;
+  o.data_dir = DataFolderOr(a.data_dir);
   o.frames = a.frames;
   bench::SimulationBenchResult r;
   {
     ProgressBar bar;
     r = bench::RunSimulationBenchmark(o, bar.Callback());
   }
-  std::printf("Simulation cost per effect: %d frames of each scene (galvo: data/scenes/default.yaml, "
-              "MEMS: mems_plane.yaml), one thread, fastest of 3 passes; each effect alone on, all others off\n\n",
-              r.frames);
+  std::printf(
+      "Simulation cost per effect: %d frames of each scene (galvo: scenes/default.yaml, "
+      "MEMS: scenes/mems_plane.yaml), one thread, fastest of 3 passes; each effect alone on, all "
+      "others off\n\n",
+      r.frames);
   std::printf("| scene | effect | ms / frame | x all off | peaks |\n|---|---|---:|---:|---:|\n");
   nlohmann::json rows = nlohmann::json::array();
   for (const bench::EffectCost& c : r.rows) {
@@ -64,7 +67,8 @@ void AddSimulationBenchCommand(CLI::App& bench) {
   auto args = std::make_shared<SimulationBenchArgs>();
   CLI::App* cmd = bench.add_subcommand("simulation", "time per frame of each simulation effect, alone and all on");
   cmd->add_option("--json", args->json_path, "write the figures as JSON");
-  cmd->add_option("--data", args->data_dir, "data folder holding scenes/ (default: data)");
+  cmd->add_option("--data", args->data_dir,
+                  "data folder holding scenes/ (default: `uwscan --data-dir`)");
   cmd->add_option("--frames", args->frames, "frames timed per row")->check(kPositiveNumber);
   cmd->callback([args] { RunSimulationBench(*args); });
 }

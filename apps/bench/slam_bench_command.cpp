@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <optional>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "apps/cli/data_cache.hpp"
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
@@ -18,8 +20,7 @@ namespace uwscan::app {
 namespace {
 
 struct SlamBenchArgs {
-  std::vector<std::string> scenes = {"data/scenes/inspection_loop.yaml", "data/scenes/inspection_pipe.yaml",
-                                     "data/scenes/inspection_long.yaml", "data/scenes/inspection_loop_mems.yaml"};
+  std::vector<std::string> scenes;  // empty: DefaultScenes()
   std::string json;
   int seeds = 1;
   int threads = 2;
@@ -165,9 +166,17 @@ nlohmann::json SummaryJson(const SceneSummary& s) {
            s.open3d_time_ratio_mean ? nlohmann::json(*s.open3d_time_ratio_mean) : nlohmann::json(nullptr)}};
 }
 
+// The loop, pipe and long dives, and the loop dive with the MEMS scanner, from the data folder.
+std::vector<std::filesystem::path> DefaultScenes() {
+  const std::filesystem::path scenes = DataFolder() / "scenes";
+  return {scenes / "inspection_loop.yaml", scenes / "inspection_pipe.yaml",
+          scenes / "inspection_long.yaml", scenes / "inspection_loop_mems.yaml"};
+}
+
 void RunSlamBench(const SlamBenchArgs& a) {
   bench::SlamBenchOptions options;
   for (const std::string& s : a.scenes) options.scenes.emplace_back(s);
+  if (options.scenes.empty()) options.scenes = DefaultScenes();
   options.threads = a.threads;
   options.seeds = a.seeds;
   options.walk_scale = a.walk_scale;
@@ -215,7 +224,10 @@ void AddSlamBenchCommand(CLI::App& bench) {
   auto a = std::make_shared<SlamBenchArgs>();
   CLI::App* cmd = bench.add_subcommand(
       "slam", "scan-matching SLAM against dead reckoning and Open3D's multiway registration on simulated dives");
-  cmd->add_option("--scene", a->scenes, "dive scenes (default: data/scenes/inspection_loop.yaml, inspection_pipe.yaml, inspection_long.yaml and inspection_loop_mems.yaml, the loop dive with the MEMS scanner)")
+  cmd->add_option("--scene", a->scenes,
+                  "dive scenes (default: inspection_loop.yaml, inspection_pipe.yaml, "
+                  "inspection_long.yaml and inspection_loop_mems.yaml, the loop dive with the MEMS "
+                  "scanner, from scenes/ in the data folder, `uwscan --data-dir`)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--seeds", a->seeds, "dives per scene: its own seed and the next ones (default 1)")
       ->check(kPositiveNumber);

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <string>
 
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
@@ -15,12 +16,14 @@ namespace {
 
 struct ThreadBenchArgs {
   std::string json;
+  std::string data;  // empty: DataFolder()
   bench::ThreadLoadOptions options;
 };
 
 void Run(ThreadBenchArgs a) {
   if (!a.json.empty()) CheckOutputPath(a.json, "--json");
   a.options.uwscan = std::filesystem::read_symlink("/proc/self/exe");
+  a.options.data_dir = DataFolderOr(a.data);
   const bench::ScratchFolder scratch("threads");
   bench::ThreadLoadResult result;
   {
@@ -57,14 +60,13 @@ void Run(ThreadBenchArgs a) {
 
 void AddThreadBenchCommand(CLI::App& bench) {
   auto args = std::make_shared<ThreadBenchArgs>();
-  args->options.data_dir = "data";
   CLI::App* cmd = bench.add_subcommand(
       "threads", "time OpenMP commands with 1 and 2 threads, wait policies PASSIVE (uwscan's default) and ACTIVE, "
                  "idle and with another process busy on the last CPU");
   cmd->add_option("--json", args->json, "write the timings as JSON");
   cmd->add_option("--repeats", args->options.repeats, "runs per configuration (the median is kept)")
       ->check(CLI::Range(1, 100));
-  cmd->add_option("--data", args->options.data_dir, "the data folder (scenes/)");
+  cmd->add_option("--data", args->data, "the data folder (scenes/; default: `uwscan --data-dir`)");
   cmd->callback([args] { Run(*args); });
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "apps/cli/data_cache.hpp"
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "apps/cli/text_file.hpp"
@@ -44,19 +45,8 @@ void WriteDemoScreenshot(const std::filesystem::path& log, const std::string& pn
               png.c_str(), info.points_drawn, info.range->lo * 1e3, info.range->hi * 1e3);
 }
 
-// data/scenes/default.yaml below the working folder (a repository root), else in the data/ folder
-// of the source tree this program was built from.
-std::string DefaultScene() {
-  const std::filesystem::path relative = "data/scenes/default.yaml";
-  if (std::filesystem::is_regular_file(relative)) return relative.string();
-  const std::filesystem::path built = std::filesystem::path(UWSCAN_SOURCE_DATA_DIR) / "scenes/default.yaml";
-  if (std::filesystem::is_regular_file(built)) return built.string();
-  throw Error("no default scene: neither " + relative.string() + " nor " + built.string() +
-              " exists (give --scene)");
-}
-
 void RunDemo(DemoArgs a) {
-  if (a.scene.empty()) a.scene = DefaultScene();
+  if (a.scene.empty()) a.scene = (DataFolder() / "scenes" / "default.yaml").string();
   if (!std::filesystem::is_regular_file(a.scene)) throw Error("--scene " + a.scene + ": no such file");
   if (!a.screenshot.empty()) viewer::RequireDisplay();  // before the run, not after it
   const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
@@ -110,7 +100,9 @@ void AddDemoCommand(CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
   CLI::App* cmd = app.add_subcommand(
       "demo", "simulate the default scene, reconstruct it with every method, compare to truth");
-  cmd->add_option("--scene", args->scene, "scene YAML (default data/scenes/default.yaml here, else in the source tree uwscan was built from)");
+  cmd->add_option(
+      "--scene", args->scene,
+      "scene YAML (default: scenes/default.yaml in the data folder, `uwscan --data-dir`)");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
       ->check(kNonNegativeNumber);
   cmd->add_option("--screenshot", args->screenshot,

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
@@ -62,17 +63,22 @@ struct BenchRun {
   std::string arguments;  // after `uwscan bench`, without --json
 };
 
-// The quick form of every bench: a run in minutes whose figures keep their order.
+// The quick form of every bench: a run in minutes whose figures keep their order. `data` is the
+// --data folder the user gave, or empty: the benches then read the data folder themselves.
 std::vector<BenchRun> QuickBenches(const std::string& data) {
-  return {{"triangulation", "triangulation --points 200000 --sweep-grid-px 1 2 4 8 16 --sweep-rays-per-fan 9 17 35 70"},
-          {"stripe", "stripe --frames 2"},
-          {"deformation", "deformation"},
-          {"accuracy", "accuracy --quick --data " + Quoted(data)},
-          {"calibration", "calibration --quick --data " + Quoted(data)},
-          {"registration", "registration --pairs-per-mesh 1 --no-open3d --sweep-voxel 0.01 0.02 0.04"},
-          {"recognition", "recognition --scans 6 --views 16 --no-images --no-peers"},
-          {"slam", "slam --scene " + Quoted(data + "/scenes/inspection_short.yaml")},
-          {"viewer", "viewer --points 200000 1000000 --frames 3"}};
+  const std::string data_option = data.empty() ? "" : " --data " + Quoted(data);
+  const fs::path slam_scene = DataFolderOr(data) / "scenes" / "inspection_short.yaml";
+  return {
+      {"triangulation",
+       "triangulation --points 200000 --sweep-grid-px 1 2 4 8 16 --sweep-rays-per-fan 9 17 35 70"},
+      {"stripe", "stripe --frames 2"},
+      {"deformation", "deformation"},
+      {"accuracy", "accuracy --quick" + data_option},
+      {"calibration", "calibration --quick" + data_option},
+      {"registration", "registration --pairs-per-mesh 1 --no-open3d --sweep-voxel 0.01 0.02 0.04"},
+      {"recognition", "recognition --scans 6 --views 16 --no-images --no-peers"},
+      {"slam", "slam --scene " + Quoted(slam_scene.string())},
+      {"viewer", "viewer --points 200000 1000000 --frames 3"}};
 }
 
 // Runs this program with `arguments`; its stdout is returned, its stderr (progress) passes.
@@ -89,7 +95,7 @@ std::pair<int, std::string> RunSelf(const std::string& arguments) {
 
 struct ReportArgs {
   std::string output;
-  std::string data = "data";
+  std::string data;  // empty: DataFolder()
   std::vector<std::string> only;
 };
 
@@ -196,7 +202,10 @@ void AddReportCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "report", "run the benches in their quick forms; write DIR/index.md with each table and its chart");
   cmd->add_option("-o,--output", a->output, "folder to write (created)")->required();
-  cmd->add_option("--data", a->data, "the data folder (scanners, scenes) of the accuracy and calibration benches");
+  cmd->add_option(
+      "--data", a->data,
+      "the data folder (scanners, scenes) of the accuracy, calibration and slam benches "
+      "(default: `uwscan --data-dir`)");
   cmd->add_option("--only", a->only, "only these benches (triangulation stripe deformation accuracy calibration "
                                      "registration recognition slam viewer)");
   cmd->callback([a] { RunReport(*a); });
