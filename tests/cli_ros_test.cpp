@@ -488,3 +488,55 @@ TEST(CliRos, AVehiclesOwnBagImportsWithItsScannerAndTopicNames) {
   const MapOutput mapped = Map(log, "vehicle");
   EXPECT_EQ(Dump(mapped.report["figures"]["frames_mapped"]), Dump(original.frame_count()));
 }
+
+namespace {
+
+// A copy of the short dive's bag with one fault (tests/ros/edit_bag.py).
+std::filesystem::path FaultyBag(const std::string& name, const std::string& fault) {
+  const std::filesystem::path bag = TempPath(name + ".bag");
+  const CommandRun run = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/edit_bag.py") + " " +
+                                    ShortBag().string() + " " + bag.string() + " " + fault);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  return bag;
+}
+
+}  // namespace
+
+// Frames of the wrong encoding, or whose stamps go back: refused with one line naming the topic
+// and what is wrong, and no log.
+TEST(CliRos, ImportRefusesWrongEncodingsAndStampsThatGoBack) {
+  const std::filesystem::path log = TempPath("faulty.db");
+  CommandRun run = RunUwscan("bag import " + FaultyBag("rgb", "encoding rgb8").string() + " -o " + log.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("/uwscan/frames: image encoding 'rgb8', expected mono8 or mono16"), std::string::npos)
+      << run.output;
+  EXPECT_FALSE(std::filesystem::exists(log));
+  run = RunUwscan("bag import " + FaultyBag("back", "stamp_back 500").string() + " -o " + log.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("topic /uwscan/frames: stamp"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("goes back"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("(message 500)"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(log));
+}
+
+// The node given frames it cannot read stops with one line naming the topic, exit 1.
+TEST(CliRos, NodeRefusesFramesOfTheWrongEncodingByName) {
+  const NodeRun r = ReplayIntoNode(FaultyBag("rgb_node", "encoding rgb8"), "rgb_node", "");
+  EXPECT_EQ(r.run.exit_code, 1) << r.run.output << r.log;
+  EXPECT_NE(r.log.find("uwscan: error: /uwscan/frames: image encoding 'rgb8'"), std::string::npos) << r.log;
+}
+
+// The camera's topic stops while the navigation goes on: the node says so, and (with
+// --idle-stop-s) ends with every frame it received logged and mapped.
+TEST(CliRos, NodeSaysWhenTheFramesStop) {
+  const NodeRun r = ReplayIntoNode(FaultyBag("frames_stop", "frames_until 8"), "frames_stop", "",
+                                   "--idle-stop-s 6");
+  ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
+  EXPECT_NE(r.log.find("no frame on /uwscan/frames for"), std::string::npos) << r.log;
+  const std::int64_t received = r.report["frames_received"].get<std::int64_t>();
+  EXPECT_GT(received, 750);
+  EXPECT_LT(received, 850);  // 8 s at 100 frames/s
+  EXPECT_EQ(r.report["frames_logged"].get<std::int64_t>(), received);
+  EXPECT_EQ(r.report["frames_mapped"].get<std::int64_t>(), received);
+  EXPECT_EQ(r.report["stop_reason"].get<std::string>().rfind("no frame for 6", 0), 0u) << r.report.dump();
+}

@@ -96,6 +96,20 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
   return o;
 }
 
+// A camera topic silent this long is said so once, on its own line (a camera or driver that
+// stopped while the vehicle goes on).
+constexpr double kSilentFrames_s = 2.0;
+
+void ReportSilence(const ros::InspectionNodeStatus& s, const std::string& topic, bool& reported) {
+  if (s.frames_silent_s >= kSilentFrames_s && !reported) {
+    std::fprintf(stderr, "%sros inspect: no frame on %s for %.1f s (%lld navigation samples so far)\n",
+                 isatty(2) ? "\n" : "", topic.c_str(), s.frames_silent_s, static_cast<long long>(s.navigation_samples));
+  } else if (s.frames_silent_s < kSilentFrames_s && reported) {
+    std::fprintf(stderr, "%sros inspect: frames on %s again\n", isatty(2) ? "\n" : "", topic.c_str());
+  }
+  reported = s.frames_silent_s >= kSilentFrames_s;
+}
+
 void PrintStatus(const ros::InspectionNodeStatus& s) {
   const mapping::InspectionStatistics& i = s.statistics;
   std::fprintf(stderr,
@@ -148,8 +162,13 @@ void RunRosInspect(const RosInspectArgs& a) {
   std::printf("ros inspect: frames on %s, navigation on %s; %s\n", options.topics.frames.c_str(),
               options.topics.odometry.c_str(), a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
   std::fflush(stdout);
-  const ros::InspectionNodeSummary s =
-      ros::RunInspectionNode(ros, options, [] { return StopRequested(); }, PrintStatus);
+  bool silence_reported = false;
+  const ros::InspectionNodeSummary s = ros::RunInspectionNode(
+      ros, options, [] { return StopRequested(); },
+      [&](const ros::InspectionNodeStatus& status) {
+        PrintStatus(status);
+        ReportSilence(status, options.topics.frames, silence_reported);
+      });
   const mapping::InspectionStatistics& i = s.result.statistics;
   std::printf("ros inspect: %lld frames received, %lld logged, %lld mapped, %lld skipped, %lld without navigation, "
               "%lld undecodable; %lld navigation samples; %lld sweeps and %lld maps published; %d submaps (%s)\n",

@@ -438,7 +438,10 @@ std::string Watch(Node& node, const InspectionNodeOptions& o, const std::functio
     if (SecondsSince(last_status) >= 1.0) {
       last_status = Clock::now();
       const bool master = node.ros.KeepRegistered();
-      if (status) status({node.inspection->statistics(), master, SecondsSince(start)});
+      const double silent_s = last_frames > 0 ? SecondsSince(last_frame_change) : 0.0;
+      if (status) {
+        status({node.inspection->statistics(), master, SecondsSince(start), silent_s, node.intake->navigation()});
+      }
     }
   }
   return "failed";

@@ -63,6 +63,8 @@ struct InspectionNodeStatus {
   mapping::InspectionStatistics statistics;
   bool master_reachable = true;
   double seconds = 0.0;  // since frames were first subscribed
+  double frames_silent_s = 0.0;  // since the last frame came (0 before the first)
+  std::int64_t navigation_samples = 0;
 };
 
 // Runs the node on `ros` until `stop_requested` says so, roscpp shuts down, or a limit in
