@@ -28,6 +28,7 @@
 #include "apps/scanner/dive_commands.hpp"
 #include "apps/scanner/object_commands.hpp"
 #include "apps/ros/bag_commands.hpp"
+#include "apps/ros/ros_bench_command.hpp"
 #include "apps/ros/ros_inspect_command.hpp"
 #include "apps/viewer/plot_commands.hpp"
 #include "apps/viewer/view_command.hpp"
@@ -91,6 +92,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddRecognitionBenchCommand(*bench);
   uwscan::app::AddViewerBenchCommand(*bench);
   uwscan::app::AddAcquisitionBenchCommand(*bench);
+  uwscan::app::AddRosBenchCommand(*bench);
   uwscan::app::AddRobustnessBenchCommand(*bench);
   uwscan::app::AddThreadBenchCommand(*bench);
 

@@ -540,3 +540,22 @@ TEST(CliRos, NodeSaysWhenTheFramesStop) {
   EXPECT_EQ(r.report["frames_mapped"].get<std::int64_t>(), received);
   EXPECT_EQ(r.report["stop_reason"].get<std::string>().rfind("no frame for 6", 0), 0u) << r.report.dump();
 }
+
+// bench ros writes every figure its JSON promises; at the seed camera's 339 frames/s the node
+// loses no frame.
+TEST(CliRos, RosBenchWritesItsFiguresAndLosesNoFrame) {
+  const std::filesystem::path json = TempPath("bench_ros.json");
+  const CommandRun run = RunUwscan("bench ros --rates 3.39 --inspect-seconds 5 --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(json);
+  const nlohmann::json r = nlohmann::json::parse(in);
+  const nlohmann::json& node = r["node"];
+  EXPECT_EQ(node["lost_frames"].get<int>(), 0) << r.dump();
+  EXPECT_GT(node["frames_per_s"].get<double>(), 300.0);
+  EXPECT_GT(node["latency_s"]["median"].get<double>(), 0.0);
+  EXPECT_GE(node["latency_s"]["p95"].get<double>(), node["latency_s"]["median"].get<double>());
+  EXPECT_GT(node["peak_rss_bytes"].get<double>(), 1e6);
+  EXPECT_GT(r["direct_inspect"]["frames_per_s"].get<double>(), 0.0);
+  EXPECT_GT(r["offline_map"]["cpu_s_per_frame"].get<double>(), 0.0);
+  EXPECT_TRUE(r["overhead_ratio"].is_number());
+}

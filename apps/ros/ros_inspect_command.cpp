@@ -132,6 +132,7 @@ nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
           {"frames_out_of_order", i.frames_out_of_order},
           {"frames_undecodable", s.frames_undecodable},
           {"navigation_samples", s.navigation_samples},
+          {"receive_span_s", s.receive_span_s},
           {"navigation_logged", i.log.navigation_written},
           {"sweeps_published", s.sweeps_published},
           {"maps_published", s.maps_published},
@@ -142,6 +143,7 @@ nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
           {"mount", s.mount},
           {"time_origin_s", s.time_origin_s},
           {"receive_to_map_s", {{"median", i.receive_to_map.median_s}, {"p95", i.receive_to_map.p95_s}}},
+          {"sweep_latency_s", {{"median", s.sweep_latency_median_s}, {"p95", s.sweep_latency_p95_s}}},
           {"stop_reason", s.stop_reason}};
 }
 

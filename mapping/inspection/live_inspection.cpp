@@ -112,7 +112,7 @@ struct LiveInspection::Impl {
       times = it->second;
       in_mapper.erase(it);
     }
-    if (on_mapped) on_mapped(MappedFrame{frame.index, frame.time_s, frame.sweep, T_W_C, points});
+    if (on_mapped) on_mapped(MappedFrame{frame.index, frame.time_s, frame.sweep, times.receive_time_s, T_W_C, points});
     std::lock_guard<std::mutex> lock(mutex);
     ++stats.frames_mapped;
     --stats.frames_waiting;

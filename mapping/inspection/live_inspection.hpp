@@ -100,6 +100,7 @@ struct MappedFrame {
   std::int64_t index = 0;  // the frame's index in the log (push order)
   double time_s = 0.0;     // its capture time (the camera's clock, as logged)
   int sweep = 0;           // its sweep, as given
+  double receive_time_s = 0.0;  // when it arrived (InspectionFrame::receive_time_s)
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::span<const Eigen::Vector3d> points_W;  // valid during the call
 };

@@ -1,5 +1,6 @@
 #include "ros/node/inspection_node.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <tuple>
 
 #include "mapping/slam/dive_mapping.hpp"
 #include "mapping/slam/mapper.hpp"
@@ -180,6 +182,8 @@ class Intake {
   std::int64_t undecodable() const { return undecodable_.load(); }
   std::int64_t dropped() const { return dropped_.load(); }
   std::int64_t navigation() const { return navigation_.load(); }
+  // From the first frame's arrival to the last one's, seconds (after Close()).
+  double receive_span_s() const { return last_receive_s_ - first_receive_s_; }
 
  private:
   // With frames_mutex_ held.
@@ -194,6 +198,8 @@ class Intake {
       mapping::InspectionFrame f;
       f.record = std::move(*frame);
       f.receive_time_s = UnixNow();
+      if (first_receive_s_ == 0.0) first_receive_s_ = f.receive_time_s;
+      last_receive_s_ = f.receive_time_s;
       // The stamp is the host's clock when it is within a second of it (a live camera), not in
       // a replayed bag.
       if (std::abs(m.header.stamp_s - f.receive_time_s) < 1.0) f.capture_time_s = m.header.stamp_s;
@@ -224,6 +230,7 @@ class Intake {
   double time_origin_s_ = 0.0;
   mapping::LiveInspection* inspection_ = nullptr;
   std::deque<ImageMessage> pending_frames_;
+  double first_receive_s_ = 0.0, last_receive_s_ = 0.0;  // Unix time, frames_mutex_
   std::deque<OdometryMessage> pending_navigation_;
   bool closed_ = false;
   std::atomic<std::int64_t> frames_{0}, undecodable_{0}, dropped_{0}, navigation_{0};
@@ -247,8 +254,8 @@ CloudMessage MapMessage(const perception::PointCloud& map, const Header& header)
 // Publishes what the mapper makes: sweeps, paths, pose, TF and map.
 class Outlet {
  public:
-  Outlet(RosConnection& ros, const InspectionNodeOptions& o, double time_origin_s)
-      : ros_(ros), options_(o), origin_s_(time_origin_s) {
+  Outlet(RosConnection& ros, const InspectionNodeOptions& o, double time_origin_s, int frames_per_sweep)
+      : ros_(ros), options_(o), origin_s_(time_origin_s), frames_per_sweep_(frames_per_sweep) {
     const RosTopics& t = o.topics;
     sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
     map_id_ = ros.Advertise(t.map, RosConnection::Kind::kCloud, true);
@@ -258,14 +265,18 @@ class Outlet {
     tf_id_ = ros.Advertise(t.tf, RosConnection::Kind::kTransforms, false);
   }
 
-  // Mapping thread: a frame placed. A sweep is published when the next one starts, in the
+  // Mapping thread: a frame placed. A sweep is published with its last frame (the scan
+  // pattern's frames per sweep), or when the next one starts if frames of it were lost; in the
   // camera frame at its last frame (each point placed with the navigation at its own frame).
   void OnMapped(const mapping::MappedFrame& f) {
-    if (sweep_ && f.sweep != *sweep_) PublishSweep();
+    if (sweep_ && f.sweep != *sweep_ && !sweep_points_W_.empty()) PublishSweep();
+    if (!sweep_ || f.sweep != *sweep_) frames_in_sweep_ = 0;
     sweep_ = f.sweep;
     sweep_time_s_ = f.time_s;
+    sweep_received_s_ = f.receive_time_s;
     T_W_C_last_ = f.T_W_C;
     sweep_points_W_.insert(sweep_points_W_.end(), f.points_W.begin(), f.points_W.end());
+    if (++frames_in_sweep_ == frames_per_sweep_) PublishSweep();
   }
 
   // Mapping thread: a submap closed.
@@ -289,7 +300,8 @@ class Outlet {
     }
   }
 
-  // After the inspection finished: the last sweep, the final map and paths.
+  // After the inspection finished: the last sweep (if frames of it were lost), the final map
+  // and paths.
   void Finish(const mapping::InspectionResult& r) {
     if (!sweep_points_W_.empty()) PublishSweep();
     if (r.slam.empty()) return;
@@ -300,6 +312,13 @@ class Outlet {
 
   std::int64_t sweeps() const { return sweeps_; }
   std::int64_t maps() const { return maps_; }
+  // Median and 95th percentile of the sweeps' latencies; call once the mapping thread ended.
+  std::pair<double, double> SweepLatency() const {
+    if (sweep_latencies_s_.empty()) return {0.0, 0.0};
+    std::vector<double> sorted = sweep_latencies_s_;
+    std::sort(sorted.begin(), sorted.end());
+    return {sorted[sorted.size() / 2], sorted[std::min(sorted.size() - 1, sorted.size() * 95 / 100)]};
+  }
 
  private:
   Header Stamp(double time_s, const std::string& frame) const { return {origin_s_ + time_s, frame}; }
@@ -311,6 +330,7 @@ class Outlet {
     c.points.reserve(sweep_points_W_.size());
     for (const Eigen::Vector3d& p : sweep_points_W_) c.points.push_back((T_C_W * p).cast<float>());
     ros_.Publish(sweep_id_, c);
+    sweep_latencies_s_.push_back(UnixNow() - sweep_received_s_);
     sweep_points_W_.clear();
     ++sweeps_;
   }
@@ -338,9 +358,13 @@ class Outlet {
   RosConnection& ros_;
   const InspectionNodeOptions& options_;
   double origin_s_;
+  int frames_per_sweep_;
+  int frames_in_sweep_ = 0;
   int sweep_id_ = 0, map_id_ = 0, slam_path_id_ = 0, navigation_path_id_ = 0, pose_id_ = 0, tf_id_ = 0;
   std::optional<int> sweep_;
   double sweep_time_s_ = 0.0;
+  double sweep_received_s_ = 0.0;
+  std::vector<double> sweep_latencies_s_;  // one per sweep: a dive of hours holds ~10^5
   Eigen::Isometry3d T_W_C_last_ = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3d> sweep_points_W_;
   std::optional<Clock::time_point> last_map_;
@@ -412,7 +436,8 @@ void StartInspection(Node& node, const InspectionNodeOptions& o, const DiveSetup
   header.producer = o.producer;
   mapping::InspectionOptions options = o.inspection;
   options.fixed_scanner = false;
-  node.outlet = std::make_unique<Outlet>(node.ros, o, setup.time_origin_s);
+  node.outlet =
+      std::make_unique<Outlet>(node.ros, o, setup.time_origin_s, setup.header.scan_pattern.frames_per_sweep());
   Outlet* outlet = node.outlet.get();
   node.inspection = std::make_unique<mapping::LiveInspection>(
       header, o.log, setup.T_V_C, header.navigation_noise.value_or(mapping::AssumedNavigationNoise()), options,
@@ -472,7 +497,9 @@ InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNode
   node.outlet->Finish(summary.result);
   summary.frames_undecodable = node.intake->undecodable();
   summary.navigation_samples = node.intake->navigation();
+  summary.receive_span_s = node.intake->receive_span_s();
   summary.sweeps_published = node.outlet->sweeps();
+  std::tie(summary.sweep_latency_median_s, summary.sweep_latency_p95_s) = node.outlet->SweepLatency();
   summary.maps_published = node.outlet->maps();
   summary.reregistrations = ros.reregistrations();
   summary.described = setup.described;

@@ -49,7 +49,11 @@ struct InspectionNodeSummary {
   mapping::InspectionResult result;
   std::int64_t frames_undecodable = 0;  // metadata row failed its checksum: not logged
   std::int64_t navigation_samples = 0;
+  double receive_span_s = 0.0;  // from the first frame's arrival to the last one's
   std::int64_t sweeps_published = 0;
+  // From the arrival of a sweep's last frame to its PointCloud2 being published, seconds.
+  double sweep_latency_median_s = 0.0;
+  double sweep_latency_p95_s = 0.0;
   std::int64_t maps_published = 0;
   int reregistrations = 0;     // times the node registered again with a restarted master
   bool described = false;      // the scanner came from the dive topic

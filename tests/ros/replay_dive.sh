@@ -64,7 +64,8 @@ until rostopic info /uwscan/frames 2>/dev/null | grep -q uwscan_inspection &&
   if [ $waited -gt 150 ]; then echo "replay_dive: the node did not subscribe (see $out/node.log)" >&2; kill -INT $node; exit 91; fi
 done
 # shellcheck disable=SC2086
-rosbag play --quiet $play_options "$bag" >"$out/play.log" 2>&1 &
+# -d 1: rosbag play waits after advertising, so that the node has connected before the first frame.
+rosbag play --quiet -d 1 $play_options "$bag" >"$out/play.log" 2>&1 &
 player=$!
 pids="$player $pids"
 if [ -n "${MASTER_DOWN_AT:-}" ]; then

@@ -1,0 +1,261 @@
+#include "apps/ros/ros_bench_command.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sched.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "apps/cli/child_process.hpp"
+#include "apps/cli/data_folder.hpp"
+#include "apps/cli/json_output.hpp"
+#include "apps/cli/output_path.hpp"
+#include "scanner/common/error.hpp"
+
+// The bench runs uwscan's own commands as a user would (simulate, bag export, ros inspect,
+// fake-camera, inspect), each a child process whose CPU time and peak memory wait4 reports, beside
+// roscore and rosbag play, all inside a private network namespace.
+namespace uwscan::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RosBenchArgs {
+  std::string json;
+  std::string scene;  // empty: scenes/inspection_short.yaml in DataFolder()
+  std::vector<double> rates = {1.0, 3.39, 20.0};  // rosbag play's rates (the dive runs at 100 frames/s)
+  double inspect_seconds = 20.0;
+  double camera_fps = 339.0;
+};
+
+// Figures of one replay through the node.
+struct NodeFigures {
+  double rate = 0.0;
+  std::int64_t frames_in_bag = 0;
+  std::int64_t frames_received = 0, frames_logged = 0, frames_mapped = 0, frames_skipped = 0;
+  double frames_per_s = 0.0;  // received over the span from the first to the last
+  double cpu_s = 0.0;
+  std::int64_t peak_rss_bytes = 0;
+  double sweep_latency_median_s = 0.0, sweep_latency_p95_s = 0.0;
+  double receive_to_map_median_s = 0.0;
+};
+
+std::string Self() { return fs::read_symlink("/proc/self/exe").string(); }
+
+nlohmann::json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path.string() + ": not written");
+  return nlohmann::json::parse(in);
+}
+
+// What a command prints on stdout, with popen (short commands only).
+std::string Output(const std::string& command) {
+  FILE* pipe = ::popen((command + " 2>/dev/null").c_str(), "r");
+  if (pipe == nullptr) return "";
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
+  ::pclose(pipe);
+  return out;
+}
+
+bool MasterAnswers() {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(11311);
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const bool up = ::connect(s, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0;
+  ::close(s);
+  return up;
+}
+
+// Polls `ready` every 200 ms for up to `seconds`; throws naming `what` when it never holds.
+template <typename Ready>
+void WaitFor(Ready ready, double seconds, const std::string& what) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!ready()) {
+    if (std::chrono::steady_clock::now() > deadline) throw Error("bench ros: " + what + " within " + std::to_string(seconds) + " s");
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+}
+
+void EnterPrivateNetwork() {
+  if (::unshare(CLONE_NEWNET) != 0) {
+    throw Error("bench ros: needs a private network namespace (root): ROS 1 nodes listen on every interface");
+  }
+  if (std::system("ip link set lo up") != 0) throw Error("bench ros: cannot bring lo up in the private namespace");
+}
+
+void SetRosEnvironment(const fs::path& folder) {
+  ::setenv("ROS_MASTER_URI", "http://127.0.0.1:11311", 1);
+  ::setenv("ROS_IP", "127.0.0.1", 1);
+  ::setenv("ROS_HOME", (folder / "ros").c_str(), 1);
+  ::setenv("ROS_LOG_DIR", (folder / "ros" / "log").c_str(), 1);
+  fs::create_directories(folder / "ros" / "log");
+}
+
+NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, double rate, const fs::path& folder) {
+  const std::string name = "node_" + std::to_string(static_cast<int>(rate * 100));
+  const fs::path json = folder / (name + ".json"), log = folder / (name + ".log");
+  ChildProcess node({Self(), "ros", "inspect", "--log", (folder / (name + ".db")).string(), "--json", json.string(),
+                     "--idle-stop-s", "2"},
+                    log);
+  WaitFor([] { return Output("rostopic info /uwscan/frames").find("uwscan_inspection") != std::string::npos; }, 30,
+          "the node did not subscribe (see " + log.string() + ")");
+  // -d: rosbag play waits after advertising, so that the node has connected before the first frame.
+  RunToEnd({"rosbag", "play", "--quiet", "-d", "1", "-r", std::to_string(rate), bag.string()}, folder / "play.log", 600);
+  const ChildProcess::Exit exit = node.Wait(600);
+  if (exit.exit_code != 0) throw Error("bench ros: the node failed (see " + log.string() + ")");
+  const nlohmann::json r = ReadJson(json);
+  NodeFigures f;
+  f.rate = rate;
+  f.frames_in_bag = frames_in_bag;
+  f.frames_received = r["frames_received"];
+  f.frames_logged = r["frames_logged"];
+  f.frames_mapped = r["frames_mapped"];
+  f.frames_skipped = r["frames_skipped"];
+  const double span_s = r["receive_span_s"];
+  f.frames_per_s = span_s > 0 ? static_cast<double>(f.frames_received - 1) / span_s : 0.0;
+  f.cpu_s = exit.cpu_s;
+  f.peak_rss_bytes = exit.max_rss_bytes;
+  f.sweep_latency_median_s = r["sweep_latency_s"]["median"];
+  f.sweep_latency_p95_s = r["sweep_latency_s"]["p95"];
+  f.receive_to_map_median_s = r["receive_to_map_s"]["median"];
+  return f;
+}
+
+struct InspectFigures {
+  std::int64_t frames = 0, lost_frames = 0;
+  double frames_per_s = 0.0, cpu_s = 0.0;
+};
+
+// `inspect` on the fake camera serving the same scene's frames as profiles.
+InspectFigures DirectInspect(const RosBenchArgs& a, const fs::path& folder) {
+  ChildProcess camera({Self(), "fake-camera", a.scene, "--mode", "profile", "--fps", std::to_string(a.camera_fps)},
+                      folder / "camera.log");
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const fs::path json = folder / "inspect.json";
+  ChildProcess inspect({Self(), "inspect", "--camera", "127.0.0.1", "--scene", a.scene, "--log",
+                        (folder / "inspect.db").string(), "--json", json.string(), "--seconds",
+                        std::to_string(a.inspect_seconds)},
+                       folder / "inspect.log");
+  const ChildProcess::Exit exit = inspect.Wait(a.inspect_seconds + 120);
+  if (exit.exit_code != 0) throw Error("bench ros: inspect failed (see " + (folder / "inspect.log").string() + ")");
+  const nlohmann::json r = ReadJson(json);
+  return {r["frames_received"], r["lost_frames"], r["frames_per_s"], exit.cpu_s};
+}
+
+// CPU seconds per frame of `uwscan map` on the dive: the same SLAM offline, without ROS, camera
+// or log writing (its tables already cached by the runs before).
+double OfflineMapCpuPerFrame(const fs::path& dive, std::int64_t frames, const fs::path& folder) {
+  ChildProcess map({Self(), "map", dive.string(), "-o", (folder / "map.ply").string()}, folder / "map.log");
+  const ChildProcess::Exit exit = map.Wait(600);
+  if (exit.exit_code != 0) throw Error("bench ros: map failed (see " + (folder / "map.log").string() + ")");
+  return exit.cpu_s / static_cast<double>(std::max<std::int64_t>(1, frames));
+}
+
+nlohmann::json NodeJson(const NodeFigures& f) {
+  return {{"rate", f.rate},
+          {"frames_per_s", f.frames_per_s},
+          {"lost_frames", f.frames_in_bag - f.frames_received},
+          {"frames_skipped_by_mapper", f.frames_skipped},
+          {"latency_s", {{"median", f.sweep_latency_median_s}, {"p95", f.sweep_latency_p95_s}}},
+          {"receive_to_map_median_s", f.receive_to_map_median_s},
+          {"cpu_s_per_frame", f.frames_received > 0 ? f.cpu_s / static_cast<double>(f.frames_received) : 0.0},
+          {"peak_rss_bytes", f.peak_rss_bytes}};
+}
+
+void RunRosBench(RosBenchArgs a) {
+  if (!a.json.empty()) CheckOutputPath(a.json, "--json");
+  if (a.scene.empty()) a.scene = (DataFolder() / "scenes" / "inspection_short.yaml").string();
+  EnterPrivateNetwork();
+  const fs::path folder = fs::temp_directory_path() / ("uwscan_bench_ros_" + std::to_string(::getpid()));
+  fs::create_directories(folder);
+  SetRosEnvironment(folder);
+  const fs::path dive = folder / "dive.db", bag = folder / "dive.bag";
+  RunToEnd({Self(), "simulate", a.scene, "-o", dive.string()}, folder / "simulate.log", 600);
+  RunToEnd({Self(), "bag", "export", dive.string(), "-o", bag.string()}, folder / "export.log", 600);
+  const std::string exported = Output("cat " + (folder / "export.log").string());
+  const std::int64_t frames_in_bag = std::stoll(exported.substr(exported.find("bag export: ") + 12));
+  ChildProcess master({"roscore", "-p", "11311"}, folder / "roscore.log");
+  WaitFor(MasterAnswers, 30, "roscore did not answer");
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  std::vector<NodeFigures> runs;
+  for (double rate : a.rates) {
+    runs.push_back(ReplayThroughNode(bag, frames_in_bag, rate, folder));
+    const NodeFigures& f = runs.back();
+    std::printf("bench ros: rate %.2f: %.0f frames/s through the node, %lld lost, sweep latency median %.1f ms "
+                "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB\n",
+                f.rate, f.frames_per_s, static_cast<long long>(f.frames_in_bag - f.frames_received),
+                f.sweep_latency_median_s * 1e3, f.sweep_latency_p95_s * 1e3,
+                f.cpu_s / static_cast<double>(std::max<std::int64_t>(1, f.frames_received)) * 1e6,
+                static_cast<double>(f.peak_rss_bytes) * 1e-6);
+  }
+  const InspectFigures direct = DirectInspect(a, folder);
+  const double inspect_cpu = direct.cpu_s / static_cast<double>(std::max<std::int64_t>(1, direct.frames));
+  std::printf("bench ros: inspect on the fake camera at %.0f frames/s: %.0f frames/s, %lld lost, %.1f us CPU per "
+              "frame\n",
+              a.camera_fps, direct.frames_per_s, static_cast<long long>(direct.lost_frames), inspect_cpu * 1e6);
+  // The headline: the run nearest the seed camera's 339 frames/s (3.39x the dive's 100).
+  const NodeFigures* headline = &runs.front();
+  for (const NodeFigures& f : runs) {
+    if (std::abs(f.rate - 3.39) < std::abs(headline->rate - 3.39)) headline = &f;
+  }
+  nlohmann::json node = NodeJson(*headline);
+  node["runs"] = nlohmann::json::array();
+  for (const NodeFigures& f : runs) node["runs"].push_back(NodeJson(f));
+  const double node_cpu = node["cpu_s_per_frame"];
+  const double overhead = inspect_cpu > 0 ? node_cpu / inspect_cpu - 1.0 : 0.0;
+  const double map_cpu = OfflineMapCpuPerFrame(dive, frames_in_bag, folder);
+  const double overhead_vs_map = map_cpu > 0 ? node_cpu / map_cpu - 1.0 : 0.0;
+  std::printf("bench ros: overhead against inspect %.2f, against map offline %.2f (CPU per frame, node / peer - 1)\n",
+              overhead, overhead_vs_map);
+  master.Interrupt();
+  master.Wait(30);
+  fs::remove_all(folder);
+  if (!a.json.empty()) {
+    WriteJsonFile(a.json, {{"scene", a.scene},
+                           {"node", node},
+                           {"direct_inspect", {{"frames_per_s", direct.frames_per_s},
+                                               {"lost_frames", direct.lost_frames},
+                                               {"cpu_s_per_frame", inspect_cpu},
+                                               {"camera_fps", a.camera_fps}}},
+                           {"offline_map", {{"cpu_s_per_frame", map_cpu}}},
+                           {"overhead_ratio", overhead},
+                           {"overhead_vs_map_ratio", overhead_vs_map}});
+  }
+}
+
+}  // namespace
+
+void AddRosBenchCommand(CLI::App& bench) {
+  auto a = std::make_shared<RosBenchArgs>();
+  CLI::App* cmd = bench.add_subcommand(
+      "ros",
+      "the ROS node end to end (rosbag play of a simulated dive at several rates) against inspect on the fake "
+      "camera: frames per second, lost frames, sweep latency, CPU per frame, peak memory (root: private network)");
+  cmd->add_option("--json", a->json, "figures as JSON");
+  cmd->add_option("--scene", a->scene, "the dive (default: scenes/inspection_short.yaml in the data folder)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--rates", a->rates, "rosbag play rates (the dive's own frame rate times these)")
+      ->capture_default_str();
+  cmd->add_option("--inspect-seconds", a->inspect_seconds, "how long inspect reads the fake camera")
+      ->capture_default_str();
+  cmd->add_option("--camera-fps", a->camera_fps, "the fake camera's frame rate (profile mode)")
+      ->capture_default_str();
+  cmd->callback([a] { RunRosBench(*a); });
+}
+
+}  // namespace uwscan::app
