@@ -9,11 +9,7 @@
 
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/stop_signal.hpp"
-#include "apps/cli/text_file.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/scanner_file.hpp"
-#include "scanner/sim/scene.hpp"
-#include "scanner/sim/simulator.hpp"
 
 namespace uwscan::app {
 
@@ -73,94 +69,13 @@ acq::CameraSettings MakeCameraSettings(const CameraArgs& a) {
 
 AcquisitionContext MakeContext(const CameraArgs& a, const acq::PayloadDescription& payload,
                                const std::string& command) {
-  AcquisitionContext c;
-  c.header.producer = "uwscan " + command + " " + UWSCAN_VERSION + " (camera " + a.camera + ", " + payload.vendor +
-                      " " + payload.model + ")";
-  if (!a.scene.empty()) {
-    const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
-    const scanner::sim::Simulator simulator(scene);
-    c.header.scanner = simulator.scanner();
-    c.header.scan_pattern = simulator.scan_pattern();
-    c.header.scene_yaml = ReadText(a.scene);
-    c.detector = scene.detector;
-    c.T_V_C = scene.trajectory.T_V_C;
-  } else {
-    c.header.scanner = scanner::LoadScanner(a.scanner_file);
-    c.header.scan_pattern.kind = c.header.scanner.kind();
-    c.detector.axis = payload.profile_layout.axis;
+  if (a.scene.empty() == a.scanner_file.empty()) {
+    throw Error("give --scene (a simulated camera: the scene's scanner and scan pattern) or --scanner "
+                "(the scanner file of a real camera)");
   }
-  return c;
-}
-
-CameraFrameDecoder::CameraFrameDecoder(const acq::PayloadDescription& payload, const AcquisitionContext& context,
-                                       bool keep_images)
-    : payload_(payload),
-      detector_(context.detector),
-      pattern_driver_(context.header.scan_pattern),
-      keep_images_(keep_images) {
-  if (!payload.metadata_row && payload.profile) throw Error("the camera sends profiles without a metadata row");
-  if (keep_images && payload.profile) {
-    throw Error("--images: the camera sends profiles (peaks found on the camera), not images");
-  }
-}
-
-std::optional<mapping::FrameRecord> CameraFrameDecoder::Decode(const acq::AcquiredFrame& frame) {
-  mapping::FrameRecord record;
-  std::optional<acq::FrameMetadata> metadata;
-  if (payload_.profile) {
-    std::optional<acq::DecodedProfile> decoded = acq::DecodeProfile(payload_.profile_layout, frame.payload);
-    if (!decoded) return std::nullopt;
-    metadata = decoded->metadata;
-    record.peaks_px = std::move(decoded->peaks_px);
-  } else {
-    const acq::ImageLayout& l = payload_.image_layout;
-    scanner::StripeImage image;
-    if (payload_.metadata_row) {
-      std::optional<acq::DecodedImage> decoded = acq::DecodeImage(l, frame.payload);
-      if (!decoded) return std::nullopt;
-      metadata = decoded->metadata;
-      image = decoded->image;
-    } else {
-      image = {frame.payload.data(), l.width_px, l.height_px, static_cast<std::ptrdiff_t>(l.row_bytes()), l.format};
-    }
-    detector_.Detect(image, &detection_);
-    record.peaks_px.reserve(detection_.peaks.size());
-    for (const scanner::StripePeak& p : detection_.peaks) record.peaks_px.emplace_back(p.u_px, p.v_px);
-    if (keep_images_) {
-      mapping::LogImage log_image;
-      log_image.width_px = image.width_px;
-      log_image.height_px = image.height_px;
-      log_image.format = image.format == scanner::PixelFormat::kMono8 ? mapping::LogPixelFormat::kMono8
-                                                                       : mapping::LogPixelFormat::kMono16;
-      const auto* bytes = static_cast<const std::uint8_t*>(image.data);
-      log_image.bytes.assign(bytes, bytes + l.row_bytes() * static_cast<std::size_t>(image.height_px));
-      record.image = std::move(log_image);
-    }
-  }
-  if (metadata) {
-    record.time_s = static_cast<double>(metadata->timestamp_ns) * 1e-9;
-    record.command = metadata->mirror_command;
-    record.sweep = metadata->sweep;
-  } else {
-    // A camera without uwscan's metadata row: the camera's clock, and the mirror driver's
-    // command for this trigger (frame numbers count from the first frame of the session).
-    const acq::MirrorCommand c = pattern_driver_.CommandOf(static_cast<std::uint64_t>(frame.frame_number));
-    record.time_s = static_cast<double>(frame.camera_timestamp_ns) * 1e-9;
-    record.command = c.command;
-    record.sweep = c.sweep;
-  }
-  return record;
-}
-
-mapping::InspectionFrame ToInspectionFrame(mapping::FrameRecord&& record, const acq::AcquiredFrame& frame) {
-  // A camera clock further than this from the host's is another clock.
-  constexpr double kSameClock_s = 1.0;
-  mapping::InspectionFrame f;
-  f.record = std::move(record);
-  f.receive_time_s = static_cast<double>(frame.host_timestamp_ns) * 1e-9;
-  const double camera_s = static_cast<double>(frame.camera_timestamp_ns) * 1e-9;
-  if (std::abs(camera_s - f.receive_time_s) < kSameClock_s) f.capture_time_s = camera_s;
-  return f;
+  return mapping::MakeAcquisitionContext(a.scene, a.scanner_file, payload,
+                                         "uwscan " + command + " " + UWSCAN_VERSION + " (camera " + a.camera +
+                                             ", " + payload.vendor + " " + payload.model + ")");
 }
 
 void CheckNewLogPath(const std::string& path, bool force, const std::string& option) {
@@ -177,52 +92,27 @@ void RemoveLog(const std::string& path) {
   std::filesystem::remove(path + "-shm");
 }
 
-ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder,
-                       const ReadLimits& limits, const std::string& name,
+ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder, const ReadLimits& limits,
+                       const std::string& name,
                        const std::function<void(mapping::FrameRecord&&, const acq::AcquiredFrame&)>& consume,
                        const std::function<void(const ReadSummary&, double now_s)>& status) {
-  const bool software_trigger = source.settings().trigger == acq::TriggerMode::kSoftware;
-  ReadSummary summary;
-  source.Start();
-  if (software_trigger) source.SoftwareTrigger();
-  double last_status = 0.0;
-  std::size_t gaps_reported = 0;
-  while (!StopRequested()) {
-    if (limits.frames > 0 && summary.frames >= limits.frames) break;
-    if (limits.seconds > 0.0 && source.ElapsedSeconds() >= limits.seconds) break;
-    std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
-    const double now = source.ElapsedSeconds();
-    summary.source = source.statistics();
-    while (gaps_reported < summary.source.gaps.size() && summary.source.gaps[gaps_reported].resumed_at_s >= 0.0) {
-      const acq::CameraGap& g = summary.source.gaps[gaps_reported++];
+  mapping::ReadCallbacks callbacks;
+  callbacks.consume = consume;
+  if (status) {
+    callbacks.status = [&status](const mapping::ReadSummary& s, double now) { status(ReadSummary{s, 0}, now); };
+  }
+  callbacks.gap = [&name](const acq::CameraGap& g) {
+    if (g.resumed_at_s >= 0.0) {
       std::fprintf(stderr, "%s%s: camera silent after %.2f s; reopened (%d attempts), frames again at %.2f s\n",
                    isatty(2) ? "\n" : "", name.c_str(), g.silent_after_s, g.reopen_attempts, g.resumed_at_s);
+    } else {
+      std::fprintf(stderr, "%s: camera silent since %.2f s (%d reopen attempts), not back when stopped\n", name.c_str(),
+                   g.silent_after_s, g.reopen_attempts);
     }
-    if (status && now - last_status >= 1.0) {
-      status(summary, now);
-      last_status = now;
-    }
-    if (!frame) continue;
-    if (software_trigger) source.SoftwareTrigger();
-    std::optional<mapping::FrameRecord> record = decoder.Decode(*frame);
-    if (!record) {
-      ++summary.undecodable;
-      continue;
-    }
-    summary.peaks += static_cast<std::int64_t>(record->peaks_px.size());
-    consume(std::move(*record), *frame);
-    ++summary.frames;
-  }
+  };
+  callbacks.stop_requested = [] { return StopRequested(); };
+  ReadSummary summary{mapping::ReadFrames(source, decoder, limits, callbacks), 0};
   summary.stop_signal = StopSignal();
-  summary.seconds = source.ElapsedSeconds();
-  source.Stop();
-  summary.source = source.statistics();
-  for (const acq::CameraGap& g : summary.source.gaps) {
-    if (g.resumed_at_s < 0.0) {
-      std::fprintf(stderr, "%s: camera silent since %.2f s (%d reopen attempts), not back when stopped\n",
-                   name.c_str(), g.silent_after_s, g.reopen_attempts);
-    }
-  }
   return summary;
 }
 
