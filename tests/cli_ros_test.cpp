@@ -559,3 +559,25 @@ TEST(CliRos, RosBenchWritesItsFiguresAndLosesNoFrame) {
   EXPECT_GT(r["offline_map"]["cpu_s_per_frame"].get<double>(), 0.0);
   EXPECT_TRUE(r["overhead_ratio"].is_number());
 }
+
+// The node reads the camera itself (the fake camera, profile mode) as `inspect` does, with the
+// vehicle's odometry from ROS: every frame received is logged, none is lost on the way, and the
+// frames the navigation covers are mapped.
+TEST(CliRos, NodeReadsACameraDirectly) {
+  const std::filesystem::path out = TempPath("camera_node");
+  const CommandRun run = RunCommand(SourcePath("tests/ros/camera_node.sh") + " " + UWSCAN_BIN + " " +
+                                    SourcePath("data/scenes/default.yaml") + " " + out.string() + " 400");
+  std::ifstream log_file(out / "node.log");
+  const std::string log((std::istreambuf_iterator<char>(log_file)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(run.exit_code, 0) << run.output << log;
+  std::ifstream json_file(out / "node.json");
+  const nlohmann::json r = nlohmann::json::parse(json_file);
+  EXPECT_EQ(Dump(r["frames_received"]), Dump(400)) << r.dump();
+  EXPECT_EQ(Dump(r["frames_logged"]), Dump(400));
+  EXPECT_EQ(Dump(r["camera_lost_frames"]), Dump(0));
+  EXPECT_GT(r["frames_mapped"].get<int>(), 300) << r.dump();
+  EXPECT_EQ(r["frames_mapped"].get<int>() + r["frames_without_navigation"].get<int>() +
+                r["frames_skipped"].get<int>() + r["frames_out_of_order"].get<int>(),
+            400);
+  EXPECT_NE(log.find("frames from the camera 127.0.0.1"), std::string::npos) << log;
+}

@@ -25,6 +25,8 @@ namespace uwscan::app {
 namespace {
 
 struct RosInspectArgs {
+  std::string camera;  // a camera's address: frames from it instead of the image topic
+  std::string scene;   // a simulated camera's scene
   std::string scanner_file;
   std::string log;
   std::string map;
@@ -71,7 +73,13 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
   f.base_link = ros.Param("base_frame", f.base_link);
   f.camera = ros.Param("camera_frame", f.camera);
   const std::string scanner_file = ros.Param("scanner", a.scanner_file);
-  if (!scanner_file.empty()) {
+  if (!a.camera.empty()) {
+    CameraArgs camera;
+    camera.camera = a.camera;
+    camera.scene = a.scene;
+    camera.scanner_file = scanner_file;
+    o.camera = ros::CameraInput{MakeCameraSettings(camera), a.scene, scanner_file};
+  } else if (!scanner_file.empty()) {
     mapping::DiveLogHeader header;
     header.scanner = scanner::LoadScanner(scanner_file);
     header.scan_pattern.kind = header.scanner.kind();
@@ -131,6 +139,7 @@ nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
           {"frames_without_navigation", i.frames_without_navigation},
           {"frames_out_of_order", i.frames_out_of_order},
           {"frames_undecodable", s.frames_undecodable},
+          {"camera_lost_frames", s.camera_lost_frames},
           {"navigation_samples", s.navigation_samples},
           {"receive_span_s", s.receive_span_s},
           {"navigation_logged", i.log.navigation_written},
@@ -148,6 +157,7 @@ nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
 }
 
 void RunRosInspect(const RosInspectArgs& a) {
+  if (!a.scene.empty() && a.camera.empty()) throw Error("--scene: only with --camera (a simulated camera's scene)");
   if (!a.log.empty()) CheckNewLogPath(a.log, a.force, "--log");
   if (!a.map.empty()) CheckCloudOutputPath(a.map, "-o");
   if (!a.trajectory.empty()) CheckOutputPath(a.trajectory, "--trajectory");
@@ -161,7 +171,8 @@ void RunRosInspect(const RosInspectArgs& a) {
   ros::RosConnection ros("uwscan_inspection", a.ros_arguments, a.master_wait_s);
   const ros::InspectionNodeOptions options = NodeOptions(ros, a);
   if (!a.log.empty()) RemoveLog(a.log);
-  std::printf("ros inspect: frames on %s, navigation on %s; %s\n", options.topics.frames.c_str(),
+  std::printf("ros inspect: frames %s %s, navigation on %s; %s\n", options.camera ? "from the camera" : "on",
+              options.camera ? a.camera.c_str() : options.topics.frames.c_str(),
               options.topics.odometry.c_str(), a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
   std::fflush(stdout);
   bool silence_reported = false;
@@ -202,7 +213,13 @@ void AddRosCommands(CLI::App& app) {
       "mapped with loop closures; sweeps, map, paths, pose and the map -> odom correction published");
   cmd->footer(kParameterHelp);
   cmd->allow_extras();
-  cmd->add_option("--scanner", a->scanner_file, "scanner (calibration) file, when no dive description comes")
+  cmd->add_option("--scanner", a->scanner_file,
+                  "scanner (calibration) file: of the camera (--camera), or when no dive description comes")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--camera", a->camera,
+                  "read frames from this camera (IPv4 address, opened directly) instead of the image topic; its clock "
+                  "must be the navigation's (PTP)");
+  cmd->add_option("--scene", a->scene, "with --camera: a simulated camera's scene (its scanner and mount)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--log", a->log, "dive log to create (.db): every frame and navigation sample, each committed");
   cmd->add_flag("--force", a->force, "replace an existing log at the --log path");

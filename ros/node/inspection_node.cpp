@@ -11,6 +11,8 @@
 #include <thread>
 #include <tuple>
 
+#include "mapping/inspection/camera_frames.hpp"
+#include "mapping/inspection/camera_reader.hpp"
 #include "mapping/slam/dive_mapping.hpp"
 #include "mapping/slam/mapper.hpp"
 #include "ros/conversions/dive_description.hpp"
@@ -160,6 +162,22 @@ class Intake {
       pending_frames_.push_back(std::move(m));
     } else {
       ++dropped_;
+    }
+  }
+
+  // A frame read from the camera (CameraInput), on the camera's thread, after Begin().
+  void OnCameraFrame(mapping::FrameRecord&& record, const scanner::acquisition::AcquiredFrame& frame) {
+    std::lock_guard<std::mutex> lock(frames_mutex_);
+    if (closed_) return;
+    ++frames_;
+    try {
+      mapping::InspectionFrame f = mapping::ToInspectionFrame(std::move(record), frame);
+      if (first_receive_s_ == 0.0) first_receive_s_ = f.receive_time_s;
+      last_receive_s_ = f.receive_time_s;
+      inspection_->Push(std::move(f));
+    } catch (...) {
+      closed_ = true;
+      failure_.Set(std::current_exception());
     }
   }
 
@@ -406,8 +424,13 @@ namespace {
 struct Node {
   explicit Node(RosConnection& r) : ros(r) {}
   ~Node() {
+    StopCamera();
     ros.Unsubscribe();
     ros.SetErrorHandler({});
+  }
+  void StopCamera() {
+    camera_stop = true;
+    if (camera_thread.joinable()) camera_thread.join();
   }
   Node(const Node&) = delete;
   Node& operator=(const Node&) = delete;
@@ -418,6 +441,12 @@ struct Node {
   std::unique_ptr<Intake> intake;  // holds no inspection after Close()
   std::unique_ptr<Outlet> outlet;
   std::unique_ptr<mapping::LiveInspection> inspection;
+  // CameraInput: the camera, read on its own thread into the intake.
+  std::unique_ptr<scanner::acquisition::FrameSource> camera;
+  std::unique_ptr<mapping::CameraFrameDecoder> decoder;
+  std::atomic<bool> camera_stop{false};
+  mapping::ReadSummary camera_read;  // once the thread ended
+  std::thread camera_thread;
 };
 
 // Frames and navigation are taken from the start (they wait in the intake), so that none is
@@ -428,7 +457,41 @@ void Subscribe(Node& node, const InspectionNodeOptions& o) {
   Intake* intake = node.intake.get();
   node.ros.SubscribeOdometry(o.topics.odometry, o.frame_queue,
                              [intake](OdometryMessage&& m) { intake->OnOdometry(std::move(m)); });
-  node.ros.SubscribeImages(o.topics.frames, o.frame_queue, [intake](ImageMessage&& m) { intake->OnImage(std::move(m)); });
+  if (!o.camera) {
+    node.ros.SubscribeImages(o.topics.frames, o.frame_queue, [intake](ImageMessage&& m) { intake->OnImage(std::move(m)); });
+  }
+}
+
+// CameraInput: the camera opened, its scanner and mount from its scene or scanner file.
+DiveSetup OpenCamera(Node& node, const InspectionNodeOptions& o) {
+  const CameraInput& c = *o.camera;
+  node.camera = std::make_unique<scanner::acquisition::FrameSource>(c.settings);
+  const mapping::AcquisitionContext context =
+      mapping::MakeAcquisitionContext(c.scene, c.scanner_file, node.camera->payload(), o.producer);
+  node.decoder = std::make_unique<mapping::CameraFrameDecoder>(node.camera->payload(), context, o.keep_images);
+  DiveSetup setup;
+  setup.header = context.header;
+  setup.T_V_C = context.T_V_C;
+  setup.mount = c.scene.empty() ? "none for a real camera: the camera is taken at the vehicle's origin"
+                                : "the scene the simulated camera serves";
+  return setup;
+}
+
+void StartCamera(Node& node, const InspectionNodeOptions& o) {
+  // The camera stops itself at max_frames: the node's watch would see the count a little late.
+  const mapping::ReadLimits limits{o.max_frames, 0.0};
+  node.camera_thread = std::thread([&node, limits] {
+    mapping::ReadCallbacks callbacks;
+    callbacks.consume = [&node](mapping::FrameRecord&& r, const scanner::acquisition::AcquiredFrame& f) {
+      node.intake->OnCameraFrame(std::move(r), f);
+    };
+    callbacks.stop_requested = [&node] { return node.camera_stop.load(); };
+    try {
+      node.camera_read = mapping::ReadFrames(*node.camera, *node.decoder, limits, callbacks);
+    } catch (...) {
+      node.failure.Set(std::current_exception());
+    }
+  });
 }
 
 void StartInspection(Node& node, const InspectionNodeOptions& o, const DiveSetup& setup) {
@@ -482,11 +545,13 @@ InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNode
   ros.SetErrorHandler([&node](std::exception_ptr e) { node.failure.Set(std::move(e)); });
   Subscribe(node, o);
   ros.Start(2);
-  const DiveSetup setup = node.listener->Wait(node.failure, stop_requested);
+  const DiveSetup setup = o.camera ? OpenCamera(node, o) : node.listener->Wait(node.failure, stop_requested);
   StartInspection(node, o, setup);
+  if (o.camera) StartCamera(node, o);
 
   InspectionNodeSummary summary;
   summary.stop_reason = Watch(node, o, stop_requested, status);
+  node.StopCamera();
   node.intake->Close();
   node.failure.Rethrow();
   if (node.intake->dropped() > 0) {
@@ -495,7 +560,8 @@ InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNode
   }
   summary.result = node.inspection->Finish();
   node.outlet->Finish(summary.result);
-  summary.frames_undecodable = node.intake->undecodable();
+  summary.frames_undecodable = node.intake->undecodable() + node.camera_read.undecodable;
+  summary.camera_lost_frames = node.camera_read.source.lost_frames;
   summary.navigation_samples = node.intake->navigation();
   summary.receive_span_s = node.intake->receive_span_s();
   summary.sweeps_published = node.outlet->sweeps();

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "mapping/inspection/live_inspection.hpp"
+#include "scanner/acquisition/frame_source.hpp"
 #include "ros/bridge/ros_connection.hpp"
 #include "ros/conversions/ros_names.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
@@ -21,7 +22,17 @@
 // correction map -> odom on /tf and the latest anchor's pose with its covariance.
 namespace uwscan::ros {
 
+// Frames straight from a camera (Aravis), as `uwscan inspect` reads them, instead of the image
+// topic. Its clock must be the navigation's (a PTP-synchronised camera): frames are placed with
+// the odometry at their camera time.
+struct CameraInput {
+  scanner::acquisition::CameraSettings settings;
+  std::string scene;         // a simulated camera: the scene it serves
+  std::string scanner_file;  // a real camera: its scanner (calibration) file
+};
+
 struct InspectionNodeOptions {
+  std::optional<CameraInput> camera;  // std::nullopt: frames from topics.frames
   RosTopics topics;
   RosFrames frames;
   std::filesystem::path log;  // dive log to create ("" = none)
@@ -48,6 +59,7 @@ struct InspectionNodeOptions {
 struct InspectionNodeSummary {
   mapping::InspectionResult result;
   std::int64_t frames_undecodable = 0;  // metadata row failed its checksum: not logged
+  std::int64_t camera_lost_frames = 0;  // camera input: frames the camera sent that never arrived
   std::int64_t navigation_samples = 0;
   double receive_span_s = 0.0;  // from the first frame's arrival to the last one's
   std::int64_t sweeps_published = 0;
