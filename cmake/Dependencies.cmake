@@ -53,6 +53,14 @@ find_package(Threads REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(Aravis REQUIRED IMPORTED_TARGET aravis-0.8)
 
+# The ROS bag reader's chunk decompression (ros/bridge/bag_decompression: liblz4's frame API and
+# libbz2, as rosbag compresses chunks). Outside the ROS block below: the fuzz build compiles the bag
+# reader, which includes nothing of ROS, without ROS.
+pkg_check_modules(lz4 REQUIRED IMPORTED_TARGET liblz4)
+find_package(BZip2 REQUIRED)
+add_library(uwscan_bag_compression INTERFACE)
+target_link_libraries(uwscan_bag_compression INTERFACE PkgConfig::lz4 BZip2::BZip2)
+
 # ROS 1 (ros/, the one module that links it). roscpp by its CMake config, which works without
 # catkin. rosbag's config is not used: through pluginlib it loads ament_cmake_core, which runs a
 # Python module (ament_package) that a non-Debian python3 first on the PATH lacks; rosbag's

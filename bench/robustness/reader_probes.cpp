@@ -8,6 +8,7 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/features/descriptor_database.hpp"
 #include "perception/recognition/object_database.hpp"
+#include "ros/bridge/bag_file.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_scene.hpp"
 #include "scanner/calibration/opencv_camera_import.hpp"
@@ -54,6 +55,22 @@ std::size_t ReadCalibrationManifest(const fs::path& path) {
   const scanner::calibration::CalibrationDataset dataset =
       scanner::calibration::LoadCalibrationDataset(path.parent_path());
   return dataset.views.size() + dataset.planes.size();
+}
+
+// A ROS bag read as `uwscan bag import` reads one: its topics, then every message of every topic
+// (the types uwscan reads; a bag with another type is refused).
+std::size_t ReadBag(const fs::path& path) {
+  const ros::BagReader reader(path.string());
+  std::vector<std::string> topics;
+  for (const ros::BagTopic& topic : reader.Topics()) topics.push_back(topic.name);
+  std::size_t messages = 0;
+  ros::BagVisitor visitor;
+  visitor.image = [&](const std::string&, ros::ImageMessage&&) { ++messages; };
+  visitor.odometry = [&](const std::string&, ros::OdometryMessage&&) { ++messages; };
+  visitor.transforms = [&](const std::string&, std::vector<ros::TransformMessage>&&) { ++messages; };
+  visitor.text = [&](const std::string&, ros::StringMessage&&) { ++messages; };
+  reader.Read(topics, visitor);
+  return messages;
 }
 
 std::vector<ReaderProbe> MakeProbes() {
@@ -104,6 +121,7 @@ std::vector<ReaderProbe> MakeProbes() {
        [](const fs::path& path) { return viewer::ReadRecognitionReport(path).objects.size(); }},
       {"tum_trajectory", ".tum",
        [](const fs::path& path) { return viewer::ReadTumTrajectory(path).size(); }},
+      {"bag", ".bag", ReadBag},
   };
 }
 

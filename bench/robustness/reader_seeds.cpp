@@ -3,16 +3,23 @@
 #include <fstream>
 #include <string>
 #include <vector>
+#include <yaml-cpp/yaml.h>
 
 #include "mapping/log/dive_log.hpp"
+#include "mapping/log/dive_simulation.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/features/descriptor_database.hpp"
 #include "perception/recognition/object_database.hpp"
+#include "ros/bag/bag_export.hpp"
+#include "ros/bridge/bag_compression.hpp"
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/scene.hpp"
+#include "scanner/sim/simulator.hpp"
 
 namespace uwscan::bench {
 namespace {
@@ -167,6 +174,44 @@ void WriteReportSeeds(const fs::path& folder) {
             "  {\"id\": \"unknown\", \"segment\": [0, 1], \"centroid_m\": [0, 0, 1.2]}]}\n");
 }
 
+void RemoveLog(const fs::path& log) {
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) fs::remove(log.string() + suffix);
+}
+
+// One sweep of five frames of the short inspection dive: a bag of a few tens of KB, small enough
+// for the fuzzers to mutate quickly.
+void SimulateSeedDive(const fs::path& data_dir, const fs::path& log) {
+  const fs::path scene_path = data_dir / "scenes" / "inspection_short.yaml";
+  YAML::Node yaml = YAML::Load(ReadFileBytes(scene_path));
+  yaml["scanner"]["sweeps"] = 1;
+  yaml["scanner"]["galvo"]["step_stride"] = 50;
+  YAML::Emitter emitter;
+  emitter << yaml;
+  const std::string text = emitter.c_str();
+  const scanner::sim::Simulator simulator(
+      scanner::sim::ParseScene(text, scene_path.string(), scene_path.parent_path()));
+  mapping::DiveSimulationOptions options;
+  options.threads = 1;  // five frames: no use for OpenMP's threads in the process that forks the readers
+  options.producer = "uwscan bench robustness";
+  RemoveLog(log);
+  mapping::SimulateDive(simulator, text, log, options);
+}
+
+// A simulated dive as `uwscan bag export` writes it (seed_0, uncompressed chunks), and the same bag
+// with lz4 (seed_1) and bz2 (seed_2) chunks, as `rosbag record --lz4/--bz2` writes them.
+void WriteBagSeeds(const fs::path& data_dir, const fs::path& folder) {
+  const fs::path log = folder / "seed_dive.db";
+  SimulateSeedDive(data_dir, log);
+  const fs::path bag = folder / "seed_0.bag";
+  for (const char* name : {"seed_0.bag", "seed_1.bag", "seed_2.bag"}) fs::remove(folder / name);
+  ros::BagExportOptions options;
+  options.producer = "uwscan bench robustness";
+  ros::ExportToBag({log}, bag, options);
+  RemoveLog(log);
+  ros::WriteCompressedCopy(bag.string(), (folder / "seed_1.bag").string(), ros::BagCompression::kLz4);
+  ros::WriteCompressedCopy(bag.string(), (folder / "seed_2.bag").string(), ros::BagCompression::kBz2);
+}
+
 }  // namespace
 
 void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
@@ -174,7 +219,7 @@ void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
        {"cloud_ply", "cloud_pcd", "cloud_xyz", "mesh_off", "mesh_stl", "mesh_obj", "mesh_ply",
         "scene_yaml", "scanner_yaml", "scan_pattern_yaml", "calibration_scene_yaml",
         "calibration_manifest", "calibration_truth", "opencv_intrinsics", "dive_log",
-        "object_database", "descriptor_database", "map_report", "recognition_report", "tum_trajectory"}) {
+        "object_database", "descriptor_database", "map_report", "recognition_report", "tum_trajectory", "bag"}) {
     fs::create_directories(folder / reader);
   }
   perception::WriteCloud(folder / "cloud_ply" / "seed_0.ply", SeedCloud(true), true);
@@ -210,6 +255,7 @@ void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
   WriteObjectDatabaseSeed(folder / "object_database" / "seed_0.db");
   WriteDescriptorDatabaseSeed(folder / "descriptor_database" / "seed_0.esfdb");
   WriteReportSeeds(folder);
+  WriteBagSeeds(data_dir, folder / "bag");
 }
 
 }  // namespace uwscan::bench

@@ -328,7 +328,8 @@ TEST_F(LiveInspectionTest, FramesAfterTheNavigationStoppedAreLeftOutWithoutPilin
   const double window_s = mapper.max_navigation_gap_s + mapper.navigation_latency_s;
   const std::int64_t last_window = static_cast<std::int64_t>(std::ceil(window_s * 339.0)) + 2;
   InspectionStatistics s = inspection.statistics();
-  for (int i = 0; i < 3000 && s.frames_waiting > last_window; ++i) {
+  // Waits for the mapping thread (long enough for the sanitized build, which maps ~10x slower).
+  for (int i = 0; i < 30000 && s.frames_waiting > last_window; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     s = inspection.statistics();
   }

@@ -1,10 +1,10 @@
+// BagWriter (bag_file.hpp) through Debian's rosbag, which writes what it is given safely; bags
+// are read by uwscan's own reader (bag_reader.cpp, bag_container.hpp says why).
 #include "ros/bridge/bag_file.hpp"
 
 #include <rosbag/bag.h>
-#include <rosbag/view.h>
 
 #include <filesystem>
-#include <map>
 
 #include "ros/bridge/message_conversions.hpp"
 #include "scanner/common/error.hpp"
@@ -18,79 +18,6 @@ void InitRosTime() {
 }
 
 }  // namespace
-
-struct BagReader::Impl {
-  std::string path;
-  mutable rosbag::Bag bag;
-};
-
-BagReader::BagReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
-  InitRosTime();
-  impl_->path = path;
-  if (!std::filesystem::is_regular_file(path)) throw Error(path + ": no such bag file");
-  try {
-    impl_->bag.open(path, rosbag::bagmode::Read);
-  } catch (const std::exception& e) {
-    throw Error(path + ": not a readable ROS bag (" + e.what() + ")");
-  }
-}
-
-BagReader::~BagReader() = default;
-
-std::vector<BagTopic> BagReader::Topics() const {
-  std::map<std::string, BagTopic> topics;
-  try {
-    rosbag::View view(impl_->bag);
-    for (const rosbag::ConnectionInfo* c : view.getConnections()) {
-      BagTopic& t = topics[c->topic];
-      t.name = c->topic;
-      t.datatype = c->datatype;
-    }
-    for (auto& [name, topic] : topics) {
-      rosbag::View one(impl_->bag, rosbag::TopicQuery(name));
-      topic.messages = static_cast<std::int64_t>(one.size());
-    }
-  } catch (const std::exception& e) {
-    throw Error(impl_->path + ": the bag's index does not read (" + e.what() + ")");
-  }
-  std::vector<BagTopic> out;
-  for (auto& [name, topic] : topics) out.push_back(topic);
-  return out;
-}
-
-void BagReader::Read(const std::vector<std::string>& topics, const BagVisitor& visitor) const {
-  const auto missing_callback = [&](const std::string& topic, const std::string& type) {
-    return Error(impl_->path + ": topic " + topic + " is " + type + ", which uwscan does not read there");
-  };
-  rosbag::View view(impl_->bag, rosbag::TopicQuery(topics));
-  for (const rosbag::MessageInstance& m : view) {
-    const std::string& topic = m.getTopic();
-    const std::string& type = m.getDataType();
-    try {
-      if (type == "sensor_msgs/Image") {
-        if (!visitor.image) throw missing_callback(topic, type);
-        visitor.image(topic, FromRos(*m.instantiate<sensor_msgs::Image>()));
-      } else if (type == "nav_msgs/Odometry") {
-        if (!visitor.odometry) throw missing_callback(topic, type);
-        visitor.odometry(topic, FromRos(*m.instantiate<nav_msgs::Odometry>()));
-      } else if (type == "tf2_msgs/TFMessage") {
-        if (!visitor.transforms) throw missing_callback(topic, type);
-        visitor.transforms(topic, FromRos(*m.instantiate<tf2_msgs::TFMessage>()));
-      } else if (type == "std_msgs/String") {
-        if (!visitor.text) throw missing_callback(topic, type);
-        visitor.text(topic, FromRos(*m.instantiate<std_msgs::String>()));
-      } else {
-        throw missing_callback(topic, type);
-      }
-    } catch (const Error& e) {
-      const std::string what = e.what();
-      if (what.rfind(impl_->path, 0) == 0) throw;
-      throw Error(impl_->path + ": topic " + topic + " at " + std::to_string(m.getTime().toSec()) + " s: " + what);
-    } catch (const std::exception& e) {
-      throw Error(impl_->path + ": topic " + topic + ": a message does not decode as " + type + " (" + e.what() + ")");
-    }
-  }
-}
 
 struct BagWriter::Impl {
   std::string path;

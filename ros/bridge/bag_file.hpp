@@ -8,8 +8,9 @@
 
 #include "ros/bridge/messages.hpp"
 
-// ROS 1 bags read and written in uwscan's message types (messages.hpp), through Debian's
-// rosbag library. No ROS master is needed. C++17, no ROS include.
+// ROS 1 bags read and written in uwscan's message types (messages.hpp): read by uwscan's own
+// bounded reader (bag_container.hpp says why), written through Debian's rosbag library. No ROS
+// master is needed. C++17, no ROS include.
 namespace uwscan::ros {
 
 struct BagTopic {

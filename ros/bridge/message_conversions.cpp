@@ -4,6 +4,7 @@
 #include <cstring>
 #include <limits>
 
+#include "ros/bridge/pose_checks.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::ros {
@@ -17,23 +18,6 @@ std_msgs::Header ToRos(const Header& header) {
 }
 
 Header FromRos(const std_msgs::Header& header) { return {header.stamp.toSec(), header.frame_id}; }
-
-// A ROS pose as T_parent_child; `what` names the message and field for the error.
-Eigen::Isometry3d ToIsometry(double x, double y, double z, double qx, double qy, double qz, double qw,
-                             const std::string& what) {
-  const double values[] = {x, y, z, qx, qy, qz, qw};
-  for (double v : values) {
-    if (!std::isfinite(v)) throw Error(what + ": a pose value is not finite");
-  }
-  const Eigen::Quaterniond q(qw, qx, qy, qz);
-  if (std::abs(q.norm() - 1.0) > 1e-3) {
-    throw Error(what + ": orientation is not a unit quaternion (norm " + std::to_string(q.norm()) + ")");
-  }
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = q.normalized().toRotationMatrix();
-  T.translation() = Eigen::Vector3d(x, y, z);
-  return T;
-}
 
 geometry_msgs::Pose ToRosPose(const Eigen::Isometry3d& T) {
   geometry_msgs::Pose p;
@@ -49,17 +33,12 @@ geometry_msgs::Pose ToRosPose(const Eigen::Isometry3d& T) {
 }
 
 Eigen::Isometry3d FromRosPose(const geometry_msgs::Pose& p, const std::string& what) {
-  return ToIsometry(p.position.x, p.position.y, p.position.z, p.orientation.x, p.orientation.y, p.orientation.z,
-                    p.orientation.w, what);
+  return PoseFromRosValues(p.position.x, p.position.y, p.position.z, p.orientation.x, p.orientation.y,
+                           p.orientation.z, p.orientation.w, what);
 }
 
 Covariance6d FromRosCovariance(const boost::array<double, 36>& c, const std::string& what) {
-  Covariance6d m;
-  for (int i = 0; i < 36; ++i) {
-    if (!std::isfinite(c[i])) throw Error(what + ": covariance value " + std::to_string(i) + " is not finite");
-    m(i / 6, i % 6) = c[i];
-  }
-  return m;
+  return CovarianceFromRosValues(c.data(), what);
 }
 
 boost::array<double, 36> ToRosCovariance(const Covariance6d& m) {
@@ -127,8 +106,8 @@ TransformMessage FromRos(const geometry_msgs::TransformStamped& m) {
   out.child_frame_id = m.child_frame_id;
   const auto& t = m.transform.translation;
   const auto& q = m.transform.rotation;
-  out.transform = ToIsometry(t.x, t.y, t.z, q.x, q.y, q.z, q.w,
-                             "transform " + m.header.frame_id + " -> " + m.child_frame_id);
+  out.transform = PoseFromRosValues(t.x, t.y, t.z, q.x, q.y, q.z, q.w,
+                                    "transform " + m.header.frame_id + " -> " + m.child_frame_id);
   return out;
 }
 
