@@ -70,10 +70,13 @@ ChildProcess::Exit ChildProcess::Wait(double timeout_s) {
   return e;
 }
 
-void RunToEnd(const std::vector<std::string>& argv, const std::filesystem::path& log, double timeout_s) {
+void RunToEnd(const std::vector<std::string>& argv, const std::filesystem::path& log,
+              double timeout_s) {
   ChildProcess child(argv, log);
   const ChildProcess::Exit e = child.Wait(timeout_s);
-  if (e.exit_code != 0) throw Error(argv.at(0) + " " + (argv.size() > 1 ? argv[1] : "") + " failed (see " + log.string() + ")");
+  if (e.exit_code != 0)
+    throw Error(argv.at(0) + " " + (argv.size() > 1 ? argv[1] : "") + " failed (see " +
+                log.string() + ")");
 }
 
 }  // namespace uwscan::app

@@ -21,8 +21,8 @@ class ChildProcess {
   ChildProcess& operator=(const ChildProcess&) = delete;
 
   struct Exit {
-    int exit_code = -1;        // -1 when a signal ended it
-    double cpu_s = 0.0;        // user + system CPU time of the child
+    int exit_code = -1;  // -1 when a signal ended it
+    double cpu_s = 0.0;  // user + system CPU time of the child
     std::int64_t max_rss_bytes = 0;
   };
   // Waits for the child to end (at most `timeout_s`, then SIGKILL and an error naming it).
@@ -37,6 +37,7 @@ class ChildProcess {
 
 // Runs argv to its end (at most `timeout_s`) and throws uwscan::Error naming it and `log` when
 // it does not exit with 0.
-void RunToEnd(const std::vector<std::string>& argv, const std::filesystem::path& log, double timeout_s);
+void RunToEnd(const std::vector<std::string>& argv, const std::filesystem::path& log,
+              double timeout_s);
 
 }  // namespace uwscan::app

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <thread>
@@ -34,7 +35,8 @@ namespace fs = std::filesystem;
 struct RosBenchArgs {
   std::string json;
   std::string scene;  // empty: scenes/inspection_short.yaml in DataFolder()
-  std::vector<double> rates = {1.0, 3.39, 20.0};  // rosbag play's rates (the dive runs at 100 frames/s)
+  std::vector<double> rates = {1.0, 3.39,
+                               20.0};  // rosbag play's rates (the dive runs at 100 frames/s)
   double inspect_seconds = 20.0;
   double camera_fps = 339.0;
 };
@@ -65,7 +67,8 @@ std::string Output(const std::string& command) {
   if (pipe == nullptr) return "";
   std::string out;
   std::array<char, 4096> buffer{};
-  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
+  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe))
+    out.append(buffer.data(), n);
   ::pclose(pipe);
   return out;
 }
@@ -86,16 +89,20 @@ template <typename Ready>
 void WaitFor(Ready ready, double seconds, const std::string& what) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!ready()) {
-    if (std::chrono::steady_clock::now() > deadline) throw Error("bench ros: " + what + " within " + std::to_string(seconds) + " s");
+    if (std::chrono::steady_clock::now() > deadline)
+      throw Error("bench ros: " + what + " within " + std::to_string(seconds) + " s");
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
 }
 
 void EnterPrivateNetwork() {
   if (::unshare(CLONE_NEWNET) != 0) {
-    throw Error("bench ros: needs a private network namespace (root): ROS 1 nodes listen on every interface");
+    throw Error(
+        "bench ros: needs a private network namespace (root): ROS 1 nodes listen on every "
+        "interface");
   }
-  if (std::system("ip link set lo up") != 0) throw Error("bench ros: cannot bring lo up in the private namespace");
+  if (std::system("ip link set lo up") != 0)
+    throw Error("bench ros: cannot bring lo up in the private namespace");
 }
 
 void SetRosEnvironment(const fs::path& folder) {
@@ -106,16 +113,22 @@ void SetRosEnvironment(const fs::path& folder) {
   fs::create_directories(folder / "ros" / "log");
 }
 
-NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, double rate, const fs::path& folder) {
+NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, double rate,
+                              const fs::path& folder) {
   const std::string name = "node_" + std::to_string(static_cast<int>(rate * 100));
   const fs::path json = folder / (name + ".json"), log = folder / (name + ".log");
-  ChildProcess node({Self(), "ros", "inspect", "--log", (folder / (name + ".db")).string(), "--json", json.string(),
-                     "--idle-stop-s", "2"},
+  ChildProcess node({Self(), "ros", "inspect", "--log", (folder / (name + ".db")).string(),
+                     "--json", json.string(), "--idle-stop-s", "2"},
                     log);
-  WaitFor([] { return Output("rostopic info /uwscan/frames").find("uwscan_inspection") != std::string::npos; }, 30,
-          "the node did not subscribe (see " + log.string() + ")");
+  WaitFor(
+      [] {
+        return Output("rostopic info /uwscan/frames").find("uwscan_inspection") !=
+               std::string::npos;
+      },
+      30, "the node did not subscribe (see " + log.string() + ")");
   // -d: rosbag play waits after advertising, so that the node has connected before the first frame.
-  RunToEnd({"rosbag", "play", "--quiet", "-d", "1", "-r", std::to_string(rate), bag.string()}, folder / "play.log", 600);
+  RunToEnd({"rosbag", "play", "--quiet", "-d", "1", "-r", std::to_string(rate), bag.string()},
+           folder / "play.log", 600);
   const ChildProcess::Exit exit = node.Wait(600);
   if (exit.exit_code != 0) throw Error("bench ros: the node failed (see " + log.string() + ")");
   const nlohmann::json r = ReadJson(json);
@@ -143,8 +156,9 @@ struct InspectFigures {
 
 // `inspect` on the fake camera serving the same scene's frames as profiles.
 InspectFigures DirectInspect(const RosBenchArgs& a, const fs::path& folder) {
-  ChildProcess camera({Self(), "fake-camera", a.scene, "--mode", "profile", "--fps", std::to_string(a.camera_fps)},
-                      folder / "camera.log");
+  ChildProcess camera(
+      {Self(), "fake-camera", a.scene, "--mode", "profile", "--fps", std::to_string(a.camera_fps)},
+      folder / "camera.log");
   std::this_thread::sleep_for(std::chrono::seconds(2));
   const fs::path json = folder / "inspect.json";
   ChildProcess inspect({Self(), "inspect", "--camera", "127.0.0.1", "--scene", a.scene, "--log",
@@ -152,7 +166,8 @@ InspectFigures DirectInspect(const RosBenchArgs& a, const fs::path& folder) {
                         std::to_string(a.inspect_seconds)},
                        folder / "inspect.log");
   const ChildProcess::Exit exit = inspect.Wait(a.inspect_seconds + 120);
-  if (exit.exit_code != 0) throw Error("bench ros: inspect failed (see " + (folder / "inspect.log").string() + ")");
+  if (exit.exit_code != 0)
+    throw Error("bench ros: inspect failed (see " + (folder / "inspect.log").string() + ")");
   const nlohmann::json r = ReadJson(json);
   return {r["frames_received"], r["lost_frames"], r["frames_per_s"], exit.cpu_s};
 }
@@ -160,9 +175,11 @@ InspectFigures DirectInspect(const RosBenchArgs& a, const fs::path& folder) {
 // CPU seconds per frame of `uwscan map` on the dive: the same SLAM offline, without ROS, camera
 // or log writing (its tables already cached by the runs before).
 double OfflineMapCpuPerFrame(const fs::path& dive, std::int64_t frames, const fs::path& folder) {
-  ChildProcess map({Self(), "map", dive.string(), "-o", (folder / "map.ply").string()}, folder / "map.log");
+  ChildProcess map({Self(), "map", dive.string(), "-o", (folder / "map.ply").string()},
+                   folder / "map.log");
   const ChildProcess::Exit exit = map.Wait(600);
-  if (exit.exit_code != 0) throw Error("bench ros: map failed (see " + (folder / "map.log").string() + ")");
+  if (exit.exit_code != 0)
+    throw Error("bench ros: map failed (see " + (folder / "map.log").string() + ")");
   return exit.cpu_s / static_cast<double>(std::max<std::int64_t>(1, frames));
 }
 
@@ -173,7 +190,8 @@ nlohmann::json NodeJson(const NodeFigures& f) {
           {"frames_skipped_by_mapper", f.frames_skipped},
           {"latency_s", {{"median", f.sweep_latency_median_s}, {"p95", f.sweep_latency_p95_s}}},
           {"receive_to_map_median_s", f.receive_to_map_median_s},
-          {"cpu_s_per_frame", f.frames_received > 0 ? f.cpu_s / static_cast<double>(f.frames_received) : 0.0},
+          {"cpu_s_per_frame",
+           f.frames_received > 0 ? f.cpu_s / static_cast<double>(f.frames_received) : 0.0},
           {"peak_rss_bytes", f.peak_rss_bytes}};
 }
 
@@ -181,14 +199,19 @@ void RunRosBench(RosBenchArgs a) {
   if (!a.json.empty()) CheckOutputPath(a.json, "--json");
   if (a.scene.empty()) a.scene = (DataFolder() / "scenes" / "inspection_short.yaml").string();
   EnterPrivateNetwork();
-  const fs::path folder = fs::temp_directory_path() / ("uwscan_bench_ros_" + std::to_string(::getpid()));
+  const fs::path folder =
+      fs::temp_directory_path() / ("uwscan_bench_ros_" + std::to_string(::getpid()));
   fs::create_directories(folder);
   SetRosEnvironment(folder);
   const fs::path dive = folder / "dive.db", bag = folder / "dive.bag";
   RunToEnd({Self(), "simulate", a.scene, "-o", dive.string()}, folder / "simulate.log", 600);
-  RunToEnd({Self(), "bag", "export", dive.string(), "-o", bag.string()}, folder / "export.log", 600);
-  const std::string exported = Output("cat " + (folder / "export.log").string());
-  const std::int64_t frames_in_bag = std::stoll(exported.substr(exported.find("bag export: ") + 12));
+  RunToEnd({Self(), "bag", "export", dive.string(), "-o", bag.string()}, folder / "export.log",
+           600);
+  std::ifstream export_log(folder / "export.log");
+  const std::string exported((std::istreambuf_iterator<char>(export_log)),
+                             std::istreambuf_iterator<char>());
+  const std::int64_t frames_in_bag =
+      std::stoll(exported.substr(exported.find("bag export: ") + 12));
   ChildProcess master({"roscore", "-p", "11311"}, folder / "roscore.log");
   WaitFor(MasterAnswers, 30, "roscore did not answer");
   std::this_thread::sleep_for(std::chrono::seconds(1));
@@ -196,18 +219,24 @@ void RunRosBench(RosBenchArgs a) {
   for (double rate : a.rates) {
     runs.push_back(ReplayThroughNode(bag, frames_in_bag, rate, folder));
     const NodeFigures& f = runs.back();
-    std::printf("bench ros: rate %.2f: %.0f frames/s through the node, %lld lost, sweep latency median %.1f ms "
-                "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB\n",
-                f.rate, f.frames_per_s, static_cast<long long>(f.frames_in_bag - f.frames_received),
-                f.sweep_latency_median_s * 1e3, f.sweep_latency_p95_s * 1e3,
-                f.cpu_s / static_cast<double>(std::max<std::int64_t>(1, f.frames_received)) * 1e6,
-                static_cast<double>(f.peak_rss_bytes) * 1e-6);
+    std::printf(
+        "bench ros: rate %.2f: %.0f frames/s through the node, %lld lost, sweep latency median "
+        "%.1f ms "
+        "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB\n",
+        f.rate, f.frames_per_s, static_cast<long long>(f.frames_in_bag - f.frames_received),
+        f.sweep_latency_median_s * 1e3, f.sweep_latency_p95_s * 1e3,
+        f.cpu_s / static_cast<double>(std::max<std::int64_t>(1, f.frames_received)) * 1e6,
+        static_cast<double>(f.peak_rss_bytes) * 1e-6);
   }
   const InspectFigures direct = DirectInspect(a, folder);
-  const double inspect_cpu = direct.cpu_s / static_cast<double>(std::max<std::int64_t>(1, direct.frames));
-  std::printf("bench ros: inspect on the fake camera at %.0f frames/s: %.0f frames/s, %lld lost, %.1f us CPU per "
-              "frame\n",
-              a.camera_fps, direct.frames_per_s, static_cast<long long>(direct.lost_frames), inspect_cpu * 1e6);
+  const double inspect_cpu =
+      direct.cpu_s / static_cast<double>(std::max<std::int64_t>(1, direct.frames));
+  std::printf(
+      "bench ros: inspect on the fake camera at %.0f frames/s: %.0f frames/s, %lld lost, %.1f us "
+      "CPU per "
+      "frame\n",
+      a.camera_fps, direct.frames_per_s, static_cast<long long>(direct.lost_frames),
+      inspect_cpu * 1e6);
   // The headline: the run nearest the seed camera's 339 frames/s (3.39x the dive's 100).
   const NodeFigures* headline = &runs.front();
   for (const NodeFigures& f : runs) {
@@ -220,18 +249,21 @@ void RunRosBench(RosBenchArgs a) {
   const double overhead = inspect_cpu > 0 ? node_cpu / inspect_cpu - 1.0 : 0.0;
   const double map_cpu = OfflineMapCpuPerFrame(dive, frames_in_bag, folder);
   const double overhead_vs_map = map_cpu > 0 ? node_cpu / map_cpu - 1.0 : 0.0;
-  std::printf("bench ros: overhead against inspect %.2f, against map offline %.2f (CPU per frame, node / peer - 1)\n",
-              overhead, overhead_vs_map);
+  std::printf(
+      "bench ros: overhead against inspect %.2f, against map offline %.2f (CPU per frame, node / "
+      "peer - 1)\n",
+      overhead, overhead_vs_map);
   master.Interrupt();
   master.Wait(30);
   fs::remove_all(folder);
   if (!a.json.empty()) {
     WriteJsonFile(a.json, {{"scene", a.scene},
                            {"node", node},
-                           {"direct_inspect", {{"frames_per_s", direct.frames_per_s},
-                                               {"lost_frames", direct.lost_frames},
-                                               {"cpu_s_per_frame", inspect_cpu},
-                                               {"camera_fps", a.camera_fps}}},
+                           {"direct_inspect",
+                            {{"frames_per_s", direct.frames_per_s},
+                             {"lost_frames", direct.lost_frames},
+                             {"cpu_s_per_frame", inspect_cpu},
+                             {"camera_fps", a.camera_fps}}},
                            {"offline_map", {{"cpu_s_per_frame", map_cpu}}},
                            {"overhead_ratio", overhead},
                            {"overhead_vs_map_ratio", overhead_vs_map}});
@@ -242,12 +274,14 @@ void RunRosBench(RosBenchArgs a) {
 
 void AddRosBenchCommand(CLI::App& bench) {
   auto a = std::make_shared<RosBenchArgs>();
-  CLI::App* cmd = bench.add_subcommand(
-      "ros",
-      "the ROS node end to end (rosbag play of a simulated dive at several rates) against inspect on the fake "
-      "camera: frames per second, lost frames, sweep latency, CPU per frame, peak memory (root: private network)");
+  CLI::App* cmd = bench.add_subcommand("ros",
+                                       "the ROS node end to end (rosbag play of a simulated dive "
+                                       "at several rates) against inspect on the fake "
+                                       "camera: frames per second, lost frames, sweep latency, CPU "
+                                       "per frame, peak memory (root: private network)");
   cmd->add_option("--json", a->json, "figures as JSON");
-  cmd->add_option("--scene", a->scene, "the dive (default: scenes/inspection_short.yaml in the data folder)")
+  cmd->add_option("--scene", a->scene,
+                  "the dive (default: scenes/inspection_short.yaml in the data folder)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--rates", a->rates, "rosbag play rates (the dive's own frame rate times these)")
       ->capture_default_str();

@@ -13,6 +13,7 @@
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/stop_signal.hpp"
+#include "apps/ros/ros_arguments.hpp"
 #include "apps/ros/ros_recognize_command.hpp"
 #include "apps/scanner/camera_frames.hpp"
 #include "mapping/slam/trajectory_metrics.hpp"
@@ -41,24 +42,33 @@ struct RosInspectArgs {
 
 // The node's private parameters: name, what it sets, its default.
 const char* const kParameterHelp =
-    "ROS parameters (private, ~name; set them with rosparam, a launch file, or _name:=value here):\n"
-    "  ~frames_topic        camera frames, sensor_msgs/Image with uwscan's payload   [/uwscan/frames]\n"
-    "  ~odometry_topic      the vehicle's navigation, nav_msgs/Odometry             [/navigation/odometry]\n"
-    "  ~dive_topic          dive description (scanner), std_msgs/String, latched     [/uwscan/dive]\n"
-    "  ~map_frame ~odom_frame ~base_frame ~camera_frame   frame names               [map odom base_link uwscan_camera]\n"
+    "ROS parameters (private, ~name; set them with rosparam, a launch file, or _name:=value "
+    "here):\n"
+    "  ~frames_topic        camera frames, sensor_msgs/Image with uwscan's payload   "
+    "[/uwscan/frames]\n"
+    "  ~odometry_topic      the vehicle's navigation, nav_msgs/Odometry             "
+    "[/navigation/odometry]\n"
+    "  ~dive_topic          dive description (scanner), std_msgs/String, latched     "
+    "[/uwscan/dive]\n"
+    "  ~map_frame ~odom_frame ~base_frame ~camera_frame   frame names               [map odom "
+    "base_link uwscan_camera]\n"
     "  ~scanner             scanner (calibration) file when no dive description comes  []\n"
     "  ~description_wait_s  how long to wait for the dive description, s            [30]\n"
     "  ~mount_wait_s        how long to wait for base_frame -> camera_frame on /tf_static, s  [3]\n"
     "  ~map_period_s        the map is published at most this often, s              [2]\n"
     "  ~voxel_m             map voxel, m                                           [0.005]\n"
     "  ~sweeps_per_submap   sweeps grouped into one submap                          [1]\n"
-    "  ~live_queue          frames waiting for the mapper (a newer frame skips the oldest)  [1024]\n"
+    "  ~live_queue          frames waiting for the mapper (a newer frame skips the oldest)  "
+    "[1024]\n"
     "  ~frame_queue         frames roscpp holds while the node is busy              [4096]\n"
     "  ~images              image-mode frames: log the images too                   [false]\n"
-    "Publishes: ~sweep (/uwscan/sweep, PointCloud2, camera frame), /uwscan/map (PointCloud2, latched),\n"
+    "Publishes: ~sweep (/uwscan/sweep, PointCloud2, camera frame), /uwscan/map (PointCloud2, "
+    "latched),\n"
     "/uwscan/path and /uwscan/navigation_path (nav_msgs/Path, map frame), /uwscan/pose\n"
-    "(PoseWithCovarianceStamped), map -> odom on /tf. Frames: NED world, forward-right-down vehicle.\n"
-    "ROS 1 has no authentication: the node binds to ROS_IP (or ROS_HOSTNAME); set it to the vehicle's\n"
+    "(PoseWithCovarianceStamped), map -> odom on /tf. Frames: NED world, forward-right-down "
+    "vehicle.\n"
+    "ROS 1 has no authentication: the node binds to ROS_IP (or ROS_HOSTNAME); set it to the "
+    "vehicle's\n"
     "private interface, never leave it to all interfaces on an open network.";
 
 ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosInspectArgs& a) {
@@ -91,7 +101,8 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
   o.frame_queue = ros.Param("frame_queue", o.frame_queue);
   o.keep_images = ros.Param("images", o.keep_images);
   o.inspection.map_voxel_m = ros.Param("voxel_m", o.inspection.map_voxel_m);
-  o.inspection.mapper.sweeps_per_submap = ros.Param("sweeps_per_submap", o.inspection.mapper.sweeps_per_submap);
+  o.inspection.mapper.sweeps_per_submap =
+      ros.Param("sweeps_per_submap", o.inspection.mapper.sweeps_per_submap);
   // On the vehicle every frame should reach SLAM (a skipped frame is a hole in the map), so the
   // live queue absorbs the mapper's pauses at submaps and solves: 1024 frames are 3 s at the
   // seed camera's 339 frames/s (and about 8 MB of peaks).
@@ -110,10 +121,13 @@ constexpr double kSilentFrames_s = 2.0;
 
 void ReportSilence(const ros::InspectionNodeStatus& s, const std::string& topic, bool& reported) {
   if (s.frames_silent_s >= kSilentFrames_s && !reported) {
-    std::fprintf(stderr, "%sros inspect: no frame on %s for %.1f s (%lld navigation samples so far)\n",
-                 isatty(2) ? "\n" : "", topic.c_str(), s.frames_silent_s, static_cast<long long>(s.navigation_samples));
+    std::fprintf(stderr,
+                 "%sros inspect: no frame on %s for %.1f s (%lld navigation samples so far)\n",
+                 isatty(2) ? "\n" : "", topic.c_str(), s.frames_silent_s,
+                 static_cast<long long>(s.navigation_samples));
   } else if (s.frames_silent_s < kSilentFrames_s && reported) {
-    std::fprintf(stderr, "%sros inspect: frames on %s again\n", isatty(2) ? "\n" : "", topic.c_str());
+    std::fprintf(stderr, "%sros inspect: frames on %s again\n", isatty(2) ? "\n" : "",
+                 topic.c_str());
   }
   reported = s.frames_silent_s >= kSilentFrames_s;
 }
@@ -121,7 +135,8 @@ void ReportSilence(const ros::InspectionNodeStatus& s, const std::string& topic,
 void PrintStatus(const ros::InspectionNodeStatus& s) {
   const mapping::InspectionStatistics& i = s.statistics;
   std::fprintf(stderr,
-               "%sros inspect: %lld frames, logged %lld, mapped %lld, skipped %lld, waiting %lld, without navigation "
+               "%sros inspect: %lld frames, logged %lld, mapped %lld, skipped %lld, waiting %lld, "
+               "without navigation "
                "%lld; %d submaps%s%s",
                isatty(2) ? "\r" : "", static_cast<long long>(i.frames_received),
                static_cast<long long>(i.frames_logged), static_cast<long long>(i.frames_mapped),
@@ -132,48 +147,49 @@ void PrintStatus(const ros::InspectionNodeStatus& s) {
 
 nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
   const mapping::InspectionStatistics& i = s.result.statistics;
-  return {{"frames_received", i.frames_received},
-          {"frames_logged", i.frames_logged},
-          {"frames_mapped", i.frames_mapped},
-          {"frames_skipped", i.frames_skipped},
-          {"frames_without_navigation", i.frames_without_navigation},
-          {"frames_out_of_order", i.frames_out_of_order},
-          {"frames_undecodable", s.frames_undecodable},
-          {"camera_lost_frames", s.camera_lost_frames},
-          {"navigation_samples", s.navigation_samples},
-          {"receive_span_s", s.receive_span_s},
-          {"navigation_logged", i.log.navigation_written},
-          {"sweeps_published", s.sweeps_published},
-          {"maps_published", s.maps_published},
-          {"submaps", i.submaps},
-          {"map_points", s.result.map.size()},
-          {"reregistrations", s.reregistrations},
-          {"scanner_from_dive_description", s.described},
-          {"mount", s.mount},
-          {"time_origin_s", s.time_origin_s},
-          {"receive_to_map_s", {{"median", i.receive_to_map.median_s}, {"p95", i.receive_to_map.p95_s}}},
-          {"sweep_latency_s", {{"median", s.sweep_latency_median_s}, {"p95", s.sweep_latency_p95_s}}},
-          {"stop_reason", s.stop_reason}};
+  return {
+      {"frames_received", i.frames_received},
+      {"frames_logged", i.frames_logged},
+      {"frames_mapped", i.frames_mapped},
+      {"frames_skipped", i.frames_skipped},
+      {"frames_without_navigation", i.frames_without_navigation},
+      {"frames_out_of_order", i.frames_out_of_order},
+      {"frames_undecodable", s.frames_undecodable},
+      {"camera_lost_frames", s.camera_lost_frames},
+      {"navigation_samples", s.navigation_samples},
+      {"receive_span_s", s.receive_span_s},
+      {"navigation_logged", i.log.navigation_written},
+      {"sweeps_published", s.sweeps_published},
+      {"maps_published", s.maps_published},
+      {"submaps", i.submaps},
+      {"map_points", s.result.map.size()},
+      {"reregistrations", s.reregistrations},
+      {"scanner_from_dive_description", s.described},
+      {"mount", s.mount},
+      {"time_origin_s", s.time_origin_s},
+      {"receive_to_map_s",
+       {{"median", i.receive_to_map.median_s}, {"p95", i.receive_to_map.p95_s}}},
+      {"sweep_latency_s", {{"median", s.sweep_latency_median_s}, {"p95", s.sweep_latency_p95_s}}},
+      {"stop_reason", s.stop_reason}};
 }
 
 void RunRosInspect(const RosInspectArgs& a) {
-  if (!a.scene.empty() && a.camera.empty()) throw Error("--scene: only with --camera (a simulated camera's scene)");
+  if (!a.scene.empty() && a.camera.empty())
+    throw Error("--scene: only with --camera (a simulated camera's scene)");
   if (!a.log.empty()) CheckNewLogPath(a.log, a.force, "--log");
   if (!a.map.empty()) CheckCloudOutputPath(a.map, "-o");
   if (!a.trajectory.empty()) CheckOutputPath(a.trajectory, "--trajectory");
   if (!a.json.empty()) CheckOutputPath(a.json, "--json");
-  for (const std::string& argument : a.ros_arguments) {
-    if (argument.find(":=") == std::string::npos) {
-      throw Error("unexpected argument '" + argument + "' (ROS remappings and parameters are name:=value)");
-    }
-  }
+  CheckRosArguments(a.ros_arguments);
   InstallStopHandlers();
   ros::RosConnection ros("uwscan_inspection", a.ros_arguments, a.master_wait_s);
   const ros::InspectionNodeOptions options = NodeOptions(ros, a);
   if (!a.log.empty()) RemoveLog(a.log);
-  std::printf("ros inspect: frames %s %s, navigation on %s; %s\n", options.camera ? "from the camera" : "on",
+  std::printf("ros inspect: frames %s %s, navigation on %s; %s\n",
+              options.camera ? "from the camera" : "on",
               options.camera ? a.camera.c_str() : options.topics.frames.c_str(),
-              options.topics.odometry.c_str(), a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
+              options.topics.odometry.c_str(),
+              a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
   std::fflush(stdout);
   bool silence_reported = false;
   const ros::InspectionNodeSummary s = ros::RunInspectionNode(
@@ -183,13 +199,17 @@ void RunRosInspect(const RosInspectArgs& a) {
         ReportSilence(status, options.topics.frames, silence_reported);
       });
   const mapping::InspectionStatistics& i = s.result.statistics;
-  std::printf("ros inspect: %lld frames received, %lld logged, %lld mapped, %lld skipped, %lld without navigation, "
-              "%lld undecodable; %lld navigation samples; %lld sweeps and %lld maps published; %d submaps (%s)\n",
-              static_cast<long long>(i.frames_received), static_cast<long long>(i.frames_logged),
-              static_cast<long long>(i.frames_mapped), static_cast<long long>(i.frames_skipped),
-              static_cast<long long>(i.frames_without_navigation), static_cast<long long>(s.frames_undecodable),
-              static_cast<long long>(s.navigation_samples), static_cast<long long>(s.sweeps_published),
-              static_cast<long long>(s.maps_published), i.submaps, s.stop_reason.c_str());
+  std::printf(
+      "ros inspect: %lld frames received, %lld logged, %lld mapped, %lld skipped, %lld without "
+      "navigation, "
+      "%lld undecodable; %lld navigation samples; %lld sweeps and %lld maps published; %d submaps "
+      "(%s)\n",
+      static_cast<long long>(i.frames_received), static_cast<long long>(i.frames_logged),
+      static_cast<long long>(i.frames_mapped), static_cast<long long>(i.frames_skipped),
+      static_cast<long long>(i.frames_without_navigation),
+      static_cast<long long>(s.frames_undecodable), static_cast<long long>(s.navigation_samples),
+      static_cast<long long>(s.sweeps_published), static_cast<long long>(s.maps_published),
+      i.submaps, s.stop_reason.c_str());
   if (i.frames_without_navigation > 0) {
     std::printf("ros inspect: %lld frames logged but not mapped: no navigation around their time\n",
                 static_cast<long long>(i.frames_without_navigation));
@@ -207,29 +227,37 @@ void AddRosCommands(CLI::App& app) {
   CLI::App* ros = app.add_subcommand("ros", "uwscan on the vehicle: ROS 1 nodes");
   ros->require_subcommand(1);
   auto a = std::make_shared<RosInspectArgs>();
-  CLI::App* cmd = ros->add_subcommand(
-      "inspect",
-      "online inspection as a ROS 1 node: frames from an image topic and the vehicle's odometry, logged and "
-      "mapped with loop closures; sweeps, map, paths, pose and the map -> odom correction published");
+  CLI::App* cmd = ros->add_subcommand("inspect",
+                                      "online inspection as a ROS 1 node: frames from an image "
+                                      "topic and the vehicle's odometry, logged and "
+                                      "mapped with loop closures; sweeps, map, paths, pose and the "
+                                      "map -> odom correction published");
   cmd->footer(kParameterHelp);
   cmd->allow_extras();
-  cmd->add_option("--scanner", a->scanner_file,
-                  "scanner (calibration) file: of the camera (--camera), or when no dive description comes")
+  cmd->add_option(
+         "--scanner", a->scanner_file,
+         "scanner (calibration) file: of the camera (--camera), or when no dive description comes")
       ->check(CLI::ExistingFile);
   cmd->add_option("--camera", a->camera,
-                  "read frames from this camera (IPv4 address, opened directly) instead of the image topic; its clock "
+                  "read frames from this camera (IPv4 address, opened directly) instead of the "
+                  "image topic; its clock "
                   "must be the navigation's (PTP)");
-  cmd->add_option("--scene", a->scene, "with --camera: a simulated camera's scene (its scanner and mount)")
+  cmd->add_option("--scene", a->scene,
+                  "with --camera: a simulated camera's scene (its scanner and mount)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--log", a->log, "dive log to create (.db): every frame and navigation sample, each committed");
+  cmd->add_option("--log", a->log,
+                  "dive log to create (.db): every frame and navigation sample, each committed");
   cmd->add_flag("--force", a->force, "replace an existing log at the --log path");
   cmd->add_option("-o,--map", a->map, "map to write at the end (.ply or .pcd)");
-  cmd->add_option("--trajectory", a->trajectory, "SLAM trajectory at the submaps' anchors to write at the end (TUM)");
+  cmd->add_option("--trajectory", a->trajectory,
+                  "SLAM trajectory at the submaps' anchors to write at the end (TUM)");
   cmd->add_option("--json", a->json, "figures as JSON at the end");
   cmd->add_option("--frames", a->frames, "stop after this many frames")->check(kPositiveNumber);
-  cmd->add_option("--idle-stop-s", a->idle_stop_s, "stop when frames stopped coming this long (replays)")
+  cmd->add_option("--idle-stop-s", a->idle_stop_s,
+                  "stop when frames stopped coming this long (replays)")
       ->check(kPositiveNumber);
-  cmd->add_option("--master-wait-s", a->master_wait_s, "how long to wait for the ROS master at start, s")
+  cmd->add_option("--master-wait-s", a->master_wait_s,
+                  "how long to wait for the ROS master at start, s")
       ->capture_default_str()
       ->check(kPositiveNumber);
   cmd->callback([a, cmd] {

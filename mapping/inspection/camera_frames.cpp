@@ -25,10 +25,14 @@ std::string FileText(const std::string& path) {
 
 }  // namespace
 
-AcquisitionContext MakeAcquisitionContext(const std::string& scene_path, const std::string& scanner_file,
-                                          const acq::PayloadDescription& payload, const std::string& producer) {
+AcquisitionContext MakeAcquisitionContext(const std::string& scene_path,
+                                          const std::string& scanner_file,
+                                          const acq::PayloadDescription& payload,
+                                          const std::string& producer) {
   if (scene_path.empty() == scanner_file.empty()) {
-    throw Error("give the scene a simulated camera serves or the scanner file of a real camera (one of them)");
+    throw Error(
+        "give the scene a simulated camera serves or the scanner file of a real camera (one of "
+        "them)");
   }
   AcquisitionContext c;
   c.header.producer = producer;
@@ -48,13 +52,14 @@ AcquisitionContext MakeAcquisitionContext(const std::string& scene_path, const s
   return c;
 }
 
-CameraFrameDecoder::CameraFrameDecoder(const acq::PayloadDescription& payload, const AcquisitionContext& context,
-                                       bool keep_images)
+CameraFrameDecoder::CameraFrameDecoder(const acq::PayloadDescription& payload,
+                                       const AcquisitionContext& context, bool keep_images)
     : payload_(payload),
       detector_(context.detector),
       pattern_driver_(context.header.scan_pattern),
       keep_images_(keep_images) {
-  if (!payload.metadata_row && payload.profile) throw Error("the camera sends profiles without a metadata row");
+  if (!payload.metadata_row && payload.profile)
+    throw Error("the camera sends profiles without a metadata row");
   if (keep_images && payload.profile) {
     throw Error("--images: the camera sends profiles (peaks found on the camera), not images");
   }
@@ -64,7 +69,8 @@ std::optional<FrameRecord> CameraFrameDecoder::Decode(const acq::AcquiredFrame& 
   FrameRecord record;
   std::optional<acq::FrameMetadata> metadata;
   if (payload_.profile) {
-    std::optional<acq::DecodedProfile> decoded = acq::DecodeProfile(payload_.profile_layout, frame.payload);
+    std::optional<acq::DecodedProfile> decoded =
+        acq::DecodeProfile(payload_.profile_layout, frame.payload);
     if (!decoded) return std::nullopt;
     metadata = decoded->metadata;
     record.peaks_px = std::move(decoded->peaks_px);
@@ -77,19 +83,22 @@ std::optional<FrameRecord> CameraFrameDecoder::Decode(const acq::AcquiredFrame& 
       metadata = decoded->metadata;
       image = decoded->image;
     } else {
-      image = {frame.payload.data(), l.width_px, l.height_px, static_cast<std::ptrdiff_t>(l.row_bytes()), l.format};
+      image = {frame.payload.data(), l.width_px, l.height_px,
+               static_cast<std::ptrdiff_t>(l.row_bytes()), l.format};
     }
     detector_.Detect(image, &detection_);
     record.peaks_px.reserve(detection_.peaks.size());
-    for (const scanner::StripePeak& p : detection_.peaks) record.peaks_px.emplace_back(p.u_px, p.v_px);
+    for (const scanner::StripePeak& p : detection_.peaks)
+      record.peaks_px.emplace_back(p.u_px, p.v_px);
     if (keep_images_) {
       LogImage log_image;
       log_image.width_px = image.width_px;
       log_image.height_px = image.height_px;
       log_image.format = image.format == scanner::PixelFormat::kMono8 ? LogPixelFormat::kMono8
-                                                                       : LogPixelFormat::kMono16;
+                                                                      : LogPixelFormat::kMono16;
       const auto* bytes = static_cast<const std::uint8_t*>(image.data);
-      log_image.bytes.assign(bytes, bytes + l.row_bytes() * static_cast<std::size_t>(image.height_px));
+      log_image.bytes.assign(bytes,
+                             bytes + l.row_bytes() * static_cast<std::size_t>(image.height_px));
       record.image = std::move(log_image);
     }
   }
@@ -100,7 +109,8 @@ std::optional<FrameRecord> CameraFrameDecoder::Decode(const acq::AcquiredFrame& 
   } else {
     // A camera without uwscan's metadata row: the camera's clock, and the mirror driver's
     // command for this trigger (frame numbers count from the first frame of the session).
-    const acq::MirrorCommand c = pattern_driver_.CommandOf(static_cast<std::uint64_t>(frame.frame_number));
+    const acq::MirrorCommand c =
+        pattern_driver_.CommandOf(static_cast<std::uint64_t>(frame.frame_number));
     record.time_s = static_cast<double>(frame.camera_timestamp_ns) * 1e-9;
     record.command = c.command;
     record.sweep = c.sweep;

@@ -16,7 +16,7 @@
 namespace uwscan::mapping {
 
 struct AcquisitionContext {
-  DiveLogHeader header;  // scanner, scan pattern (and scene text when simulated)
+  DiveLogHeader header;                     // scanner, scan pattern (and scene text when simulated)
   scanner::StripeDetectorOptions detector;  // how image-mode frames are searched
   // The camera on the vehicle: the scene's mount when simulated, identity for a real camera.
   Eigen::Isometry3d T_V_C = Eigen::Isometry3d::Identity();
@@ -25,7 +25,8 @@ struct AcquisitionContext {
 // A simulated camera's context from the scene it serves (`scene_path`), or a real camera's from
 // its scanner file (`scanner_file`): give exactly one. `producer` goes into the log's header.
 // Throws uwscan::Error when neither or both are given, or a file cannot be read.
-AcquisitionContext MakeAcquisitionContext(const std::string& scene_path, const std::string& scanner_file,
+AcquisitionContext MakeAcquisitionContext(const std::string& scene_path,
+                                          const std::string& scanner_file,
                                           const scanner::acquisition::PayloadDescription& payload,
                                           const std::string& producer);
 
@@ -38,8 +39,8 @@ class CameraFrameDecoder {
   // keep_images: image mode, each image goes into its record as well. Throws uwscan::Error
   // when the camera sends profiles without a metadata row (the peaks' mirror command would be
   // unknown), or profiles while images are to be kept.
-  CameraFrameDecoder(const scanner::acquisition::PayloadDescription& payload, const AcquisitionContext& context,
-                     bool keep_images);
+  CameraFrameDecoder(const scanner::acquisition::PayloadDescription& payload,
+                     const AcquisitionContext& context, bool keep_images);
 
   // std::nullopt when the payload does not decode (packets lost: its checksum fails).
   std::optional<FrameRecord> Decode(const scanner::acquisition::AcquiredFrame& frame);
@@ -56,6 +57,6 @@ class CameraFrameDecoder {
 // captured at the camera's, when the camera's clock is the host's (within a second of it: a
 // PTP-synchronised camera, or the fake camera), else unknown (a camera counting from power-up).
 InspectionFrame ToInspectionFrame(FrameRecord&& record,
-                                           const scanner::acquisition::AcquiredFrame& frame);
+                                  const scanner::acquisition::AcquiredFrame& frame);
 
 }  // namespace uwscan::mapping

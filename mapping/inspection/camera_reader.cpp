@@ -6,8 +6,8 @@ namespace uwscan::mapping {
 
 namespace acq = scanner::acquisition;
 
-ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder, const ReadLimits& limits,
-                       const ReadCallbacks& callbacks) {
+ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder,
+                       const ReadLimits& limits, const ReadCallbacks& callbacks) {
   const bool software_trigger = source.settings().trigger == acq::TriggerMode::kSoftware;
   ReadSummary summary;
   source.Start();
@@ -20,7 +20,8 @@ ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder, co
     std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
     const double now = source.ElapsedSeconds();
     summary.source = source.statistics();
-    while (gaps_reported < summary.source.gaps.size() && summary.source.gaps[gaps_reported].resumed_at_s >= 0.0) {
+    while (gaps_reported < summary.source.gaps.size() &&
+           summary.source.gaps[gaps_reported].resumed_at_s >= 0.0) {
       if (callbacks.gap) callbacks.gap(summary.source.gaps[gaps_reported]);
       ++gaps_reported;
     }

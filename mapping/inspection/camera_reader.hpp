@@ -39,7 +39,7 @@ struct ReadCallbacks {
 // Starts the camera and hands every decoded frame on until the limits are reached or a stop is
 // requested. Software trigger mode: triggers one frame at a time. Stops the camera before it
 // returns.
-ReadSummary ReadFrames(scanner::acquisition::FrameSource& source, CameraFrameDecoder& decoder, const ReadLimits& limits,
-                       const ReadCallbacks& callbacks);
+ReadSummary ReadFrames(scanner::acquisition::FrameSource& source, CameraFrameDecoder& decoder,
+                       const ReadLimits& limits, const ReadCallbacks& callbacks);
 
 }  // namespace uwscan::mapping

@@ -1,10 +1,9 @@
 #include "ros/bag/bag_export.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "mapping/log/dive_log.hpp"
 #include "ros/bag/report_export.hpp"
@@ -68,20 +67,23 @@ double TimeOriginOf(const std::vector<std::filesystem::path>& inputs) {
   return kUnixTimeFloor_s;
 }
 
-ImageMessage FrameMessage(const mapping::FrameRecord& frame, const scanner::acquisition::ProfileLayout& layout,
-                          double origin_s, const RosFrames& frames) {
+ImageMessage FrameMessage(const mapping::FrameRecord& frame,
+                          const scanner::acquisition::ProfileLayout& layout, double origin_s,
+                          const RosFrames& frames) {
   return FrameToImage(frame, layout, static_cast<std::uint64_t>(frame.index),
                       Header{origin_s + frame.time_s, frames.camera});
 }
 
-void WriteNavigation(const mapping::NavigationRecord& nav, double origin_s, const BagExportOptions& o, BagWriter& bag) {
+void WriteNavigation(const mapping::NavigationRecord& nav, double origin_s,
+                     const BagExportOptions& o, BagWriter& bag) {
   const Header header{origin_s + nav.time_s, o.frames.odom};
   OdometryMessage odometry;
   odometry.header = header;
   odometry.child_frame_id = o.frames.base_link;
   odometry.pose = nav.T_W_V;
   bag.Write(o.topics.odometry, odometry);
-  bag.Write(o.topics.tf, std::vector<TransformMessage>{{header, o.frames.base_link, nav.T_W_V}}, header.stamp_s);
+  bag.Write(o.topics.tf, std::vector<TransformMessage>{{header, o.frames.base_link, nav.T_W_V}},
+            header.stamp_s);
 }
 
 // The profile layout that carries every frame of the log whole.
@@ -95,8 +97,8 @@ scanner::acquisition::ProfileLayout LayoutOf(const mapping::DiveLogReader& reade
   return finder.Layout(reader.header().scanner.camera().camera);
 }
 
-void ExportDive(const std::filesystem::path& log, double origin_s, const BagExportOptions& o, BagWriter& bag,
-                BagExportSummary& summary) {
+void ExportDive(const std::filesystem::path& log, double origin_s, const BagExportOptions& o,
+                BagWriter& bag, BagExportSummary& summary) {
   const mapping::DiveLogReader reader(log);
   if (reader.frame_count() == 0) throw Error(log.string() + ": the log holds no frames");
   summary.layout = LayoutOf(reader);
@@ -105,7 +107,8 @@ void ExportDive(const std::filesystem::path& log, double origin_s, const BagExpo
   description.header.producer = o.producer;
   bag.Write(o.topics.dive, StringMessage{DiveDescriptionToYaml(description)}, start_s, true);
   const Eigen::Isometry3d T_V_C = reader.vehicle_mount().value_or(Eigen::Isometry3d::Identity());
-  bag.Write(o.topics.tf_static, std::vector<TransformMessage>{{{start_s, o.frames.base_link}, o.frames.camera, T_V_C}},
+  bag.Write(o.topics.tf_static,
+            std::vector<TransformMessage>{{{start_s, o.frames.base_link}, o.frames.camera, T_V_C}},
             start_s);
   reader.ForEachFrame(
       [&](const mapping::FrameRecord& f, const mapping::GroundTruthRecord*) {
@@ -136,7 +139,8 @@ void ExportInput(const std::filesystem::path& input, const BagExportOptions& o, 
 
 }  // namespace
 
-BagExportSummary ExportToBag(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& bag_path,
+BagExportSummary ExportToBag(const std::vector<std::filesystem::path>& inputs,
+                             const std::filesystem::path& bag_path,
                              const BagExportOptions& options) {
   for (const std::filesystem::path& input : inputs) {
     if (!std::filesystem::is_regular_file(input)) throw Error(input.string() + ": no such file");

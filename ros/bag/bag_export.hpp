@@ -38,7 +38,7 @@ struct BagExportSummary {
 // simulated dive): the first dive log's, else that of the log a map report names. Throws
 // uwscan::Error naming the file on any failure (a recognition report: not exported yet); the bag
 // is then removed.
-BagExportSummary ExportToBag(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& bag,
-                             const BagExportOptions& options);
+BagExportSummary ExportToBag(const std::vector<std::filesystem::path>& inputs,
+                             const std::filesystem::path& bag, const BagExportOptions& options);
 
 }  // namespace uwscan::ros

@@ -13,22 +13,25 @@ namespace {
 
 std::string TopicList(const std::vector<BagTopic>& topics) {
   std::string list;
-  for (const BagTopic& t : topics) list += (list.empty() ? "" : ", ") + t.name + " (" + t.datatype + ")";
+  for (const BagTopic& t : topics)
+    list += (list.empty() ? "" : ", ") + t.name + " (" + t.datatype + ")";
   return list.empty() ? "none" : list;
 }
 
 // Throws unless the bag has `name` with messages of `datatype`.
-void RequireTopic(const std::vector<BagTopic>& topics, const std::string& name, const std::string& datatype,
-                  const std::string& what, const std::filesystem::path& bag) {
+void RequireTopic(const std::vector<BagTopic>& topics, const std::string& name,
+                  const std::string& datatype, const std::string& what,
+                  const std::filesystem::path& bag) {
   for (const BagTopic& t : topics) {
     if (t.name != name) continue;
     if (t.datatype != datatype) {
-      throw Error(bag.string() + ": topic " + name + " is " + t.datatype + ", expected " + datatype + " (" + what + ")");
+      throw Error(bag.string() + ": topic " + name + " is " + t.datatype + ", expected " +
+                  datatype + " (" + what + ")");
     }
     if (t.messages > 0) return;
   }
-  throw Error(bag.string() + ": no " + what + " on topic " + name + " (" + datatype + "); the bag's topics: " +
-              TopicList(topics));
+  throw Error(bag.string() + ": no " + what + " on topic " + name + " (" + datatype +
+              "); the bag's topics: " + TopicList(topics));
 }
 
 bool HasTopic(const std::vector<BagTopic>& topics, const std::string& name) {
@@ -43,8 +46,9 @@ class StampOrder {
  public:
   void Check(const std::string& topic, double stamp_s, const std::filesystem::path& bag) {
     if (last_s_ && stamp_s < *last_s_) {
-      throw Error(bag.string() + ": topic " + topic + ": stamp " + std::to_string(stamp_s) + " s goes back from " +
-                  std::to_string(*last_s_) + " s (message " + std::to_string(count_) + ")");
+      throw Error(bag.string() + ": topic " + topic + ": stamp " + std::to_string(stamp_s) +
+                  " s goes back from " + std::to_string(*last_s_) + " s (message " +
+                  std::to_string(count_) + ")");
     }
     last_s_ = stamp_s;
     ++count_;
@@ -68,7 +72,8 @@ Description ReadDescription(const BagReader& reader, const std::vector<BagTopic>
   BagVisitor visitor;
   visitor.text = [&](const std::string& topic, StringMessage&& m) {
     if (d.described) return;
-    const DiveDescription description = ParseDiveDescription(m.data, bag.string() + " topic " + topic);
+    const DiveDescription description =
+        ParseDiveDescription(m.data, bag.string() + " topic " + topic);
     d.header = description.header;
     d.time_origin_s = description.time_origin_s;
     d.described = true;
@@ -100,8 +105,8 @@ void ReadDive(const BagReader& reader, const std::filesystem::path& bag, const B
   visitor.image = [&](const std::string& topic, ImageMessage&& m) {
     frame_order.Check(topic, m.header.stamp_s, bag);
     if (camera_frame.empty()) camera_frame = m.header.frame_id;
-    std::optional<mapping::FrameRecord> frame = decoder.Decode(m, m.header.stamp_s - d.time_origin_s,
-                                                               bag.string() + ": topic " + topic);
+    std::optional<mapping::FrameRecord> frame =
+        decoder.Decode(m, m.header.stamp_s - d.time_origin_s, bag.string() + ": topic " + topic);
     if (!frame) {
       ++summary.undecodable;
       return;
@@ -122,7 +127,8 @@ void ReadDive(const BagReader& reader, const std::filesystem::path& bag, const B
 
 BagImportSummary ImportBag(const std::filesystem::path& bag, const std::filesystem::path& log,
                            const BagImportOptions& o) {
-  if (std::filesystem::exists(log)) throw Error(log.string() + ": exists (a dive log is never overwritten)");
+  if (std::filesystem::exists(log))
+    throw Error(log.string() + ": exists (a dive log is never overwritten)");
   const BagReader reader(bag.string());
   const std::vector<BagTopic> topics = reader.Topics();
   RequireTopic(topics, o.topics.frames, "sensor_msgs/Image", "camera frames", bag);
@@ -135,7 +141,8 @@ BagImportSummary ImportBag(const std::filesystem::path& bag, const std::filesyst
   mapping::DiveLogHeader header = d.header;
   header.producer = o.producer;
   const std::filesystem::path partial = log.string() + ".partial";
-  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(partial.string() + suffix);
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+    std::filesystem::remove(partial.string() + suffix);
   try {
     std::string camera_frame, vehicle_frame;
     {
@@ -144,12 +151,13 @@ BagImportSummary ImportBag(const std::filesystem::path& bag, const std::filesyst
       const std::optional<Eigen::Isometry3d> T_V_C = d.statics.Find(vehicle_frame, camera_frame);
       writer.SetVehicleMount(T_V_C.value_or(Eigen::Isometry3d::Identity()));
       summary.mount = T_V_C ? o.topics.tf_static + " " + vehicle_frame + " -> " + camera_frame
-                            : "none on " + o.topics.tf_static + " from " + vehicle_frame + " to " + camera_frame +
-                                  ": the camera is taken at the vehicle's origin";
+                            : "none on " + o.topics.tf_static + " from " + vehicle_frame + " to " +
+                                  camera_frame + ": the camera is taken at the vehicle's origin";
     }
     std::filesystem::rename(partial, log);
   } catch (...) {
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(partial.string() + suffix);
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+      std::filesystem::remove(partial.string() + suffix);
     throw;
   }
   return summary;

@@ -30,7 +30,7 @@ struct BagImportSummary {
   std::int64_t frames = 0;
   std::int64_t undecodable = 0;  // frames whose metadata row failed its checksum: left out
   std::int64_t navigation = 0;
-  bool described = false;  // the bag carried a dive description (else options.header was used)
+  bool described = false;      // the bag carried a dive description (else options.header was used)
   double time_origin_s = 0.0;  // ROS time of the log's time 0
   // Where the mount came from: "/tf_static base_link -> uwscan_camera", or a note that none
   // was found and the camera is taken at the vehicle's origin.

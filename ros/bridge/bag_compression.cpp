@@ -12,16 +12,20 @@ namespace {
 
 rosbag::compression::CompressionType ToRosbag(BagCompression c) {
   switch (c) {
-    case BagCompression::kBz2: return rosbag::compression::BZ2;
-    case BagCompression::kLz4: return rosbag::compression::LZ4;
-    case BagCompression::kNone: break;
+    case BagCompression::kBz2:
+      return rosbag::compression::BZ2;
+    case BagCompression::kLz4:
+      return rosbag::compression::LZ4;
+    case BagCompression::kNone:
+      break;
   }
   return rosbag::compression::Uncompressed;
 }
 
 }  // namespace
 
-void WriteCompressedCopy(const std::string& from, const std::string& to, BagCompression compression) {
+void WriteCompressedCopy(const std::string& from, const std::string& to,
+                         BagCompression compression) {
   if (!::ros::Time::isValid()) ::ros::Time::init();  // rosbag needs ROS time, nothing else of ROS
   if (std::filesystem::exists(to)) throw Error(to + ": exists (a bag is never overwritten)");
   try {

@@ -13,6 +13,7 @@ enum class BagCompression { kNone, kBz2, kLz4 };
 // connection header, in chunks compressed with `compression`. `from` is read through Debian's
 // rosbag, which trusts its input (bag_container.hpp): give it only a bag uwscan has just written.
 // Throws uwscan::Error naming the file on any failure.
-void WriteCompressedCopy(const std::string& from, const std::string& to, BagCompression compression);
+void WriteCompressedCopy(const std::string& from, const std::string& to,
+                         BagCompression compression);
 
 }  // namespace uwscan::ros

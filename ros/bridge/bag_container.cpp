@@ -54,8 +54,8 @@ template <typename T>
 T FixedField(const Fields& fields, const char* name) {
   const std::string_view value = Field(fields, name);
   if (value.size() != sizeof(T)) {
-    throw Error(std::string("field '") + name + "' has " + std::to_string(value.size()) + " bytes, not " +
-                std::to_string(sizeof(T)));
+    throw Error(std::string("field '") + name + "' has " + std::to_string(value.size()) +
+                " bytes, not " + std::to_string(sizeof(T)));
   }
   T v;
   std::memcpy(&v, value.data(), sizeof(T));
@@ -65,15 +65,16 @@ T FixedField(const Fields& fields, const char* name) {
 BagTime TimeField(const Fields& fields, const char* name) {
   const std::uint64_t packed = FixedField<std::uint64_t>(fields, name);
   const BagTime t{static_cast<std::uint32_t>(packed), static_cast<std::uint32_t>(packed >> 32)};
-  if (t.nsec >= 1000000000u) throw Error(std::string("field '") + name + "' has " + std::to_string(t.nsec) + " ns");
+  if (t.nsec >= 1000000000u)
+    throw Error(std::string("field '") + name + "' has " + std::to_string(t.nsec) + " ns");
   return t;
 }
 
 void ExpectOp(const Fields& fields, std::uint8_t op, const char* record) {
   const auto found = FixedField<std::uint8_t>(fields, "op");
   if (found != op) {
-    throw Error(std::string("expected a ") + record + " record (op " + std::to_string(op) + "), found op " +
-                std::to_string(found));
+    throw Error(std::string("expected a ") + record + " record (op " + std::to_string(op) +
+                "), found op " + std::to_string(found));
   }
 }
 
@@ -87,8 +88,8 @@ struct MemoryRecord {
 MemoryRecord ParseRecordAt(std::string_view buffer, std::size_t at) {
   const auto need = [&](std::size_t bytes, const char* what) {
     if (bytes > buffer.size() - at) {
-      throw Error(std::string(what) + " of the record at offset " + std::to_string(at) + " runs past the chunk's " +
-                  std::to_string(buffer.size()) + " bytes");
+      throw Error(std::string(what) + " of the record at offset " + std::to_string(at) +
+                  " runs past the chunk's " + std::to_string(buffer.size()) + " bytes");
     }
   };
   need(4, "the header length");
@@ -148,13 +149,16 @@ class BagContainer::File {
     r.data_at = position + 4 + header_length + 4;
     r.data_length = LoadU32(Read(r.data_at - 4, 4, what), 0);
     if (r.data_length > size_ - std::min(size_, r.data_at)) {
-      throw Error(std::string(what) + At(position) + ": its data of " + std::to_string(r.data_length) +
-                  " bytes runs past the end of the file (byte " + std::to_string(size_) + ")");
+      throw Error(std::string(what) + At(position) + ": its data of " +
+                  std::to_string(r.data_length) + " bytes runs past the end of the file (byte " +
+                  std::to_string(size_) + ")");
     }
     r.end = r.data_at + r.data_length;
     return r;
   }
-  std::string ReadData(const Record& r, const char* what) { return Read(r.data_at, r.data_length, what); }
+  std::string ReadData(const Record& r, const char* what) {
+    return Read(r.data_at, r.data_length, what);
+  }
 
  private:
   std::ifstream in_;
@@ -167,7 +171,8 @@ struct BagContainer::MessageEntry {
   std::uint32_t offset = 0;  // of its record in the decompressed chunk
   std::uint32_t slot = 0;    // index in connections_
   bool operator<(const MessageEntry& o) const {
-    return std::tie(time.sec, time.nsec, chunk, offset) < std::tie(o.time.sec, o.time.nsec, o.chunk, o.offset);
+    return std::tie(time.sec, time.nsec, chunk, offset) <
+           std::tie(o.time.sec, o.time.nsec, o.chunk, o.offset);
   }
 };
 
@@ -185,9 +190,10 @@ auto Damaged(const std::string& path, Read read) -> decltype(read()) {
 
 void CheckVersionLine(const std::string& path, std::string line) {
   if (line == kVersionLine) return;
-  for (char& c : line) c = c >= 0x20 && c < 0x7F ? c : '?';  // a one-line message, whatever the bytes
-  throw Error(path + ": not a ROS bag of version 2.0, the one uwscan reads (it starts with '" + line +
-              "', not '#ROSBAG V2.0')");
+  for (char& c : line)
+    c = c >= 0x20 && c < 0x7F ? c : '?';  // a one-line message, whatever the bytes
+  throw Error(path + ": not a ROS bag of version 2.0, the one uwscan reads (it starts with '" +
+              line + "', not '#ROSBAG V2.0')");
 }
 
 BagConnection ParseConnection(const Fields& header, const std::string& data) {
@@ -201,7 +207,8 @@ BagConnection ParseConnection(const Fields& header, const std::string& data) {
 }
 
 BagChunkInfo ParseChunkInfo(const Fields& header, const std::string& data) {
-  if (FixedField<std::uint32_t>(header, "ver") != 1) throw Error("a chunk info record of another version than 1");
+  if (FixedField<std::uint32_t>(header, "ver") != 1)
+    throw Error("a chunk info record of another version than 1");
   BagChunkInfo info;
   info.position = FixedField<std::uint64_t>(header, "chunk_pos");
   info.start = TimeField(header, "start_time");
@@ -238,7 +245,8 @@ BagContainer::BagContainer(std::string path) : path_(std::move(path)) {
     }
     records_begin_ = header.end;
     const auto index = FixedField<std::uint64_t>(header.fields, "index_pos");
-    if (index == 0) throw Error("the bag was never closed, so it has no index (`rosbag reindex` it)");
+    if (index == 0)
+      throw Error("the bag was never closed, so it has no index (`rosbag reindex` it)");
     if (index < records_begin_ || index > file.size()) {  // at the very end: a bag without messages
       throw Error("its index position " + std::to_string(index) + " is outside the file (" +
                   std::to_string(file.size()) + " bytes)");
@@ -257,7 +265,8 @@ void BagContainer::ReadIndex(File& file, std::uint64_t index_position, std::uint
   std::sort(chunks_.begin(), chunks_.end(),
             [](const BagChunkInfo& a, const BagChunkInfo& b) { return a.position < b.position; });
   for (std::size_t i = 1; i < chunks_.size(); ++i) {
-    if (chunks_[i].position == chunks_[i - 1].position) throw Error("two chunks" + At(chunks_[i].position));
+    if (chunks_[i].position == chunks_[i - 1].position)
+      throw Error("two chunks" + At(chunks_[i].position));
   }
 }
 
@@ -277,13 +286,13 @@ std::uint64_t BagContainer::ReadChunkInfo(File& file, std::uint64_t at) {
   ExpectOp(r.fields, kChunkInfo, "chunk info");
   BagChunkInfo info = ParseChunkInfo(r.fields, file.ReadData(r, "a chunk info record"));
   if (info.position < records_begin_ || info.position >= index_position_) {
-    throw Error("a chunk" + At(info.position) + " lies outside the records (bytes " + std::to_string(records_begin_) +
-                " to " + std::to_string(index_position_) + ")");
+    throw Error("a chunk" + At(info.position) + " lies outside the records (bytes " +
+                std::to_string(records_begin_) + " to " + std::to_string(index_position_) + ")");
   }
   for (const auto& [connection, messages] : info.messages) {
     if (connection_slot_.count(connection) == 0) {
-      throw Error("the chunk" + At(info.position) + " holds connection " + std::to_string(connection) +
-                  ", which the index does not list");
+      throw Error("the chunk" + At(info.position) + " holds connection " +
+                  std::to_string(connection) + ", which the index does not list");
     }
   }
   chunks_.push_back(std::move(info));
@@ -305,23 +314,26 @@ std::string BagContainer::LoadChunk(File& file, std::size_t chunk) const {
 
 // The connection slot of a message record found in chunk `info`, checked against the index: a
 // connection the chunk's entry lists, a time within the chunk's.
-std::size_t BagContainer::CheckMessage(const BagChunkInfo& info, std::uint32_t connection, BagTime time) const {
+std::size_t BagContainer::CheckMessage(const BagChunkInfo& info, std::uint32_t connection,
+                                       BagTime time) const {
   const auto slot = connection_slot_.find(connection);
   if (slot == connection_slot_.end() || info.messages.count(connection) == 0) {
-    throw Error("the chunk" + At(info.position) + " holds a message of connection " + std::to_string(connection) +
-                ", which its index entry does not list");
+    throw Error("the chunk" + At(info.position) + " holds a message of connection " +
+                std::to_string(connection) + ", which its index entry does not list");
   }
   if (time < info.start || time > info.end) {
-    throw Error("the chunk" + At(info.position) + " holds a message at " + std::to_string(time.seconds()) +
-                " s, outside its index's " + std::to_string(info.start.seconds()) + " to " +
-                std::to_string(info.end.seconds()) + " s");
+    throw Error("the chunk" + At(info.position) + " holds a message at " +
+                std::to_string(time.seconds()) + " s, outside its index's " +
+                std::to_string(info.start.seconds()) + " to " + std::to_string(info.end.seconds()) +
+                " s");
   }
   return slot->second;
 }
 
 // Lists the messages of `wanted` in one chunk, each checked against the index, and checks that
 // the chunk holds as many messages per connection as the index says.
-void BagContainer::ScanChunk(std::string_view buffer, std::size_t chunk, const std::set<std::uint32_t>& wanted,
+void BagContainer::ScanChunk(std::string_view buffer, std::size_t chunk,
+                             const std::set<std::uint32_t>& wanted,
                              std::vector<MessageEntry>& entries) const {
   const BagChunkInfo& info = chunks_[chunk];
   std::map<std::uint32_t, std::uint32_t> found;
@@ -338,8 +350,8 @@ void BagContainer::ScanChunk(std::string_view buffer, std::size_t chunk, const s
                            static_cast<std::uint32_t>(slot)});
       }
     } else if (op != kConnection) {  // a chunk holds messages and the connections they use
-      throw Error("the chunk" + At(info.position) + " holds a record of op " + std::to_string(op) + " at offset " +
-                  std::to_string(at));
+      throw Error("the chunk" + At(info.position) + " holds a record of op " + std::to_string(op) +
+                  " at offset " + std::to_string(at));
     }
     at = r.end;
   }
@@ -352,13 +364,13 @@ void BagContainer::ScanChunk(std::string_view buffer, std::size_t chunk, const s
   }
 }
 
-std::vector<BagContainer::MessageEntry> BagContainer::IndexMessages(File& file,
-                                                                    const std::set<std::uint32_t>& wanted) const {
+std::vector<BagContainer::MessageEntry> BagContainer::IndexMessages(
+    File& file, const std::set<std::uint32_t>& wanted) const {
   std::vector<MessageEntry> entries;
   for (std::size_t chunk = 0; chunk < chunks_.size(); ++chunk) {
     const auto& held = chunks_[chunk].messages;
-    const bool needed =
-        std::any_of(held.begin(), held.end(), [&](const auto& c) { return wanted.count(c.first) != 0; });
+    const bool needed = std::any_of(held.begin(), held.end(),
+                                    [&](const auto& c) { return wanted.count(c.first) != 0; });
     if (needed) ScanChunk(LoadChunk(file, chunk), chunk, wanted, entries);
   }
   std::sort(entries.begin(), entries.end());
@@ -367,7 +379,8 @@ std::vector<BagContainer::MessageEntry> BagContainer::IndexMessages(File& file,
 
 void BagContainer::ForEachMessage(const std::set<std::uint32_t>& wanted, const Visit& visit) const {
   File file(path_);
-  const std::vector<MessageEntry> entries = Damaged(path_, [&] { return IndexMessages(file, wanted); });
+  const std::vector<MessageEntry> entries =
+      Damaged(path_, [&] { return IndexMessages(file, wanted); });
   // One decompressed chunk at a time, as rosbag keeps it: messages in time order mostly come
   // chunk after chunk.
   std::size_t loaded = chunks_.size();

@@ -46,8 +46,8 @@ struct BagConnection {
 
 // What the index says of one chunk.
 struct BagChunkInfo {
-  std::uint64_t position = 0;  // byte offset of the chunk record in the file
-  BagTime start, end;          // record times of its first and last message
+  std::uint64_t position = 0;                       // byte offset of the chunk record in the file
+  BagTime start, end;                               // record times of its first and last message
   std::map<std::uint32_t, std::uint32_t> messages;  // connection id -> its messages in the chunk
 };
 
@@ -61,7 +61,8 @@ class BagContainer {
   const std::vector<BagConnection>& connections() const { return connections_; }
   const std::vector<BagChunkInfo>& chunks() const { return chunks_; }  // by position in the file
 
-  using Visit = std::function<void(const BagConnection& connection, BagTime time, std::string_view data)>;
+  using Visit =
+      std::function<void(const BagConnection& connection, BagTime time, std::string_view data)>;
   // Calls `visit` with the serialized bytes of every message of the connections `wanted`, in
   // record-time order (equal times in file order), reading only the chunks that hold them.
   // Throws uwscan::Error naming the file when a chunk is damaged, cut short or disagrees with the
@@ -72,8 +73,10 @@ class BagContainer {
  private:
   struct MessageEntry;
   class File;
-  void ReadIndex(File& file, std::uint64_t index_position, std::uint32_t connections, std::uint32_t chunks);
-  std::uint64_t ReadConnection(File& file, std::uint64_t at);  // returns where the next record starts
+  void ReadIndex(File& file, std::uint64_t index_position, std::uint32_t connections,
+                 std::uint32_t chunks);
+  std::uint64_t ReadConnection(File& file,
+                               std::uint64_t at);  // returns where the next record starts
   std::uint64_t ReadChunkInfo(File& file, std::uint64_t at);
   std::size_t CheckMessage(const BagChunkInfo& info, std::uint32_t connection, BagTime time) const;
   std::string LoadChunk(File& file, std::size_t chunk) const;

@@ -21,7 +21,8 @@ void Grow(std::string& out, std::size_t limit) {
 void MakeRoom(std::string& out, std::size_t used, std::size_t size) {
   if (used < out.size()) return;
   if (out.size() > size) {
-    throw Error("the data decompresses to more than the chunk's " + std::to_string(size) + " bytes");
+    throw Error("the data decompresses to more than the chunk's " + std::to_string(size) +
+                " bytes");
   }
   Grow(out, size + 1);
 }
@@ -35,7 +36,8 @@ void CheckSize(std::size_t produced, std::size_t size) {
 
 std::string DecompressLz4(std::string_view data, std::size_t size) {
   LZ4F_dctx* raw = nullptr;
-  if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) throw Error("lz4: no decompression context");
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION)))
+    throw Error("lz4: no decompression context");
   const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> context(
       raw, LZ4F_freeDecompressionContext);
   std::string out;
@@ -43,15 +45,17 @@ std::string DecompressLz4(std::string_view data, std::size_t size) {
   for (;;) {
     MakeRoom(out, out_at, size);
     std::size_t produced = out.size() - out_at, consumed = data.size() - in_at;
-    const std::size_t hint = LZ4F_decompress(context.get(), out.data() + out_at, &produced, data.data() + in_at,
-                                             &consumed, nullptr);
-    if (LZ4F_isError(hint)) throw Error(std::string("damaged lz4 data (") + LZ4F_getErrorName(hint) + ")");
+    const std::size_t hint = LZ4F_decompress(context.get(), out.data() + out_at, &produced,
+                                             data.data() + in_at, &consumed, nullptr);
+    if (LZ4F_isError(hint))
+      throw Error(std::string("damaged lz4 data (") + LZ4F_getErrorName(hint) + ")");
     in_at += consumed;
     out_at += produced;
     if (hint == 0) break;  // the frame is complete (its checksum, when it has one, verified)
     if (consumed == 0 && produced == 0) throw Error("the lz4 data ends inside its frame");
   }
-  if (in_at != data.size()) throw Error(std::to_string(data.size() - in_at) + " bytes after the lz4 frame");
+  if (in_at != data.size())
+    throw Error(std::to_string(data.size() - in_at) + " bytes after the lz4 frame");
   CheckSize(out_at, size);
   out.resize(out_at);
   return out;
@@ -61,8 +65,10 @@ std::string DecompressBz2(std::string_view data, std::size_t size) {
   bz_stream stream{};
   if (BZ2_bzDecompressInit(&stream, 0, 0) != BZ_OK) throw Error("bz2: no decompression stream");
   const std::unique_ptr<bz_stream, int (*)(bz_stream*)> end(&stream, BZ2_bzDecompressEnd);
-  stream.next_in = const_cast<char*>(data.data());  // bzlib's API is not const-correct; it only reads
-  stream.avail_in = static_cast<unsigned int>(data.size());  // a chunk's data is at most 4 GB (uint32)
+  stream.next_in =
+      const_cast<char*>(data.data());  // bzlib's API is not const-correct; it only reads
+  stream.avail_in =
+      static_cast<unsigned int>(data.size());  // a chunk's data is at most 4 GB (uint32)
   std::string out;
   std::size_t out_at = 0;
   for (;;) {
@@ -73,9 +79,11 @@ std::string DecompressBz2(std::string_view data, std::size_t size) {
     out_at = out.size() - stream.avail_out;
     if (rc == BZ_STREAM_END) break;  // every block's CRC and the stream's verified
     if (rc != BZ_OK) throw Error("damaged bz2 data (bzip2 error " + std::to_string(rc) + ")");
-    if (stream.avail_in == 0 && stream.avail_out > 0) throw Error("the bz2 data ends inside its stream");
+    if (stream.avail_in == 0 && stream.avail_out > 0)
+      throw Error("the bz2 data ends inside its stream");
   }
-  if (stream.avail_in != 0) throw Error(std::to_string(stream.avail_in) + " bytes after the bz2 stream");
+  if (stream.avail_in != 0)
+    throw Error(std::to_string(stream.avail_in) + " bytes after the bz2 stream");
   CheckSize(out_at, size);
   out.resize(out_at);
   return out;
@@ -83,21 +91,23 @@ std::string DecompressBz2(std::string_view data, std::size_t size) {
 
 }  // namespace
 
-std::string DecompressBagChunk(std::string_view compression, std::string_view data, std::size_t size) {
+std::string DecompressBagChunk(std::string_view compression, std::string_view data,
+                               std::size_t size) {
   if (size > kMaxBagChunkBytes) {
     throw Error("a chunk of " + std::to_string(size) + " bytes, more than uwscan reads (" +
                 std::to_string(kMaxBagChunkBytes) + ")");
   }
   if (compression == "none") {
     if (data.size() != size) {
-      throw Error("an uncompressed chunk of " + std::to_string(data.size()) + " bytes, its header says " +
-                  std::to_string(size));
+      throw Error("an uncompressed chunk of " + std::to_string(data.size()) +
+                  " bytes, its header says " + std::to_string(size));
     }
     return std::string(data);
   }
   if (compression == "lz4") return DecompressLz4(data, size);
   if (compression == "bz2") return DecompressBz2(data, size);
-  throw Error("chunk compression '" + std::string(compression) + "' (uwscan reads none, bz2 and lz4)");
+  throw Error("chunk compression '" + std::string(compression) +
+              "' (uwscan reads none, bz2 and lz4)");
 }
 
 }  // namespace uwscan::ros

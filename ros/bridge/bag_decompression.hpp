@@ -16,6 +16,7 @@ inline constexpr std::size_t kMaxBagChunkBytes = std::size_t{1} << 30;
 // grows with what the stream really produces, never with `size` alone, so a damaged size costs
 // nothing. Throws uwscan::Error saying what is wrong (unknown compression, damaged or cut data,
 // a size that does not match), without naming the file: the caller does.
-std::string DecompressBagChunk(std::string_view compression, std::string_view data, std::size_t size);
+std::string DecompressBagChunk(std::string_view compression, std::string_view data,
+                               std::size_t size);
 
 }  // namespace uwscan::ros

@@ -25,11 +25,13 @@ struct BagWriter::Impl {
   bool open = false;
 
   template <typename RosMessage>
-  void Write(const std::string& topic, double record_time_s, const RosMessage& message, bool latched = false) {
+  void Write(const std::string& topic, double record_time_s, const RosMessage& message,
+             bool latched = false) {
     if (!open) throw Error(path + ": the bag is closed");
     try {
       // rosbag refuses times below one nanosecond.
-      const ::ros::Time t = ToRosTime(record_time_s) < ::ros::TIME_MIN ? ::ros::TIME_MIN : ToRosTime(record_time_s);
+      const ::ros::Time t =
+          ToRosTime(record_time_s) < ::ros::TIME_MIN ? ::ros::TIME_MIN : ToRosTime(record_time_s);
       if (latched) {
         // A connection header given to write() replaces rosbag's own: it names the type too.
         auto header = boost::make_shared<::ros::M_string>();
@@ -91,10 +93,12 @@ void BagWriter::Write(const std::string& topic, const std::vector<TransformMessa
                       double record_time_s) {
   impl_->Write(topic, record_time_s, ToRos(transforms), topic == "/tf_static");
 }
-void BagWriter::Write(const std::string& topic, const std::vector<MarkerMessage>& markers, double record_time_s) {
+void BagWriter::Write(const std::string& topic, const std::vector<MarkerMessage>& markers,
+                      double record_time_s) {
   impl_->Write(topic, record_time_s, ToRos(markers));
 }
-void BagWriter::Write(const std::string& topic, const StringMessage& m, double record_time_s, bool latched) {
+void BagWriter::Write(const std::string& topic, const StringMessage& m, double record_time_s,
+                      bool latched) {
   impl_->Write(topic, record_time_s, ToRos(m), latched);
 }
 

@@ -65,12 +65,15 @@ class BagWriter {
   void Write(const std::string& topic, const PoseMessage& message);
   void Write(const std::string& topic, const PoseArrayMessage& message);
   // A tf2_msgs/TFMessage, recorded at `record_time_s`.
-  void Write(const std::string& topic, const std::vector<TransformMessage>& transforms, double record_time_s);
+  void Write(const std::string& topic, const std::vector<TransformMessage>& transforms,
+             double record_time_s);
   // A visualization_msgs/MarkerArray, recorded at `record_time_s`.
-  void Write(const std::string& topic, const std::vector<MarkerMessage>& markers, double record_time_s);
+  void Write(const std::string& topic, const std::vector<MarkerMessage>& markers,
+             double record_time_s);
   // A std_msgs/String, recorded at `record_time_s`; `latched` marks the connection as latching
   // (rosbag play republishes it to late subscribers).
-  void Write(const std::string& topic, const StringMessage& message, double record_time_s, bool latched);
+  void Write(const std::string& topic, const StringMessage& message, double record_time_s,
+             bool latched);
   // Closes the file (the index is written): the bag is whole only after this.
   void Close();
 

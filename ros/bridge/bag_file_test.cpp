@@ -12,8 +12,8 @@ namespace uwscan::ros {
 namespace {
 
 std::filesystem::path Scratch(const std::string& name) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("uwscan_bag_file_test_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("uwscan_bag_file_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::filesystem::remove(dir / name);
   return dir / name;
@@ -83,7 +83,9 @@ TEST(BagFile, WritesAndReadsBackEveryMessageUwscanReads) {
     EXPECT_EQ(m.child_frame_id, "base_link");
     ++odometry_seen;
   };
-  visitor.text = [&](const std::string&, StringMessage&& m) { EXPECT_EQ(m.data, "uwscan_format: 1"); };
+  visitor.text = [&](const std::string&, StringMessage&& m) {
+    EXPECT_EQ(m.data, "uwscan_format: 1");
+  };
   visitor.transforms = [&](const std::string&, std::vector<TransformMessage>&& t) {
     ASSERT_EQ(t.size(), 1u);
     EXPECT_TRUE(t[0].transform.isApprox(Pose(0.3, 0.1), 1e-12));
@@ -91,10 +93,12 @@ TEST(BagFile, WritesAndReadsBackEveryMessageUwscanReads) {
   reader.Read({"/dive", "/tf_static", "/frames", "/odometry"}, visitor);
   EXPECT_EQ(odometry_seen, 5);
   ASSERT_EQ(stamps.size(), 5u);
-  for (int i = 0; i < 5; ++i) EXPECT_NEAR(stamps[static_cast<std::size_t>(i)], 100.0 + 0.01 * i, 1e-9);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_NEAR(stamps[static_cast<std::size_t>(i)], 100.0 + 0.01 * i, 1e-9);
   // Recorded order: frames and odometry interleave by time.
   ASSERT_EQ(order.size(), 10u);
-  for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], i % 2 == 0 ? "/frames" : "/odometry");
+  for (std::size_t i = 0; i < order.size(); ++i)
+    EXPECT_EQ(order[i], i % 2 == 0 ? "/frames" : "/odometry");
   std::filesystem::remove_all(path.parent_path());
 }
 

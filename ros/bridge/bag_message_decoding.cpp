@@ -19,7 +19,8 @@ class SerializedReader {
   T Get(const char* field) {
     Need(sizeof(T), field);
     T value;
-    std::memcpy(&value, data_.data() + at_, sizeof(T));  // ROS 1 and the machines uwscan targets are little-endian
+    std::memcpy(&value, data_.data() + at_,
+                sizeof(T));  // ROS 1 and the machines uwscan targets are little-endian
     at_ += sizeof(T);
     return value;
   }
@@ -29,14 +30,16 @@ class SerializedReader {
     at_ += length;
     return bytes;
   }
-  std::string GetString(const char* field) { return std::string(GetBytes(Get<std::uint32_t>(field), field)); }
+  std::string GetString(const char* field) {
+    return std::string(GetBytes(Get<std::uint32_t>(field), field));
+  }
   // An array's length, checked to fit the bytes left at `min_item_bytes` or more per item, so
   // that a damaged length never sizes a container beyond the message.
   std::size_t GetCount(const char* field, std::size_t min_item_bytes) {
     const std::size_t count = Get<std::uint32_t>(field);
     if (count > (data_.size() - at_) / min_item_bytes) {
-      Fail(std::string(field) + " says " + std::to_string(count) + " items but " + std::to_string(data_.size() - at_) +
-           " bytes are left");
+      Fail(std::string(field) + " says " + std::to_string(count) + " items but " +
+           std::to_string(data_.size() - at_) + " bytes are left");
     }
     return count;
   }
@@ -53,14 +56,15 @@ class SerializedReader {
     return h;
   }
   void ExpectEnd() const {
-    if (at_ != data_.size()) Fail(std::to_string(data_.size() - at_) + " bytes left over after the whole message");
+    if (at_ != data_.size())
+      Fail(std::to_string(data_.size() - at_) + " bytes left over after the whole message");
   }
 
  private:
   void Need(std::size_t bytes, const char* field) const {
     if (data_.size() - at_ < bytes) {
-      Fail(std::string(field) + " needs " + std::to_string(bytes) + " bytes, " + std::to_string(data_.size() - at_) +
-           " are left");
+      Fail(std::string(field) + " needs " + std::to_string(bytes) + " bytes, " +
+           std::to_string(data_.size() - at_) + " are left");
     }
   }
   [[noreturn]] void Fail(const std::string& what) const {

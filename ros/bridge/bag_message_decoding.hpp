@@ -22,8 +22,10 @@ struct BagMessageType {
   const char* md5sum;
 };
 inline constexpr BagMessageType kImageType{"sensor_msgs/Image", "060021388200f6f0f447d0fcd9c64743"};
-inline constexpr BagMessageType kOdometryType{"nav_msgs/Odometry", "cd5e73d190d741a2f92e81eda573aca7"};
-inline constexpr BagMessageType kTransformsType{"tf2_msgs/TFMessage", "94810edda583a504dfda3829e70d7eec"};
+inline constexpr BagMessageType kOdometryType{"nav_msgs/Odometry",
+                                              "cd5e73d190d741a2f92e81eda573aca7"};
+inline constexpr BagMessageType kTransformsType{"tf2_msgs/TFMessage",
+                                                "94810edda583a504dfda3829e70d7eec"};
 inline constexpr BagMessageType kStringType{"std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1"};
 
 // Each throws uwscan::Error saying what is wrong (a length past the end, bytes left over, a pose

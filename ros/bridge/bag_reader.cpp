@@ -15,22 +15,26 @@ namespace uwscan::ros {
 namespace {
 
 Error NotRead(const std::string& path, const BagConnection& c) {
-  return Error(path + ": topic " + c.topic + " is " + c.datatype + ", which uwscan does not read there");
+  return Error(path + ": topic " + c.topic + " is " + c.datatype +
+               ", which uwscan does not read there");
 }
 
 // Throws uwscan::Error naming the file when the visitor has no callback for the connection's
 // type or the bag's definition of the type is another than uwscan decodes.
-void CheckType(const std::string& path, const BagConnection& c, const BagMessageType& type, bool has_callback) {
+void CheckType(const std::string& path, const BagConnection& c, const BagMessageType& type,
+               bool has_callback) {
   if (!has_callback) throw NotRead(path, c);
   if (c.md5sum != type.md5sum) {
-    throw Error(path + ": topic " + c.topic + " is " + c.datatype + " of another definition (md5sum " + c.md5sum +
-                ", uwscan reads " + type.md5sum + ")");
+    throw Error(path + ": topic " + c.topic + " is " + c.datatype +
+                " of another definition (md5sum " + c.md5sum + ", uwscan reads " + type.md5sum +
+                ")");
   }
 }
 
 // Hands one message to its callback. Throws as CheckType; without naming the file when the
 // message's bytes do not decode or its values are invalid; and what the callback throws.
-void Dispatch(const std::string& path, const BagConnection& c, std::string_view data, const BagVisitor& visitor) {
+void Dispatch(const std::string& path, const BagConnection& c, std::string_view data,
+              const BagVisitor& visitor) {
   if (c.datatype == kImageType.datatype) {
     CheckType(path, c, kImageType, bool(visitor.image));
     visitor.image(c.topic, DecodeImage(data));
@@ -85,15 +89,18 @@ void BagReader::Read(const std::vector<std::string>& topics, const BagVisitor& v
     if (asked.count(c.topic) != 0) wanted.insert(c.id);
   }
   const std::string& path = impl_->path;
-  impl_->bag.ForEachMessage(wanted, [&](const BagConnection& c, BagTime time, std::string_view data) {
-    try {
-      Dispatch(path, c, data, visitor);
-    } catch (const Error& e) {
-      const std::string what = e.what();
-      if (what.rfind(path, 0) == 0) throw;  // names the file already (a callback's own error, ...)
-      throw Error(path + ": topic " + c.topic + " at " + std::to_string(time.seconds()) + " s: " + what);
-    }
-  });
+  impl_->bag.ForEachMessage(wanted,
+                            [&](const BagConnection& c, BagTime time, std::string_view data) {
+                              try {
+                                Dispatch(path, c, data, visitor);
+                              } catch (const Error& e) {
+                                const std::string what = e.what();
+                                if (what.rfind(path, 0) == 0)
+                                  throw;  // names the file already (a callback's own error, ...)
+                                throw Error(path + ": topic " + c.topic + " at " +
+                                            std::to_string(time.seconds()) + " s: " + what);
+                              }
+                            });
 }
 
 }  // namespace uwscan::ros

@@ -27,8 +27,10 @@ class BagReaderDamage : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     WriteDive(dir_ / "none.bag");
-    WriteCompressedCopy((dir_ / "none.bag").string(), (dir_ / "lz4.bag").string(), BagCompression::kLz4);
-    WriteCompressedCopy((dir_ / "none.bag").string(), (dir_ / "bz2.bag").string(), BagCompression::kBz2);
+    WriteCompressedCopy((dir_ / "none.bag").string(), (dir_ / "lz4.bag").string(),
+                        BagCompression::kLz4);
+    WriteCompressedCopy((dir_ / "none.bag").string(), (dir_ / "bz2.bag").string(),
+                        BagCompression::kBz2);
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
@@ -52,7 +54,8 @@ class BagReaderDamage : public ::testing::Test {
       image.step = 1200;
       image.encoding = "mono16";
       image.data.resize(300000);
-      for (std::size_t k = 0; k < image.data.size(); ++k) image.data[k] = static_cast<std::uint8_t>((k * 7 + i) % 251);
+      for (std::size_t k = 0; k < image.data.size(); ++k)
+        image.data[k] = static_cast<std::uint8_t>((k * 7 + i) % 251);
       bag.Write("/frames", image);
       OdometryMessage odometry;
       odometry.header = {100.05 + 0.1 * i, "odom"};
@@ -80,17 +83,21 @@ class BagReaderDamage : public ::testing::Test {
     }
     BagVisitor v;
     v.image = [&](const std::string& topic, ImageMessage&& m) {
-      out << topic << ' ' << m.header.stamp_s << ' ' << m.encoding << ' ' << m.width << 'x' << m.height << ' '
-          << std::hash<std::string>()(std::string(m.data.begin(), m.data.end())) << '\n';
+      out << topic << ' ' << m.header.stamp_s << ' ' << m.encoding << ' ' << m.width << 'x'
+          << m.height << ' ' << std::hash<std::string>()(std::string(m.data.begin(), m.data.end()))
+          << '\n';
     };
     v.odometry = [&](const std::string& topic, OdometryMessage&& m) {
       out << topic << ' ' << m.header.stamp_s << ' ' << m.pose.translation().transpose() << ' '
           << m.pose_covariance.sum() << '\n';
     };
     v.transforms = [&](const std::string& topic, std::vector<TransformMessage>&& m) {
-      for (const TransformMessage& t : m) out << topic << ' ' << t.child_frame_id << ' ' << t.header.stamp_s << '\n';
+      for (const TransformMessage& t : m)
+        out << topic << ' ' << t.child_frame_id << ' ' << t.header.stamp_s << '\n';
     };
-    v.text = [&](const std::string& topic, StringMessage&& m) { out << topic << ' ' << m.data << '\n'; };
+    v.text = [&](const std::string& topic, StringMessage&& m) {
+      out << topic << ' ' << m.data << '\n';
+    };
     reader.Read(names, v);
     return out.str();
   }
@@ -100,7 +107,8 @@ class BagReaderDamage : public ::testing::Test {
   // file's name). `read` receives what ReadAll gave.
   static bool ReadsOrIsRefusedByName(const std::string& bytes, std::string* read = nullptr) {
     const fs::path path = dir_ / "damaged.bag";
-    std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), std::streamsize(bytes.size()));
+    std::ofstream(path, std::ios::binary | std::ios::trunc)
+        .write(bytes.data(), std::streamsize(bytes.size()));
     try {
       const std::string all = ReadAll(path);
       if (read != nullptr) *read = all;
@@ -205,7 +213,8 @@ TEST_F(BagReaderDamage, EveryCutIsRefusedByName) {
     std::vector<std::size_t> cuts = {0, 1, 12, 13, 16, 17, 100, 4108, 4109, 4200, bytes.size() - 1};
     for (std::size_t k = 1; k < 60; ++k) cuts.push_back(bytes.size() * k / 60);
     for (std::size_t cut : cuts) {
-      EXPECT_FALSE(ReadsOrIsRefusedByName(bytes.substr(0, cut))) << name << " cut at " << cut << " was read";
+      EXPECT_FALSE(ReadsOrIsRefusedByName(bytes.substr(0, cut)))
+          << name << " cut at " << cut << " was read";
     }
   }
 }
@@ -216,7 +225,8 @@ TEST_F(BagReaderDamage, DamageWhereTheReaderDoesNotLookLeavesTheBagWhole) {
   // The bag header record's padding (spaces up to 4 KB).
   const RawRecord header = RecordAt(bytes, 13);
   std::string damaged = bytes;
-  for (std::size_t at = header.data_at; at < header.end(); at += 7) damaged[at] = static_cast<char>(at);
+  for (std::size_t at = header.data_at; at < header.end(); at += 7)
+    damaged[at] = static_cast<char>(at);
   std::string read;
   ASSERT_TRUE(ReadsOrIsRefusedByName(damaged, &read)) << last_error_;
   EXPECT_EQ(read, whole);
@@ -235,7 +245,8 @@ TEST_F(BagReaderDamage, DamagedStructureIsRefusedNamingWhatIsWrong) {
   const std::size_t index_field = FieldValue(bytes, RecordAt(bytes, 13), "index_pos");
   std::uint64_t index_position = 0;
   std::memcpy(&index_position, bytes.data() + index_field, 8);
-  const auto refused = [&](std::string damaged, const std::string& expected, const std::string& what) {
+  const auto refused = [&](std::string damaged, const std::string& expected,
+                           const std::string& what) {
     EXPECT_FALSE(ReadsOrIsRefusedByName(damaged)) << what << " was read";
     EXPECT_NE(last_error_.find(expected), std::string::npos) << what << ": " << last_error_;
   };
@@ -250,7 +261,8 @@ TEST_F(BagReaderDamage, DamagedStructureIsRefusedNamingWhatIsWrong) {
   refused(d, "outside the file", "an index position past the end");
   const RawRecord chunk_info = First(bytes, 0x06);
   d = bytes;
-  d[chunk_info.data_at + 4] = static_cast<char>(d[chunk_info.data_at + 4] + 1);  // first connection's count
+  d[chunk_info.data_at + 4] =
+      static_cast<char>(d[chunk_info.data_at + 4] + 1);  // first connection's count
   refused(d, "its index says", "a chunk info's message count one higher");
   const RawRecord chunk = First(bytes, 0x05);
   d = bytes;
@@ -260,7 +272,8 @@ TEST_F(BagReaderDamage, DamagedStructureIsRefusedNamingWhatIsWrong) {
   std::memset(d.data() + FieldValue(bytes, chunk, "size"), 0xFF, 4);
   refused(d, "more than uwscan reads", "a chunk size of 4 GB");
   d = bytes;
-  const RawRecord message = RecordAt(bytes, RecordAt(bytes, chunk.data_at).end());  // after the first connection
+  const RawRecord message =
+      RecordAt(bytes, RecordAt(bytes, chunk.data_at).end());  // after the first connection
   ASSERT_EQ(Op(bytes, message), 0x02);
   d[FieldValue(bytes, message, "time") + 3] = 0x7F;  // seconds moved decades ahead
   refused(d, "outside its index's", "a message's time outside its chunk's");
@@ -275,8 +288,8 @@ TEST_F(BagReaderDamage, DamagedCompressedDataIsRefusedByItsChecksum) {
   for (const char* name : {"lz4.bag", "bz2.bag"}) {
     const std::string bytes = Bytes(name);
     const RawRecord chunk = First(bytes, 0x05);
-    for (std::size_t at : {chunk.data_at + chunk.data_length / 3, chunk.data_at + chunk.data_length / 2,
-                           chunk.end() - 2}) {
+    for (std::size_t at : {chunk.data_at + chunk.data_length / 3,
+                           chunk.data_at + chunk.data_length / 2, chunk.end() - 2}) {
       std::string d = bytes;
       d[at] = static_cast<char>(d[at] ^ 0x10);
       EXPECT_FALSE(ReadsOrIsRefusedByName(d)) << name << ": byte " << at << " flipped was read";
@@ -295,7 +308,8 @@ TEST_F(BagReaderDamage, RandomDamageEndsReadOrRefusedByName) {
         for (int k = 0; k < 1 + trial % 8; ++k) d[rng() % d.size()] = static_cast<char>(rng());
       } else if (kind == 1) {  // bytes changed in the index at the end
         const std::size_t from = d.size() - d.size() / 50;
-        for (int k = 0; k < 1 + trial % 4; ++k) d[from + rng() % (d.size() - from)] = static_cast<char>(rng());
+        for (int k = 0; k < 1 + trial % 4; ++k)
+          d[from + rng() % (d.size() - from)] = static_cast<char>(rng());
       } else {  // a block of zeros
         const std::size_t length = std::size_t{16} << (rng() % 10);
         std::memset(d.data() + rng() % (d.size() - length), 0, length);

@@ -33,8 +33,8 @@ geometry_msgs::Pose ToRosPose(const Eigen::Isometry3d& T) {
 }
 
 Eigen::Isometry3d FromRosPose(const geometry_msgs::Pose& p, const std::string& what) {
-  return PoseFromRosValues(p.position.x, p.position.y, p.position.z, p.orientation.x, p.orientation.y,
-                           p.orientation.z, p.orientation.w, what);
+  return PoseFromRosValues(p.position.x, p.position.y, p.position.z, p.orientation.x,
+                           p.orientation.y, p.orientation.z, p.orientation.w, what);
 }
 
 Covariance6d FromRosCovariance(const boost::array<double, 36>& c, const std::string& what) {
@@ -141,8 +141,9 @@ sensor_msgs::PointCloud2 ToRos(const CloudMessage& m) {
   out.header = ToRos(m.header);
   const bool with_scalar = !m.scalars.empty();
   if (with_scalar && m.scalars.size() != m.points.size()) {
-    throw Error("cloud " + m.header.frame_id + ": " + std::to_string(m.scalars.size()) + " values of '" +
-                m.scalar_name + "' for " + std::to_string(m.points.size()) + " points");
+    throw Error("cloud " + m.header.frame_id + ": " + std::to_string(m.scalars.size()) +
+                " values of '" + m.scalar_name + "' for " + std::to_string(m.points.size()) +
+                " points");
   }
   std::vector<std::string> names = {"x", "y", "z"};
   if (with_scalar) names.push_back(m.scalar_name);
@@ -182,7 +183,8 @@ CloudMessage FromRos(const sensor_msgs::PointCloud2& m) {
     bool found = false;
     for (const sensor_msgs::PointField& f : m.fields) {
       if (f.name != names[k]) continue;
-      if (f.datatype != sensor_msgs::PointField::FLOAT32 && f.datatype != sensor_msgs::PointField::FLOAT64) {
+      if (f.datatype != sensor_msgs::PointField::FLOAT32 &&
+          f.datatype != sensor_msgs::PointField::FLOAT64) {
         throw Error(what + ": field " + f.name + " is neither float32 nor float64");
       }
       offsets[k] = f.offset;
@@ -192,8 +194,8 @@ CloudMessage FromRos(const sensor_msgs::PointCloud2& m) {
     if (!found) throw Error(what + ": no field " + names[k]);
   }
   const std::size_t points = static_cast<std::size_t>(m.width) * m.height;
-  if (m.data.size() < static_cast<std::size_t>(m.row_step) * m.height || m.row_step < m.point_step * m.width ||
-      (points > 0 && m.point_step < 12)) {
+  if (m.data.size() < static_cast<std::size_t>(m.row_step) * m.height ||
+      m.row_step < m.point_step * m.width || (points > 0 && m.point_step < 12)) {
     throw Error(what + ": data of " + std::to_string(m.data.size()) + " bytes does not hold " +
                 std::to_string(points) + " points");
   }

@@ -12,8 +12,8 @@ namespace uwscan::ros {
 
 // T_parent_child from a ROS position and quaternion. Throws uwscan::Error "WHAT: a pose value is
 // not finite" or "WHAT: orientation is not a unit quaternion (norm N)" (within 1e-3).
-Eigen::Isometry3d PoseFromRosValues(double x, double y, double z, double qx, double qy, double qz, double qw,
-                                    const std::string& what);
+Eigen::Isometry3d PoseFromRosValues(double x, double y, double z, double qx, double qy, double qz,
+                                    double qw, const std::string& what);
 
 // A 6x6 covariance from ROS's 36 row-major values. Throws uwscan::Error naming the value that is
 // not finite.

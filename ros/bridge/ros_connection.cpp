@@ -67,7 +67,8 @@ struct RosConnection::Impl {
 
   template <typename RosMessage, typename Message>
   void Subscribe(const std::string& topic, int queue, std::function<void(Message&&)> callback) {
-    auto handler = [this, topic, callback = std::move(callback)](const boost::shared_ptr<const RosMessage>& m) {
+    auto handler = [this, topic,
+                    callback = std::move(callback)](const boost::shared_ptr<const RosMessage>& m) {
       // An exception must not reach roscpp's spinner thread (it would end the process).
       try {
         callback(FromRos(*m));
@@ -75,8 +76,9 @@ struct RosConnection::Impl {
         if (on_error) on_error(std::make_exception_ptr(Error("topic " + topic + ": " + e.what())));
       }
     };
-    subscribers.push_back(node->subscribe<RosMessage>(topic, static_cast<std::uint32_t>(queue), handler,
-                                                      ::ros::VoidConstPtr(), ::ros::TransportHints().tcpNoDelay()));
+    subscribers.push_back(node->subscribe<RosMessage>(topic, static_cast<std::uint32_t>(queue),
+                                                      handler, ::ros::VoidConstPtr(),
+                                                      ::ros::TransportHints().tcpNoDelay()));
     subscribed.push_back({node->resolveName(topic), DataType<RosMessage>()});
   }
 
@@ -102,11 +104,12 @@ RosConnection::RosConnection(const std::string& name, const std::vector<std::str
   for (std::string& s : argv_strings) argv.push_back(s.data());
   int argc = static_cast<int>(argv.size());
   ::ros::init(argc, argv.data(), name, ::ros::init_options::NoSigintHandler);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(master_wait_s);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(master_wait_s);
   while (!::ros::master::check()) {
     if (std::chrono::steady_clock::now() >= deadline) {
-      throw Error("no ROS master at " + ::ros::master::getURI() + " (waited " + std::to_string(master_wait_s) +
-                  " s; start roscore, or set ROS_MASTER_URI)");
+      throw Error("no ROS master at " + ::ros::master::getURI() + " (waited " +
+                  std::to_string(master_wait_s) + " s; start roscore, or set ROS_MASTER_URI)");
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
@@ -152,21 +155,24 @@ void RosConnection::SetErrorHandler(std::function<void(std::exception_ptr)> hand
   impl_->on_error = std::move(handler);
 }
 
-void RosConnection::SubscribeImages(const std::string& topic, int queue, std::function<void(ImageMessage&&)> callback) {
+void RosConnection::SubscribeImages(const std::string& topic, int queue,
+                                    std::function<void(ImageMessage&&)> callback) {
   impl_->Subscribe<sensor_msgs::Image>(topic, queue, std::move(callback));
 }
 void RosConnection::SubscribeOdometry(const std::string& topic, int queue,
                                       std::function<void(OdometryMessage&&)> callback) {
   impl_->Subscribe<nav_msgs::Odometry>(topic, queue, std::move(callback));
 }
-void RosConnection::SubscribeText(const std::string& topic, std::function<void(StringMessage&&)> callback) {
+void RosConnection::SubscribeText(const std::string& topic,
+                                  std::function<void(StringMessage&&)> callback) {
   impl_->Subscribe<std_msgs::String>(topic, 10, std::move(callback));
 }
-void RosConnection::SubscribeClouds(const std::string& topic, int queue, std::function<void(CloudMessage&&)> callback) {
+void RosConnection::SubscribeClouds(const std::string& topic, int queue,
+                                    std::function<void(CloudMessage&&)> callback) {
   impl_->Subscribe<sensor_msgs::PointCloud2>(topic, queue, std::move(callback));
 }
-void RosConnection::SubscribeTransforms(const std::string& topic,
-                                        std::function<void(std::vector<TransformMessage>&&)> callback) {
+void RosConnection::SubscribeTransforms(
+    const std::string& topic, std::function<void(std::vector<TransformMessage>&&)> callback) {
   impl_->Subscribe<tf2_msgs::TFMessage>(topic, 100, std::move(callback));
 }
 
@@ -211,7 +217,9 @@ void RosConnection::Publish(int id, const PathMessage& m) { impl_->Publish(id, m
 void RosConnection::Publish(int id, const PoseMessage& m) { impl_->Publish(id, m); }
 void RosConnection::Publish(int id, const PoseArrayMessage& m) { impl_->Publish(id, m); }
 void RosConnection::Publish(int id, const std::vector<MarkerMessage>& m) { impl_->Publish(id, m); }
-void RosConnection::Publish(int id, const std::vector<TransformMessage>& m) { impl_->Publish(id, m); }
+void RosConnection::Publish(int id, const std::vector<TransformMessage>& m) {
+  impl_->Publish(id, m);
+}
 
 void RosConnection::Start(int threads) {
   impl_->spinner = std::make_unique<::ros::AsyncSpinner>(static_cast<std::uint32_t>(threads));
@@ -229,9 +237,11 @@ bool RosConnection::KeepRegistered() {
   bool all = true;
   {
     std::lock_guard<std::mutex> lock(impl_->mutex);
-    for (const Impl::Registration& r : impl_->published) all = Register("registerPublisher", r.topic, r.datatype) && all;
+    for (const Impl::Registration& r : impl_->published)
+      all = Register("registerPublisher", r.topic, r.datatype) && all;
   }
-  for (const Impl::Registration& r : impl_->subscribed) all = Register("registerSubscriber", r.topic, r.datatype) && all;
+  for (const Impl::Registration& r : impl_->subscribed)
+    all = Register("registerSubscriber", r.topic, r.datatype) && all;
   if (all) {
     impl_->master_lost = false;
     ++impl_->reregistrations;

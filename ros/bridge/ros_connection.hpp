@@ -22,7 +22,8 @@ class RosConnection {
   // Starts roscpp as node `name` (command-line remappings "from:=to" in `arguments`), without
   // its SIGINT handler (the caller stops on its own signals). Throws uwscan::Error when the
   // master (ROS_MASTER_URI) does not answer within `master_wait_s`.
-  RosConnection(const std::string& name, const std::vector<std::string>& arguments, double master_wait_s);
+  RosConnection(const std::string& name, const std::vector<std::string>& arguments,
+                double master_wait_s);
   ~RosConnection();  // shuts roscpp down
   RosConnection(const RosConnection&) = delete;
   RosConnection& operator=(const RosConnection&) = delete;
@@ -39,11 +40,15 @@ class RosConnection {
   // that does not convert (a NaN pose, a cloud without x) goes to the error handler instead,
   // as a uwscan::Error naming the topic; without a handler it is dropped.
   void SetErrorHandler(std::function<void(std::exception_ptr)> handler);
-  void SubscribeImages(const std::string& topic, int queue, std::function<void(ImageMessage&&)> callback);
-  void SubscribeOdometry(const std::string& topic, int queue, std::function<void(OdometryMessage&&)> callback);
+  void SubscribeImages(const std::string& topic, int queue,
+                       std::function<void(ImageMessage&&)> callback);
+  void SubscribeOdometry(const std::string& topic, int queue,
+                         std::function<void(OdometryMessage&&)> callback);
   void SubscribeText(const std::string& topic, std::function<void(StringMessage&&)> callback);
-  void SubscribeClouds(const std::string& topic, int queue, std::function<void(CloudMessage&&)> callback);
-  void SubscribeTransforms(const std::string& topic, std::function<void(std::vector<TransformMessage>&&)> callback);
+  void SubscribeClouds(const std::string& topic, int queue,
+                       std::function<void(CloudMessage&&)> callback);
+  void SubscribeTransforms(const std::string& topic,
+                           std::function<void(std::vector<TransformMessage>&&)> callback);
 
   // Ends every subscription; when it returns, no callback runs or will run (a callback in
   // progress is waited for).

@@ -49,12 +49,15 @@ std::string DiveDescriptionToYaml(const DiveDescription& d) {
   out << YAML::Key << "uwscan_format" << YAML::Value << kFormat;
   out << YAML::Key << "producer" << YAML::Value << d.header.producer;
   out << YAML::Key << "time_origin_s" << YAML::Value << YAML::Precision(17) << d.time_origin_s;
-  out << YAML::Key << "scanner" << YAML::Value << YAML::Literal << scanner::ScannerToYaml(d.header.scanner);
-  out << YAML::Key << "scan_pattern" << YAML::Value << YAML::Literal << scanner::ScanPatternToYaml(d.header.scan_pattern);
+  out << YAML::Key << "scanner" << YAML::Value << YAML::Literal
+      << scanner::ScannerToYaml(d.header.scanner);
+  out << YAML::Key << "scan_pattern" << YAML::Value << YAML::Literal
+      << scanner::ScanPatternToYaml(d.header.scan_pattern);
   if (d.header.navigation_noise) {
     out << YAML::Key << "navigation_noise" << YAML::Value << YAML::BeginMap;
     for (const NoiseField& f : kNoiseFields) {
-      out << YAML::Key << f.name << YAML::Value << YAML::Precision(17) << (*d.header.navigation_noise).*f.value;
+      out << YAML::Key << f.name << YAML::Value << YAML::Precision(17)
+          << (*d.header.navigation_noise).*f.value;
     }
     out << YAML::EndMap;
   }
@@ -72,8 +75,8 @@ DiveDescription ParseDiveDescription(const std::string& text, const std::string&
   if (!root.IsMap()) throw Error(source + ": dive description is not a YAML map");
   const int format = As<int>(Field(root, "uwscan_format", source), "uwscan_format", source);
   if (format != kFormat) {
-    throw Error(source + ": dive description format " + std::to_string(format) + ", this uwscan reads " +
-                std::to_string(kFormat));
+    throw Error(source + ": dive description format " + std::to_string(format) +
+                ", this uwscan reads " + std::to_string(kFormat));
   }
   DiveDescription d;
   if (root["producer"]) d.header.producer = As<std::string>(root["producer"], "producer", source);
@@ -81,17 +84,19 @@ DiveDescription ParseDiveDescription(const std::string& text, const std::string&
   if (!std::isfinite(d.time_origin_s) || d.time_origin_s < 0.0) {
     throw Error(source + ": dive description field 'time_origin_s' must be finite and >= 0");
   }
-  d.header.scanner =
-      scanner::ParseScanner(As<std::string>(Field(root, "scanner", source), "scanner", source), source + " (scanner)");
+  d.header.scanner = scanner::ParseScanner(
+      As<std::string>(Field(root, "scanner", source), "scanner", source), source + " (scanner)");
   d.header.scan_pattern = scanner::ParseScanPattern(
-      As<std::string>(Field(root, "scan_pattern", source), "scan_pattern", source), source + " (scan_pattern)");
+      As<std::string>(Field(root, "scan_pattern", source), "scan_pattern", source),
+      source + " (scan_pattern)");
   if (d.header.scan_pattern.kind != d.header.scanner.kind()) {
     throw Error(source + ": dive description's scan pattern is for another kind of scanner");
   }
   if (const YAML::Node noise = root["navigation_noise"]) {
     mapping::NavigationNoise n;
     for (const NoiseField& f : kNoiseFields) {
-      n.*f.value = As<double>(Field(noise, f.name, source), std::string("navigation_noise.") + f.name, source);
+      n.*f.value = As<double>(Field(noise, f.name, source),
+                              std::string("navigation_noise.") + f.name, source);
     }
     try {
       n.Check();

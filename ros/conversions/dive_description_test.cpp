@@ -19,7 +19,8 @@ TEST(DiveDescription, RoundTripsTheScannerPatternNoiseAndOrigin) {
   EXPECT_EQ(back.time_origin_s, d.time_origin_s);
   EXPECT_EQ(back.header.producer, "test");
   EXPECT_EQ(scanner::ScannerToYaml(back.header.scanner), scanner::ScannerToYaml(d.header.scanner));
-  EXPECT_EQ(scanner::ScanPatternToYaml(back.header.scan_pattern), scanner::ScanPatternToYaml(d.header.scan_pattern));
+  EXPECT_EQ(scanner::ScanPatternToYaml(back.header.scan_pattern),
+            scanner::ScanPatternToYaml(d.header.scan_pattern));
   ASSERT_TRUE(back.header.navigation_noise);
   EXPECT_EQ(back.header.navigation_noise->heading_bias_sigma_rad, 0.02);
   EXPECT_EQ(back.header.navigation_noise->depth_sigma_m, 0.001);
@@ -37,7 +38,8 @@ TEST(DiveDescription, MalformedTextNamesTheSourceAndField) {
   EXPECT_NE(message("[1, 2").find("topic /d"), std::string::npos);
   EXPECT_NE(message("uwscan_format: 2\n").find("format 2"), std::string::npos);
   EXPECT_NE(message("uwscan_format: 1\n").find("time_origin_s"), std::string::npos);
-  EXPECT_NE(message("uwscan_format: 1\ntime_origin_s: -1\n").find("time_origin_s"), std::string::npos);
+  EXPECT_NE(message("uwscan_format: 1\ntime_origin_s: -1\n").find("time_origin_s"),
+            std::string::npos);
   EXPECT_NE(message("uwscan_format: 1\ntime_origin_s: 0\n").find("scanner"), std::string::npos);
 }
 

@@ -37,21 +37,23 @@ class ProfileLayoutFinder {
 // The frame as the camera would send it: its image (image mode) when it has one, else its
 // peaks (profile mode, `layout`). `counter`: the camera's frame counter. Throws uwscan::Error
 // when a peak does not fit the layout.
-ImageMessage FrameToImage(const mapping::FrameRecord& frame, const scanner::acquisition::ProfileLayout& layout,
-                          std::uint64_t counter, const Header& header);
+ImageMessage FrameToImage(const mapping::FrameRecord& frame,
+                          const scanner::acquisition::ProfileLayout& layout, std::uint64_t counter,
+                          const Header& header);
 
 // Turns images of a topic back into frames. Not thread-safe.
 class FrameImageDecoder {
  public:
   // camera: the scanner's (its size tells a profile from an image); detector: how image-mode
   // frames are searched; keep_images: image mode, the image goes into the frame as well.
-  FrameImageDecoder(const scanner::PinholeCamera& camera, const scanner::StripeDetectorOptions& detector,
-                    bool keep_images);
+  FrameImageDecoder(const scanner::PinholeCamera& camera,
+                    const scanner::StripeDetectorOptions& detector, bool keep_images);
 
   // The frame at dive-log time `time_s`. Throws uwscan::Error naming `topic` when the encoding
   // or the size is not one of a payload above; std::nullopt when the metadata row does not
   // decode (packets lost on the camera's link: its checksum fails).
-  std::optional<mapping::FrameRecord> Decode(const ImageMessage& image, double time_s, const std::string& topic);
+  std::optional<mapping::FrameRecord> Decode(const ImageMessage& image, double time_s,
+                                             const std::string& topic);
 
  private:
   scanner::PinholeCamera camera_;

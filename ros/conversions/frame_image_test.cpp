@@ -49,7 +49,8 @@ TEST(FrameImage, ProfileCarriesEveryPeakWithinHalfAStep) {
   EXPECT_EQ(layout.axis, scanner::StripeAxis::kRows);
   EXPECT_EQ(layout.lines, 480);
   EXPECT_EQ(layout.peak_rows, 2);
-  const ImageMessage image = FrameToImage(frame, layout, 99, Header{1000.0 + frame.time_s, "camera"});
+  const ImageMessage image =
+      FrameToImage(frame, layout, 99, Header{1000.0 + frame.time_s, "camera"});
   EXPECT_EQ(image.encoding, "mono16");
   EXPECT_EQ(image.width, 480u);
   EXPECT_EQ(image.height, 3u);
@@ -83,9 +84,12 @@ TEST(FrameImage, ColumnsAreFoundFromWholeUAndImagesTravelWhole) {
 
   mapping::FrameRecord with_image;
   with_image.command = 5;
-  with_image.image = mapping::LogImage{320, 200, mapping::LogPixelFormat::kMono8, std::vector<std::uint8_t>(320 * 200)};
-  for (int v = 0; v < 200; ++v) with_image.image->bytes[static_cast<std::size_t>(v * 320 + 100)] = 250;
-  const ImageMessage image = FrameToImage(with_image, finder.Layout(camera), 0, Header{5.0, "camera"});
+  with_image.image = mapping::LogImage{320, 200, mapping::LogPixelFormat::kMono8,
+                                       std::vector<std::uint8_t>(320 * 200)};
+  for (int v = 0; v < 200; ++v)
+    with_image.image->bytes[static_cast<std::size_t>(v * 320 + 100)] = 250;
+  const ImageMessage image =
+      FrameToImage(with_image, finder.Layout(camera), 0, Header{5.0, "camera"});
   EXPECT_EQ(image.encoding, "mono8");
   EXPECT_EQ(image.height, 201u);
   FrameImageDecoder decoder(camera, {}, true);

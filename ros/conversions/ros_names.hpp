@@ -11,17 +11,18 @@
 namespace uwscan::ros {
 
 struct RosTopics {
-  std::string frames = "/uwscan/frames";  // sensor_msgs/Image: profile or image payload (frame_image.hpp)
+  std::string frames =
+      "/uwscan/frames";  // sensor_msgs/Image: profile or image payload (frame_image.hpp)
   std::string odometry = "/navigation/odometry";  // nav_msgs/Odometry: T_odom_base_link
-  std::string dive = "/uwscan/dive";              // std_msgs/String: DiveDescription (YAML), latched
+  std::string dive = "/uwscan/dive";  // std_msgs/String: DiveDescription (YAML), latched
   std::string tf = "/tf";
   std::string tf_static = "/tf_static";
   // What uwscan publishes.
-  std::string sweeps = "/uwscan/sweep";             // sensor_msgs/PointCloud2, camera frame
-  std::string map = "/uwscan/map";                  // sensor_msgs/PointCloud2, map frame, latched
-  std::string slam_path = "/uwscan/path";           // nav_msgs/Path, map frame
+  std::string sweeps = "/uwscan/sweep";    // sensor_msgs/PointCloud2, camera frame
+  std::string map = "/uwscan/map";         // sensor_msgs/PointCloud2, map frame, latched
+  std::string slam_path = "/uwscan/path";  // nav_msgs/Path, map frame
   std::string navigation_path = "/uwscan/navigation_path";  // nav_msgs/Path, map frame
-  std::string truth_path = "/uwscan/truth_path";            // nav_msgs/Path, map frame (simulated dives)
+  std::string truth_path = "/uwscan/truth_path";  // nav_msgs/Path, map frame (simulated dives)
   std::string pose = "/uwscan/pose";  // geometry_msgs/PoseWithCovarianceStamped, map frame
 };
 

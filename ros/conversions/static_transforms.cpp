@@ -9,7 +9,8 @@ void StaticTransforms::Add(const TransformMessage& t) {
   edges_[t.child_frame_id][t.header.frame_id] = t.transform.inverse();
 }
 
-std::optional<Eigen::Isometry3d> StaticTransforms::Find(const std::string& from, const std::string& to) const {
+std::optional<Eigen::Isometry3d> StaticTransforms::Find(const std::string& from,
+                                                        const std::string& to) const {
   // Breadth first from `from`, composing T_from_frame along the way.
   std::map<std::string, Eigen::Isometry3d> T_from = {{from, Eigen::Isometry3d::Identity()}};
   std::deque<std::string> queue = {from};

@@ -25,7 +25,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 double UnixNow() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -64,7 +66,8 @@ struct DiveSetup {
 
 class SetupListener {
  public:
-  SetupListener(RosConnection& ros, const InspectionNodeOptions& o, Failure& failure) : options_(o) {
+  SetupListener(RosConnection& ros, const InspectionNodeOptions& o, Failure& failure)
+      : options_(o) {
     if (!o.header) {
       ros.SubscribeText(o.topics.dive, [this, &failure, topic = o.topics.dive](StringMessage&& m) {
         try {
@@ -92,7 +95,8 @@ class SetupListener {
       if (stop_requested()) throw Error("stopped while waiting for the dive description");
       if (SecondsSince(start) > options_.description_wait_s) {
         throw Error("no dive description on " + options_.topics.dive + " within " +
-                    std::to_string(options_.description_wait_s) + " s: give the scanner (--scanner, or ~scanner)");
+                    std::to_string(options_.description_wait_s) +
+                    " s: give the scanner (--scanner, or ~scanner)");
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
@@ -106,14 +110,15 @@ class SetupListener {
     }
     const Clock::time_point mount_start = Clock::now();
     std::optional<Eigen::Isometry3d> T_V_C;
-    while (!(T_V_C = Mount()) && SecondsSince(mount_start) < options_.mount_wait_s && !stop_requested()) {
+    while (!(T_V_C = Mount()) && SecondsSince(mount_start) < options_.mount_wait_s &&
+           !stop_requested()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     const RosFrames& f = options_.frames;
     setup.T_V_C = T_V_C.value_or(Eigen::Isometry3d::Identity());
     setup.mount = T_V_C ? options_.topics.tf_static + " " + f.base_link + " -> " + f.camera
-                        : "none on " + options_.topics.tf_static + " from " + f.base_link + " to " + f.camera +
-                              ": the camera is taken at the vehicle's origin";
+                        : "none on " + options_.topics.tf_static + " from " + f.base_link + " to " +
+                              f.camera + ": the camera is taken at the vehicle's origin";
     return setup;
   }
 
@@ -166,7 +171,8 @@ class Intake {
   }
 
   // A frame read from the camera (CameraInput), on the camera's thread, after Begin().
-  void OnCameraFrame(mapping::FrameRecord&& record, const scanner::acquisition::AcquiredFrame& frame) {
+  void OnCameraFrame(mapping::FrameRecord&& record,
+                     const scanner::acquisition::AcquiredFrame& frame) {
     std::lock_guard<std::mutex> lock(frames_mutex_);
     if (closed_) return;
     ++frames_;
@@ -208,7 +214,8 @@ class Intake {
   void AddFrame(const ImageMessage& m) {
     if (closed_) return;
     try {
-      std::optional<mapping::FrameRecord> frame = decoder_->Decode(m, m.header.stamp_s - time_origin_s_, options_.topics.frames);
+      std::optional<mapping::FrameRecord> frame =
+          decoder_->Decode(m, m.header.stamp_s - time_origin_s_, options_.topics.frames);
       if (!frame) {
         ++undecodable_;
         return;
@@ -257,7 +264,8 @@ class Intake {
 // ROS's covariance order (position, rotation) from uwscan's [rotation, position].
 Covariance6d RosCovariance(const mapping::Matrix6d& c) {
   Covariance6d out;
-  out << c.bottomRightCorner<3, 3>(), c.bottomLeftCorner<3, 3>(), c.topRightCorner<3, 3>(), c.topLeftCorner<3, 3>();
+  out << c.bottomRightCorner<3, 3>(), c.bottomLeftCorner<3, 3>(), c.topRightCorner<3, 3>(),
+      c.topLeftCorner<3, 3>();
   return out;
 }
 
@@ -272,7 +280,8 @@ CloudMessage MapMessage(const perception::PointCloud& map, const Header& header)
 // Publishes what the mapper makes: sweeps, paths, pose, TF and map.
 class Outlet {
  public:
-  Outlet(RosConnection& ros, const InspectionNodeOptions& o, double time_origin_s, int frames_per_sweep)
+  Outlet(RosConnection& ros, const InspectionNodeOptions& o, double time_origin_s,
+         int frames_per_sweep)
       : ros_(ros), options_(o), origin_s_(time_origin_s), frames_per_sweep_(frames_per_sweep) {
     const RosTopics& t = o.topics;
     sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
@@ -307,8 +316,9 @@ class Outlet {
     PublishTrajectory(slam, navigation);
     const int last = m.submap_count() - 1;
     if (const std::optional<mapping::Mapper::SubmapCovariances> c = m.Covariances()) {
-      ros_.Publish(pose_id_, PoseMessage{Stamp(slam.back().time_s, options_.frames.map), slam.back().T_W_V,
-                                         RosCovariance(c->anchors[static_cast<std::size_t>(last)])});
+      ros_.Publish(pose_id_,
+                   PoseMessage{Stamp(slam.back().time_s, options_.frames.map), slam.back().T_W_V,
+                               RosCovariance(c->anchors[static_cast<std::size_t>(last)])});
     }
     if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
       ros_.Publish(map_id_, MapMessage(m.Map(options_.inspection.map_voxel_m),
@@ -335,11 +345,14 @@ class Outlet {
     if (sweep_latencies_s_.empty()) return {0.0, 0.0};
     std::vector<double> sorted = sweep_latencies_s_;
     std::sort(sorted.begin(), sorted.end());
-    return {sorted[sorted.size() / 2], sorted[std::min(sorted.size() - 1, sorted.size() * 95 / 100)]};
+    return {sorted[sorted.size() / 2],
+            sorted[std::min(sorted.size() - 1, sorted.size() * 95 / 100)]};
   }
 
  private:
-  Header Stamp(double time_s, const std::string& frame) const { return {origin_s_ + time_s, frame}; }
+  Header Stamp(double time_s, const std::string& frame) const {
+    return {origin_s_ + time_s, frame};
+  }
 
   void PublishSweep() {
     CloudMessage c;
@@ -355,12 +368,14 @@ class Outlet {
 
   // Both paths in the map frame (uwscan's world: the navigation's, corrected), and the
   // correction at the latest anchor as map -> odom.
-  void PublishTrajectory(const std::vector<mapping::TimedPose>& slam, const std::vector<mapping::TimedPose>& navigation) {
+  void PublishTrajectory(const std::vector<mapping::TimedPose>& slam,
+                         const std::vector<mapping::TimedPose>& navigation) {
     const RosFrames& f = options_.frames;
     ros_.Publish(slam_path_id_, Path(slam));
     ros_.Publish(navigation_path_id_, Path(navigation));
     const Eigen::Isometry3d T_map_odom = slam.back().T_W_V * navigation.back().T_W_V.inverse();
-    ros_.Publish(tf_id_, std::vector<TransformMessage>{{Stamp(slam.back().time_s, f.map), f.odom, T_map_odom}});
+    ros_.Publish(tf_id_, std::vector<TransformMessage>{
+                             {Stamp(slam.back().time_s, f.map), f.odom, T_map_odom}});
   }
 
   PathMessage Path(const std::vector<mapping::TimedPose>& poses) const {
@@ -378,7 +393,8 @@ class Outlet {
   double origin_s_;
   int frames_per_sweep_;
   int frames_in_sweep_ = 0;
-  int sweep_id_ = 0, map_id_ = 0, slam_path_id_ = 0, navigation_path_id_ = 0, pose_id_ = 0, tf_id_ = 0;
+  int sweep_id_ = 0, map_id_ = 0, slam_path_id_ = 0, navigation_path_id_ = 0, pose_id_ = 0,
+      tf_id_ = 0;
   std::optional<int> sweep_;
   double sweep_time_s_ = 0.0;
   double sweep_received_s_ = 0.0;
@@ -394,7 +410,8 @@ std::string StopReason(const InspectionNodeOptions& o, RosConnection& ros, const
                        const std::function<bool()>& stop_requested, double idle_s) {
   if (stop_requested()) return "stop requested";
   if (!ros.Ok()) return "ROS shut the node down";
-  if (o.max_frames > 0 && intake.frames() >= o.max_frames) return std::to_string(o.max_frames) + " frames received";
+  if (o.max_frames > 0 && intake.frames() >= o.max_frames)
+    return std::to_string(o.max_frames) + " frames received";
   if (o.idle_stop_s > 0.0 && intake.frames() > 0 && idle_s >= o.idle_stop_s) {
     return "no frame for " + std::to_string(o.idle_stop_s) + " s";
   }
@@ -458,7 +475,8 @@ void Subscribe(Node& node, const InspectionNodeOptions& o) {
   node.ros.SubscribeOdometry(o.topics.odometry, o.frame_queue,
                              [intake](OdometryMessage&& m) { intake->OnOdometry(std::move(m)); });
   if (!o.camera) {
-    node.ros.SubscribeImages(o.topics.frames, o.frame_queue, [intake](ImageMessage&& m) { intake->OnImage(std::move(m)); });
+    node.ros.SubscribeImages(o.topics.frames, o.frame_queue,
+                             [intake](ImageMessage&& m) { intake->OnImage(std::move(m)); });
   }
 }
 
@@ -468,12 +486,14 @@ DiveSetup OpenCamera(Node& node, const InspectionNodeOptions& o) {
   node.camera = std::make_unique<scanner::acquisition::FrameSource>(c.settings);
   const mapping::AcquisitionContext context =
       mapping::MakeAcquisitionContext(c.scene, c.scanner_file, node.camera->payload(), o.producer);
-  node.decoder = std::make_unique<mapping::CameraFrameDecoder>(node.camera->payload(), context, o.keep_images);
+  node.decoder =
+      std::make_unique<mapping::CameraFrameDecoder>(node.camera->payload(), context, o.keep_images);
   DiveSetup setup;
   setup.header = context.header;
   setup.T_V_C = context.T_V_C;
-  setup.mount = c.scene.empty() ? "none for a real camera: the camera is taken at the vehicle's origin"
-                                : "the scene the simulated camera serves";
+  setup.mount = c.scene.empty()
+                    ? "none for a real camera: the camera is taken at the vehicle's origin"
+                    : "the scene the simulated camera serves";
   return setup;
 }
 
@@ -482,7 +502,8 @@ void StartCamera(Node& node, const InspectionNodeOptions& o) {
   const mapping::ReadLimits limits{o.max_frames, 0.0};
   node.camera_thread = std::thread([&node, limits] {
     mapping::ReadCallbacks callbacks;
-    callbacks.consume = [&node](mapping::FrameRecord&& r, const scanner::acquisition::AcquiredFrame& f) {
+    callbacks.consume = [&node](mapping::FrameRecord&& r,
+                                const scanner::acquisition::AcquiredFrame& f) {
       node.intake->OnCameraFrame(std::move(r), f);
     };
     callbacks.stop_requested = [&node] { return node.camera_stop.load(); };
@@ -499,18 +520,21 @@ void StartInspection(Node& node, const InspectionNodeOptions& o, const DiveSetup
   header.producer = o.producer;
   mapping::InspectionOptions options = o.inspection;
   options.fixed_scanner = false;
-  node.outlet =
-      std::make_unique<Outlet>(node.ros, o, setup.time_origin_s, setup.header.scan_pattern.frames_per_sweep());
+  node.outlet = std::make_unique<Outlet>(node.ros, o, setup.time_origin_s,
+                                         setup.header.scan_pattern.frames_per_sweep());
   Outlet* outlet = node.outlet.get();
   node.inspection = std::make_unique<mapping::LiveInspection>(
-      header, o.log, setup.T_V_C, header.navigation_noise.value_or(mapping::AssumedNavigationNoise()), options,
+      header, o.log, setup.T_V_C,
+      header.navigation_noise.value_or(mapping::AssumedNavigationNoise()), options,
       [outlet](const mapping::MappedFrame& f) { outlet->OnMapped(f); });
-  node.inspection->SetSubmapClosedCallback([outlet](const mapping::Mapper& m) { outlet->OnSubmapClosed(m); });
+  node.inspection->SetSubmapClosedCallback(
+      [outlet](const mapping::Mapper& m) { outlet->OnSubmapClosed(m); });
   node.intake->Begin(setup, *node.inspection);
 }
 
 // Until a reason to stop; reports about once a second and keeps the node registered.
-std::string Watch(Node& node, const InspectionNodeOptions& o, const std::function<bool()>& stop_requested,
+std::string Watch(Node& node, const InspectionNodeOptions& o,
+                  const std::function<bool()>& stop_requested,
                   const std::function<void(const InspectionNodeStatus&)>& status) {
   const Clock::time_point start = Clock::now();
   Clock::time_point last_frame_change = start, last_status = start;
@@ -520,7 +544,8 @@ std::string Watch(Node& node, const InspectionNodeOptions& o, const std::functio
       last_frames = node.intake->frames();
       last_frame_change = Clock::now();
     }
-    const std::string reason = StopReason(o, node.ros, *node.intake, stop_requested, SecondsSince(last_frame_change));
+    const std::string reason =
+        StopReason(o, node.ros, *node.intake, stop_requested, SecondsSince(last_frame_change));
     if (!reason.empty()) return reason;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     if (SecondsSince(last_status) >= 1.0) {
@@ -528,7 +553,8 @@ std::string Watch(Node& node, const InspectionNodeOptions& o, const std::functio
       const bool master = node.ros.KeepRegistered();
       const double silent_s = last_frames > 0 ? SecondsSince(last_frame_change) : 0.0;
       if (status) {
-        status({node.inspection->statistics(), master, SecondsSince(start), silent_s, node.intake->navigation()});
+        status({node.inspection->statistics(), master, SecondsSince(start), silent_s,
+                node.intake->navigation()});
       }
     }
   }
@@ -537,15 +563,16 @@ std::string Watch(Node& node, const InspectionNodeOptions& o, const std::functio
 
 }  // namespace
 
-InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNodeOptions& o,
-                                        const std::function<bool()>& stop_requested,
-                                        const std::function<void(const InspectionNodeStatus&)>& status) {
+InspectionNodeSummary RunInspectionNode(
+    RosConnection& ros, const InspectionNodeOptions& o, const std::function<bool()>& stop_requested,
+    const std::function<void(const InspectionNodeStatus&)>& status) {
   o.Check();
   Node node(ros);
   ros.SetErrorHandler([&node](std::exception_ptr e) { node.failure.Set(std::move(e)); });
   Subscribe(node, o);
   ros.Start(2);
-  const DiveSetup setup = o.camera ? OpenCamera(node, o) : node.listener->Wait(node.failure, stop_requested);
+  const DiveSetup setup =
+      o.camera ? OpenCamera(node, o) : node.listener->Wait(node.failure, stop_requested);
   StartInspection(node, o, setup);
   if (o.camera) StartCamera(node, o);
 
@@ -555,8 +582,9 @@ InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNode
   node.intake->Close();
   node.failure.Rethrow();
   if (node.intake->dropped() > 0) {
-    throw Error(std::to_string(node.intake->dropped()) + " frames on " + o.topics.frames +
-                " came before the scanner was known and beyond ~frame_queue; they are not in the log");
+    throw Error(
+        std::to_string(node.intake->dropped()) + " frames on " + o.topics.frames +
+        " came before the scanner was known and beyond ~frame_queue; they are not in the log");
   }
   summary.result = node.inspection->Finish();
   node.outlet->Finish(summary.result);
@@ -565,7 +593,8 @@ InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNode
   summary.navigation_samples = node.intake->navigation();
   summary.receive_span_s = node.intake->receive_span_s();
   summary.sweeps_published = node.outlet->sweeps();
-  std::tie(summary.sweep_latency_median_s, summary.sweep_latency_p95_s) = node.outlet->SweepLatency();
+  std::tie(summary.sweep_latency_median_s, summary.sweep_latency_p95_s) =
+      node.outlet->SweepLatency();
   summary.maps_published = node.outlet->maps();
   summary.reregistrations = ros.reregistrations();
   summary.described = setup.described;

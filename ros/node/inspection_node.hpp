@@ -7,9 +7,9 @@
 #include <string>
 
 #include "mapping/inspection/live_inspection.hpp"
-#include "scanner/acquisition/frame_source.hpp"
 #include "ros/bridge/ros_connection.hpp"
 #include "ros/conversions/ros_names.hpp"
+#include "scanner/acquisition/frame_source.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
 
 // Online inspection on the vehicle (`uwscan ros inspect`): the same LiveInspection as
@@ -43,8 +43,8 @@ struct InspectionNodeOptions {
   // The camera's mount is looked up on /tf_static (frames.base_link -> frames.camera) for up to
   // this long before the camera is taken at the vehicle's origin, seconds, >= 0.
   double mount_wait_s = 3.0;
-  double map_period_s = 2.0;  // the map is published at most this often, seconds, > 0
-  int frame_queue = 4096;     // frames roscpp holds while the node is busy, > 0
+  double map_period_s = 2.0;                // the map is published at most this often, seconds, > 0
+  int frame_queue = 4096;                   // frames roscpp holds while the node is busy, > 0
   scanner::StripeDetectorOptions detector;  // how image-mode frames are searched
   bool keep_images = false;                 // image-mode frames: log the images with the peaks
   mapping::InspectionOptions inspection;    // fixed_scanner is set false (navigation comes)
@@ -78,7 +78,7 @@ struct InspectionNodeSummary {
 struct InspectionNodeStatus {
   mapping::InspectionStatistics statistics;
   bool master_reachable = true;
-  double seconds = 0.0;  // since frames were first subscribed
+  double seconds = 0.0;          // since frames were first subscribed
   double frames_silent_s = 0.0;  // since the last frame came (0 before the first)
   std::int64_t navigation_samples = 0;
 };
@@ -88,8 +88,9 @@ struct InspectionNodeStatus {
 // and paths. Throws uwscan::Error on a scanner that never came, a frame of the wrong encoding
 // or size (naming the topic), a log that cannot be written, or mapping that failed; the log
 // then holds every frame received before.
-InspectionNodeSummary RunInspectionNode(RosConnection& ros, const InspectionNodeOptions& options,
-                                        const std::function<bool()>& stop_requested,
-                                        const std::function<void(const InspectionNodeStatus&)>& status);
+InspectionNodeSummary RunInspectionNode(
+    RosConnection& ros, const InspectionNodeOptions& options,
+    const std::function<bool()>& stop_requested,
+    const std::function<void(const InspectionNodeStatus&)>& status);
 
 }  // namespace uwscan::ros

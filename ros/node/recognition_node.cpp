@@ -15,7 +15,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& c) {
   Eigen::Matrix3d m;
@@ -71,7 +73,8 @@ perception::PointCloud ToCloud(const CloudMessage& sweep) {
 Eigen::Vector4f Colour(const std::string& id) {
   std::uint32_t h = 2166136261u;
   for (char c : id) h = (h ^ static_cast<std::uint8_t>(c)) * 16777619u;
-  return {0.3F + 0.7F * static_cast<float>(h & 0xFF) / 255.0F, 0.3F + 0.7F * static_cast<float>((h >> 8) & 0xFF) / 255.0F,
+  return {0.3F + 0.7F * static_cast<float>(h & 0xFF) / 255.0F,
+          0.3F + 0.7F * static_cast<float>((h >> 8) & 0xFF) / 255.0F,
           0.3F + 0.7F * static_cast<float>((h >> 16) & 0xFF) / 255.0F, 1.0F};
 }
 
@@ -85,8 +88,10 @@ void AddMarkers(const perception::RecognizedObject& o, const perception::ObjectM
   points.kind = MarkerMessage::Kind::kPoints;
   points.pose = o.T_S_O;
   points.rgba = Colour(o.object_id);
-  const std::size_t stride = std::max<std::size_t>(1, model.model.size() / static_cast<std::size_t>(max_points));
-  for (std::size_t i = 0; i < model.model.size(); i += stride) points.points.push_back(model.model.Point(i).cast<float>());
+  const std::size_t stride =
+      std::max<std::size_t>(1, model.model.size() / static_cast<std::size_t>(max_points));
+  for (std::size_t i = 0; i < model.model.size(); i += stride)
+    points.points.push_back(model.model.Point(i).cast<float>());
   markers.push_back(points);
   MarkerMessage label;
   label.header = header;
@@ -94,7 +99,8 @@ void AddMarkers(const perception::RecognizedObject& o, const perception::ObjectM
   label.id = id;
   label.kind = MarkerMessage::Kind::kText;
   label.pose = o.T_S_O;
-  label.pose.translation() -= Eigen::Vector3d(0.0, 0.6 * model.diameter_m, 0.0);  // above it (y down)
+  label.pose.translation() -=
+      Eigen::Vector3d(0.0, 0.6 * model.diameter_m, 0.0);  // above it (y down)
   char text[96];
   std::snprintf(text, sizeof(text), "%s %.2f", o.object_id.c_str(), o.score);
   label.text = text;
@@ -102,7 +108,8 @@ void AddMarkers(const perception::RecognizedObject& o, const perception::ObjectM
   markers.push_back(label);
 }
 
-const perception::ObjectModel* FindModel(const perception::ObjectDatabase& db, const std::string& id) {
+const perception::ObjectModel* FindModel(const perception::ObjectDatabase& db,
+                                         const std::string& id) {
   for (const perception::ObjectModel& m : db.objects) {
     if (m.id == id) return &m;
   }
@@ -114,8 +121,8 @@ struct Publishers {
 };
 
 void Publish(RosConnection& ros, const Publishers& p, const perception::ObjectDatabase& db,
-             const perception::RecognitionResult& result, const Header& header, const RecognitionNodeOptions& o,
-             RecognitionNodeSummary& summary) {
+             const perception::RecognitionResult& result, const Header& header,
+             const RecognitionNodeOptions& o, RecognitionNodeSummary& summary) {
   std::vector<MarkerMessage> markers;
   MarkerMessage clear;
   clear.header = header;
@@ -129,9 +136,10 @@ void Publish(RosConnection& ros, const Publishers& p, const perception::ObjectDa
     if (model == nullptr) continue;  // "unknown"
     ++summary.objects[object.object_id];
     AddMarkers(object, *model, id++, header, o.model_marker_points, markers);
-    ros.Publish(p.poses, PoseMessage{header, object.T_S_O,
-                                     ObjectPoseCovariance(object.T_S_O, perception::Centroid(model->model),
-                                                          object.covariance)});
+    ros.Publish(p.poses,
+                PoseMessage{header, object.T_S_O,
+                            ObjectPoseCovariance(object.T_S_O, perception::Centroid(model->model),
+                                                 object.covariance)});
     for (const auto& [name, T_S_G] : object.grasps_S) grasps.poses.push_back(T_S_G);
   }
   ros.Publish(p.objects, markers);
@@ -139,11 +147,14 @@ void Publish(RosConnection& ros, const Publishers& p, const perception::ObjectDa
 }
 
 std::string StopReason(const RecognitionNodeOptions& o, RosConnection& ros, const SweepSlot& slot,
-                       const RecognitionNodeSummary& s, const std::function<bool()>& stop_requested) {
+                       const RecognitionNodeSummary& s,
+                       const std::function<bool()>& stop_requested) {
   if (stop_requested()) return "stop requested";
   if (!ros.Ok()) return "ROS shut the node down";
-  if (o.max_sweeps > 0 && s.sweeps_recognised >= o.max_sweeps) return std::to_string(o.max_sweeps) + " sweeps recognised";
-  if (o.idle_stop_s > 0.0 && slot.idle_s() >= o.idle_stop_s) return "no sweep for " + std::to_string(o.idle_stop_s) + " s";
+  if (o.max_sweeps > 0 && s.sweeps_recognised >= o.max_sweeps)
+    return std::to_string(o.max_sweeps) + " sweeps recognised";
+  if (o.idle_stop_s > 0.0 && slot.idle_s() >= o.idle_stop_s)
+    return "no sweep for " + std::to_string(o.idle_stop_s) + " s";
   return "";
 }
 
@@ -193,7 +204,8 @@ RecognitionNodeSummary RunRecognitionNode(RosConnection& ros, const perception::
       ++summary.sweeps_skipped;
       continue;
     }
-    const perception::RecognitionResult result = perception::RecognizeObjects(ToCloud(*sweep), db, cache, o.recognition);
+    const perception::RecognitionResult result =
+        perception::RecognizeObjects(ToCloud(*sweep), db, cache, o.recognition);
     Publish(ros, publishers, db, result, sweep->header, o, summary);
     ++summary.sweeps_recognised;
   }
