@@ -78,9 +78,12 @@ if [ -n "${SIGINT_AT:-}" ]; then
   sleep "$SIGINT_AT"
   kill -INT "$node"
 fi
-wait $player
+# The node ends on its own (idle after the last frame, SIGINT, or an error): the player, if still
+# playing, is stopped then.
 wait $node
 status=$?
+kill -INT $player 2>/dev/null
+wait $player
 if [ -n "$recognizer" ]; then
   wait "$recognizer" || status=$?
 fi
