@@ -396,24 +396,37 @@ TEST(CliRos, ADiveAndItsMapReportExportTogether) {
     const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(), path[i][3].get<double>());
     EXPECT_LT((p - mapped.trajectory[i].p).norm(), 1e-9);
   }
-  const CommandRun recognition = RunUwscan("bag export " + TempPath("for_export.tum").string() + " -o " +
+  const CommandRun tum = RunUwscan("bag export " + TempPath("for_export.tum").string() + " -o " +
                                            TempPath("refused.bag").string());
-  EXPECT_EQ(recognition.exit_code, 1) << recognition.output;
+  EXPECT_EQ(tum.exit_code, 1) << tum.output;
   EXPECT_FALSE(std::filesystem::exists(TempPath("refused.bag")));
 }
 
-// Recognition on the vehicle: the node's published sweep of the demo scene (a valve, a flanged
-// pipe) searched by `uwscan ros recognize`, which finds what `uwscan recognize` finds in the
-// same sweep offline, at the same place, and publishes it with standard messages.
+// The demo scene (a valve, a flanged pipe) simulated, a database of its objects built and the
+// scene recognised offline (`uwscan recognize --json`), once.
+struct OfflineRecognition {
+  std::filesystem::path db, log, report;
+};
+const OfflineRecognition& RecognisedDemo() {
+  static const OfflineRecognition r = [] {
+    OfflineRecognition o{TempPath("objects.db"), TempPath("demo.db"), TempPath("offline.json")};
+    CommandRun run = RunUwscan("build-db valve_wheel flange pipe --views 16 -o " + o.db.string());
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + o.log.string()).exit_code, 0);
+    run = RunUwscan("recognize " + o.log.string() + " --db " + o.db.string() + " --json " + o.report.string());
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return o;
+  }();
+  return r;
+}
+
+// Recognition on the vehicle: the node's published sweep of the demo scene searched by
+// `uwscan ros recognize`, which finds what `uwscan recognize` finds in the same sweep offline, at
+// the same place, and publishes it with standard messages.
 TEST(CliRos, RecognitionNodeFindsWhatRecognizeFindsOffline) {
-  const std::filesystem::path db = TempPath("objects.db");
-  CommandRun run = RunUwscan("build-db valve_wheel flange pipe --views 16 -o " + db.string());
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  const std::filesystem::path log = TempPath("demo.db"), bag = TempPath("demo.bag"), offline = TempPath("offline.json");
-  ASSERT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string()).exit_code, 0);
-  run = RunUwscan("recognize " + log.string() + " --db " + db.string() + " --json " + offline.string());
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  ASSERT_EQ(RunUwscan("bag export " + log.string() + " -o " + bag.string()).exit_code, 0);
+  const OfflineRecognition& demo = RecognisedDemo();
+  const std::filesystem::path db = demo.db, bag = TempPath("demo.bag"), offline = demo.report;
+  ASSERT_EQ(RunUwscan("bag export " + demo.log.string() + " -o " + bag.string()).exit_code, 0);
   const NodeRun r = ReplayIntoNode(bag, "recognition", "RECOGNIZE_DB=" + db.string());
   ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
 
@@ -445,6 +458,128 @@ TEST(CliRos, RecognitionNodeFindsWhatRecognizeFindsOffline) {
     EXPECT_LT(nearest, 0.005) << "an object offline at " << e.transpose();
   }
   EXPECT_EQ(Dump(published["/uwscan/object_poses"]["frame_ids"]), Dump(nlohmann::json::array({"uwscan_camera"})));
+}
+
+namespace {
+
+// The short dive's bag as a vehicle in REP 103's default axes records it (tests/ros/enu_bag.py).
+const std::filesystem::path& EnuBag() {
+  static const std::filesystem::path bag = [] {
+    const std::filesystem::path path = TempPath("enu.bag");
+    const CommandRun run = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/enu_bag.py") + " " +
+                                      ShortBag().string() + " " + path.string());
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return path;
+  }();
+  return bag;
+}
+
+// The largest gap between two logs' navigation samples (translation, m, plus rotation, rad), and
+// between their mounts; infinity when their counts differ.
+double NavigationGap(const std::filesystem::path& a_log, const std::filesystem::path& b_log) {
+  const uwscan::mapping::DiveLogReader a(a_log), b(b_log);
+  const std::vector<uwscan::mapping::NavigationRecord> nav_a = a.ReadNavigation(), nav_b = b.ReadNavigation();
+  if (nav_a.size() != nav_b.size() || !a.vehicle_mount() || !b.vehicle_mount()) return INFINITY;
+  const auto gap = [](const Eigen::Isometry3d& x, const Eigen::Isometry3d& y) {
+    return (x.translation() - y.translation()).norm() + (x.linear() - y.linear()).norm();
+  };
+  double largest = gap(*a.vehicle_mount(), *b.vehicle_mount());
+  for (std::size_t i = 0; i < nav_a.size(); ++i) {
+    largest = std::max({largest, std::abs(nav_a[i].time_s - nav_b[i].time_s), gap(nav_a[i].T_W_V, nav_b[i].T_W_V)});
+  }
+  return largest;
+}
+
+}  // namespace
+
+// A vehicle whose navigation is in ENU with a forward-left-up base_link (REP 103's default, as
+// robot_localization publishes it), read from its odometry or from /tf alone: imported with
+// --navigation-axes enu, the log holds the original dive's navigation and mount; taken as NED it
+// does not; a /tf without the navigation's frames is refused by name.
+TEST(CliRos, ImportTakesNavigationInEnuAxesAndFromTf) {
+  const std::filesystem::path original = TempPath("original_nav.db");
+  ASSERT_EQ(RunUwscan("bag import " + ShortBag().string() + " -o " + original.string()).exit_code, 0);
+  for (const char* source : {"odometry", "tf"}) {
+    const std::filesystem::path log = TempPath(std::string("enu_") + source + ".db");
+    const CommandRun run = RunUwscan("bag import " + EnuBag().string() + " -o " + log.string() +
+                                     " --navigation-axes enu --navigation " + source);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_LT(NavigationGap(original, log), 1e-9) << source;
+  }
+  const std::filesystem::path as_ned = TempPath("enu_as_ned.db");
+  ASSERT_EQ(RunUwscan("bag import " + EnuBag().string() + " -o " + as_ned.string()).exit_code, 0);
+  EXPECT_GT(NavigationGap(original, as_ned), 1.0);
+  const std::filesystem::path refused = TempPath("enu_refused.db");
+  const CommandRun run = RunUwscan("bag import " + EnuBag().string() + " -o " + refused.string() +
+                                   " --navigation tf --odom-frame world_enu");
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("no world_enu -> base_link transform on /tf"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(refused));
+}
+
+// The node on that vehicle, its navigation from /tf alone in ENU/FLU: it logs and maps the dive
+// as it does from NED odometry, and publishes its path in the vehicle's ENU axes.
+TEST(CliRos, NodeTakesNavigationFromTfInEnuAxes) {
+  const NodeRun r = ReplayIntoNode(EnuBag(), "enu_tf", "",
+                                   "--idle-stop-s 3 _navigation_source:=tf _navigation_axes:=enu");
+  ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
+  EXPECT_EQ(Dump(r.report["frames_mapped"]), Dump(1989)) << r.report.dump();
+  EXPECT_NE(r.log.find("navigation on /tf (odom -> base_link) in ENU/FLU axes"), std::string::npos) << r.log;
+  const std::filesystem::path out = TempPath("enu_tf");
+  EXPECT_LT(NavigationGap(ShortDive(), out / "node.db"), 1e-6);  // stamps in ROS time: ~1e-7 s steps
+  const MapOutput offline = Map(ShortDive(), "offline_for_enu");
+  const std::vector<TimedPosition> online = ReadTum(out / "node.tum");
+  EXPECT_LT(LargestGap(online, offline.trajectory), 0.001);
+  const nlohmann::json published = CheckBag(out / "published.bag");
+  const nlohmann::json& path = published["/uwscan/path"]["last_path"];
+  ASSERT_EQ(path.size(), online.size());
+  for (std::size_t i = 0; i < online.size(); ++i) {
+    const Eigen::Vector3d enu(online[i].p.y(), online[i].p.x(), -online[i].p.z());
+    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(), path[i][3].get<double>());
+    EXPECT_LT((p - enu).norm(), 1e-6) << "anchor " << i;
+  }
+}
+
+// A recognition report exported to a bag replays what was recognised as the recognition node
+// publishes it: the scan on the sweep topic, each object's pose (where the report puts it) with a
+// covariance, its grasps and its model and label, in the camera frame at the sweep's middle.
+TEST(CliRos, ARecognitionReportExportsAsTheRecognitionNodePublishes) {
+  const OfflineRecognition& demo = RecognisedDemo();
+  const std::filesystem::path bag = TempPath("recognition_report.bag");
+  const CommandRun run = RunUwscan("bag export " + demo.report.string() + " -o " + bag.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream report_file(demo.report);
+  const nlohmann::json report = nlohmann::json::parse(report_file);
+  std::vector<Eigen::Vector3d> positions;
+  std::size_t grasps = 0;
+  for (const nlohmann::json& o : report["objects"]) {
+    if (o["id"] == "unknown") continue;
+    const nlohmann::json& p = o["T_S_O"]["position_m"];
+    positions.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+    grasps += o["grasps"].size();
+  }
+  ASSERT_GE(positions.size(), 2u);
+  const nlohmann::json topics = CheckBag(bag);
+  EXPECT_EQ(Dump(topics["/uwscan/sweep"]["count"]), Dump(1));
+  EXPECT_GT(topics["/uwscan/sweep"]["last_points"].get<int>(), 1000) << topics.dump().substr(0, 2000);
+  const nlohmann::json& poses = topics["/uwscan/object_poses"]["positions"];
+  ASSERT_EQ(poses.size(), positions.size()) << poses.dump();
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const Eigen::Vector3d p(poses[i][0].get<double>(), poses[i][1].get<double>(), poses[i][2].get<double>());
+    EXPECT_LT((p - positions[i]).norm(), 1e-9) << "object " << i;
+  }
+  EXPECT_EQ(topics["/uwscan/objects"]["last_labels"].size(), positions.size());
+  EXPECT_EQ(Dump(topics["/uwscan/grasps"]["last_poses"]), Dump(grasps));
+  for (const char* topic : {"/uwscan/sweep", "/uwscan/object_poses", "/uwscan/grasps"}) {
+    EXPECT_EQ(Dump(topics[topic]["frame_ids"]), Dump(nlohmann::json::array({"uwscan_camera"}))) << topic;
+  }
+  // The scan's time: within the simulated dive's frames, on the clock a bag of that dive has.
+  const std::filesystem::path dive_bag = TempPath("demo_for_time.bag");
+  ASSERT_EQ(RunUwscan("bag export " + demo.log.string() + " -o " + dive_bag.string()).exit_code, 0);
+  const nlohmann::json dive = CheckBag(dive_bag);
+  const double t = topics["/uwscan/sweep"]["first_stamp"].get<double>();
+  EXPECT_GT(t, dive["/uwscan/frames"]["first_stamp"].get<double>());
+  EXPECT_LT(t, dive["/uwscan/frames"]["last_stamp"].get<double>());
 }
 
 // A vehicle's own bag (tests/ros/vehicle_bag.py): its topic and frame names, frames and
@@ -555,6 +690,11 @@ TEST(CliRos, RosBenchWritesItsFiguresAndLosesNoFrame) {
   EXPECT_GT(node["latency_s"]["median"].get<double>(), 0.0);
   EXPECT_GE(node["latency_s"]["p95"].get<double>(), node["latency_s"]["median"].get<double>());
   EXPECT_GT(node["peak_rss_bytes"].get<double>(), 1e6);
+  const nlohmann::json& memory = node["memory"];
+  ASSERT_TRUE(memory.is_object()) << node.dump();
+  EXPECT_GT(memory["rss_at_end_bytes"].get<double>(), 1e6);
+  EXPECT_LE(memory["rss_at_end_bytes"].get<double>(), node["peak_rss_bytes"].get<double>());
+  EXPECT_GE(memory["samples_s_bytes"].size(), 4u);
   EXPECT_GT(r["direct_inspect"]["frames_per_s"].get<double>(), 0.0);
   EXPECT_GT(r["offline_map"]["cpu_s_per_frame"].get<double>(), 0.0);
   EXPECT_TRUE(r["overhead_ratio"].is_number());

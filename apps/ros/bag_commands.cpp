@@ -20,6 +20,9 @@ struct ImportArgs {
   std::string log;
   std::string scanner_file;
   ros::RosTopics topics;
+  ros::RosFrames frames;
+  std::string navigation_source = "odometry";
+  std::string navigation_axes = "ned";
   bool images = false;
 };
 
@@ -36,6 +39,9 @@ void RunImport(const ImportArgs& a) {
     throw Error("-o " + a.log + ": exists (a dive log is never overwritten)");
   ros::BagImportOptions options;
   options.topics = a.topics;
+  options.frames = a.frames;
+  options.navigation.source = ros::ParseNavigationSource(a.navigation_source, "--navigation");
+  options.navigation.axes = ros::ParseNavigationAxes(a.navigation_axes, "--navigation-axes");
   options.keep_images = a.images;
   options.producer = std::string("uwscan bag import ") + UWSCAN_VERSION + " (" +
                      std::filesystem::path(a.bag).filename().string() + ")";
@@ -87,6 +93,13 @@ void RunExport(const ExportArgs& a) {
         static_cast<long long>(s.map_points), a.topics.map.c_str(),
         static_cast<long long>(s.anchors));
   }
+  if (s.scan_points > 0) {
+    std::printf("bag export: a scan of %lld points on %s; %lld objects on %s, %s and %lld grasps on %s\n",
+                static_cast<long long>(s.scan_points), a.topics.sweeps.c_str(),
+                static_cast<long long>(s.objects), a.topics.objects.c_str(),
+                a.topics.object_poses.c_str(), static_cast<long long>(s.grasps),
+                a.topics.grasps.c_str());
+  }
   std::printf("bag export: written to %s\n", a.bag.c_str());
   if (s.time_origin_s != 0.0)
     std::printf("bag export: log time 0 is ROS time %.0f s\n", s.time_origin_s);
@@ -118,7 +131,8 @@ void AddBagCommands(CLI::App& app) {
       "image line,\n"
       "peak rows + metadata row; image: mono8/mono16 with the metadata row below), time = the "
       "message's stamp.\n"
-      "Navigation: nav_msgs/Odometry (T_odom_base_link, NED world, forward-right-down vehicle).\n"
+      "Navigation: nav_msgs/Odometry, or /tf with --navigation tf (T_odom_base_link; NED world,\n"
+      "forward-right-down vehicle, or with --navigation-axes enu ENU, forward-left-up).\n"
       "Camera mount: /tf_static from the odometry's child frame to the images' frame (else "
       "identity).\n"
       "Scanner: the bag's dive description (bags uwscan wrote), else --scanner.");
@@ -131,16 +145,32 @@ void AddBagCommands(CLI::App& app) {
   import->add_flag("--images", in->images,
                    "image-mode frames: keep the images in the log as well as the peaks");
   AddTopicOptions(*import, in->topics);
+  import
+      ->add_option("--navigation", in->navigation_source,
+                   "odometry (the odometry topic) or tf (--odom-frame -> --base-frame on /tf)")
+      ->check(CLI::IsMember({"odometry", "tf"}))
+      ->capture_default_str();
+  import
+      ->add_option("--navigation-axes", in->navigation_axes,
+                   "ned (NED world, forward-right-down vehicle) or enu (ENU world, "
+                   "forward-left-up vehicle: REP 103's default); the mount is read in them too")
+      ->check(CLI::IsMember({"ned", "enu"}))
+      ->capture_default_str();
+  import->add_option("--odom-frame", in->frames.odom, "the navigation's world frame (--navigation tf)")
+      ->capture_default_str();
+  import->add_option("--base-frame", in->frames.base_link, "the vehicle's frame (--navigation tf)")
+      ->capture_default_str();
   import->callback([in] { RunImport(*in);
 });
 
 auto out = std::make_shared<ExportArgs>();
 CLI::App* exp =
     bag->add_subcommand("export",
-                        "dive logs and map reports -> a ROS 1 bag for rosbag play and RViz: a "
-                        "log's frames, odometry, TF and "
-                        "dive description; a map report's map, paths, poses and map -> odom");
-exp->add_option("inputs", out->inputs, "dive logs (.db) and map reports (map --json)")
+                        "dive logs, map and recognition reports -> a ROS 1 bag for rosbag play "
+                        "and RViz: a log's frames, odometry, TF and dive description; a map "
+                        "report's map, paths, poses and map -> odom; a recognition report's "
+                        "scan, object poses, grasps and markers");
+exp->add_option("inputs", out->inputs, "dive logs (.db), map reports (map --json) and recognition reports (recognize --json)")
     ->required()
     ->check(CLI::ExistingFile);
 exp->add_option("-o,--output", out->bag, "bag to create (.bag)")->required();

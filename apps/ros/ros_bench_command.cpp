@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "apps/cli/child_process.hpp"
@@ -51,6 +53,41 @@ struct NodeFigures {
   std::int64_t peak_rss_bytes = 0;
   double sweep_latency_median_s = 0.0, sweep_latency_p95_s = 0.0;
   double receive_to_map_median_s = 0.0;
+  std::vector<std::pair<double, std::int64_t>> rss;  // (seconds since the node started, bytes)
+};
+
+// A process's resident memory, sampled every half second on a thread of its own.
+class RssSampler {
+ public:
+  explicit RssSampler(pid_t pid) : pid_(pid), thread_([this] { Run(); }) {}
+  ~RssSampler() { Stop(); }
+  RssSampler(const RssSampler&) = delete;
+  RssSampler& operator=(const RssSampler&) = delete;
+  std::vector<std::pair<double, std::int64_t>> Stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+    return samples_;
+  }
+
+ private:
+  void Run() {
+    const auto start = std::chrono::steady_clock::now();
+    while (!stop_) {
+      std::ifstream status("/proc/" + std::to_string(pid_) + "/status");
+      std::string line;
+      while (std::getline(status, line)) {
+        if (line.rfind("VmRSS:", 0) != 0) continue;
+        const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        samples_.emplace_back(t, std::stoll(line.substr(6)) * 1024);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    }
+  }
+
+  pid_t pid_;
+  std::atomic<bool> stop_{false};
+  std::vector<std::pair<double, std::int64_t>> samples_;
+  std::thread thread_;
 };
 
 std::string Self() { return fs::read_symlink("/proc/self/exe").string(); }
@@ -126,9 +163,11 @@ NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, d
                std::string::npos;
       },
       30, "the node did not subscribe (see " + log.string() + ")");
+  RssSampler memory(node.pid());
   // -d: rosbag play waits after advertising, so that the node has connected before the first frame.
   RunToEnd({"rosbag", "play", "--quiet", "-d", "1", "-r", std::to_string(rate), bag.string()},
-           folder / "play.log", 600);
+           folder / "play.log", 3600);
+  const std::vector<std::pair<double, std::int64_t>> rss = memory.Stop();
   const ChildProcess::Exit exit = node.Wait(600);
   if (exit.exit_code != 0) throw Error("bench ros: the node failed (see " + log.string() + ")");
   const nlohmann::json r = ReadJson(json);
@@ -146,6 +185,7 @@ NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, d
   f.sweep_latency_median_s = r["sweep_latency_s"]["median"];
   f.sweep_latency_p95_s = r["sweep_latency_s"]["p95"];
   f.receive_to_map_median_s = r["receive_to_map_s"]["median"];
+  f.rss = rss;
   return f;
 }
 
@@ -183,6 +223,23 @@ double OfflineMapCpuPerFrame(const fs::path& dive, std::int64_t frames, const fs
   return exit.cpu_s / static_cast<double>(std::max<std::int64_t>(1, frames));
 }
 
+// Resident memory while the bag played: at a quarter of the replay and at its end (the mapper
+// and its queues settled in, then all of the dive), the growth between them per minute of dive
+// (replay seconds times the rate), and every sample.
+nlohmann::json MemoryJson(const NodeFigures& f) {
+  if (f.rss.size() < 4) return nullptr;
+  const std::pair<double, std::int64_t>& quarter = f.rss[f.rss.size() / 4];
+  const std::pair<double, std::int64_t>& end = f.rss.back();
+  const double dive_minutes = (end.first - quarter.first) * f.rate / 60.0;
+  nlohmann::json samples = nlohmann::json::array();
+  for (const auto& [t, bytes] : f.rss) samples.push_back({t, bytes});
+  return {{"rss_at_quarter_bytes", quarter.second},
+          {"rss_at_end_bytes", end.second},
+          {"growth_bytes_per_dive_minute",
+           dive_minutes > 0 ? static_cast<double>(end.second - quarter.second) / dive_minutes : 0.0},
+          {"samples_s_bytes", samples}};
+}
+
 nlohmann::json NodeJson(const NodeFigures& f) {
   return {{"rate", f.rate},
           {"frames_per_s", f.frames_per_s},
@@ -192,7 +249,8 @@ nlohmann::json NodeJson(const NodeFigures& f) {
           {"receive_to_map_median_s", f.receive_to_map_median_s},
           {"cpu_s_per_frame",
            f.frames_received > 0 ? f.cpu_s / static_cast<double>(f.frames_received) : 0.0},
-          {"peak_rss_bytes", f.peak_rss_bytes}};
+          {"peak_rss_bytes", f.peak_rss_bytes},
+          {"memory", MemoryJson(f)}};
 }
 
 void RunRosBench(RosBenchArgs a) {
@@ -222,11 +280,14 @@ void RunRosBench(RosBenchArgs a) {
     std::printf(
         "bench ros: rate %.2f: %.0f frames/s through the node, %lld lost, sweep latency median "
         "%.1f ms "
-        "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB\n",
+        "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB, RSS %.0f -> %.0f MB from a quarter of "
+        "the replay to its end\n",
         f.rate, f.frames_per_s, static_cast<long long>(f.frames_in_bag - f.frames_received),
         f.sweep_latency_median_s * 1e3, f.sweep_latency_p95_s * 1e3,
         f.cpu_s / static_cast<double>(std::max<std::int64_t>(1, f.frames_received)) * 1e6,
-        static_cast<double>(f.peak_rss_bytes) * 1e-6);
+        static_cast<double>(f.peak_rss_bytes) * 1e-6,
+        f.rss.empty() ? 0.0 : static_cast<double>(f.rss[f.rss.size() / 4].second) * 1e-6,
+        f.rss.empty() ? 0.0 : static_cast<double>(f.rss.back().second) * 1e-6);
   }
   const InspectFigures direct = DirectInspect(a, folder);
   const double inspect_cpu =

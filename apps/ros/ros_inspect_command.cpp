@@ -50,6 +50,11 @@ const char* const kParameterHelp =
     "[/navigation/odometry]\n"
     "  ~dive_topic          dive description (scanner), std_msgs/String, latched     "
     "[/uwscan/dive]\n"
+    "  ~navigation_source   odometry (nav_msgs/Odometry) or tf (odom_frame -> base_frame on /tf)  "
+    "[odometry]\n"
+    "  ~navigation_axes     ned (NED world, forward-right-down vehicle) or enu (ENU, forward-left-up,\n"
+    "                       REP 103's default: the mount read and map, paths, poses published so)  "
+    "[ned]\n"
     "  ~map_frame ~odom_frame ~base_frame ~camera_frame   frame names               [map odom "
     "base_link uwscan_camera]\n"
     "  ~scanner             scanner (calibration) file when no dive description comes  []\n"
@@ -65,8 +70,7 @@ const char* const kParameterHelp =
     "Publishes: ~sweep (/uwscan/sweep, PointCloud2, camera frame), /uwscan/map (PointCloud2, "
     "latched),\n"
     "/uwscan/path and /uwscan/navigation_path (nav_msgs/Path, map frame), /uwscan/pose\n"
-    "(PoseWithCovarianceStamped), map -> odom on /tf. Frames: NED world, forward-right-down "
-    "vehicle.\n"
+    "(PoseWithCovarianceStamped), map -> odom on /tf, in the navigation's axes (~navigation_axes).\n"
     "ROS 1 has no authentication: the node binds to ROS_IP (or ROS_HOSTNAME); set it to the "
     "vehicle's\n"
     "private interface, never leave it to all interfaces on an open network.";
@@ -77,6 +81,10 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
   t.frames = ros.Param("frames_topic", t.frames);
   t.odometry = ros.Param("odometry_topic", t.odometry);
   t.dive = ros.Param("dive_topic", t.dive);
+  o.navigation.source = ros::ParseNavigationSource(
+      ros.Param("navigation_source", ros::ToString(o.navigation.source)), "~navigation_source");
+  o.navigation.axes = ros::ParseNavigationAxes(
+      ros.Param("navigation_axes", ros::ToString(o.navigation.axes)), "~navigation_axes");
   ros::RosFrames& f = o.frames;
   f.map = ros.Param("map_frame", f.map);
   f.odom = ros.Param("odom_frame", f.odom);
@@ -185,10 +193,14 @@ void RunRosInspect(const RosInspectArgs& a) {
   ros::RosConnection ros("uwscan_inspection", a.ros_arguments, a.master_wait_s);
   const ros::InspectionNodeOptions options = NodeOptions(ros, a);
   if (!a.log.empty()) RemoveLog(a.log);
-  std::printf("ros inspect: frames %s %s, navigation on %s; %s\n",
+  const std::string navigation =
+      options.navigation.source == ros::NavigationSource::kTf
+          ? options.topics.tf + " (" + options.frames.odom + " -> " + options.frames.base_link + ")"
+          : options.topics.odometry;
+  std::printf("ros inspect: frames %s %s, navigation on %s in %s axes; %s\n",
               options.camera ? "from the camera" : "on",
-              options.camera ? a.camera.c_str() : options.topics.frames.c_str(),
-              options.topics.odometry.c_str(),
+              options.camera ? a.camera.c_str() : options.topics.frames.c_str(), navigation.c_str(),
+              options.navigation.axes == ros::NavigationAxes::kEnuFlu ? "ENU/FLU" : "NED/FRD",
               a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
   std::fflush(stdout);
   bool silence_reported = false;

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mapping/log/dive_log.hpp"
+#include "ros/bag/recognition_export.hpp"
 #include "ros/bag/report_export.hpp"
 #include "ros/bridge/bag_file.hpp"
 #include "ros/conversions/dive_description.hpp"
@@ -51,18 +52,31 @@ std::string ReportKind(const std::filesystem::path& path) {
   }
 }
 
-// The origin of the first dive log, else of the log the first map report names.
+// The dive log a report was made from: a map report's "log", a recognition report's scan when
+// that is a log; empty for anything else.
+std::filesystem::path LogOfReport(const std::filesystem::path& input) {
+  std::ifstream in(input);
+  const nlohmann::json report = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!report.is_object()) return {};
+  std::filesystem::path log;
+  if (report.value("kind", "") == "map_report" && report.contains("log") && report["log"].is_string()) {
+    log = report["log"].get<std::string>();
+  }
+  if (report.value("kind", "") == "recognition_report" && report.contains("scan") &&
+      report["scan"].is_string()) {
+    log = input.parent_path() / report["scan"].get<std::string>();
+  }
+  return std::filesystem::is_regular_file(log) && IsSqlite(log) ? log : std::filesystem::path();
+}
+
+// The origin of the first dive log, else of the log the first report names.
 double TimeOriginOf(const std::vector<std::filesystem::path>& inputs) {
   for (const std::filesystem::path& input : inputs) {
     if (IsSqlite(input)) return TimeOrigin(mapping::DiveLogReader(input));
   }
   for (const std::filesystem::path& input : inputs) {
-    std::ifstream in(input);
-    const nlohmann::json report = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (report.is_object() && report.contains("log") && report["log"].is_string() &&
-        std::filesystem::is_regular_file(report["log"].get<std::string>())) {
-      return TimeOrigin(mapping::DiveLogReader(report["log"].get<std::string>()));
-    }
+    if (const std::filesystem::path log = LogOfReport(input); !log.empty())
+      return TimeOrigin(mapping::DiveLogReader(log));
   }
   return kUnixTimeFloor_s;
 }
@@ -131,9 +145,15 @@ void ExportInput(const std::filesystem::path& input, const BagExportOptions& o, 
     summary.anchors += r.anchors;
     summary.map_points += r.map_points;
   } else if (kind == "recognition_report") {
-    throw Error(input.string() + ": recognition reports are not exported to bags yet");
+    const RecognitionExportSummary r =
+        ExportRecognitionReport(input, summary.time_origin_s, o, bag);
+    summary.scan_points += r.scan_points;
+    summary.objects += r.objects;
+    summary.grasps += r.grasps;
   } else {
-    throw Error(input.string() + ": a JSON file that is not a map report (kind '" + kind + "')");
+    throw Error(input.string() +
+                ": a JSON file that is neither a map nor a recognition report (kind '" + kind +
+                "')");
   }
 }
 

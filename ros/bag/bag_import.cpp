@@ -95,6 +95,10 @@ Description ReadDescription(const BagReader& reader, const std::vector<BagTopic>
   return d;
 }
 
+const std::string& NavigationTopic(const BagImportOptions& o) {
+  return o.navigation.source == NavigationSource::kTf ? o.topics.tf : o.topics.odometry;
+}
+
 // The frames and the navigation, in the order they were recorded.
 void ReadDive(const BagReader& reader, const std::filesystem::path& bag, const BagImportOptions& o,
               const Description& d, mapping::DiveLogWriter& writer, BagImportSummary& summary,
@@ -114,13 +118,22 @@ void ReadDive(const BagReader& reader, const std::filesystem::path& bag, const B
     writer.AppendFrame(*frame);
     ++summary.frames;
   };
-  visitor.odometry = [&](const std::string& topic, OdometryMessage&& m) {
+  const auto navigation = [&](const std::string& topic, const OdometryMessage& m) {
     navigation_order.Check(topic, m.header.stamp_s, bag);
     if (vehicle_frame.empty()) vehicle_frame = m.child_frame_id;
-    writer.AppendNavigation({m.header.stamp_s - d.time_origin_s, m.pose});
+    writer.AppendNavigation({m.header.stamp_s - d.time_origin_s,
+                             VehiclePoseInUwscanAxes(m.pose, o.navigation.axes)});
     ++summary.navigation;
   };
-  reader.Read({o.topics.frames, o.topics.odometry}, visitor);
+  if (o.navigation.source == NavigationSource::kOdometry) {
+    visitor.odometry = navigation;
+  } else {
+    visitor.transforms = [&](const std::string& topic, std::vector<TransformMessage>&& ts) {
+      if (const std::optional<OdometryMessage> m = NavigationFromTransforms(ts, o.frames))
+        navigation(topic, *m);
+    };
+  }
+  reader.Read({o.topics.frames, NavigationTopic(o)}, visitor);
 }
 
 }  // namespace
@@ -132,7 +145,11 @@ BagImportSummary ImportBag(const std::filesystem::path& bag, const std::filesyst
   const BagReader reader(bag.string());
   const std::vector<BagTopic> topics = reader.Topics();
   RequireTopic(topics, o.topics.frames, "sensor_msgs/Image", "camera frames", bag);
-  RequireTopic(topics, o.topics.odometry, "nav_msgs/Odometry", "navigation", bag);
+  if (o.navigation.source == NavigationSource::kOdometry) {
+    RequireTopic(topics, o.topics.odometry, "nav_msgs/Odometry", "navigation", bag);
+  } else {
+    RequireTopic(topics, o.topics.tf, "tf2_msgs/TFMessage", "navigation", bag);
+  }
   const Description d = ReadDescription(reader, topics, bag, o);
 
   BagImportSummary summary;
@@ -148,8 +165,13 @@ BagImportSummary ImportBag(const std::filesystem::path& bag, const std::filesyst
     {
       mapping::DiveLogWriter writer(partial, header);
       ReadDive(reader, bag, o, d, writer, summary, camera_frame, vehicle_frame);
+      if (o.navigation.source == NavigationSource::kTf && summary.navigation == 0) {
+        throw Error(bag.string() + ": no " + o.frames.odom + " -> " + o.frames.base_link +
+                    " transform on " + o.topics.tf + " (the navigation)");
+      }
       const std::optional<Eigen::Isometry3d> T_V_C = d.statics.Find(vehicle_frame, camera_frame);
-      writer.SetVehicleMount(T_V_C.value_or(Eigen::Isometry3d::Identity()));
+      writer.SetVehicleMount(MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()),
+                                               o.navigation.axes));
       summary.mount = T_V_C ? o.topics.tf_static + " " + vehicle_frame + " -> " + camera_frame
                             : "none on " + o.topics.tf_static + " from " + vehicle_frame + " to " +
                                   camera_frame + ": the camera is taken at the vehicle's origin";

@@ -7,17 +7,22 @@
 #include <vector>
 
 #include "mapping/log/dive_log.hpp"
+#include "ros/conversions/navigation_input.hpp"
 #include "ros/conversions/ros_names.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
 
 // A ROS 1 bag turned into a dive log that `map`, `reconstruct`, `recognize` and `view` take:
-// frames from an image topic (frame_image.hpp), navigation from nav_msgs/Odometry, the camera's
+// frames from an image topic (frame_image.hpp), navigation from nav_msgs/Odometry or /tf
+// (navigation_input.hpp), the camera's
 // mount from /tf_static, the scanner from the bag's dive description (a bag uwscan wrote) or
 // from the caller (a vehicle's own bag).
 namespace uwscan::ros {
 
 struct BagImportOptions {
-  RosTopics topics;  // frames, odometry, dive description, /tf_static
+  RosTopics topics;  // frames, odometry (or /tf), dive description, /tf_static
+  RosFrames frames;  // odom and base_link: the navigation's frames on /tf
+  // Odometry or /tf; in uwscan's axes or ENU/FLU (then poses and the mount are turned).
+  NavigationInput navigation;
   // The scanner the dive was taken with, when the bag carries no dive description (its
   // scan_pattern.kind set); a bag's own description wins over nothing but this.
   std::optional<mapping::DiveLogHeader> header;

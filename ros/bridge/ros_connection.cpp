@@ -172,8 +172,9 @@ void RosConnection::SubscribeClouds(const std::string& topic, int queue,
   impl_->Subscribe<sensor_msgs::PointCloud2>(topic, queue, std::move(callback));
 }
 void RosConnection::SubscribeTransforms(
-    const std::string& topic, std::function<void(std::vector<TransformMessage>&&)> callback) {
-  impl_->Subscribe<tf2_msgs::TFMessage>(topic, 100, std::move(callback));
+    const std::string& topic, int queue,
+    std::function<void(std::vector<TransformMessage>&&)> callback) {
+  impl_->Subscribe<tf2_msgs::TFMessage>(topic, queue, std::move(callback));
 }
 
 void RosConnection::Unsubscribe() {

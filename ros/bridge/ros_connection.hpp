@@ -47,7 +47,7 @@ class RosConnection {
   void SubscribeText(const std::string& topic, std::function<void(StringMessage&&)> callback);
   void SubscribeClouds(const std::string& topic, int queue,
                        std::function<void(CloudMessage&&)> callback);
-  void SubscribeTransforms(const std::string& topic,
+  void SubscribeTransforms(const std::string& topic, int queue,
                            std::function<void(std::vector<TransformMessage>&&)> callback);
 
   // Ends every subscription; when it returns, no callback runs or will run (a callback in

@@ -24,6 +24,10 @@ struct RosTopics {
   std::string navigation_path = "/uwscan/navigation_path";  // nav_msgs/Path, map frame
   std::string truth_path = "/uwscan/truth_path";  // nav_msgs/Path, map frame (simulated dives)
   std::string pose = "/uwscan/pose";  // geometry_msgs/PoseWithCovarianceStamped, map frame
+  // Recognition's (object_messages.hpp), in the camera frame.
+  std::string objects = "/uwscan/objects";            // visualization_msgs/MarkerArray, latched
+  std::string object_poses = "/uwscan/object_poses";  // geometry_msgs/PoseWithCovarianceStamped
+  std::string grasps = "/uwscan/grasps";              // geometry_msgs/PoseArray, latched
 };
 
 struct RosFrames {

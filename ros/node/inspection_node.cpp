@@ -79,7 +79,7 @@ class SetupListener {
         }
       });
     }
-    ros.SubscribeTransforms(o.topics.tf_static, [this](std::vector<TransformMessage>&& transforms) {
+    ros.SubscribeTransforms(o.topics.tf_static, 100, [this](std::vector<TransformMessage>&& transforms) {
       std::lock_guard<std::mutex> lock(mutex_);
       for (const TransformMessage& t : transforms) statics_.Add(t);
     });
@@ -115,7 +115,8 @@ class SetupListener {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     const RosFrames& f = options_.frames;
-    setup.T_V_C = T_V_C.value_or(Eigen::Isometry3d::Identity());
+    setup.T_V_C = MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()),
+                                    options_.navigation.axes);
     setup.mount = T_V_C ? options_.topics.tf_static + " " + f.base_link + " -> " + f.camera
                         : "none on " + options_.topics.tf_static + " from " + f.base_link + " to " +
                               f.camera + ": the camera is taken at the vehicle's origin";
@@ -239,7 +240,8 @@ class Intake {
   void AddNavigation(const OdometryMessage& m) {
     if (closed_) return;
     try {
-      inspection_->AddNavigation({m.header.stamp_s - time_origin_s_, m.pose});
+      inspection_->AddNavigation({m.header.stamp_s - time_origin_s_,
+                                  VehiclePoseInUwscanAxes(m.pose, options_.navigation.axes)});
       ++navigation_;
     } catch (...) {
       closed_ = true;
@@ -269,11 +271,13 @@ Covariance6d RosCovariance(const mapping::Matrix6d& c) {
   return out;
 }
 
-CloudMessage MapMessage(const perception::PointCloud& map, const Header& header) {
+CloudMessage MapMessage(const perception::PointCloud& map, const Header& header,
+                        NavigationAxes axes) {
   CloudMessage c;
   c.header = header;
   c.points.reserve(map.size());
-  for (std::size_t i = 0; i < map.size(); ++i) c.points.push_back(map.Point(i).cast<float>());
+  for (std::size_t i = 0; i < map.size(); ++i)
+    c.points.push_back(WorldPointInNavigationAxes(map.Point(i), axes).cast<float>());
   return c;
 }
 
@@ -317,12 +321,13 @@ class Outlet {
     const int last = m.submap_count() - 1;
     if (const std::optional<mapping::Mapper::SubmapCovariances> c = m.Covariances()) {
       ros_.Publish(pose_id_,
-                   PoseMessage{Stamp(slam.back().time_s, options_.frames.map), slam.back().T_W_V,
-                               RosCovariance(c->anchors[static_cast<std::size_t>(last)])});
+                   PoseMessage{Stamp(slam.back().time_s, options_.frames.map), Out(slam.back().T_W_V),
+                               WorldCovarianceInNavigationAxes(
+                                   RosCovariance(c->anchors[static_cast<std::size_t>(last)]), axes())});
     }
     if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
       ros_.Publish(map_id_, MapMessage(m.Map(options_.inspection.map_voxel_m),
-                                       Stamp(slam.back().time_s, options_.frames.map)));
+                                       Stamp(slam.back().time_s, options_.frames.map), axes()));
       last_map_ = Clock::now();
       ++maps_;
     }
@@ -334,7 +339,8 @@ class Outlet {
     if (!sweep_points_W_.empty()) PublishSweep();
     if (r.slam.empty()) return;
     PublishTrajectory(r.slam, r.navigation);
-    ros_.Publish(map_id_, MapMessage(r.map, Stamp(r.slam.back().time_s, options_.frames.map)));
+    ros_.Publish(map_id_,
+                 MapMessage(r.map, Stamp(r.slam.back().time_s, options_.frames.map), axes()));
     ++maps_;
   }
 
@@ -352,6 +358,11 @@ class Outlet {
  private:
   Header Stamp(double time_s, const std::string& frame) const {
     return {origin_s_ + time_s, frame};
+  }
+  NavigationAxes axes() const { return options_.navigation.axes; }
+  // A vehicle pose in the navigation's own axes, as the vehicle's software reads it.
+  Eigen::Isometry3d Out(const Eigen::Isometry3d& T_W_V) const {
+    return VehiclePoseInNavigationAxes(T_W_V, axes());
   }
 
   void PublishSweep() {
@@ -373,7 +384,8 @@ class Outlet {
     const RosFrames& f = options_.frames;
     ros_.Publish(slam_path_id_, Path(slam));
     ros_.Publish(navigation_path_id_, Path(navigation));
-    const Eigen::Isometry3d T_map_odom = slam.back().T_W_V * navigation.back().T_W_V.inverse();
+    const Eigen::Isometry3d T_map_odom =
+        Out(slam.back().T_W_V) * Out(navigation.back().T_W_V).inverse();
     ros_.Publish(tf_id_, std::vector<TransformMessage>{
                              {Stamp(slam.back().time_s, f.map), f.odom, T_map_odom}});
   }
@@ -383,7 +395,7 @@ class Outlet {
     p.header = Stamp(poses.back().time_s, options_.frames.map);
     for (const mapping::TimedPose& pose : poses) {
       p.stamps_s.push_back(origin_s_ + pose.time_s);
-      p.poses.push_back(pose.T_W_V);
+      p.poses.push_back(Out(pose.T_W_V));
     }
     return p;
   }
@@ -472,8 +484,16 @@ void Subscribe(Node& node, const InspectionNodeOptions& o) {
   node.listener = std::make_unique<SetupListener>(node.ros, o, node.failure);
   node.intake = std::make_unique<Intake>(o, node.failure);
   Intake* intake = node.intake.get();
-  node.ros.SubscribeOdometry(o.topics.odometry, o.frame_queue,
-                             [intake](OdometryMessage&& m) { intake->OnOdometry(std::move(m)); });
+  if (o.navigation.source == NavigationSource::kOdometry) {
+    node.ros.SubscribeOdometry(o.topics.odometry, o.frame_queue,
+                               [intake](OdometryMessage&& m) { intake->OnOdometry(std::move(m)); });
+  } else {
+    node.ros.SubscribeTransforms(o.topics.tf, o.frame_queue,
+                                 [intake, &o](std::vector<TransformMessage>&& ts) {
+      if (std::optional<OdometryMessage> m = NavigationFromTransforms(ts, o.frames))
+        intake->OnOdometry(std::move(*m));
+    });
+  }
   if (!o.camera) {
     node.ros.SubscribeImages(o.topics.frames, o.frame_queue,
                              [intake](ImageMessage&& m) { intake->OnImage(std::move(m)); });

@@ -8,6 +8,7 @@
 
 #include "mapping/inspection/live_inspection.hpp"
 #include "ros/bridge/ros_connection.hpp"
+#include "ros/conversions/navigation_input.hpp"
 #include "ros/conversions/ros_names.hpp"
 #include "scanner/acquisition/frame_source.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
@@ -35,6 +36,9 @@ struct InspectionNodeOptions {
   std::optional<CameraInput> camera;  // std::nullopt: frames from topics.frames
   RosTopics topics;
   RosFrames frames;
+  // Odometry or /tf, in uwscan's axes or REP 103's ENU/FLU (then the mount is read in FLU and
+  // the map, paths and poses are published in ENU/FLU too).
+  NavigationInput navigation;
   std::filesystem::path log;  // dive log to create ("" = none)
   // The scanner and scan pattern when given by the user; else the dive description on
   // topics.dive (a bag uwscan wrote, played) is waited for, up to description_wait_s.

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "perception/recognition/object_pose_search.hpp"
+#include "ros/conversions/object_messages.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::ros {
@@ -17,12 +18,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& c) {
-  Eigen::Matrix3d m;
-  m << 0.0, -c.z(), c.y(), c.z(), 0.0, -c.x(), -c.y(), c.x(), 0.0;
-  return m;
 }
 
 // The newest sweep, handed from roscpp's thread to the recognising one.
@@ -69,81 +64,37 @@ perception::PointCloud ToCloud(const CloudMessage& sweep) {
   return perception::MakeCloud(points);
 }
 
-// A colour per object id, stable from run to run.
-Eigen::Vector4f Colour(const std::string& id) {
-  std::uint32_t h = 2166136261u;
-  for (char c : id) h = (h ^ static_cast<std::uint8_t>(c)) * 16777619u;
-  return {0.3F + 0.7F * static_cast<float>(h & 0xFF) / 255.0F,
-          0.3F + 0.7F * static_cast<float>((h >> 8) & 0xFF) / 255.0F,
-          0.3F + 0.7F * static_cast<float>((h >> 16) & 0xFF) / 255.0F, 1.0F};
-}
-
-// The model at its pose and a label above it.
-void AddMarkers(const perception::RecognizedObject& o, const perception::ObjectModel& model, int id,
-                const Header& header, int max_points, std::vector<MarkerMessage>& markers) {
-  MarkerMessage points;
-  points.header = header;
-  points.ns = "uwscan_models";
-  points.id = id;
-  points.kind = MarkerMessage::Kind::kPoints;
-  points.pose = o.T_S_O;
-  points.rgba = Colour(o.object_id);
-  const std::size_t stride =
-      std::max<std::size_t>(1, model.model.size() / static_cast<std::size_t>(max_points));
-  for (std::size_t i = 0; i < model.model.size(); i += stride)
-    points.points.push_back(model.model.Point(i).cast<float>());
-  markers.push_back(points);
-  MarkerMessage label;
-  label.header = header;
-  label.ns = "uwscan_labels";
-  label.id = id;
-  label.kind = MarkerMessage::Kind::kText;
-  label.pose = o.T_S_O;
-  label.pose.translation() -=
-      Eigen::Vector3d(0.0, 0.6 * model.diameter_m, 0.0);  // above it (y down)
-  char text[96];
-  std::snprintf(text, sizeof(text), "%s %.2f", o.object_id.c_str(), o.score);
-  label.text = text;
-  label.scale_m = 0.05;
-  markers.push_back(label);
-}
-
-const perception::ObjectModel* FindModel(const perception::ObjectDatabase& db,
-                                         const std::string& id) {
-  for (const perception::ObjectModel& m : db.objects) {
-    if (m.id == id) return &m;
-  }
-  return nullptr;
-}
-
 struct Publishers {
   int objects = 0, poses = 0, grasps = 0;
 };
 
+// Recognition's objects as the report's, which MakeObjectMessages takes.
+std::vector<perception::ReportedObject> Reported(const perception::RecognitionResult& result) {
+  std::vector<perception::ReportedObject> objects;
+  for (const perception::RecognizedObject& o : result.objects) {
+    perception::ReportedObject r;
+    r.id = o.object_id;
+    r.score = o.score;
+    r.T_S_O = o.T_S_O;
+    r.covariance = o.covariance;
+    r.grasps_S = o.grasps_S;
+    r.centroid_S = o.centroid_S;
+    objects.push_back(std::move(r));
+  }
+  return objects;
+}
+
 void Publish(RosConnection& ros, const Publishers& p, const perception::ObjectDatabase& db,
              const perception::RecognitionResult& result, const Header& header,
              const RecognitionNodeOptions& o, RecognitionNodeSummary& summary) {
-  std::vector<MarkerMessage> markers;
-  MarkerMessage clear;
-  clear.header = header;
-  clear.kind = MarkerMessage::Kind::kDeleteAll;
-  markers.push_back(clear);
-  PoseArrayMessage grasps;
-  grasps.header = header;
-  int id = 0;
-  for (const perception::RecognizedObject& object : result.objects) {
-    const perception::ObjectModel* model = FindModel(db, object.object_id);
-    if (model == nullptr) continue;  // "unknown"
-    ++summary.objects[object.object_id];
-    AddMarkers(object, *model, id++, header, o.model_marker_points, markers);
-    ros.Publish(p.poses,
-                PoseMessage{header, object.T_S_O,
-                            ObjectPoseCovariance(object.T_S_O, perception::Centroid(model->model),
-                                                 object.covariance)});
-    for (const auto& [name, T_S_G] : object.grasps_S) grasps.poses.push_back(T_S_G);
+  const std::vector<perception::ReportedObject> objects = Reported(result);
+  const ObjectMessages messages = MakeObjectMessages(objects, db, header, o.model_marker_points);
+  for (const perception::ReportedObject& object : objects) {
+    if (object.recognised()) ++summary.objects[object.id];
   }
-  ros.Publish(p.objects, markers);
-  ros.Publish(p.grasps, grasps);
+  for (const PoseMessage& pose : messages.poses) ros.Publish(p.poses, pose);
+  ros.Publish(p.objects, messages.markers);
+  ros.Publish(p.grasps, messages.grasps);
 }
 
 std::string StopReason(const RecognitionNodeOptions& o, RosConnection& ros, const SweepSlot& slot,
@@ -168,17 +119,6 @@ void RecognitionNodeOptions::Check() const {
   if (model_marker_points < 1) fail("model_marker_points", ">= 1");
   if (max_sweeps < 0) fail("max_sweeps", ">= 0");
   if (!(idle_stop_s >= 0.0)) fail("idle_stop_s", ">= 0 s");
-}
-
-Covariance6d ObjectPoseCovariance(const Eigen::Isometry3d& T_S_O, const Eigen::Vector3d& c,
-                                  const Eigen::Matrix<double, 6, 6>& covariance) {
-  // The object's origin moves by R (v + c x w), its orientation by R w about the scan's axes.
-  const Eigen::Matrix3d R = T_S_O.rotation();
-  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
-  J.topLeftCorner<3, 3>() = R * Skew(c);
-  J.topRightCorner<3, 3>() = R;
-  J.bottomLeftCorner<3, 3>() = R;
-  return J * covariance * J.transpose();
 }
 
 RecognitionNodeSummary RunRecognitionNode(RosConnection& ros, const perception::ObjectDatabase& db,

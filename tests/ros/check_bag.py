@@ -2,7 +2,8 @@
 """Reads a bag with ROS's own Python reader (python3-rosbag), independently of uwscan's C++ one,
 and prints one JSON line per topic: type, message count, first and last header stamp, frame ids
 seen, whether header stamps never go back, and for some types what they hold (the last path's
-positions, the last marker array's labels, every pose's position). Used by tests/cli_ros_test.cpp."""
+positions, the last marker array's labels, every pose's position, the last cloud's point
+count and the last pose array's size). Used by tests/cli_ros_test.cpp."""
 import json
 import sys
 
@@ -38,6 +39,10 @@ def main():
         if message._type == "geometry_msgs/PoseWithCovarianceStamped":
             p = message.pose.pose.position
             entry.setdefault("positions", []).append([p.x, p.y, p.z])
+        if message._type == "sensor_msgs/PointCloud2":
+            entry["last_points"] = message.width * message.height
+        if message._type == "geometry_msgs/PoseArray":
+            entry["last_poses"] = len(message.poses)
         if topic.endswith("/path") and hasattr(message, "poses"):
             entry["last_path"] = [[p.header.stamp.to_sec(), p.pose.position.x, p.pose.position.y,
                                    p.pose.position.z] for p in message.poses]

@@ -7,7 +7,7 @@
 
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
-#include "viewer/scene/json_fields.hpp"
+#include "scanner/common/json_fields.hpp"
 #include "viewer/scene/scene_files.hpp"
 
 namespace uwscan::viewer {
@@ -15,9 +15,9 @@ namespace {
 
 using nlohmann::json;
 
-using internal::Field;
-using internal::Numbers;
-using internal::Require;
+using json_fields::Field;
+using json_fields::Numbers;
+using json_fields::Require;
 
 std::vector<StampedPose> Trajectory(const json& value, const Field& field) {
   if (!value.is_array()) field.Fail("expected an array of [t tx ty tz qx qy qz qw]");
@@ -65,14 +65,14 @@ Rgb TrajectoryColour(const std::string& name, int index) {
 }  // namespace
 
 bool IsMapReport(const std::filesystem::path& path) {
-  return internal::ReportKind(path) == "map_report";
+  return json_fields::ReportKind(path) == "map_report";
 }
 
 MapReport ReadMapReport(const std::filesystem::path& path) {
   const std::string file = path.string();
-  const json j = internal::ParseJsonFile(path);
+  const json j = json_fields::ParseJsonFile(path);
   const Field root{file, ""};
-  internal::RequireFormatAndKind(j, "map_report", root);
+  json_fields::RequireFormatAndKind(j, "map_report", root);
 
   MapReport report;
   if (const auto it = j.find("log"); it != j.end() && it->is_string()) report.log = it->get<std::string>();

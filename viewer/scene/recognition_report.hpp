@@ -1,46 +1,17 @@
 #pragma once
 
-#include <Eigen/Geometry>
-#include <cstddef>
-#include <filesystem>
-#include <optional>
-#include <string>
-#include <utility>
-#include <vector>
-
 #include "mapping/reconstruction/reconstruction.hpp"
+#include "perception/recognition/recognition_report.hpp"
 #include "viewer/scene/scene.hpp"
 
-// The recognition report that `uwscan recognize --json` writes (issue 11), read for drawing.
+// Drawing the recognition report `uwscan recognize --json` writes (issue 11; read by
+// perception/recognition/recognition_report).
 namespace uwscan::viewer {
 
-struct ReportedObject {
-  std::string id;  // "unknown" when no object was verified (then no pose and no grasps)
-  double score = 0.0;
-  Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();
-  std::vector<std::pair<std::string, Eigen::Isometry3d>> grasps_S;  // name, T_S_G
-  std::vector<std::size_t> segment;                                  // indices into the scan
-  Eigen::Vector3d centroid_S = Eigen::Vector3d::Zero();
-  bool recognised() const { return id != "unknown"; }
-};
-
-struct RecognitionReport {
-  std::filesystem::path scan;      // resolved against the report's folder
-  std::filesystem::path database;  // resolved against the report's folder
-  std::size_t scan_points = 0;     // rows of the scan file, what the segments index
-  std::optional<int> scan_sweep;   // the sweep of a dive log recognised
-  std::vector<ReportedObject> objects;
-};
-
-// Reads {"uwscan_format": 1, "kind": "recognition_report", "scan", "database", "scan_points",
-// optionally "scan_sweep", "objects": [{"id", "segment", "centroid_m", and for a recognised object "score", "T_S_O":
-// {"matrix"}, "grasps": [{"name", "matrix"}]}]}. Throws uwscan::Error naming the file and the
-// field when the JSON does not parse, the format or kind differs, or a value has the wrong
-// type or count, is not finite, a pose is not rigid, or an index is beyond scan_points.
-RecognitionReport ReadRecognitionReport(const std::filesystem::path& path);
-
-// Whether a JSON file says it is a recognition report.
-bool IsRecognitionReport(const std::filesystem::path& path);
+using perception::IsRecognitionReport;
+using perception::ReadRecognitionReport;
+using perception::RecognitionReport;
+using perception::ReportedObject;
 
 // The scan (sensor frame) with each recognised segment's points carrying its object's index
 // (-1 for planes, unsegmented points and unknown segments), each recognised object's model from the database placed at

@@ -1,5 +1,5 @@
 #pragma once
-// Internal to viewer/: reading the reports uwscan writes (map and recognition reports) with
+// Reading the JSON files uwscan writes (map and recognition reports) with
 // errors that name the file and the field.
 
 #include <cstddef>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace uwscan::viewer::internal {
+namespace uwscan::json_fields {
 
 // A place in a JSON file, for errors such as "report.json: trajectories.slam[3]: ...".
 struct Field {
@@ -31,4 +31,4 @@ std::string ReportKind(const std::filesystem::path& path);
 // Fails unless the root holds "uwscan_format": 1 and "kind": `kind`.
 void RequireFormatAndKind(const nlohmann::json& root, const std::string& kind, const Field& field);
 
-}  // namespace uwscan::viewer::internal
+}  // namespace uwscan::json_fields

@@ -1,11 +1,11 @@
-#include "viewer/scene/json_fields.hpp"
+#include "scanner/common/json_fields.hpp"
 
 #include <cmath>
 #include <fstream>
 
 #include "scanner/common/error.hpp"
 
-namespace uwscan::viewer::internal {
+namespace uwscan::json_fields {
 
 using nlohmann::json;
 
@@ -54,4 +54,4 @@ void RequireFormatAndKind(const json& root, const std::string& kind, const Field
   if (!k.is_string() || k.get<std::string>() != kind) field["kind"].Fail("expected \"" + kind + "\"");
 }
 
-}  // namespace uwscan::viewer::internal
+}  // namespace uwscan::json_fields
