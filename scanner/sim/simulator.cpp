@@ -175,9 +175,13 @@ SimulatedFrame Simulator::Frame(std::int64_t index) const {
     std::mt19937_64 rng(FrameSeed(m.scene.seed ^ kPeakNoiseStream, index));
     std::normal_distribution<double> along(0.0, noise.sigma_px);
     const int along_axis = m.scene.detector.axis == StripeAxis::kRows ? 0 : 1;
+    const PinholeCamera& camera = m.source->camera().camera;
+    const double along_size_px = along_axis == 0 ? camera.width_px : camera.height_px;
     for (const TracedPeak& peak : exact) {
       Eigen::Vector2d px = peak.px;
       if (noise.on) px[along_axis] += along(rng);
+      // A crossing at the sensor's edge that the noise moved off it: no detector reports it.
+      if (px[along_axis] < -0.5 || px[along_axis] > along_size_px - 0.5) continue;
       frame.peaks_px.push_back(px);
       frame.truth_W.push_back(peak.p_W);
       frame.object_ids.push_back(peak.object_index);

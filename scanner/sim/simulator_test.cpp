@@ -227,6 +227,33 @@ TEST(Simulator, PeakNoiseIsGaussianAlongTheDetectionAxisAroundTheExactCrossing) 
   for (std::size_t k = 0; k < exact.peaks_px.size(); ++k) EXPECT_EQ(exact.peaks_px[k], exact.crossing_px[k]);
 }
 
+// Noise that moves a crossing near the sensor's edge off it drops that peak, as no detector
+// reports a peak off the sensor (the camera's profile encoding refuses one); the frame's arrays
+// stay one entry per peak.
+TEST(Simulator, PeakNoiseNeverPutsAPeakOffTheSensor) {
+  Scene scene = GalvoScene();
+  scene.effects.peak_noise.on = true;
+  scene.effects.peak_noise.sigma_px = 400.0;
+  const Simulator noisy(scene);
+  scene.effects.peak_noise.on = false;
+  const Simulator exact(scene);
+  const double width_px = noisy.scanner().camera().camera.width_px;
+  std::size_t kept = 0, crossings = 0;
+  for (std::int64_t i = 0; i < noisy.frame_count(); i += 7) {
+    const SimulatedFrame frame = noisy.Frame(i);
+    ASSERT_EQ(frame.crossing_px.size(), frame.peaks_px.size());
+    ASSERT_EQ(frame.truth_W.size(), frame.peaks_px.size());
+    for (const Eigen::Vector2d& px : frame.peaks_px) {
+      EXPECT_GE(px.x(), -0.5);
+      EXPECT_LE(px.x(), width_px - 0.5);
+    }
+    kept += frame.peaks_px.size();
+    crossings += exact.Frame(i).peaks_px.size();
+  }
+  EXPECT_GT(kept, crossings / 4);
+  EXPECT_LT(kept, crossings);
+}
+
 TEST(Simulator, EffectsThatAreOffChangeNothingWhateverTheirParameters) {
   Scene base = GalvoScene();
   base.effects.image.on = true;
