@@ -103,8 +103,7 @@ void CheckImage(const CalibrationDataset& d, const std::string& name, const std:
   }
 }
 
-// Everything LoadCalibrationDataset promises to check once the fields are read.
-void Validate(const CalibrationDataset& d, const Locator& at) {
+void CheckStepAndFiles(const CalibrationDataset& d, const Locator& at) {
   const std::vector<std::string>& steps = CalibrationSteps();
   if (std::find(steps.begin(), steps.end(), d.step) == steps.end()) {
     std::string names;
@@ -123,8 +122,10 @@ void Validate(const CalibrationDataset& d, const Locator& at) {
   if (d.truth_file && !fs::is_regular_file(*d.truth_file)) {
     at.Fail("truth", "truth file not found (looked for " + d.truth_file->string() + ")");
   }
+}
 
-  // What the step needs, and nothing another step needs.
+// Views for the steps that take views, enough planes for the others, and never both.
+void CheckViewsOrPlanes(const CalibrationDataset& d, const Locator& at) {
   if (TakesViews(d.step)) {
     if (d.views.size() < 3) {
       at.Fail("views", "a " + d.step + " dataset needs at least 3 views of the pattern, got " +
@@ -144,49 +145,72 @@ void Validate(const CalibrationDataset& d, const Locator& at) {
                             std::to_string(d.planes.size()));
     }
   }
+}
+
+// Stripes on every plane of a stripe step and dots on every plane of a dot step, and neither
+// where the step takes none.
+void CheckPlaneContents(const std::string& step, const CalibrationDataset::Plane& plane,
+                        const std::string& field, const Locator& at) {
+  if (TakesStripes(step) && plane.stripes.empty()) {
+    at.Fail(field, "a " + step + " dataset needs stripes on every plane; this one has none");
+  }
+  if (!TakesStripes(step) && !plane.stripes.empty()) {
+    at.Fail(field + ".stripes", "stripes belong to laser and laser_viewport datasets, not " + step);
+  }
+  if (TakesDots(step) && plane.dots.empty()) {
+    at.Fail(field, "a mems dataset needs laser dots on every plane; this one has none");
+  }
+  if (!TakesDots(step) && !plane.dots.empty()) {
+    at.Fail(field + ".dots", "dots belong to mems datasets, not " + step);
+  }
+}
+
+// Each mirror step once on the plane; returns the plane's steps.
+std::set<int> CheckMirrorStepsOnce(const CalibrationDataset::Plane& plane, const std::string& field,
+                                   const Locator& at) {
+  std::set<int> mirror_steps;
+  for (size_t k = 0; k < plane.stripes.size(); ++k) {
+    const int step = plane.stripes[k].second;
+    if (!mirror_steps.insert(step).second) {
+      at.Fail(Indexed(field + ".stripes", k) + ".mirror_step",
+              "mirror step " + std::to_string(step) + " appears twice on this plane");
+    }
+  }
+  return mirror_steps;
+}
+
+// Each voltage pair finite and once on the plane.
+void CheckVoltsOnce(const CalibrationDataset::Plane& plane, const std::string& field,
+                    const Locator& at) {
+  for (size_t k = 0; k < plane.dots.size(); ++k) {
+    const Eigen::Vector2d& volts = plane.dots[k].second;
+    const std::string dot = Indexed(field + ".dots", k) + ".volts";
+    if (!volts.allFinite()) at.Fail(dot, "volts must be finite numbers");
+    for (size_t j = 0; j < k; ++j) {
+      if (plane.dots[j].second == volts) {
+        at.Fail(dot, "voltage pair [" + Shortest(volts.x()) + ", " + Shortest(volts.y()) +
+                         "] appears twice on this plane (also dots[" + std::to_string(j) + "])");
+      }
+    }
+  }
+}
+
+void CheckPlanes(const CalibrationDataset& d, const Locator& at) {
   std::set<int> all_steps;
   for (size_t p = 0; p < d.planes.size(); ++p) {
     const CalibrationDataset::Plane& plane = d.planes[p];
     const std::string field = Indexed("planes", p);
-    if (TakesStripes(d.step) && plane.stripes.empty()) {
-      at.Fail(field, "a " + d.step + " dataset needs stripes on every plane; this one has none");
-    }
-    if (!TakesStripes(d.step) && !plane.stripes.empty()) {
-      at.Fail(field + ".stripes",
-              "stripes belong to laser and laser_viewport datasets, not " + d.step);
-    }
-    if (TakesDots(d.step) && plane.dots.empty()) {
-      at.Fail(field, "a mems dataset needs laser dots on every plane; this one has none");
-    }
-    if (!TakesDots(d.step) && !plane.dots.empty()) {
-      at.Fail(field + ".dots", "dots belong to mems datasets, not " + d.step);
-    }
-    std::set<int> mirror_steps;
-    for (size_t k = 0; k < plane.stripes.size(); ++k) {
-      const int step = plane.stripes[k].second;
-      if (!mirror_steps.insert(step).second) {
-        at.Fail(Indexed(field + ".stripes", k) + ".mirror_step",
-                "mirror step " + std::to_string(step) + " appears twice on this plane");
-      }
-      all_steps.insert(step);
-    }
-    for (size_t k = 0; k < plane.dots.size(); ++k) {
-      const Eigen::Vector2d& volts = plane.dots[k].second;
-      const std::string dot = Indexed(field + ".dots", k) + ".volts";
-      if (!volts.allFinite()) at.Fail(dot, "volts must be finite numbers");
-      for (size_t j = 0; j < k; ++j) {
-        if (plane.dots[j].second == volts) {
-          at.Fail(dot, "voltage pair [" + Shortest(volts.x()) + ", " + Shortest(volts.y()) +
-                           "] appears twice on this plane (also dots[" + std::to_string(j) + "])");
-        }
-      }
-    }
+    CheckPlaneContents(d.step, plane, field, at);
+    all_steps.merge(CheckMirrorStepsOnce(plane, field, at));
+    CheckVoltsOnce(plane, field, at);
   }
   if (TakesStripes(d.step) && all_steps.size() < 2) {
     at.Fail("planes", "a " + d.step + " dataset needs at least 2 distinct mirror steps");
   }
+}
 
-  // Every image: named once, present, PNG, greyscale, of image_size.
+// Every image: named once, present, PNG, greyscale, of image_size.
+void CheckImages(const CalibrationDataset& d, const Locator& at) {
   std::map<std::string, std::string> seen;
   auto image = [&](const std::string& name, const std::string& field) {
     const auto [it, added] = seen.emplace(name, field);
@@ -204,6 +228,14 @@ void Validate(const CalibrationDataset& d, const Locator& at) {
       image(d.planes[p].dots[k].first, Indexed(field + ".dots", k) + ".image");
     }
   }
+}
+
+// Everything LoadCalibrationDataset promises to check once the fields are read.
+void Validate(const CalibrationDataset& d, const Locator& at) {
+  CheckStepAndFiles(d, at);
+  CheckViewsOrPlanes(d, at);  // what the step needs, and nothing another step needs
+  CheckPlanes(d, at);
+  CheckImages(d, at);
 }
 
 // --- reading ----------------------------------------------------------------------------------

@@ -40,7 +40,8 @@ void ReadInitialScanner(const Context& where, const YAML::Node& node, const fs::
         // Fitted projection functions are not a section of the file: the truth gives none.
         const bool fitted_functions = section == "projection_functions" &&
                                       !cs->scene.scanner.model.mems().functions_from_file;
-        if (std::find(sections.begin(), sections.end(), section) == sections.end() || fitted_functions) {
+        if (std::find(sections.begin(), sections.end(), section) == sections.end() ||
+            fitted_functions) {
           yaml::Fail(Item(at, i), list[i],
                      "expected a top-level section of the true scanner file " +
                          cs->scene.scanner.file.string() + ", got '" + section + "'");
@@ -69,42 +70,59 @@ TargetRenderOptions ReadRender(const Context& where, const YAML::Node& node, boo
   return r;
 }
 
-void ReadSection(const Context& where, const YAML::Node& node, const fs::path& base_dir,
-                 CalibrationScene* cs) {
-  yaml::RequireKnownKeys(where, node,
-                         {"step", "pattern", "board_size_m", "board_reflectance", "initial_scanner",
-                          "views", "planes", "distance_m", "max_tilt_rad", "max_roll_rad",
-                          "mirror_steps", "volts_grid", "volts_fraction", "image_scale", "render"});
-  cs->step = String(where, node, "step");
+// One of CalibrationSteps().
+std::string ReadStep(const Context& where, const YAML::Node& node) {
+  std::string step = String(where, node, "step");
   const std::vector<std::string>& steps = CalibrationSteps();
-  if (std::find(steps.begin(), steps.end(), cs->step) == steps.end()) {
+  if (std::find(steps.begin(), steps.end(), step) == steps.end()) {
     std::string names;
     for (const std::string& s : steps) names += (names.empty() ? "" : ", ") + s;
-    FailField(where, node, "step", "got '" + cs->step + "', expected one of " + names);
+    FailField(where, node, "step", "got '" + step + "', expected one of " + names);
   }
-  const bool views = cs->step == "intrinsics" || cs->step == "viewport";
-  const bool stripes = cs->step == "laser" || cs->step == "laser_viewport";
-  const bool dots = cs->step == "mems";
-  // A field the step ignores is most likely a mistake (copied from another step's scene).
+  return step;
+}
+
+// What a step's images are: pattern views, laser stripes on planes, or laser dots on planes.
+struct StepKind {
+  bool views = false;
+  bool stripes = false;
+  bool dots = false;
+};
+
+StepKind KindOf(const std::string& step) {
+  return StepKind{step == "intrinsics" || step == "viewport",
+                  step == "laser" || step == "laser_viewport", step == "mems"};
+}
+
+// A field the step ignores is most likely a mistake (copied from another step's scene).
+void RejectOtherStepsFields(const Context& where, const YAML::Node& node, const std::string& step,
+                            const StepKind& kind) {
   auto only = [&](const char* key, bool used, const char* which) {
     if (Has(node, key) && !used) {
       FailField(where, node, key,
-                std::string("not used by a ") + cs->step + " step (only " + which + ")");
+                std::string("not used by a ") + step + " step (only " + which + ")");
     }
   };
-  only("views", views, "intrinsics and viewport");
-  only("planes", !views, "laser, laser_viewport and mems");
-  only("mirror_steps", stripes, "laser and laser_viewport");
-  only("volts_grid", dots, "mems");
-  only("volts_fraction", dots, "mems");
-  const bool mems_scanner = cs->scene.scanner.model.kind() == ScannerKind::kMems;
-  if ((stripes && mems_scanner) || (dots && !mems_scanner)) {
+  only("views", kind.views, "intrinsics and viewport");
+  only("planes", !kind.views, "laser, laser_viewport and mems");
+  only("mirror_steps", kind.stripes, "laser and laser_viewport");
+  only("volts_grid", kind.dots, "mems");
+  only("volts_fraction", kind.dots, "mems");
+}
+
+// Stripes need a galvanometer scanner, dots a MEMS one.
+void CheckScannerFitsStep(const Context& where, const YAML::Node& node, const CalibrationScene& cs,
+                          const StepKind& kind) {
+  const bool mems_scanner = cs.scene.scanner.model.kind() == ScannerKind::kMems;
+  if ((kind.stripes && mems_scanner) || (kind.dots && !mems_scanner)) {
     FailField(where, node, "step",
-              "a " + cs->step + " step needs a " + (stripes ? "galvanometer" : "MEMS") +
-                  " scanner; " + cs->scene.scanner.file.string() + " is a " +
+              "a " + cs.step + " step needs a " + (kind.stripes ? "galvanometer" : "MEMS") +
+                  " scanner; " + cs.scene.scanner.file.string() + " is a " +
                   (mems_scanner ? "MEMS" : "galvanometer") + " scanner");
   }
+}
 
+void ReadBoard(const Context& where, const YAML::Node& node, CalibrationScene* cs) {
   cs->pattern = ReadPattern(yaml::Enter(where, "pattern"), yaml::Child(where, node, "pattern"));
   if (Has(node, "board_size_m")) {
     cs->board_size_m = Pair(where, node, "board_size_m");
@@ -113,10 +131,10 @@ void ReadSection(const Context& where, const YAML::Node& node, const fs::path& b
   }
   cs->board_reflectance =
       Number(where, node, "board_reflectance", Range::kFraction, cs->board_reflectance);
-  if (Has(node, "initial_scanner")) {
-    ReadInitialScanner(yaml::Enter(where, "initial_scanner"), node["initial_scanner"], base_dir,
-                       cs);
-  }
+}
+
+// How many board poses, and how they are drawn: depth, tilt, roll.
+void ReadPoses(const Context& where, const YAML::Node& node, CalibrationScene* cs) {
   cs->views = Integer(where, node, "views", 3, cs->views);
   cs->planes = Integer(where, node, "planes", 2, cs->planes);
   if (Has(node, "distance_m")) {
@@ -129,47 +147,71 @@ void ReadSection(const Context& where, const YAML::Node& node, const fs::path& b
   if (cs->max_tilt_rad > 1.3) FailField(where, node, "max_tilt_rad", "expected <= 1.3 rad");
   cs->max_roll_rad = Number(where, node, "max_roll_rad", Range::kNonNegative, cs->max_roll_rad);
   if (cs->max_roll_rad > M_PI) FailField(where, node, "max_roll_rad", "expected <= pi rad");
+}
+
+// Distinct integer steps within the laser's range, at least 2.
+std::vector<int> ReadMirrorSteps(const Context& where, const YAML::Node& node,
+                                 const GalvoLaser& laser) {
+  const Context at = yaml::Enter(where, "mirror_steps");
+  const YAML::Node list = yaml::Child(where, node, "mirror_steps");
+  if (!list.IsSequence()) yaml::Fail(at, list, "expected a list of mirror steps");
+  std::vector<int> mirror_steps;
+  std::set<int> seen;
+  for (size_t i = 0; i < list.size(); ++i) {
+    int step = 0;
+    if (!list[i].IsScalar() || !YAML::convert<int>::decode(list[i], step)) {
+      yaml::Fail(Item(at, i), list[i], "expected an integer mirror step");
+    }
+    if (step < laser.step_min || step > laser.step_max) {
+      yaml::Fail(Item(at, i), list[i],
+                 "mirror step " + std::to_string(step) + " outside the laser's range [" +
+                     std::to_string(laser.step_min) + ", " + std::to_string(laser.step_max) + "]");
+    }
+    if (!seen.insert(step).second) {
+      yaml::Fail(Item(at, i), list[i], "mirror step " + std::to_string(step) + " given twice");
+    }
+    mirror_steps.push_back(step);
+  }
+  if (mirror_steps.size() < 2) yaml::Fail(at, list, "expected at least 2 mirror steps");
+  return mirror_steps;
+}
+
+void ReadVoltsGrid(const Context& where, const YAML::Node& node, CalibrationScene* cs) {
+  if (Has(node, "volts_grid")) {
+    const Eigen::VectorXd grid = yaml::Vector(where, node, "volts_grid", 2);
+    if (grid[0] < 1 || grid[1] < 1 || grid[0] != std::floor(grid[0]) ||
+        grid[1] != std::floor(grid[1]) || grid[0] * grid[1] > 100000) {
+      FailField(where, node, "volts_grid", "expected [a, b], whole numbers >= 1");
+    }
+    cs->volts_grid = Eigen::Vector2i(static_cast<int>(grid[0]), static_cast<int>(grid[1]));
+  }
+  cs->volts_fraction = Number(where, node, "volts_fraction", Range::kFraction, cs->volts_fraction);
+}
+
+void ReadSection(const Context& where, const YAML::Node& node, const fs::path& base_dir,
+                 CalibrationScene* cs) {
+  yaml::RequireKnownKeys(where, node,
+                         {"step", "pattern", "board_size_m", "board_reflectance", "initial_scanner",
+                          "views", "planes", "distance_m", "max_tilt_rad", "max_roll_rad",
+                          "mirror_steps", "volts_grid", "volts_fraction", "image_scale", "render"});
+  cs->step = ReadStep(where, node);
+  const StepKind kind = KindOf(cs->step);
+  RejectOtherStepsFields(where, node, cs->step, kind);
+  CheckScannerFitsStep(where, node, *cs, kind);
+  ReadBoard(where, node, cs);
+  if (Has(node, "initial_scanner")) {
+    ReadInitialScanner(yaml::Enter(where, "initial_scanner"), node["initial_scanner"], base_dir,
+                       cs);
+  }
+  ReadPoses(where, node, cs);
   cs->image_scale = Number(where, node, "image_scale", Range::kFraction, cs->image_scale);
   cs->render = ReadRender(yaml::Enter(where, "render"),
                           Has(node, "render") ? node["render"] : YAML::Node(YAML::NodeType::Map),
                           cs->scene.effects.image.format == PixelFormat::kMono16);
-
-  if (stripes) {
-    const Context at = yaml::Enter(where, "mirror_steps");
-    const YAML::Node list = yaml::Child(where, node, "mirror_steps");
-    const GalvoLaser& laser = cs->scene.scanner.model.galvo().laser;
-    if (!list.IsSequence()) yaml::Fail(at, list, "expected a list of mirror steps");
-    std::set<int> seen;
-    for (size_t i = 0; i < list.size(); ++i) {
-      int step = 0;
-      if (!list[i].IsScalar() || !YAML::convert<int>::decode(list[i], step)) {
-        yaml::Fail(Item(at, i), list[i], "expected an integer mirror step");
-      }
-      if (step < laser.step_min || step > laser.step_max) {
-        yaml::Fail(Item(at, i), list[i],
-                   "mirror step " + std::to_string(step) + " outside the laser's range [" +
-                       std::to_string(laser.step_min) + ", " + std::to_string(laser.step_max) +
-                       "]");
-      }
-      if (!seen.insert(step).second) {
-        yaml::Fail(Item(at, i), list[i], "mirror step " + std::to_string(step) + " given twice");
-      }
-      cs->mirror_steps.push_back(step);
-    }
-    if (cs->mirror_steps.size() < 2) yaml::Fail(at, list, "expected at least 2 mirror steps");
+  if (kind.stripes) {
+    cs->mirror_steps = ReadMirrorSteps(where, node, cs->scene.scanner.model.galvo().laser);
   }
-  if (dots) {
-    if (Has(node, "volts_grid")) {
-      const Eigen::VectorXd grid = yaml::Vector(where, node, "volts_grid", 2);
-      if (grid[0] < 1 || grid[1] < 1 || grid[0] != std::floor(grid[0]) ||
-          grid[1] != std::floor(grid[1]) || grid[0] * grid[1] > 100000) {
-        FailField(where, node, "volts_grid", "expected [a, b], whole numbers >= 1");
-      }
-      cs->volts_grid = Eigen::Vector2i(static_cast<int>(grid[0]), static_cast<int>(grid[1]));
-    }
-    cs->volts_fraction =
-        Number(where, node, "volts_fraction", Range::kFraction, cs->volts_fraction);
-  }
+  if (kind.dots) ReadVoltsGrid(where, node, cs);
 }
 
 }  // namespace

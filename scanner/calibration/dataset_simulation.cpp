@@ -63,20 +63,21 @@ void ScaleCamera(double scale, Scanner* scanner) {
 // would have calibrated taken from the true scanner, and the camera scaled like the truth's.
 std::string InitialScannerText(const CalibrationScene& cs) {
   Scanner initial = LoadScanner(*cs.initial_scanner);
-  std::string comment = "Initial scanner for a " + cs.step + " calibration: " +
-                        cs.initial_scanner->filename().string();
+  std::string comment = "Initial scanner for a " + cs.step +
+                        " calibration: " + cs.initial_scanner->filename().string();
   if (!cs.initial_true_sections.empty()) {
     std::string names;
     for (const std::string& section : cs.initial_true_sections) {
       try {
         CopySection(cs.scene.scanner.model, section, &initial);
       } catch (const Error& e) {
-        throw Error(cs.initial_scanner->string() + ": true section from " + cs.scene.scanner.file.string() +
-                    ": " + e.what());
+        throw Error(cs.initial_scanner->string() + ": true section from " +
+                    cs.scene.scanner.file.string() + ": " + e.what());
       }
       names += (names.empty() ? "" : ", ") + section;
     }
-    comment += " with " + names + " from the true scanner " + cs.scene.scanner.file.filename().string();
+    comment +=
+        " with " + names + " from the true scanner " + cs.scene.scanner.file.filename().string();
   }
   if (cs.image_scale != 1.0) {
     ScaleCamera(cs.image_scale, &initial);
@@ -321,11 +322,8 @@ Eigen::Isometry3d DrawPose(const Setup& s, std::mt19937_64& rng, bool plane) {
               (s.galvo ? "mirror_steps" : "image_scale"));
 }
 
-}  // namespace
-
-void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_folder,
-                                const std::function<void(double)>& progress) {
-  cs.Check();
+// The scene with its camera scaled, and the effective scanner the images are made from.
+Setup MakeSetup(const CalibrationScene& cs) {
   Setup s{cs, {}, {}, {}, {}, BoardOf(cs.pattern, cs.board_size_m), cs.scene};
   if (cs.image_scale != 1.0) ScaleCamera(cs.image_scale, &s.scene.scanner.model);
   s.truth = sim::EffectiveScanner(s.scene);
@@ -335,28 +333,165 @@ void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_
   } else {
     s.mems = s.truth.mems();
   }
-  PrepareFolder(out_folder);
+  return s;
+}
 
-  const bool views = cs.step == "intrinsics" || cs.step == "viewport";
-  const int poses = views ? cs.views : cs.planes;
+// Images the dataset holds at most: one pattern image per pose and, per plane, one per mirror
+// step or voltage pair. The fraction of them written is the progress.
+double ImageCount(const Setup& s, int poses, bool views) {
   const int per_pose = views     ? 1
-                       : s.galvo ? 1 + static_cast<int>(cs.mirror_steps.size())
-                                 : 1 + cs.volts_grid.prod();
-  const double total = static_cast<double>(poses) * per_pose;
-  int written = 0;
-  std::mutex progress_mutex;
-  auto done = [&](int images) {
-    const std::lock_guard<std::mutex> lock(progress_mutex);
-    written += images;
-    if (progress) progress(std::min(1.0, written / total));
-  };
+                       : s.galvo ? 1 + static_cast<int>(s.cs.mirror_steps.size())
+                                 : 1 + s.cs.volts_grid.prod();
+  return static_cast<double>(poses) * per_pose;
+}
 
+// Counts the images written and reports the fraction done, one call at a time (the images are
+// written by OpenMP worker threads).
+class ProgressCounter {
+ public:
+  ProgressCounter(const std::function<void(double)>& progress, double total)
+      : progress_(progress), total_(total) {}
+
+  void Add(int images) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    written_ += images;
+    if (progress_) progress_(std::min(1.0, written_ / total_));
+  }
+
+ private:
+  const std::function<void(double)>& progress_;
+  const double total_;
+  int written_ = 0;
+  std::mutex mutex_;
+};
+
+// The manifest's fields known before any image: folder, step, pattern, image size.
+CalibrationDataset DatasetHeader(const Setup& s, const fs::path& out_folder) {
   CalibrationDataset dataset;
   dataset.folder = out_folder;
-  dataset.step = cs.step;
-  dataset.pattern = cs.pattern;
+  dataset.step = s.cs.step;
+  dataset.pattern = s.cs.pattern;
   dataset.width_px = s.camera.camera.width_px;
   dataset.height_px = s.camera.camera.height_px;
+  return dataset;
+}
+
+// Pose p's pattern image (lights on, laser off); returns its file name.
+std::string WritePatternImage(const Setup& s, const TargetRenderer& renderer,
+                              TargetRenderOptions render, const Eigen::Isometry3d& T_C_O, int p,
+                              bool views, const fs::path& out_folder) {
+  render.seed = Seed(s.cs.scene.seed, 1, static_cast<std::uint64_t>(p));
+  const StripeFrame pattern = renderer.Render(s.cs.pattern, T_C_O, render);
+  const std::string name = Name(views ? "view_%03d.png" : "plane_%02d.png", p);
+  WriteImage(out_folder / name, pattern);
+  return name;
+}
+
+// The board as the simulator's only object: a plane of the board's size and reflectance.
+sim::SceneObject BoardObject(const Setup& s, const Eigen::Isometry3d& T_C_O) {
+  sim::SceneObject board;
+  board.name = "board";
+  board.shape = sim::ObjectShape::kPlane;
+  board.mesh = sim::MakeRectangle(s.board.size_m.x(), s.board.size_m.y());
+  board.T_W_O = T_C_O * Eigen::Translation3d(s.board.centre_O.x(), s.board.centre_O.y(), 0.0);
+  board.reflectance = s.cs.board_reflectance;
+  return board;
+}
+
+// The scene the simulator renders pose p's stripes in: the board alone, the lights off, one
+// sweep over the imaged mirror steps (frame k is step step_min + k).
+sim::Scene StripeScene(const Setup& s, const Eigen::Isometry3d& T_C_O, int p) {
+  const CalibrationScene& cs = s.cs;
+  sim::Scene lit = s.scene;
+  lit.objects = {BoardObject(s, T_C_O)};
+  lit.scanner.galvo.step_min = *std::min_element(cs.mirror_steps.begin(), cs.mirror_steps.end());
+  lit.scanner.galvo.step_max = *std::max_element(cs.mirror_steps.begin(), cs.mirror_steps.end());
+  lit.scanner.galvo.step_stride = 1;
+  lit.scanner.sweeps = 1;
+  if (!lit.effects.AnyImageStage()) lit.effects.image.on = true;
+  lit.seed = Seed(cs.scene.seed, 2, static_cast<std::uint64_t>(p));
+  return lit;
+}
+
+// Pose p's stripe images, one per mirror step; returns the manifest's (image, step) list.
+std::vector<std::pair<std::string, int>> WriteStripeImages(const Setup& s,
+                                                           const Eigen::Isometry3d& T_C_O, int p,
+                                                           const fs::path& out_folder,
+                                                           ProgressCounter& done) {
+  const std::vector<int>& steps = s.cs.mirror_steps;
+  const sim::Scene lit = StripeScene(s, T_C_O, p);
+  const int step_min = lit.scanner.galvo.step_min;
+  const sim::Simulator simulator(lit);
+  RunParallelTasks(std::ssize(steps), 0, [&](std::ptrdiff_t k) {
+    const int step = steps[static_cast<size_t>(k)];
+    const sim::SimulatedFrame frame = simulator.Frame(step - step_min);
+    WriteImage(out_folder / StripeImageName(p, step), *frame.image);
+    done.Add(1);
+  });
+  std::vector<std::pair<std::string, int>> stripes;
+  for (const int step : steps) stripes.emplace_back(StripeImageName(p, step), step);
+  return stripes;
+}
+
+// Lights off: the ambient level and read noise of the scene's image stages.
+TargetRenderOptions DarkImage(const sim::SimulationEffects& effects) {
+  TargetRenderOptions dark;
+  dark.format = effects.image.format;
+  dark.black_level = effects.ambient.on ? effects.ambient.level : 0.0;
+  dark.white_level = MaxPixelValue(dark.format);
+  dark.noise_sigma = effects.sensor_noise.on ? effects.sensor_noise.read_sigma : 0.0;
+  return dark;
+}
+
+// Pose p's dot images, one per voltage pair whose dot lands on the board and in the image;
+// returns the manifest's (image, volts) list.
+std::vector<std::pair<std::string, Eigen::Vector2d>> WriteDotImages(const Setup& s,
+                                                                    const Eigen::Isometry3d& T_C_O,
+                                                                    int p,
+                                                                    const fs::path& out_folder,
+                                                                    ProgressCounter& done) {
+  const TargetRenderOptions dark = DarkImage(s.scene.effects);
+  const std::vector<Dot> dots = DotsOnBoard(s, T_C_O);
+  RunParallelTasks(std::ssize(dots), 0, [&](std::ptrdiff_t k) {
+    const Dot& dot = dots[static_cast<size_t>(k)];
+    TargetRenderOptions options = dark;
+    options.seed = Seed(s.cs.scene.seed, 3, static_cast<std::uint64_t>(p) * 1000003u + dot.index);
+    const StripeFrame image = RenderDot(s.camera.camera.width_px, s.camera.camera.height_px, dot.px,
+                                        dot.sigma_px, dot.amplitude, options);
+    WriteImage(out_folder / Name("plane_%02d_dot_%03d.png", p, dot.index), image);
+    done.Add(1);
+  });
+  // Voltage pairs whose dot missed the board or the image count as done, unwritten.
+  done.Add(s.cs.volts_grid.prod() - static_cast<int>(dots.size()));
+  std::vector<std::pair<std::string, Eigen::Vector2d>> named;
+  for (const Dot& dot : dots) {
+    named.emplace_back(Name("plane_%02d_dot_%03d.png", p, dot.index), dot.volts);
+  }
+  return named;
+}
+
+// initial_scanner.yaml when the scene names an initial scanner; returns its path.
+std::optional<fs::path> WriteInitialScanner(const CalibrationScene& cs,
+                                            const fs::path& out_folder) {
+  if (!cs.initial_scanner) return std::nullopt;
+  const fs::path initial = out_folder / "initial_scanner.yaml";
+  std::ofstream out(initial);
+  out << InitialScannerText(cs);
+  if (!out) throw Error(initial.string() + ": cannot write");
+  return initial;
+}
+
+}  // namespace
+
+void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_folder,
+                                const std::function<void(double)>& progress) {
+  cs.Check();
+  const Setup s = MakeSetup(cs);
+  PrepareFolder(out_folder);
+  const bool views = cs.step == "intrinsics" || cs.step == "viewport";
+  const int poses = views ? cs.views : cs.planes;
+  ProgressCounter done(progress, ImageCount(s, poses, views));
+  CalibrationDataset dataset = DatasetHeader(s, out_folder);
   DatasetTruth truth;
   truth.scanner = s.truth;
   const TargetRenderer renderer(s.camera);
@@ -366,11 +501,8 @@ void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_
 
   for (int p = 0; p < poses; ++p) {
     const Eigen::Isometry3d T_C_O = DrawPose(s, rng, !views);
-    render.seed = Seed(cs.scene.seed, 1, static_cast<std::uint64_t>(p));
-    const StripeFrame pattern = renderer.Render(cs.pattern, T_C_O, render);
-    const std::string name = Name(views ? "view_%03d.png" : "plane_%02d.png", p);
-    WriteImage(out_folder / name, pattern);
-    done(1);
+    const std::string name = WritePatternImage(s, renderer, render, T_C_O, p, views, out_folder);
+    done.Add(1);
     if (views) {
       dataset.views.push_back(name);
       truth.T_C_O_views.push_back(T_C_O);
@@ -380,66 +512,14 @@ void SimulateCalibrationDataset(const CalibrationScene& cs, const fs::path& out_
     plane.pattern_image = name;
     truth.T_C_O_planes.push_back(T_C_O);
     if (s.galvo) {
-      // The simulator renders each mirror step's stripe on the board with the lights off.
-      sim::Scene lit = s.scene;
-      sim::SceneObject board;
-      board.name = "board";
-      board.shape = sim::ObjectShape::kPlane;
-      board.mesh = sim::MakeRectangle(s.board.size_m.x(), s.board.size_m.y());
-      board.T_W_O = T_C_O * Eigen::Translation3d(s.board.centre_O.x(), s.board.centre_O.y(), 0.0);
-      board.reflectance = cs.board_reflectance;
-      lit.objects = {board};
-      const int step_min = *std::min_element(cs.mirror_steps.begin(), cs.mirror_steps.end());
-      lit.scanner.galvo.step_min = step_min;
-      lit.scanner.galvo.step_max =
-          *std::max_element(cs.mirror_steps.begin(), cs.mirror_steps.end());
-      lit.scanner.galvo.step_stride = 1;
-      lit.scanner.sweeps = 1;
-      if (!lit.effects.AnyImageStage()) lit.effects.image.on = true;
-      lit.seed = Seed(cs.scene.seed, 2, static_cast<std::uint64_t>(p));
-      const sim::Simulator simulator(lit);
-      RunParallelTasks(std::ssize(cs.mirror_steps), 0, [&](std::ptrdiff_t k) {
-        const int step = cs.mirror_steps[static_cast<size_t>(k)];
-        const sim::SimulatedFrame frame = simulator.Frame(step - step_min);
-        WriteImage(out_folder / StripeImageName(p, step), *frame.image);
-        done(1);
-      });
-      for (const int step : cs.mirror_steps)
-        plane.stripes.emplace_back(StripeImageName(p, step), step);
+      plane.stripes = WriteStripeImages(s, T_C_O, p, out_folder, done);
     } else {
-      // Lights off: the ambient level and read noise of the scene's image stages.
-      const sim::SimulationEffects& effects = s.scene.effects;
-      TargetRenderOptions dark;
-      dark.format = effects.image.format;
-      dark.black_level = effects.ambient.on ? effects.ambient.level : 0.0;
-      dark.white_level = MaxPixelValue(dark.format);
-      dark.noise_sigma = effects.sensor_noise.on ? effects.sensor_noise.read_sigma : 0.0;
-      const std::vector<Dot> dots = DotsOnBoard(s, T_C_O);
-      RunParallelTasks(std::ssize(dots), 0, [&](std::ptrdiff_t k) {
-        const Dot& dot = dots[static_cast<size_t>(k)];
-        TargetRenderOptions options = dark;
-        options.seed = Seed(cs.scene.seed, 3, static_cast<std::uint64_t>(p) * 1000003u + dot.index);
-        const StripeFrame image = RenderDot(s.camera.camera.width_px, s.camera.camera.height_px,
-                                            dot.px, dot.sigma_px, dot.amplitude, options);
-        WriteImage(out_folder / Name("plane_%02d_dot_%03d.png", p, dot.index), image);
-        done(1);
-      });
-      // Voltage pairs whose dot missed the board or the image count as done, unwritten.
-      done(cs.volts_grid.prod() - static_cast<int>(dots.size()));
-      for (const Dot& dot : dots) {
-        plane.dots.emplace_back(Name("plane_%02d_dot_%03d.png", p, dot.index), dot.volts);
-      }
+      plane.dots = WriteDotImages(s, T_C_O, p, out_folder, done);
     }
     dataset.planes.push_back(std::move(plane));
   }
 
-  if (cs.initial_scanner) {
-    const fs::path initial = out_folder / "initial_scanner.yaml";
-    std::ofstream out(initial);
-    out << InitialScannerText(cs);
-    if (!out) throw Error(initial.string() + ": cannot write");
-    dataset.scanner_file = initial;
-  }
+  dataset.scanner_file = WriteInitialScanner(cs, out_folder);
   dataset.water_refractive_index = cs.scene.water.refractive_index;
   dataset.truth_file = out_folder / "truth.yaml";
   WriteDatasetTruth(*dataset.truth_file, truth);

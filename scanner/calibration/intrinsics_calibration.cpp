@@ -115,6 +115,141 @@ double RmsOfLeftOutView(const CvView& view, const cv::Mat& K, const cv::Mat& D) 
   }
 }
 
+// Every view in OpenCV's form, and which of them can be used.
+struct CvViews {
+  std::vector<CvView> views;  // in view order
+  std::vector<int> usable;    // indices into views, ascending
+  int unusable = 0;
+};
+
+CvViews ToCvViews(const PatternSpec& spec, const std::vector<PatternObservation>& observations) {
+  const int m = static_cast<int>(observations.size());
+  CvViews cv_views;
+  cv_views.views.resize(observations.size());
+  for (int i = 0; i < m; ++i) {
+    const CornerCorrespondences corners =
+        MatchCorners(spec, observations[static_cast<std::size_t>(i)], i);
+    CvView& view = cv_views.views[static_cast<std::size_t>(i)];
+    for (std::size_t j = 0; j < corners.points_O.size(); ++j) {
+      const Eigen::Vector3d& p = corners.points_O[j];
+      view.object.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                               static_cast<float>(p.z()));
+      view.image.emplace_back(static_cast<float>(corners.pixels[j].x()),
+                              static_cast<float>(corners.pixels[j].y()));
+    }
+    if (Usable(corners)) {
+      cv_views.usable.push_back(i);
+    } else {
+      ++cv_views.unusable;
+    }
+  }
+  return cv_views;
+}
+
+// The final calibration and the views it was made from.
+struct Selection {
+  CvCalibration calibration;
+  std::vector<int> active;     // views calibrated from, ascending
+  std::vector<bool> rejected;  // per view: rejected for its rms (not merely unusable)
+};
+
+// Index into `active` of the view with the largest rms (the first such).
+int WorstView(const CvCalibration& calibration, int active) {
+  int worst = 0;
+  for (int k = 1; k < active; ++k) {
+    if (calibration.per_view_rms.at<double>(k) > calibration.per_view_rms.at<double>(worst)) {
+      worst = k;
+    }
+  }
+  return worst;
+}
+
+// Calibrates from the usable views, then drops the worst view while its rms is above the limit
+// and calibrates again (see the header). Throws when fewer than min_views remain.
+Selection CalibrateRejectingWorst(const CvViews& views, cv::Size size,
+                                  const IntrinsicsOptions& options) {
+  Selection fit;
+  fit.active = views.usable;
+  fit.rejected.assign(views.views.size(), false);
+  int rejected_count = 0;
+  for (;;) {
+    if (static_cast<int>(fit.active.size()) < options.min_views) {
+      std::ostringstream message;
+      message << "CalibrateIntrinsics: " << fit.active.size() << " of " << views.views.size()
+              << " views usable, need " << options.min_views << " (" << views.unusable
+              << " with fewer than " << kMinCornersPerView << " corners or all on one line, "
+              << rejected_count << " rejected with an rms above " << options.reject_view_rms_px
+              << " px)";
+      throw Error(message.str());
+    }
+    fit.calibration = Calibrate(views.views, fit.active, size, options.fix_k3);
+    const int worst = WorstView(fit.calibration, static_cast<int>(fit.active.size()));
+    if (!(fit.calibration.per_view_rms.at<double>(worst) > options.reject_view_rms_px)) break;
+    fit.rejected[static_cast<std::size_t>(fit.active[static_cast<std::size_t>(worst)])] = true;
+    ++rejected_count;
+    fit.active.erase(fit.active.begin() + worst);
+  }
+  return fit;
+}
+
+// The camera OpenCV's K and distortion describe; throws when it is not usable.
+PinholeCamera CameraOf(const CvCalibration& calibration, int width_px, int height_px) {
+  const cv::Mat& K = calibration.K;
+  const cv::Mat& D = calibration.D;
+  PinholeCamera camera;
+  camera.width_px = width_px;
+  camera.height_px = height_px;
+  camera.fx_px = K.at<double>(0, 0);
+  camera.fy_px = K.at<double>(1, 1);
+  camera.cx_px = K.at<double>(0, 2);
+  camera.cy_px = K.at<double>(1, 2);
+  const auto coefficient = [&D](int k) {
+    return k < static_cast<int>(D.total()) ? D.at<double>(k) : 0.0;
+  };
+  camera.k1 = coefficient(0);
+  camera.k2 = coefficient(1);
+  camera.p1 = coefficient(2);
+  camera.p2 = coefficient(3);
+  camera.k3 = coefficient(4);
+  try {
+    camera.Check();
+  } catch (const Error& e) {
+    throw Error(std::string("CalibrateIntrinsics: the calibration is not usable: ") + e.what());
+  }
+  return camera;
+}
+
+// Every view's residual: the calibration's own for the views it used, a PnP pose's with the
+// final intrinsics for the rejected ones, NaN for the unusable ones.
+std::vector<ViewResidual> ViewResiduals(const std::vector<PatternObservation>& observations,
+                                        const std::vector<CvView>& views, const Selection& fit) {
+  std::vector<ViewResidual> residuals(observations.size());
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    ViewResidual& view = residuals[i];
+    view.image = observations[i].image;
+    view.rejected = true;
+    view.rms_px = std::numeric_limits<double>::quiet_NaN();
+    if (fit.rejected[i])
+      view.rms_px = RmsOfLeftOutView(views[i], fit.calibration.K, fit.calibration.D);
+  }
+  for (std::size_t k = 0; k < fit.active.size(); ++k) {
+    ViewResidual& view = residuals[static_cast<std::size_t>(fit.active[k])];
+    view.rejected = false;
+    view.rms_px = fit.calibration.per_view_rms.at<double>(static_cast<int>(k));
+  }
+  return residuals;
+}
+
+// Every view's pattern pose from the calibration; identity for the views it did not use.
+std::vector<Eigen::Isometry3d> ViewPoses(std::size_t view_count, const Selection& fit) {
+  std::vector<Eigen::Isometry3d> T_C_O(view_count, Eigen::Isometry3d::Identity());
+  for (std::size_t k = 0; k < fit.active.size(); ++k) {
+    T_C_O[static_cast<std::size_t>(fit.active[k])] =
+        ToIsometry(fit.calibration.rvecs[k], fit.calibration.tvecs[k]);
+  }
+  return T_C_O;
+}
+
 }  // namespace
 
 void IntrinsicsOptions::Check() const {
@@ -142,103 +277,21 @@ IntrinsicsResult CalibrateIntrinsics(const PatternSpec& spec,
     throw Error("CalibrateIntrinsics: image size must be positive, got " +
                 std::to_string(width_px) + " x " + std::to_string(height_px) + " px");
   }
-  const int m = static_cast<int>(observations.size());
-  std::vector<CvView> views(observations.size());
-  std::vector<int> active;
-  int unusable = 0;
-  for (int i = 0; i < m; ++i) {
-    const CornerCorrespondences corners =
-        MatchCorners(spec, observations[static_cast<std::size_t>(i)], i);
-    CvView& view = views[static_cast<std::size_t>(i)];
-    for (std::size_t j = 0; j < corners.points_O.size(); ++j) {
-      const Eigen::Vector3d& p = corners.points_O[j];
-      view.object.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                               static_cast<float>(p.z()));
-      view.image.emplace_back(static_cast<float>(corners.pixels[j].x()),
-                              static_cast<float>(corners.pixels[j].y()));
-    }
-    if (Usable(corners)) {
-      active.push_back(i);
-    } else {
-      ++unusable;
-    }
-  }
-
-  const cv::Size size(width_px, height_px);
-  std::vector<bool> rejected(observations.size(), false);
-  int rejected_count = 0;
-  CvCalibration calibration;
-  for (;;) {
-    if (static_cast<int>(active.size()) < options.min_views) {
-      std::ostringstream message;
-      message << "CalibrateIntrinsics: " << active.size() << " of " << m << " views usable, need "
-              << options.min_views << " (" << unusable << " with fewer than " << kMinCornersPerView
-              << " corners or all on one line, " << rejected_count << " rejected with an rms above "
-              << options.reject_view_rms_px << " px)";
-      throw Error(message.str());
-    }
-    calibration = Calibrate(views, active, size, options.fix_k3);
-    int worst = 0;
-    for (int k = 1; k < static_cast<int>(active.size()); ++k) {
-      if (calibration.per_view_rms.at<double>(k) > calibration.per_view_rms.at<double>(worst)) {
-        worst = k;
-      }
-    }
-    if (!(calibration.per_view_rms.at<double>(worst) > options.reject_view_rms_px)) break;
-    rejected[static_cast<std::size_t>(active[static_cast<std::size_t>(worst)])] = true;
-    ++rejected_count;
-    active.erase(active.begin() + worst);
-  }
+  const CvViews views = ToCvViews(spec, observations);
+  const Selection fit = CalibrateRejectingWorst(views, cv::Size(width_px, height_px), options);
 
   IntrinsicsResult result;
-  const cv::Mat& K = calibration.K;
-  const cv::Mat& D = calibration.D;
-  PinholeCamera& camera = result.camera;
-  camera.width_px = width_px;
-  camera.height_px = height_px;
-  camera.fx_px = K.at<double>(0, 0);
-  camera.fy_px = K.at<double>(1, 1);
-  camera.cx_px = K.at<double>(0, 2);
-  camera.cy_px = K.at<double>(1, 2);
-  const auto coefficient = [&D](int k) {
-    return k < static_cast<int>(D.total()) ? D.at<double>(k) : 0.0;
-  };
-  camera.k1 = coefficient(0);
-  camera.k2 = coefficient(1);
-  camera.p1 = coefficient(2);
-  camera.p2 = coefficient(3);
-  camera.k3 = coefficient(4);
-  try {
-    camera.Check();
-  } catch (const Error& e) {
-    throw Error(std::string("CalibrateIntrinsics: the calibration is not usable: ") + e.what());
-  }
-  const cv::Mat& s = calibration.std_intrinsics;
+  result.camera = CameraOf(fit.calibration, width_px, height_px);
+  const cv::Mat& s = fit.calibration.std_intrinsics;
   result.fx_std = s.at<double>(0);
   result.fy_std = s.at<double>(1);
   result.cx_std = s.at<double>(2);
   result.cy_std = s.at<double>(3);
   for (int k = 0; k < 5; ++k)
     result.distortion_std[static_cast<std::size_t>(k)] = s.at<double>(4 + k);
-  result.rms_px = calibration.rms;
-
-  result.views.resize(observations.size());
-  result.T_C_O.assign(observations.size(), Eigen::Isometry3d::Identity());
-  for (int i = 0; i < m; ++i) {
-    ViewResidual& view = result.views[static_cast<std::size_t>(i)];
-    view.image = observations[static_cast<std::size_t>(i)].image;
-    view.rejected = true;
-    view.rms_px = std::numeric_limits<double>::quiet_NaN();
-    if (rejected[static_cast<std::size_t>(i)]) {
-      view.rms_px = RmsOfLeftOutView(views[static_cast<std::size_t>(i)], K, D);
-    }
-  }
-  for (std::size_t k = 0; k < active.size(); ++k) {
-    const std::size_t i = static_cast<std::size_t>(active[k]);
-    result.views[i].rejected = false;
-    result.views[i].rms_px = calibration.per_view_rms.at<double>(static_cast<int>(k));
-    result.T_C_O[i] = ToIsometry(calibration.rvecs[k], calibration.tvecs[k]);
-  }
+  result.rms_px = fit.calibration.rms;
+  result.views = ViewResiduals(observations, views.views, fit);
+  result.T_C_O = ViewPoses(observations.size(), fit);
   return result;
 }
 

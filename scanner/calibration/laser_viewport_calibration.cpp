@@ -193,6 +193,106 @@ FlatViewport ViewportOf(const FlatViewport& start, const TiltBasis& basis, const
   return v;
 }
 
+// Every point whose camera ray leaves the viewport, as an observation. Throws on a point that
+// is not finite or whose mirror step is outside the laser's range.
+std::vector<Observation> ObservationsOf(const GalvoScannerModel& model,
+                                        const std::vector<LaserCalibrationPoint>& points) {
+  const GalvoLaser& laser = model.laser;
+  std::vector<Observation> observations;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const LaserCalibrationPoint& point = points[k];
+    if (!point.p_C.allFinite() || !point.px.allFinite()) {
+      throw Error("CalibrateLaserViewport: point " + std::to_string(k) + " is not finite");
+    }
+    if (point.mirror_step < laser.step_min || point.mirror_step > laser.step_max) {
+      throw Error("CalibrateLaserViewport: point " + std::to_string(k) + " has mirror step " +
+                  std::to_string(point.mirror_step) + ", outside the laser's step range");
+    }
+    const RayTrace camera = model.camera.PixelToRayInWater(point.px);
+    if (camera.ok()) observations.push_back(Observation{point.mirror_step, camera.ray, point.p_C});
+  }
+  return observations;
+}
+
+ceres::Solver::Options SolverOptions(const LaserViewportCalibrationOptions& options) {
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = 1e-16;  // exact data must reach rounding
+  solver_options.parameter_tolerance = 1e-14;
+  solver_options.gradient_tolerance = 0.0;
+  solver_options.num_threads = 1;  // deterministic
+  solver_options.logging_type = ceres::SILENT;
+  return solver_options;
+}
+
+// One-sigma standard deviations of the normal's angle, the distance and the thickness; NaN
+// when they cannot be computed.
+struct Deviations {
+  double normal_rad = kNaN;
+  double distance_m = kNaN;
+  double thickness_m = kNaN;
+};
+
+// From the covariance of the unknowns (the tilts, distance and, when refined, thickness) scaled
+// by the residual variance. A held thickness has 0.
+Deviations StandardDeviations(ceres::Problem& problem, const Unknowns& y, bool refine_thickness,
+                              double variance) {
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.num_threads = 1;
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {y.tilt.data(), y.tilt.data()}, {y.distance.data(), y.distance.data()}};
+  if (refine_thickness) blocks.emplace_back(y.thickness.data(), y.thickness.data());
+  if (!covariance.Compute(blocks, &problem)) return Deviations{};
+  double tilt[4], distance = 0.0, thickness = 0.0;
+  covariance.GetCovarianceBlock(y.tilt.data(), y.tilt.data(), tilt);
+  covariance.GetCovarianceBlock(y.distance.data(), y.distance.data(), &distance);
+  if (refine_thickness) {
+    covariance.GetCovarianceBlock(y.thickness.data(), y.thickness.data(), &thickness);
+  }
+  return Deviations{std::sqrt(std::max(0.0, (tilt[0] + tilt[3]) * variance)),
+                    std::sqrt(std::max(0.0, distance * variance)),
+                    std::sqrt(std::max(0.0, thickness * variance))};
+}
+
+// The residuals at the solution and the standard deviations of the unknowns.
+struct FitFigures {
+  double residual_rms_m = 0.0;
+  double residual_max_m = 0.0;
+  Deviations deviations;
+};
+
+// Residuals and standard deviations around the solution: the problem built again there (tilt
+// zero, so the tilts are the normal's angles). Residuals of +infinity when they cannot be
+// evaluated.
+FitFigures FiguresAtSolution(const std::vector<Observation>& observations, const GalvoLaser& laser,
+                             const FlatViewport& solution,
+                             const LaserViewportCalibrationOptions& options) {
+  const TiltBasis at_solution(solution.normal);
+  ceres::Problem problem;
+  Unknowns y;
+  const int unknowns =
+      BuildProblem(observations, laser, at_solution, solution, options, y, problem);
+  std::vector<double> residuals;
+  double cost = 0.0;
+  if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, &residuals, nullptr, nullptr)) {
+    const double infinity = std::numeric_limits<double>::infinity();
+    return FitFigures{infinity, infinity, Deviations{}};
+  }
+  double sum_sq = 0.0, max_abs = 0.0;
+  for (const double r : residuals) {
+    sum_sq += r * r;
+    max_abs = std::max(max_abs, std::abs(r));
+  }
+  const double rms = std::sqrt(sum_sq / static_cast<double>(residuals.size()));
+  const int points = static_cast<int>(observations.size());
+  const double variance = 2.0 * cost / static_cast<double>(points - unknowns);
+  return FitFigures{rms, max_abs,
+                    StandardDeviations(problem, y, options.refine_thickness, variance)};
+}
+
 }  // namespace
 
 void LaserViewportCalibrationOptions::Check() const {
@@ -208,19 +308,7 @@ LaserViewportCalibrationResult CalibrateLaserViewport(
   options.Check();
   model.Check();
   const GalvoLaser& laser = model.laser;
-  std::vector<Observation> observations;
-  for (size_t k = 0; k < points.size(); ++k) {
-    const LaserCalibrationPoint& point = points[k];
-    if (!point.p_C.allFinite() || !point.px.allFinite()) {
-      throw Error("CalibrateLaserViewport: point " + std::to_string(k) + " is not finite");
-    }
-    if (point.mirror_step < laser.step_min || point.mirror_step > laser.step_max) {
-      throw Error("CalibrateLaserViewport: point " + std::to_string(k) + " has mirror step " +
-                  std::to_string(point.mirror_step) + ", outside the laser's step range");
-    }
-    const RayTrace camera = model.camera.PixelToRayInWater(point.px);
-    if (camera.ok()) observations.push_back(Observation{point.mirror_step, camera.ray, point.p_C});
-  }
+  const std::vector<Observation> observations = ObservationsOf(model, points);
 
   const FlatViewport& initial = laser.viewport;
   const TiltBasis basis(initial.normal);
@@ -231,65 +319,20 @@ LaserViewportCalibrationResult CalibrateLaserViewport(
     throw Error("CalibrateLaserViewport: " + std::to_string(observations.size()) +
                 " usable points for " + std::to_string(unknowns) + " unknowns");
   }
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = 1e-16;  // exact data must reach rounding
-  solver_options.parameter_tolerance = 1e-14;
-  solver_options.gradient_tolerance = 0.0;
-  solver_options.num_threads = 1;  // deterministic
-  solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
+  ceres::Solve(SolverOptions(options), &problem, &summary);
 
   LaserViewportCalibrationResult result;
   result.viewport = ViewportOf(initial, basis, x);
   result.points = static_cast<int>(observations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;
   result.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-
-  // Residuals and standard deviations around the solution (tilt zero there, so the tilts are
-  // the normal's angles).
-  const TiltBasis at_solution(result.viewport.normal);
-  ceres::Problem final_problem;
-  Unknowns y;
-  BuildProblem(observations, laser, at_solution, result.viewport, options, y, final_problem);
-  std::vector<double> residuals;
-  double cost = 0.0;
-  if (!final_problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, &residuals, nullptr,
-                              nullptr)) {
-    result.residual_rms_m = result.residual_max_m = std::numeric_limits<double>::infinity();
-    result.normal_std_rad = result.distance_std_m = result.thickness_std_m = kNaN;
-    return result;
-  }
-  double sum_sq = 0.0;
-  for (const double r : residuals) {
-    sum_sq += r * r;
-    result.residual_max_m = std::max(result.residual_max_m, std::abs(r));
-  }
-  result.residual_rms_m = std::sqrt(sum_sq / static_cast<double>(residuals.size()));
-  const double variance = 2.0 * cost / static_cast<double>(result.points - unknowns);
-
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.num_threads = 1;
-  ceres::Covariance covariance(covariance_options);
-  std::vector<std::pair<const double*, const double*>> blocks = {
-      {y.tilt.data(), y.tilt.data()}, {y.distance.data(), y.distance.data()}};
-  if (options.refine_thickness) blocks.emplace_back(y.thickness.data(), y.thickness.data());
-  if (!covariance.Compute(blocks, &final_problem)) {
-    result.normal_std_rad = result.distance_std_m = result.thickness_std_m = kNaN;
-    return result;
-  }
-  double tilt[4], distance = 0.0, thickness = 0.0;
-  covariance.GetCovarianceBlock(y.tilt.data(), y.tilt.data(), tilt);
-  covariance.GetCovarianceBlock(y.distance.data(), y.distance.data(), &distance);
-  if (options.refine_thickness) {
-    covariance.GetCovarianceBlock(y.thickness.data(), y.thickness.data(), &thickness);
-  }
-  result.normal_std_rad = std::sqrt(std::max(0.0, (tilt[0] + tilt[3]) * variance));
-  result.distance_std_m = std::sqrt(std::max(0.0, distance * variance));
-  result.thickness_std_m = std::sqrt(std::max(0.0, thickness * variance));
+  const FitFigures figures = FiguresAtSolution(observations, laser, result.viewport, options);
+  result.residual_rms_m = figures.residual_rms_m;
+  result.residual_max_m = figures.residual_max_m;
+  result.normal_std_rad = figures.deviations.normal_rad;
+  result.distance_std_m = figures.deviations.distance_m;
+  result.thickness_std_m = figures.deviations.thickness_m;
   return result;
 }
 

@@ -84,14 +84,16 @@ struct Unknowns {
   std::vector<Pose6> poses;
 };
 
+// Parameters with a lower bound the active set may hold them on: value, bound.
+using Bounds = std::vector<std::pair<double*, double>>;
+
 // Ends a solve (successfully) once a refined parameter has been on its lower bound for
-// kStreak successive iterations: see the active set in CalibrateCameraViewport.
+// kStreak successive iterations: see SolveWithActiveSet.
 class BoundWatcher final : public ceres::IterationCallback {
  public:
   static constexpr int kStreak = 5;
 
-  BoundWatcher(const ceres::Problem& problem,
-               const std::vector<std::pair<double*, double>>& bounded)
+  BoundWatcher(const ceres::Problem& problem, const Bounds& bounded)
       : problem_(problem), bounded_(bounded) {}
 
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
@@ -107,7 +109,7 @@ class BoundWatcher final : public ceres::IterationCallback {
 
  private:
   const ceres::Problem& problem_;
-  const std::vector<std::pair<double*, double>>& bounded_;
+  const Bounds& bounded_;
   int streak_ = 0;
 };
 
@@ -176,84 +178,96 @@ void FillStandardDeviations(ceres::Problem& problem, Unknowns& x,
   if (options.refine_water_index) result.n_water_std = scalar_std(&x.n_water);
 }
 
-}  // namespace
-
-void ViewportCalibrationOptions::Check() const {
-  if (max_iterations <= 0) {
-    throw Error("ViewportCalibrationOptions.max_iterations: expected > 0, got " +
-                std::to_string(max_iterations));
-  }
-}
-
-ViewportCalibrationResult CalibrateCameraViewport(
-    const PinholeCamera& intrinsics, const FlatViewport& initial, const PatternSpec& spec,
-    const std::vector<PatternObservation>& observations,
-    const ViewportCalibrationOptions& options) {
-  options.Check();
-  spec.Check();
+// The camera through the CAD viewport, checked; its errors name CalibrateCameraViewport.
+RefractiveCamera CheckedCadCamera(const PinholeCamera& intrinsics, const FlatViewport& initial) {
   const RefractiveCamera cad{intrinsics, initial};
   try {
     cad.Check();
   } catch (const Error& e) {
     throw Error(std::string("CalibrateCameraViewport: ") + e.what());
   }
-  if (static_cast<int>(observations.size()) < kMinViews) {
-    throw Error("CalibrateCameraViewport: " + std::to_string(observations.size()) +
-                " views, need at least " + std::to_string(kMinViews));
-  }
+  return cad;
+}
 
-  // Start: the CAD viewport and each pattern pose through it.
+// Every view's corners and its pattern pose through the CAD viewport (the fit's start).
+struct ViewStarts {
+  std::vector<CornerCorrespondences> views;
+  std::vector<Pose6> poses;
+};
+
+ViewStarts MatchAndPoseViews(const RefractiveCamera& cad, const PatternSpec& spec,
+                             const std::vector<PatternObservation>& observations) {
+  ViewStarts start;
+  start.views.reserve(observations.size());
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    try {
+      start.views.push_back(MatchCorners(spec, observations[i], static_cast<int>(i)));
+      start.poses.push_back(ToPose6(EstimatePatternPose(cad, spec, observations[i]).T_C_O));
+    } catch (const Error& e) {
+      throw Error("CalibrateCameraViewport: view " + std::to_string(i) + ": " + e.what());
+    }
+  }
+  return start;
+}
+
+// The start: the CAD viewport and the given pattern poses.
+Unknowns UnknownsAt(const FlatViewport& initial, std::vector<Pose6> poses) {
   Unknowns x;
   x.normal = {initial.normal.x(), initial.normal.y(), initial.normal.z()};
   x.distance_m = initial.distance_m;
   x.thickness_m = initial.thickness_m;
   x.n_glass = initial.n_glass;
   x.n_water = initial.n_water;
-  std::vector<CornerCorrespondences> views;
-  views.reserve(observations.size());
-  for (std::size_t i = 0; i < observations.size(); ++i) {
-    try {
-      views.push_back(MatchCorners(spec, observations[i], static_cast<int>(i)));
-      x.poses.push_back(ToPose6(EstimatePatternPose(cad, spec, observations[i]).T_C_O));
-    } catch (const Error& e) {
-      throw Error("CalibrateCameraViewport: view " + std::to_string(i) + ": " + e.what());
-    }
-  }
+  x.poses = std::move(poses);
+  return x;
+}
 
-  ceres::Problem problem;
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+// One reprojection residual per corner, view by view; each view's pose goes to the group the
+// Schur complement eliminates first. Returns the number of residuals.
+int AddCornerResiduals(const PinholeCamera& intrinsics, double n_air,
+                       const std::vector<CornerCorrespondences>& views, Unknowns& x,
+                       ceres::Problem& problem, ceres::ParameterBlockOrdering& ordering) {
   int residual_count = 0;
   for (std::size_t i = 0; i < views.size(); ++i) {
     for (std::size_t j = 0; j < views[i].points_O.size(); ++j) {
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<ViewportResidual, 2, 6, 3, 1, 1, 1, 1>(
-              new ViewportResidual(intrinsics, initial.n_air, views[i].points_O[j],
-                                   views[i].pixels[j])),
+              new ViewportResidual(intrinsics, n_air, views[i].points_O[j], views[i].pixels[j])),
           nullptr, x.poses[i].data(), x.normal.data(), &x.distance_m, &x.thickness_m, &x.n_glass,
           &x.n_water);
       residual_count += 2;
     }
-    ordering->AddElementToGroup(x.poses[i].data(), 0);  // eliminated first (Schur)
+    ordering.AddElementToGroup(x.poses[i].data(), 0);  // eliminated first (Schur)
   }
+  return residual_count;
+}
+
+// The viewport's blocks: the normal on the unit sphere, bounds, the parameters not refined held,
+// and all of them in the second group of the ordering.
+void BoundAndHoldViewport(double n_air, const ViewportCalibrationOptions& options, Unknowns& x,
+                          ceres::Problem& problem, ceres::ParameterBlockOrdering& ordering) {
   problem.SetManifold(x.normal.data(), new ceres::SphereManifold<3>);
   // The camera centre stays inside the housing and the slab keeps a thickness; the indices
   // stay physical (denser than air) when refined.
   problem.SetParameterLowerBound(&x.distance_m, 0, kMinDistanceM);
   problem.SetParameterLowerBound(&x.thickness_m, 0, 0.0);
   for (double* index : {&x.n_glass, &x.n_water}) {
-    problem.SetParameterLowerBound(index, 0, initial.n_air);
+    problem.SetParameterLowerBound(index, 0, n_air);
     problem.SetParameterUpperBound(index, 0, 3.0);
   }
   if (!options.refine_thickness) problem.SetParameterBlockConstant(&x.thickness_m);
   if (!options.refine_glass_index) problem.SetParameterBlockConstant(&x.n_glass);
   if (!options.refine_water_index) problem.SetParameterBlockConstant(&x.n_water);
   for (double* block : {x.normal.data(), &x.distance_m, &x.thickness_m, &x.n_glass, &x.n_water}) {
-    ordering->AddElementToGroup(block, 1);
+    ordering.AddElementToGroup(block, 1);
   }
+}
 
+ceres::Solver::Options SolverOptions(const ViewportCalibrationOptions& options,
+                                     std::shared_ptr<ceres::ParameterBlockOrdering> ordering) {
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering = ordering;
+  solver_options.linear_solver_ordering = std::move(ordering);
   solver_options.max_num_iterations = options.max_iterations;
   // Units differ by orders of magnitude (pixels per metre of distance, per radian of normal,
   // per unit of index); Ceres' Jacobi scaling (on by default) equalises the columns, so the
@@ -265,53 +279,72 @@ ViewportCalibrationResult CalibrateCameraViewport(
   solver_options.parameter_tolerance = 1e-14;
   solver_options.num_threads = 1;  // deterministic
   solver_options.logging_type = ceres::SILENT;
-  // Active set. Ceres keeps bounds by projecting each step onto the box; when the optimum lies
-  // on a bound and the parameter is strongly correlated with others (the thickness with the
-  // distance and every pose), the projected steps are poor and LM crawls along the bound for
-  // hundreds of iterations. So a solve ends once a refined parameter has sat on its bound for
-  // a few iterations; that parameter is then held on the bound and the rest solved again,
-  // which reaches the constrained optimum directly.
-  const std::vector<std::pair<double*, double>> bounded = {{&x.distance_m, kMinDistanceM},
-                                                           {&x.thickness_m, 0.0},
-                                                           {&x.n_glass, initial.n_air},
-                                                           {&x.n_water, initial.n_air}};
+  return solver_options;
+}
+
+// Holds every refined parameter that has reached its lower bound there; returns whether one did.
+bool PinParametersOnBounds(const Bounds& bounded, ceres::Problem& problem,
+                           std::vector<double*>& pinned) {
+  bool pinned_one = false;
+  for (const auto& [value, lower] : bounded) {
+    if (!problem.IsParameterBlockConstant(value) && *value <= lower) {
+      *value = lower;
+      problem.SetParameterBlockConstant(value);
+      pinned.push_back(value);
+      pinned_one = true;
+    }
+  }
+  return pinned_one;
+}
+
+struct SolveOutcome {
+  ceres::Solver::Summary summary;  // of the last solve
+  int iterations = 0;              // over all solves
+};
+
+// Active set. Ceres keeps bounds by projecting each step onto the box; when the optimum lies on
+// a bound and the parameter is strongly correlated with others (the thickness with the distance
+// and every pose), the projected steps are poor and LM crawls along the bound for hundreds of
+// iterations. So a solve ends once a refined parameter has sat on its bound for a few
+// iterations; that parameter is then held on the bound and the rest solved again, which reaches
+// the constrained optimum directly.
+SolveOutcome SolveWithActiveSet(ceres::Solver::Options solver_options, const Bounds& bounded,
+                                ceres::Problem& problem) {
   BoundWatcher watcher(problem, bounded);
   solver_options.callbacks.push_back(&watcher);
   solver_options.update_state_every_iteration = true;  // the watcher reads the parameters
-  ceres::Solver::Summary summary;
-  int iterations = 0;
+  SolveOutcome outcome;
   std::vector<double*> pinned;
   for (std::size_t round = 0; round <= bounded.size(); ++round) {
     watcher.Reset();
-    ceres::Solve(solver_options, &problem, &summary);
-    iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-    if (summary.termination_type == ceres::FAILURE) break;
-    bool pinned_one = false;
-    for (const auto& [value, lower] : bounded) {
-      if (!problem.IsParameterBlockConstant(value) && *value <= lower) {
-        *value = lower;
-        problem.SetParameterBlockConstant(value);
-        pinned.push_back(value);
-        pinned_one = true;
-      }
-    }
-    if (!pinned_one) break;
+    ceres::Solve(solver_options, &problem, &outcome.summary);
+    outcome.iterations += std::max(0, static_cast<int>(outcome.summary.iterations.size()) - 1);
+    if (outcome.summary.termination_type == ceres::FAILURE) break;
+    if (!PinParametersOnBounds(bounded, problem, pinned)) break;
   }
   // The covariance describes the model without the bound: how far the data leave the
   // parameter undetermined, which is why it reached the bound.
   for (double* value : pinned) problem.SetParameterBlockVariable(value);
+  return outcome;
+}
 
+FlatViewport ViewportOf(const FlatViewport& initial, const Unknowns& x) {
+  FlatViewport viewport = initial;
+  viewport.normal = Eigen::Vector3d(x.normal[0], x.normal[1], x.normal[2]).normalized();
+  viewport.distance_m = x.distance_m;
+  viewport.thickness_m = x.thickness_m;
+  viewport.n_glass = x.n_glass;
+  viewport.n_water = x.n_water;
+  return viewport;
+}
+
+// The fitted viewport and pattern poses, with the corners' 2-D reprojection errors at them
+// (recomputed with the double path for the reported figures).
+ViewportCalibrationResult FittedResult(const PinholeCamera& intrinsics, const FlatViewport& initial,
+                                       const std::vector<CornerCorrespondences>& views,
+                                       const Unknowns& x) {
   ViewportCalibrationResult result;
-  result.iterations = iterations;
-  result.converged = summary.termination_type == ceres::CONVERGENCE;
-  result.viewport = initial;
-  result.viewport.normal = Eigen::Vector3d(x.normal[0], x.normal[1], x.normal[2]).normalized();
-  result.viewport.distance_m = x.distance_m;
-  result.viewport.thickness_m = x.thickness_m;
-  result.viewport.n_glass = x.n_glass;
-  result.viewport.n_water = x.n_water;
-
-  // Residuals at the solution, recomputed with the double path for the reported figures.
+  result.viewport = ViewportOf(initial, x);
   const RefractiveCamera fitted{intrinsics, result.viewport};
   double sum_sq = 0.0;
   int corners = 0;
@@ -332,11 +365,54 @@ ViewportCalibrationResult CalibrateCameraViewport(
         std::sqrt(view_sq / static_cast<double>(views[i].points_O.size())));
   }
   result.rms_px = std::sqrt(sum_sq / corners);
-  if (summary.termination_type == ceres::FAILURE) {
+  return result;
+}
+
+}  // namespace
+
+void ViewportCalibrationOptions::Check() const {
+  if (max_iterations <= 0) {
+    throw Error("ViewportCalibrationOptions.max_iterations: expected > 0, got " +
+                std::to_string(max_iterations));
+  }
+}
+
+ViewportCalibrationResult CalibrateCameraViewport(
+    const PinholeCamera& intrinsics, const FlatViewport& initial, const PatternSpec& spec,
+    const std::vector<PatternObservation>& observations,
+    const ViewportCalibrationOptions& options) {
+  options.Check();
+  spec.Check();
+  const RefractiveCamera cad = CheckedCadCamera(intrinsics, initial);
+  if (static_cast<int>(observations.size()) < kMinViews) {
+    throw Error("CalibrateCameraViewport: " + std::to_string(observations.size()) +
+                " views, need at least " + std::to_string(kMinViews));
+  }
+  ViewStarts start = MatchAndPoseViews(cad, spec, observations);
+  Unknowns x = UnknownsAt(initial, std::move(start.poses));
+  const std::vector<CornerCorrespondences>& views = start.views;
+
+  // The problem holds pointers into x: x stays where it is from here on.
+  ceres::Problem problem;
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  const int residual_count =
+      AddCornerResiduals(intrinsics, initial.n_air, views, x, problem, *ordering);
+  BoundAndHoldViewport(initial.n_air, options, x, problem, *ordering);
+  const Bounds bounded = {{&x.distance_m, kMinDistanceM},
+                          {&x.thickness_m, 0.0},
+                          {&x.n_glass, initial.n_air},
+                          {&x.n_water, initial.n_air}};
+  const SolveOutcome solved =
+      SolveWithActiveSet(SolverOptions(options, ordering), bounded, problem);
+
+  ViewportCalibrationResult result = FittedResult(intrinsics, initial, views, x);
+  result.iterations = solved.iterations;
+  result.converged = solved.summary.termination_type == ceres::CONVERGENCE;
+  if (solved.summary.termination_type == ceres::FAILURE) {
     MarkUndetermined(options, result);  // no covariance of a failed solve
     return result;
   }
-  FillStandardDeviations(problem, x, options, residual_count, summary.final_cost, result);
+  FillStandardDeviations(problem, x, options, residual_count, solved.summary.final_cost, result);
   return result;
 }
 
