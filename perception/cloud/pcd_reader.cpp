@@ -7,8 +7,10 @@
 #include <charconv>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <initializer_list>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -54,88 +56,133 @@ std::vector<std::string> Words(std::istringstream& line) {
   return words;
 }
 
-Header ParseHeader(const std::string& file, const std::string& name) {
-  Header header;
-  std::uint64_t width = 0, height = 0;
-  bool width_seen = false, height_seen = false, points_seen = false;
+// The header's values as its lines give them, before they are checked against each other.
+struct HeaderLines {
+  std::vector<std::string> fields;
   std::vector<int> sizes, counts;
   std::string types;
+  std::optional<std::uint64_t> width, height, points;
+  std::string data;
+};
+
+// A value of a SIZE or COUNT line: an integer in [1, max].
+int FieldValue(const std::string& word, int max,
+               const std::function<Error(const std::string&)>& bad) {
+  int value = 0;
+  if (!ParseNumber(word, value) || value < 1 || value > max) {
+    throw bad("'" + word.substr(0, 20) + "' is not a valid value");
+  }
+  return value;
+}
+
+// A value of a TYPE line: I, U or F.
+char FieldType(const std::string& word, const std::function<Error(const std::string&)>& bad) {
+  if (word.size() != 1 || (word[0] != 'I' && word[0] != 'U' && word[0] != 'F')) {
+    throw bad("'" + word.substr(0, 20) + "' is not I, U or F");
+  }
+  return word[0];
+}
+
+// The values of one header line (`key` and the words after it, at `where`) added to `lines`.
+void ReadHeaderLine(const std::string& key, const std::vector<std::string>& words,
+                    const std::string& where, HeaderLines& lines) {
+  const std::function<Error(const std::string&)> bad = [&](const std::string& what) {
+    return Error(where + " (" + key + "): " + what);
+  };
+  if (key == "FIELDS") {
+    lines.fields.insert(lines.fields.end(), words.begin(), words.end());
+  } else if (key == "SIZE" || key == "COUNT") {
+    std::vector<int>& values = key == "SIZE" ? lines.sizes : lines.counts;
+    for (const std::string& word : words) {
+      values.push_back(FieldValue(word, key == "SIZE" ? 8 : 100000, bad));
+    }
+  } else if (key == "TYPE") {
+    for (const std::string& word : words) lines.types.push_back(FieldType(word, bad));
+  } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+    std::uint64_t value = 0;
+    if (words.size() != 1 || !ParseNumber(words[0], value)) throw bad("expected one count");
+    (key == "WIDTH" ? lines.width : key == "HEIGHT" ? lines.height : lines.points) = value;
+  } else if (key == "DATA") {
+    if (words.size() != 1 ||
+        (words[0] != "ascii" && words[0] != "binary" && words[0] != "binary_compressed")) {
+      throw bad("expected ascii, binary or binary_compressed");
+    }
+    lines.data = words[0];
+  } else {
+    throw Error(where + ": unknown key '" + key.substr(0, 40) + "': not a PCD header");
+  }
+}
+
+// The fields with their sizes, types and counts (1 when there is no COUNT line), laid out one
+// after another in a point.
+std::vector<Field> LayOutFields(const HeaderLines& lines, const std::string& name) {
+  if (lines.fields.empty()) throw Error(name + ": the header has no FIELDS");
+  const std::size_t n = lines.fields.size();
+  const std::vector<int> counts = lines.counts.empty() ? std::vector<int>(n, 1) : lines.counts;
+  if (lines.sizes.size() != n || lines.types.size() != n || counts.size() != n) {
+    throw Error(name + ": FIELDS, SIZE, TYPE and COUNT list different numbers of fields");
+  }
+  std::vector<Field> fields;
+  std::size_t offset = 0;
+  for (std::size_t f = 0; f < n; ++f) {
+    Field field{lines.fields[f], lines.sizes[f], lines.types[f], counts[f]};
+    const bool valid = field.type == 'F' ? (field.size == 4 || field.size == 8)
+                                         : (field.size == 1 || field.size == 2 || field.size == 4 ||
+                                            field.size == 8);
+    if (!valid) {
+      throw Error(name + ": field '" + field.name + "' has type " + field.type + " of size " +
+                  std::to_string(field.size));
+    }
+    field.offset = offset;
+    offset += std::size_t(field.size) * std::size_t(field.count);
+    field.first_value = f == 0 ? 0 : fields[f - 1].first_value + std::size_t(fields[f - 1].count);
+    fields.push_back(field);
+  }
+  return fields;
+}
+
+// The number of points: POINTS, which must be WIDTH x HEIGHT when both are given; without it,
+// WIDTH x HEIGHT (HEIGHT 1 when not given).
+std::uint64_t PointCount(const HeaderLines& lines, const std::string& name) {
+  const std::optional<std::uint64_t>& width = lines.width;
+  const std::optional<std::uint64_t>& height = lines.height;
+  constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
+  if (!lines.points) {
+    if (!width) throw Error(name + ": the header has neither POINTS nor WIDTH");
+    if (height && *height != 0 && *width > kMax / *height) {
+      throw Error(name + ": WIDTH x HEIGHT overflows");
+    }
+    return *width * (height ? *height : 1);
+  }
+  if (width && height && *height != 0 && *width <= kMax / *height &&
+      *width * *height != *lines.points) {
+    throw Error(name + ": POINTS " + std::to_string(*lines.points) + " is not WIDTH x HEIGHT");
+  }
+  return *lines.points;
+}
+
+Header ParseHeader(const std::string& file, const std::string& name) {
+  HeaderLines lines;
   std::size_t at = 0;
-  for (int number = 1; header.data.empty(); ++number) {
+  for (int number = 1; lines.data.empty(); ++number) {
     if (at >= file.size() || at > kMaxHeaderBytes) throw Error(name + ": no DATA line: not a PCD file");
     std::size_t end = file.find('\n', at);
     if (end == std::string::npos) end = file.size();
-    const std::string line = file.substr(at, end - at);
+    std::istringstream stream(file.substr(at, end - at));
     at = end + 1;
-    std::istringstream stream(line);
     std::string key;
     stream >> key;
-    const std::string where = name + ": header line " + std::to_string(number);
     if (key.empty() || key[0] == '#' || key == "VERSION" || key == "VIEWPOINT") continue;
-    const std::vector<std::string> words = Words(stream);
-    auto bad = [&](const std::string& what) { return Error(where + " (" + key + "): " + what); };
-    if (key == "FIELDS") {
-      for (const std::string& word : words) header.fields.push_back({word});
-    } else if (key == "SIZE" || key == "COUNT") {
-      std::vector<int>& values = key == "SIZE" ? sizes : counts;
-      for (const std::string& word : words) {
-        int value = 0;
-        if (!ParseNumber(word, value) || value < 1 || value > (key == "SIZE" ? 8 : 100000)) {
-          throw bad("'" + word.substr(0, 20) + "' is not a valid value");
-        }
-        values.push_back(value);
-      }
-    } else if (key == "TYPE") {
-      for (const std::string& word : words) {
-        if (word.size() != 1 || (word[0] != 'I' && word[0] != 'U' && word[0] != 'F')) {
-          throw bad("'" + word.substr(0, 20) + "' is not I, U or F");
-        }
-        types.push_back(word[0]);
-      }
-    } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
-      std::uint64_t value = 0;
-      if (words.size() != 1 || !ParseNumber(words[0], value)) throw bad("expected one count");
-      if (key == "WIDTH") width = value, width_seen = true;
-      if (key == "HEIGHT") height = value, height_seen = true;
-      if (key == "POINTS") header.points = value, points_seen = true;
-    } else if (key == "DATA") {
-      if (words.size() != 1 || (words[0] != "ascii" && words[0] != "binary" && words[0] != "binary_compressed")) {
-        throw bad("expected ascii, binary or binary_compressed");
-      }
-      header.data = words[0];
-    } else {
-      throw Error(where + ": unknown key '" + key.substr(0, 40) + "': not a PCD header");
-    }
+    ReadHeaderLine(key, Words(stream), name + ": header line " + std::to_string(number), lines);
   }
+  Header header;
+  header.data = lines.data;
   header.body_offset = std::min(at, file.size());
-  if (header.fields.empty()) throw Error(name + ": the header has no FIELDS");
-  if (counts.empty()) counts.assign(header.fields.size(), 1);
-  if (sizes.size() != header.fields.size() || types.size() != header.fields.size() ||
-      counts.size() != header.fields.size()) {
-    throw Error(name + ": FIELDS, SIZE, TYPE and COUNT list different numbers of fields");
-  }
-  for (std::size_t f = 0; f < header.fields.size(); ++f) {
-    Field& field = header.fields[f];
-    field.size = sizes[f];
-    field.type = types[f];
-    field.count = counts[f];
-    const bool valid = field.type == 'F' ? (field.size == 4 || field.size == 8)
-                                         : (field.size == 1 || field.size == 2 || field.size == 4 || field.size == 8);
-    if (!valid) throw Error(name + ": field '" + field.name + "' has type " + field.type + " of size " + std::to_string(field.size));
-    field.offset = header.point_step;
+  header.fields = LayOutFields(lines, name);
+  for (const Field& field : header.fields) {
     header.point_step += std::size_t(field.size) * std::size_t(field.count);
-    field.first_value = f == 0 ? 0 : header.fields[f - 1].first_value + std::size_t(header.fields[f - 1].count);
   }
-  if (!points_seen) {
-    if (!width_seen) throw Error(name + ": the header has neither POINTS nor WIDTH");
-    if (height_seen && height != 0 && width > std::numeric_limits<std::uint64_t>::max() / height) {
-      throw Error(name + ": WIDTH x HEIGHT overflows");
-    }
-    header.points = width * (height_seen ? height : 1);
-  } else if (width_seen && height_seen && height != 0 && width <= std::numeric_limits<std::uint64_t>::max() / height &&
-             width * height != header.points) {
-    throw Error(name + ": POINTS " + std::to_string(header.points) + " is not WIDTH x HEIGHT");
-  }
+  header.points = PointCount(lines, name);
   return header;
 }
 

@@ -11,6 +11,8 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "perception/cloud/pcl_conversion.hpp"
@@ -87,89 +89,101 @@ float SquaredArea(const Eigen::Vector3f& p1, const Eigen::Vector3f& p2, const Ei
   return 0.25f * (p2 - p1).cross(p3 - p1).squaredNorm();
 }
 
-ScaledCloud ScaleToGrid(const PointCloud& cloud, int grid_size) {
-  ScaledCloud out;
+// Why ESF cannot take `cloud` whatever its shape (empty, not finite, too few or too many
+// points); empty when it can.
+std::string UnusableReason(const PointCloud& cloud) {
   const std::size_t n = cloud.size();
-  if (n == 0) {
-    out.reason = "empty cloud";
-    return out;
-  }
-  if (!cloud.origin.allFinite()) {
-    out.reason = "the cloud's origin is not finite";
-    return out;
-  }
+  if (n == 0) return "empty cloud";
+  if (!cloud.origin.allFinite()) return "the cloud's origin is not finite";
   for (std::size_t i = 0; i < n; ++i) {
     if (!cloud.points[i].allFinite()) {
-      out.reason = "point " + std::to_string(i) + " is not finite (NaN or inf)";
-      return out;
+      return "point " + std::to_string(i) + " is not finite (NaN or inf)";
     }
   }
   if (n > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
-    out.reason = std::to_string(n) + " points; ESF takes at most 2^31 - 1";
-    return out;
+    return std::to_string(n) + " points; ESF takes at most 2^31 - 1";
   }
-  if (n < 3) {
-    out.reason = std::to_string(n) + " point(s); ESF needs at least 3 distinct points";
-    return out;
-  }
-  // Offsets from the origin suffice: ESF does not depend on where the cloud is.
+  if (n < 3) return std::to_string(n) + " point(s); ESF needs at least 3 distinct points";
+  return "";
+}
+
+// The points' centroid and their largest distance from it. Offsets from the cloud's origin
+// suffice: ESF does not depend on where the cloud is.
+std::pair<Eigen::Vector3d, double> CentroidAndRadius(const std::vector<Eigen::Vector3f>& points) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& p : cloud.points) centroid += p.cast<double>();
-  centroid /= static_cast<double>(n);
+  for (const Eigen::Vector3f& p : points) centroid += p.cast<double>();
+  centroid /= static_cast<double>(points.size());
   double radius = 0.0;
-  for (const Eigen::Vector3f& p : cloud.points) {
+  for (const Eigen::Vector3f& p : points) {
     radius = std::max(radius, (p.cast<double>() - centroid).norm());
   }
-  if (!(radius > 0.0)) {
-    out.reason = "all " + std::to_string(n) + " points are identical";
-    return out;
-  }
-  const double scale = 0.5 * grid_size / radius;
-  out.points.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    out.points[i] = ((cloud.points[i].cast<double>() - centroid) * scale).cast<float>();
-  }
+  return {centroid, radius};
+}
 
-  // Fewer than 3 distinct points, or all collinear: A is the point farthest from the centroid,
-  // B the one farthest from A, C the one farthest from the line AB. When even ABC is thinner
-  // than PCL's area threshold, no triangle of the cloud is usefully thicker.
-  const auto farthest = [&](auto&& distance) {
-    std::size_t best = 0;
-    float best_d = -1.0f;
-    for (std::size_t i = 0; i < n; ++i) {
-      const float d = distance(out.points[i]);
-      if (d > best_d) {
-        best_d = d;
-        best = i;
-      }
+// The index of the point farthest by `distance` (the first of equals).
+template <typename Distance>
+std::size_t Farthest(const std::vector<Eigen::Vector3f>& points, const Distance& distance) {
+  std::size_t best = 0;
+  float best_d = -1.0f;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const float d = distance(points[i]);
+    if (d > best_d) {
+      best_d = d;
+      best = i;
     }
-    return best;
-  };
-  const std::size_t a = farthest([](const Eigen::Vector3f& p) { return p.squaredNorm(); });
-  const Eigen::Vector3f pa = out.points[a];
-  const std::size_t b = farthest([&](const Eigen::Vector3f& p) { return (p - pa).squaredNorm(); });
-  const Eigen::Vector3f pb = out.points[b];
+  }
+  return best;
+}
+
+// Why no triangle of the cloud is usefully thick (fewer than 3 distinct points, or all
+// collinear); empty when some is. `scaled` are the cloud's points in grid units. A is the point
+// farthest from the centroid, B the one farthest from A, C the one farthest from the line AB:
+// when even ABC is thinner than PCL's area threshold, no triangle of the cloud is thicker.
+std::string FlatReason(const PointCloud& cloud, const std::vector<Eigen::Vector3f>& scaled) {
+  const std::size_t a = Farthest(scaled, [](const Eigen::Vector3f& p) { return p.squaredNorm(); });
+  const Eigen::Vector3f pa = scaled[a];
+  const std::size_t b =
+      Farthest(scaled, [&](const Eigen::Vector3f& p) { return (p - pa).squaredNorm(); });
+  const Eigen::Vector3f pb = scaled[b];
   const Eigen::Vector3f ab = pb - pa;
   const std::size_t c =
-      farthest([&](const Eigen::Vector3f& p) { return ab.cross(p - pa).squaredNorm(); });
+      Farthest(scaled, [&](const Eigen::Vector3f& p) { return ab.cross(p - pa).squaredNorm(); });
   const bool two_distinct = std::all_of(
       cloud.points.begin(), cloud.points.end(),
       [&](const Eigen::Vector3f& p) { return p == cloud.points[a] || p == cloud.points[b]; });
-  if (two_distinct) {
-    out.reason = "only 2 distinct points; ESF needs at least 3";
-    return out;
+  if (two_distinct) return "only 2 distinct points; ESF needs at least 3";
+  if (!(SquaredArea(pa, pb, scaled[c]) > kMinSquaredArea)) {
+    return "all points are collinear (no triangle above the area threshold)";
   }
-  if (!(SquaredArea(pa, pb, out.points[c]) > kMinSquaredArea)) {
-    out.reason = "all points are collinear (no triangle above the area threshold)";
-    return out;
-  }
+  return "";
+}
 
-  out.voxels.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3f& p = out.points[i];
-    out.voxels[i] = {VoxelOf(p.x(), grid_size), VoxelOf(p.y(), grid_size),
-                     VoxelOf(p.z(), grid_size)};
+std::vector<Eigen::Vector3i> VoxelsOf(const std::vector<Eigen::Vector3f>& points, int grid_size) {
+  std::vector<Eigen::Vector3i> voxels(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    voxels[i] = {VoxelOf(p.x(), grid_size), VoxelOf(p.y(), grid_size), VoxelOf(p.z(), grid_size)};
   }
+  return voxels;
+}
+
+ScaledCloud ScaleToGrid(const PointCloud& cloud, int grid_size) {
+  ScaledCloud out;
+  out.reason = UnusableReason(cloud);
+  if (!out.reason.empty()) return out;
+  const auto [centroid, radius] = CentroidAndRadius(cloud.points);
+  if (!(radius > 0.0)) {
+    out.reason = "all " + std::to_string(cloud.size()) + " points are identical";
+    return out;
+  }
+  const double scale = 0.5 * grid_size / radius;
+  out.points.resize(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    out.points[i] = ((cloud.points[i].cast<double>() - centroid) * scale).cast<float>();
+  }
+  out.reason = FlatReason(cloud, out.points);
+  if (!out.reason.empty()) return out;
+  out.voxels = VoxelsOf(out.points, grid_size);
   return out;
 }
 

@@ -240,105 +240,190 @@ struct SegmentOutcome {
   std::deque<PendingSegment> queued;
 };
 
+// A segment being recognised, as the steps of RecognizeSegment see it.
+struct SegmentInView {
+  const PendingSegment& pending;
+  const PointCloud& remaining;  // the plane-free cloud pending.indices index
+  const PointCloud& cloud;      // the segment's points
+  const SceneAround& around;
+  const DescribedSegment& described;
+};
+
+// The segment before any object is accepted on it: unknown, keeping all its points.
+SegmentOutcome Unrecognized(const SegmentInView& seg) {
+  SegmentOutcome out;
+  out.object.object_id = "unknown";
+  out.object.centroid_S = Centroid(seg.cloud);
+  out.kept = seg.pending.indices;
+  return out;
+}
+
+// The highest score of a verified candidate among `posed`, -1 when none is verified.
+double BestVerifiedScore(const std::vector<PosedObject>& posed) {
+  double best = -1.0;
+  for (const PosedObject& q : posed) {
+    if (q.candidate.verified) best = std::max(best, q.candidate.score);
+  }
+  return best;
+}
+
+// The objects beyond the chosen worth posing: when the chosen explain the segment poorly (their
+// best verified score `weak` is under weak_score) or not at all (weak < 0), the others may.
+std::vector<std::size_t> OthersWorthPosing(const ChosenObjects& chosen, double weak,
+                                           const RecognitionOptions& options) {
+  if (weak < 0.0) return chosen.others_that_fit;
+  return weak < options.weak_score ? chosen.others : std::vector<std::size_t>{};
+}
+
+// The segment's candidates posed and verified, the contenders placed along their free
+// directions, best first.
+std::vector<PosedObject> PoseAndRank(const SegmentInView& seg, const ChosenObjects& chosen,
+                                     const ScanContext& ctx) {
+  const RecognitionOptions& options = ctx.options;
+  std::vector<PosedObject> posed;
+  for (std::size_t i : chosen.objects) {
+    posed.push_back(PoseCandidate(seg.described, i, chosen, seg.around, ctx));
+  }
+  const double weak = BestVerifiedScore(posed);
+  RecognitionOptions others_options = options;
+  if (weak < 0.0) others_options.pose_views = options.unverified_pose_views;
+  const ScanContext others_ctx{ctx.db,         others_options, ctx.cache, ctx.down,
+                               ctx.down_index, ctx.planes,     ctx.clock};
+  for (std::size_t i : OthersWorthPosing(chosen, weak, options)) {
+    posed.push_back(PoseCandidate(seg.described, i, chosen, seg.around, others_ctx));
+  }
+  PlaceContendersAlongFreeDirections(seg.described.cloud, seg.around, ctx, posed);
+  ctx.clock.Lap("free");
+  std::stable_sort(posed.begin(), posed.end(), [](const PosedObject& a, const PosedObject& b) {
+    return Better(a.candidate, b.candidate);
+  });
+  BreakTie(options.score_tie, options.buried_depth_m, posed);
+  return posed;
+}
+
+// The segment's points `best` leaves unexplained, which may be another object touching it, as
+// segments of their own.
+std::deque<PendingSegment> LeftUnexplained(const SegmentInView& seg, const PosedObject& best,
+                                           const ScanContext& ctx) {
+  const std::vector<std::size_t> on_model = PointsOnModel(
+      seg.described.cloud, ctx.db.objects[best.object], ctx.cache.Model(best.object).nearest(),
+      best.candidate.T_S_O.inverse(), 3.0 * ctx.db.parameters.voxel_m);
+  const std::vector<std::size_t> rest = Partition(seg.pending.indices, on_model).second;
+  std::deque<PendingSegment> queued;
+  QueueClusters(seg.remaining, rest, seg.pending.objects_before + 1, ctx.options, queued);
+  return queued;
+}
+
+// `indices` without those the `queued` segments took.
+std::vector<std::size_t> WithoutQueued(std::vector<std::size_t> indices,
+                                       const std::deque<PendingSegment>& queued) {
+  std::vector<std::size_t> taken;
+  for (const PendingSegment& q : queued) {
+    taken.insert(taken.end(), q.indices.begin(), q.indices.end());
+  }
+  std::sort(taken.begin(), taken.end());
+  std::erase_if(indices,
+                [&](std::size_t i) { return std::binary_search(taken.begin(), taken.end(), i); });
+  return indices;
+}
+
+// The best-ranked (verified) candidate accepted, with the other objects that fit as well and the
+// poses as good as its own; with `split_allowed`, what it leaves unexplained is queued.
+SegmentOutcome AcceptBest(const SegmentInView& seg, const std::vector<PosedObject>& ranked,
+                          const std::vector<double>& nearest_chi_square, bool split_allowed,
+                          const ScanContext& ctx) {
+  SegmentOutcome out = Unrecognized(seg);
+  const PosedObject& best = ranked.front();
+  Accept(best, seg.described.cloud, ctx.db.objects[best.object],
+         NearestOther(best.object, nearest_chi_square), ctx, out.object);
+  // The others that fit as well, as posed by the same search and placed as the answer is.
+  out.object.equivalent_objects_S = EquivalentObjects(ranked, ctx.options.score_tie);
+  out.object.equivalent_poses_S = EquivalentPoses(seg.described, best, seg.around, ctx);
+  ctx.clock.Lap("equivalents");
+  if (split_allowed) {
+    out.queued = LeftUnexplained(seg, best, ctx);
+    out.kept = WithoutQueued(seg.pending.indices, out.queued);
+  }
+  return out;
+}
+
+// The chi-square of the part's ESF to every object's nearest view, with the posed object's
+// chi-square and view set from it; none when the part has no ESF.
+std::vector<double> PartChiSquares(const EsfResult& part_esf, const ObjectDatabase& db,
+                                   PosedObject& posed) {
+  std::vector<double> chi_square;
+  if (!part_esf.ok) return chi_square;
+  for (const auto& nearest : NearestViews(part_esf.histogram, db, 1)) {
+    chi_square.push_back(nearest.front().first);
+    if (chi_square.size() == posed.object + 1) posed.candidate.view = nearest.front().second;
+  }
+  posed.candidate.chi_square = chi_square[posed.object];
+  return chi_square;
+}
+
+// With no candidate verified, the part of the segment one object explains (ExplainPart) accepted
+// as its object, and the rest queued as segments of their own; unrecognised when there is none.
+SegmentOutcome SplitOffPart(const SegmentInView& seg, const ScanContext& ctx) {
+  SegmentOutcome out = Unrecognized(seg);
+  std::optional<ExplainedPart> part = ExplainPart(seg.described, ctx);
+  ctx.clock.Lap("split");
+  if (!part) return out;
+  const RecognitionOptions& options = ctx.options;
+  const PointCloud part_cloud = Subset(seg.cloud, part->points);
+  // The part's own ESF for its chi-square and margin.
+  const EsfResult part_esf =
+      VoxelisedEsf(part_cloud, ctx.db.parameters.voxel_m, options.seed, options.threads);
+  const std::vector<double> part_chi_square = PartChiSquares(part_esf, ctx.db, part->posed);
+  // On the part's points with their normals (the fine ICP's normal gate needs them).
+  PlaceAlongFreeDirections(Subset(seg.described.cloud, part->points),
+                           SceneAroundOf(part_cloud, ctx), ctx, part->posed);
+  out.object.candidates.push_back(part->posed.candidate);
+  Accept(part->posed, part_cloud, ctx.db.objects[part->posed.object],
+         part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, out.object);
+  out.object.centroid_S = Centroid(part_cloud);
+  std::vector<std::size_t> rest;
+  std::tie(out.kept, rest) = Partition(seg.pending.indices, part->points);
+  QueueClusters(seg.remaining, rest, seg.pending.objects_before + 1, options, out.queued);
+  return out;
+}
+
+// A described segment recognised from its ESF: the objects it resembles posed, verified and
+// ranked, and the best accepted or, when none is verified, the part one object explains split
+// off it. Every ranked candidate is listed, after the part's.
+SegmentOutcome RecognizeDescribed(const SegmentInView& seg, const EsfDescriptor& esf,
+                                  const ScanContext& ctx) {
+  const RecognitionOptions& options = ctx.options;
+  const ChosenObjects chosen = ChooseObjects(esf, seg.pending.core_diameter_m, ctx);
+  ctx.clock.Lap("match");
+  const std::vector<PosedObject> ranked = PoseAndRank(seg, chosen, ctx);
+  const bool split_allowed = seg.pending.objects_before + 1 < options.max_objects_per_segment;
+  SegmentOutcome out;
+  if (!ranked.empty() && ranked.front().candidate.verified) {
+    out = AcceptBest(seg, ranked, chosen.nearest_chi_square, split_allowed, ctx);
+  } else if (split_allowed &&
+             seg.cloud.size() >= 2 * static_cast<std::size_t>(options.min_segment_points)) {
+    out = SplitOffPart(seg, ctx);
+  } else {
+    out = Unrecognized(seg);
+  }
+  for (const PosedObject& c : ranked) out.object.candidates.push_back(c.candidate);
+  return out;
+}
+
 // One segment of the plane-free cloud `remaining` recognised: its candidates posed and verified,
 // the best accepted, or, when none is verified, the part one object explains split off it.
 SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& remaining, const ScanContext& ctx) {
-  const ObjectDatabase& db = ctx.db;
-  const RecognitionOptions& options = ctx.options;
-  const ObjectDatabaseParameters& p = db.parameters;
-  RecognitionCache& cache = ctx.cache;
-  StageClock& clock = ctx.clock;
-  SegmentOutcome out;
-  RecognizedObject& object = out.object;
-  object.object_id = "unknown";
-  std::vector<std::size_t>& kept = out.kept;
-  kept = next.indices;
   const PointCloud segment = Subset(remaining, next.indices);
-  object.centroid_S = Centroid(segment);
   const SceneAround around = SceneAroundOf(segment, ctx);
   const DescribedSegment described = DescribeSegment(segment, ctx);
-  const EsfResult esf = VoxelisedEsf(segment, p.voxel_m, options.seed, options.threads);
-  clock.Lap("describe");
-  if (esf.ok && described.cloud.size() >= 10) {
-    const ChosenObjects chosen = ChooseObjects(esf.histogram, next.core_diameter_m, ctx);
-    const std::vector<double>& nearest_chi_square = chosen.nearest_chi_square;
-    clock.Lap("match");
-    std::vector<PosedObject> posed;
-    for (std::size_t i : chosen.objects) posed.push_back(PoseCandidate(described, i, chosen, around, ctx));
-    auto best_verified_score = [&] {
-      double best = -1.0;
-      for (const PosedObject& q : posed) {
-        if (q.candidate.verified) best = std::max(best, q.candidate.score);
-      }
-      return best;
-    };
-    // When the chosen explain the segment poorly or not at all, the others may (weak_score).
-    const double weak = best_verified_score();
-    const std::vector<std::size_t> no_others;
-    const std::vector<std::size_t>& others = weak < 0.0                  ? chosen.others_that_fit
-                                             : weak < options.weak_score ? chosen.others
-                                                                         : no_others;
-    RecognitionOptions others_options = options;
-    if (weak < 0.0) others_options.pose_views = options.unverified_pose_views;
-    const ScanContext others_ctx{ctx.db, others_options, ctx.cache, ctx.down, ctx.down_index, ctx.planes, ctx.clock};
-    for (std::size_t i : others) posed.push_back(PoseCandidate(described, i, chosen, around, others_ctx));
-    PlaceContendersAlongFreeDirections(described.cloud, around, ctx, posed);
-    clock.Lap("free");
-    std::stable_sort(posed.begin(), posed.end(),
-                     [](const PosedObject& a, const PosedObject& b) { return Better(a.candidate, b.candidate); });
-    BreakTie(options.score_tie, options.buried_depth_m, posed);
-    // The others that fit as well, as posed by the same search and placed as the answer is.
-    const std::vector<std::pair<std::string, Eigen::Isometry3d>> equivalent_objects =
-        EquivalentObjects(posed, options.score_tie);
-    for (const PosedObject& c : posed) object.candidates.push_back(c.candidate);
-    const bool split_allowed = next.objects_before + 1 < options.max_objects_per_segment;
-    if (!posed.empty() && posed.front().candidate.verified) {
-      const PosedObject& best = posed.front();
-      const ObjectModel& model = db.objects[best.object];
-      Accept(best, described.cloud, model, NearestOther(best.object, nearest_chi_square), ctx, object);
-      object.equivalent_objects_S = equivalent_objects;
-      object.equivalent_poses_S = EquivalentPoses(described, best, around, ctx);
-      clock.Lap("equivalents");
-      if (split_allowed) {
-        // What the object leaves unexplained may be another one touching it.
-        const std::vector<std::size_t> rest =
-            Partition(next.indices, PointsOnModel(described.cloud, model, cache.Model(best.object).nearest(),
-                                                  best.candidate.T_S_O.inverse(), 3.0 * p.voxel_m)).second;
-        QueueClusters(remaining, rest, next.objects_before + 1, options, out.queued);
-        std::vector<std::size_t> taken;
-        for (const PendingSegment& q : out.queued) taken.insert(taken.end(), q.indices.begin(), q.indices.end());
-        std::sort(taken.begin(), taken.end());
-        std::erase_if(kept, [&](std::size_t i) { return std::binary_search(taken.begin(), taken.end(), i); });
-      }
-    } else if (split_allowed && segment.size() >= 2 * static_cast<std::size_t>(options.min_segment_points)) {
-      std::optional<ExplainedPart> part = ExplainPart(described, ctx);
-      clock.Lap("split");
-      if (part) {
-        const PointCloud part_cloud = Subset(segment, part->points);
-        // The part's own ESF for its chi-square and margin.
-        const EsfResult part_esf = VoxelisedEsf(part_cloud, p.voxel_m, options.seed, options.threads);
-        std::vector<double> part_chi_square;
-        if (part_esf.ok) {
-          for (const auto& nearest : NearestViews(part_esf.histogram, db, 1)) {
-            part_chi_square.push_back(nearest.front().first);
-            if (part_chi_square.size() == part->posed.object + 1) part->posed.candidate.view = nearest.front().second;
-          }
-          part->posed.candidate.chi_square = part_chi_square[part->posed.object];
-        }
-        // On the part's points with their normals (the fine ICP's normal gate needs them).
-        PlaceAlongFreeDirections(Subset(described.cloud, part->points), SceneAroundOf(part_cloud, ctx), ctx,
-                                 part->posed);
-        object.candidates.insert(object.candidates.begin(), part->posed.candidate);
-        Accept(part->posed, part_cloud, db.objects[part->posed.object],
-               part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, object);
-        object.centroid_S = Centroid(part_cloud);
-        std::vector<std::size_t> rest;
-        std::tie(kept, rest) = Partition(next.indices, part->points);
-        QueueClusters(remaining, rest, next.objects_before + 1, options, out.queued);
-      }
-    }
-  }
-  clock.Lap("verify");
+  const SegmentInView seg{next, remaining, segment, around, described};
+  const EsfResult esf =
+      VoxelisedEsf(segment, ctx.db.parameters.voxel_m, ctx.options.seed, ctx.options.threads);
+  ctx.clock.Lap("describe");
+  SegmentOutcome out = esf.ok && described.cloud.size() >= 10
+                           ? RecognizeDescribed(seg, esf.histogram, ctx)
+                           : Unrecognized(seg);
+  ctx.clock.Lap("verify");
   return out;
 }
 

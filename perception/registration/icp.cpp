@@ -252,6 +252,208 @@ void RequireRigid(const Eigen::Isometry3d& T) {
   }
 }
 
+// T_target_source as it maps source points relative to the source origin to target points
+// relative to the target origin.
+Eigen::Isometry3d RelativeToOrigins(const Eigen::Isometry3d& T_target_source,
+                                    const PointCloud& source, const PointCloud& target) {
+  return Eigen::Translation3d(-target.origin) * T_target_source *
+         Eigen::Translation3d(source.origin);
+}
+
+std::vector<Eigen::Vector3d> PointsInDouble(const PointCloud& cloud) {
+  std::vector<Eigen::Vector3d> points(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) points[i] = cloud.points[i].cast<double>();
+  return points;
+}
+
+// Unit normals of the source and the target for the normal gate, computed once; both empty
+// when IcpOptions::max_normal_angle_rad does not gate the pairs.
+struct UnitNormals {
+  std::vector<Eigen::Vector3f> source;
+  std::vector<Eigen::Vector3f> target;
+};
+
+UnitNormals NormalsForGate(const PointCloud& source, const PointCloud& target,
+                           const IcpOptions& options) {
+  UnitNormals normals;
+  if (!(options.max_normal_angle_rad > 0.0)) return normals;
+  if (!source.has_normals() || !target.has_normals()) {
+    throw Error("AlignIcp: max_normal_angle_rad needs normals on both the source and the target");
+  }
+  for (const Eigen::Vector3f& n : source.normals) normals.source.push_back(n.normalized());
+  for (const Eigen::Vector3f& n : target.normals) normals.target.push_back(n.normalized());
+  return normals;
+}
+
+NormalGate GateOf(const UnitNormals& normals, const IcpOptions& options) {
+  if (!(options.max_normal_angle_rad > 0.0)) return {};
+  return {&normals.source, &normals.target,
+          static_cast<float>(std::cos(options.max_normal_angle_rad))};
+}
+
+// What stays fixed through one alignment; all geometry relative to the target origin.
+struct IcpProblem {
+  const std::vector<Eigen::Vector3d>& source_rel;
+  const PointCloud& target;
+  const TargetTree& tree;
+  const IcpOptions& options;
+  NormalGate gate;
+  Eigen::Vector3d target_centroid;
+  // With a prior the linearisation is about the target origin, where the prior's information
+  // is expressed; without one about the centroid, which conditions the step best.
+  Eigen::Vector3d pivot;
+  Eigen::Isometry3d prior_rel;  // the prior's pose; identity without a prior
+  bool point_to_plane;
+};
+
+// Where the alignment stands between iterations.
+struct IcpState {
+  Eigen::Isometry3d T_rel;  // the current pose, relative to the origins
+  int iterations = 0;       // over all stages
+  bool stopped = false;     // too few pairs or degenerate pairs
+};
+
+// Buffers of the iterations, reused.
+struct IcpScratch {
+  std::vector<int> pairs;
+  std::vector<Eigen::Vector3d> moved, matched;  // point-to-point pairs
+};
+
+// One iteration's increment and the RMS residual of the pairs it was solved from.
+struct IcpStep {
+  Eigen::Isometry3d increment;
+  double rmse;
+};
+
+// One Gauss-Newton step on the point-to-plane sums; none with fewer than 3 pairs.
+std::optional<IcpStep> PointToPlaneStep(const IcpProblem& problem, const Sums& sums,
+                                        const Eigen::Isometry3d& T_rel) {
+  if (sums.count < 3) return std::nullopt;
+  const double rmse = std::sqrt(sums.squared_residual / static_cast<double>(sums.count));
+  const std::optional<IcpPrior>& prior = problem.options.prior;
+  const Vector6d x = prior ? SolveWithPrior(sums, *prior, T_rel * problem.prior_rel.inverse())
+                           : SolveTruncated(sums.JtJ, sums.Jtr);
+  return IcpStep{IncrementAbout(problem.pivot, x.head<3>(), x.tail<3>()), rmse};
+}
+
+// The closed-form step on the pairs found by the last Pass; none with fewer than 3 pairs or
+// collinear ones.
+std::optional<IcpStep> PointToPointStep(const IcpProblem& problem, const Eigen::Isometry3d& T_rel,
+                                        IcpScratch& scratch) {
+  std::vector<Eigen::Vector3d>& moved = scratch.moved;
+  std::vector<Eigen::Vector3d>& matched = scratch.matched;
+  moved.clear();
+  matched.clear();
+  for (std::size_t i = 0; i < problem.source_rel.size(); ++i) {
+    if (scratch.pairs[i] == kNoMatch) continue;
+    moved.push_back(T_rel * problem.source_rel[i]);
+    matched.push_back(
+        problem.target.points[static_cast<std::size_t>(scratch.pairs[i])].cast<double>());
+  }
+  if (moved.size() < 3) return std::nullopt;
+  const SvdAlignment step = AlignSvd(moved, matched);
+  if (step.status != SvdAlignmentStatus::kSuccess) return std::nullopt;
+  double squared = 0.0;
+  for (std::size_t i = 0; i < moved.size(); ++i) squared += (moved[i] - matched[i]).squaredNorm();
+  return IcpStep{step.T_target_source, std::sqrt(squared / static_cast<double>(moved.size()))};
+}
+
+// Pairs the source moved by T_rel with the target within `radius` and solves for the next
+// increment; none when the pairs cannot give one.
+std::optional<IcpStep> Iterate(const IcpProblem& problem, double radius,
+                               const Eigen::Isometry3d& T_rel, IcpScratch& scratch) {
+  const IcpOptions& options = problem.options;
+  const Sums sums =
+      Pass(problem.source_rel, problem.target, problem.tree, T_rel, radius, problem.pivot,
+           options.method, problem.point_to_plane, options.threads, problem.gate, scratch.pairs);
+  return problem.point_to_plane ? PointToPlaneStep(problem, sums, T_rel)
+                                : PointToPointStep(problem, T_rel, scratch);
+}
+
+// A stage's lowest residual so far, the pose it was measured at, and the iterations since
+// (IcpOptions::stall_iterations).
+struct StallWatch {
+  double lowest_rmse = std::numeric_limits<double>::infinity();
+  Eigen::Isometry3d T_lowest;
+  int since_lowest = 0;
+
+  // Whether the stage has stalled with `rmse`, measured at T_rel.
+  bool Stalled(double rmse, const Eigen::Isometry3d& T_rel, const IcpOptions& options) {
+    if (rmse < lowest_rmse * (1.0 - options.relative_rmse_tolerance)) {
+      lowest_rmse = rmse;
+      T_lowest = T_rel;
+      since_lowest = 0;
+      return false;
+    }
+    return options.stall_iterations > 0 && ++since_lowest >= options.stall_iterations;
+  }
+};
+
+// Whether a stage has converged: the increment is below both step tolerances, or the residual
+// changed by at most relative_rmse_tolerance of the previous one (NaN: none yet).
+bool StageConverged(const IcpProblem& problem, const IcpStep& step, double previous_rmse) {
+  const IcpOptions& options = problem.options;
+  const Eigen::Vector3d& centroid = problem.target_centroid;
+  const double rotation_step = Eigen::AngleAxisd(step.increment.linear()).angle();
+  const double translation_step = (step.increment * centroid - centroid).norm();
+  const bool small_step = rotation_step < options.rotation_tolerance_rad &&
+                          translation_step < options.translation_tolerance_m;
+  const bool flat_rmse =
+      std::isfinite(previous_rmse) &&
+      std::abs(previous_rmse - step.rmse) <= options.relative_rmse_tolerance * previous_rmse;
+  return small_step || flat_rmse;
+}
+
+// Iterates with the pairs within `radius` until the stage converges (returns true), stalls,
+// reaches an iteration cap or stops.
+bool RunStage(const IcpProblem& problem, double radius, IcpState& state, IcpScratch& scratch) {
+  const IcpOptions& options = problem.options;
+  double previous_rmse = std::numeric_limits<double>::quiet_NaN();
+  StallWatch stall{.T_lowest = state.T_rel};
+  for (int k = 0; k < options.max_iterations_per_stage; ++k) {
+    if (state.iterations >= options.max_iterations) break;
+    const std::optional<IcpStep> step = Iterate(problem, radius, state.T_rel, scratch);
+    if (!step) {
+      // Nothing to match: with a prior, the prior is the answer.
+      if (problem.point_to_plane && options.prior) state.T_rel = problem.prior_rel;
+      state.stopped = true;
+      return false;
+    }
+    if (stall.Stalled(step->rmse, state.T_rel, options)) {
+      state.T_rel = stall.T_lowest;
+      ++state.iterations;
+      return false;
+    }
+    state.T_rel = step->increment * state.T_rel;
+    ++state.iterations;
+    if (StageConverged(problem, *step, previous_rmse)) return true;
+    previous_rmse = step->rmse;
+  }
+  return false;
+}
+
+// Fitness, RMSE and information at T_rel, with the last stage's distance; the information's
+// rotation is about the target origin.
+RegistrationResult Evaluate(const IcpProblem& problem, const PointCloud& source,
+                            const Eigen::Isometry3d& T_rel, IcpScratch& scratch) {
+  const IcpOptions& options = problem.options;
+  const PointCloud& target = problem.target;
+  const Sums sums = Pass(problem.source_rel, target, problem.tree, T_rel,
+                         options.max_correspondence_distance_m.back(), Eigen::Vector3d::Zero(),
+                         options.method, true, options.threads, problem.gate, scratch.pairs);
+  RegistrationResult result;
+  result.T_target_source =
+      Eigen::Translation3d(target.origin) * T_rel * Eigen::Translation3d(-source.origin);
+  result.fitness = static_cast<double>(sums.count) / static_cast<double>(source.size());
+  result.inlier_rmse =
+      sums.count == 0 ? 0.0 : std::sqrt(sums.squared_distance / static_cast<double>(sums.count));
+  if (problem.point_to_plane && sums.count > 0) {
+    result.inlier_plane_rmse = std::sqrt(sums.squared_residual / static_cast<double>(sums.count));
+  }
+  result.information = sums.JtJ;
+  return result;
+}
+
 }  // namespace
 
 void IcpOptions::Check() const {
@@ -345,136 +547,38 @@ RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
     throw Error("AlignIcp: target has no normals; point-to-plane needs one per target point");
   }
   RequireRigid(T_target_source_init);
-  // Unit normals for the gate, computed once.
-  std::vector<Eigen::Vector3f> source_normals, target_normals;
-  NormalGate gate;
-  if (options.max_normal_angle_rad > 0.0) {
-    if (!source.has_normals() || !target.has_normals()) {
-      throw Error("AlignIcp: max_normal_angle_rad needs normals on both the source and the target");
-    }
-    for (const Eigen::Vector3f& n : source.normals) source_normals.push_back(n.normalized());
-    for (const Eigen::Vector3f& n : target.normals) target_normals.push_back(n.normalized());
-    gate = {&source_normals, &target_normals, static_cast<float>(std::cos(options.max_normal_angle_rad))};
-  }
+  const UnitNormals normals = NormalsForGate(source, target, options);
+  const std::optional<IcpPrior>& prior = options.prior;
+  if (prior) RequireRigid(prior->T_target_source);
 
   // Everything below is relative to the target origin: T_rel maps source points relative to
   // their origin to target points relative to theirs.
-  Eigen::Isometry3d T_rel = Eigen::Translation3d(-target.origin) * T_target_source_init *
-                            Eigen::Translation3d(source.origin);
-  std::vector<Eigen::Vector3d> source_rel(source.size());
-  for (std::size_t i = 0; i < source.size(); ++i) source_rel[i] = source.points[i].cast<double>();
-  const Eigen::Vector3d target_centroid = prepared.centroid_rel_;
+  const std::vector<Eigen::Vector3d> source_rel = PointsInDouble(source);
+  const Eigen::Vector3d& target_centroid = prepared.centroid_rel_;
+  const IcpProblem problem{
+      .source_rel = source_rel,
+      .target = target,
+      .tree = prepared.tree_->tree,
+      .options = options,
+      .gate = GateOf(normals, options),
+      .target_centroid = target_centroid,
+      .pivot = prior ? Eigen::Vector3d::Zero() : target_centroid,
+      .prior_rel = prior ? RelativeToOrigins(prior->T_target_source, source, target)
+                         : Eigen::Isometry3d::Identity(),
+      .point_to_plane = options.method == IcpMethod::kPointToPlane};
 
-  // With a prior the linearisation is about the target origin, where the prior's information
-  // is expressed; without one about the centroid, which conditions the step best.
-  const std::optional<IcpPrior>& prior = options.prior;
-  const Eigen::Vector3d pivot = prior ? Eigen::Vector3d::Zero() : target_centroid;
-  const Eigen::Isometry3d prior_rel =
-      prior ? Eigen::Translation3d(-target.origin) * prior->T_target_source *
-                  Eigen::Translation3d(source.origin)
-            : Eigen::Isometry3d::Identity();
-  if (prior) RequireRigid(prior->T_target_source);
-
-  const TargetTree& tree = prepared.tree_->tree;
-  std::vector<int> pairs;
-  std::vector<Eigen::Vector3d> moved, matched;  // point-to-point pairs, reused
-  RegistrationResult result;
-  bool stopped = false;  // too few pairs or degenerate pairs
+  IcpState state{.T_rel = RelativeToOrigins(T_target_source_init, source, target)};
+  IcpScratch scratch;
+  bool converged = false;  // the last stage's
   const std::size_t stages = options.max_correspondence_distance_m.size();
-  const bool point_to_plane = options.method == IcpMethod::kPointToPlane;
-  for (std::size_t stage = 0; stage < stages && !stopped; ++stage) {
-    const double radius = options.max_correspondence_distance_m[stage];
-    bool stage_converged = false;
-    double previous_rmse = std::numeric_limits<double>::quiet_NaN();
-    // The stage's lowest residual, the pose it was measured at, and iterations since.
-    double lowest_rmse = std::numeric_limits<double>::infinity();
-    Eigen::Isometry3d T_lowest = T_rel;
-    int since_lowest = 0;
-    for (int k = 0;
-         k < options.max_iterations_per_stage && result.iterations < options.max_iterations; ++k) {
-      const Sums sums = Pass(source_rel, target, tree, T_rel, radius, pivot,
-                             options.method, point_to_plane, options.threads, gate, pairs);
-      Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
-      double rmse = 0.0;
-      if (point_to_plane) {
-        if (sums.count < 3) {
-          if (prior) T_rel = prior_rel;  // nothing to match: the prior is the answer
-          stopped = true;
-          break;
-        }
-        rmse = std::sqrt(sums.squared_residual / static_cast<double>(sums.count));
-        const Vector6d x = prior ? SolveWithPrior(sums, *prior, T_rel * prior_rel.inverse())
-                                 : SolveTruncated(sums.JtJ, sums.Jtr);
-        increment = IncrementAbout(pivot, x.head<3>(), x.tail<3>());
-      } else {
-        moved.clear();
-        matched.clear();
-        for (std::size_t i = 0; i < source_rel.size(); ++i) {
-          if (pairs[i] == kNoMatch) continue;
-          moved.push_back(T_rel * source_rel[i]);
-          matched.push_back(target.points[static_cast<std::size_t>(pairs[i])].cast<double>());
-        }
-        if (moved.size() < 3) {
-          stopped = true;
-          break;
-        }
-        const SvdAlignment step = AlignSvd(moved, matched);
-        if (step.status != SvdAlignmentStatus::kSuccess) {
-          stopped = true;
-          break;
-        }
-        double squared = 0.0;
-        for (std::size_t i = 0; i < moved.size(); ++i) {
-          squared += (moved[i] - matched[i]).squaredNorm();
-        }
-        rmse = std::sqrt(squared / static_cast<double>(moved.size()));
-        increment = step.T_target_source;
-      }
-      if (rmse < lowest_rmse * (1.0 - options.relative_rmse_tolerance)) {
-        lowest_rmse = rmse;
-        T_lowest = T_rel;
-        since_lowest = 0;
-      } else if (options.stall_iterations > 0 && ++since_lowest >= options.stall_iterations) {
-        T_rel = T_lowest;
-        ++result.iterations;
-        break;
-      }
-      T_rel = increment * T_rel;
-      ++result.iterations;
-
-      const double rotation_step = Eigen::AngleAxisd(increment.linear()).angle();
-      const double translation_step = (increment * target_centroid - target_centroid).norm();
-      const bool small_step = rotation_step < options.rotation_tolerance_rad &&
-                              translation_step < options.translation_tolerance_m;
-      const bool flat_rmse =
-          std::isfinite(previous_rmse) &&
-          std::abs(previous_rmse - rmse) <= options.relative_rmse_tolerance * previous_rmse;
-      previous_rmse = rmse;
-      if (small_step || flat_rmse) {
-        stage_converged = true;
-        break;
-      }
-    }
-    if (stage + 1 == stages) result.converged = stage_converged && !stopped;
+  for (std::size_t stage = 0; stage < stages && !state.stopped; ++stage) {
+    const bool stage_converged =
+        RunStage(problem, options.max_correspondence_distance_m[stage], state, scratch);
+    if (stage + 1 == stages) converged = stage_converged && !state.stopped;
   }
-
-  // Fitness, RMSE and information at the returned transform, with the last stage's distance;
-  // the information's rotation is about the target origin.
-  const Sums final_sums =
-      Pass(source_rel, target, tree, T_rel, options.max_correspondence_distance_m.back(),
-           Eigen::Vector3d::Zero(), options.method, true, options.threads, gate, pairs);
-  result.T_target_source =
-      Eigen::Translation3d(target.origin) * T_rel * Eigen::Translation3d(-source.origin);
-  result.fitness = static_cast<double>(final_sums.count) / static_cast<double>(source.size());
-  result.inlier_rmse =
-      final_sums.count == 0
-          ? 0.0
-          : std::sqrt(final_sums.squared_distance / static_cast<double>(final_sums.count));
-  if (point_to_plane && final_sums.count > 0) {
-    result.inlier_plane_rmse =
-        std::sqrt(final_sums.squared_residual / static_cast<double>(final_sums.count));
-  }
-  result.information = final_sums.JtJ;
+  RegistrationResult result = Evaluate(problem, source, state.T_rel, scratch);
+  result.iterations = state.iterations;
+  result.converged = converged;
   return result;
 }
 

@@ -13,6 +13,8 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "scanner/common/error.hpp"
 #include "scanner/common/file_bytes.hpp"
@@ -208,93 +210,167 @@ std::size_t MinRowBytes(const Element& element, Encoding encoding) {
   return bytes;
 }
 
+// The columns of a vertex row's values (-1: no such property).
+struct VertexColumns {
+  int xyz[3];
+  int n[3];
+  int intensity;
+  bool with_normals() const { return n[0] >= 0 && n[1] >= 0 && n[2] >= 0; }
+};
+
+VertexColumns VertexColumnsOf(const Element& element) {
+  return {{IndexOf(element, {"x"}), IndexOf(element, {"y"}), IndexOf(element, {"z"})},
+          {IndexOf(element, {"nx", "normal_x"}), IndexOf(element, {"ny", "normal_y"}),
+           IndexOf(element, {"nz", "normal_z"})},
+          IndexOf(element, {"intensity", "scalar_intensity", "scalar_Intensity"})};
+}
+
+// Reads a PLY body element by element, keeping the vertices and, when asked, the faces.
+class BodyReader {
+ public:
+  BodyReader(std::string_view body, Encoding encoding, const std::string& name, bool faces)
+      : cursor_(body, encoding), encoding_(encoding), name_(name), faces_(faces) {}
+
+  // Reads every row of `element`: the vertex element's points (with their normals and
+  // intensities when it has them), a face element's polygons; other elements are read past.
+  void Read(const Element& element) {
+    RequireRowsFit(element);
+    const bool is_vertex = element.name == "vertex";
+    const bool is_face = faces_ && element.name == "face";
+    const VertexColumns columns = VertexColumnsOf(element);
+    if (is_vertex) StartVertices(element, columns);
+    std::vector<double> row(element.properties.size());
+    for (std::uint64_t r = 0; r < element.count; ++r) {
+      ReadRow(element, r, is_face, row);
+      if (is_vertex) AddVertex(row, columns);
+    }
+  }
+
+  // What was read, the faces fan-triangulated; throws when there was no vertex element or a
+  // face is not a polygon of the vertices.
+  PlyContent Finish() {
+    if (!vertices_seen_) throw Error(name_ + ": no vertex element");
+    for (std::size_t f = 0; f < polygons_.size(); ++f) {
+      const std::vector<int>& polygon = polygons_[f];
+      RequirePolygon(f, polygon);
+      for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+        content_.triangles.emplace_back(polygon[0], polygon[k], polygon[k + 1]);
+      }
+    }
+    return std::move(content_);
+  }
+
+ private:
+  // A row's problem, named by the element and row.
+  Error RowError(const Element& element, std::uint64_t r, const std::string& what) const {
+    return Error(name_ + ": element " + element.name + " row " + std::to_string(r) + ": " + what);
+  }
+
+  // Throws when `element` claims more rows than the rest of the body can hold.
+  void RequireRowsFit(const Element& element) const {
+    const std::size_t min_row = MinRowBytes(element, encoding_);
+    if (min_row > 0 && element.count > cursor_.BytesLeft() / min_row) {
+      throw Error(name_ + ": element " + element.name + " claims " + std::to_string(element.count) +
+                  " rows, more than the " + std::to_string(cursor_.BytesLeft()) +
+                  " bytes left can hold");
+    }
+  }
+
+  void StartVertices(const Element& element, const VertexColumns& columns) {
+    if (columns.xyz[0] < 0 || columns.xyz[1] < 0 || columns.xyz[2] < 0) {
+      throw Error(name_ + ": element vertex has no x, y and z");
+    }
+    vertices_seen_ = true;
+    content_.vertices.reserve(element.count);
+    if (columns.with_normals()) content_.normals.reserve(element.count);
+    if (columns.intensity >= 0) content_.intensity.reserve(element.count);
+  }
+
+  // Row r of `element`: its scalar values into `row` (by property), the vertex indices of a
+  // face's polygon into polygons_.
+  void ReadRow(const Element& element, std::uint64_t r, bool is_face, std::vector<double>& row) {
+    for (std::size_t p = 0; p < element.properties.size(); ++p) {
+      const Property& property = element.properties[p];
+      if (!property.list_count) {
+        if (!cursor_.Read(property.type, row[p])) {
+          throw RowError(element, r, "the file ends or a value is not a number");
+        }
+        continue;
+      }
+      const bool keep =
+          is_face && (property.name == "vertex_indices" || property.name == "vertex_index");
+      std::vector<int> polygon = ReadList(element, r, property, keep);
+      if (keep) polygons_.push_back(std::move(polygon));
+    }
+  }
+
+  // The items of a list property; as vertex indices when `keep`, else read past (none).
+  std::vector<int> ReadList(const Element& element, std::uint64_t r, const Property& property,
+                            bool keep) {
+    double length = 0.0;
+    if (!cursor_.Read(*property.list_count, length) || length < 0.0 ||
+        length != std::floor(length) || length > double(cursor_.BytesLeft())) {
+      throw RowError(element, r, "list '" + property.name + "' has no valid length");
+    }
+    std::vector<int> polygon;
+    for (std::size_t k = 0; k < std::size_t(length); ++k) {
+      double item = 0.0;
+      if (!cursor_.Read(property.type, item)) {
+        throw RowError(element, r, "list '" + property.name + "' is cut short");
+      }
+      if (!keep) continue;
+      if (!(item >= 0.0 && item < 2147483647.0) || item != std::floor(item)) {
+        throw RowError(element, r,
+                       "vertex index " + std::to_string(item) + " is not a valid index");
+      }
+      polygon.push_back(int(item));
+    }
+    return polygon;
+  }
+
+  void AddVertex(const std::vector<double>& row, const VertexColumns& c) {
+    content_.vertices.emplace_back(row[std::size_t(c.xyz[0])], row[std::size_t(c.xyz[1])],
+                                   row[std::size_t(c.xyz[2])]);
+    if (c.with_normals()) {
+      content_.normals.emplace_back(row[std::size_t(c.n[0])], row[std::size_t(c.n[1])],
+                                    row[std::size_t(c.n[2])]);
+    }
+    if (c.intensity >= 0) content_.intensity.push_back(row[std::size_t(c.intensity)]);
+  }
+
+  // Throws unless face f has at least 3 vertices, all of them read.
+  void RequirePolygon(std::size_t f, const std::vector<int>& polygon) const {
+    if (polygon.size() < 3) {
+      throw Error(name_ + ": face " + std::to_string(f) + " has " + std::to_string(polygon.size()) +
+                  " vertices, expected at least 3");
+    }
+    for (int index : polygon) {
+      if (std::size_t(index) >= content_.vertices.size()) {
+        throw Error(name_ + ": face " + std::to_string(f) + " names vertex " +
+                    std::to_string(index) + " of " + std::to_string(content_.vertices.size()));
+      }
+    }
+  }
+
+  BodyCursor cursor_;
+  Encoding encoding_;
+  const std::string& name_;
+  bool faces_;
+  PlyContent content_;
+  bool vertices_seen_ = false;
+  std::vector<std::vector<int>> polygons_;
+};
+
 }  // namespace
 
 PlyContent ReadPly(const fs::path& path, bool faces) {
   const std::string name = QuotedPath(path);
   const std::string file = ReadFileBytes(path);
   const Header header = ParseHeader(file, name);
-
   const std::string_view body(file.data() + header.body_offset, file.size() - header.body_offset);
-  BodyCursor cursor(body, header.encoding);
-  PlyContent content;
-  bool vertices_seen = false;
-  std::vector<std::vector<int>> polygons;
-  for (const Element& element : header.elements) {
-    const std::size_t min_row = MinRowBytes(element, header.encoding);
-    if (min_row > 0 && element.count > cursor.BytesLeft() / min_row) {
-      throw Error(name + ": element " + element.name + " claims " + std::to_string(element.count) +
-                  " rows, more than the " + std::to_string(cursor.BytesLeft()) + " bytes left can hold");
-    }
-    const bool is_vertex = element.name == "vertex";
-    const bool is_face = faces && element.name == "face";
-    const int xyz[3] = {IndexOf(element, {"x"}), IndexOf(element, {"y"}), IndexOf(element, {"z"})};
-    const int n[3] = {IndexOf(element, {"nx", "normal_x"}), IndexOf(element, {"ny", "normal_y"}),
-                      IndexOf(element, {"nz", "normal_z"})};
-    const bool with_normals = n[0] >= 0 && n[1] >= 0 && n[2] >= 0;
-    const int intensity = IndexOf(element, {"intensity", "scalar_intensity", "scalar_Intensity"});
-    if (is_vertex) {
-      if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) throw Error(name + ": element vertex has no x, y and z");
-      vertices_seen = true;
-      content.vertices.reserve(element.count);
-      if (with_normals) content.normals.reserve(element.count);
-      if (intensity >= 0) content.intensity.reserve(element.count);
-    }
-    std::vector<double> row(element.properties.size());
-    for (std::uint64_t r = 0; r < element.count; ++r) {
-      auto short_of = [&](const std::string& what) {
-        return Error(name + ": element " + element.name + " row " + std::to_string(r) + ": " + what);
-      };
-      for (std::size_t p = 0; p < element.properties.size(); ++p) {
-        const Property& property = element.properties[p];
-        if (!property.list_count) {
-          if (!cursor.Read(property.type, row[p])) throw short_of("the file ends or a value is not a number");
-          continue;
-        }
-        double length = 0.0;
-        if (!cursor.Read(*property.list_count, length) || length < 0.0 || length != std::floor(length) ||
-            length > double(cursor.BytesLeft())) {
-          throw short_of("list '" + property.name + "' has no valid length");
-        }
-        const bool keep = is_face && (property.name == "vertex_indices" || property.name == "vertex_index");
-        std::vector<int> polygon;
-        for (std::size_t k = 0; k < std::size_t(length); ++k) {
-          double item = 0.0;
-          if (!cursor.Read(property.type, item)) throw short_of("list '" + property.name + "' is cut short");
-          if (keep) {
-            if (!(item >= 0.0 && item < 2147483647.0) || item != std::floor(item)) {
-              throw short_of("vertex index " + std::to_string(item) + " is not a valid index");
-            }
-            polygon.push_back(int(item));
-          }
-        }
-        if (keep) polygons.push_back(std::move(polygon));
-      }
-      if (is_vertex) {
-        content.vertices.emplace_back(row[std::size_t(xyz[0])], row[std::size_t(xyz[1])], row[std::size_t(xyz[2])]);
-        if (with_normals) {
-          content.normals.emplace_back(row[std::size_t(n[0])], row[std::size_t(n[1])], row[std::size_t(n[2])]);
-        }
-        if (intensity >= 0) content.intensity.push_back(row[std::size_t(intensity)]);
-      }
-    }
-  }
-  if (!vertices_seen) throw Error(name + ": no vertex element");
-  for (std::size_t f = 0; f < polygons.size(); ++f) {
-    const std::vector<int>& polygon = polygons[f];
-    if (polygon.size() < 3) {
-      throw Error(name + ": face " + std::to_string(f) + " has " + std::to_string(polygon.size()) +
-                  " vertices, expected at least 3");
-    }
-    for (int index : polygon) {
-      if (std::size_t(index) >= content.vertices.size()) {
-        throw Error(name + ": face " + std::to_string(f) + " names vertex " + std::to_string(index) +
-                    " of " + std::to_string(content.vertices.size()));
-      }
-    }
-    for (std::size_t k = 1; k + 1 < polygon.size(); ++k) content.triangles.emplace_back(polygon[0], polygon[k], polygon[k + 1]);
-  }
-  return content;
+  BodyReader reader(body, header.encoding, name, faces);
+  for (const Element& element : header.elements) reader.Read(element);
+  return reader.Finish();
 }
 
 }  // namespace uwscan::scanner

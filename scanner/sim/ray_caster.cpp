@@ -11,6 +11,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "scanner/common/error.hpp"
 
@@ -212,6 +213,73 @@ std::string DeviceErrorText(RTCError code) {
   }
 }
 
+std::unique_ptr<Geometry> SphereGeometry(const SceneObject& object) {
+  if (!(object.sphere_radius_m > 0.0) || !std::isfinite(object.sphere_radius_m)) {
+    throw Error("ray caster: object '" + object.name + "': sphere radius " +
+                std::to_string(object.sphere_radius_m) + ", expected > 0 m");
+  }
+  auto g = std::make_unique<Geometry>();
+  g->sphere = true;
+  g->centre_W = object.T_W_O.translation();
+  g->radius_m = object.sphere_radius_m;
+  return g;
+}
+
+std::unique_ptr<Geometry> MeshGeometry(const SceneObject& object) {
+  if (object.mesh.triangles.empty()) {
+    throw Error("ray caster: object '" + object.name + "' has no triangles");
+  }
+  const int count = static_cast<int>(object.mesh.vertices.size());
+  for (const Eigen::Vector3i& t : object.mesh.triangles) {
+    if ((t.array() < 0).any() || (t.array() >= count).any()) {
+      throw Error("ray caster: object '" + object.name + "': a triangle indexes a missing vertex");
+    }
+  }
+  auto g = std::make_unique<Geometry>();
+  g->vertices_W.reserve(count);
+  for (const Eigen::Vector3d& v : object.mesh.vertices) {
+    g->vertices_W.push_back(object.T_W_O * v);
+    if (!g->vertices_W.back().allFinite()) {
+      throw Error("ray caster: object '" + object.name + "' has a non-finite vertex");
+    }
+  }
+  g->triangles = object.mesh.triangles;
+  return g;
+}
+
+// Object `index` checked and posed in the world frame, as the caster keeps it.
+std::unique_ptr<Geometry> PosedGeometry(const SceneObject& object, int index) {
+  std::unique_ptr<Geometry> g =
+      object.shape == ObjectShape::kSphere ? SphereGeometry(object) : MeshGeometry(object);
+  g->object_index = index;
+  g->reflectance = object.reflectance;
+  return g;
+}
+
+// The world-frame box holding every geometry.
+Eigen::AlignedBox3d BoundsOf(const std::vector<std::unique_ptr<Geometry>>& geometries) {
+  Eigen::AlignedBox3d bounds;
+  for (const std::unique_ptr<Geometry>& g : geometries) {
+    if (g->sphere) {
+      bounds.extend(g->centre_W - Eigen::Vector3d::Constant(g->radius_m));
+      bounds.extend(g->centre_W + Eigen::Vector3d::Constant(g->radius_m));
+    } else {
+      for (const Eigen::Vector3d& v : g->vertices_W) bounds.extend(v);
+    }
+  }
+  return bounds;
+}
+
+// An Embree user geometry for one sphere, intersected exactly (SphereDistance).
+RTCGeometry NewSphereGeometry(RTCDevice device) {
+  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geometry, 1);
+  rtcSetGeometryBoundsFunction(geometry, SphereBounds, nullptr);
+  rtcSetGeometryIntersectFunction(geometry, SphereIntersect);
+  rtcSetGeometryOccludedFunction(geometry, SphereOccluded);
+  return geometry;
+}
+
 }  // namespace
 
 struct RayCaster::Impl {
@@ -243,98 +311,78 @@ struct RayCaster::Impl {
                                             : std::numeric_limits<float>::infinity();
     return {tnear, tfar};
   }
+
+  // The device and an empty scene.
+  void CreateScene();
+  // Geometry g added to the scene as Embree geometry `id`; `name` is its object's, for messages.
+  void Attach(Geometry& g, unsigned id, const std::string& name);
+  // An Embree triangle mesh of g, its vertices in float relative to origin_E_W; the exact range
+  // test (TriangleFilter) decides its hits.
+  RTCGeometry NewMeshGeometry(const Geometry& g) const;
 };
 
-RayCaster::RayCaster(const std::vector<SceneObject>& objects) : impl_(std::make_unique<Impl>()) {
-  Impl& m = *impl_;
-  // Posed geometry first: its bounds give Embree's origin.
-  Eigen::AlignedBox3d bounds;
-  for (size_t i = 0; i < objects.size(); ++i) {
-    const SceneObject& object = objects[i];
-    auto g = std::make_unique<Geometry>();
-    g->object_index = static_cast<int>(i);
-    g->reflectance = object.reflectance;
-    if (object.shape == ObjectShape::kSphere) {
-      if (!(object.sphere_radius_m > 0.0) || !std::isfinite(object.sphere_radius_m)) {
-        throw Error("ray caster: object '" + object.name + "': sphere radius " +
-                    std::to_string(object.sphere_radius_m) + ", expected > 0 m");
-      }
-      g->sphere = true;
-      g->centre_W = object.T_W_O.translation();
-      g->radius_m = object.sphere_radius_m;
-      bounds.extend(g->centre_W - Eigen::Vector3d::Constant(g->radius_m));
-      bounds.extend(g->centre_W + Eigen::Vector3d::Constant(g->radius_m));
-    } else {
-      if (object.mesh.triangles.empty()) {
-        throw Error("ray caster: object '" + object.name + "' has no triangles");
-      }
-      const int count = static_cast<int>(object.mesh.vertices.size());
-      for (const Eigen::Vector3i& t : object.mesh.triangles) {
-        if ((t.array() < 0).any() || (t.array() >= count).any()) {
-          throw Error("ray caster: object '" + object.name +
-                      "': a triangle indexes a missing vertex");
-        }
-      }
-      g->vertices_W.reserve(count);
-      for (const Eigen::Vector3d& v : object.mesh.vertices) {
-        g->vertices_W.push_back(object.T_W_O * v);
-        if (!g->vertices_W.back().allFinite()) {
-          throw Error("ray caster: object '" + object.name + "' has a non-finite vertex");
-        }
-        bounds.extend(g->vertices_W.back());
-      }
-      g->triangles = object.mesh.triangles;
-    }
-    m.geometries.push_back(std::move(g));
-  }
-  if (!bounds.isEmpty()) m.origin_E_W = bounds.center();
-
-  m.device = rtcNewDevice(nullptr);
-  if (m.device == nullptr) {
+void RayCaster::Impl::CreateScene() {
+  device = rtcNewDevice(nullptr);
+  if (device == nullptr) {
     throw Error("ray caster: cannot create an Embree device: " +
                 DeviceErrorText(rtcGetDeviceError(nullptr)));
   }
-  if (rtcGetDeviceProperty(m.device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0) {
+  if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0) {
     throw Error(
         "ray caster: this Embree was built without filter functions, which the exact "
         "double-precision range test needs");
   }
-  m.scene = rtcNewScene(m.device);
-  rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST);
+  scene = rtcNewScene(device);
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+}
+
+void RayCaster::Impl::Attach(Geometry& g, unsigned id, const std::string& name) {
+  RTCGeometry geometry = nullptr;
+  if (g.sphere) {
+    g.centre_E = g.centre_W - origin_E_W;
+    geometry = NewSphereGeometry(device);
+  } else {
+    geometry = NewMeshGeometry(g);
+  }
+  rtcSetGeometryUserData(geometry, &g);
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometryByID(scene, geometry, id);
+  rtcReleaseGeometry(geometry);
+  CheckDevice("adding object '" + name + "'");
+}
+
+RTCGeometry RayCaster::Impl::NewMeshGeometry(const Geometry& g) const {
+  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                               g.vertices_W.size()));
+  auto* indices = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                              3 * sizeof(unsigned), g.triangles.size()));
+  if (vertices == nullptr || indices == nullptr) CheckDevice("allocating a mesh");
+  for (size_t v = 0; v < g.vertices_W.size(); ++v) {
+    const Eigen::Vector3d p = g.vertices_W[v] - origin_E_W;
+    for (int k = 0; k < 3; ++k) vertices[3 * v + k] = static_cast<float>(p[k]);
+  }
+  for (size_t t = 0; t < g.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) indices[3 * t + k] = static_cast<unsigned>(g.triangles[t][k]);
+  }
+  rtcSetGeometryIntersectFilterFunction(geometry, TriangleFilter);
+  rtcSetGeometryOccludedFilterFunction(geometry, TriangleFilter);
+  return geometry;
+}
+
+RayCaster::RayCaster(const std::vector<SceneObject>& objects) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  // Posed geometry first: its bounds give Embree's origin.
+  for (size_t i = 0; i < objects.size(); ++i) {
+    m.geometries.push_back(PosedGeometry(objects[i], static_cast<int>(i)));
+  }
+  const Eigen::AlignedBox3d bounds = BoundsOf(m.geometries);
+  if (!bounds.isEmpty()) m.origin_E_W = bounds.center();
+  m.CreateScene();
   for (size_t i = 0; i < m.geometries.size(); ++i) {
-    Geometry& g = *m.geometries[i];
-    RTCGeometry geometry = nullptr;
-    if (g.sphere) {
-      g.centre_E = g.centre_W - m.origin_E_W;
-      geometry = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
-      rtcSetGeometryUserPrimitiveCount(geometry, 1);
-      rtcSetGeometryBoundsFunction(geometry, SphereBounds, nullptr);
-      rtcSetGeometryIntersectFunction(geometry, SphereIntersect);
-      rtcSetGeometryOccludedFunction(geometry, SphereOccluded);
-    } else {
-      geometry = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-      auto* vertices = static_cast<float*>(
-          rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                  3 * sizeof(float), g.vertices_W.size()));
-      auto* indices = static_cast<unsigned*>(
-          rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                  3 * sizeof(unsigned), g.triangles.size()));
-      if (vertices == nullptr || indices == nullptr) m.CheckDevice("allocating a mesh");
-      for (size_t v = 0; v < g.vertices_W.size(); ++v) {
-        const Eigen::Vector3d p = g.vertices_W[v] - m.origin_E_W;
-        for (int k = 0; k < 3; ++k) vertices[3 * v + k] = static_cast<float>(p[k]);
-      }
-      for (size_t t = 0; t < g.triangles.size(); ++t) {
-        for (int k = 0; k < 3; ++k) indices[3 * t + k] = static_cast<unsigned>(g.triangles[t][k]);
-      }
-      rtcSetGeometryIntersectFilterFunction(geometry, TriangleFilter);
-      rtcSetGeometryOccludedFilterFunction(geometry, TriangleFilter);
-    }
-    rtcSetGeometryUserData(geometry, &g);
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometryByID(m.scene, geometry, static_cast<unsigned>(i));
-    rtcReleaseGeometry(geometry);
-    m.CheckDevice("adding object '" + objects[i].name + "'");
+    m.Attach(*m.geometries[i], static_cast<unsigned>(i), objects[i].name);
   }
   rtcCommitScene(m.scene);
   m.CheckDevice("building the scene");

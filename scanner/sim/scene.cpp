@@ -152,23 +152,11 @@ bool ReadStage(const Context& where, const YAML::Node& node, const std::string& 
   return Has(stage, "on") ? Boolean(here, stage, "on") : true;
 }
 
-SimulationEffects ReadEffects(const Context& where, const YAML::Node& node) {
-  yaml::RequireKnownKeys(where, node,
-                         {"refraction", "lens_distortion", "occlusion", "mirror_dynamics", "motion",
-                          "navigation_drift", "peak_noise", "image", "beam", "sensor_noise", "speckle",
-                          "attenuation", "backscatter", "ambient"});
-  SimulationEffects e;
-  auto flag = [&](const char* key, bool* value) {
-    if (Has(node, key)) *value = Boolean(where, node, key);
-  };
-  flag("refraction", &e.refraction);
-  flag("lens_distortion", &e.lens_distortion);
-  flag("occlusion", &e.occlusion);
-  flag("mirror_dynamics", &e.mirror_dynamics);
-  flag("motion", &e.motion);
-  flag("attenuation", &e.attenuation);
+// The stages of SimulationEffects with settings, each read from its key of `node` (ReadStage).
+using Effects = SimulationEffects;
 
-  auto& drift = e.navigation_drift;
+Effects::NavigationDrift ReadNavigationDrift(const Context& where, const YAML::Node& node) {
+  Effects::NavigationDrift drift;
   drift.on = ReadStage(where, node, "navigation_drift",
                        {"on", "position_walk_m_per_sqrt_s", "yaw_walk_rad_per_sqrt_s",
                         "speed_scale_sigma", "heading_bias_sigma_rad", "depth_sigma_m",
@@ -184,30 +172,42 @@ SimulationEffects ReadEffects(const Context& where, const YAML::Node& node) {
                          read("depth_sigma_m", &drift.depth_sigma_m);
                          read("roll_pitch_sigma_rad", &drift.roll_pitch_sigma_rad);
                        });
-  auto& peak_noise = e.peak_noise;
+  return drift;
+}
+
+Effects::PeakNoise ReadPeakNoise(const Context& where, const YAML::Node& node) {
+  Effects::PeakNoise peak_noise;
   peak_noise.on = ReadStage(where, node, "peak_noise", {"on", "sigma_px"},
                             [&](const Context& at, const YAML::Node& n) {
                               peak_noise.sigma_px =
                                   Number(at, n, "sigma_px", Range::kNonNegative, peak_noise.sigma_px);
                             });
-  auto& image = e.image;
+  return peak_noise;
+}
+
+// The image's pixel format: mono8 or mono16, `fallback` when not given.
+PixelFormat ReadPixelFormat(const Context& where, const YAML::Node& node, PixelFormat fallback) {
+  if (!Has(node, "format")) return fallback;
+  const std::string f = String(where, node, "format");
+  if (f == "mono8") return PixelFormat::kMono8;
+  if (f == "mono16") return PixelFormat::kMono16;
+  FailField(where, node, "format", "got '" + f + "', expected mono8 or mono16");
+}
+
+Effects::Image ReadImage(const Context& where, const YAML::Node& node) {
+  Effects::Image image;
   image.on = ReadStage(
       where, node, "image", {"on", "format", "peak_level", "blur_sigma_px"},
       [&](const Context& at, const YAML::Node& n) {
-        if (Has(n, "format")) {
-          const std::string f = String(at, n, "format");
-          if (f == "mono8") {
-            image.format = PixelFormat::kMono8;
-          } else if (f == "mono16") {
-            image.format = PixelFormat::kMono16;
-          } else {
-            FailField(at, n, "format", "got '" + f + "', expected mono8 or mono16");
-          }
-        }
+        image.format = ReadPixelFormat(at, n, image.format);
         image.peak_level = Number(at, n, "peak_level", Range::kPositive, image.peak_level);
         image.blur_sigma_px = Number(at, n, "blur_sigma_px", Range::kPositive, image.blur_sigma_px);
       });
-  auto& beam = e.beam;
+  return image;
+}
+
+Effects::Beam ReadBeam(const Context& where, const YAML::Node& node) {
+  Effects::Beam beam;
   beam.on =
       ReadStage(where, node, "beam", {"on", "diameter_m", "divergence_rad"},
                 [&](const Context& at, const YAML::Node& n) {
@@ -215,7 +215,11 @@ SimulationEffects ReadEffects(const Context& where, const YAML::Node& node) {
                   beam.divergence_rad =
                       Number(at, n, "divergence_rad", Range::kNonNegative, beam.divergence_rad);
                 });
-  auto& noise = e.sensor_noise;
+  return beam;
+}
+
+Effects::SensorNoise ReadSensorNoise(const Context& where, const YAML::Node& node) {
+  Effects::SensorNoise noise;
   noise.on = ReadStage(
       where, node, "sensor_noise", {"on", "read_sigma", "electrons_per_level"},
       [&](const Context& at, const YAML::Node& n) {
@@ -223,21 +227,59 @@ SimulationEffects ReadEffects(const Context& where, const YAML::Node& node) {
         noise.electrons_per_level =
             Number(at, n, "electrons_per_level", Range::kPositive, noise.electrons_per_level);
       });
-  auto& speckle = e.speckle;
+  return noise;
+}
+
+Effects::Speckle ReadSpeckle(const Context& where, const YAML::Node& node) {
+  Effects::Speckle speckle;
   speckle.on = ReadStage(
       where, node, "speckle", {"on", "contrast"}, [&](const Context& at, const YAML::Node& n) {
         speckle.contrast = Number(at, n, "contrast", Range::kUnitInterval, speckle.contrast);
       });
-  auto& backscatter = e.backscatter;
+  return speckle;
+}
+
+Effects::Backscatter ReadBackscatter(const Context& where, const YAML::Node& node) {
+  Effects::Backscatter backscatter;
   backscatter.on = ReadStage(
       where, node, "backscatter", {"on", "level"}, [&](const Context& at, const YAML::Node& n) {
         backscatter.level = Number(at, n, "level", Range::kNonNegative, backscatter.level);
       });
-  auto& ambient = e.ambient;
+  return backscatter;
+}
+
+Effects::Ambient ReadAmbient(const Context& where, const YAML::Node& node) {
+  Effects::Ambient ambient;
   ambient.on = ReadStage(
       where, node, "ambient", {"on", "level"}, [&](const Context& at, const YAML::Node& n) {
         ambient.level = Number(at, n, "level", Range::kNonNegative, ambient.level);
       });
+  return ambient;
+}
+
+SimulationEffects ReadEffects(const Context& where, const YAML::Node& node) {
+  yaml::RequireKnownKeys(where, node,
+                         {"refraction", "lens_distortion", "occlusion", "mirror_dynamics", "motion",
+                          "navigation_drift", "peak_noise", "image", "beam", "sensor_noise",
+                          "speckle", "attenuation", "backscatter", "ambient"});
+  SimulationEffects e;
+  auto flag = [&](const char* key, bool* value) {
+    if (Has(node, key)) *value = Boolean(where, node, key);
+  };
+  flag("refraction", &e.refraction);
+  flag("lens_distortion", &e.lens_distortion);
+  flag("occlusion", &e.occlusion);
+  flag("mirror_dynamics", &e.mirror_dynamics);
+  flag("motion", &e.motion);
+  flag("attenuation", &e.attenuation);
+  e.navigation_drift = ReadNavigationDrift(where, node);
+  e.peak_noise = ReadPeakNoise(where, node);
+  e.image = ReadImage(where, node);
+  e.beam = ReadBeam(where, node);
+  e.sensor_noise = ReadSensorNoise(where, node);
+  e.speckle = ReadSpeckle(where, node);
+  e.backscatter = ReadBackscatter(where, node);
+  e.ambient = ReadAmbient(where, node);
   Checked(where, node, [&] { e.Check(); });
   return e;
 }

@@ -1,6 +1,9 @@
 #include "scanner/sim/scene_objects.hpp"
 
+#include <functional>
 #include <map>
+#include <optional>
+#include <string>
 
 #include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
@@ -72,110 +75,148 @@ void RequireObjectKeys(const Context& where, const YAML::Node& node, ObjectShape
   }
 }
 
-// The geometry of one object in {O}, from the fields of its shape.
-void ReadGeometry(const Context& where, const YAML::Node& node,
-                  const std::filesystem::path& base_dir, SceneObject* object) {
-  const double chord = Number(where, node, "chord_error_m", Range::kPositive, kDefaultChordErrorM);
-  auto length = [&](const char* key, double fallback) {
+// The fields of one object's mapping, as the readers of its geometry take them.
+struct ObjectFields {
+  const Context& where;
+  const YAML::Node& node;
+  double chord_error_m;
+
+  // A length in metres, > 0; required unless a fallback is given.
+  double Length(const char* key, std::optional<double> fallback = std::nullopt) const {
     return Number(where, node, key, Range::kPositive, fallback);
-  };
-  auto sizes = [&](int n) {
+  }
+  // The size_m field: n positive lengths.
+  Eigen::VectorXd Sizes(int n) const {
     const Eigen::VectorXd v = yaml::Vector(where, node, "size_m", n);
     if (!(v.array() > 0.0).all()) FailField(where, node, "size_m", "expected positive lengths");
     return v;
-  };
+  }
+  // The mesh `make` builds from the fields read, a failure reported at the object.
+  TriangleMesh Built(const std::function<TriangleMesh()>& make) const {
+    TriangleMesh mesh;
+    Checked(where, node, [&] { mesh = make(); });
+    return mesh;
+  }
+};
+
+// A mesh file, scaled.
+TriangleMesh ReadMeshFile(const ObjectFields& f, const std::filesystem::path& base_dir) {
+  const std::filesystem::path file = Resolve(base_dir, String(f.where, f.node, "file"));
+  const double scale = Number(f.where, f.node, "scale", Range::kPositive, 1.0);
+  TriangleMesh mesh;
+  try {
+    mesh = LoadMesh(file);
+  } catch (const Error& e) {
+    FailField(f.where, f.node, "file", e.what());
+  }
+  for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
+  return mesh;
+}
+
+TriangleMesh ReadPipe(const ObjectFields& f) {
+  PipeShape s;
+  s.outer_radius_m = f.Length("outer_radius_m", s.outer_radius_m);
+  s.wall_m = f.Length("wall_m", s.wall_m);
+  s.length_m = f.Length("length_m", s.length_m);
+  return f.Built([&] { return MakePipe(s, f.chord_error_m); });
+}
+
+TriangleMesh ReadElbow(const ObjectFields& f) {
+  ElbowShape s;
+  s.outer_radius_m = f.Length("outer_radius_m", s.outer_radius_m);
+  s.wall_m = f.Length("wall_m", s.wall_m);
+  s.bend_radius_m = f.Length("bend_radius_m", s.bend_radius_m);
+  s.bend_angle_rad = Number(f.where, f.node, "bend_angle_rad", Range::kPositive, s.bend_angle_rad);
+  return f.Built([&] { return MakeElbow(s, f.chord_error_m); });
+}
+
+TriangleMesh ReadTee(const ObjectFields& f) {
+  TeeShape s;
+  s.outer_radius_m = f.Length("outer_radius_m", s.outer_radius_m);
+  s.wall_m = f.Length("wall_m", s.wall_m);
+  s.run_length_m = f.Length("run_length_m", s.run_length_m);
+  s.branch_length_m = f.Length("branch_length_m", s.branch_length_m);
+  return f.Built([&] { return MakeTee(s, f.chord_error_m); });
+}
+
+TriangleMesh ReadFlange(const ObjectFields& f) {
+  FlangeShape s;
+  s.outer_radius_m = f.Length("outer_radius_m", s.outer_radius_m);
+  s.wall_m = f.Length("wall_m", s.wall_m);
+  s.length_m = f.Length("length_m", s.length_m);
+  s.flange_radius_m = f.Length("flange_radius_m", s.flange_radius_m);
+  s.flange_thickness_m = f.Length("flange_thickness_m", s.flange_thickness_m);
+  s.bolts = Integer(f.where, f.node, "bolts", 0, s.bolts);
+  s.bolt_head_radius_m = f.Length("bolt_head_radius_m", s.bolt_head_radius_m);
+  s.bolt_head_height_m = f.Length("bolt_head_height_m", s.bolt_head_height_m);
+  return f.Built([&] { return MakeFlange(s, f.chord_error_m); });
+}
+
+// The valve's handle: wheel or lever, `fallback` when not given.
+ValveHandle ReadHandle(const ObjectFields& f, ValveHandle fallback) {
+  if (!Has(f.node, "handle")) return fallback;
+  const std::string handle = String(f.where, f.node, "handle");
+  if (handle == "wheel") return ValveHandle::kWheel;
+  if (handle == "lever") return ValveHandle::kLever;
+  FailField(f.where, f.node, "handle", "got '" + handle + "', expected wheel or lever");
+}
+
+TriangleMesh ReadValve(const ObjectFields& f) {
+  ValveShape s;
+  s.outer_radius_m = f.Length("outer_radius_m", s.outer_radius_m);
+  s.wall_m = f.Length("wall_m", s.wall_m);
+  s.body_radius_m = f.Length("body_radius_m", s.body_radius_m);
+  s.body_length_m = f.Length("body_length_m", s.body_length_m);
+  s.stub_length_m = f.Length("stub_length_m", s.stub_length_m);
+  s.stem_radius_m = f.Length("stem_radius_m", s.stem_radius_m);
+  s.stem_length_m = f.Length("stem_length_m", s.stem_length_m);
+  s.handle_radius_m = f.Length("handle_radius_m", s.handle_radius_m);
+  s.handle = ReadHandle(f, s.handle);
+  return f.Built([&] { return MakeValve(s, f.chord_error_m); });
+}
+
+// The geometry of one object in {O}, from the fields of its shape.
+void ReadGeometry(const Context& where, const YAML::Node& node,
+                  const std::filesystem::path& base_dir, SceneObject* object) {
+  const ObjectFields f{where, node,
+                       Number(where, node, "chord_error_m", Range::kPositive, kDefaultChordErrorM)};
   switch (object->shape) {
     case ObjectShape::kPlane: {
-      const Eigen::VectorXd s = sizes(2);
+      const Eigen::VectorXd s = f.Sizes(2);
       object->mesh = MakeRectangle(s[0], s[1]);
       return;
     }
     case ObjectShape::kBox:
-      object->mesh = MakeBox(sizes(3));
+      object->mesh = MakeBox(f.Sizes(3));
       return;
     case ObjectShape::kSphere:
-      object->sphere_radius_m = Number(where, node, "radius_m", Range::kPositive);
+      object->sphere_radius_m = f.Length("radius_m");
       return;
     case ObjectShape::kCylinder: {
-      const double r = Number(where, node, "radius_m", Range::kPositive);
-      object->mesh = MakeCylinder(r, Number(where, node, "length_m", Range::kPositive), chord);
+      const double r = f.Length("radius_m");
+      object->mesh = MakeCylinder(r, f.Length("length_m"), f.chord_error_m);
       return;
     }
-    case ObjectShape::kMesh: {
-      const std::filesystem::path file = Resolve(base_dir, String(where, node, "file"));
-      const double scale = Number(where, node, "scale", Range::kPositive, 1.0);
-      try {
-        object->mesh = LoadMesh(file);
-      } catch (const Error& e) {
-        FailField(where, node, "file", e.what());
-      }
-      for (Eigen::Vector3d& v : object->mesh.vertices) v *= scale;
+    case ObjectShape::kMesh:
+      object->mesh = ReadMeshFile(f, base_dir);
       return;
-    }
-    case ObjectShape::kPipe: {
-      PipeShape s;
-      s.outer_radius_m = length("outer_radius_m", s.outer_radius_m);
-      s.wall_m = length("wall_m", s.wall_m);
-      s.length_m = length("length_m", s.length_m);
-      Checked(where, node, [&] { object->mesh = MakePipe(s, chord); });
+    case ObjectShape::kPipe:
+      object->mesh = ReadPipe(f);
       return;
-    }
-    case ObjectShape::kElbow: {
-      ElbowShape s;
-      s.outer_radius_m = length("outer_radius_m", s.outer_radius_m);
-      s.wall_m = length("wall_m", s.wall_m);
-      s.bend_radius_m = length("bend_radius_m", s.bend_radius_m);
-      s.bend_angle_rad = Number(where, node, "bend_angle_rad", Range::kPositive, s.bend_angle_rad);
-      Checked(where, node, [&] { object->mesh = MakeElbow(s, chord); });
+    case ObjectShape::kElbow:
+      object->mesh = ReadElbow(f);
       return;
-    }
-    case ObjectShape::kTee: {
-      TeeShape s;
-      s.outer_radius_m = length("outer_radius_m", s.outer_radius_m);
-      s.wall_m = length("wall_m", s.wall_m);
-      s.run_length_m = length("run_length_m", s.run_length_m);
-      s.branch_length_m = length("branch_length_m", s.branch_length_m);
-      Checked(where, node, [&] { object->mesh = MakeTee(s, chord); });
+    case ObjectShape::kTee:
+      object->mesh = ReadTee(f);
       return;
-    }
-    case ObjectShape::kFlange: {
-      FlangeShape s;
-      s.outer_radius_m = length("outer_radius_m", s.outer_radius_m);
-      s.wall_m = length("wall_m", s.wall_m);
-      s.length_m = length("length_m", s.length_m);
-      s.flange_radius_m = length("flange_radius_m", s.flange_radius_m);
-      s.flange_thickness_m = length("flange_thickness_m", s.flange_thickness_m);
-      s.bolts = Integer(where, node, "bolts", 0, s.bolts);
-      s.bolt_head_radius_m = length("bolt_head_radius_m", s.bolt_head_radius_m);
-      s.bolt_head_height_m = length("bolt_head_height_m", s.bolt_head_height_m);
-      Checked(where, node, [&] { object->mesh = MakeFlange(s, chord); });
+    case ObjectShape::kFlange:
+      object->mesh = ReadFlange(f);
       return;
-    }
-    case ObjectShape::kValve: {
-      ValveShape s;
-      s.outer_radius_m = length("outer_radius_m", s.outer_radius_m);
-      s.wall_m = length("wall_m", s.wall_m);
-      s.body_radius_m = length("body_radius_m", s.body_radius_m);
-      s.body_length_m = length("body_length_m", s.body_length_m);
-      s.stub_length_m = length("stub_length_m", s.stub_length_m);
-      s.stem_radius_m = length("stem_radius_m", s.stem_radius_m);
-      s.stem_length_m = length("stem_length_m", s.stem_length_m);
-      s.handle_radius_m = length("handle_radius_m", s.handle_radius_m);
-      if (Has(node, "handle")) {
-        const std::string handle = String(where, node, "handle");
-        if (handle == "wheel") {
-          s.handle = ValveHandle::kWheel;
-        } else if (handle == "lever") {
-          s.handle = ValveHandle::kLever;
-        } else {
-          FailField(where, node, "handle", "got '" + handle + "', expected wheel or lever");
-        }
-      }
-      Checked(where, node, [&] { object->mesh = MakeValve(s, chord); });
+    case ObjectShape::kValve:
+      object->mesh = ReadValve(f);
       return;
-    }
     case ObjectShape::kGauge:
-      object->gauge_length_m = Number(where, node, "length_m", Range::kPositive);
+      object->gauge_length_m = f.Length("length_m");
       object->mesh = MakeGaugeBlock(object->gauge_length_m);
       return;
   }

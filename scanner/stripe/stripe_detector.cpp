@@ -80,6 +80,111 @@ std::optional<double> ZeroCrossingNear(const Slope& s) {
   return std::nullopt;
 }
 
+// The lowest of the samples p(k), k in [-left, right], and `top`.
+template <typename Profile>
+double LowestIn(const Profile& p, int left, int right, double top) {
+  double low = top;
+  for (int k = -left; k <= right; ++k) low = std::min(low, p(k));
+  return low;
+}
+
+// The centre of a flat top (saturated, or a run of equal samples 0..run_end): the midpoint of
+// its half-level crossings, searched within k in [-left, right]; std::nullopt when they are not
+// found there.
+template <typename Profile>
+std::optional<double> FlatTopCentre(const Profile& p, int run_end, int left, int right) {
+  const double top = p(0);
+  const double low = LowestIn(p, left, right, top);
+  const double level = 0.5 * (top + low);
+  if (!(level < top)) return std::nullopt;
+  int a = -1;
+  while (a >= -left && p(a) > level) --a;
+  int b = run_end + 1;
+  while (b <= right && p(b) > level) ++b;
+  if (a < -left || b > right) return std::nullopt;
+  const double left_x = a + (level - p(a)) / (p(a + 1) - p(a));
+  const double right_x = b - 1 + (p(b - 1) - level) / (p(b - 1) - p(b));
+  return 0.5 * (left_x + right_x);
+}
+
+// Centre of mass of the samples above the lowest within h of the peak.
+template <typename Profile>
+double CentreOfMassOffset(const Profile& p, int h) {
+  const double low = LowestIn(p, h, h, p(0));
+  double sum_w = 0.0, sum_kw = 0.0;
+  for (int k = -h; k <= h; ++k) {
+    const double w = p(k) - low;
+    sum_w += w;
+    sum_kw += k * w;
+  }
+  return sum_w > 0.0 ? sum_kw / sum_w : 0.0;
+}
+
+// The vertex of the parabola through the logarithms of the three samples at the peak, above the
+// lowest within h of it.
+template <typename Profile>
+std::optional<double> GaussianOffset(const Profile& p, int h) {
+  const double top = p(0);
+  const double low = LowestIn(p, h, h, top);
+  // Half an intensity level keeps the logarithm finite where a neighbour is at background.
+  const double a = std::log(std::max(p(-1) - low, 0.5));
+  const double b = std::log(std::max(top - low, 0.5));
+  const double c = std::log(std::max(p(1) - low, 0.5));
+  const double curvature = a - 2.0 * b + c;
+  if (!(curvature < 0.0)) return std::nullopt;
+  return 0.5 * (a - c) / curvature;
+}
+
+// The vertex of the parabola through the three samples at the peak.
+template <typename Profile>
+std::optional<double> ParabolaOffset(const Profile& p) {
+  const double top = p(0);
+  const double curvature = p(-1) - 2.0 * top + p(1);
+  if (!(curvature < 0.0)) return std::nullopt;
+  return 0.5 * (p(-1) - p(1)) / curvature;
+}
+
+template <typename Profile>
+std::optional<double> BlaisRiouxOffset(const Profile& p) {
+  // Blais & Rioux's filter g(k) = I(k-2) + I(k-1) - I(k+1) - I(k+2), negated here so that,
+  // like a slope, it is positive on the rising side; the centre is its zero crossing.
+  const auto g = [&](int k) { return p(k + 1) + p(k + 2) - p(k - 1) - p(k - 2); };
+  return ZeroCrossingNear(g);
+}
+
+template <typename Profile>
+std::optional<double> StegerOffset(const Profile& p, std::span<const double> steger_d1) {
+  // First derivative of the Gaussian-smoothed profile: positive rising, negative after.
+  const int r = static_cast<int>(steger_d1.size() / 2);
+  const auto d = [&](int k) {
+    double sum = 0.0;
+    for (int j = -r; j <= r; ++j) sum += p(k + j) * steger_d1[j + r];
+    return sum;
+  };
+  return ZeroCrossingNear(d);
+}
+
+// The sub-pixel offset of a peak that is not flat by rp.method, its samples p(k) reaching h
+// each side.
+template <typename Profile>
+std::optional<double> PeakOffset(const RefineParams& rp, const Profile& p, int h) {
+  switch (rp.method) {
+    case StripeMethod::kMaximum:
+      return 0.0;
+    case StripeMethod::kCentreOfMass:
+      return CentreOfMassOffset(p, h);
+    case StripeMethod::kGaussian:
+      return GaussianOffset(p, h);
+    case StripeMethod::kParabola:
+      return ParabolaOffset(p);
+    case StripeMethod::kBlaisRioux:
+      return BlaisRiouxOffset(p);
+    case StripeMethod::kSteger:
+      return StegerOffset(p, rp.steger_d1);
+  }
+  return std::nullopt;
+}
+
 // The refinement of one line. at(i) is the line's sample i in [0, n); i0 its brightest sample
 // (the first of equal maxima). Returns the sub-pixel offset from i0, or std::nullopt.
 template <typename Get>
@@ -96,79 +201,17 @@ std::optional<double> RefineLine(const RefineParams& rp, const Get& at, int n, i
   if (rp.method == StripeMethod::kMaximum) return 0.5 * run_end;
 
   if (top >= saturation || run_end >= 2) {
-    // Flat top: midpoint of the half-level crossings, searched within half_window of the run.
-    const int left = std::min(available_left, rp.half_window);
-    const int right = std::min(available_right, run_end + rp.half_window);
-    double low = top;
-    for (int k = -left; k <= right; ++k) low = std::min(low, p(k));
-    const double level = 0.5 * (top + low);
-    if (!(level < top)) return std::nullopt;
-    int a = -1;
-    while (a >= -left && p(a) > level) --a;
-    int b = run_end + 1;
-    while (b <= right && p(b) > level) ++b;
-    if (a < -left || b > right) return std::nullopt;
-    const double left_x = a + (level - p(a)) / (p(a + 1) - p(a));
-    const double right_x = b - 1 + (p(b - 1) - level) / (p(b - 1) - p(b));
-    return 0.5 * (left_x + right_x);
+    // A flat top: its half-level crossings are searched within half_window of the run.
+    return FlatTopCentre(p, run_end, std::min(available_left, rp.half_window),
+                         std::min(available_right, run_end + rp.half_window));
   }
-
   if (available_left < rp.support || available_right < rp.support) {
+    // Only the centre of mass makes do with less support, as long as there is a sample each side.
     if (rp.method != StripeMethod::kCentreOfMass || available_left < 1 || available_right < 1) {
       return std::nullopt;
     }
   }
-
-  switch (rp.method) {
-    case StripeMethod::kMaximum:
-      return 0.0;
-    case StripeMethod::kCentreOfMass: {
-      const int h = std::min({rp.half_window, available_left, available_right});
-      double low = top;
-      for (int k = -h; k <= h; ++k) low = std::min(low, p(k));
-      double sum_w = 0.0, sum_kw = 0.0;
-      for (int k = -h; k <= h; ++k) {
-        const double w = p(k) - low;
-        sum_w += w;
-        sum_kw += k * w;
-      }
-      return sum_w > 0.0 ? sum_kw / sum_w : 0.0;
-    }
-    case StripeMethod::kGaussian: {
-      const int h = std::min({rp.half_window, available_left, available_right});
-      double low = top;
-      for (int k = -h; k <= h; ++k) low = std::min(low, p(k));
-      // Half an intensity level keeps the logarithm finite where a neighbour is at background.
-      const double a = std::log(std::max(p(-1) - low, 0.5));
-      const double b = std::log(std::max(top - low, 0.5));
-      const double c = std::log(std::max(p(1) - low, 0.5));
-      const double curvature = a - 2.0 * b + c;
-      if (!(curvature < 0.0)) return std::nullopt;
-      return 0.5 * (a - c) / curvature;
-    }
-    case StripeMethod::kParabola: {
-      const double curvature = p(-1) - 2.0 * top + p(1);
-      if (!(curvature < 0.0)) return std::nullopt;
-      return 0.5 * (p(-1) - p(1)) / curvature;
-    }
-    case StripeMethod::kBlaisRioux: {
-      // Blais & Rioux's filter g(k) = I(k-2) + I(k-1) - I(k+1) - I(k+2), negated here so that,
-      // like a slope, it is positive on the rising side; the centre is its zero crossing.
-      const auto g = [&](int k) { return p(k + 1) + p(k + 2) - p(k - 1) - p(k - 2); };
-      return ZeroCrossingNear(g);
-    }
-    case StripeMethod::kSteger: {
-      // First derivative of the Gaussian-smoothed profile: positive rising, negative after.
-      const int r = static_cast<int>(rp.steger_d1.size() / 2);
-      const auto d = [&](int k) {
-        double sum = 0.0;
-        for (int j = -r; j <= r; ++j) sum += p(k + j) * rp.steger_d1[j + r];
-        return sum;
-      };
-      return ZeroCrossingNear(d);
-    }
-  }
-  return std::nullopt;
+  return PeakOffset(rp, p, std::min({rp.half_window, available_left, available_right}));
 }
 
 // The one pass over the frame, in row order: each column's maximum over each block of

@@ -132,39 +132,55 @@ ConeParameters PlaneStart(std::span<const Eigen::Vector3d> points_in_C,
   return params;
 }
 
-// The second start (see FitCone): the algebraic (linear least squares) quadric
-// x^T M x + 2 w^T x + c = 0 through the points, read as a cone: apex = its centre -M^-1 w, axis =
-// the eigenvector of M whose eigenvalue has the odd sign, a and b from the other two. On bent
-// fans it lands within a few percent of the optimum. nullopt when the quadric is not an
-// elliptic cone (e.g. for planar points, where the plane start is right).
-std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> points_in_C) {
-  const Eigen::Index n = static_cast<Eigen::Index>(points_in_C.size());
+// The points' centroid and RMS distance from it.
+struct Spread {
+  Eigen::Vector3d centroid;
+  double scale;
+};
+
+Spread SpreadOf(std::span<const Eigen::Vector3d> points) {
+  const Eigen::Index n = static_cast<Eigen::Index>(points.size());
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points_in_C) {
+  for (const Eigen::Vector3d& p : points) {
     centroid += p;
   }
   centroid /= static_cast<double>(n);
   double scale = 0.0;
-  for (const Eigen::Vector3d& p : points_in_C) {
+  for (const Eigen::Vector3d& p : points) {
     scale += (p - centroid).squaredNorm();
   }
-  scale = std::sqrt(scale / static_cast<double>(n));
-  // Centred and scaled to unit spread so that the ten monomials have comparable sizes.
+  return {centroid, std::sqrt(scale / static_cast<double>(n))};
+}
+
+// The quadric x^T M x + 2 w^T x + c = 0 in the units of a Spread (x = (p - centroid) / scale).
+struct Quadric {
+  Eigen::Matrix3d M;
+  Eigen::Vector3d w;
+};
+
+// The algebraic (linear least squares) quadric through the points: the right singular vector of
+// the smallest singular value. The points are centred and scaled to unit spread so that the ten
+// monomials have comparable sizes.
+Quadric FitQuadric(std::span<const Eigen::Vector3d> points, const Spread& spread) {
+  const Eigen::Index n = static_cast<Eigen::Index>(points.size());
   Eigen::Matrix<double, Eigen::Dynamic, 10> design(n, 10);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d p = (points_in_C[i] - centroid) / scale;
+    const Eigen::Vector3d p = (points[i] - spread.centroid) / spread.scale;
     design.row(i) << p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), 2.0 * p.x() * p.y(),
         2.0 * p.x() * p.z(), 2.0 * p.y() * p.z(), 2.0 * p.x(), 2.0 * p.y(), 2.0 * p.z(), 1.0;
   }
   const Eigen::JacobiSVD<Eigen::Matrix<double, Eigen::Dynamic, 10>> svd(design,
                                                                         Eigen::ComputeFullV);
   const Eigen::Matrix<double, 10, 1> v = svd.matrixV().col(9);
-  Eigen::Matrix3d M;
-  M << v(0), v(3), v(4), v(3), v(1), v(5), v(4), v(5), v(2);
-  const Eigen::Vector3d w(v(6), v(7), v(8));
+  Quadric quadric;
+  quadric.M << v(0), v(3), v(4), v(3), v(1), v(5), v(4), v(5), v(2);
+  quadric.w = Eigen::Vector3d(v(6), v(7), v(8));
+  return quadric;
+}
 
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(M);
-  const Eigen::Vector3d lambda = eigen.eigenvalues();
+// The index of the eigenvalue of M with the odd sign, the cone's axis; std::nullopt when the
+// quadric with these eigenvalues is not an elliptic cone.
+std::optional<int> ConeAxis(const Eigen::Vector3d& lambda) {
   const double lambda_max = lambda.cwiseAbs().maxCoeff();
   if (!(lambda.cwiseAbs().minCoeff() > 1e-9 * lambda_max)) return std::nullopt;  // not a cone
   const int positives = static_cast<int>((lambda.array() > 0.0).count());
@@ -175,14 +191,21 @@ std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> poin
       k_axis = k;
     }
   }
-  const Eigen::Vector3d apex_C = centroid + scale * (-M.inverse() * w);
-  if (!apex_C.allFinite()) {
-    return std::nullopt;
-  }
+  return k_axis;
+}
 
-  // Orient the axis towards the points and take as y_Q the other eigenvector closer to the
-  // fan's mean direction: the lit sheet is centred on beta = pi/2, i.e. on the y_Q side.
-  Eigen::Vector3d z_axis = eigen.eigenvectors().col(k_axis);
+// The cone's frame {Q} from M's eigenvectors: z_Q along the axis (column k_axis), oriented towards
+// the points; y_Q the other eigenvector closer to the fan's mean direction, as the lit sheet is
+// centred on beta = pi/2, i.e. on the y_Q side; and which eigenvectors became x_Q and y_Q.
+struct ConeFrame {
+  Eigen::Matrix3d R_C_Q;
+  int k_x;
+  int k_y;
+};
+
+ConeFrame FrameOf(const Eigen::Matrix3d& eigenvectors, int k_axis, const Eigen::Vector3d& apex_C,
+                  std::span<const Eigen::Vector3d> points_in_C) {
+  Eigen::Vector3d z_axis = eigenvectors.col(k_axis);
   Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& p : points_in_C) {
     mean_dir += (p - apex_C).normalized();
@@ -192,27 +215,25 @@ std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> poin
   }
   const int k1 = (k_axis + 1) % 3;
   const int k2 = (k_axis + 2) % 3;
-  const bool k1_is_y = std::abs(eigen.eigenvectors().col(k1).dot(mean_dir)) >=
-                       std::abs(eigen.eigenvectors().col(k2).dot(mean_dir));
-  const int k_y = k1_is_y ? k1 : k2;
-  const int k_x = k1_is_y ? k2 : k1;
-  const Eigen::Vector3d y_axis = eigen.eigenvectors().col(k_y);
-  Eigen::Matrix3d R_C_Q;
-  R_C_Q << y_axis.cross(z_axis), y_axis, z_axis;
-  // Normalised so that the axis eigenvalue is -1: then M ~ diag(1/a^2, 1/b^2, -1) in {Q}.
-  const double inv_a_sq = lambda(k_x) / -lambda(k_axis);
-  const double inv_b_sq = lambda(k_y) / -lambda(k_axis);
+  const bool k1_is_y =
+      std::abs(eigenvectors.col(k1).dot(mean_dir)) >= std::abs(eigenvectors.col(k2).dot(mean_dir));
+  ConeFrame frame;
+  frame.k_y = k1_is_y ? k1 : k2;
+  frame.k_x = k1_is_y ? k2 : k1;
+  const Eigen::Vector3d y_axis = eigenvectors.col(frame.k_y);
+  frame.R_C_Q << y_axis.cross(z_axis), y_axis, z_axis;
+  return frame;
+}
 
+// The start on the cone with apex apex_C, orientation R_C_Q and cross-section slopes a, b: each
+// point's (h, beta) read from its position in {Q}.
+ConeParameters StartOnCone(std::span<const Eigen::Vector3d> points_in_C,
+                           const Eigen::Matrix3d& R_C_Q, const Eigen::Vector3d& apex_C, double a,
+                           double b) {
   ConeParameters params;
   const Eigen::Quaterniond q(R_C_Q);
   params.q_wxyz = {q.w(), q.x(), q.y(), q.z()};
   params.t_C_Q = {apex_C.x(), apex_C.y(), apex_C.z()};
-  double sum_y = 0.0;
-  for (const Eigen::Vector3d& p : points_in_C) {
-    sum_y += y_axis.dot(p - apex_C);
-  }
-  const double a = 1.0 / std::sqrt(inv_a_sq);
-  const double b = std::copysign(1.0 / std::sqrt(inv_b_sq), sum_y);  // the points' sheet
   params.ab = {a, b};
   params.h_beta.reserve(points_in_C.size());
   for (const Eigen::Vector3d& p : points_in_C) {
@@ -220,6 +241,37 @@ std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> poin
     params.h_beta.push_back({p_Q.z(), std::atan2(p_Q.y() / b, p_Q.x() / a)});
   }
   return params;
+}
+
+// The second start (see FitCone): the algebraic (linear least squares) quadric
+// x^T M x + 2 w^T x + c = 0 through the points, read as a cone: apex = its centre -M^-1 w, axis =
+// the eigenvector of M whose eigenvalue has the odd sign, a and b from the other two. On bent
+// fans it lands within a few percent of the optimum. nullopt when the quadric is not an
+// elliptic cone (e.g. for planar points, where the plane start is right).
+std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> points_in_C) {
+  const Spread spread = SpreadOf(points_in_C);
+  const Quadric quadric = FitQuadric(points_in_C, spread);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(quadric.M);
+  const Eigen::Vector3d lambda = eigen.eigenvalues();
+  const std::optional<int> k_axis = ConeAxis(lambda);
+  if (!k_axis) return std::nullopt;
+  const Eigen::Vector3d apex_C =
+      spread.centroid + spread.scale * (-quadric.M.inverse() * quadric.w);
+  if (!apex_C.allFinite()) {
+    return std::nullopt;
+  }
+  const ConeFrame frame = FrameOf(eigen.eigenvectors(), *k_axis, apex_C, points_in_C);
+  // Normalised so that the axis eigenvalue is -1: then M ~ diag(1/a^2, 1/b^2, -1) in {Q}.
+  const double inv_a_sq = lambda(frame.k_x) / -lambda(*k_axis);
+  const double inv_b_sq = lambda(frame.k_y) / -lambda(*k_axis);
+  const Eigen::Vector3d y_axis = frame.R_C_Q.col(1);
+  double sum_y = 0.0;
+  for (const Eigen::Vector3d& p : points_in_C) {
+    sum_y += y_axis.dot(p - apex_C);
+  }
+  const double a = 1.0 / std::sqrt(inv_a_sq);
+  const double b = std::copysign(1.0 / std::sqrt(inv_b_sq), sum_y);  // the points' sheet
+  return StartOnCone(points_in_C, frame.R_C_Q, apex_C, a, b);
 }
 
 // Sum of squared residuals of a start, to choose between starts.
