@@ -60,8 +60,8 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o, const std::vect
   j["std_rot_rad_trans_m"] = std_dev;
   nlohmann::json free = nlohmann::json::array();
   for (const perception::FreeDirection& f : o.free_directions) {
-    free.push_back({{"kind", f.kind},
-                    {"motion", f.motion},
+    free.push_back({{"kind", perception::ToString(f.kind)},
+                    {"motion", perception::ToString(f.motion)},
                     {"axis", Vector(f.axis_S)},
                     {"point_m", Vector(f.point_S)},
                     {"order", f.order}});

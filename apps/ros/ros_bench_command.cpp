@@ -199,7 +199,14 @@ InspectFigures DirectInspect(const RosBenchArgs& a, const fs::path& folder) {
   ChildProcess camera(
       {Self(), "fake-camera", a.scene, "--mode", "profile", "--fps", std::to_string(a.camera_fps)},
       folder / "camera.log");
-  std::this_thread::sleep_for(std::chrono::seconds(2));
+  // The camera simulates the whole dive before it serves (minutes for a long one).
+  WaitFor(
+      [&folder] {
+        std::ifstream log(folder / "camera.log");
+        const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+        return text.find("fake-camera: serving") != std::string::npos;
+      },
+      1800, "the fake camera did not start serving (see " + (folder / "camera.log").string() + ")");
   const fs::path json = folder / "inspect.json";
   ChildProcess inspect({Self(), "inspect", "--camera", "127.0.0.1", "--scene", a.scene, "--log",
                         (folder / "inspect.db").string(), "--json", json.string(), "--seconds",

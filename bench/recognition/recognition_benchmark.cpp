@@ -158,7 +158,7 @@ std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
 // The offset left once the translation along the answer's reported free slides is taken out.
 Eigen::Vector3d OffsetAcrossFreeSlides(Eigen::Vector3d offset, const perception::RecognizedObject& reported) {
   for (const perception::FreeDirection& f : reported.free_directions) {
-    if (f.kind == "unconstrained" && f.motion == "translation") offset -= offset.dot(f.axis_S) * f.axis_S;
+    if (f.kind == perception::FreeKind::kUnconstrained && f.motion == perception::FreeMotion::kTranslation) offset -= offset.dot(f.axis_S) * f.axis_S;
   }
   return offset;
 }
@@ -186,7 +186,7 @@ bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Ei
   }
   if (PosedButForFreeSlides(e, T_S_O, *reported)) return true;
   for (const perception::FreeDirection& f : reported->free_directions) {
-    if (f.kind != "unconstrained" || f.motion != "rotation") continue;
+    if (f.kind != perception::FreeKind::kUnconstrained || f.motion != perception::FreeMotion::kRotation) continue;
     for (int degrees = -180; degrees < 180; ++degrees) {
       const Eigen::Isometry3d turn = Eigen::Translation3d(f.point_S) *
                                      Eigen::AngleAxisd(degrees * kDeg, f.axis_S) * Eigen::Translation3d(-f.point_S);
@@ -437,8 +437,8 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
         outcome.candidate_errors.push_back(CandidateError(c, truth, T_S_O_true, db));
       }
       for (const perception::FreeDirection& f : ours.free_directions) {
-        if (f.kind != "unconstrained") continue;
-        ++(f.motion == "translation" ? outcome.free_slides : outcome.free_turns);
+        if (f.kind != perception::FreeKind::kUnconstrained) continue;
+        ++(f.motion == perception::FreeMotion::kTranslation ? outcome.free_slides : outcome.free_turns);
       }
       if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"], &ours)) {
         outcome.rotation_error_rad = e->rotation_rad;

@@ -412,6 +412,91 @@ std::string ForEachInteger(sqlite3* db, const std::string& sql, const std::funct
 
 }  // namespace
 
+namespace {
+
+// SQLite's own check of the file's structure (pages, b-trees), without the index cross-checks:
+// what it found wrong ("ok" left out).
+std::vector<std::string> QuickCheck(sqlite3* db) {
+  std::vector<std::string> problems;
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(db, "PRAGMA quick_check(20)", -1, &raw, nullptr) != SQLITE_OK) {
+    problems.push_back(sqlite3_errmsg(db));
+  }
+  const Statement statement(raw);
+  int rc = SQLITE_DONE;
+  while (raw && (rc = sqlite3_step(raw)) == SQLITE_ROW) {
+    const auto* text = reinterpret_cast<const char*>(sqlite3_column_text(raw, 0));
+    const std::string line = text ? text : "?";
+    if (line != "ok") problems.push_back(line);
+  }
+  if (raw && rc != SQLITE_DONE) problems.push_back(sqlite3_errmsg(db));
+  return problems;
+}
+
+// Frames one by one through the primary key, so that a damaged page costs only its rows. A
+// frame is worth keeping without its ground truth: a real dive has none.
+void CheckFrames(const DiveLogReader& log, sqlite3* db, const std::string& name,
+                 const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
+                 DiveLogCheck& check) {
+  std::vector<std::int64_t> indices;
+  const std::string listing = ForEachInteger(db, "SELECT frame_index FROM frames ORDER BY frame_index",
+                                             [&](std::int64_t index) { indices.push_back(index); });
+  if (!listing.empty()) {
+    check.damage.push_back({"file", -1, name + ": cannot list the frames past " + std::to_string(indices.size()) +
+                                            " (" + listing + ")"});
+  }
+  check.frames = static_cast<std::int64_t>(indices.size());
+  std::int64_t expected = 0;
+  for (std::int64_t index : indices) {
+    for (; expected < index; ++expected) {
+      check.damage.push_back({"frames", expected, name + ": " + FrameName(expected) + " is missing"});
+    }
+    expected = index + 1;
+    std::optional<FrameRecord> record;
+    try {
+      record = log.ReadFrame(index);
+    } catch (const Error& e) {
+      check.damage.push_back({"frames", index, e.what()});
+      continue;
+    }
+    std::optional<GroundTruthRecord> truth;
+    try {
+      truth = log.ReadGroundTruth(index);
+    } catch (const Error& e) {
+      check.damage.push_back({"ground_truth", index, e.what()});
+      ++check.frames_with_damaged_truth;
+    }
+    ++check.frames_intact;
+    if (frame) frame(*record, truth ? &*truth : nullptr);
+  }
+}
+
+// Navigation row by row, in the order it was appended, from `s` (nav_id, time, pose, checksums).
+void CheckNavigation(sqlite3_stmt* s, sqlite3* db, const std::string& name, bool checksummed,
+                     const std::function<void(const NavigationRecord&)>& navigation, DiveLogCheck& check) {
+  int rc;
+  while ((rc = sqlite3_step(s)) == SQLITE_ROW) {
+    ++check.navigation;
+    const std::int64_t nav_id = sqlite3_column_int64(s, 0);
+    try {
+      const Row row(s, name, "navigation sample " + std::to_string(nav_id));
+      if (checksummed) row.VerifyChecksums(1, 8, 9);
+      const NavigationRecord record{row.Real(1), row.Pose(2)};
+      ++check.navigation_intact;
+      if (navigation) navigation(record);
+    } catch (const Error& e) {
+      check.damage.push_back({"navigation", nav_id, e.what()});
+    }
+  }
+  if (rc != SQLITE_DONE) {
+    check.damage.push_back({"file", -1, name + ": cannot read the navigation past " +
+                                            std::to_string(check.navigation) + " samples (" + sqlite3_errmsg(db) +
+                                            ")"});
+  }
+}
+
+}  // namespace
+
 DiveLogCheck DiveLogReader::Check(
     const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
     const std::function<void(const NavigationRecord&)>& navigation) const {
@@ -422,92 +507,17 @@ DiveLogCheck DiveLogReader::Check(
   if (const std::optional<std::string> truncation = Truncation(r.path)) {
     check.integrity.push_back("the file is " + *truncation);
   }
-
-  // SQLite's own check of the file's structure (pages, b-trees), without the index cross-checks.
-  {
-    sqlite3_stmt* raw = nullptr;
-    if (sqlite3_prepare_v2(r.db.get(), "PRAGMA quick_check(20)", -1, &raw, nullptr) != SQLITE_OK) {
-      check.integrity.push_back(sqlite3_errmsg(r.db.get()));
-    }
-    const Statement statement(raw);
-    int rc = SQLITE_DONE;
-    while (raw && (rc = sqlite3_step(raw)) == SQLITE_ROW) {
-      const auto* text = reinterpret_cast<const char*>(sqlite3_column_text(raw, 0));
-      const std::string line = text ? text : "?";
-      if (line != "ok") check.integrity.push_back(line);
-    }
-    if (raw && rc != SQLITE_DONE) check.integrity.push_back(sqlite3_errmsg(r.db.get()));
-  }
-  auto damaged = [&](const std::string& table, std::int64_t row, const std::string& message) {
-    check.damage.push_back({table, row, message});
-  };
-
+  for (std::string& problem : QuickCheck(r.db.get())) check.integrity.push_back(std::move(problem));
   try {
     vehicle_mount();
   } catch (const Error& e) {
-    damaged("header", -1, e.what());
+    check.damage.push_back({"header", -1, e.what()});
   }
-
-  // Frames one by one through the primary key, so that a damaged page costs only its rows.
-  std::vector<std::int64_t> indices;
-  const std::string listing =
-      ForEachInteger(r.db.get(), "SELECT frame_index FROM frames ORDER BY frame_index",
-                     [&](std::int64_t index) { indices.push_back(index); });
-  if (!listing.empty()) {
-    damaged("file", -1, r.name + ": cannot list the frames past " + std::to_string(indices.size()) +
-                            " (" + listing + ")");
-  }
-  check.frames = static_cast<std::int64_t>(indices.size());
-  std::int64_t expected = 0;
-  for (std::int64_t index : indices) {
-    for (; expected < index; ++expected) {
-      damaged("frames", expected, r.name + ": " + FrameName(expected) + " is missing");
-    }
-    expected = index + 1;
-    std::optional<FrameRecord> record;
-    try {
-      record = ReadFrame(index);
-    } catch (const Error& e) {
-      damaged("frames", index, e.what());
-      continue;
-    }
-    // A frame is worth keeping without its ground truth: a real dive has none.
-    std::optional<GroundTruthRecord> truth;
-    try {
-      truth = ReadGroundTruth(index);
-    } catch (const Error& e) {
-      damaged("ground_truth", index, e.what());
-      ++check.frames_with_damaged_truth;
-    }
-    ++check.frames_intact;
-    if (frame) frame(*record, truth ? &*truth : nullptr);
-  }
-
-  // Navigation: row by row, in the order it was appended.
-  const bool checksummed = r.checksummed();
+  CheckFrames(*this, r.db.get(), r.name, frame, check);
   const Statement statement = r.Prepare(
       "SELECT nav_id, time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, T_W_V_qz, "
-      "T_W_V_qw, " + Checksums("navigation", checksummed) + " FROM navigation ORDER BY nav_id", 0);
-  sqlite3_stmt* s = statement.get();
-  int rc;
-  while ((rc = sqlite3_step(s)) == SQLITE_ROW) {
-    ++check.navigation;
-    const std::int64_t nav_id = sqlite3_column_int64(s, 0);
-    try {
-      const Row row(s, r.name, "navigation sample " + std::to_string(nav_id));
-      if (checksummed) row.VerifyChecksums(1, 8, 9);
-      const NavigationRecord record{row.Real(1), row.Pose(2)};
-      ++check.navigation_intact;
-      if (navigation) navigation(record);
-    } catch (const Error& e) {
-      damaged("navigation", nav_id, e.what());
-    }
-  }
-  if (rc != SQLITE_DONE) {
-    damaged("file", -1, r.name + ": cannot read the navigation past " +
-                            std::to_string(check.navigation) + " samples (" +
-                            sqlite3_errmsg(r.db.get()) + ")");
-  }
+      "T_W_V_qw, " + Checksums("navigation", r.checksummed()) + " FROM navigation ORDER BY nav_id", 0);
+  CheckNavigation(statement.get(), r.db.get(), r.name, r.checksummed(), navigation, check);
   return check;
 }
 

@@ -63,6 +63,84 @@ void CheckPose(const Eigen::Isometry3d& T, const std::string& where) {
   }
 }
 
+// Throws, naming the log, unless the header can be written.
+void CheckHeader(const DiveLogHeader& header, const std::string& name) {
+  try {
+    header.scanner.Check();
+    header.scan_pattern.Check();
+    if (header.navigation_noise) header.navigation_noise->Check();
+  } catch (const Error& e) {
+    throw Error(name + ": invalid header: " + e.what());
+  }
+  if (header.scan_pattern.kind != header.scanner.kind()) {
+    throw Error(name + ": header.scan_pattern is for a " + scanner::ToString(header.scan_pattern.kind) +
+                " scanner, header.scanner is " + scanner::ToString(header.scanner.kind()));
+  }
+}
+
+// Creates the empty file exclusively: an existing file, a log being written included, is never
+// overwritten, and SQLite would replay a leftover journal of an earlier file into the new one.
+void CreateExclusively(const fs::path& path, const std::string& name) {
+  for (const char* suffix : {"-wal", "-journal"}) {
+    std::error_code ec;
+    if (fs::exists(WithSuffix(path, suffix), ec)) {
+      throw Error(name + ": a stray " + Quoted(WithSuffix(path, suffix)) +
+                  " exists; remove it (or the log it belongs to) first");
+    }
+  }
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    if (errno == EEXIST) {
+      throw Error(name + ": the file already exists; a dive log is never overwritten");
+    }
+    throw Error(name + ": cannot create (" + std::strerror(errno) + ")");
+  }
+  ::close(fd);
+}
+
+void CheckImage(const LogImage& image, const std::string& where) {
+  if (image.width_px <= 0 || image.height_px <= 0) {
+    throw Error(where + ": image size " + std::to_string(image.width_px) + "x" +
+                std::to_string(image.height_px) + " px, expected at least 1x1");
+  }
+  if (image.format != LogPixelFormat::kMono8 && image.format != LogPixelFormat::kMono16) {
+    throw Error(where + ": image format " + std::to_string(static_cast<int>(image.format)) +
+                " is neither Mono8 nor Mono16");
+  }
+  const std::uint64_t expected = std::uint64_t(image.width_px) * std::uint64_t(image.height_px) *
+                                 (image.format == LogPixelFormat::kMono8 ? 1 : 2);
+  if (image.bytes.size() != expected) {
+    throw Error(where + ": image holds " + std::to_string(image.bytes.size()) +
+                " bytes, expected " + std::to_string(expected) + " for its size and format");
+  }
+}
+
+void CheckTruth(const GroundTruthRecord& truth, std::size_t peaks, const std::string& where) {
+  CheckPose(truth.T_W_C, where + ": ground truth T_W_C");
+  if (truth.points_W.size() != peaks || truth.object_ids.size() != peaks) {
+    throw Error(where + ": ground truth has " + std::to_string(truth.points_W.size()) +
+                " points and " + std::to_string(truth.object_ids.size()) +
+                " object ids, expected one per peak (" + std::to_string(peaks) + ")");
+  }
+  for (std::size_t i = 0; i < truth.points_W.size(); ++i) {
+    if (!truth.points_W[i].allFinite()) {
+      throw Error(where + ": ground truth point " + std::to_string(i) + " is not finite");
+    }
+  }
+}
+
+// Everything about a frame that would make its row unreadable, checked before its transaction.
+void CheckFrame(const FrameRecord& frame, const GroundTruthRecord* truth, const std::string& where) {
+  if (!std::isfinite(frame.time_s)) throw Error(where + ": time_s is not finite");
+  for (std::size_t i = 0; i < frame.peaks_px.size(); ++i) {
+    if (!frame.peaks_px[i].allFinite()) {
+      throw Error(where + ": peak " + std::to_string(i) + " is not finite");
+    }
+  }
+  if (frame.image) CheckImage(*frame.image, where);
+  if (truth) CheckTruth(*truth, frame.peaks_px.size(), where);
+}
+
 // The coordinates of packed fixed-size Eigen vectors as one array (null when there are none).
 template <typename Vector>
 const double* Coordinates(const std::vector<Vector>& vectors) {
@@ -128,6 +206,125 @@ struct DiveLogWriter::Impl {
     return sqlite::Prepare(db.get(), sql, SQLITE_PREPARE_PERSISTENT, name, "cannot prepare");
   }
 
+  void OpenInWalMode() {
+    db = sqlite::Open(path, SQLITE_OPEN_READWRITE, kBusyTimeout_ms, name);
+    const std::string application_id = "PRAGMA application_id = " + std::to_string(kApplicationId);
+    sqlite::Exec(db.get(), application_id.c_str(), name, "cannot set the application id");
+    // WAL: a commit appends to the -wal file, so a killed writer never leaves a half-written
+    // page in the database, and readers (other processes too) read while it writes.
+    Statement mode = Prepare("PRAGMA journal_mode = WAL");
+    const bool stepped = sqlite3_step(mode.get()) == SQLITE_ROW;
+    const auto* text = stepped ? sqlite3_column_text(mode.get(), 0) : nullptr;
+    if (!text || std::string(reinterpret_cast<const char*>(text)) != "wal") {
+      throw Error(name + ": cannot use a WAL journal here (a file system without shared memory?)");
+    }
+  }
+
+  // The header reaches the disk at once, the file's directory entry too: a power cut never
+  // loses the log itself. Afterwards the WAL is synced at checkpoints, not at each commit: a
+  // frame costs a write, not a flush to disk (README: what a power cut can lose).
+  void WriteHeaderDurably(const DiveLogHeader& header) {
+    sqlite::Exec(db.get(), "PRAGMA synchronous = FULL", name, "cannot set synchronous mode");
+    WriteHeader(header);
+    sqlite::Exec(db.get(), "PRAGMA synchronous = NORMAL", name, "cannot set synchronous mode");
+    SyncDirectoryOf(path);
+  }
+
+  void PrepareStatements() {
+    begin = Prepare("BEGIN IMMEDIATE");
+    commit = Prepare("COMMIT");
+    rollback = Prepare("ROLLBACK");
+    insert_frame = Prepare(
+        "INSERT INTO frames (frame_index, time_s, command, sweep, peaks_px, image_width_px, "
+        "image_height_px, image_format, image, checksums) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    insert_truth = Prepare(
+        "INSERT INTO ground_truth (frame_index, T_W_C_tx, T_W_C_ty, T_W_C_tz, T_W_C_qx, "
+        "T_W_C_qy, T_W_C_qz, T_W_C_qw, points_W, object_ids, checksums) "
+        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    insert_navigation = Prepare(
+        "INSERT INTO navigation (time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, "
+        "T_W_V_qz, T_W_V_qw, checksums) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    update_mount = Prepare(
+        "UPDATE header SET T_V_C_tx = ?, T_V_C_ty = ?, T_V_C_tz = ?, T_V_C_qx = ?, "
+        "T_V_C_qy = ?, T_V_C_qz = ?, T_V_C_qw = ?, checksums = ?");
+  }
+
+  // The frame's row; the checksums follow the columns' order (dive_log_format.hpp).
+  void InsertFrame(std::int64_t index, const FrameRecord& frame) {
+    int rc = SQLITE_OK;  // the first failure of a bind
+    auto bind = [&rc](int result) {
+      if (rc == SQLITE_OK) rc = result;
+    };
+    sqlite3_stmt* s = insert_frame.get();
+    ResetOnExit reset(s);
+    RowChecksums checksums;
+    bind(sqlite3_bind_int64(s, 1, index));
+    bind(sqlite3_bind_double(s, 2, frame.time_s));
+    bind(sqlite3_bind_int(s, 3, frame.command));
+    bind(sqlite3_bind_int(s, 4, frame.sweep));
+    for (double value : {double(index), frame.time_s, double(frame.command), double(frame.sweep)}) {
+      checksums.Number(value);
+    }
+    const std::size_t num_peaks = frame.peaks_px.size();
+    const void* peaks = sqlite::LittleEndianBytes(Coordinates(frame.peaks_px), 2 * num_peaks, scratch[0]);
+    bind(sqlite::BindBlob(s, 5, peaks, num_peaks * sizeof(Eigen::Vector2d)));
+    checksums.Bytes(peaks, num_peaks * sizeof(Eigen::Vector2d));
+    if (frame.image) {
+      BindImage(s, *frame.image, bind, checksums);
+    } else {  // the image columns stay NULL
+      for (int i = 0; i < 4; ++i) checksums.Null();
+    }
+    bind(sqlite::BindBlob(s, 10, checksums.blob().data(), checksums.blob().size()));
+    if (rc != SQLITE_OK) sqlite::Fail(name, "cannot bind " + FrameName(index), db.get());
+    if (sqlite3_step(s) != SQLITE_DONE) sqlite::Fail(name, "cannot insert " + FrameName(index), db.get());
+  }
+
+  // Columns 6-9 of a frame's row.
+  template <typename Bind>
+  void BindImage(sqlite3_stmt* s, const LogImage& image, Bind& bind, RowChecksums& checksums) {
+    bind(sqlite3_bind_int(s, 6, image.width_px));
+    bind(sqlite3_bind_int(s, 7, image.height_px));
+    bind(sqlite3_bind_int(s, 8, static_cast<int>(image.format)));
+    for (int value : {image.width_px, image.height_px, static_cast<int>(image.format)}) {
+      checksums.Number(value);
+    }
+    const void* pixels = image.bytes.data();
+    if constexpr (std::endian::native != std::endian::little) {
+      if (image.format == LogPixelFormat::kMono16) {  // little-endian in the file
+        scratch[1] = image.bytes;
+        SwapBytePairs(scratch[1]);
+        pixels = scratch[1].data();
+      }
+    }
+    bind(sqlite::BindBlob(s, 9, pixels, image.bytes.size()));
+    checksums.Bytes(pixels, image.bytes.size());
+  }
+
+  void InsertTruth(std::int64_t index, const GroundTruthRecord& truth) {
+    int rc = SQLITE_OK;
+    auto bind = [&rc](int result) {
+      if (rc == SQLITE_OK) rc = result;
+    };
+    const std::size_t num_peaks = truth.points_W.size();
+    sqlite3_stmt* t = insert_truth.get();
+    ResetOnExit reset_truth(t);
+    RowChecksums checksums;
+    bind(sqlite3_bind_int64(t, 1, index));
+    bind(sqlite::BindPose(t, 2, truth.T_W_C));
+    checksums.Number(double(index));
+    for (double value : sqlite::PoseColumns(truth.T_W_C)) checksums.Number(value);
+    const void* points = sqlite::LittleEndianBytes(Coordinates(truth.points_W), 3 * num_peaks, scratch[2]);
+    const void* ids = sqlite::LittleEndianBytes(truth.object_ids.data(), num_peaks, scratch[3]);
+    bind(sqlite::BindBlob(t, 9, points, num_peaks * sizeof(Eigen::Vector3d)));
+    bind(sqlite::BindBlob(t, 10, ids, num_peaks * sizeof(std::int32_t)));
+    checksums.Bytes(points, num_peaks * sizeof(Eigen::Vector3d));
+    checksums.Bytes(ids, num_peaks * sizeof(std::int32_t));
+    bind(sqlite::BindBlob(t, 11, checksums.blob().data(), checksums.blob().size()));
+    if (rc != SQLITE_OK || sqlite3_step(t) != SQLITE_DONE) {
+      sqlite::Fail(name, "cannot insert the ground truth of " + FrameName(index), db.get());
+    }
+  }
+
   // Creates the tables and writes the header in one transaction.
   void WriteHeader(const DiveLogHeader& header) {
     sqlite3* handle = db.get();
@@ -189,82 +386,12 @@ DiveLogWriter::DiveLogWriter(const std::filesystem::path& path, const DiveLogHea
   Impl& w = *impl_;
   w.path = path;
   w.name = LogName(path);
+  CheckHeader(header, w.name);
+  CreateExclusively(path, w.name);
   try {
-    header.scanner.Check();
-    header.scan_pattern.Check();
-  } catch (const Error& e) {
-    throw Error(w.name + ": invalid header: " + e.what());
-  }
-  if (header.navigation_noise) {
-    try {
-      header.navigation_noise->Check();
-    } catch (const Error& e) {
-      throw Error(w.name + ": invalid header: " + e.what());
-    }
-  }
-  if (header.scan_pattern.kind != header.scanner.kind()) {
-    throw Error(w.name + ": header.scan_pattern is for a " + scanner::ToString(header.scan_pattern.kind) +
-                " scanner, header.scanner is " + scanner::ToString(header.scanner.kind()));
-  }
-  // SQLite would replay a leftover journal of an earlier file into the new one.
-  for (const char* suffix : {"-wal", "-journal"}) {
-    std::error_code ec;
-    if (fs::exists(WithSuffix(path, suffix), ec)) {
-      throw Error(w.name + ": a stray " + Quoted(WithSuffix(path, suffix)) +
-                  " exists; remove it (or the log it belongs to) first");
-    }
-  }
-  // Created exclusively: an existing file, a log being written included, is never overwritten.
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    if (errno == EEXIST) {
-      throw Error(w.name + ": the file already exists; a dive log is never overwritten");
-    }
-    throw Error(w.name + ": cannot create (" + std::strerror(errno) + ")");
-  }
-  ::close(fd);
-
-  try {
-    w.db = sqlite::Open(path, SQLITE_OPEN_READWRITE, kBusyTimeout_ms, w.name);
-    sqlite3* db = w.db.get();
-    const std::string application_id = "PRAGMA application_id = " + std::to_string(kApplicationId);
-    sqlite::Exec(db, application_id.c_str(), w.name, "cannot set the application id");
-    {
-      // WAL: a commit appends to the -wal file, so a killed writer never leaves a half-written
-      // page in the database, and readers (other processes too) read while it writes.
-      Statement mode = w.Prepare("PRAGMA journal_mode = WAL");
-      const bool stepped = sqlite3_step(mode.get()) == SQLITE_ROW;
-      const auto* text = stepped ? sqlite3_column_text(mode.get(), 0) : nullptr;
-      if (!text || std::string(reinterpret_cast<const char*>(text)) != "wal") {
-        throw Error(w.name +
-                    ": cannot use a WAL journal here (a file system without shared "
-                    "memory?)");
-      }
-    }
-    // The header reaches the disk at once, the file's directory entry too: a power cut never
-    // loses the log itself. Afterwards the WAL is synced at checkpoints, not at each commit: a
-    // frame costs a write, not a flush to disk (README: what a power cut can lose).
-    sqlite::Exec(db, "PRAGMA synchronous = FULL", w.name, "cannot set synchronous mode");
-    w.WriteHeader(header);
-    sqlite::Exec(db, "PRAGMA synchronous = NORMAL", w.name, "cannot set synchronous mode");
-    SyncDirectoryOf(path);
-
-    w.begin = w.Prepare("BEGIN IMMEDIATE");
-    w.commit = w.Prepare("COMMIT");
-    w.rollback = w.Prepare("ROLLBACK");
-    w.insert_frame = w.Prepare(
-        "INSERT INTO frames (frame_index, time_s, command, sweep, peaks_px, image_width_px, "
-        "image_height_px, image_format, image, checksums) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    w.insert_truth = w.Prepare(
-        "INSERT INTO ground_truth (frame_index, T_W_C_tx, T_W_C_ty, T_W_C_tz, T_W_C_qx, "
-        "T_W_C_qy, T_W_C_qz, T_W_C_qw, points_W, object_ids, checksums) "
-        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    w.insert_navigation = w.Prepare(
-        "INSERT INTO navigation (time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, "
-        "T_W_V_qz, T_W_V_qw, checksums) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    w.update_mount = w.Prepare(
-        "UPDATE header SET T_V_C_tx = ?, T_V_C_ty = ?, T_V_C_tz = ?, T_V_C_qx = ?, "
-        "T_V_C_qy = ?, T_V_C_qz = ?, T_V_C_qw = ?, checksums = ?");
+    w.OpenInWalMode();
+    w.WriteHeaderDurably(header);
+    w.PrepareStatements();
   } catch (...) {
     // The file is ours (created exclusively above): leave nothing half-made behind.
     impl_.reset();
@@ -284,115 +411,11 @@ std::int64_t DiveLogWriter::AppendFrame(const FrameRecord& frame, const GroundTr
   assert(impl_ && "DiveLogWriter used after being moved from");
   Impl& w = *impl_;
   const std::int64_t index = w.frame_count;
-  const std::string where = w.name + ": " + FrameName(index);
-
   // Everything is checked before the transaction: a refused frame leaves no trace.
-  if (!std::isfinite(frame.time_s)) throw Error(where + ": time_s is not finite");
-  for (std::size_t i = 0; i < frame.peaks_px.size(); ++i) {
-    if (!frame.peaks_px[i].allFinite()) {
-      throw Error(where + ": peak " + std::to_string(i) + " is not finite");
-    }
-  }
-  if (frame.image) {
-    const LogImage& image = *frame.image;
-    if (image.width_px <= 0 || image.height_px <= 0) {
-      throw Error(where + ": image size " + std::to_string(image.width_px) + "x" +
-                  std::to_string(image.height_px) + " px, expected at least 1x1");
-    }
-    if (image.format != LogPixelFormat::kMono8 && image.format != LogPixelFormat::kMono16) {
-      throw Error(where + ": image format " + std::to_string(static_cast<int>(image.format)) +
-                  " is neither Mono8 nor Mono16");
-    }
-    const std::uint64_t expected = std::uint64_t(image.width_px) * std::uint64_t(image.height_px) *
-                                   (image.format == LogPixelFormat::kMono8 ? 1 : 2);
-    if (image.bytes.size() != expected) {
-      throw Error(where + ": image holds " + std::to_string(image.bytes.size()) +
-                  " bytes, expected " + std::to_string(expected) + " for its size and format");
-    }
-  }
-  if (truth) {
-    CheckPose(truth->T_W_C, where + ": ground truth T_W_C");
-    if (truth->points_W.size() != frame.peaks_px.size() ||
-        truth->object_ids.size() != frame.peaks_px.size()) {
-      throw Error(where + ": ground truth has " + std::to_string(truth->points_W.size()) +
-                  " points and " + std::to_string(truth->object_ids.size()) +
-                  " object ids, expected one per peak (" + std::to_string(frame.peaks_px.size()) +
-                  ")");
-    }
-    for (std::size_t i = 0; i < truth->points_W.size(); ++i) {
-      if (!truth->points_W[i].allFinite()) {
-        throw Error(where + ": ground truth point " + std::to_string(i) + " is not finite");
-      }
-    }
-  }
-
+  CheckFrame(frame, truth, w.name + ": " + FrameName(index));
   w.InTransaction(FrameName(index), [&] {
-    int rc = SQLITE_OK;  // the first failure of a bind
-    auto bind = [&rc](int result) {
-      if (rc == SQLITE_OK) rc = result;
-    };
-    sqlite3_stmt* s = w.insert_frame.get();
-    ResetOnExit reset(s);
-    // The checksums follow the columns' order (dive_log_format.hpp).
-    RowChecksums checksums;
-    bind(sqlite3_bind_int64(s, 1, index));
-    bind(sqlite3_bind_double(s, 2, frame.time_s));
-    bind(sqlite3_bind_int(s, 3, frame.command));
-    bind(sqlite3_bind_int(s, 4, frame.sweep));
-    for (double value : {double(index), frame.time_s, double(frame.command), double(frame.sweep)}) {
-      checksums.Number(value);
-    }
-    const std::size_t num_peaks = frame.peaks_px.size();
-    const void* peaks =
-        sqlite::LittleEndianBytes(Coordinates(frame.peaks_px), 2 * num_peaks, w.scratch[0]);
-    bind(sqlite::BindBlob(s, 5, peaks, num_peaks * sizeof(Eigen::Vector2d)));
-    checksums.Bytes(peaks, num_peaks * sizeof(Eigen::Vector2d));
-    if (!frame.image) {  // the image columns stay NULL
-      for (int i = 0; i < 4; ++i) checksums.Null();
-    } else {
-      const LogImage& image = *frame.image;
-      bind(sqlite3_bind_int(s, 6, image.width_px));
-      bind(sqlite3_bind_int(s, 7, image.height_px));
-      bind(sqlite3_bind_int(s, 8, static_cast<int>(image.format)));
-      for (int value : {image.width_px, image.height_px, static_cast<int>(image.format)}) {
-        checksums.Number(value);
-      }
-      const void* pixels = image.bytes.data();
-      if constexpr (std::endian::native != std::endian::little) {
-        if (image.format == LogPixelFormat::kMono16) {  // little-endian in the file
-          w.scratch[1] = image.bytes;
-          SwapBytePairs(w.scratch[1]);
-          pixels = w.scratch[1].data();
-        }
-      }
-      bind(sqlite::BindBlob(s, 9, pixels, image.bytes.size()));
-      checksums.Bytes(pixels, image.bytes.size());
-    }
-    bind(sqlite::BindBlob(s, 10, checksums.blob().data(), checksums.blob().size()));
-    if (rc != SQLITE_OK) sqlite::Fail(w.name, "cannot bind " + FrameName(index), w.db.get());
-    if (sqlite3_step(s) != SQLITE_DONE) {
-      sqlite::Fail(w.name, "cannot insert " + FrameName(index), w.db.get());
-    }
-    if (!truth) return;
-
-    sqlite3_stmt* t = w.insert_truth.get();
-    ResetOnExit reset_truth(t);
-    RowChecksums truth_checksums;
-    bind(sqlite3_bind_int64(t, 1, index));
-    bind(sqlite::BindPose(t, 2, truth->T_W_C));
-    truth_checksums.Number(double(index));
-    for (double value : sqlite::PoseColumns(truth->T_W_C)) truth_checksums.Number(value);
-    const void* points =
-        sqlite::LittleEndianBytes(Coordinates(truth->points_W), 3 * num_peaks, w.scratch[2]);
-    const void* ids = sqlite::LittleEndianBytes(truth->object_ids.data(), num_peaks, w.scratch[3]);
-    bind(sqlite::BindBlob(t, 9, points, num_peaks * sizeof(Eigen::Vector3d)));
-    bind(sqlite::BindBlob(t, 10, ids, num_peaks * sizeof(std::int32_t)));
-    truth_checksums.Bytes(points, num_peaks * sizeof(Eigen::Vector3d));
-    truth_checksums.Bytes(ids, num_peaks * sizeof(std::int32_t));
-    bind(sqlite::BindBlob(t, 11, truth_checksums.blob().data(), truth_checksums.blob().size()));
-    if (rc != SQLITE_OK || sqlite3_step(t) != SQLITE_DONE) {
-      sqlite::Fail(w.name, "cannot insert the ground truth of " + FrameName(index), w.db.get());
-    }
+    w.InsertFrame(index, frame);
+    if (truth) w.InsertTruth(index, *truth);
   });
   return w.frame_count++;
 }

@@ -1,4 +1,5 @@
 #include "mapping/slam/map_report.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 #include <algorithm>
 #include <Eigen/Eigenvalues>
@@ -13,7 +14,7 @@ namespace {
 // Exact when the free direction is a pure translation (a slide, mapper.cpp); a loop without a
 // usable information is judged whole.
 Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& error, const Matrix6d& information) {
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (information + information.transpose()));
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(Symmetrized(information));
   const double largest = eigen.eigenvalues()(5);
   if (!information.allFinite() || !(largest > 0.0)) return error;
   Eigen::Matrix<double, 6, 1> measured = Eigen::Matrix<double, 6, 1>::Zero();

@@ -14,6 +14,7 @@
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/triangulation/triangulator_factory.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -59,6 +60,20 @@ double LargestStd(const Eigen::Matrix3d& covariance) {
   return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
 }
 
+// The ICP of a registration with the given stages, as MapperOptions sets it.
+perception::IcpOptions RegistrationIcp(const MapperOptions& o, const std::vector<double>& distances) {
+  perception::IcpOptions icp;
+  icp.method = perception::IcpMethod::kPointToPlane;
+  icp.max_correspondence_distance_m = distances;
+  icp.max_iterations = o.icp_max_iterations;
+  icp.max_iterations_per_stage = o.icp_max_iterations_per_stage;
+  icp.translation_tolerance_m = o.icp_translation_tolerance_voxels * o.clouds.map_voxel_m;
+  icp.rotation_tolerance_rad = o.icp_rotation_tolerance_rad;
+  icp.relative_rmse_tolerance = o.icp_relative_rmse_tolerance;
+  icp.threads = o.threads;
+  return icp;
+}
+
 }  // namespace
 
 void MapperOptions::Check() const {
@@ -86,11 +101,15 @@ void MapperOptions::Check() const {
   if (!(max_navigation_gap_s > 0.0 && std::isfinite(max_navigation_gap_s))) fail("max_navigation_gap_s", "> 0 s");
   if (!(navigation_latency_s >= 0.0 && std::isfinite(navigation_latency_s))) fail("navigation_latency_s", ">= 0 s");
   if (threads < 0) fail("threads", ">= 0");
-  perception::IcpOptions icp;
-  icp.max_correspondence_distance_m = icp_distances_m;
-  icp.Check();
-  icp.max_correspondence_distance_m = loop_icp_distances_m;
-  icp.Check();
+  if (icp_max_iterations < 1) fail("icp_max_iterations", "> 0");
+  if (icp_max_iterations_per_stage < 1) fail("icp_max_iterations_per_stage", "> 0");
+  if (!(icp_translation_tolerance_voxels > 0.0)) fail("icp_translation_tolerance_voxels", "> 0");
+  if (!(icp_rotation_tolerance_rad > 0.0)) fail("icp_rotation_tolerance_rad", "> 0 rad");
+  if (!(icp_relative_rmse_tolerance >= 0.0 && icp_relative_rmse_tolerance < 1.0)) {
+    fail("icp_relative_rmse_tolerance", "in [0, 1)");
+  }
+  RegistrationIcp(*this, icp_distances_m).Check();
+  RegistrationIcp(*this, loop_icp_distances_m).Check();
 }
 
 struct Mapper::Impl {
@@ -150,7 +169,21 @@ struct Mapper::Impl {
   // calibration may still be settling.
   Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
   Matrix6d ChainCovariance(int from, int to) const;
+  // Loop closures (TryLoopClosures), step by step.
+  struct LoopCandidate {
+    int j;            // the earlier submap
+    double distance;  // between the two centres, as the graph places them now
+    Matrix6d covariance;  // of T_j_k, predicted along the chain between them
+  };
   void TryLoopClosures(int k);
+  std::vector<LoopCandidate> LoopCandidates(int k) const;
+  perception::PointCloud LoopTarget(int j, int k) const;  // submap j with its neighbours, in j's frame
+  std::vector<double> LoopIcpDistances(const LoopCandidate& c, const Eigen::Isometry3d& T_pred) const;
+  LoopClosure JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c, int k,
+                        const Eigen::Isometry3d& T_pred) const;
+  std::string LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
+                            const Matrix6d& information, const Matrix6d& prediction_covariance,
+                            const Eigen::Isometry3d& T_pred, double* chi2) const;
   void Solve(bool last = false);  // last: the solve at Finish, to the full tolerance
   static int AnchorNode(int submap) { return 2 * submap; }
   static int ScanNode(int submap) { return 2 * submap + 1; }
@@ -163,7 +196,7 @@ struct Mapper::Impl {
   // corrected by the placement calibration.
   Eigen::Isometry3d PlacementPose(double time_s) const {
     Eigen::Isometry3d T_W_V =
-        navigation.T_W_V(std::clamp(time_s, navigation.first_time_s(), navigation.last_time_s()));
+        navigation.T_W_V(navigation.HeldTime(time_s));
     T_W_V.translation() = placement_origin_W + placement.Correct(T_W_V.translation() - placement_origin_W);
     return T_W_V;
   }
@@ -197,7 +230,7 @@ void Mapper::Impl::Place(const FrameRecord& frame) {
     first_sweep = frame.sweep;
     placement = graph.calibration();
     placement_origin_W = navigation
-                             .T_W_V(std::clamp(frame.time_s, navigation.first_time_s(), navigation.last_time_s()))
+                             .T_W_V(navigation.HeldTime(frame.time_s))
                              .translation();
   }
   const Clock::time_point start = Clock::now();
@@ -229,13 +262,13 @@ void Mapper::Impl::CloseSubmap() {
   submap.last_frame = frames.back().first;
   submap.start_s = frames.front().second;
   submap.end_s = frames.back().second;
-  const double t = std::clamp(anchor.second, navigation.first_time_s(), navigation.last_time_s());
+  const double t = navigation.HeldTime(anchor.second);
   submap.T_W_V_nav = navigation.T_W_V(t);
-  const auto clamped = [&](double time) {
-    return navigation.T_W_V(std::clamp(time, navigation.first_time_s(), navigation.last_time_s()));
+  const auto held_pose = [&](double time) {
+    return navigation.T_W_V(navigation.HeldTime(time));
   };
-  submap.T_W_V_start = clamped(submap.start_s);
-  submap.T_W_V_end = clamped(submap.end_s);
+  submap.T_W_V_start = held_pose(submap.start_s);
+  submap.T_W_V_end = held_pose(submap.end_s);
   // The points in the anchor's frame as the corrected navigation placed it.
   const Eigen::Isometry3d T_V_W = PlacementPose(anchor.second).inverse();
   std::vector<Eigen::Vector3d> points_V;
@@ -259,21 +292,11 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
                                                       const Eigen::Isometry3d& T_init,
                                                       const Matrix6d& prior_covariance,
                                                       const std::vector<double>& distances) const {
-  perception::IcpOptions icp;
-  icp.method = perception::IcpMethod::kPointToPlane;
-  icp.max_correspondence_distance_m = distances;
-  icp.max_iterations = 120;
-  icp.max_iterations_per_stage = 30;
-  // Converged once a step moves the data less than a twentieth of the finest voxel: finer
-  // steps are the pairing flickering between neighbours, not progress.
-  icp.translation_tolerance_m = 0.05 * options.clouds.map_voxel_m;
-  icp.rotation_tolerance_rad = 2e-5;
-  icp.relative_rmse_tolerance = 1e-4;
-  icp.threads = options.threads;
+  perception::IcpOptions icp = RegistrationIcp(options, distances);
   perception::IcpPrior prior;
   prior.T_target_source = T_init;
   prior.information = prior_covariance.inverse();
-  prior.information = 0.5 * (prior.information + prior.information.transpose());
+  prior.information = Symmetrized(prior.information);
   prior.point_sigma_m = 2.0 * options.point_sigma_floor_m;
   icp.prior = prior;
   return perception::AlignIcp(source.sparse, target, T_init, icp);
@@ -311,7 +334,7 @@ Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b) const 
   const Matrix6d covariance =
       uncertainty.IncrementCovariance(a.T_W_V_nav, b.T_W_V_nav, b.anchor_time_s - a.anchor_time_s, systematic_errors) +
       Distortion(a, systematic_errors) + ad * Distortion(b, systematic_errors) * ad.transpose();
-  return 0.5 * (covariance + covariance.transpose());
+  return Symmetrized(covariance);
 }
 
 Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
@@ -361,7 +384,8 @@ void Mapper::Impl::AddToGraph(Submap submap) {
     // Along a slide the registration measures nothing, so the test has as many degrees of
     // freedom as directions it pins.
     if (r.fitness >= options.min_fitness && chi2 <= Chi2Quantile999(kept.count)) {
-      registration = RelativePoseEdge{ScanNode(k - 1), ScanNode(k), r.T_target_source, information, false, 3.0};
+      registration = RelativePoseEdge{
+          .from = ScanNode(k - 1), .to = ScanNode(k), .T_from_to = r.T_target_source, .information = information};
       slides = SlideCovariance(kept.slides, r.T_target_source, options.slide_sigma_m);
       scan_initial = ScanPose(k - 1) * r.T_target_source;
       const Matrix6d combined = (increment_cov.inverse() + information).inverse();
@@ -375,22 +399,26 @@ void Mapper::Impl::AddToGraph(Submap submap) {
   const int scan = graph.AddNode(scan_initial);
   if (anchor != AnchorNode(k) || scan != ScanNode(k)) throw Error("mapper: graph nodes out of step with submaps");
   const Matrix6d distortion_information = (Distortion(submap, systematic()) + slides).inverse();
-  graph.AddEdge({anchor, scan, Eigen::Isometry3d::Identity(),
-                 0.5 * (distortion_information + distortion_information.transpose()), false, 3.0});
+  graph.AddEdge({.from = anchor, .to = scan, .information = Symmetrized(distortion_information)});
   if (k == 0) {
-    graph.AddPrior({anchor, submap.T_W_V_nav, StartInformation()});
+    graph.AddPrior({.node = anchor, .T_W_V = submap.T_W_V_nav, .information = StartInformation()});
   } else {
     const Submap& previous = submaps.back();
-    graph.AddEdge({AnchorNode(k - 1), anchor, previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
-                   uncertainty.OdometryInformation(previous.T_W_V_nav, submap.T_W_V_nav,
-                                                   submap.anchor_time_s - previous.anchor_time_s, systematic()),
-                   false, 3.0, options.estimate_dead_reckoning_calibration});
+    graph.AddEdge({.from = AnchorNode(k - 1),
+                   .to = anchor,
+                   .T_from_to = previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
+                   .information = uncertainty.OdometryInformation(previous.T_W_V_nav, submap.T_W_V_nav,
+                                                                  submap.anchor_time_s - previous.anchor_time_s,
+                                                                  systematic()),
+                   .dead_reckoned = options.estimate_dead_reckoning_calibration});
     if (registration) graph.AddEdge(*registration);
   }
-  graph.AddDepth({anchor, submap.T_W_V_nav.translation().z(), noise.depth_sigma_m});
-  graph.AddGravity({anchor, submap.T_W_V_nav.linear().transpose() * Eigen::Vector3d::UnitZ(), noise.roll_pitch_sigma_rad});
+  graph.AddDepth({.node = anchor, .z_m = submap.T_W_V_nav.translation().z(), .sigma_m = noise.depth_sigma_m});
+  graph.AddGravity({.node = anchor,
+                    .down_in_V = submap.T_W_V_nav.linear().transpose() * Eigen::Vector3d::UnitZ(),
+                    .sigma_rad = noise.roll_pitch_sigma_rad});
   submaps.push_back(std::move(submap));
-  increment_covariance.push_back(0.5 * (increment_cov + increment_cov.transpose()));
+  increment_covariance.push_back(Symmetrized(increment_cov));
 
   const std::size_t loops_before = std::count_if(loops.begin(), loops.end(), [](const LoopClosure& l) { return l.accepted; });
   TryLoopClosures(k);
@@ -398,17 +426,33 @@ void Mapper::Impl::AddToGraph(Submap submap) {
   if (loops_after > loops_before || ++since_solve >= options.solve_every_submaps) Solve();
 }
 
+// Loop closures for submap k: the earlier submaps whose overlap with it is plausible, nearest
+// first, each registered from the predicted pose and judged (JudgeLoop); an accepted one becomes
+// an edge between the two scans.
 void Mapper::Impl::TryLoopClosures(int k) {
   if (options.max_loop_candidates == 0 || k % options.loop_every_submaps != 0) return;
   const Clock::time_point start = Clock::now();
+  for (const LoopCandidate& c : LoopCandidates(k)) {
+    const Eigen::Isometry3d T_pred = ScanPose(c.j).inverse() * ScanPose(k);
+    const perception::RegistrationResult r = Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), T_pred,
+                                                      c.covariance, LoopIcpDistances(c, T_pred));
+    const LoopClosure loop = JudgeLoop(r, c, k, T_pred);
+    if (loop.accepted) {
+      graph.AddEdge({.from = ScanNode(c.j),
+                     .to = ScanNode(k),
+                     .T_from_to = r.T_target_source,
+                     .information = loop.information,
+                     .robust = true});
+    }
+    loops.push_back(loop);
+  }
+  stats.loop_s += Since(start);
+}
+
+std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) const {
   const Submap& current = submaps[static_cast<size_t>(k)];
   const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
-  struct Candidate {
-    int j;
-    double distance;
-    Matrix6d covariance;
-  };
-  std::vector<Candidate> candidates;
+  std::vector<LoopCandidate> candidates;
   for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
     const Submap& old = submaps[static_cast<size_t>(j)];
     const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
@@ -424,63 +468,73 @@ void Mapper::Impl::TryLoopClosures(int k) {
     candidates.push_back({j, distance, covariance});
   }
   std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+                   [](const LoopCandidate& a, const LoopCandidate& b) { return a.distance < b.distance; });
   if (candidates.size() > static_cast<size_t>(options.max_loop_candidates)) {
     candidates.resize(static_cast<size_t>(options.max_loop_candidates));
   }
-  for (const Candidate& c : candidates) {
-    const int j = c.j;
-    perception::PointCloud target;
-    for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
-      AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i), &target);
-    }
-    const Eigen::Isometry3d T_pred = ScanPose(j).inverse() * ScanPose(k);
-    const Eigen::Vector3d t = T_pred.translation();
-    // The first stage reaches as far as the prediction may be off: three times the largest
-    // position std of the scan's origin (the gate above asked the narrower question, whether
-    // the two centres can meet at all).
-    std::vector<double> distances = options.loop_icp_distances_m;
-    const double reach = options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, t));
-    if (reach > distances.front()) distances.insert(distances.begin(), reach);
-    const perception::RegistrationResult r = Register(current, target, T_pred, c.covariance, distances);
+  return candidates;
+}
 
-    LoopClosure loop;
-    loop.from = j;
-    loop.to = k;
-    loop.fitness = r.fitness;
-    loop.T_from_to = r.T_target_source;
-    KeptDirections kept;
-    const Matrix6d information = RegistrationInformation(r, submaps[static_cast<size_t>(j)], current, &kept);
-    const int constrained = kept.count;
-    loop.constrained_directions = constrained;
-    loop.information = information;
-    // Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
-    // others, as for consecutive submaps, are left to the navigation), and the registration
-    // must be certain and consistent with the prediction in them.
-    const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
-    const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
-    if (r.fitness < options.loop_min_fitness) {
-      loop.reason = "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
-    } else if (constrained < options.loop_min_directions) {
-      loop.reason = "degenerate: the scans pin " + std::to_string(constrained) + " directions, fewer than " +
-                    std::to_string(options.loop_min_directions);
-    } else if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
-      loop.reason = "uncertain: registration std " + std::to_string(sigma_m) + " m, " + std::to_string(sigma_rad) +
-                    " rad";
-    } else {
-      const Vector6d innovation = PoseError(r.T_target_source, T_pred);
-      loop.chi2 = innovation.dot(InformationOfSum(information, c.covariance) * innovation);
-      if (!(loop.chi2 <= Chi2Quantile999(constrained))) {
-        loop.reason = "inconsistent with the prediction: chi2 " + std::to_string(loop.chi2) + " in " +
-                      std::to_string(constrained) + " directions";
-      } else {
-        loop.accepted = true;
-        graph.AddEdge({ScanNode(j), ScanNode(k), r.T_target_source, information, true, 3.0});
-      }
-    }
-    loops.push_back(loop);
+perception::PointCloud Mapper::Impl::LoopTarget(int j, int k) const {
+  perception::PointCloud target;
+  for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
+    AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i), &target);
   }
-  stats.loop_s += Since(start);
+  return target;
+}
+
+std::vector<double> Mapper::Impl::LoopIcpDistances(const LoopCandidate& c, const Eigen::Isometry3d& T_pred) const {
+  // The first stage reaches as far as the prediction may be off: three times the largest
+  // position std of the scan's origin (the gate asked the narrower question, whether the two
+  // centres can meet at all).
+  std::vector<double> distances = options.loop_icp_distances_m;
+  const double reach = options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, T_pred.translation()));
+  if (reach > distances.front()) distances.insert(distances.begin(), reach);
+  return distances;
+}
+
+LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c, int k,
+                                    const Eigen::Isometry3d& T_pred) const {
+  LoopClosure loop;
+  loop.from = c.j;
+  loop.to = k;
+  loop.fitness = r.fitness;
+  loop.T_from_to = r.T_target_source;
+  KeptDirections kept;
+  loop.information =
+      RegistrationInformation(r, submaps[static_cast<size_t>(c.j)], submaps[static_cast<size_t>(k)], &kept);
+  loop.constrained_directions = kept.count;
+  loop.reason = LoopRejection(r, kept, loop.information, c.covariance, T_pred, &loop.chi2);
+  loop.accepted = loop.reason.empty();
+  return loop;
+}
+
+// Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
+// others, as for consecutive submaps, are left to the navigation), and the registration must be
+// certain and consistent with the prediction in them. "" when it is.
+std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
+                                        const Matrix6d& information, const Matrix6d& prediction_covariance,
+                                        const Eigen::Isometry3d& T_pred, double* chi2) const {
+  const int constrained = kept.count;
+  const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
+  const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
+  if (r.fitness < options.loop_min_fitness) {
+    return "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
+  }
+  if (constrained < options.loop_min_directions) {
+    return "degenerate: the scans pin " + std::to_string(constrained) + " directions, fewer than " +
+           std::to_string(options.loop_min_directions);
+  }
+  if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
+    return "uncertain: registration std " + std::to_string(sigma_m) + " m, " + std::to_string(sigma_rad) + " rad";
+  }
+  const Vector6d innovation = PoseError(r.T_target_source, T_pred);
+  *chi2 = innovation.dot(InformationOfSum(information, prediction_covariance) * innovation);
+  if (!(*chi2 <= Chi2Quantile999(constrained))) {
+    return "inconsistent with the prediction: chi2 " + std::to_string(*chi2) + " in " + std::to_string(constrained) +
+           " directions";
+  }
+  return "";
 }
 
 void Mapper::Impl::Solve(bool last) {

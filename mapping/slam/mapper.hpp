@@ -29,6 +29,15 @@ struct MapperOptions {
   // ICP stages (metres, non-increasing) for consecutive submaps and for loop closures.
   std::vector<double> icp_distances_m = {0.04, 0.02, 0.01};
   std::vector<double> loop_icp_distances_m = {0.10, 0.04, 0.02, 0.01};
+  // Every registration's ICP (point-to-plane, the prediction as its prior): iterations in all
+  // and per stage (> 0), and when a stage has converged: once a step moves the data less than
+  // this fraction of the map voxel (finer steps are the pairing flickering between neighbours,
+  // not progress), turns it less than this angle, or lowers the RMSE by less than this fraction.
+  int icp_max_iterations = 120;
+  int icp_max_iterations_per_stage = 30;
+  double icp_translation_tolerance_voxels = 0.05;
+  double icp_rotation_tolerance_rad = 2e-5;
+  double icp_relative_rmse_tolerance = 1e-4;
   double point_sigma_floor_m = 0.0003;  // a point-to-plane residual is never trusted beyond this
   // A registration edge is kept only above this fitness, and only if it agrees with the
   // navigation's motion in the directions it pins (chi-square at 99.9 % for their number).

@@ -28,6 +28,10 @@ double NavigationBuffer::first_time_s() const {
   return samples_.front().time_s;
 }
 
+double NavigationBuffer::HeldTime(double time_s) const {
+  return std::clamp(time_s, first_time_s(), last_time_s());
+}
+
 double NavigationBuffer::last_time_s() const {
   if (samples_.empty()) throw Error("navigation: no sample yet");
   return samples_.back().time_s;

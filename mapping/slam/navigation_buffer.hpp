@@ -26,6 +26,9 @@ class NavigationBuffer {
   double GapAround(double time_s) const;
   // T_W_V at time_s; throws uwscan::Error outside [first, last] or when empty.
   Eigen::Isometry3d T_W_V(double time_s) const;
+  // time_s held to [first, last] sample time, where the pose is known (the buffer must not be
+  // empty): for frames at the very ends of a dive, a pose held at its nearest sample.
+  double HeldTime(double time_s) const;
   // Forgets samples that no time >= time_s needs (keeps the one at or before it).
   void DropBefore(double time_s);
 

@@ -41,5 +41,15 @@ TEST(NavigationBuffer, OutsideItsSpanItSaysWhereItsSamplesAre) {
   EXPECT_THROW(nav.T_W_V(0.5), Error);
 }
 
+TEST(NavigationBuffer, HeldTimeStaysWithinTheSamples) {
+  NavigationBuffer nav;
+  nav.Add(At(1.0, 0.0));
+  nav.Add(At(2.0, 0.5));
+  EXPECT_EQ(nav.HeldTime(0.2), 1.0);
+  EXPECT_EQ(nav.HeldTime(1.25), 1.25);
+  EXPECT_EQ(nav.HeldTime(7.0), 2.0);
+  EXPECT_EQ(nav.T_W_V(nav.HeldTime(7.0)).translation().x(), 0.5);
+}
+
 }  // namespace
 }  // namespace uwscan::mapping

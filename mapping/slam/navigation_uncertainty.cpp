@@ -1,4 +1,5 @@
 #include "mapping/slam/navigation_uncertainty.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 #include <algorithm>
 
@@ -151,7 +152,7 @@ Matrix6d InformationOfSum(const Matrix6d& information_a, const Matrix6d& covaria
   const Matrix6d information_b = covariance_b.inverse();
   const Matrix6d inner = (information_a + information_b).inverse();
   const Matrix6d sum = information_a - information_a * inner * information_a;
-  return 0.5 * (sum + sum.transpose());
+  return Symmetrized(sum);
 }
 
 Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,

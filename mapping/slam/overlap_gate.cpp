@@ -1,4 +1,5 @@
 #include "mapping/slam/overlap_gate.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -31,7 +32,7 @@ double ErrorNorm(const Eigen::Vector3d& g, const Eigen::Vector3d& s, double lamb
 double MahalanobisGapToOverlap(const Eigen::Vector3d& gap_m, double overlap_m, const Eigen::Matrix3d& covariance) {
   if (!gap_m.allFinite() || !covariance.allFinite() || !std::isfinite(overlap_m)) return kInfinity;
   if (gap_m.norm() <= overlap_m) return 0.0;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(0.5 * (covariance + covariance.transpose()));
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(Symmetrized(covariance));
   const Eigen::Vector3d s = eigen.eigenvalues().cwiseMax(0.0);
   const Eigen::Vector3d g = eigen.eigenvectors().transpose() * gap_m;
   // What no amount of error can close: the gap along directions without variance.

@@ -13,6 +13,7 @@
 
 #include "mapping/slam/inverse_blocks.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -158,7 +159,7 @@ Vector6d PoseError(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) {
 }
 
 Matrix6d SqrtPsd(const Matrix6d& information) {
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(0.5 * (information + information.transpose()));
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(Symmetrized(information));
   const Vector6d root = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   return solver.eigenvectors() * root.asDiagonal() * solver.eigenvectors().transpose();
 }

@@ -1,4 +1,5 @@
 #include "mapping/slam/registration_information.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -49,7 +50,7 @@ KeptDirections WithoutWeakDirections(const Matrix6d& information, const percepti
   out.count = static_cast<int>((values.array() > 0.0).count());
   const Matrix6d c = N * eigen.eigenvectors() * inverse_values.asDiagonal() * eigen.eigenvectors().transpose() *
                      N.transpose();
-  out.covariance = 0.5 * (c + c.transpose());
+  out.covariance = Symmetrized(c);
   const Matrix6d N_inverse = N.inverse();
   const Matrix6d kept = N_inverse.transpose() * eigen.eigenvectors() * values.asDiagonal() *
                         eigen.eigenvectors().transpose() * N_inverse;
@@ -71,7 +72,7 @@ KeptDirections WithoutWeakDirections(const Matrix6d& information, const percepti
     out.slides.push_back(slide.tail<3>());
   }
   const Matrix6d projected = P * kept * P;
-  out.information = 0.5 * (projected + projected.transpose());
+  out.information = Symmetrized(projected);
   return out;
 }
 

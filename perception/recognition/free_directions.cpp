@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -34,9 +35,9 @@ void Check(const Matrix6d& information, const Matrix6d& patch_spread, const Eige
   }
 }
 
-FreeDirection Free(const char* motion, const Eigen::Vector3d& axis_O, const Eigen::Vector3d& point_O) {
+FreeDirection Free(FreeMotion motion, const Eigen::Vector3d& axis_O, const Eigen::Vector3d& point_O) {
   FreeDirection f;
-  f.kind = "unconstrained";
+  f.kind = FreeKind::kUnconstrained;
   f.motion = motion;
   f.axis_S = axis_O;
   f.point_S = point_O;
@@ -47,7 +48,7 @@ FreeDirection Free(const char* motion, const Eigen::Vector3d& axis_O, const Eige
 // c + w x v / |w|^2 along w (its pitch, v along w, is dropped).
 FreeDirection Rotation(const Vector6d& twist, const Eigen::Vector3d& centre_O) {
   const Eigen::Vector3d w = twist.head<3>(), v = twist.tail<3>();
-  return Free("rotation", w.normalized(), centre_O + w.cross(v) / w.squaredNorm());
+  return Free(FreeMotion::kRotation, w.normalized(), centre_O + w.cross(v) / w.squaredNorm());
 }
 
 // Two free twists combined into the two whose pitch w . v is zero, when there are two: the
@@ -83,8 +84,8 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
   // Rotations scaled by the radius: both halves in metres, so one tolerance judges both.
   Matrix6d D = Matrix6d::Identity();
   D.topLeftCorner<3, 3>() *= 1.0 / radius_m;
-  const Matrix6d scaled = D * (0.5 * (information + information.transpose())) * D;
-  const Matrix6d spread = D * (0.5 * (patch_spread + patch_spread.transpose())) * D;
+  const Matrix6d scaled = D * Symmetrized(information) * D;
+  const Matrix6d spread = D * Symmetrized(patch_spread) * D;
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(scaled);
   PoseConstraints out;
   Matrix6d inverse = Matrix6d::Zero();  // over the pinned directions, scaled
@@ -125,7 +126,7 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
     for (const Eigen::Vector3d& s : slides) axis -= axis.dot(s) * s;  // orthonormal slides
     if (axis.norm() > 1e-6) slides.push_back(axis.normalized());
   }
-  for (const Eigen::Vector3d& s : slides) out.free_O.push_back(Free("translation", s, centre_O));
+  for (const Eigen::Vector3d& s : slides) out.free_O.push_back(Free(FreeMotion::kTranslation, s, centre_O));
   // A free slide can be added to any rotation: taken out, the rotation's axis is the one that
   // moves least, e.g. a pipe's roll about its own axis rather than a screw along it.
   for (Vector6d& r : rotations) {
@@ -137,6 +138,12 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
   }
   for (const Vector6d& r : rotations) out.free_O.push_back(Rotation(r, centre_O));
   return out;
+}
+
+std::string ToString(FreeKind kind) { return kind == FreeKind::kSymmetry ? "symmetry" : "unconstrained"; }
+
+std::string ToString(FreeMotion motion) {
+  return motion == FreeMotion::kRotation ? "rotation" : "translation";
 }
 
 }  // namespace uwscan::perception

@@ -8,9 +8,17 @@
 namespace uwscan::perception {
 
 // A direction a recognised object's pose leaves undetermined.
+// Why a pose leaves a direction free: the object looks the same moved along it (a symmetry), or
+// the scan does not show enough of it to pin it (unconstrained).
+enum class FreeKind { kSymmetry, kUnconstrained };
+enum class FreeMotion { kRotation, kTranslation };
+// "symmetry" | "unconstrained", "rotation" | "translation": as recognition reports write them.
+std::string ToString(FreeKind kind);
+std::string ToString(FreeMotion motion);
+
 struct FreeDirection {
-  std::string kind;    // "symmetry" (of the object) or "unconstrained" (by the data)
-  std::string motion;  // "rotation" or "translation"
+  FreeKind kind = FreeKind::kUnconstrained;
+  FreeMotion motion = FreeMotion::kTranslation;
   Eigen::Vector3d axis_S = Eigen::Vector3d::UnitZ();  // unit, scan frame
   Eigen::Vector3d point_S = Eigen::Vector3d::Zero();  // a point on a rotation axis, scan frame
   int order = 0;  // symmetry: 0 continuous, N-fold; unconstrained: 0

@@ -43,10 +43,10 @@ double DistanceToLine(const Eigen::Vector3d& p, const Eigen::Vector3d& on_line, 
   return (d - d.dot(axis.normalized()) * axis.normalized()).norm();
 }
 
-std::vector<FreeDirection> Of(const PoseConstraints& c, const std::string& motion) {
+std::vector<FreeDirection> Of(const PoseConstraints& c, FreeMotion motion) {
   std::vector<FreeDirection> out;
   for (const FreeDirection& f : c.free_O) {
-    EXPECT_EQ(f.kind, "unconstrained");
+    EXPECT_EQ(f.kind, FreeKind::kUnconstrained);
     if (f.motion == motion) out.push_back(f);
   }
   return out;
@@ -69,7 +69,7 @@ TEST(FreeDirections, APipeWithoutEndsSlidesAndRollsAboutItsOwnAxis) {
   const Eigen::Vector3d centre = pipe.Centroid();  // off the axis: half the circumference
   const PoseConstraints c = AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, 0.2, 1e-3);
   ASSERT_EQ(c.free_O.size(), 2u);
-  const auto slides = Of(c, "translation"), rolls = Of(c, "rotation");
+  const auto slides = Of(c, FreeMotion::kTranslation), rolls = Of(c, FreeMotion::kRotation);
   ASSERT_EQ(slides.size(), 1u);
   ASSERT_EQ(rolls.size(), 1u);
   EXPECT_NEAR(std::abs(slides[0].axis_S.dot(axis)), 1.0, 1e-9);
@@ -116,7 +116,7 @@ TEST(FreeDirections, AnElbowWithoutEndsTurnsAboutItsBendAxis) {
   const PoseConstraints c = AnalysePoseConstraints(Information(elbow, centre), kNoSpread, centre, 1e-4, 0.2, 1e-3);
   ASSERT_EQ(c.free_O.size(), 1u);
   const FreeDirection& turn = c.free_O[0];
-  EXPECT_EQ(turn.motion, "rotation");
+  EXPECT_EQ(turn.motion, FreeMotion::kRotation);
   EXPECT_NEAR(std::abs(turn.axis_S.z()), 1.0, 1e-9);
   EXPECT_LT(DistanceToLine(turn.point_S, bend_centre, Eigen::Vector3d::UnitZ()), 1e-9);
 }
@@ -144,7 +144,7 @@ TEST(FreeDirections, TwoFreeRotationsComeBackAboutTheirOwnAxes) {
   const Matrix6d information = D_inverse * scaled * D_inverse;
 
   const PoseConstraints c = AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, radius, 1e-3);
-  const auto rotations = Of(c, "rotation");
+  const auto rotations = Of(c, FreeMotion::kRotation);
   ASSERT_EQ(c.free_O.size(), 2u);
   ASSERT_EQ(rotations.size(), 2u);
   for (const auto& [point, axis] : {std::pair(point_a, axis_a), std::pair(point_b, axis_b)}) {
@@ -167,7 +167,7 @@ TEST(FreeDirections, APlaneSlidesInItselfAndTurnsAboutItsNormal) {
   }
   const Eigen::Vector3d centre = plane.Centroid();
   const PoseConstraints c = AnalysePoseConstraints(Information(plane, centre), kNoSpread, centre, 1e-4, 0.1, 1e-3);
-  const auto slides = Of(c, "translation"), turns = Of(c, "rotation");
+  const auto slides = Of(c, FreeMotion::kTranslation), turns = Of(c, FreeMotion::kRotation);
   ASSERT_EQ(slides.size(), 2u);
   ASSERT_EQ(turns.size(), 1u);
   for (const FreeDirection& s : slides) EXPECT_LT(std::abs(s.axis_S.z()), 1e-9);
@@ -215,7 +215,7 @@ TEST(FreeDirections, ResidualsCorrelatedOverPatchesLoosenTheDirectionTheyPush) {
   spread(5, 5) = 4e-6 * lambda * lambda;  // adds (2 mm)^2
   const PoseConstraints c = AnalysePoseConstraints(information, spread, centre, sigma, radius, tolerance);
   ASSERT_EQ(c.free_O.size(), 1u);
-  EXPECT_EQ(c.free_O[0].motion, "translation");
+  EXPECT_EQ(c.free_O[0].motion, FreeMotion::kTranslation);
   EXPECT_NEAR(std::abs(c.free_O[0].axis_S.z()), 1.0, 1e-12);
 }
 
@@ -235,8 +235,8 @@ TEST(FreeDirections, TheToleranceIsAStandardDeviationInMetres) {
                                      tolerance).free_O.empty());
   const PoseConstraints loose =
       AnalysePoseConstraints(information_for(1.1 * tolerance, 1.1 * tolerance), kNoSpread, centre, sigma, radius, tolerance);
-  EXPECT_EQ(Of(loose, "translation").size(), 1u);
-  EXPECT_EQ(Of(loose, "rotation").size(), 1u);
+  EXPECT_EQ(Of(loose, FreeMotion::kTranslation).size(), 1u);
+  EXPECT_EQ(Of(loose, FreeMotion::kRotation).size(), 1u);
 }
 
 TEST(FreeDirections, BadInputIsRefused) {

@@ -246,9 +246,9 @@ TEST(ObjectRecognition, APipeSeenWithoutItsEndsReportsItsFreeSlideAndRoll) {
   bool slide = false, roll = false;
   for (const FreeDirection& f : pipe->free_directions) {
     const bool along = std::abs(f.axis_S.dot(axis_S)) > 0.98;
-    slide |= f.kind == "unconstrained" && f.motion == "translation" && along;
-    roll |= f.kind == "symmetry" && f.motion == "rotation" && f.order == 0 && along;
-    EXPECT_FALSE(f.kind == "unconstrained" && f.motion == "rotation") << "the roll reported twice";
+    slide |= f.kind == FreeKind::kUnconstrained && f.motion == FreeMotion::kTranslation && along;
+    roll |= f.kind == FreeKind::kSymmetry && f.motion == FreeMotion::kRotation && f.order == 0 && along;
+    EXPECT_FALSE(f.kind == FreeKind::kUnconstrained && f.motion == FreeMotion::kRotation) << "the roll reported twice";
   }
   EXPECT_TRUE(slide);
   EXPECT_TRUE(roll);
@@ -334,7 +334,7 @@ TEST(ObjectRecognition, AFlangeSeenFromItsFaceReportsItsTurnFree) {
     if (found == nullptr) return false;
     const Eigen::Vector3d axis_S = scan.T_S_O.linear() * Eigen::Vector3d::UnitZ();
     return std::any_of(found->free_directions.begin(), found->free_directions.end(), [&](const FreeDirection& f) {
-      return f.kind == "unconstrained" && f.motion == "rotation" && std::abs(f.axis_S.dot(axis_S)) > 0.999;
+      return f.kind == FreeKind::kUnconstrained && f.motion == FreeMotion::kRotation && std::abs(f.axis_S.dot(axis_S)) > 0.999;
     });
   };
   // The flange's face is at +z_O, which OnSeabed lays along -y; its neck and bolts face +y.

@@ -55,7 +55,7 @@ bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& mo
 // Whether `rotation_O` turns about the same axis as a rotation among `free_O`.
 bool AlreadyFree(const FreeDirection& rotation_O, const std::vector<FreeDirection>& free_O) {
   return std::any_of(free_O.begin(), free_O.end(), [&](const FreeDirection& f) {
-    return f.motion == "rotation" && SameAxis(rotation_O.axis_S, rotation_O.point_S, f.axis_S, f.point_S);
+    return f.motion == FreeMotion::kRotation && SameAxis(rotation_O.axis_S, rotation_O.point_S, f.axis_S, f.point_S);
   });
 }
 
@@ -70,8 +70,8 @@ void AddUnpinnedPhases(const PosedObject& posed, const PointCloud& fitted, const
       continue;
     }
     FreeDirection turn;
-    turn.kind = "unconstrained";
-    turn.motion = "rotation";
+    turn.kind = FreeKind::kUnconstrained;
+    turn.motion = FreeMotion::kRotation;
     turn.axis_S = axis.axis_O.normalized();
     turn.point_S = axis.point_O;
     if (AlreadyFree(turn, c.free_O)) continue;
@@ -103,7 +103,7 @@ void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, cons
   AddUnpinnedPhases(posed, fitted, model, ctx, c);
   const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
   for (FreeDirection f : c.free_O) {
-    if (f.motion == "rotation" && IsContinuousSymmetry(f, model)) continue;
+    if (f.motion == FreeMotion::kRotation && IsContinuousSymmetry(f, model)) continue;
     f.axis_S = T_S_O.linear() * f.axis_S;
     f.point_S = T_S_O * f.point_S;
     out.free_directions.push_back(f);
@@ -177,8 +177,8 @@ void Accept(const PosedObject& posed, const PointCloud& fitted, const ObjectMode
   object.margin = std::isfinite(other_chi_square) && std::isfinite(best.chi_square) ? other_chi_square - best.chi_square : 0.0;
   for (const SymmetryAxis& s : model.symmetries) {
     FreeDirection f;
-    f.kind = "symmetry";
-    f.motion = "rotation";
+    f.kind = FreeKind::kSymmetry;
+    f.motion = FreeMotion::kRotation;
     f.axis_S = best.T_S_O.linear() * s.axis_O;
     f.point_S = best.T_S_O * s.point_O;
     f.order = s.order;

@@ -273,7 +273,7 @@ void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& arou
   const IcpOptions last = FineIcpLastStage(model.diameter_m, ctx.db.parameters, ctx.options.threads);
   const double min_gain = std::max(10.0, 0.02 * static_cast<double>(segment.size()));
   for (const FreeDirection& free : constraints.free_O) {
-    const bool slide = free.motion == "translation";
+    const bool slide = free.motion == FreeMotion::kTranslation;
     // The model moved by `offset_m` along the free direction (a turn's arc at the radius), in its frame.
     auto motion_O = [&](double offset_m) -> Eigen::Isometry3d {
       if (slide) return Eigen::Isometry3d(Eigen::Translation3d(offset_m * free.axis_S));

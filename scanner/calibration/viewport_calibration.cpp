@@ -18,6 +18,7 @@
 #include "scanner/calibration/pattern_pose.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/optics/refractive_camera.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -163,7 +164,7 @@ void FillStandardDeviations(ceres::Problem& problem, Unknowns& x,
   // variance (the sphere manifold's own tangent coordinates are twice the angle).
   Eigen::Matrix<double, 3, 3, Eigen::RowMajor> normal_covariance;
   covariance.GetCovarianceBlock(x.normal.data(), x.normal.data(), normal_covariance.data());
-  const Eigen::Matrix3d symmetric = 0.5 * (normal_covariance + normal_covariance.transpose());
+  const Eigen::Matrix3d symmetric = Symmetrized(normal_covariance);
   const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(symmetric).eigenvalues()(2);
   result.normal_std_rad = std::sqrt(std::max(0.0, largest * sigma2));
   result.distance_std_m = scalar_std(&x.distance_m);
