@@ -22,28 +22,31 @@
 #include "apps/mapping/map_command.hpp"
 #include "apps/perception/perception_commands.hpp"
 #include "apps/perception/recognition_commands.hpp"
+#include "apps/ros/bag_commands.hpp"
+#include "apps/ros/ros_bench_command.hpp"
+#include "apps/ros/ros_inspect_command.hpp"
 #include "apps/scanner/acquisition_commands.hpp"
 #include "apps/scanner/calibrate_command.hpp"
 #include "apps/scanner/demo_command.hpp"
 #include "apps/scanner/dive_commands.hpp"
 #include "apps/scanner/object_commands.hpp"
-#include "apps/ros/bag_commands.hpp"
-#include "apps/ros/ros_bench_command.hpp"
-#include "apps/ros/ros_inspect_command.hpp"
 #include "apps/viewer/plot_commands.hpp"
 #include "apps/viewer/view_command.hpp"
 #include "scanner/common/error.hpp"
 
 // OpenMP's threads wait for work by sleeping, not spinning, unless the user asks otherwise:
 // libgomp's default spin-wait made 2 threads slower than 1 whenever the other core was busy
-// (a vehicle's computer always runs something else; docs/reliability.md, "Threads under load"). libgomp reads
-// OMP_WAIT_POLICY in its own constructor, before main; an entry in the program's .preinit_array
-// runs before any shared library's constructor, so the default is set there.
+// (a vehicle's computer always runs something else; docs/reliability.md, "Threads under load").
+// libgomp reads OMP_WAIT_POLICY in its own constructor, before main; an entry in the program's
+// .preinit_array runs before any shared library's constructor, so the default is set there.
 namespace {
-void PassiveOpenMpWaitByDefault(int, char**, char**) { setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0); }
+void PassiveOpenMpWaitByDefault(int, char**, char**) {
+  setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0);
+}
 }  // namespace
-__attribute__((section(".preinit_array"), used)) static void (*const kPreinit)(int, char**, char**) =
-    &PassiveOpenMpWaitByDefault;
+__attribute__((section(".preinit_array"),
+               used)) static void (*const kPreinit)(int, char**,
+                                                    char**) = &PassiveOpenMpWaitByDefault;
 
 int main(int argc, char** argv) {
   CLI::App app{"uwscan: underwater laser scanner perception toolkit"};

@@ -2,9 +2,9 @@
 
 #include <fcntl.h>
 #include <sched.h>
-#include <sys/prctl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,13 +29,15 @@ int LastCpu() {
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
   if (::sched_getaffinity(0, sizeof(allowed), &allowed) != 0) {
-    throw Error(std::string("bench threads: cannot read the CPUs allowed (") + std::strerror(errno) + ")");
+    throw Error(std::string("bench threads: cannot read the CPUs allowed (") +
+                std::strerror(errno) + ")");
   }
   int last = -1;
   for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
     if (CPU_ISSET(cpu, &allowed)) last = cpu;
   }
-  if (CPU_COUNT(&allowed) < 2) throw Error("bench threads: needs 2 CPUs or more (this process may use 1)");
+  if (CPU_COUNT(&allowed) < 2)
+    throw Error("bench threads: needs 2 CPUs or more (this process may use 1)");
   return last;
 }
 
@@ -47,7 +49,9 @@ class SpinningProcess {
     const int cpu = LastCpu();
     const pid_t parent = ::getpid();
     pid_ = ::fork();
-    if (pid_ < 0) throw Error(std::string("bench threads: cannot start the load process (") + std::strerror(errno) + ")");
+    if (pid_ < 0)
+      throw Error(std::string("bench threads: cannot start the load process (") +
+                  std::strerror(errno) + ")");
     if (pid_ == 0) {
       // Never outlive the benchmark, however it ends.
       ::prctl(PR_SET_PDEATHSIG, SIGKILL);
@@ -80,7 +84,8 @@ std::vector<std::string> ChildEnvironment(const std::string& policy, int threads
   std::vector<std::string> env;
   for (char** e = environ; *e != nullptr; ++e) {
     const std::string entry = *e;
-    if (entry.rfind("OMP_WAIT_POLICY=", 0) == 0 || entry.rfind("OMP_NUM_THREADS=", 0) == 0) continue;
+    if (entry.rfind("OMP_WAIT_POLICY=", 0) == 0 || entry.rfind("OMP_NUM_THREADS=", 0) == 0)
+      continue;
     env.push_back(entry);
   }
   env.push_back("OMP_WAIT_POLICY=" + policy);
@@ -96,8 +101,8 @@ std::vector<char*> Pointers(std::vector<std::string>& strings) {
 }
 
 // Runs uwscan with `arguments` and returns its wall-clock time; its output goes to `log`.
-double TimedRun(const ThreadLoadOptions& options, const Workload& workload, const std::string& policy, int threads,
-                const std::filesystem::path& log) {
+double TimedRun(const ThreadLoadOptions& options, const Workload& workload,
+                const std::string& policy, int threads, const std::filesystem::path& log) {
   std::vector<std::string> argv = {options.uwscan.string()};
   argv.insert(argv.end(), workload.arguments.begin(), workload.arguments.end());
   std::vector<std::string> env = ChildEnvironment(policy, threads);
@@ -108,9 +113,11 @@ double TimedRun(const ThreadLoadOptions& options, const Workload& workload, cons
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
   const Clock::time_point start = Clock::now();
   pid_t child = -1;
-  const int spawned = posix_spawn(&child, argv[0].c_str(), &actions, nullptr, c_argv.data(), c_env.data());
+  const int spawned =
+      posix_spawn(&child, argv[0].c_str(), &actions, nullptr, c_argv.data(), c_env.data());
   posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) throw Error("bench threads: cannot run " + argv[0] + " (" + std::strerror(spawned) + ")");
+  if (spawned != 0)
+    throw Error("bench threads: cannot run " + argv[0] + " (" + std::strerror(spawned) + ")");
   int status = 0;
   const bool waited = ::waitpid(child, &status, 0) == child;
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -132,24 +139,30 @@ double Median(std::vector<double> values) {
 
 void ThreadLoadOptions::Check() const {
   if (repeats < 1 || repeats > 100) throw Error("bench threads: repeats must be in [1, 100]");
-  if (!std::filesystem::is_regular_file(uwscan)) throw Error("bench threads: no uwscan executable at " + uwscan.string());
-  if (!std::filesystem::is_directory(data_dir)) throw Error("bench threads: no data folder at " + data_dir.string());
+  if (!std::filesystem::is_regular_file(uwscan))
+    throw Error("bench threads: no uwscan executable at " + uwscan.string());
+  if (!std::filesystem::is_directory(data_dir))
+    throw Error("bench threads: no data folder at " + data_dir.string());
 }
 
 double ThreadLoadResult::Median(const std::string& workload, const std::string& policy, bool loaded,
                                 int threads) const {
   for (const ThreadLoadTiming& t : timings) {
-    if (t.workload == workload && t.policy == policy && t.loaded == loaded && t.threads == threads) return t.median_s;
+    if (t.workload == workload && t.policy == policy && t.loaded == loaded && t.threads == threads)
+      return t.median_s;
   }
-  throw Error("bench threads: no timing for " + workload + ", " + policy + ", " + std::to_string(threads) + " threads");
+  throw Error("bench threads: no timing for " + workload + ", " + policy + ", " +
+              std::to_string(threads) + " threads");
 }
 
-ThreadLoadResult RunThreadLoadBenchmark(const ThreadLoadOptions& options, const std::filesystem::path& scratch,
+ThreadLoadResult RunThreadLoadBenchmark(const ThreadLoadOptions& options,
+                                        const std::filesystem::path& scratch,
                                         const Progress& progress) {
   options.Check();
   const Clock::time_point start = Clock::now();
   // Two commands that spend their time in OpenMP loops of different grain: the object database
-  // (virtual scans, normals, ESF and FPFH per view) and a dive's simulation (ray casting per frame).
+  // (virtual scans, normals, ESF and FPFH per view) and a dive's simulation (ray casting per
+  // frame).
   const std::vector<Workload> workloads = {
       {"build-db pipe", {"build-db", "pipe", "-o", (scratch / "objects.db").string()}},
       {"simulate inspection_short",
@@ -162,7 +175,8 @@ ThreadLoadResult RunThreadLoadBenchmark(const ThreadLoadOptions& options, const 
   for (const bool loaded : {false, true}) {
     for (const Workload& workload : workloads) {
       for (const std::string& policy : policies) {
-        for (const int threads : {1, 2}) result.timings.push_back({workload.name, policy, loaded, threads, 0.0, {}});
+        for (const int threads : {1, 2})
+          result.timings.push_back({workload.name, policy, loaded, threads, 0.0, {}});
       }
     }
   }
@@ -176,10 +190,13 @@ ThreadLoadResult RunThreadLoadBenchmark(const ThreadLoadOptions& options, const 
     for (int repeat = 0; repeat < options.repeats; ++repeat) {
       for (ThreadLoadTiming& timing : result.timings) {
         if (timing.loaded != loaded) continue;
-        const auto workload = std::find_if(workloads.begin(), workloads.end(),
-                                           [&](const Workload& w) { return w.name == timing.workload; });
-        timing.runs_s.push_back(TimedRun(options, *workload, timing.policy, timing.threads, scratch / "command.log"));
-        if (progress) progress(loaded ? "other CPU loaded" : "idle", static_cast<double>(++done) / total);
+        const auto workload =
+            std::find_if(workloads.begin(), workloads.end(),
+                         [&](const Workload& w) { return w.name == timing.workload; });
+        timing.runs_s.push_back(
+            TimedRun(options, *workload, timing.policy, timing.threads, scratch / "command.log"));
+        if (progress)
+          progress(loaded ? "other CPU loaded" : "idle", static_cast<double>(++done) / total);
       }
     }
   }

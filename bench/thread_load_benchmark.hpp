@@ -39,12 +39,14 @@ struct ThreadLoadResult {
   double seconds = 0.0;
 
   // Median seconds of one configuration; throws uwscan::Error when it was not measured.
-  double Median(const std::string& workload, const std::string& policy, bool loaded, int threads) const;
+  double Median(const std::string& workload, const std::string& policy, bool loaded,
+                int threads) const;
 };
 
 // Runs the workloads in `scratch` (their outputs are written there). Throws uwscan::Error when a
 // command fails.
-ThreadLoadResult RunThreadLoadBenchmark(const ThreadLoadOptions& options, const std::filesystem::path& scratch,
+ThreadLoadResult RunThreadLoadBenchmark(const ThreadLoadOptions& options,
+                                        const std::filesystem::path& scratch,
                                         const Progress& progress);
 
 }  // namespace uwscan::bench

@@ -15,8 +15,8 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -33,7 +33,8 @@ namespace fs = std::filesystem;
 using namespace uwscan::test;
 
 fs::path TempPath(const std::string& name) { return TempPathOf("uwscan_cli_acq_", name); }
-std::unique_ptr<Background> StartFakeCamera(const std::vector<std::string>& args, const std::string& name) {
+std::unique_ptr<Background> StartFakeCamera(const std::vector<std::string>& args,
+                                            const std::string& name) {
   return StartFakeCameraLogged(args, TempPath(name + ".log"));
 }
 
@@ -41,7 +42,8 @@ using PeaksByLine = std::map<int, std::vector<double>>;  // row -> sorted u posi
 
 PeaksByLine ByRow(const std::vector<Eigen::Vector2d>& peaks) {
   PeaksByLine rows;
-  for (const Eigen::Vector2d& p : peaks) rows[static_cast<int>(std::lround(p.y()))].push_back(p.x());
+  for (const Eigen::Vector2d& p : peaks)
+    rows[static_cast<int>(std::lround(p.y()))].push_back(p.x());
   for (auto& [row, us] : rows) std::sort(us.begin(), us.end());
   return rows;
 }
@@ -50,9 +52,9 @@ PeaksByLine ByRow(const std::vector<Eigen::Vector2d>& peaks) {
 std::map<int, uwscan::mapping::FrameRecord> FramesByCommand(const fs::path& log) {
   std::map<int, uwscan::mapping::FrameRecord> frames;
   uwscan::mapping::DiveLogReader reader(log);
-  reader.ForEachFrame([&](const uwscan::mapping::FrameRecord& f, const uwscan::mapping::GroundTruthRecord*) {
-    frames[f.command] = f;
-  }, false);
+  reader.ForEachFrame([&](const uwscan::mapping::FrameRecord& f,
+                          const uwscan::mapping::GroundTruthRecord*) { frames[f.command] = f; },
+                      false);
   return frames;
 }
 
@@ -67,8 +69,9 @@ TEST(CliAcquisition, ProfileModeCarriesTheExactPeaksOverBothReceivePaths) {
   for (const std::string path : {"packet", "udp"}) {
     const fs::path log = TempPath("profile_" + path + ".db");
     const fs::path json = TempPath("profile_" + path + ".json");
-    const CommandRun run = RunUwscan("acquire --camera 127.0.0.1 -o " + log.string() + " --frames 201 --scene " +
-                                     scene + " --receive " + path + " --json " + json.string());
+    const CommandRun run =
+        RunUwscan("acquire --camera 127.0.0.1 -o " + log.string() + " --frames 201 --scene " +
+                  scene + " --receive " + path + " --json " + json.string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
     // A loaded machine can starve the receiver into dropping a frame or two; not more than 1 %.
     EXPECT_LE(ReadJson(json)["lost_frames"].get<int>(), 2) << path;
@@ -76,20 +79,23 @@ TEST(CliAcquisition, ProfileModeCarriesTheExactPeaksOverBothReceivePaths) {
     ASSERT_EQ(reader.frame_count(), 201) << path;
     std::set<int> commands;
     const double step = 1.0 / 32.0;
-    reader.ForEachFrame([&](const uwscan::mapping::FrameRecord& f, const uwscan::mapping::GroundTruthRecord*) {
-      commands.insert(f.command);
-      ASSERT_TRUE(expected.count(f.command)) << f.command;
-      const uwscan::mapping::FrameRecord& e = expected.at(f.command);
-      EXPECT_NEAR(f.time_s, e.time_s + f.sweep * 201 / 339.0, 1e-6);
-      const PeaksByLine got = ByRow(f.peaks_px);
-      const PeaksByLine want = ByRow(e.peaks_px);
-      ASSERT_EQ(got.size(), want.size()) << "command " << f.command;
-      for (const auto& [row, us] : want) {
-        ASSERT_TRUE(got.count(row)) << row;
-        ASSERT_EQ(got.at(row).size(), us.size()) << row;
-        for (std::size_t k = 0; k < us.size(); ++k) EXPECT_LE(std::abs(got.at(row)[k] - us[k]), step / 2 + 1e-9);
-      }
-    }, false);
+    reader.ForEachFrame(
+        [&](const uwscan::mapping::FrameRecord& f, const uwscan::mapping::GroundTruthRecord*) {
+          commands.insert(f.command);
+          ASSERT_TRUE(expected.count(f.command)) << f.command;
+          const uwscan::mapping::FrameRecord& e = expected.at(f.command);
+          EXPECT_NEAR(f.time_s, e.time_s + f.sweep * 201 / 339.0, 1e-6);
+          const PeaksByLine got = ByRow(f.peaks_px);
+          const PeaksByLine want = ByRow(e.peaks_px);
+          ASSERT_EQ(got.size(), want.size()) << "command " << f.command;
+          for (const auto& [row, us] : want) {
+            ASSERT_TRUE(got.count(row)) << row;
+            ASSERT_EQ(got.at(row).size(), us.size()) << row;
+            for (std::size_t k = 0; k < us.size(); ++k)
+              EXPECT_LE(std::abs(got.at(row)[k] - us[k]), step / 2 + 1e-9);
+          }
+        },
+        false);
     EXPECT_EQ(commands.size(), 201u) << "every mirror step once";
   }
   camera->Signal(SIGINT);
@@ -118,7 +124,8 @@ TEST(CliAcquisition, ImageModePeaksMatchTheExactPeaksWithinTheDetectorsAccuracy)
   const CommandRun sim = RunUwscan("simulate " + exact_scene.string() + " -o " + truth.string());
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   const auto expected = FramesByCommand(truth);
-  auto camera = StartFakeCamera({"fake-camera", scene, "--mode", "image", "--fps", "60"}, "image_camera");
+  auto camera =
+      StartFakeCamera({"fake-camera", scene, "--mode", "image", "--fps", "60"}, "image_camera");
   const fs::path log = TempPath("image.db");
   const CommandRun run = RunUwscan("acquire --camera 127.0.0.1 -o " + log.string() +
                                    " --frames 21 --images --scene " + scene);
@@ -127,18 +134,20 @@ TEST(CliAcquisition, ImageModePeaksMatchTheExactPeaksWithinTheDetectorsAccuracy)
   ASSERT_EQ(reader.frame_count(), 21);
   std::vector<double> errors;
   std::int64_t expected_peaks = 0;
-  reader.ForEachFrame([&](const uwscan::mapping::FrameRecord& f, const uwscan::mapping::GroundTruthRecord*) {
-    ASSERT_TRUE(f.image) << "--images keeps the frame";
-    EXPECT_EQ(f.image->width_px, 2048);
-    EXPECT_EQ(f.image->height_px, 1088);
-    const PeaksByLine got = ByRow(f.peaks_px);
-    const PeaksByLine want = ByRow(expected.at(f.command).peaks_px);
-    for (const auto& [row, us] : want) {
-      expected_peaks += static_cast<std::int64_t>(us.size());
-      if (us.size() != 1 || !got.count(row) || got.at(row).size() != 1) continue;
-      errors.push_back(std::abs(got.at(row)[0] - us[0]));
-    }
-  }, false);
+  reader.ForEachFrame(
+      [&](const uwscan::mapping::FrameRecord& f, const uwscan::mapping::GroundTruthRecord*) {
+        ASSERT_TRUE(f.image) << "--images keeps the frame";
+        EXPECT_EQ(f.image->width_px, 2048);
+        EXPECT_EQ(f.image->height_px, 1088);
+        const PeaksByLine got = ByRow(f.peaks_px);
+        const PeaksByLine want = ByRow(expected.at(f.command).peaks_px);
+        for (const auto& [row, us] : want) {
+          expected_peaks += static_cast<std::int64_t>(us.size());
+          if (us.size() != 1 || !got.count(row) || got.at(row).size() != 1) continue;
+          errors.push_back(std::abs(got.at(row)[0] - us[0]));
+        }
+      },
+      false);
   ASSERT_GT(errors.size(), 0.9 * expected_peaks) << "rows with one exact and one detected peak";
   std::sort(errors.begin(), errors.end());
   EXPECT_LT(errors[errors.size() / 2], 0.05) << "median error, px";
@@ -149,11 +158,12 @@ TEST(CliAcquisition, ImageModePeaksMatchTheExactPeaksWithinTheDetectorsAccuracy)
 // frames themselves: each carries the camera's frame counter's mirror command and sweep.
 TEST(CliAcquisition, LostFramesAreCountedExactly) {
   const std::string scene = SourcePath("data/scenes/default.yaml");
-  auto camera = StartFakeCamera({"fake-camera", scene, "--fps", "1000", "--loss", "0.01", "--seed", "5"}, "loss_camera");
+  auto camera = StartFakeCamera(
+      {"fake-camera", scene, "--fps", "1000", "--loss", "0.01", "--seed", "5"}, "loss_camera");
   const fs::path log = TempPath("loss.db");
   const fs::path json = TempPath("loss.json");
-  const CommandRun run = RunUwscan("acquire --camera 127.0.0.1 -o " + log.string() + " --frames 2000 --scene " +
-                                   scene + " --json " + json.string());
+  const CommandRun run = RunUwscan("acquire --camera 127.0.0.1 -o " + log.string() +
+                                   " --frames 2000 --scene " + scene + " --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const CounterGaps gaps = CounterGapsOf(log);
   ASSERT_EQ(gaps.logged, 2000);
@@ -175,8 +185,8 @@ TEST(CliAcquisition, ACameraThatDiesIsReopenedAndTheGapReported) {
   auto camera = StartFakeCamera({"fake-camera", scene}, "dying_camera");
   const fs::path log = TempPath("gap.db");
   const fs::path json = TempPath("gap.json");
-  Background acquire({"acquire", "--camera", "127.0.0.1", "-o", log.string(), "--seconds", "5", "--scene", scene,
-                      "--watchdog-s", "0.5", "--json", json.string()},
+  Background acquire({"acquire", "--camera", "127.0.0.1", "-o", log.string(), "--seconds", "5",
+                      "--scene", scene, "--watchdog-s", "0.5", "--json", json.string()},
                      TempPath("gap_acquire.log"));
   ASSERT_TRUE(acquire.WaitFor("profile mode", 20.0)) << acquire.Output();
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
@@ -226,13 +236,15 @@ TEST(CliAcquisition, KilledMidStreamTheLogHoldsEveryCommittedFrame) {
   const std::string scene = SourcePath("data/scenes/default.yaml");
   auto camera = StartFakeCamera({"fake-camera", scene}, "killed_camera");
   {
-    Background holder({"acquire", "--camera", "127.0.0.1", "-o", TempPath("holder.db").string(), "--scene", scene},
+    Background holder({"acquire", "--camera", "127.0.0.1", "-o", TempPath("holder.db").string(),
+                       "--scene", scene},
                       TempPath("holder_acquire.log"));
     ASSERT_TRUE(holder.WaitFor("profile mode", 20.0)) << holder.Output();
-    const CommandRun second = RunUwscan("acquire --camera 127.0.0.1 --frames 10 -o " + TempPath("second.db").string() +
-                                        " --scene " + scene);
+    const CommandRun second = RunUwscan("acquire --camera 127.0.0.1 --frames 10 -o " +
+                                        TempPath("second.db").string() + " --scene " + scene);
     EXPECT_NE(second.exit_code, 0);
-    EXPECT_NE(second.output.find("another program controls the camera"), std::string::npos) << second.output;
+    EXPECT_NE(second.output.find("another program controls the camera"), std::string::npos)
+        << second.output;
     holder.Signal(SIGINT);  // a clean stop hands the camera back at once
     EXPECT_EQ(holder.Wait(), 0) << holder.Output();
   }
@@ -247,8 +259,10 @@ TEST(CliAcquisition, KilledMidStreamTheLogHoldsEveryCommittedFrame) {
     const CommandRun check = RunUwscan("log check " + log.string());
     EXPECT_EQ(check.exit_code, 0) << check.output;
     const uwscan::mapping::DiveLogReader reader(log);
-    ASSERT_GT(reader.frame_count(), 0) << "killed after " << after_ms << " ms:\n" << acquire.Output();
-    for (std::int64_t i = 0; i + 1 < reader.frame_count(); ++i) reader.ReadFrame(i);  // each checks its checksums
+    ASSERT_GT(reader.frame_count(), 0) << "killed after " << after_ms << " ms:\n"
+                                       << acquire.Output();
+    for (std::int64_t i = 0; i + 1 < reader.frame_count(); ++i)
+      reader.ReadFrame(i);  // each checks its checksums
     EXPECT_GT(reader.ReadFrame(reader.frame_count() - 1).peaks_px.size(), 500u);
   }
 }
@@ -259,7 +273,9 @@ TEST(CliAcquisition, AWrongAddressFailsClearlyWithinSeconds) {
                                    " --scene " + SourcePath("data/scenes/default.yaml"));
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("camera 127.0.0.2: no GigE Vision camera answers there"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("camera 127.0.0.2: no GigE Vision camera answers there"),
+            std::string::npos)
+      << run.output;
   EXPECT_LT(seconds, 5.0);
   EXPECT_FALSE(fs::exists(TempPath("none.db")));
 }
@@ -273,12 +289,17 @@ TEST(CliAcquisition, AnAcquiredSceneReconstructsToTheSimulatedCloud) {
   ASSERT_EQ(RunUwscan("simulate " + scene + " -o " + simulated.string()).exit_code, 0);
   auto camera = StartFakeCamera({"fake-camera", scene}, "recon_camera");
   const fs::path acquired = TempPath("recon_acq.db");
-  const CommandRun run = RunUwscan("acquire --camera 127.0.0.1 -o " + acquired.string() + " --frames 201 --scene " + scene);
+  const CommandRun run = RunUwscan("acquire --camera 127.0.0.1 -o " + acquired.string() +
+                                   " --frames 201 --scene " + scene);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const fs::path cloud_sim = TempPath("sim.ply");
   const fs::path cloud_acq = TempPath("acq.ply");
-  ASSERT_EQ(RunUwscan("reconstruct " + simulated.string() + " --scanner-frame --ascii -o " + cloud_sim.string()).exit_code, 0);
-  const CommandRun rec = RunUwscan("reconstruct " + acquired.string() + " --ascii -o " + cloud_acq.string());
+  ASSERT_EQ(RunUwscan("reconstruct " + simulated.string() + " --scanner-frame --ascii -o " +
+                      cloud_sim.string())
+                .exit_code,
+            0);
+  const CommandRun rec =
+      RunUwscan("reconstruct " + acquired.string() + " --ascii -o " + cloud_acq.string());
   ASSERT_EQ(rec.exit_code, 0) << rec.output;
   const std::vector<Eigen::Vector3d> a = ReadAsciiPly(cloud_sim);
   const std::vector<Eigen::Vector3d> b = ReadAsciiPly(cloud_acq);

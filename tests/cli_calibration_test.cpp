@@ -1,7 +1,5 @@
 // `uwscan simulate` of a calibration scene and `uwscan calibrate` end to end, good and bad.
 #include <gtest/gtest.h>
-
-#include "tests/cli_run.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,9 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
+
+#include "tests/cli_run.hpp"
 
 namespace {
 
@@ -30,7 +30,8 @@ std::string Read(const std::filesystem::path& path) {
 class CliCalibration : public testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / ("uwscan_cli_calibration_" + std::to_string(getpid()));
+    dir_ = std::filesystem::temp_directory_path() /
+           ("uwscan_cli_calibration_" + std::to_string(getpid()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_ / "scenes");
     std::filesystem::create_directories(dir_ / "scanners");
@@ -52,15 +53,15 @@ class CliCalibration : public testing::Test {
            "  distance_m: [0.5, 0.8]\n"
            "  max_tilt_rad: 0.5\n"
            "  image_scale: 0.5\n";
-    const CommandRun sim = RunUwscan("simulate " + (dir_ / "scenes" / "small.yaml").string() + " -o " +
-                                     dataset().string());
+    const CommandRun sim = RunUwscan("simulate " + (dir_ / "scenes" / "small.yaml").string() +
+                                     " -o " + dataset().string());
     ASSERT_EQ(sim.exit_code, 0) << sim.output;
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::filesystem::path dataset() const { return dir_ / "dataset"; }
   std::string Calibrate(const std::string& output) const {
-    return "calibrate intrinsics " + dataset().string() + " -o " + (dir_ / output).string() + " --from " +
-           (dir_ / "scanners" / "galvo_default.yaml").string();
+    return "calibrate intrinsics " + dataset().string() + " -o " + (dir_ / output).string() +
+           " --from " + (dir_ / "scanners" / "galvo_default.yaml").string();
   }
   std::filesystem::path dir_;
 };
@@ -74,7 +75,8 @@ TEST_F(CliCalibration, IntrinsicsFromASimulatedDatasetLandNearTheTruth) {
   EXPECT_NE(calib.find("intrinsics:"), std::string::npos);
   EXPECT_NE(calib.find("date_utc"), std::string::npos);
   // The file is a scanner file every command reads: reconstruct's parser accepts it.
-  const CommandRun bench = RunUwscan("bench triangulation --points 1000 --scanner " + (dir_ / "calib.yaml").string());
+  const CommandRun bench =
+      RunUwscan("bench triangulation --points 1000 --scanner " + (dir_ / "calib.yaml").string());
   EXPECT_EQ(bench.exit_code, 0) << bench.output;
 }
 
@@ -120,9 +122,11 @@ TEST_F(CliCalibration, InconsistentManifestNamesTheField) {
 
 TEST(CliCalibrationBench, EveryStepRecoversItsTruthAndTheGaugesHoldUp) {
   const std::filesystem::path json =
-      std::filesystem::temp_directory_path() / ("uwscan_cli_calibration_bench_" + std::to_string(getpid()) + ".json");
+      std::filesystem::temp_directory_path() /
+      ("uwscan_cli_calibration_bench_" + std::to_string(getpid()) + ".json");
   const CommandRun run =
-      RunUwscan("bench calibration --quick --data " + std::string(UWSCAN_SOURCE_DIR) + "/data --json " + json.string());
+      RunUwscan("bench calibration --quick --data " + std::string(UWSCAN_SOURCE_DIR) +
+                "/data --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -134,7 +138,9 @@ TEST(CliCalibrationBench, EveryStepRecoversItsTruthAndTheGaugesHoldUp) {
   // Intrinsics within 4 standard deviations of the truth.
   for (const char* name : {"fx_px", "fy_px", "cx_px", "cy_px"}) {
     const nlohmann::json& p = steps["intrinsics"]["params"][name];
-    EXPECT_LT(std::abs(p["estimated"].get<double>() - p["true"].get<double>()), 4.0 * p["std"].get<double>()) << name;
+    EXPECT_LT(std::abs(p["estimated"].get<double>() - p["true"].get<double>()),
+              4.0 * p["std"].get<double>())
+        << name;
   }
   const nlohmann::json& distance = steps["viewport"]["params"]["camera_viewport.distance_m"];
   EXPECT_LT(std::abs(distance["estimated"].get<double>() - distance["true"].get<double>()), 1e-3);

@@ -2,13 +2,13 @@
 // What the camera tests (cli_acquisition_test, cli_inspect_test) share: `uwscan` processes in
 // the background (the fake camera), temporary files, JSON, cloud comparisons and lost frames.
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <Eigen/Core>
-#include <gtest/gtest.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -39,17 +39,21 @@ using Clock = std::chrono::steady_clock;
 // process with the same pid left behind (killed before it cleaned up) would be taken for this
 // one's, so it is removed the first time this process asks for the name.
 inline fs::path TempPathOf(const std::string& prefix, const std::string& name) {
-  const fs::path path = fs::temp_directory_path() / (prefix + std::to_string(getpid()) + "_" + name);
+  const fs::path path =
+      fs::temp_directory_path() / (prefix + std::to_string(getpid()) + "_" + name);
   static std::mutex mutex;
   static std::set<fs::path> fresh;
   const std::lock_guard<std::mutex> lock(mutex);
   if (fresh.insert(path).second) {
     std::error_code ignored;
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) fs::remove_all(path.string() + suffix, ignored);
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+      fs::remove_all(path.string() + suffix, ignored);
   }
   return path;
 }
-inline std::string SourcePath(const std::string& relative) { return std::string(UWSCAN_SOURCE_DIR) + "/" + relative; }
+inline std::string SourcePath(const std::string& relative) {
+  return std::string(UWSCAN_SOURCE_DIR) + "/" + relative;
+}
 
 inline std::string ReadFile(const fs::path& path) {
   std::ifstream in(path);
@@ -74,7 +78,8 @@ class Background {
     c_argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 1, output.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
     posix_spawn_file_actions_adddup2(&actions, 1, 2);
     const int rc = posix_spawn(&pid_, UWSCAN_BIN, &actions, nullptr, c_argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
@@ -111,7 +116,8 @@ class Background {
 };
 
 // `uwscan fake-camera ...` in the background, once it serves; its output in `log`.
-inline std::unique_ptr<Background> StartFakeCameraLogged(const std::vector<std::string>& args, const fs::path& log) {
+inline std::unique_ptr<Background> StartFakeCameraLogged(const std::vector<std::string>& args,
+                                                         const fs::path& log) {
   auto camera = std::make_unique<Background>(args, log);
   EXPECT_TRUE(camera->WaitFor("serving", 60.0)) << camera->Output();
   return camera;
@@ -134,8 +140,8 @@ inline std::vector<Eigen::Vector3d> ReadAsciiPly(const fs::path& path) {
 
 // Largest distance from a point of `a` to its nearest point of `b`, searched on a grid of
 // `cell` metres (the 27 cells around a point): distances beyond `cell` come out as 1 m.
-inline double MaxNearestDistance(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
-                                 double cell = 1e-3) {
+inline double MaxNearestDistance(const std::vector<Eigen::Vector3d>& a,
+                                 const std::vector<Eigen::Vector3d>& b, double cell = 1e-3) {
   auto key = [cell](const Eigen::Vector3d& p, int dx, int dy, int dz) {
     const auto i = static_cast<std::int64_t>(std::floor(p.x() / cell)) + dx;
     const auto j = static_cast<std::int64_t>(std::floor(p.y() / cell)) + dy;

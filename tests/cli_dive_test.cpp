@@ -1,7 +1,5 @@
 // The dive commands end to end: simulate, reconstruct, demo, make-object, bench accuracy.
 #include <gtest/gtest.h>
-
-#include "tests/cli_run.hpp"
 #include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,13 +9,15 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "tests/cli_run.hpp"
 
 namespace {
 
@@ -40,7 +40,8 @@ std::string SourcePath(const std::string& relative) {
 
 TEST(CliDive, SimulateThenReconstructRecoversTheSceneWithEveryMethod) {
   const std::filesystem::path log = TempPath("default.db");
-  const CommandRun sim = RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
+  const CommandRun sim =
+      RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   EXPECT_NE(sim.output.find("201 frames"), std::string::npos) << sim.output;
 
@@ -61,7 +62,8 @@ TEST(CliDive, SimulateThenReconstructRecoversTheSceneWithEveryMethod) {
     std::filesystem::remove(json);
   }
   // A log is never overwritten by accident.
-  const CommandRun again = RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
+  const CommandRun again =
+      RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string());
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_NE(again.output.find("exists"), std::string::npos) << again.output;
   std::filesystem::remove(log);
@@ -71,13 +73,16 @@ TEST(CliDive, SimulateThenReconstructRecoversTheSceneWithEveryMethod) {
 TEST(CliDive, MapRefusesAnUnusableLogWithOneLine) {
   const std::filesystem::path log = TempPath("short.db"), map = TempPath("map.ply");
   const CommandRun simulated =
-      RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " + log.string() + " --force");
+      RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " +
+                log.string() + " --force");
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
   // Each damage applied to a fresh copy of the log.
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"DELETE FROM navigation", "has no navigation"},
-      {"DELETE FROM ground_truth WHERE frame_index > 0; DELETE FROM frames WHERE frame_index > 0", "has 1 frame"},
-      {"UPDATE meta SET value = 99 WHERE key = 'schema_version'", "has schema version 99, this uwscan reads 1 to"}};
+      {"DELETE FROM ground_truth WHERE frame_index > 0; DELETE FROM frames WHERE frame_index > 0",
+       "has 1 frame"},
+      {"UPDATE meta SET value = 99 WHERE key = 'schema_version'",
+       "has schema version 99, this uwscan reads 1 to"}};
   for (const auto& [sql, reason] : cases) {
     const std::filesystem::path copy = TempPath("damaged.db");
     std::filesystem::copy_file(log, copy, std::filesystem::copy_options::overwrite_existing);
@@ -88,8 +93,10 @@ TEST(CliDive, MapRefusesAnUnusableLogWithOneLine) {
     const CommandRun run = RunUwscan("map " + copy.string() + " -o " + map.string());
     EXPECT_EQ(run.exit_code, 1) << sql << "\n" << run.output;
     EXPECT_NE(run.output.find(reason), std::string::npos) << sql << "\n" << run.output;
-    EXPECT_NE(run.output.find(copy.string()), std::string::npos) << "the log is named: " << run.output;
-    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << "one line: " << run.output;
+    EXPECT_NE(run.output.find(copy.string()), std::string::npos)
+        << "the log is named: " << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1)
+        << "one line: " << run.output;
     EXPECT_FALSE(std::filesystem::exists(map)) << sql;
     std::filesystem::remove(copy);
   }
@@ -100,7 +107,8 @@ TEST(CliDive, MapRefusesAnUnusableLogWithOneLine) {
   ASSERT_EQ(sqlite3_open(copy.c_str(), &db), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(db, "DELETE FROM ground_truth", nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(db);
-  const CommandRun run = RunUwscan("map " + copy.string() + " -o " + map.string() + " --truth " + truth.string());
+  const CommandRun run =
+      RunUwscan("map " + copy.string() + " -o " + map.string() + " --truth " + truth.string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find("holds no ground truth"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(map));
@@ -113,8 +121,9 @@ TEST(CliDive, MapRefusesAnUnusableLogWithOneLine) {
 // the ones with a ground truth to hold them to are sane.
 TEST(CliDive, SlamBenchWritesEveryFigureOfADive) {
   const std::filesystem::path json = TempPath("slam.json");
-  const CommandRun run = RunUwscan("bench slam --scene " + SourcePath("data/scenes/inspection_short.yaml") +
-                                   " --seeds 1 --json " + json.string());
+  const CommandRun run =
+      RunUwscan("bench slam --scene " + SourcePath("data/scenes/inspection_short.yaml") +
+                " --seeds 1 --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   ASSERT_EQ(j["dives"].size(), 1u);
@@ -154,16 +163,19 @@ std::string FileBytes(const std::filesystem::path& path) {
 TEST(CliDive, MapWritesTheSameBitsOnOneOrTwoThreadsAndInEveryRun) {
   const std::filesystem::path log = TempPath("bits.db");
   const CommandRun simulated =
-      RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " + log.string() + " --force");
+      RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " +
+                log.string() + " --force");
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
   struct Output {
     std::string map, trajectory;
     nlohmann::json report;
   };
   auto map = [&](int threads) {
-    const std::filesystem::path ply = TempPath("bits.ply"), tum = TempPath("bits.tum"), json = TempPath("bits.json");
-    const CommandRun run = RunUwscan("map " + log.string() + " -o " + ply.string() + " --trajectory " + tum.string() +
-                                     " --json " + json.string() + " --threads " + std::to_string(threads));
+    const std::filesystem::path ply = TempPath("bits.ply"), tum = TempPath("bits.tum"),
+                                json = TempPath("bits.json");
+    const CommandRun run =
+        RunUwscan("map " + log.string() + " -o " + ply.string() + " --trajectory " + tum.string() +
+                  " --json " + json.string() + " --threads " + std::to_string(threads));
     EXPECT_EQ(run.exit_code, 0) << run.output;
     Output out{FileBytes(ply), FileBytes(tum), ReadJson(json)};
     for (const char* timing : {"seconds", "real_time_factor"}) out.report["figures"].erase(timing);
@@ -177,7 +189,8 @@ TEST(CliDive, MapWritesTheSameBitsOnOneOrTwoThreadsAndInEveryRun) {
     EXPECT_TRUE(other->map == one.map);
     EXPECT_TRUE(other->trajectory == one.trajectory);
     // Doubles are written to the last bit, so equal JSON is equal bits.
-    EXPECT_TRUE(other->report == one.report) << nlohmann::json::diff(one.report, other->report).dump().substr(0, 2000);
+    EXPECT_TRUE(other->report == one.report)
+        << nlohmann::json::diff(one.report, other->report).dump().substr(0, 2000);
   }
   std::filesystem::remove(log);
 }
@@ -202,7 +215,8 @@ TEST(CliDive, MalformedSceneNamesTheFileLineAndField) {
 TEST(CliDive, ReconstructRejectsWhatIsNotADiveLog) {
   const std::filesystem::path junk = TempPath("junk.db");
   std::ofstream(junk) << "this is not a dive log";
-  const CommandRun run = RunUwscan("reconstruct " + junk.string() + " -o " + TempPath("x.ply").string());
+  const CommandRun run =
+      RunUwscan("reconstruct " + junk.string() + " -o " + TempPath("x.ply").string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find(junk.string()), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(TempPath("x.ply")));
@@ -222,7 +236,8 @@ TEST(CliDive, DemoPrintsEveryMethodAgainstTruth) {
 TEST(CliDive, DemoWithoutASceneRunsFromAnyFolder) {
   const std::filesystem::path elsewhere = TempPath("demo_elsewhere");
   std::filesystem::create_directories(elsewhere);
-  const CommandRun run = uwscan::test::RunCommand("cd " + elsewhere.string() + " && " + std::string(UWSCAN_BIN) + " demo");
+  const CommandRun run = uwscan::test::RunCommand("cd " + elsewhere.string() + " && " +
+                                                  std::string(UWSCAN_BIN) + " demo");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("default.yaml"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("ray_ray"), std::string::npos) << run.output;
@@ -245,7 +260,9 @@ TEST(CliDive, MakeObjectRefusesASizeInMillimetres) {
   const std::filesystem::path mesh = TempPath("pipe.ply");
   std::filesystem::remove(mesh);
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"pipe --length-m 300", "--length-m"}, {"box --size-m 0.1 0.2 150", "--size-m"}, {"valve --handle-radius-m 0", "--handle-radius-m"}};
+      {"pipe --length-m 300", "--length-m"},
+      {"box --size-m 0.1 0.2 150", "--size-m"},
+      {"valve --handle-radius-m 0", "--handle-radius-m"}};
   for (const auto& [options, option] : cases) {
     const CommandRun run = RunUwscan("make-object " + options + " -o " + mesh.string());
     EXPECT_NE(run.exit_code, 0) << options;
@@ -259,7 +276,8 @@ TEST(CliDive, MakeObjectRefusesASizeInMillimetres) {
 
 TEST(CliDive, SimulationBenchTimesEveryEffectAndOffStagesChangeNothing) {
   const std::filesystem::path json = TempPath("simulation.json");
-  const CommandRun run = RunUwscan("bench simulation --frames 2 --data " + SourcePath("data") + " --json " + json.string());
+  const CommandRun run = RunUwscan("bench simulation --frames 2 --data " + SourcePath("data") +
+                                   " --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json rows = ReadJson(json).at("rows");
   std::map<std::string, nlohmann::json> galvo, mems;
@@ -267,9 +285,10 @@ TEST(CliDive, SimulationBenchTimesEveryEffectAndOffStagesChangeNothing) {
     (row["scene"] == "galvo" ? galvo : mems)[row["effect"].get<std::string>()] = row;
     EXPECT_GT(row["ms_per_frame"].get<double>(), 0.0);
   }
-  for (const char* effect : {"none", "refraction", "lens_distortion", "occlusion", "motion", "navigation_drift",
-                             "image", "beam", "sensor_noise", "speckle", "attenuation", "backscatter", "ambient",
-                             "off_with_parameters", "all"}) {
+  for (const char* effect :
+       {"none", "refraction", "lens_distortion", "occlusion", "motion", "navigation_drift", "image",
+        "beam", "sensor_noise", "speckle", "attenuation", "backscatter", "ambient",
+        "off_with_parameters", "all"}) {
     EXPECT_TRUE(galvo.contains(effect)) << effect;
     EXPECT_TRUE(mems.contains(effect)) << effect;
   }
@@ -282,7 +301,8 @@ TEST(CliDive, SimulationBenchTimesEveryEffectAndOffStagesChangeNothing) {
 
 TEST(CliDive, AccuracyBenchWritesEveryTable) {
   const std::filesystem::path json = TempPath("accuracy.json");
-  const CommandRun run = RunUwscan("bench accuracy --quick --data " + SourcePath("data") + " --json " + json.string());
+  const CommandRun run =
+      RunUwscan("bench accuracy --quick --data " + SourcePath("data") + " --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   for (const char* medium : {"air", "water"}) {
@@ -296,7 +316,8 @@ TEST(CliDive, AccuracyBenchWritesEveryTable) {
   EXPECT_LT(std::abs(j["sphere"][0]["radius_err_m"].get<double>()), 2e-3);
   ASSERT_EQ(j["waypoints"].size(), 2u);
   // More waypoints per line: slower lines.
-  EXPECT_GT(j["waypoints"][0]["lines_per_s"].get<double>(), j["waypoints"][1]["lines_per_s"].get<double>());
+  EXPECT_GT(j["waypoints"][0]["lines_per_s"].get<double>(),
+            j["waypoints"][1]["lines_per_s"].get<double>());
   // The detector's error on the rendered stripes: sub-pixel and centred.
   for (const char* stripes : {"gauges_water", "plane"}) {
     const nlohmann::json& p = j["peak_errors"][stripes];
@@ -311,11 +332,14 @@ TEST(CliDive, AccuracyBenchWritesEveryTable) {
 
 TEST(CliDive, ReconstructUsesTheCalibrationItIsGiven) {
   const std::filesystem::path log = TempPath("calibrated.db");
-  ASSERT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string()).exit_code, 0);
+  ASSERT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + log.string())
+                .exit_code,
+            0);
   const auto mean_error = [&](const std::string& calibration) {
     const std::filesystem::path json = TempPath("calibrated.json");
-    const CommandRun run = RunUwscan("reconstruct " + log.string() + " -o " + TempPath("c.ply").string() +
-                                     " --method ray --calibration " + calibration + " --json " + json.string());
+    const CommandRun run =
+        RunUwscan("reconstruct " + log.string() + " -o " + TempPath("c.ply").string() +
+                  " --method ray --calibration " + calibration + " --json " + json.string());
     EXPECT_EQ(run.exit_code, 0) << run.output;
     const double mean = ReadJson(json)["truth_error"]["mean_m"].get<double>();
     std::filesystem::remove(json);
@@ -331,35 +355,42 @@ TEST(CliDive, ReconstructUsesTheCalibrationItIsGiven) {
 
 TEST(CliDive, ImportIntrinsicsFromOpenCv) {
   const std::filesystem::path ocv = TempPath("opencv.yaml");
-  std::ofstream(ocv) << "%YAML:1.0\n---\nimage_width: 2048\nimage_height: 1088\n"
-                        "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-                        "   data: [ 1700.5, 0., 1020.25, 0., 1701.5, 540.75, 0., 0., 1. ]\n"
-                        "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
-                        "   data: [ -0.1, 0.05, 0.001, -0.002, 0.01 ]\n";
+  std::ofstream(ocv)
+      << "%YAML:1.0\n---\nimage_width: 2048\nimage_height: 1088\n"
+         "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+         "   data: [ 1700.5, 0., 1020.25, 0., 1701.5, 540.75, 0., 0., 1. ]\n"
+         "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+         "   data: [ -0.1, 0.05, 0.001, -0.002, 0.01 ]\n";
   const std::filesystem::path out = TempPath("imported.yaml");
-  const CommandRun run = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
-                                   SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
+  const CommandRun run =
+      RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::ifstream in(out);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("fx_px: 1700.5"), std::string::npos) << text;
   EXPECT_NE(text.find("intrinsics:"), std::string::npos) << text;
   // Intrinsics of another image size (a binned camera) are refused; so is writing over an input.
-  std::ofstream(ocv) << "%YAML:1.0\n---\nimage_width: 1024\nimage_height: 544\n"
-                        "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-                        "   data: [ 850.25, 0., 510.125, 0., 850.75, 270.375, 0., 0., 1. ]\n"
-                        "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
-                        "   data: [ -0.1, 0.05, 0.001, -0.002, 0.01 ]\n";
-  const CommandRun binned = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
-                                      SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
+  std::ofstream(ocv)
+      << "%YAML:1.0\n---\nimage_width: 1024\nimage_height: 544\n"
+         "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+         "   data: [ 850.25, 0., 510.125, 0., 850.75, 270.375, 0., 0., 1. ]\n"
+         "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+         "   data: [ -0.1, 0.05, 0.001, -0.002, 0.01 ]\n";
+  const CommandRun binned =
+      RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
   EXPECT_EQ(binned.exit_code, 1) << binned.output;
-  EXPECT_NE(binned.output.find("calibrated on 1024x544 images, the camera of"), std::string::npos) << binned.output;
-  const CommandRun over = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
-                                    SourcePath("data/scanners/galvo_default.yaml") + " -o " + ocv.string());
+  EXPECT_NE(binned.output.find("calibrated on 1024x544 images, the camera of"), std::string::npos)
+      << binned.output;
+  const CommandRun over =
+      RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                SourcePath("data/scanners/galvo_default.yaml") + " -o " + ocv.string());
   EXPECT_NE(over.output.find("is also an input"), std::string::npos) << over.output;
   std::ofstream(ocv) << "%YAML:1.0\n---\nimage_width: 2048\n";
-  const CommandRun bad = RunUwscan("import-intrinsics " + ocv.string() + " --into " +
-                                   SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
+  const CommandRun bad =
+      RunUwscan("import-intrinsics " + ocv.string() + " --into " +
+                SourcePath("data/scanners/galvo_default.yaml") + " -o " + out.string());
   EXPECT_EQ(bad.exit_code, 1) << bad.output;
   EXPECT_NE(bad.output.find("missing node"), std::string::npos) << bad.output;
   std::filesystem::remove(ocv);
@@ -379,8 +410,9 @@ TEST(CliDive, ForceReplacesOnlyWhatItShouldAndOnlyAfterChecking) {
   const std::filesystem::path folder = TempPath("not_a_dataset");
   std::filesystem::create_directories(folder);
   std::ofstream(folder / "notes.txt") << "keep me";
-  const CommandRun dataset = RunUwscan("simulate " + SourcePath("data/scenes/calib_intrinsics.yaml") + " -o " +
-                                       folder.string() + " --force");
+  const CommandRun dataset =
+      RunUwscan("simulate " + SourcePath("data/scenes/calib_intrinsics.yaml") + " -o " +
+                folder.string() + " --force");
   EXPECT_EQ(dataset.exit_code, 1) << dataset.output;
   EXPECT_TRUE(std::filesystem::exists(folder / "notes.txt"));
   std::filesystem::remove_all(folder);

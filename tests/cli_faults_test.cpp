@@ -5,9 +5,8 @@
 // does as root; without one the tests fail saying why.
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <unistd.h>
-
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -32,7 +31,9 @@ std::string Bytes(const fs::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-std::string Scene(const char* name) { return std::string(UWSCAN_SOURCE_DIR) + "/data/scenes/" + name; }
+std::string Scene(const char* name) {
+  return std::string(UWSCAN_SOURCE_DIR) + "/data/scenes/" + name;
+}
 
 class CliFaults : public ::testing::Test {
  protected:
@@ -40,19 +41,26 @@ class CliFaults : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("uwscan_cli_faults_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    ASSERT_EQ(RunUwscan("simulate " + Scene("default.yaml") + " -o " + (dir_ / "dive.db").string()).exit_code, 0);
-    ASSERT_EQ(RunUwscan("reconstruct " + (dir_ / "dive.db").string() + " -o " + (dir_ / "cloud.ply").string())
-                  .exit_code, 0);
-    ASSERT_EQ(RunUwscan("reconstruct " + (dir_ / "dive.db").string() + " --method plane --ascii -o " +
-                        (dir_ / "old.ply").string()).exit_code, 0);
+    ASSERT_EQ(RunUwscan("simulate " + Scene("default.yaml") + " -o " + (dir_ / "dive.db").string())
+                  .exit_code,
+              0);
+    ASSERT_EQ(RunUwscan("reconstruct " + (dir_ / "dive.db").string() + " -o " +
+                        (dir_ / "cloud.ply").string())
+                  .exit_code,
+              0);
+    ASSERT_EQ(RunUwscan("reconstruct " + (dir_ / "dive.db").string() +
+                        " --method plane --ascii -o " + (dir_ / "old.ply").string())
+                  .exit_code,
+              0);
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
   // A shell command line run in a private mount namespace with a tmpfs at `folder`.
-  static CommandRun InTmpfs(const fs::path& folder, const std::string& options, const std::string& commands) {
+  static CommandRun InTmpfs(const fs::path& folder, const std::string& options,
+                            const std::string& commands) {
     fs::create_directories(folder);
-    return RunCommand("unshare -m sh -c 'mount -t tmpfs -o " + options + " tmpfs " + folder.string() + " && " +
-                      commands + "'");
+    return RunCommand("unshare -m sh -c 'mount -t tmpfs -o " + options + " tmpfs " +
+                      folder.string() + " && " + commands + "'");
   }
 
   static inline fs::path dir_;
@@ -70,27 +78,33 @@ TEST_F(CliFaults, OutputsThatCannotBeWrittenAreRefusedBeforeAnyWork) {
       {"reconstruct " + dive + " -o " + missing + "/c.ply", "does not exist"},
       {"reconstruct " + dive + " -o " + cloud + " --json " + dive, "is also an input"},
       {"reconstruct " + dive + " -o " + dir_.string(), "is a folder"},
-      {"register " + cloud + " " + (dir_ / "old.ply").string() + " -o " + cloud, "is also an input"},
+      {"register " + cloud + " " + (dir_ / "old.ply").string() + " -o " + cloud,
+       "is also an input"},
       {"map " + dive + " -o " + missing + "/m.ply", "does not exist"},
-      {"map " + dive + " -o " + (dir_ / "m.ply").string() + " --trajectory " + dive, "is also an input"},
+      {"map " + dive + " -o " + (dir_ / "m.ply").string() + " --trajectory " + dive,
+       "is also an input"},
       {"build-db pipe -o " + missing + "/o.db", "does not exist"},
       {"acquire --camera 127.0.0.1 -o " + missing + "/a.db --frames 1", "does not exist"},
       {"log salvage " + dive + " -o " + dive, "is also an input"},
       {"view " + dive + " --screenshot " + missing + "/v.png", "does not exist"},
       {"plot " + dive + " -o " + dive, "is also an input"},
       {"recognize " + cloud + " --db " + dive + " --json " + missing + "/r.json", "does not exist"},
-      {"reconstruct " + dive + " -o " + (dir_ / "c.xyz").string(), "a point cloud is written as .ply or .pcd"},
-      {"map " + dive + " -o " + (dir_ / "m.xyz").string(), "a point cloud is written as .ply or .pcd"},
+      {"reconstruct " + dive + " -o " + (dir_ / "c.xyz").string(),
+       "a point cloud is written as .ply or .pcd"},
+      {"map " + dive + " -o " + (dir_ / "m.xyz").string(),
+       "a point cloud is written as .ply or .pcd"},
       {"register " + cloud + " " + (dir_ / "old.ply").string() + " -o " + (dir_ / "r.txt").string(),
        "a point cloud is written as .ply or .pcd"},
   };
   for (const Case& c : cases) {
     const auto start = std::chrono::steady_clock::now();
     const CommandRun run = RunUwscan(c.arguments);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_NE(run.exit_code, 0) << c.arguments;
     EXPECT_NE(run.output.find(c.expected), std::string::npos) << c.arguments << "\n" << run.output;
-    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << c.arguments << "\n" << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << c.arguments << "\n"
+                                                                         << run.output;
     // Refused before the work starts (the slowest of these takes tens of seconds when it runs).
     EXPECT_LT(seconds, 5.0) << c.arguments;
   }
@@ -100,9 +114,12 @@ TEST_F(CliFaults, OutputsThatCannotBeWrittenAreRefusedBeforeAnyWork) {
 
 TEST_F(CliFaults, AReadOnlyFolderIsRefusedBeforeAnyWork) {
   const fs::path folder = dir_ / "read_only";
-  const CommandRun run = InTmpfs(folder, "ro", std::string(UWSCAN_BIN) + " reconstruct " + (dir_ / "dive.db").string() +
-                                                   " -o " + (folder / "c.ply").string());
-  ASSERT_EQ(run.output.find("unshare:"), std::string::npos) << "no private mount namespace (CI runs as root): " << run.output;
+  const CommandRun run =
+      InTmpfs(folder, "ro",
+              std::string(UWSCAN_BIN) + " reconstruct " + (dir_ / "dive.db").string() + " -o " +
+                  (folder / "c.ply").string());
+  ASSERT_EQ(run.output.find("unshare:"), std::string::npos)
+      << "no private mount namespace (CI runs as root): " << run.output;
   EXPECT_NE(run.exit_code, 0);
   EXPECT_NE(run.output.find("is not writable"), std::string::npos) << run.output;
 }
@@ -112,17 +129,20 @@ TEST_F(CliFaults, AFullDiskGivesAClearErrorAndKeepsTheOldFile) {
   const std::string bin = UWSCAN_BIN;
   // 1 MiB: the old file fits, the new cloud (a few MB) does not, nor does a dive log.
   const std::string commands =
-      "printf old-cloud > " + folder.string() + "/c.ply; " +
-      bin + " reconstruct " + (dir_ / "dive.db").string() + " -o " + folder.string() + "/c.ply; echo exit=$?; " +
-      bin + " simulate " + Scene("default.yaml") + " -o " + folder.string() + "/d.db; echo exit=$?; " +
+      "printf old-cloud > " + folder.string() + "/c.ply; " + bin + " reconstruct " +
+      (dir_ / "dive.db").string() + " -o " + folder.string() + "/c.ply; echo exit=$?; " + bin +
+      " simulate " + Scene("default.yaml") + " -o " + folder.string() + "/d.db; echo exit=$?; " +
       "echo files: $(ls -A " + folder.string() + "); [ \"$(cat " + folder.string() +
       "/c.ply)\" = old-cloud ] && echo old-file-intact";
   const CommandRun run = InTmpfs(folder, "size=1m", commands);
-  ASSERT_EQ(run.output.find("unshare:"), std::string::npos) << "no private mount namespace: " << run.output;
+  ASSERT_EQ(run.output.find("unshare:"), std::string::npos)
+      << "no private mount namespace: " << run.output;
   EXPECT_EQ(run.output.find("exit=0"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("No space left on device"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("old-file-intact"), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("files: c.ply\n"), std::string::npos) << "a half-written file was left:\n" << run.output;
+  EXPECT_NE(run.output.find("files: c.ply\n"), std::string::npos)
+      << "a half-written file was left:\n"
+      << run.output;
 }
 
 // One output of a command killed at random moments: what it held before, and what a complete run
@@ -138,7 +158,8 @@ std::string WithoutRunRecord(const std::string& text) {
   std::istringstream lines(text);
   std::string kept, line;
   while (std::getline(lines, line)) {
-    if (line.find("seconds:") == std::string::npos && line.find("date_utc:") == std::string::npos) kept += line + '\n';
+    if (line.find("seconds:") == std::string::npos && line.find("date_utc:") == std::string::npos)
+      kept += line + '\n';
   }
   return kept;
 }
@@ -157,18 +178,23 @@ pid_t StartShell(const std::string& command) {
 // outputs are written: each output must then be its old bytes or the complete new ones.
 void KillAtRandomMoments(const std::string& command, std::vector<KilledOutput> outputs, int trials,
                          std::string (*normalise)(const std::string&) = nullptr) {
-  const auto normalised = [normalise](const std::string& bytes) { return normalise ? normalise(bytes) : bytes; };
+  const auto normalised = [normalise](const std::string& bytes) {
+    return normalise ? normalise(bytes) : bytes;
+  };
   for (const KilledOutput& output : outputs) fs::remove(output.path);
   const auto start = std::chrono::steady_clock::now();
   const CommandRun complete = RunCommand(command);
-  const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double run_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(complete.exit_code, 0) << command << "\n" << complete.output;
   for (KilledOutput& output : outputs) output.new_bytes = normalised(Bytes(output.path));
 
   std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> anywhere(0.0, run_s), near_the_end(0.8 * run_s, 1.05 * run_s);
+  std::uniform_real_distribution<double> anywhere(0.0, run_s),
+      near_the_end(0.8 * run_s, 1.05 * run_s);
   for (int trial = 0; trial < trials; ++trial) {
-    for (const KilledOutput& output : outputs) std::ofstream(output.path, std::ios::binary) << output.old_bytes;
+    for (const KilledOutput& output : outputs)
+      std::ofstream(output.path, std::ios::binary) << output.old_bytes;
     const double moment_s = trial % 2 == 0 ? anywhere(rng) : near_the_end(rng);
     const pid_t child = StartShell(command);
     ASSERT_GE(child, 0);
@@ -178,8 +204,9 @@ void KillAtRandomMoments(const std::string& command, std::vector<KilledOutput> o
     for (const KilledOutput& output : outputs) {
       const std::string now = Bytes(output.path);
       EXPECT_TRUE(now == output.old_bytes || normalised(now) == output.new_bytes)
-          << command << ": killed after " << moment_s << " s (of " << run_s << "), " << output.path << " holds "
-          << now.size() << " bytes (old " << output.old_bytes.size() << ", new " << output.new_bytes.size() << ")";
+          << command << ": killed after " << moment_s << " s (of " << run_s << "), " << output.path
+          << " holds " << now.size() << " bytes (old " << output.old_bytes.size() << ", new "
+          << output.new_bytes.size() << ")";
     }
   }
 }
@@ -188,31 +215,38 @@ TEST_F(CliFaults, KilledAtAnyMomentTheOutputIsTheOldFileOrACompleteNewOne) {
   const std::string old_bytes = Bytes(dir_ / "old.ply");
   const std::string bin = UWSCAN_BIN, dive = (dir_ / "dive.db").string();
   const fs::path cloud = dir_ / "killed.ply";
-  KillAtRandomMoments(bin + " reconstruct " + dive + " -o " + cloud.string(), {{cloud, old_bytes, ""}}, 8);
+  KillAtRandomMoments(bin + " reconstruct " + dive + " -o " + cloud.string(),
+                      {{cloud, old_bytes, ""}}, 8);
 
   const fs::path registered = dir_ / "registered.ply";
-  KillAtRandomMoments(bin + " register " + (dir_ / "cloud.ply").string() + " " + (dir_ / "old.ply").string() +
-                          " -o " + registered.string(),
+  KillAtRandomMoments(bin + " register " + (dir_ / "cloud.ply").string() + " " +
+                          (dir_ / "old.ply").string() + " -o " + registered.string(),
                       {{registered, old_bytes, ""}}, 8);
 
   const fs::path map = dir_ / "map.ply", trajectory = dir_ / "slam.tum";
-  KillAtRandomMoments(bin + " map " + dive + " -o " + map.string() + " --trajectory " + trajectory.string(),
-                      {{map, old_bytes, ""}, {trajectory, "0 0 0 0 0 0 0 1\n", ""}}, 8);
+  KillAtRandomMoments(
+      bin + " map " + dive + " -o " + map.string() + " --trajectory " + trajectory.string(),
+      {{map, old_bytes, ""}, {trajectory, "0 0 0 0 0 0 0 1\n", ""}}, 8);
 
   const fs::path database = dir_ / "objects.db";
-  KillAtRandomMoments(bin + " build-db pipe -o " + database.string(), {{database, "old database", ""}}, 6);
+  KillAtRandomMoments(bin + " build-db pipe -o " + database.string(),
+                      {{database, "old database", ""}}, 6);
 
-  // calibrate on a small simulated intrinsics dataset; its record holds the run's date and duration.
+  // calibrate on a small simulated intrinsics dataset; its record holds the run's date and
+  // duration.
   const fs::path scene = dir_ / "calibration.yaml", dataset = dir_ / "calibration_dataset";
-  std::ofstream(scene) << "uwscan_format: 1\nseed: 5\nwater: {refractive_index: 1.0}\nscanner:\n  file: "
-                       << UWSCAN_SOURCE_DIR << "/data/scanners/galvo_default.yaml\neffects:\n  refraction: false\n"
-                       << "  image: {format: mono8}\ncalibration:\n  step: intrinsics\n  pattern: {type: chessboard, "
-                       << "columns: 9, rows: 6, square_m: 0.03}\n  views: 6\n  distance_m: [0.5, 0.8]\n"
-                       << "  max_tilt_rad: 0.5\n  image_scale: 0.5\n";
+  std::ofstream(scene)
+      << "uwscan_format: 1\nseed: 5\nwater: {refractive_index: 1.0}\nscanner:\n  file: "
+      << UWSCAN_SOURCE_DIR << "/data/scanners/galvo_default.yaml\neffects:\n  refraction: false\n"
+      << "  image: {format: mono8}\ncalibration:\n  step: intrinsics\n  pattern: {type: "
+         "chessboard, "
+      << "columns: 9, rows: 6, square_m: 0.03}\n  views: 6\n  distance_m: [0.5, 0.8]\n"
+      << "  max_tilt_rad: 0.5\n  image_scale: 0.5\n";
   ASSERT_EQ(RunUwscan("simulate " + scene.string() + " -o " + dataset.string()).exit_code, 0);
   const fs::path calibration = dir_ / "calibrated.yaml";
-  KillAtRandomMoments(bin + " calibrate intrinsics " + dataset.string() + " -o " + calibration.string() +
-                          " --from " + UWSCAN_SOURCE_DIR + "/data/scanners/galvo_default.yaml",
+  KillAtRandomMoments(bin + " calibrate intrinsics " + dataset.string() + " -o " +
+                          calibration.string() + " --from " + UWSCAN_SOURCE_DIR +
+                          "/data/scanners/galvo_default.yaml",
                       {{calibration, "old: calibration\n", ""}}, 8, WithoutRunRecord);
 
   // simulate --force over an older log: the output stays a readable log, old or new.
@@ -224,7 +258,8 @@ TEST_F(CliFaults, KilledAtAnyMomentTheOutputIsTheOldFileOrACompleteNewOne) {
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
-      ::execl(UWSCAN_BIN, UWSCAN_BIN, "simulate", Scene("default.yaml").c_str(), "-o", log.c_str(), "--force", nullptr);
+      ::execl(UWSCAN_BIN, UWSCAN_BIN, "simulate", Scene("default.yaml").c_str(), "-o", log.c_str(),
+              "--force", nullptr);
       ::_exit(127);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100 + rng() % 1200));

@@ -18,7 +18,8 @@ namespace fs = std::filesystem;
 using namespace uwscan::test;
 
 fs::path TempPath(const std::string& name) { return TempPathOf("uwscan_cli_inspect_", name); }
-std::unique_ptr<Background> StartFakeCamera(const std::vector<std::string>& args, const std::string& name) {
+std::unique_ptr<Background> StartFakeCamera(const std::vector<std::string>& args,
+                                            const std::string& name) {
   return StartFakeCameraLogged(args, TempPath(name + ".log"));
 }
 
@@ -40,8 +41,9 @@ void ExpectLossCountedAndSmall(const nlohmann::json& j, const fs::path& log) {
   ASSERT_GT(gaps.logged, 0);
   ASSERT_TRUE(gaps.in_order);
   const std::int64_t lost = j["lost_frames"].get<std::int64_t>();
-  std::printf("profile mode: %lld of %lld frames lost (%lld incomplete)\n", static_cast<long long>(lost),
-              static_cast<long long>(gaps.logged), static_cast<long long>(j["incomplete_frames"].get<std::int64_t>()));
+  std::printf("profile mode: %lld of %lld frames lost (%lld incomplete)\n",
+              static_cast<long long>(lost), static_cast<long long>(gaps.logged),
+              static_cast<long long>(j["incomplete_frames"].get<std::int64_t>()));
   EXPECT_EQ(lost, gaps.missing);
   EXPECT_LE(lost, gaps.logged / 100);
 }
@@ -53,13 +55,18 @@ TEST(CliInspect, ProfileModeLogsEveryFrameAndMapsTheScene) {
   const std::string scene = SourcePath("data/scenes/default.yaml");
   const fs::path simulated = TempPath("sim.db"), cloud = TempPath("sim.ply");
   ASSERT_EQ(RunUwscan("simulate " + scene + " -o " + simulated.string()).exit_code, 0);
-  ASSERT_EQ(RunUwscan("reconstruct " + simulated.string() + " --scanner-frame --ascii -o " + cloud.string()).exit_code, 0);
+  ASSERT_EQ(RunUwscan("reconstruct " + simulated.string() + " --scanner-frame --ascii -o " +
+                      cloud.string())
+                .exit_code,
+            0);
   auto camera = StartFakeCamera({"fake-camera", scene}, "profile_camera");
-  const fs::path log = TempPath("profile.db"), json = TempPath("profile.json"), map = TempPath("map.ply");
+  const fs::path log = TempPath("profile.db"), json = TempPath("profile.json"),
+                 map = TempPath("map.ply");
   const double voxel_m = 0.002;
-  const CommandRun run = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --log " + log.string() +
-                                   " --frames 603 --voxel " + std::to_string(voxel_m) + " --ascii -o " + map.string() +
-                                   " --json " + json.string());
+  const CommandRun run =
+      RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --log " + log.string() +
+                " --frames 603 --voxel " + std::to_string(voxel_m) + " --ascii -o " + map.string() +
+                " --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   EXPECT_EQ(j["frames_received"].get<std::int64_t>(), 603) << run.output;
@@ -78,7 +85,8 @@ TEST(CliInspect, ProfileModeLogsEveryFrameAndMapsTheScene) {
   ASSERT_GT(mapped.size(), 10000u);
   EXPECT_EQ(mapped.size(), j["map_points"].get<std::size_t>());
   const double worst_m = MaxNearestDistance(mapped, truth, 0.005);
-  std::printf("profile mode: %zu map points, farthest %.3f mm from the simulated cloud\n", mapped.size(), worst_m * 1e3);
+  std::printf("profile mode: %zu map points, farthest %.3f mm from the simulated cloud\n",
+              mapped.size(), worst_m * 1e3);
   EXPECT_LT(worst_m, std::sqrt(3.0) * voxel_m + 1e-4);
 }
 
@@ -88,11 +96,17 @@ TEST(CliInspect, ImageModeDetectsOnTheHostAndMapsTheScene) {
   const std::string scene = SourcePath("data/scenes/camera_image.yaml");
   const fs::path simulated = TempPath("image_sim.db"), cloud = TempPath("image_sim.ply");
   ASSERT_EQ(RunUwscan("simulate " + scene + " -o " + simulated.string()).exit_code, 0);
-  ASSERT_EQ(RunUwscan("reconstruct " + simulated.string() + " --scanner-frame --ascii -o " + cloud.string()).exit_code, 0);
-  auto camera = StartFakeCamera({"fake-camera", scene, "--mode", "image", "--fps", "60"}, "image_camera");
-  const fs::path log = TempPath("image.db"), json = TempPath("image.json"), map = TempPath("image_map.ply");
-  const CommandRun run = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --log " + log.string() +
-                                   " --frames 63 --voxel 0.002 --ascii -o " + map.string() + " --json " + json.string());
+  ASSERT_EQ(RunUwscan("reconstruct " + simulated.string() + " --scanner-frame --ascii -o " +
+                      cloud.string())
+                .exit_code,
+            0);
+  auto camera =
+      StartFakeCamera({"fake-camera", scene, "--mode", "image", "--fps", "60"}, "image_camera");
+  const fs::path log = TempPath("image.db"), json = TempPath("image.json"),
+                 map = TempPath("image_map.ply");
+  const CommandRun run = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --log " +
+                                   log.string() + " --frames 63 --voxel 0.002 --ascii -o " +
+                                   map.string() + " --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   EXPECT_EQ(j["frames_received"].get<std::int64_t>(), 63);
@@ -100,7 +114,8 @@ TEST(CliInspect, ImageModeDetectsOnTheHostAndMapsTheScene) {
   const std::vector<Eigen::Vector3d> mapped = ReadAsciiPly(map);
   ASSERT_GT(mapped.size(), 1000u);
   const double worst_m = MaxNearestDistance(mapped, ReadAsciiPly(cloud), 0.005);
-  std::printf("image mode: %zu map points, farthest %.3f mm from the simulated cloud\n", mapped.size(), worst_m * 1e3);
+  std::printf("image mode: %zu map points, farthest %.3f mm from the simulated cloud\n",
+              mapped.size(), worst_m * 1e3);
   EXPECT_LT(worst_m, std::sqrt(3.0) * 0.002 + 0.5e-3);
 }
 
@@ -110,8 +125,8 @@ TEST(CliInspect, CtrlCStopsCleanlyWithAReadableLog) {
   const std::string scene = SourcePath("data/scenes/default.yaml");
   auto camera = StartFakeCamera({"fake-camera", scene}, "ctrlc_camera");
   const fs::path log = TempPath("ctrlc.db"), json = TempPath("ctrlc.json");
-  Background inspect({"inspect", "--camera", "127.0.0.1", "--scene", scene, "--log", log.string(), "--json",
-                      json.string()},
+  Background inspect({"inspect", "--camera", "127.0.0.1", "--scene", scene, "--log", log.string(),
+                      "--json", json.string()},
                      TempPath("ctrlc_inspect.log"));
   ASSERT_TRUE(inspect.WaitFor("profile mode", 20.0)) << inspect.Output();
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
@@ -129,28 +144,34 @@ TEST(CliInspect, CtrlCStopsCleanlyWithAReadableLog) {
 
 TEST(CliInspect, AWrongAddressFailsClearlyWithinSeconds) {
   const Clock::time_point start = Clock::now();
-  const CommandRun run = RunUwscan("inspect --camera 127.0.0.2 --log " + TempPath("none.db").string() + " --scene " +
-                                   SourcePath("data/scenes/default.yaml"));
+  const CommandRun run =
+      RunUwscan("inspect --camera 127.0.0.2 --log " + TempPath("none.db").string() + " --scene " +
+                SourcePath("data/scenes/default.yaml"));
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("camera 127.0.0.2: no GigE Vision camera answers there"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("camera 127.0.0.2: no GigE Vision camera answers there"),
+            std::string::npos)
+      << run.output;
   EXPECT_LT(seconds, 5.0);
   EXPECT_FALSE(fs::exists(TempPath("none.db")));
 }
 
 TEST(CliInspect, BadOptionsFailBeforeTheCameraIsOpened) {
   const std::string scene = SourcePath("data/scenes/default.yaml");
-  const CommandRun both = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --frames 3 --seconds 1");
+  const CommandRun both =
+      RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --frames 3 --seconds 1");
   EXPECT_EQ(both.exit_code, 1);
   EXPECT_NE(both.output.find("--frames and --seconds"), std::string::npos) << both.output;
   const CommandRun neither = RunUwscan("inspect --camera 127.0.0.1");
   EXPECT_EQ(neither.exit_code, 1);
   EXPECT_NE(neither.output.find("give --scene"), std::string::npos) << neither.output;
-  const CommandRun xyz = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " -o " + TempPath("m.xyz").string());
+  const CommandRun xyz = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " -o " +
+                                   TempPath("m.xyz").string());
   EXPECT_EQ(xyz.exit_code, 1);
-  EXPECT_NE(xyz.output.find("a point cloud is written as .ply or .pcd"), std::string::npos) << xyz.output;
-  const CommandRun shot = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene + " --screenshot " +
-                                    TempPath("never.png").string());
+  EXPECT_NE(xyz.output.find("a point cloud is written as .ply or .pcd"), std::string::npos)
+      << xyz.output;
+  const CommandRun shot = RunUwscan("inspect --camera 127.0.0.1 --scene " + scene +
+                                    " --screenshot " + TempPath("never.png").string());
   EXPECT_EQ(shot.exit_code, 1);
   EXPECT_NE(shot.output.find("--screenshot: say when"), std::string::npos) << shot.output;
 }
@@ -161,9 +182,10 @@ TEST(CliInspect, TheLiveViewWritesItsLastPicture) {
   const std::string scene = SourcePath("data/scenes/default.yaml");
   auto camera = StartFakeCamera({"fake-camera", scene}, "view_camera");
   const fs::path png = TempPath("live.png"), json = TempPath("view.json");
-  const CommandRun run = RunCommand(SourcePath("cmake/run_with_display.sh") + " " + UWSCAN_BIN +
-                                    " inspect --camera 127.0.0.1 --scene " + scene + " --frames 402 --screenshot " +
-                                    png.string() + " --json " + json.string());
+  const CommandRun run =
+      RunCommand(SourcePath("cmake/run_with_display.sh") + " " + UWSCAN_BIN +
+                 " inspect --camera 127.0.0.1 --scene " + scene + " --frames 402 --screenshot " +
+                 png.string() + " --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find(png.string() + ": written"), std::string::npos) << run.output;
   ASSERT_TRUE(fs::exists(png));

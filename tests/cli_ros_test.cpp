@@ -25,13 +25,15 @@ using uwscan::test::CommandRun;
 using uwscan::test::RunCommand;
 using uwscan::test::RunUwscan;
 
-std::string SourcePath(const std::string& relative) { return std::string(UWSCAN_SOURCE_DIR) + "/" + relative; }
+std::string SourcePath(const std::string& relative) {
+  return std::string(UWSCAN_SOURCE_DIR) + "/" + relative;
+}
 
 // A folder of this test process's own, removed at exit.
 const std::filesystem::path& Folder() {
   static const struct Scratch {
-    std::filesystem::path path =
-        std::filesystem::temp_directory_path() / ("uwscan_cli_ros_test_" + std::to_string(::getpid()));
+    std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                 ("uwscan_cli_ros_test_" + std::to_string(::getpid()));
     Scratch() { std::filesystem::create_directories(path); }
     ~Scratch() { std::filesystem::remove_all(path); }
   } scratch;
@@ -44,8 +46,8 @@ std::filesystem::path TempPath(const std::string& name) { return Folder() / name
 const std::filesystem::path& ShortDive() {
   static const std::filesystem::path log = [] {
     const std::filesystem::path path = TempPath("short.db");
-    const CommandRun run = RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " +
-                                     path.string());
+    const CommandRun run = RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") +
+                                     " -o " + path.string());
     EXPECT_EQ(run.exit_code, 0) << run.output;
     return path;
   }();
@@ -86,20 +88,23 @@ std::vector<TimedPosition> ReadTum(const std::filesystem::path& path) {
 double LargestGap(const std::vector<TimedPosition>& a, const std::vector<TimedPosition>& b) {
   EXPECT_EQ(a.size(), b.size());
   double gap = 0.0;
-  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) gap = std::max(gap, (a[i].p - b[i].p).norm());
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+    gap = std::max(gap, (a[i].p - b[i].p).norm());
   return gap;
 }
 
 // The fraction of `a`'s points with a point of `b` within `radius_m` (a grid of `b` by cells of
 // the radius: the 27 cells around a point hold every candidate).
-double FractionWithin(const uwscan::perception::PointCloud& a, const uwscan::perception::PointCloud& b,
-                      double radius_m) {
+double FractionWithin(const uwscan::perception::PointCloud& a,
+                      const uwscan::perception::PointCloud& b, double radius_m) {
   const auto cell = [radius_m](const Eigen::Vector3d& p) {
-    return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / radius_m)), static_cast<int>(std::floor(p.y() / radius_m)),
+    return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / radius_m)),
+                           static_cast<int>(std::floor(p.y() / radius_m)),
                            static_cast<int>(std::floor(p.z() / radius_m)));
   };
   const auto key = [](const Eigen::Vector3i& c) {
-    return (static_cast<std::int64_t>(c.x()) * 73856093) ^ (static_cast<std::int64_t>(c.y()) * 19349663) ^
+    return (static_cast<std::int64_t>(c.x()) * 73856093) ^
+           (static_cast<std::int64_t>(c.y()) * 19349663) ^
            (static_cast<std::int64_t>(c.z()) * 83492791);
   };
   std::unordered_map<std::int64_t, std::vector<Eigen::Vector3d>> grid;
@@ -132,8 +137,8 @@ struct MapOutput {
 MapOutput Map(const std::filesystem::path& log, const std::string& name) {
   const std::filesystem::path ply = TempPath(name + ".ply"), tum = TempPath(name + ".tum"),
                               json = TempPath(name + ".json");
-  const CommandRun run = RunUwscan("map " + log.string() + " -o " + ply.string() + " --trajectory " + tum.string() +
-                                   " --json " + json.string());
+  const CommandRun run = RunUwscan("map " + log.string() + " -o " + ply.string() +
+                                   " --trajectory " + tum.string() + " --json " + json.string());
   EXPECT_EQ(run.exit_code, 0) << run.output;
   MapOutput out;
   if (run.exit_code != 0) return out;
@@ -145,7 +150,8 @@ MapOutput Map(const std::filesystem::path& log, const std::string& name) {
 }
 
 nlohmann::json CheckBag(const std::filesystem::path& bag) {
-  const CommandRun run = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/check_bag.py") + " " + bag.string());
+  const CommandRun run =
+      RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/check_bag.py") + " " + bag.string());
   EXPECT_EQ(run.exit_code, 0) << run.output;
   return run.exit_code == 0 ? nlohmann::json::parse(run.output) : nlohmann::json::object();
 }
@@ -174,11 +180,13 @@ TEST(CliRos, ExportedBagReadsWithRosOwnReader) {
   EXPECT_EQ(Dump(odometry["frame_ids"]), Dump(nlohmann::json::array({"odom"})));
   EXPECT_EQ(Dump(odometry["children"]), Dump(nlohmann::json::array({"base_link"})));
   EXPECT_EQ(Dump(topics["/tf"]["count"]), Dump(odometry["count"]));
-  EXPECT_EQ(Dump(topics["/tf_static"]["children"]), Dump(nlohmann::json::array({"base_link uwscan_camera"})));
+  EXPECT_EQ(Dump(topics["/tf_static"]["children"]),
+            Dump(nlohmann::json::array({"base_link uwscan_camera"})));
   EXPECT_EQ(Dump(topics["/uwscan/dive"]["type"]), Dump("std_msgs/String"));
   // Stamps are ROS time (the log's creation), not the dive's clock that starts at 0.
   EXPECT_GT(frames["first_stamp"].get<double>(), 1.6e9);
-  EXPECT_NEAR(frames["last_stamp"].get<double>() - frames["first_stamp"].get<double>(), 19.88, 1e-6);
+  EXPECT_NEAR(frames["last_stamp"].get<double>() - frames["first_stamp"].get<double>(), 19.88,
+              1e-6);
 }
 
 // simulate -> bag export -> bag import -> map maps as map on the original log: the profiles carry
@@ -186,10 +194,12 @@ TEST(CliRos, ExportedBagReadsWithRosOwnReader) {
 // voxel and a millimetre along the trajectory.
 TEST(CliRos, BagRoundTripMapsLikeTheOriginalLog) {
   const std::filesystem::path imported = TempPath("imported.db");
-  const CommandRun run = RunUwscan("bag import " + ShortBag().string() + " -o " + imported.string());
+  const CommandRun run =
+      RunUwscan("bag import " + ShortBag().string() + " -o " + imported.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("1989 frames"), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("/tf_static base_link -> uwscan_camera"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("/tf_static base_link -> uwscan_camera"), std::string::npos)
+      << run.output;
   const MapOutput original = Map(ShortDive(), "original");
   const MapOutput round_trip = Map(imported, "round_trip");
   ASSERT_GT(original.map.size(), 1000u);
@@ -198,7 +208,8 @@ TEST(CliRos, BagRoundTripMapsLikeTheOriginalLog) {
   EXPECT_GE(FractionWithin(original.map, round_trip.map, kVoxelDiagonal_m), 0.999);
   const nlohmann::json& a = original.report["figures"];
   const nlohmann::json& b = round_trip.report["figures"];
-  for (const char* count : {"submaps", "frames_mapped", "loops_accepted", "loops_rejected", "registrations"}) {
+  for (const char* count :
+       {"submaps", "frames_mapped", "loops_accepted", "loops_rejected", "registrations"}) {
     EXPECT_EQ(Dump(a[count]), Dump(b[count])) << count;
   }
   EXPECT_EQ(Dump(b["navigation_noise_assumed"]), "false");  // the noise model travelled in the bag
@@ -214,15 +225,19 @@ TEST(CliRos, ImportRefusesUnusableBagsByName) {
   const std::filesystem::path log = TempPath("refused.db");
   CommandRun run = RunUwscan("bag import " + no_odometry.string() + " -o " + log.string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("no navigation on topic /navigation/odometry"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("no navigation on topic /navigation/odometry"), std::string::npos)
+      << run.output;
   EXPECT_FALSE(std::filesystem::exists(log));
 
-  run = RunUwscan("bag import " + ShortBag().string() + " -o " + log.string() + " --frames-topic /camera/image");
+  run = RunUwscan("bag import " + ShortBag().string() + " -o " + log.string() +
+                  " --frames-topic /camera/image");
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("no camera frames on topic /camera/image"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("no camera frames on topic /camera/image"), std::string::npos)
+      << run.output;
   EXPECT_NE(run.output.find("/uwscan/frames (sensor_msgs/Image)"), std::string::npos) << run.output;
 
-  run = RunUwscan("bag import " + ShortBag().string() + " -o " + log.string() + " --dive-topic /nothing");
+  run = RunUwscan("bag import " + ShortBag().string() + " -o " + log.string() +
+                  " --dive-topic /nothing");
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find("--scanner"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(log));
@@ -252,10 +267,12 @@ TEST(CliRos, ImportRefusesUnusableBagsByName) {
 // reckoning as map's does.
 TEST(CliRos, NodeMapsAPlayedBagAsMapDoesOffline) {
   const std::filesystem::path out = TempPath("node");
-  const CommandRun run = RunCommand(SourcePath("tests/ros/replay_dive.sh") + " " + UWSCAN_BIN + " " +
-                                    ShortBag().string() + " " + out.string() + " --idle-stop-s 3");
+  const CommandRun run =
+      RunCommand(SourcePath("tests/ros/replay_dive.sh") + " " + UWSCAN_BIN + " " +
+                 ShortBag().string() + " " + out.string() + " --idle-stop-s 3");
   std::ifstream log_file(out / "node.log");
-  const std::string node_log((std::istreambuf_iterator<char>(log_file)), std::istreambuf_iterator<char>());
+  const std::string node_log((std::istreambuf_iterator<char>(log_file)),
+                             std::istreambuf_iterator<char>());
   ASSERT_EQ(run.exit_code, 0) << run.output << node_log;
   std::ifstream json_file(out / "node.json");
   const nlohmann::json node = nlohmann::json::parse(json_file);
@@ -283,15 +300,20 @@ TEST(CliRos, NodeMapsAPlayedBagAsMapDoesOffline) {
   const nlohmann::json published = CheckBag(out / "published.bag");
   ASSERT_TRUE(published.contains("/uwscan/path")) << published.dump().substr(0, 2000);
   EXPECT_EQ(Dump(published["/uwscan/path"]["frame_ids"]), Dump(nlohmann::json::array({"map"})));
-  EXPECT_EQ(Dump(published["/uwscan/sweep"]["frame_ids"]), Dump(nlohmann::json::array({"uwscan_camera"})));
+  EXPECT_EQ(Dump(published["/uwscan/sweep"]["frame_ids"]),
+            Dump(nlohmann::json::array({"uwscan_camera"})));
   EXPECT_EQ(Dump(published["/uwscan/map"]["type"]), Dump("sensor_msgs/PointCloud2"));
-  EXPECT_EQ(Dump(published["/uwscan/pose"]["type"]), Dump("geometry_msgs/PoseWithCovarianceStamped"));
-  const nlohmann::json& transforms = published["/tf"]["children"];  // the bag's odom -> base_link too
-  EXPECT_NE(std::find(transforms.begin(), transforms.end(), "map odom"), transforms.end()) << transforms.dump();
+  EXPECT_EQ(Dump(published["/uwscan/pose"]["type"]),
+            Dump("geometry_msgs/PoseWithCovarianceStamped"));
+  const nlohmann::json& transforms =
+      published["/tf"]["children"];  // the bag's odom -> base_link too
+  EXPECT_NE(std::find(transforms.begin(), transforms.end(), "map odom"), transforms.end())
+      << transforms.dump();
   const nlohmann::json& path = published["/uwscan/path"]["last_path"];
   ASSERT_EQ(path.size(), online.size());
   for (std::size_t i = 0; i < online.size(); ++i) {
-    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(), path[i][3].get<double>());
+    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(),
+                            path[i][3].get<double>());
     EXPECT_LT((p - online[i].p).norm(), 1e-6) << "anchor " << i;
   }
 }
@@ -305,12 +327,13 @@ struct NodeRun {
 };
 
 // Plays `bag` into the node (tests/ros/replay_dive.sh) with `environment` (fault settings).
-NodeRun ReplayIntoNode(const std::filesystem::path& bag, const std::string& name, const std::string& environment,
+NodeRun ReplayIntoNode(const std::filesystem::path& bag, const std::string& name,
+                       const std::string& environment,
                        const std::string& node_options = "--idle-stop-s 3") {
   const std::filesystem::path out = TempPath(name);
   NodeRun r;
-  r.run = RunCommand(environment + " " + SourcePath("tests/ros/replay_dive.sh") + " " + UWSCAN_BIN + " " +
-                     bag.string() + " " + out.string() + " " + node_options);
+  r.run = RunCommand(environment + " " + SourcePath("tests/ros/replay_dive.sh") + " " + UWSCAN_BIN +
+                     " " + bag.string() + " " + out.string() + " " + node_options);
   std::ifstream log_file(out / "node.log");
   r.log.assign(std::istreambuf_iterator<char>(log_file), std::istreambuf_iterator<char>());
   std::ifstream json_file(out / "node.json");
@@ -357,8 +380,8 @@ TEST(CliRos, FramesAfterTheNavigationStoppedAreLoggedNotMapped) {
   const double stop_s = topics["/uwscan/frames"]["first_stamp"].get<double>() + 10.0;
   const std::filesystem::path bag = TempPath("navigation_stops.bag");
   ASSERT_EQ(RunCommand("rosbag filter " + ShortBag().string() + " " + bag.string() +
-                       " \"topic != '/navigation/odometry' or m.header.stamp.to_sec() < " + std::to_string(stop_s) +
-                       "\"")
+                       " \"topic != '/navigation/odometry' or m.header.stamp.to_sec() < " +
+                       std::to_string(stop_s) + "\"")
                 .exit_code,
             0);
   const NodeRun r = ReplayIntoNode(bag, "navigation_stops", "");
@@ -368,7 +391,8 @@ TEST(CliRos, FramesAfterTheNavigationStoppedAreLoggedNotMapped) {
   EXPECT_GT(left_out, 900);  // the last ten seconds, at 100 frames/s
   EXPECT_LT(left_out, 1100);
   EXPECT_EQ(r.report["frames_mapped"].get<std::int64_t>() + left_out, 1989);
-  EXPECT_NE(r.log.find(std::to_string(left_out) + " frames logged but not mapped: no navigation"), std::string::npos)
+  EXPECT_NE(r.log.find(std::to_string(left_out) + " frames logged but not mapped: no navigation"),
+            std::string::npos)
       << r.log;
 }
 
@@ -377,8 +401,8 @@ TEST(CliRos, FramesAfterTheNavigationStoppedAreLoggedNotMapped) {
 TEST(CliRos, ADiveAndItsMapReportExportTogether) {
   const MapOutput mapped = Map(ShortDive(), "for_export");
   const std::filesystem::path bag = TempPath("dive_and_map.bag");
-  const CommandRun run = RunUwscan("bag export " + ShortDive().string() + " " + TempPath("for_export.json").string() +
-                                   " -o " + bag.string());
+  const CommandRun run = RunUwscan("bag export " + ShortDive().string() + " " +
+                                   TempPath("for_export.json").string() + " -o " + bag.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json topics = CheckBag(bag);
   const std::size_t anchors = mapped.trajectory.size();
@@ -393,11 +417,12 @@ TEST(CliRos, ADiveAndItsMapReportExportTogether) {
   ASSERT_EQ(path.size(), anchors);
   for (std::size_t i = 0; i < anchors; ++i) {
     EXPECT_NEAR(path[i][0].get<double>() - origin_s, mapped.trajectory[i].time_s, 1e-6);
-    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(), path[i][3].get<double>());
+    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(),
+                            path[i][3].get<double>());
     EXPECT_LT((p - mapped.trajectory[i].p).norm(), 1e-9);
   }
   const CommandRun tum = RunUwscan("bag export " + TempPath("for_export.tum").string() + " -o " +
-                                           TempPath("refused.bag").string());
+                                   TempPath("refused.bag").string());
   EXPECT_EQ(tum.exit_code, 1) << tum.output;
   EXPECT_FALSE(std::filesystem::exists(TempPath("refused.bag")));
 }
@@ -412,8 +437,12 @@ const OfflineRecognition& RecognisedDemo() {
     OfflineRecognition o{TempPath("objects.db"), TempPath("demo.db"), TempPath("offline.json")};
     CommandRun run = RunUwscan("build-db valve_wheel flange pipe --views 16 -o " + o.db.string());
     EXPECT_EQ(run.exit_code, 0) << run.output;
-    EXPECT_EQ(RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + o.log.string()).exit_code, 0);
-    run = RunUwscan("recognize " + o.log.string() + " --db " + o.db.string() + " --json " + o.report.string());
+    EXPECT_EQ(
+        RunUwscan("simulate " + SourcePath("data/scenes/default.yaml") + " -o " + o.log.string())
+            .exit_code,
+        0);
+    run = RunUwscan("recognize " + o.log.string() + " --db " + o.db.string() + " --json " +
+                    o.report.string());
     EXPECT_EQ(run.exit_code, 0) << run.output;
     return o;
   }();
@@ -443,7 +472,8 @@ TEST(CliRos, RecognitionNodeFindsWhatRecognizeFindsOffline) {
     expected_positions.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
   }
   ASSERT_GE(expected_ids.size(), 2u) << expected.dump().substr(0, 2000);
-  for (const std::string& id : expected_ids) EXPECT_TRUE(online["objects"].contains(id)) << id << online.dump();
+  for (const std::string& id : expected_ids)
+    EXPECT_TRUE(online["objects"].contains(id)) << id << online.dump();
 
   const nlohmann::json published = CheckBag(TempPath("recognition") / "published.bag");
   const nlohmann::json& labels = published["/uwscan/objects"]["last_labels"];
@@ -453,11 +483,14 @@ TEST(CliRos, RecognitionNodeFindsWhatRecognizeFindsOffline) {
   for (const Eigen::Vector3d& e : expected_positions) {
     double nearest = 1e9;
     for (const nlohmann::json& p : positions) {
-      nearest = std::min(nearest, (Eigen::Vector3d(p[0].get<double>(), p[1].get<double>(), p[2].get<double>()) - e).norm());
+      nearest = std::min(
+          nearest,
+          (Eigen::Vector3d(p[0].get<double>(), p[1].get<double>(), p[2].get<double>()) - e).norm());
     }
     EXPECT_LT(nearest, 0.005) << "an object offline at " << e.transpose();
   }
-  EXPECT_EQ(Dump(published["/uwscan/object_poses"]["frame_ids"]), Dump(nlohmann::json::array({"uwscan_camera"})));
+  EXPECT_EQ(Dump(published["/uwscan/object_poses"]["frame_ids"]),
+            Dump(nlohmann::json::array({"uwscan_camera"})));
 }
 
 namespace {
@@ -466,8 +499,8 @@ namespace {
 const std::filesystem::path& EnuBag() {
   static const std::filesystem::path bag = [] {
     const std::filesystem::path path = TempPath("enu.bag");
-    const CommandRun run = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/enu_bag.py") + " " +
-                                      ShortBag().string() + " " + path.string());
+    const CommandRun run = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/enu_bag.py") +
+                                      " " + ShortBag().string() + " " + path.string());
     EXPECT_EQ(run.exit_code, 0) << run.output;
     return path;
   }();
@@ -478,14 +511,16 @@ const std::filesystem::path& EnuBag() {
 // between their mounts; infinity when their counts differ.
 double NavigationGap(const std::filesystem::path& a_log, const std::filesystem::path& b_log) {
   const uwscan::mapping::DiveLogReader a(a_log), b(b_log);
-  const std::vector<uwscan::mapping::NavigationRecord> nav_a = a.ReadNavigation(), nav_b = b.ReadNavigation();
+  const std::vector<uwscan::mapping::NavigationRecord> nav_a = a.ReadNavigation(),
+                                                       nav_b = b.ReadNavigation();
   if (nav_a.size() != nav_b.size() || !a.vehicle_mount() || !b.vehicle_mount()) return INFINITY;
   const auto gap = [](const Eigen::Isometry3d& x, const Eigen::Isometry3d& y) {
     return (x.translation() - y.translation()).norm() + (x.linear() - y.linear()).norm();
   };
   double largest = gap(*a.vehicle_mount(), *b.vehicle_mount());
   for (std::size_t i = 0; i < nav_a.size(); ++i) {
-    largest = std::max({largest, std::abs(nav_a[i].time_s - nav_b[i].time_s), gap(nav_a[i].T_W_V, nav_b[i].T_W_V)});
+    largest = std::max({largest, std::abs(nav_a[i].time_s - nav_b[i].time_s),
+                        gap(nav_a[i].T_W_V, nav_b[i].T_W_V)});
   }
   return largest;
 }
@@ -498,7 +533,8 @@ double NavigationGap(const std::filesystem::path& a_log, const std::filesystem::
 // does not; a /tf without the navigation's frames is refused by name.
 TEST(CliRos, ImportTakesNavigationInEnuAxesAndFromTf) {
   const std::filesystem::path original = TempPath("original_nav.db");
-  ASSERT_EQ(RunUwscan("bag import " + ShortBag().string() + " -o " + original.string()).exit_code, 0);
+  ASSERT_EQ(RunUwscan("bag import " + ShortBag().string() + " -o " + original.string()).exit_code,
+            0);
   for (const char* source : {"odometry", "tf"}) {
     const std::filesystem::path log = TempPath(std::string("enu_") + source + ".db");
     const CommandRun run = RunUwscan("bag import " + EnuBag().string() + " -o " + log.string() +
@@ -513,7 +549,8 @@ TEST(CliRos, ImportTakesNavigationInEnuAxesAndFromTf) {
   const CommandRun run = RunUwscan("bag import " + EnuBag().string() + " -o " + refused.string() +
                                    " --navigation tf --odom-frame world_enu");
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("no world_enu -> base_link transform on /tf"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("no world_enu -> base_link transform on /tf"), std::string::npos)
+      << run.output;
   EXPECT_FALSE(std::filesystem::exists(refused));
 }
 
@@ -524,9 +561,11 @@ TEST(CliRos, NodeTakesNavigationFromTfInEnuAxes) {
                                    "--idle-stop-s 3 _navigation_source:=tf _navigation_axes:=enu");
   ASSERT_EQ(r.run.exit_code, 0) << r.run.output << r.log;
   EXPECT_EQ(Dump(r.report["frames_mapped"]), Dump(1989)) << r.report.dump();
-  EXPECT_NE(r.log.find("navigation on /tf (odom -> base_link) in ENU/FLU axes"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("navigation on /tf (odom -> base_link) in ENU/FLU axes"), std::string::npos)
+      << r.log;
   const std::filesystem::path out = TempPath("enu_tf");
-  EXPECT_LT(NavigationGap(ShortDive(), out / "node.db"), 1e-6);  // stamps in ROS time: ~1e-7 s steps
+  EXPECT_LT(NavigationGap(ShortDive(), out / "node.db"),
+            1e-6);  // stamps in ROS time: ~1e-7 s steps
   const MapOutput offline = Map(ShortDive(), "offline_for_enu");
   const std::vector<TimedPosition> online = ReadTum(out / "node.tum");
   EXPECT_LT(LargestGap(online, offline.trajectory), 0.001);
@@ -535,7 +574,8 @@ TEST(CliRos, NodeTakesNavigationFromTfInEnuAxes) {
   ASSERT_EQ(path.size(), online.size());
   for (std::size_t i = 0; i < online.size(); ++i) {
     const Eigen::Vector3d enu(online[i].p.y(), online[i].p.x(), -online[i].p.z());
-    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(), path[i][3].get<double>());
+    const Eigen::Vector3d p(path[i][1].get<double>(), path[i][2].get<double>(),
+                            path[i][3].get<double>());
     EXPECT_LT((p - enu).norm(), 1e-6) << "anchor " << i;
   }
 }
@@ -561,17 +601,20 @@ TEST(CliRos, ARecognitionReportExportsAsTheRecognitionNodePublishes) {
   ASSERT_GE(positions.size(), 2u);
   const nlohmann::json topics = CheckBag(bag);
   EXPECT_EQ(Dump(topics["/uwscan/sweep"]["count"]), Dump(1));
-  EXPECT_GT(topics["/uwscan/sweep"]["last_points"].get<int>(), 1000) << topics.dump().substr(0, 2000);
+  EXPECT_GT(topics["/uwscan/sweep"]["last_points"].get<int>(), 1000)
+      << topics.dump().substr(0, 2000);
   const nlohmann::json& poses = topics["/uwscan/object_poses"]["positions"];
   ASSERT_EQ(poses.size(), positions.size()) << poses.dump();
   for (std::size_t i = 0; i < positions.size(); ++i) {
-    const Eigen::Vector3d p(poses[i][0].get<double>(), poses[i][1].get<double>(), poses[i][2].get<double>());
+    const Eigen::Vector3d p(poses[i][0].get<double>(), poses[i][1].get<double>(),
+                            poses[i][2].get<double>());
     EXPECT_LT((p - positions[i]).norm(), 1e-9) << "object " << i;
   }
   EXPECT_EQ(topics["/uwscan/objects"]["last_labels"].size(), positions.size());
   EXPECT_EQ(Dump(topics["/uwscan/grasps"]["last_poses"]), Dump(grasps));
   for (const char* topic : {"/uwscan/sweep", "/uwscan/object_poses", "/uwscan/grasps"}) {
-    EXPECT_EQ(Dump(topics[topic]["frame_ids"]), Dump(nlohmann::json::array({"uwscan_camera"}))) << topic;
+    EXPECT_EQ(Dump(topics[topic]["frame_ids"]), Dump(nlohmann::json::array({"uwscan_camera"})))
+        << topic;
   }
   // The scan's time: within the simulated dive's frames, on the clock a bag of that dive has.
   const std::filesystem::path dive_bag = TempPath("demo_for_time.bag");
@@ -588,18 +631,21 @@ TEST(CliRos, ARecognitionReportExportsAsTheRecognitionNodePublishes) {
 // gives the dive's frames and navigation back, the camera where the chain puts it, and maps.
 TEST(CliRos, AVehiclesOwnBagImportsWithItsScannerAndTopicNames) {
   const std::filesystem::path vehicle = TempPath("vehicle.bag");
-  const CommandRun rewrite = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/vehicle_bag.py") + " " +
-                                        ShortBag().string() + " " + vehicle.string());
+  const CommandRun rewrite =
+      RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/vehicle_bag.py") + " " +
+                 ShortBag().string() + " " + vehicle.string());
   ASSERT_EQ(rewrite.exit_code, 0) << rewrite.output;
   const std::filesystem::path log = TempPath("vehicle.db");
-  const std::string topics = " --frames-topic /girona500/camera/profile --odometry-topic /girona500/navigator/odometry";
+  const std::string topics =
+      " --frames-topic /girona500/camera/profile --odometry-topic /girona500/navigator/odometry";
   CommandRun run = RunUwscan("bag import " + vehicle.string() + " -o " + log.string() + topics);
   EXPECT_EQ(run.exit_code, 1) << run.output;  // no dive description: the scanner must be given
   EXPECT_NE(run.output.find("--scanner"), std::string::npos) << run.output;
-  run = RunUwscan("bag import " + vehicle.string() + " -o " + log.string() + topics + " --scanner " +
-                  SourcePath("data/scanners/galvo_binned.yaml"));
+  run = RunUwscan("bag import " + vehicle.string() + " -o " + log.string() + topics +
+                  " --scanner " + SourcePath("data/scanners/galvo_binned.yaml"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("girona500/base_link -> girona500/laser_camera"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("girona500/base_link -> girona500/laser_camera"), std::string::npos)
+      << run.output;
 
   const uwscan::mapping::DiveLogReader original(ShortDive()), imported(log);
   ASSERT_EQ(imported.frame_count(), original.frame_count());
@@ -609,7 +655,8 @@ TEST(CliRos, AVehiclesOwnBagImportsWithItsScannerAndTopicNames) {
     EXPECT_EQ(a.sweep, b.sweep);
     EXPECT_EQ(a.peaks_px.size(), b.peaks_px.size());
   }
-  const std::vector<uwscan::mapping::NavigationRecord> nav_a = original.ReadNavigation(), nav_b = imported.ReadNavigation();
+  const std::vector<uwscan::mapping::NavigationRecord> nav_a = original.ReadNavigation(),
+                                                       nav_b = imported.ReadNavigation();
   ASSERT_EQ(nav_a.size(), nav_b.size());
   // The vehicle's stamps are ROS time: the dive's clock plus the bag's origin, kept as they are.
   const double origin_s = imported.ReadFrame(0).time_s - original.ReadFrame(0).time_s;
@@ -629,8 +676,8 @@ namespace {
 // A copy of the short dive's bag with one fault (tests/ros/edit_bag.py).
 std::filesystem::path FaultyBag(const std::string& name, const std::string& fault) {
   const std::filesystem::path bag = TempPath(name + ".bag");
-  const CommandRun run = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/edit_bag.py") + " " +
-                                    ShortBag().string() + " " + bag.string() + " " + fault);
+  const CommandRun run = RunCommand("/usr/bin/python3 " + SourcePath("tests/ros/edit_bag.py") +
+                                    " " + ShortBag().string() + " " + bag.string() + " " + fault);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   return bag;
 }
@@ -641,12 +688,15 @@ std::filesystem::path FaultyBag(const std::string& name, const std::string& faul
 // and what is wrong, and no log.
 TEST(CliRos, ImportRefusesWrongEncodingsAndStampsThatGoBack) {
   const std::filesystem::path log = TempPath("faulty.db");
-  CommandRun run = RunUwscan("bag import " + FaultyBag("rgb", "encoding rgb8").string() + " -o " + log.string());
+  CommandRun run =
+      RunUwscan("bag import " + FaultyBag("rgb", "encoding rgb8").string() + " -o " + log.string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("/uwscan/frames: image encoding 'rgb8', expected mono8 or mono16"), std::string::npos)
+  EXPECT_NE(run.output.find("/uwscan/frames: image encoding 'rgb8', expected mono8 or mono16"),
+            std::string::npos)
       << run.output;
   EXPECT_FALSE(std::filesystem::exists(log));
-  run = RunUwscan("bag import " + FaultyBag("back", "stamp_back 500").string() + " -o " + log.string());
+  run = RunUwscan("bag import " + FaultyBag("back", "stamp_back 500").string() + " -o " +
+                  log.string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find("topic /uwscan/frames: stamp"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("goes back"), std::string::npos) << run.output;
@@ -658,7 +708,8 @@ TEST(CliRos, ImportRefusesWrongEncodingsAndStampsThatGoBack) {
 TEST(CliRos, NodeRefusesFramesOfTheWrongEncodingByName) {
   const NodeRun r = ReplayIntoNode(FaultyBag("rgb_node", "encoding rgb8"), "rgb_node", "");
   EXPECT_EQ(r.run.exit_code, 1) << r.run.output << r.log;
-  EXPECT_NE(r.log.find("uwscan: error: /uwscan/frames: image encoding 'rgb8'"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("uwscan: error: /uwscan/frames: image encoding 'rgb8'"), std::string::npos)
+      << r.log;
 }
 
 // The camera's topic stops while the navigation goes on: the node says so, and (with
@@ -673,14 +724,16 @@ TEST(CliRos, NodeSaysWhenTheFramesStop) {
   EXPECT_LT(received, 850);  // 8 s at 100 frames/s
   EXPECT_EQ(r.report["frames_logged"].get<std::int64_t>(), received);
   EXPECT_EQ(r.report["frames_mapped"].get<std::int64_t>(), received);
-  EXPECT_EQ(r.report["stop_reason"].get<std::string>().rfind("no frame for 6", 0), 0u) << r.report.dump();
+  EXPECT_EQ(r.report["stop_reason"].get<std::string>().rfind("no frame for 6", 0), 0u)
+      << r.report.dump();
 }
 
 // bench ros writes every figure its JSON promises; at the seed camera's 339 frames/s the node
 // loses no frame.
 TEST(CliRos, RosBenchWritesItsFiguresAndLosesNoFrame) {
   const std::filesystem::path json = TempPath("bench_ros.json");
-  const CommandRun run = RunUwscan("bench ros --rates 3.39 --inspect-seconds 5 --json " + json.string());
+  const CommandRun run =
+      RunUwscan("bench ros --rates 3.39 --inspect-seconds 5 --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::ifstream in(json);
   const nlohmann::json r = nlohmann::json::parse(in);
@@ -705,10 +758,12 @@ TEST(CliRos, RosBenchWritesItsFiguresAndLosesNoFrame) {
 // frames the navigation covers are mapped.
 TEST(CliRos, NodeReadsACameraDirectly) {
   const std::filesystem::path out = TempPath("camera_node");
-  const CommandRun run = RunCommand(SourcePath("tests/ros/camera_node.sh") + " " + UWSCAN_BIN + " " +
-                                    SourcePath("data/scenes/default.yaml") + " " + out.string() + " 400");
+  const CommandRun run =
+      RunCommand(SourcePath("tests/ros/camera_node.sh") + " " + UWSCAN_BIN + " " +
+                 SourcePath("data/scenes/default.yaml") + " " + out.string() + " 400");
   std::ifstream log_file(out / "node.log");
-  const std::string log((std::istreambuf_iterator<char>(log_file)), std::istreambuf_iterator<char>());
+  const std::string log((std::istreambuf_iterator<char>(log_file)),
+                        std::istreambuf_iterator<char>());
   ASSERT_EQ(run.exit_code, 0) << run.output << log;
   std::ifstream json_file(out / "node.json");
   const nlohmann::json r = nlohmann::json::parse(json_file);

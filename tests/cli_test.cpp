@@ -1,25 +1,25 @@
 // Runs the `uwscan` program the way a user does and checks what it prints and writes.
 #include <gtest/gtest.h>
-
-#include "tests/cli_run.hpp"
 #include <sys/wait.h>
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <Eigen/Geometry>
-#include <algorithm>
-#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "tests/cli_run.hpp"
+
 namespace {
 
-using uwscan::test::RunCommand;
 using uwscan::test::CommandRun;
+using uwscan::test::RunCommand;
 using uwscan::test::RunUwscan;
 
 std::filesystem::path TempPath(const std::string& name) {
@@ -58,9 +58,12 @@ TEST(Cli, BadInputEndsWithOneLineReason) {
     EXPECT_EQ(usage.output.rfind("uwscan: error: ", 0), 0u) << usage.output;
   }
   const CommandRun zero_voxel = RunUwscan("map " + std::string(UWSCAN_BIN) + " -o m.ply --voxel 0");
-  EXPECT_EQ(zero_voxel.output, "uwscan: error: --voxel: expected a number > 0, got '0' (--help lists the options)\n");
-  const CommandRun word = RunUwscan("map " + std::string(UWSCAN_BIN) + " -o m.ply --max-navigation-gap soon");
-  EXPECT_NE(word.output.find("--max-navigation-gap: expected a number > 0, got 'soon'"), std::string::npos)
+  EXPECT_EQ(zero_voxel.output,
+            "uwscan: error: --voxel: expected a number > 0, got '0' (--help lists the options)\n");
+  const CommandRun word =
+      RunUwscan("map " + std::string(UWSCAN_BIN) + " -o m.ply --max-navigation-gap soon");
+  EXPECT_NE(word.output.find("--max-navigation-gap: expected a number > 0, got 'soon'"),
+            std::string::npos)
       << word.output;
 }
 
@@ -104,7 +107,8 @@ TEST(Cli, TriangulationBenchWritesItsJson) {
   EXPECT_GT(limit, 0.0);
   for (const char* method : {"ray_plane", "ray_cone", "ray_ray"}) {
     const nlohmann::json& m = j["methods"][method];
-    EXPECT_NEAR(m.at("fraction_of_limit").get<double>(), m["points_per_s"].get<double>() / limit, 1e-9)
+    EXPECT_NEAR(m.at("fraction_of_limit").get<double>(), m["points_per_s"].get<double>() / limit,
+                1e-9)
         << method;
   }
   EXPECT_FALSE(j.at("cpu").get<std::string>().empty());
@@ -114,10 +118,11 @@ TEST(Cli, TriangulationBenchWritesItsJson) {
 TEST(Cli, KernelInstructionCountsComeFromCallgrind) {
   const CommandRun kernels = RunUwscan("bench kernels --frames 1 --points 3000");
   ASSERT_EQ(kernels.exit_code, 0) << kernels.output;
-  EXPECT_NE(kernels.output.find("ray_cone: 3000 points, 3000 triangulated"), std::string::npos) << kernels.output;
+  EXPECT_NE(kernels.output.find("ray_cone: 3000 points, 3000 triangulated"), std::string::npos)
+      << kernels.output;
   const std::filesystem::path json = TempPath("instructions.json");
-  const CommandRun run = RunCommand(std::string(UWSCAN_SOURCE_DIR) + "/bench/instructions.sh " + UWSCAN_BIN +
-                                    " --json " + json.string());
+  const CommandRun run = RunCommand(std::string(UWSCAN_SOURCE_DIR) + "/bench/instructions.sh " +
+                                    UWSCAN_BIN + " --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   // Fixed work, counted: exact ray-ray costs several times ray-cone, ray-cone more than ray-plane,
@@ -142,7 +147,8 @@ TEST(Cli, StripeBenchReportsEachMethodBesideItsLimit) {
   EXPECT_GT(limit, 0.0);
   ASSERT_EQ(j.at("methods").size(), 6u);
   for (const auto& [name, m] : j["methods"].items()) {
-    EXPECT_NEAR(m.at("fraction_of_limit").get<double>(), m["frames_per_s"].get<double>() / limit, 1e-9)
+    EXPECT_NEAR(m.at("fraction_of_limit").get<double>(), m["frames_per_s"].get<double>() / limit,
+                1e-9)
         << name;
     // Accuracy holds whatever the machine: every centre-finding method within 0.05 px.
     if (name != "maximum") {
@@ -182,8 +188,8 @@ namespace {
 
 TEST(Cli, RegistrationBenchComparesThePipelines) {
   const std::filesystem::path json = TempPath("registration.json");
-  const CommandRun run =
-      RunUwscan("bench registration --pairs-per-mesh 1 --no-real-scans --no-pcl --json " + json.string());
+  const CommandRun run = RunUwscan(
+      "bench registration --pairs-per-mesh 1 --no-real-scans --no-pcl --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
   // PCL's pipeline is left out: its RANSAC takes ~10 s a pair, 90 % of this test's time.
@@ -205,12 +211,14 @@ TEST(Cli, RegistrationBenchComparesThePipelines) {
 // for every object and "unknown", zeros included; its diagonal is the recognition rate.
 TEST(Cli, RecognitionBenchWritesAFullConfusionMatrix) {
   const std::filesystem::path json = TempPath("recognition.json");
-  const CommandRun run = RunUwscan("bench recognition --scans 3 --views 4 --no-peers --json " + json.string());
+  const CommandRun run =
+      RunUwscan("bench recognition --scans 3 --views 4 --no-peers --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("| true \\ answer |"), std::string::npos) << run.output;
   const nlohmann::json j = ReadJson(json);
   const nlohmann::json& confusion = j.at("confusion").at("uwscan");
-  const std::vector<std::string> objects = {"elbow", "flange", "pipe", "tee", "valve_lever", "valve_wheel"};
+  const std::vector<std::string> objects = {"elbow", "flange",      "pipe",
+                                            "tee",   "valve_lever", "valve_wheel"};
   ASSERT_EQ(confusion.size(), objects.size() + 1);  // and "foreign"
   int total = 0, diagonal = 0;
   for (const auto& [truth, row] : confusion.items()) {
@@ -224,7 +232,8 @@ TEST(Cli, RecognitionBenchWritesAFullConfusionMatrix) {
   const nlohmann::json& uwscan = j.at("pipelines").at("uwscan");
   EXPECT_EQ(total, uwscan.at("objects").get<int>());
   ASSERT_GT(total, 0);
-  EXPECT_DOUBLE_EQ(static_cast<double>(diagonal) / total, uwscan.at("recognition_rate").get<double>());
+  EXPECT_DOUBLE_EQ(static_cast<double>(diagonal) / total,
+                   uwscan.at("recognition_rate").get<double>());
   std::filesystem::remove(json);
 }
 
@@ -232,13 +241,15 @@ TEST(Cli, RecognitionBenchWritesAFullConfusionMatrix) {
 // threads: bytes for the database, every field but the stage times for the answers.
 TEST(Cli, BuildDbAndRecognizeGiveTheSameAnswerAcrossRunsAndThreads) {
   const std::filesystem::path dive = TempPath("objects_dive.db");
-  const CommandRun simulated = RunUwscan("simulate " + std::string(UWSCAN_SOURCE_DIR) +
-                                         "/data/scenes/default.yaml -o " + dive.string() + " --force");
+  const CommandRun simulated =
+      RunUwscan("simulate " + std::string(UWSCAN_SOURCE_DIR) + "/data/scenes/default.yaml -o " +
+                dive.string() + " --force");
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
   std::array<std::filesystem::path, 2> db = {TempPath("objects_1.db"), TempPath("objects_2.db")};
   for (int t = 0; t < 2; ++t) {
-    const CommandRun built = RunUwscan("build-db pipe flange valve_lever --views 4 --threads " + std::to_string(t + 1) +
-                                       " -o " + db[static_cast<std::size_t>(t)].string());
+    const CommandRun built =
+        RunUwscan("build-db pipe flange valve_lever --views 4 --threads " + std::to_string(t + 1) +
+                  " -o " + db[static_cast<std::size_t>(t)].string());
     ASSERT_EQ(built.exit_code, 0) << built.output;
   }
   auto bytes = [](const std::filesystem::path& path) {
@@ -249,8 +260,9 @@ TEST(Cli, BuildDbAndRecognizeGiveTheSameAnswerAcrossRunsAndThreads) {
   std::vector<nlohmann::json> answers;
   for (const int threads : {1, 2, 2}) {
     const std::filesystem::path json = TempPath("answer.json");
-    const CommandRun run = RunUwscan("recognize " + dive.string() + " --db " + db[0].string() + " --threads " +
-                                     std::to_string(threads) + " --json " + json.string());
+    const CommandRun run =
+        RunUwscan("recognize " + dive.string() + " --db " + db[0].string() + " --threads " +
+                  std::to_string(threads) + " --json " + json.string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
     nlohmann::json j = ReadJson(json);
     ASSERT_TRUE(j.contains("objects"));
@@ -278,8 +290,9 @@ TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
         const auto bump = [&](double cx, double cy, double height, double width) {
           return height * std::exp(-((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (width * width));
         };
-        const Eigen::Vector3d p(x, y, bump(0.12, 0.30, 0.08, 0.05) + bump(0.35, 0.12, 0.05, 0.03) +
-                                          bump(0.30, 0.38, 0.03, 0.08));
+        const Eigen::Vector3d p(x, y,
+                                bump(0.12, 0.30, 0.08, 0.05) + bump(0.35, 0.12, 0.05, 0.03) +
+                                    bump(0.30, 0.38, 0.03, 0.08));
         t << p.x() << " " << p.y() << " " << p.z() << "\n";
         const Eigen::Vector3d q = R * p + shift;
         s << q.x() << " " << q.y() << " " << q.z() << "\n";
@@ -295,7 +308,8 @@ TEST(Cli, RegisterAlignsAMovedCopyOfACloud) {
   // the spread of voxel centroids, millimetres here).
   EXPECT_EQ(j["whole_clouds"]["fitness"].get<double>(), 1.0);
   EXPECT_LT(j["whole_clouds"]["inlier_rmse_m"].get<double>(), 1e-3);  // 0.06 mm measured
-  EXPECT_GT(j["inlier_rmse_m"].get<double>(), 10.0 * j["whole_clouds"]["inlier_rmse_m"].get<double>());
+  EXPECT_GT(j["inlier_rmse_m"].get<double>(),
+            10.0 * j["whole_clouds"]["inlier_rmse_m"].get<double>());
   Eigen::Matrix4d T;
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) T(r, c) = j["T_target_source"][r][c].get<double>();
@@ -364,7 +378,8 @@ TEST(Cli, FeaturesBenchWritesItsJson) {
     EXPECT_GT(j["esf"][key].get<double>(), 0.0) << key;
   }
   // uwscan's ESF differs from PCL's no more than two samplings of one view differ (x2 margin).
-  EXPECT_LT(j["esf"]["chi2_to_pcl"].get<double>(), 2.0 * j["esf"]["chi2_seed_to_seed"].get<double>());
+  EXPECT_LT(j["esf"]["chi2_to_pcl"].get<double>(),
+            2.0 * j["esf"]["chi2_seed_to_seed"].get<double>());
   std::filesystem::remove(json);
 }
 

@@ -24,12 +24,18 @@ struct AccuracyArgs {
 };
 
 nlohmann::json GaugeJson(const bench::GaugeFigures& g) {
-  return {{"mean_err_m", g.mean_err_m}, {"std_err_m", g.std_err_m}, {"n", g.n},
-          {"bias_m", g.bias_m}, {"missed", g.missed}};
+  return {{"mean_err_m", g.mean_err_m},
+          {"std_err_m", g.std_err_m},
+          {"n", g.n},
+          {"bias_m", g.bias_m},
+          {"missed", g.missed}};
 }
 
 nlohmann::json PeakJson(const bench::PeakErrorFigures& f) {
-  return {{"std_px", f.std_px}, {"rms_px", f.rms_px}, {"bias_px", f.bias_px}, {"p95_abs_px", f.p95_abs_px},
+  return {{"std_px", f.std_px},
+          {"rms_px", f.rms_px},
+          {"bias_px", f.bias_px},
+          {"p95_abs_px", f.p95_abs_px},
           {"peaks", f.peaks}};
 }
 
@@ -58,65 +64,86 @@ void RunAccuracy(const AccuracyArgs& a) {
     ProgressBar bar;
     r = bench::RunAccuracyBenchmark(o, bar.Callback());
   }
-  std::printf("Seed 000 gauges (galvanometer scanner, %d positions %.2f-%.2f m, lengths 20/50/100 mm):\n\n",
-              o.gauge_positions, o.gauge_near_m, o.gauge_far_m);
-  std::printf("| medium | mean abs err mm | std mm | bias mm | gauges | missed | exact peaks: mean abs / bias mm | seed mean / std mm |\n");
+  std::printf(
+      "Seed 000 gauges (galvanometer scanner, %d positions %.2f-%.2f m, lengths 20/50/100 mm):\n\n",
+      o.gauge_positions, o.gauge_near_m, o.gauge_far_m);
+  std::printf(
+      "| medium | mean abs err mm | std mm | bias mm | gauges | missed | exact peaks: mean abs / "
+      "bias mm | seed mean / std mm |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---|\n");
-  const auto gauge_row = [](const char* medium, const bench::GaugeFigures& g, const bench::GaugeFigures& exact,
-                            const char* seed) {
-    std::printf("| %s | %.3f | %.3f | %.3f | %d | %d | %.3f / %.3f | %s |\n", medium, g.mean_err_m * 1e3,
-                g.std_err_m * 1e3, g.bias_m * 1e3, g.n, g.missed, exact.mean_err_m * 1e3, exact.bias_m * 1e3, seed);
+  const auto gauge_row = [](const char* medium, const bench::GaugeFigures& g,
+                            const bench::GaugeFigures& exact, const char* seed) {
+    std::printf("| %s | %.3f | %.3f | %.3f | %d | %d | %.3f / %.3f | %s |\n", medium,
+                g.mean_err_m * 1e3, g.std_err_m * 1e3, g.bias_m * 1e3, g.n, g.missed,
+                exact.mean_err_m * 1e3, exact.bias_m * 1e3, seed);
   };
   gauge_row("air", r.gauges_air, r.gauges_air_exact, "0.44 / 0.35");
   gauge_row("water", r.gauges_water, r.gauges_water_exact, "0.98 / 0.72");
   std::printf("\n");
 
   nlohmann::json plane = nlohmann::json::array();
-  std::printf("Seed 001 plane (MEMS scanner, %d lines x 50 waypoints, under water):\n\n", o.mems_lines);
+  std::printf("Seed 001 plane (MEMS scanner, %d lines x 50 waypoints, under water):\n\n",
+              o.mems_lines);
   std::printf("| distance m | plane rms mm | points |\n|---:|---:|---:|\n");
   for (const bench::PlaneRow& row : r.plane) {
-    std::printf("| %.2f | %.3f | %lld |\n", row.distance_m, row.rms_m * 1e3, static_cast<long long>(row.points));
+    std::printf("| %.2f | %.3f | %lld |\n", row.distance_m, row.rms_m * 1e3,
+                static_cast<long long>(row.points));
     plane.push_back({{"distance_m", row.distance_m}, {"rms_m", row.rms_m}, {"points", row.points}});
   }
   nlohmann::json sphere = nlohmann::json::array();
   std::printf("\nSeed 001 sphere (radius %.0f mm):\n\n", o.sphere_radius_m * 1e3);
   std::printf("| distance m | radius err mm | fit rms mm | points |\n|---:|---:|---:|---:|\n");
   for (const bench::SphereRow& row : r.sphere) {
-    std::printf("| %.2f | %.3f | %.3f | %lld |\n", row.distance_m, row.radius_err_m * 1e3, row.rms_m * 1e3,
-                static_cast<long long>(row.points));
-    sphere.push_back({{"distance_m", row.distance_m}, {"radius_err_m", row.radius_err_m},
-                      {"rms_m", row.rms_m}, {"points", row.points}});
+    std::printf("| %.2f | %.3f | %.3f | %lld |\n", row.distance_m, row.radius_err_m * 1e3,
+                row.rms_m * 1e3, static_cast<long long>(row.points));
+    sphere.push_back({{"distance_m", row.distance_m},
+                      {"radius_err_m", row.radius_err_m},
+                      {"rms_m", row.rms_m},
+                      {"points", row.points}});
   }
   nlohmann::json waypoints = nlohmann::json::array();
-  std::printf("\nSeed 001 waypoints per line (plane at %.2f m; seed: ~70 lines/s, 140 k points/s at 50):\n\n",
-              o.waypoint_plane_distance_m);
-  std::printf("| waypoints/line | plane rms mm | rms mm, exact peaks | lines/s | points/s |\n|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "\nSeed 001 waypoints per line (plane at %.2f m; seed: ~70 lines/s, 140 k points/s at "
+      "50):\n\n",
+      o.waypoint_plane_distance_m);
+  std::printf(
+      "| waypoints/line | plane rms mm | rms mm, exact peaks | lines/s | points/s "
+      "|\n|---:|---:|---:|---:|---:|\n");
   for (const bench::WaypointRow& row : r.waypoints) {
     std::printf("| %d | %.3f | %.4f | %.1f | %.0f |\n", row.waypoints_per_line, row.rms_m * 1e3,
                 row.rms_noise_free_m * 1e3, row.lines_per_s, row.points_per_s);
-    waypoints.push_back({{"waypoints_per_line", row.waypoints_per_line}, {"rms_m", row.rms_m},
-                         {"rms_noise_free_m", row.rms_noise_free_m}, {"lines_per_s", row.lines_per_s},
+    waypoints.push_back({{"waypoints_per_line", row.waypoints_per_line},
+                         {"rms_m", row.rms_m},
+                         {"rms_noise_free_m", row.rms_noise_free_m},
+                         {"lines_per_s", row.lines_per_s},
                          {"points_per_s", row.points_per_s}});
   }
-  std::printf("\nThe detector on the rendered stripes (detected peak minus the exact crossing of its image line):\n\n");
-  std::printf("| stripes | std px | rms px | bias px | p95 abs px | peaks |\n|---|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "\nThe detector on the rendered stripes (detected peak minus the exact crossing of its image "
+      "line):\n\n");
+  std::printf(
+      "| stripes | std px | rms px | bias px | p95 abs px | peaks "
+      "|\n|---|---:|---:|---:|---:|---:|\n");
   const auto peak_row = [](const char* what, const bench::PeakErrorFigures& f) {
-    std::printf("| %s | %.3f | %.3f | %+.3f | %.3f | %lld |\n", what, f.std_px, f.rms_px, f.bias_px, f.p95_abs_px,
-                static_cast<long long>(f.peaks));
+    std::printf("| %s | %.3f | %.3f | %+.3f | %.3f | %lld |\n", what, f.std_px, f.rms_px, f.bias_px,
+                f.p95_abs_px, static_cast<long long>(f.peaks));
   };
   peak_row("galvanometer, gauges in water", r.peak_errors_gauges_water);
   peak_row("MEMS, plane", r.peak_errors_plane);
-  std::printf("\n%.1f s. The accuracy-versus-time plot (PNG) is left to the viewer issue.\n", r.seconds);
+  std::printf("\n%.1f s. The accuracy-versus-time plot (PNG) is left to the viewer issue.\n",
+              r.seconds);
   if (!a.json_path.empty()) {
-    WriteJsonFile(a.json_path, {{"gauges", {{"air", GaugeJson(r.gauges_air)},
-                                            {"water", GaugeJson(r.gauges_water)},
-                                            {"air_exact_peaks", GaugeJson(r.gauges_air_exact)},
-                                            {"water_exact_peaks", GaugeJson(r.gauges_water_exact)}}},
+    WriteJsonFile(a.json_path, {{"gauges",
+                                 {{"air", GaugeJson(r.gauges_air)},
+                                  {"water", GaugeJson(r.gauges_water)},
+                                  {"air_exact_peaks", GaugeJson(r.gauges_air_exact)},
+                                  {"water_exact_peaks", GaugeJson(r.gauges_water_exact)}}},
                                 {"plane", plane},
                                 {"sphere", sphere},
                                 {"waypoints", waypoints},
-                                {"peak_errors", {{"gauges_water", PeakJson(r.peak_errors_gauges_water)},
-                                                 {"plane", PeakJson(r.peak_errors_plane)}}},
+                                {"peak_errors",
+                                 {{"gauges_water", PeakJson(r.peak_errors_gauges_water)},
+                                  {"plane", PeakJson(r.peak_errors_plane)}}},
                                 {"seconds", r.seconds}});
   }
 }
@@ -126,7 +153,8 @@ void RunAccuracy(const AccuracyArgs& a) {
 void AddAccuracyBenchCommand(CLI::App& bench) {
   auto args = std::make_shared<AccuracyArgs>();
   CLI::App* cmd = bench.add_subcommand(
-      "accuracy", "the seeds' accuracy experiments in simulation: gauges, plane, sphere, waypoints");
+      "accuracy",
+      "the seeds' accuracy experiments in simulation: gauges, plane, sphere, waypoints");
   cmd->add_option("--json", args->json_path, "write the figures as JSON");
   cmd->add_option("--data", args->data_dir,
                   "data folder holding scanners/ (default: `uwscan --data-dir`)");

@@ -52,10 +52,10 @@ scanner::GalvoScannerModel LoadModel(const std::string& path) {
 nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
   nlohmann::json methods = nlohmann::json::object();
   for (const auto& [name, m] : r.methods) {
-    methods[name] = {{"points_per_s", m.points_per_s},     {"fraction_of_limit", m.fraction_of_limit},
-                     {"mean_err_m", m.mean_err_m},
-                     {"std_err_m", m.std_err_m},           {"max_err_m", m.max_err_m},
-                     {"seconds", m.seconds},               {"triangulated", m.triangulated}};
+    methods[name] = {{"points_per_s", m.points_per_s}, {"fraction_of_limit", m.fraction_of_limit},
+                     {"mean_err_m", m.mean_err_m},     {"std_err_m", m.std_err_m},
+                     {"max_err_m", m.max_err_m},       {"seconds", m.seconds},
+                     {"triangulated", m.triangulated}};
   }
   const double ratio = r.methods.at("ray_ray").seconds / r.methods.at("ray_cone").seconds;
   nlohmann::json resolution = nlohmann::json::array();
@@ -63,12 +63,14 @@ nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
     resolution.push_back({{"table", row.table},
                           {"value", row.value},
                           {"setup_s", row.setup_s},
-                          {"ray_plane", {{"points_per_s", row.ray_plane.points_per_s},
-                                         {"mean_err_m", row.ray_plane.mean_err_m},
-                                         {"max_err_m", row.ray_plane.max_err_m}}},
-                          {"ray_cone", {{"points_per_s", row.ray_cone.points_per_s},
-                                        {"mean_err_m", row.ray_cone.mean_err_m},
-                                        {"max_err_m", row.ray_cone.max_err_m}}}});
+                          {"ray_plane",
+                           {{"points_per_s", row.ray_plane.points_per_s},
+                            {"mean_err_m", row.ray_plane.mean_err_m},
+                            {"max_err_m", row.ray_plane.max_err_m}}},
+                          {"ray_cone",
+                           {{"points_per_s", row.ray_cone.points_per_s},
+                            {"mean_err_m", row.ray_cone.mean_err_m},
+                            {"max_err_m", row.ray_cone.max_err_m}}}});
   }
   return {{"points", r.points},
           {"resolution", resolution},
@@ -80,7 +82,8 @@ nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
             {"seconds", r.limit_seconds},
             {"what", "camera-ray table lookup (prefetched) and one multiply-add per coordinate"}}},
           {"cpu", bench::CpuModel()},
-          {"targets", {{"points_per_s", kTargetPointsPerS}, {"fraction_of_limit", kTargetFractionOfLimit}}},
+          {"targets",
+           {{"points_per_s", kTargetPointsPerS}, {"fraction_of_limit", kTargetFractionOfLimit}}},
           {"ray_ray_over_ray_cone_time", ratio},
           {"seed",
            {{"ray_ray_s", kSeedRayRaySeconds},
@@ -90,47 +93,57 @@ nlohmann::json ToJson(const bench::TriangulationBenchResult& r) {
             {"ray_cone_std_err_m", kSeedRayConeStdErrM}}}};
 }
 
-void PrintTriangulationTable(const bench::TriangulationBenchResult& r, int grid_px, int rays_per_fan) {
+void PrintTriangulationTable(const bench::TriangulationBenchResult& r, int grid_px,
+                             int rays_per_fan) {
   std::printf("Triangulation of %lld stripe pixels on one core (errors against exact ray-ray)\n\n",
               static_cast<long long>(r.points));
-  std::printf("| method | points/s | fraction of limit | time s | mean err mm | std err mm | max err mm | points |\n");
+  std::printf(
+      "| method | points/s | fraction of limit | time s | mean err mm | std err mm | max err mm | "
+      "points |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const char* name : {"ray_plane", "ray_cone", "ray_ray"}) {
     const bench::MethodFigures& m = r.methods.at(name);
     std::printf("| %s | %.3g | %.3f | %.3f | %.4f | %.4f | %.4f | %lld |\n", name, m.points_per_s,
-                m.fraction_of_limit, m.seconds, m.mean_err_m * 1e3, m.std_err_m * 1e3, m.max_err_m * 1e3,
-                static_cast<long long>(m.triangulated));
+                m.fraction_of_limit, m.seconds, m.mean_err_m * 1e3, m.std_err_m * 1e3,
+                m.max_err_m * 1e3, static_cast<long long>(m.triangulated));
   }
-  std::printf("| limit: table lookup + one multiply-add per coordinate | %.3g | 1 | %.3f | | | | |\n",
-              r.limit_points_per_s, r.limit_seconds);
+  std::printf(
+      "| limit: table lookup + one multiply-add per coordinate | %.3g | 1 | %.3f | | | | |\n",
+      r.limit_points_per_s, r.limit_seconds);
   std::printf("\nCPU: %s\n", bench::CpuModel().c_str());
   for (const char* name : {"ray_plane", "ray_cone"}) {
     const bench::MethodFigures& m = r.methods.at(name);
-    std::printf("%s: %.3g points/s (target %.0f M: %s), %.3f of the limit (target %.1f: %s)\n", name,
-                m.points_per_s, kTargetPointsPerS / 1e6, m.points_per_s >= kTargetPointsPerS ? "met" : "missed",
-                m.fraction_of_limit, kTargetFractionOfLimit,
+    std::printf("%s: %.3g points/s (target %.0f M: %s), %.3f of the limit (target %.1f: %s)\n",
+                name, m.points_per_s, kTargetPointsPerS / 1e6,
+                m.points_per_s >= kTargetPointsPerS ? "met" : "missed", m.fraction_of_limit,
+                kTargetFractionOfLimit,
                 m.fraction_of_limit >= kTargetFractionOfLimit ? "met" : "missed");
   }
   const double ratio = r.methods.at("ray_ray").seconds / r.methods.at("ray_cone").seconds;
-  std::printf("\nray-ray / ray-cone time: %.1fx (seed: %.0f s / %.0f s = %.1fx); ray-cone error "
-              "mean %.4f mm, std %.4f mm (seed: %.2f mm, %.3f mm)\n",
-              ratio, kSeedRayRaySeconds, kSeedRayConeSeconds,
-              kSeedRayRaySeconds / kSeedRayConeSeconds, r.methods.at("ray_cone").mean_err_m * 1e3,
-              r.methods.at("ray_cone").std_err_m * 1e3, kSeedRayConeMeanErrM * 1e3,
-              kSeedRayConeStdErrM * 1e3);
+  std::printf(
+      "\nray-ray / ray-cone time: %.1fx (seed: %.0f s / %.0f s = %.1fx); ray-cone error "
+      "mean %.4f mm, std %.4f mm (seed: %.2f mm, %.3f mm)\n",
+      ratio, kSeedRayRaySeconds, kSeedRayConeSeconds, kSeedRayRaySeconds / kSeedRayConeSeconds,
+      r.methods.at("ray_cone").mean_err_m * 1e3, r.methods.at("ray_cone").std_err_m * 1e3,
+      kSeedRayConeMeanErrM * 1e3, kSeedRayConeStdErrM * 1e3);
   std::printf("exact ray-ray against the generating points: max %.3g m; tables built in %.2f s\n",
               r.exact_vs_truth_max_m, r.setup_s);
   if (r.resolution.empty()) return;
-  std::printf("\nTable resolutions, one table at a time (the other at the bench's: %d px grid, %d rays per fan)\n\n",
-              grid_px, rays_per_fan);
-  std::printf("| table | resolution | build s | ray-cone points/s | ray-cone mean err mm | ray-cone max err mm | "
-              "ray-plane points/s | ray-plane mean err mm |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "\nTable resolutions, one table at a time (the other at the bench's: %d px grid, %d rays per "
+      "fan)\n\n",
+      grid_px, rays_per_fan);
+  std::printf(
+      "| table | resolution | build s | ray-cone points/s | ray-cone mean err mm | ray-cone max "
+      "err mm | "
+      "ray-plane points/s | ray-plane mean err mm |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const bench::TableResolutionRow& row : r.resolution) {
     const bool camera = row.table == "camera_rays";
-    std::printf("| %s | %d %s | %.3f | %.3g | %.4f | %.4f | %.3g | %.4f |\n", camera ? "camera rays" : "light surfaces",
-                row.value, camera ? "px grid" : "rays per fan", row.setup_s, row.ray_cone.points_per_s,
-                row.ray_cone.mean_err_m * 1e3, row.ray_cone.max_err_m * 1e3, row.ray_plane.points_per_s,
-                row.ray_plane.mean_err_m * 1e3);
+    std::printf("| %s | %d %s | %.3f | %.3g | %.4f | %.4f | %.3g | %.4f |\n",
+                camera ? "camera rays" : "light surfaces", row.value,
+                camera ? "px grid" : "rays per fan", row.setup_s, row.ray_cone.points_per_s,
+                row.ray_cone.mean_err_m * 1e3, row.ray_cone.max_err_m * 1e3,
+                row.ray_plane.points_per_s, row.ray_plane.mean_err_m * 1e3);
   }
 }
 
@@ -166,8 +179,9 @@ void AddTriangulationOptions(CLI::App& command, TriangulationArgs& args) {
   command.add_option("--seed", args.seed, "random seed of the generated pixels");
   command.add_option("--sweep-grid-px", args.sweep_grid_px,
                      "also measure camera-ray tables of these grid spacings, px (e.g. 1 2 4 8 16)");
-  command.add_option("--sweep-rays-per-fan", args.sweep_rays_per_fan,
-                     "also measure light-surface tables fitted to these rays per fan (e.g. 9 17 35 70)");
+  command.add_option(
+      "--sweep-rays-per-fan", args.sweep_rays_per_fan,
+      "also measure light-surface tables fitted to these rays per fan (e.g. 9 17 35 70)");
   command.add_option("--scanner", args.scanner_path, "scanner YAML (default: embedded)")
       ->check(CLI::ExistingFile);
 }
@@ -179,8 +193,9 @@ void RunDeformation(const std::string& json_path) {
     ProgressBar bar;
     rows = bench::RunDeformationExperiment(bench::DeformationOptions{}, bar.Callback());
   }
-  std::printf("Light-surface deformation: 35 rays, 55 deg, n = 1 / 1.49 / 1.33, 5 points per ray\n"
-              "at 100 mm intervals up to 1.5 m from the viewport; RMS orthogonal fit residual\n\n");
+  std::printf(
+      "Light-surface deformation: 35 rays, 55 deg, n = 1 / 1.49 / 1.33, 5 points per ray\n"
+      "at 100 mm intervals up to 1.5 m from the viewport; RMS orthogonal fit residual\n\n");
   std::printf("| incidence deg | plane rms mm | cone rms mm |\n|---:|---:|---:|\n");
   nlohmann::json json_rows = nlohmann::json::array();
   for (const bench::DeformationRow& row : rows) {

@@ -51,10 +51,12 @@ void RunCalibrationBench(const CalibrationBenchArgs& a) {
   }
   nlohmann::json steps = nlohmann::json::object();
   for (const bench::StepFigures& step : r.steps) {
-    std::printf("Step %s: residual rms %.4g %s, calibration %.2f s (dataset simulated in %.1f s)\n\n",
-                step.step.c_str(), step.residual_rms, step.residual_unit.c_str(), step.seconds,
-                step.dataset_seconds);
-    std::printf("| parameter | true | estimated | std | error / std |\n|---|---:|---:|---:|---:|\n");
+    std::printf(
+        "Step %s: residual rms %.4g %s, calibration %.2f s (dataset simulated in %.1f s)\n\n",
+        step.step.c_str(), step.residual_rms, step.residual_unit.c_str(), step.seconds,
+        step.dataset_seconds);
+    std::printf(
+        "| parameter | true | estimated | std | error / std |\n|---|---:|---:|---:|---:|\n");
     nlohmann::json params = nlohmann::json::object();
     for (const bench::ParameterFigure& p : step.params) {
       const double error = p.estimated - p.truth;
@@ -62,7 +64,9 @@ void RunCalibrationBench(const CalibrationBenchArgs& a) {
           std::isfinite(error) && p.std > 0.0 ? std::to_string(error / p.std).substr(0, 6) : "-";
       std::printf("| %s | %.9g | %.9g | %.3g | %s |\n", p.name.c_str(), p.truth, p.estimated, p.std,
                   ratio.c_str());
-      params[p.name] = {{"true", NumberOrNull(p.truth)}, {"estimated", NumberOrNull(p.estimated)}, {"std", p.std}};
+      params[p.name] = {{"true", NumberOrNull(p.truth)},
+                        {"estimated", NumberOrNull(p.estimated)},
+                        {"std", p.std}};
     }
     std::printf("\n");
     steps[step.step] = {{"params", params},
@@ -71,21 +75,24 @@ void RunCalibrationBench(const CalibrationBenchArgs& a) {
                         {"seconds", step.seconds},
                         {"dataset_seconds", step.dataset_seconds}};
   }
-  const double ratio = r.gauges_estimated_calibration_mean_err_m / r.gauges_true_calibration_mean_err_m;
-  std::printf("Gauges under water (%d measured): mean abs length error %.3f mm with the true calibration, "
-              "%.3f mm with the estimated one (%.2fx; target <= %.1fx: %s)\n",
-              r.gauges, r.gauges_true_calibration_mean_err_m * 1e3,
-              r.gauges_estimated_calibration_mean_err_m * 1e3, ratio, kGaugeRatioTarget,
-              ratio <= kGaugeRatioTarget ? "met" : "missed");
+  const double ratio =
+      r.gauges_estimated_calibration_mean_err_m / r.gauges_true_calibration_mean_err_m;
+  std::printf(
+      "Gauges under water (%d measured): mean abs length error %.3f mm with the true calibration, "
+      "%.3f mm with the estimated one (%.2fx; target <= %.1fx: %s)\n",
+      r.gauges, r.gauges_true_calibration_mean_err_m * 1e3,
+      r.gauges_estimated_calibration_mean_err_m * 1e3, ratio, kGaugeRatioTarget,
+      ratio <= kGaugeRatioTarget ? "met" : "missed");
   std::printf("%.1f s\n", r.seconds);
   if (!a.json_path.empty()) {
-    WriteJsonFile(a.json_path,
-                  {{"steps", steps},
-                   {"gauges",
-                    {{"true_calibration_mean_err_m", r.gauges_true_calibration_mean_err_m},
-                     {"estimated_calibration_mean_err_m", r.gauges_estimated_calibration_mean_err_m},
-                     {"gauges", r.gauges}}},
-                   {"seconds", r.seconds}});
+    WriteJsonFile(
+        a.json_path,
+        {{"steps", steps},
+         {"gauges",
+          {{"true_calibration_mean_err_m", r.gauges_true_calibration_mean_err_m},
+           {"estimated_calibration_mean_err_m", r.gauges_estimated_calibration_mean_err_m},
+           {"gauges", r.gauges}}},
+         {"seconds", r.seconds}});
   }
 }
 

@@ -51,7 +51,8 @@ void RunTriangulators(int points) {
   model.laser.step_min = -kStepRange;
   model.laser.step_max = kStepRange;
   auto rays = std::make_shared<const scanner::CameraRayTable>(model.camera);
-  auto surfaces = std::make_shared<const scanner::LightSurfaceTable>(model.laser, scanner::LightSurfaceTableOptions{});
+  auto surfaces = std::make_shared<const scanner::LightSurfaceTable>(
+      model.laser, scanner::LightSurfaceTableOptions{});
   const scanner::RayPlaneTriangulator ray_plane(rays, surfaces);
   const scanner::RayConeTriangulator ray_cone(rays, surfaces);
   const scanner::RayRayTriangulator ray_ray(model);
@@ -62,7 +63,8 @@ void RunTriangulators(int points) {
     std::vector<Eigen::Vector2d>& peaks = frames.emplace_back();
     const int f = static_cast<int>(frames.size());
     for (int v = 0; v < rows && done + v < points; ++v) {
-      peaks.emplace_back(1024.0 + 300.0 * std::sin(0.3 * f) + 80.0 * std::sin(0.004 * v + f), v + 0.37);
+      peaks.emplace_back(1024.0 + 300.0 * std::sin(0.3 * f) + 80.0 * std::sin(0.004 * v + f),
+                         v + 0.37);
     }
   }
   std::vector<scanner::TriangulatedPoint> out;
@@ -86,9 +88,11 @@ void RunTriangulators(int points) {
 void AddKernelsCommand(CLI::App& bench) {
   auto args = std::make_shared<KernelsArgs>();
   CLI::App* cmd = bench.add_subcommand(
-      "kernels", "fixed work for each hot kernel, once (for bench/instructions.sh under callgrind)");
+      "kernels",
+      "fixed work for each hot kernel, once (for bench/instructions.sh under callgrind)");
   cmd->add_option("--frames", args->frames, "stripe frames to detect")->check(kPositiveNumber);
-  cmd->add_option("--points", args->points, "stripe pixels per triangulation method")->check(kPositiveNumber);
+  cmd->add_option("--points", args->points, "stripe pixels per triangulation method")
+      ->check(kPositiveNumber);
   cmd->callback([args] {
     RunStripe(args->frames);
     RunTriangulators(args->points);

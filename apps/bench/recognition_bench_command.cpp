@@ -75,29 +75,35 @@ void PrintConfusion(const Confusion& c, const ConfusionShape& shape) {
 void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
   std::printf("uwscan per object (scan, truth -> answer, its points, pose error):\n");
   for (const bench::ObjectOutcome& o : outcomes) {
-    std::printf("  scan %3d  %-12s -> %-12s %6d pts, %6d in a segment of %6d", o.scan, o.truth.c_str(),
-                o.answer.c_str(), o.points, o.points_in_segment, o.segment_points);
+    std::printf("  scan %3d  %-12s -> %-12s %6d pts, %6d in a segment of %6d", o.scan,
+                o.truth.c_str(), o.answer.c_str(), o.points, o.points_in_segment, o.segment_points);
     if (o.rotation_error_rad >= 0.0) {
-      std::printf("  %.2f deg %.1f mm", o.rotation_error_rad * kRadToDeg, o.translation_error_m * 1e3);
+      std::printf("  %.2f deg %.1f mm", o.rotation_error_rad * kRadToDeg,
+                  o.translation_error_m * 1e3);
     }
-    if (o.equivalent_poses > 0) std::printf(", %d equivalent pose%s", o.equivalent_poses, o.equivalent_poses > 1 ? "s" : "");
+    if (o.equivalent_poses > 0)
+      std::printf(", %d equivalent pose%s", o.equivalent_poses, o.equivalent_poses > 1 ? "s" : "");
     for (const std::string& id : o.equivalent_objects) std::printf(", or %s", id.c_str());
-    if (o.free_slides + o.free_turns > 0) std::printf(", free: %d slide, %d turn", o.free_slides, o.free_turns);
+    if (o.free_slides + o.free_turns > 0)
+      std::printf(", free: %d slide, %d turn", o.free_slides, o.free_turns);
     if (!o.why_wrong.empty()) {
       std::printf(", why: %s", o.why_wrong.c_str());
       if (const auto& t = o.truth_check) {
-        std::printf(" (the truth at its pose: fitness %.2f close %.2f missing %.2f score %.3f)", t->fitness, t->close,
-                    t->missing, t->score);
+        std::printf(" (the truth at its pose: fitness %.2f close %.2f missing %.2f score %.3f)",
+                    t->fitness, t->close, t->missing, t->score);
       }
     }
     std::printf("\n");
     for (std::size_t k = 0; k < o.candidates.size(); ++k) {
       const perception::RecognitionCandidate& c = o.candidates[k];
-      std::printf("      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f buried %.2f rmse %.2f mm%s",
-                  c.object_id.c_str(), c.chi_square, c.view, c.fitness, c.close, c.missing, c.buried, c.rmse_m * 1e3,
-                  c.verified ? " verified" : "");
+      std::printf(
+          "      %-12s chi2 %.3f view %2d fitness %.2f close %.2f missing %.2f buried %.2f rmse "
+          "%.2f mm%s",
+          c.object_id.c_str(), c.chi_square, c.view, c.fitness, c.close, c.missing, c.buried,
+          c.rmse_m * 1e3, c.verified ? " verified" : "");
       if (k < o.candidate_errors.size() && o.candidate_errors[k].first >= 0.0) {
-        std::printf(", off by %.2f deg %.1f mm", o.candidate_errors[k].first * kRadToDeg, o.candidate_errors[k].second * 1e3);
+        std::printf(", off by %.2f deg %.1f mm", o.candidate_errors[k].first * kRadToDeg,
+                    o.candidate_errors[k].second * 1e3);
       }
       std::printf("\n");
     }
@@ -120,34 +126,40 @@ void Run(Args a) {
   std::printf("%d scans (%s), database %.1f s, simulation %.1f s\n", r.scans,
               a.options.images ? "rendered and detected frames" : "exact peaks + 0.1 px noise",
               r.database_seconds, r.simulation_seconds);
-  std::printf("| pipeline | recognised | ... or among the objects reported to fit as well | pose 5 mm / 2 deg | ... or its ambiguity reported | MSSD < 0.1 d | "
-              "grasp 5 mm / 3 deg | foreign -> unknown | median rot / trans err | s per scan |\n"
-              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "| pipeline | recognised | ... or among the objects reported to fit as well | pose 5 mm / 2 "
+      "deg | ... or its ambiguity reported | MSSD < 0.1 d | "
+      "grasp 5 mm / 3 deg | foreign -> unknown | median rot / trans err | s per scan |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json pipelines = nlohmann::json::object();
   nlohmann::json confusion = nlohmann::json::object();
   const ConfusionShape shape = ShapeOf(r.object_ids);
   for (const auto& [name, f] : r.pipelines) {
     const double per_scan = f.seconds / r.scans;
-    std::printf("| %s | %d/%d (%.1f %%) | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %d/%d | %.2f deg / %.1f mm | %.3f |\n",
-                name.c_str(), f.recognised, f.objects, 100.0 * Ratio(f.recognised, f.objects),
-                100.0 * Ratio(f.recognised_or_reported, f.objects),
-                100.0 * Ratio(f.pose_success, f.recognised), 100.0 * Ratio(f.pose_or_reported, f.recognised),
-                100.0 * Ratio(f.mssd_success, f.recognised),
-                100.0 * Ratio(f.grasp_success, f.recognised), f.foreign_unknown, f.foreign,
-                Median(f.rotation_errors_rad) * kRadToDeg, Median(f.translation_errors_m) * 1e3, per_scan);
-    pipelines[name] = {{"recognition_rate", Ratio(f.recognised, f.objects)},
-                       {"recognition_or_reported_ambiguity_rate", Ratio(f.recognised_or_reported, f.objects)},
-                       {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
-                       {"pose_or_reported_ambiguity_rate", Ratio(f.pose_or_reported, f.recognised)},
-                       {"mssd_success_rate", Ratio(f.mssd_success, f.recognised)},
-                       {"grasp_success_rate", Ratio(f.grasp_success, f.recognised)},
-                       {"foreign_unknown_rate", Ratio(f.foreign_unknown, f.foreign)},
-                       {"objects", f.objects},
-                       {"median_rotation_error_deg", Median(f.rotation_errors_rad) * kRadToDeg},
-                       {"median_translation_error_m", Median(f.translation_errors_m)},
-                       {"median_grasp_position_error_m", Median(f.grasp_position_errors_m)},
-                       {"median_grasp_angle_error_deg", Median(f.grasp_angle_errors_rad) * kRadToDeg},
-                       {"seconds_per_scan", per_scan}};
+    std::printf(
+        "| %s | %d/%d (%.1f %%) | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %d/%d | %.2f "
+        "deg / %.1f mm | %.3f |\n",
+        name.c_str(), f.recognised, f.objects, 100.0 * Ratio(f.recognised, f.objects),
+        100.0 * Ratio(f.recognised_or_reported, f.objects),
+        100.0 * Ratio(f.pose_success, f.recognised),
+        100.0 * Ratio(f.pose_or_reported, f.recognised),
+        100.0 * Ratio(f.mssd_success, f.recognised), 100.0 * Ratio(f.grasp_success, f.recognised),
+        f.foreign_unknown, f.foreign, Median(f.rotation_errors_rad) * kRadToDeg,
+        Median(f.translation_errors_m) * 1e3, per_scan);
+    pipelines[name] = {
+        {"recognition_rate", Ratio(f.recognised, f.objects)},
+        {"recognition_or_reported_ambiguity_rate", Ratio(f.recognised_or_reported, f.objects)},
+        {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
+        {"pose_or_reported_ambiguity_rate", Ratio(f.pose_or_reported, f.recognised)},
+        {"mssd_success_rate", Ratio(f.mssd_success, f.recognised)},
+        {"grasp_success_rate", Ratio(f.grasp_success, f.recognised)},
+        {"foreign_unknown_rate", Ratio(f.foreign_unknown, f.foreign)},
+        {"objects", f.objects},
+        {"median_rotation_error_deg", Median(f.rotation_errors_rad) * kRadToDeg},
+        {"median_translation_error_m", Median(f.translation_errors_m)},
+        {"median_grasp_position_error_m", Median(f.grasp_position_errors_m)},
+        {"median_grasp_angle_error_deg", Median(f.grasp_angle_errors_rad) * kRadToDeg},
+        {"seconds_per_scan", per_scan}};
     if (!f.pose_nees_per_dimension.empty()) {
       pipelines[name]["pose_nees_per_dimension_mean"] = Mean(f.pose_nees_per_dimension);
       pipelines[name]["pose_nees_per_dimension_median"] = Median(f.pose_nees_per_dimension);
@@ -159,13 +171,16 @@ void Run(Args a) {
     confusion[name] = DenseConfusion(f.confusion, shape);
   }
   std::printf("uwscan stages (s per scan):");
-  for (const auto& [stage, s] : r.uwscan_stage_seconds) std::printf(" %s %.3f", stage.c_str(), s / r.scans);
+  for (const auto& [stage, s] : r.uwscan_stage_seconds)
+    std::printf(" %s %.3f", stage.c_str(), s / r.scans);
   std::printf("\n");
   if (r.pipelines.count("uwscan") && !r.pipelines.at("uwscan").pose_nees_per_dimension.empty()) {
     const std::vector<double>& nees = r.pipelines.at("uwscan").pose_nees_per_dimension;
-    std::printf("uwscan pose covariance: NEES per pinned direction mean %.2f, median %.2f over %zu poses within "
-                "10 deg and 5 cm (1 when consistent)\n",
-                Mean(nees), Median(nees), nees.size());
+    std::printf(
+        "uwscan pose covariance: NEES per pinned direction mean %.2f, median %.2f over %zu poses "
+        "within "
+        "10 deg and 5 cm (1 when consistent)\n",
+        Mean(nees), Median(nees), nees.size());
     std::printf("  median by class:");
     for (const auto& [truth, by_class] : r.pipelines.at("uwscan").pose_nees_by_class) {
       std::printf(" %s %.1f (%zu)", truth.c_str(), Median(by_class), by_class.size());
@@ -182,7 +197,9 @@ void Run(Args a) {
     if (!o.why_wrong.empty()) ++why_wrong[o.why_wrong];
   }
   if (r.pipelines.count("uwscan")) {
-    std::printf("uwscan wrong answers, the true object checked at its true pose on the segment answered for it:");
+    std::printf(
+        "uwscan wrong answers, the true object checked at its true pose on the segment answered "
+        "for it:");
     for (const auto& [why, n] : why_wrong) std::printf(" %s %d", why.c_str(), n);
     if (why_wrong.empty()) std::printf(" none");
     std::printf("\n");
@@ -211,19 +228,26 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
       "recognition",
       "object recognition on simulated scans: uwscan vs PCL's ESF pipeline vs OpenCV's PPF");
   cmd->add_option("--scans", a->options.scans, "scenes scanned")->check(CLI::Range(1, 100000));
-  cmd->add_option("--views", a->options.views, "database views per object")->check(CLI::Range(1, 10000));
-  cmd->add_flag("--no-images", a->no_images, "exact peaks with 0.1 px noise instead of rendered frames");
-  cmd->add_flag("--no-peers", [a](std::int64_t) { a->options.run_peers = false; }, "uwscan only");
-  cmd->add_flag("--no-ppf", [a](std::int64_t) { a->options.run_ppf = false; },
-                "leave OpenCV's PPF out of the peers (about 30 s of training, then seconds per scan)");
+  cmd->add_option("--views", a->options.views, "database views per object")
+      ->check(CLI::Range(1, 10000));
+  cmd->add_flag("--no-images", a->no_images,
+                "exact peaks with 0.1 px noise instead of rendered frames");
+  cmd->add_flag(
+      "--no-peers", [a](std::int64_t) { a->options.run_peers = false; }, "uwscan only");
+  cmd->add_flag(
+      "--no-ppf", [a](std::int64_t) { a->options.run_ppf = false; },
+      "leave OpenCV's PPF out of the peers (about 30 s of training, then seconds per scan)");
   cmd->add_option("--threads", a->options.threads, "threads")->check(CLI::Range(1, 256));
   cmd->add_option("--seed", a->options.seed, "scene and noise seed");
-  cmd->add_option("--only", a->options.only, "run only these scenes (indices below --scans), to look at a case");
-  cmd->add_option("--scan-cache", a->options.scan_cache,
-                  "keep the simulated scans in this folder and read them from it in later runs (for comparing "
-                  "versions of the recogniser; a scan is named by a hash of its scene and of the simulator's "
-                  "sources, so scans made by other simulator code are never read back)");
-  cmd->add_flag("--details", a->details, "print every object's answer and the candidates weighed for it");
+  cmd->add_option("--only", a->options.only,
+                  "run only these scenes (indices below --scans), to look at a case");
+  cmd->add_option(
+      "--scan-cache", a->options.scan_cache,
+      "keep the simulated scans in this folder and read them from it in later runs (for comparing "
+      "versions of the recogniser; a scan is named by a hash of its scene and of the simulator's "
+      "sources, so scans made by other simulator code are never read back)");
+  cmd->add_flag("--details", a->details,
+                "print every object's answer and the candidates weighed for it");
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { Run(*a); });
 }

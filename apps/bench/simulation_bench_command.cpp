@@ -45,17 +45,18 @@ void RunSimulationBench(const SimulationBenchArgs& a) {
   std::printf("| scene | effect | ms / frame | x all off | peaks |\n|---|---|---:|---:|---:|\n");
   nlohmann::json rows = nlohmann::json::array();
   for (const bench::EffectCost& c : r.rows) {
-    std::printf("| %s | %s | %.3f | %.2f | %lld |\n", c.scene.c_str(), c.effect.c_str(), c.ms_per_frame,
-                c.ratio_to_none, static_cast<long long>(c.peaks));
+    std::printf("| %s | %s | %.3f | %.2f | %lld |\n", c.scene.c_str(), c.effect.c_str(),
+                c.ms_per_frame, c.ratio_to_none, static_cast<long long>(c.peaks));
     rows.push_back({{"scene", c.scene},
                     {"effect", c.effect},
                     {"ms_per_frame", c.ms_per_frame},
                     {"ratio_to_none", c.ratio_to_none},
                     {"peaks", c.peaks}});
   }
-  std::printf("\nCPU: %s. \"off_with_parameters\": every effect off, every parameter changed: an off\n"
-              "stage must cost nothing (ratio ~1). Image stages render and search 2048x1088 frames.\n",
-              bench::CpuModel().c_str());
+  std::printf(
+      "\nCPU: %s. \"off_with_parameters\": every effect off, every parameter changed: an off\n"
+      "stage must cost nothing (ratio ~1). Image stages render and search 2048x1088 frames.\n",
+      bench::CpuModel().c_str());
   if (!a.json_path.empty()) {
     WriteJsonFile(a.json_path, {{"frames", r.frames}, {"rows", rows}, {"cpu", bench::CpuModel()}});
   }
@@ -65,7 +66,8 @@ void RunSimulationBench(const SimulationBenchArgs& a) {
 
 void AddSimulationBenchCommand(CLI::App& bench) {
   auto args = std::make_shared<SimulationBenchArgs>();
-  CLI::App* cmd = bench.add_subcommand("simulation", "time per frame of each simulation effect, alone and all on");
+  CLI::App* cmd = bench.add_subcommand(
+      "simulation", "time per frame of each simulation effect, alone and all on");
   cmd->add_option("--json", args->json_path, "write the figures as JSON");
   cmd->add_option("--data", args->data_dir,
                   "data folder holding scenes/ (default: `uwscan --data-dir`)");

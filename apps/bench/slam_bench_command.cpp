@@ -43,34 +43,43 @@ nlohmann::json TrajectoryJson(const bench::TrajectoryFigures& t) {
 void Print(const bench::DiveFigures& f) {
   std::printf("\n%s (seed %llu): %.0f s dive, %d submaps, simulated in %.1f s\n", f.name.c_str(),
               static_cast<unsigned long long>(f.seed), f.duration_s, f.submaps, f.simulate_seconds);
-  std::printf("| | ATE | RPE per m | map to surfaces: mean | rms | p95 | seconds |\n|---|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "| | ATE | RPE per m | map to surfaces: mean | rms | p95 | seconds "
+      "|\n|---|---:|---:|---:|---:|---:|---:|\n");
   const auto row = [](const char* name, const bench::TrajectoryFigures& t) {
-    std::printf("| %s | %.4f m | %.4f | %.2f mm | %.2f mm | %.2f mm | %.2f |\n", name, t.ate_m, t.rpe_per_m.value_or(NAN),
-                t.map.mean_m * 1e3, t.map.rms_m * 1e3, t.map.p95_m * 1e3, t.seconds);
+    std::printf("| %s | %.4f m | %.4f | %.2f mm | %.2f mm | %.2f mm | %.2f |\n", name, t.ate_m,
+                t.rpe_per_m.value_or(NAN), t.map.mean_m * 1e3, t.map.rms_m * 1e3, t.map.p95_m * 1e3,
+                t.seconds);
   };
   row("dead reckoning", f.dead_reckoning);
   row("uwscan SLAM", f.slam);
   if (f.open3d) row("Open3D multiway", *f.open3d);
   const bench::SurfaceDistance& floor = f.true_poses_map;
-  std::printf("| true poses (the sensor's floor) | | | %.2f mm | %.2f mm | %.2f mm | |\n", floor.mean_m * 1e3,
-              floor.rms_m * 1e3, floor.p95_m * 1e3);
-  std::printf("SLAM/DR: ATE %.3f, map rms %.3f; loops accepted %d (false %d), rejected %d; NEES %.2f (6 = consistent); "
-              "%.1fx real time\n",
-              f.slam.ate_m / f.dead_reckoning.ate_m, f.slam.map.rms_m / f.dead_reckoning.map.rms_m, f.loops_accepted,
-              f.loops_false, f.loops_rejected, f.nees_mean.value_or(NAN), f.real_time_factor);
+  std::printf("| true poses (the sensor's floor) | | | %.2f mm | %.2f mm | %.2f mm | |\n",
+              floor.mean_m * 1e3, floor.rms_m * 1e3, floor.p95_m * 1e3);
+  std::printf(
+      "SLAM/DR: ATE %.3f, map rms %.3f; loops accepted %d (false %d), rejected %d; NEES %.2f (6 = "
+      "consistent); "
+      "%.1fx real time\n",
+      f.slam.ate_m / f.dead_reckoning.ate_m, f.slam.map.rms_m / f.dead_reckoning.map.rms_m,
+      f.loops_accepted, f.loops_false, f.loops_rejected, f.nees_mean.value_or(NAN),
+      f.real_time_factor);
   if (f.expected_map_error_m) {
-    std::printf("SLAM map rms %.2f mm; its poses' covariance predicts %.2f mm (what the navigation and the scene "
-                "allow)\n",
-                f.slam.map.rms_m * 1e3, *f.expected_map_error_m * 1e3);
+    std::printf(
+        "SLAM map rms %.2f mm; its poses' covariance predicts %.2f mm (what the navigation and the "
+        "scene "
+        "allow)\n",
+        f.slam.map.rms_m * 1e3, *f.expected_map_error_m * 1e3);
   }
   if (f.expected_ate_m) {
     std::printf("SLAM ATE %.1f mm; its poses' covariance predicts %.1f mm\n", f.slam.ate_m * 1e3,
                 *f.expected_ate_m * 1e3);
   }
   if (f.open3d) {
-    std::printf("uwscan vs Open3D: ATE %.3f, time %.3f (uwscan's whole pipeline from the log vs Open3D's "
-                "registration and optimisation of the finished submaps)\n",
-                f.slam.ate_m / f.open3d->ate_m, f.slam.seconds / f.open3d->seconds);
+    std::printf(
+        "uwscan vs Open3D: ATE %.3f, time %.3f (uwscan's whole pipeline from the log vs Open3D's "
+        "registration and optimisation of the finished submaps)\n",
+        f.slam.ate_m / f.open3d->ate_m, f.slam.seconds / f.open3d->seconds);
   }
 }
 
@@ -89,7 +98,8 @@ struct SceneSummary {
 std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives) {
   std::vector<SceneSummary> scenes;
   for (const bench::DiveFigures& f : dives) {
-    auto it = std::find_if(scenes.begin(), scenes.end(), [&](const SceneSummary& s) { return s.name == f.name; });
+    auto it = std::find_if(scenes.begin(), scenes.end(),
+                           [&](const SceneSummary& s) { return s.name == f.name; });
     if (it == scenes.end()) {
       scenes.push_back({});
       it = scenes.end() - 1;
@@ -110,7 +120,8 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
     it->real_time_factor_min = std::min(it->real_time_factor_min, f.real_time_factor);
     it->loops_false += f.loops_false;
     if (f.open3d) {
-      it->open3d_ate_ratio_mean = it->open3d_ate_ratio_mean.value_or(0.0) + f.slam.ate_m / f.open3d->ate_m;
+      it->open3d_ate_ratio_mean =
+          it->open3d_ate_ratio_mean.value_or(0.0) + f.slam.ate_m / f.open3d->ate_m;
       it->open3d_time_ratio_mean =
           it->open3d_time_ratio_mean.value_or(0.0) + f.slam.seconds / f.open3d->seconds;
     }
@@ -118,7 +129,8 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
   for (SceneSummary& s : scenes) {
     const double n = s.seeds;
     for (double* v : {&s.ate_ratio_mean, &s.ate_mean_m, &s.expected_ate_mean_m, &s.map_rms_mean_m,
-                      &s.map_ratio_mean, &s.expected_map_error_mean_m, &s.nees_mean, &s.real_time_factor_mean}) {
+                      &s.map_ratio_mean, &s.expected_map_error_mean_m, &s.nees_mean,
+                      &s.real_time_factor_mean}) {
       *v /= n;
     }
     if (s.open3d_ate_ratio_mean) *s.open3d_ate_ratio_mean /= n;
@@ -128,18 +140,24 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
 }
 
 void Print(const std::vector<SceneSummary>& scenes) {
-  std::printf("\nOver the seeds (means; SLAM/DR ratios; the worst ATE ratio and real-time factor):\n");
-  std::printf("| dive | seeds | ATE ratio (worst) | SLAM ATE | predicted ATE | map rms | map ratio | predicted map rms "
-              "| NEES | real time (worst) | false loops | uwscan/Open3D ATE, time |\n"
-              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "\nOver the seeds (means; SLAM/DR ratios; the worst ATE ratio and real-time factor):\n");
+  std::printf(
+      "| dive | seeds | ATE ratio (worst) | SLAM ATE | predicted ATE | map rms | map ratio | "
+      "predicted map rms "
+      "| NEES | real time (worst) | false loops | uwscan/Open3D ATE, time |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const SceneSummary& s : scenes) {
-    std::printf("| %s | %d | %.3f (%.3f) | %.1f mm | %.1f mm | %.2f mm | %.3f | %.2f mm | %.2f | %.1fx (%.1fx) | %d | ",
-                s.name.c_str(), s.seeds, s.ate_ratio_mean, s.ate_ratio_max, s.ate_mean_m * 1e3,
-                s.expected_ate_mean_m * 1e3, s.map_rms_mean_m * 1e3, s.map_ratio_mean,
-                s.expected_map_error_mean_m * 1e3, s.nees_mean, s.real_time_factor_mean, s.real_time_factor_min,
-                s.loops_false);
+    std::printf(
+        "| %s | %d | %.3f (%.3f) | %.1f mm | %.1f mm | %.2f mm | %.3f | %.2f mm | %.2f | %.1fx "
+        "(%.1fx) | %d | ",
+        s.name.c_str(), s.seeds, s.ate_ratio_mean, s.ate_ratio_max, s.ate_mean_m * 1e3,
+        s.expected_ate_mean_m * 1e3, s.map_rms_mean_m * 1e3, s.map_ratio_mean,
+        s.expected_map_error_mean_m * 1e3, s.nees_mean, s.real_time_factor_mean,
+        s.real_time_factor_min, s.loops_false);
     if (s.open3d_ate_ratio_mean) {
-      std::printf("%.3f, %.2f |\n", *s.open3d_ate_ratio_mean, s.open3d_time_ratio_mean.value_or(NAN));
+      std::printf("%.3f, %.2f |\n", *s.open3d_ate_ratio_mean,
+                  s.open3d_time_ratio_mean.value_or(NAN));
     } else {
       std::printf("|\n");
     }
@@ -147,23 +165,25 @@ void Print(const std::vector<SceneSummary>& scenes) {
 }
 
 nlohmann::json SummaryJson(const SceneSummary& s) {
-  return {{"name", s.name},
-          {"seeds", s.seeds},
-          {"ate_ratio_mean", s.ate_ratio_mean},
-          {"ate_ratio_max", s.ate_ratio_max},
-          {"ate_mean_m", s.ate_mean_m},
-          {"expected_ate_mean_m", s.expected_ate_mean_m},
-          {"map_rms_mean_m", s.map_rms_mean_m},
-          {"map_ratio_mean", s.map_ratio_mean},
-          {"expected_map_error_mean_m", s.expected_map_error_mean_m},
-          {"nees_mean", s.nees_mean},
-          {"real_time_factor_mean", s.real_time_factor_mean},
-          {"real_time_factor_min", s.real_time_factor_min},
-          {"loops_false", s.loops_false},
-          {"open3d_ate_ratio_mean",
-           s.open3d_ate_ratio_mean ? nlohmann::json(*s.open3d_ate_ratio_mean) : nlohmann::json(nullptr)},
-          {"open3d_time_ratio_mean",
-           s.open3d_time_ratio_mean ? nlohmann::json(*s.open3d_time_ratio_mean) : nlohmann::json(nullptr)}};
+  return {
+      {"name", s.name},
+      {"seeds", s.seeds},
+      {"ate_ratio_mean", s.ate_ratio_mean},
+      {"ate_ratio_max", s.ate_ratio_max},
+      {"ate_mean_m", s.ate_mean_m},
+      {"expected_ate_mean_m", s.expected_ate_mean_m},
+      {"map_rms_mean_m", s.map_rms_mean_m},
+      {"map_ratio_mean", s.map_ratio_mean},
+      {"expected_map_error_mean_m", s.expected_map_error_mean_m},
+      {"nees_mean", s.nees_mean},
+      {"real_time_factor_mean", s.real_time_factor_mean},
+      {"real_time_factor_min", s.real_time_factor_min},
+      {"loops_false", s.loops_false},
+      {"open3d_ate_ratio_mean", s.open3d_ate_ratio_mean ? nlohmann::json(*s.open3d_ate_ratio_mean)
+                                                        : nlohmann::json(nullptr)},
+      {"open3d_time_ratio_mean", s.open3d_time_ratio_mean
+                                     ? nlohmann::json(*s.open3d_time_ratio_mean)
+                                     : nlohmann::json(nullptr)}};
 }
 
 // The loop, pipe and long dives, and the loop dive with the MEMS scanner, from the data folder.
@@ -198,7 +218,8 @@ void RunSlamBench(const SlamBenchArgs& a) {
     slam["real_time_factor"] = f.real_time_factor;
     slam["expected_map_error_m"] =
         f.expected_map_error_m ? nlohmann::json(*f.expected_map_error_m) : nlohmann::json(nullptr);
-    slam["expected_ate_m"] = f.expected_ate_m ? nlohmann::json(*f.expected_ate_m) : nlohmann::json(nullptr);
+    slam["expected_ate_m"] =
+        f.expected_ate_m ? nlohmann::json(*f.expected_ate_m) : nlohmann::json(nullptr);
     nlohmann::json dive = {{"name", f.name},
                            {"seed", f.seed},
                            {"duration_s", f.duration_s},
@@ -222,18 +243,21 @@ void RunSlamBench(const SlamBenchArgs& a) {
 
 void AddSlamBenchCommand(CLI::App& bench) {
   auto a = std::make_shared<SlamBenchArgs>();
-  CLI::App* cmd = bench.add_subcommand(
-      "slam", "scan-matching SLAM against dead reckoning and Open3D's multiway registration on simulated dives");
+  CLI::App* cmd = bench.add_subcommand("slam",
+                                       "scan-matching SLAM against dead reckoning and Open3D's "
+                                       "multiway registration on simulated dives");
   cmd->add_option("--scene", a->scenes,
                   "dive scenes (default: inspection_loop.yaml, inspection_pipe.yaml, "
                   "inspection_long.yaml and inspection_loop_mems.yaml, the loop dive with the MEMS "
                   "scanner, from scenes/ in the data folder, `uwscan --data-dir`)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--seeds", a->seeds, "dives per scene: its own seed and the next ones (default 1)")
+  cmd->add_option("--seeds", a->seeds,
+                  "dives per scene: its own seed and the next ones (default 1)")
       ->check(kPositiveNumber);
   cmd->add_option("--threads", a->threads, "threads")->check(kPositiveNumber);
   cmd->add_option("--walk-scale", a->walk_scale,
-                  "multiply the navigation's random walks (position, heading) by this: what SLAM's error owes to "
+                  "multiply the navigation's random walks (position, heading) by this: what SLAM's "
+                  "error owes to "
                   "them (default 1)")
       ->check(kPositiveNumber);
   cmd->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");

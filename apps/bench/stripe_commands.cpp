@@ -15,9 +15,9 @@
 namespace uwscan::app {
 namespace {
 
-constexpr double kTargetFramesPerS = 2000.0;  // DESIGN.md: on one core, 2048x1088 Mono8
+constexpr double kTargetFramesPerS = 2000.0;    // DESIGN.md: on one core, 2048x1088 Mono8
 constexpr double kTargetFractionOfLimit = 0.5;  // of the one-pass column maximum, same run
-constexpr double kTargetRmsePx = 0.05;        // DESIGN.md: clean synthetic stripes
+constexpr double kTargetRmsePx = 0.05;          // DESIGN.md: clean synthetic stripes
 
 struct StripeArgs {
   int frames = 8;
@@ -58,9 +58,9 @@ void RunStripe(const StripeArgs& args) {
     const bench::StripeMethodFigures& m = result.methods.at(name);
     const bool meets = m.rmse_px_sigma1_5 <= kTargetRmsePx && m.rmse_px_sigma3 <= kTargetRmsePx;
     std::printf("| %s%s | %.0f | %.3f | %.4f | %.4f | %.4f | %.4f | %.4f | %s |\n", name.c_str(),
-                name == result.default_method ? " (default)" : "", m.frames_per_s, m.fraction_of_limit,
-                m.rmse_px_sigma1_5, m.rmse_px_sigma3, m.max_err_px_sigma1_5, m.max_err_px_sigma3,
-                m.detected_fraction, meets ? "met" : "missed");
+                name == result.default_method ? " (default)" : "", m.frames_per_s,
+                m.fraction_of_limit, m.rmse_px_sigma1_5, m.rmse_px_sigma3, m.max_err_px_sigma1_5,
+                m.max_err_px_sigma3, m.detected_fraction, meets ? "met" : "missed");
     methods[name] = {{"frames_per_s", m.frames_per_s},
                      {"fraction_of_limit", m.fraction_of_limit},
                      {"rmse_px_sigma1_5", m.rmse_px_sigma1_5},
@@ -75,25 +75,28 @@ void RunStripe(const StripeArgs& args) {
   std::printf("| limit: one pass, running maximum per column | %.0f | 1 | | | | | | |\n",
               result.limit_frames_per_s);
   std::printf("\nCPU: %s\n", cpu.c_str());
-  std::printf("default method %s: %.0f frames/s (target %.0f: %s), %.3f of the limit (target %.1f: %s)\n",
-              result.default_method.c_str(), default_fps, kTargetFramesPerS,
-              default_fps >= kTargetFramesPerS ? "met" : "missed", default_fraction,
-              kTargetFractionOfLimit, default_fraction >= kTargetFractionOfLimit ? "met" : "missed");
+  std::printf(
+      "default method %s: %.0f frames/s (target %.0f: %s), %.3f of the limit (target %.1f: %s)\n",
+      result.default_method.c_str(), default_fps, kTargetFramesPerS,
+      default_fps >= kTargetFramesPerS ? "met" : "missed", default_fraction, kTargetFractionOfLimit,
+      default_fraction >= kTargetFractionOfLimit ? "met" : "missed");
   if (!args.json_path.empty()) {
-    WriteJsonFile(args.json_path,
-                  {{"default", result.default_method},
-                   {"methods", methods},
-                   {"limit", {{"frames_per_s", result.limit_frames_per_s},
-                              {"what", "one pass over every pixel in row order, running maximum per column"}}},
-                   {"cpu", cpu},
-                   {"targets",
-                    {{"frames_per_s", kTargetFramesPerS},
-                     {"rmse_px", kTargetRmsePx},
-                     {"fraction_of_limit", kTargetFractionOfLimit}}},
-                   {"image",
-                    {{"width_px", options.width_px},
-                     {"height_px", options.height_px},
-                     {"format", "Mono8"}}}});
+    WriteJsonFile(
+        args.json_path,
+        {{"default", result.default_method},
+         {"methods", methods},
+         {"limit",
+          {{"frames_per_s", result.limit_frames_per_s},
+           {"what", "one pass over every pixel in row order, running maximum per column"}}},
+         {"cpu", cpu},
+         {"targets",
+          {{"frames_per_s", kTargetFramesPerS},
+           {"rmse_px", kTargetRmsePx},
+           {"fraction_of_limit", kTargetFractionOfLimit}}},
+         {"image",
+          {{"width_px", options.width_px},
+           {"height_px", options.height_px},
+           {"format", "Mono8"}}}});
   }
 }
 

@@ -27,8 +27,10 @@ std::filesystem::path TableCache() {
     return value != nullptr && *value != '\0' ? value : nullptr;
   };
   if (const char* dir = env("UWSCAN_TABLE_CACHE")) return dir;
-  if (const char* xdg = env("XDG_CACHE_HOME")) return std::filesystem::path(xdg) / "uwscan" / "tables";
-  if (const char* home = env("HOME")) return std::filesystem::path(home) / ".cache" / "uwscan" / "tables";
+  if (const char* xdg = env("XDG_CACHE_HOME"))
+    return std::filesystem::path(xdg) / "uwscan" / "tables";
+  if (const char* home = env("HOME"))
+    return std::filesystem::path(home) / ".cache" / "uwscan" / "tables";
   return {};
 }
 

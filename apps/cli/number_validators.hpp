@@ -4,7 +4,6 @@
 // NonNegativeNumber are ranges up to the largest double and print all of its 309 digits.
 
 #include <CLI/CLI.hpp>
-
 #include <cerrno>
 #include <cstdlib>
 #include <string>
@@ -27,10 +26,14 @@ std::string CheckNumber(const std::string& text, const char* expected, Accept ac
 }  // namespace internal
 
 inline const CLI::Validator kPositiveNumber(
-    [](std::string& text) { return internal::CheckNumber(text, "> 0", [](double v) { return v > 0.0; }); },
+    [](std::string& text) {
+      return internal::CheckNumber(text, "> 0", [](double v) { return v > 0.0; });
+    },
     "POSITIVE", "POSITIVE");
 inline const CLI::Validator kNonNegativeNumber(
-    [](std::string& text) { return internal::CheckNumber(text, ">= 0", [](double v) { return v >= 0.0; }); },
+    [](std::string& text) {
+      return internal::CheckNumber(text, ">= 0", [](double v) { return v >= 0.0; });
+    },
     "NONNEGATIVE", "NONNEGATIVE");
 
 // A length in metres that an object a vehicle inspects or grasps can have: over 0.1 mm and at

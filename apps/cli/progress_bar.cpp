@@ -34,8 +34,8 @@ void ProgressBar::Update(std::string_view stage, double fraction) {
   if (!terminal_) return;
   constexpr int kWidth = 30;
   const int filled = percent * kWidth / 100;
-  std::fprintf(stderr, "\r  [%.*s%*s] %3d%% %s", filled, "==============================",
-               kWidth - filled, "", percent, stage_.c_str());
+  std::fprintf(stderr, "\r  [%.*s%*s] %3d%% %s", filled,
+               "==============================", kWidth - filled, "", percent, stage_.c_str());
   std::fflush(stderr);
 }
 

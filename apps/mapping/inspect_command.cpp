@@ -46,13 +46,16 @@ struct InspectArgs {
   int threads = 0;
 };
 
-void PrintStatus(const ReadSummary& r, const mapping::InspectionStatistics& s, double seconds, bool final_line) {
+void PrintStatus(const ReadSummary& r, const mapping::InspectionStatistics& s, double seconds,
+                 bool final_line) {
   std::fprintf(stderr,
-               "%sinspect: %lld frames, %.1f frames/s, %lld lost; mapped %lld, skipped %lld; latency to map %.1f ms; "
+               "%sinspect: %lld frames, %.1f frames/s, %lld lost; mapped %lld, skipped %lld; "
+               "latency to map %.1f ms; "
                "log queue %.1f MB%s",
-               isatty(2) ? "\r" : "", static_cast<long long>(r.frames), seconds > 0 ? r.frames / seconds : 0.0,
-               static_cast<long long>(r.source.lost_frames), static_cast<long long>(s.frames_mapped),
-               static_cast<long long>(s.frames_skipped), s.receive_to_map.median_s * 1e3, s.log.queued_bytes * 1e-6,
+               isatty(2) ? "\r" : "", static_cast<long long>(r.frames),
+               seconds > 0 ? r.frames / seconds : 0.0, static_cast<long long>(r.source.lost_frames),
+               static_cast<long long>(s.frames_mapped), static_cast<long long>(s.frames_skipped),
+               s.receive_to_map.median_s * 1e3, s.log.queued_bytes * 1e-6,
                final_line || !isatty(2) ? "\n" : "   ");
 }
 
@@ -60,11 +63,13 @@ nlohmann::json LatencyJson(const mapping::LatencyFigures& f) {
   return {{"frames", f.frames}, {"median_s", f.median_s}, {"p95_s", f.p95_s}, {"max_s", f.max_s}};
 }
 
-void WriteReport(const InspectArgs& a, const ReadSummary& r, const mapping::InspectionResult& result) {
+void WriteReport(const InspectArgs& a, const ReadSummary& r,
+                 const mapping::InspectionResult& result) {
   const mapping::InspectionStatistics& s = result.statistics;
   nlohmann::json gaps = nlohmann::json::array();
   for (const acq::CameraGap& g : r.source.gaps) {
-    gaps.push_back({{"silent_after_s", g.silent_after_s}, {"resumed_at_s", g.resumed_at_s},
+    gaps.push_back({{"silent_after_s", g.silent_after_s},
+                    {"resumed_at_s", g.resumed_at_s},
                     {"reopen_attempts", g.reopen_attempts}});
   }
   nlohmann::json latency = {{"receive_to_map", LatencyJson(s.receive_to_map)}};
@@ -95,10 +100,12 @@ void WriteReport(const InspectArgs& a, const ReadSummary& r, const mapping::Insp
 void RunInspect(const InspectArgs& a) {
   if (a.frames > 0 && a.seconds > 0.0) throw Error("--frames and --seconds: give one of them");
   if (!a.log.empty()) CheckNewLogPath(a.log, a.force, "--log");
-  for (const auto& [path, option] : {std::pair{a.map, "-o"}, {a.json, "--json"}, {a.screenshot, "--screenshot"}}) {
+  for (const auto& [path, option] :
+       {std::pair{a.map, "-o"}, {a.json, "--json"}, {a.screenshot, "--screenshot"}}) {
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
     if (!path.empty() && !parent.empty() && !std::filesystem::is_directory(parent)) {
-      throw Error(std::string(option) + " " + path + ": folder '" + parent.string() + "' does not exist");
+      throw Error(std::string(option) + " " + path + ": folder '" + parent.string() +
+                  "' does not exist");
     }
   }
   if (!a.map.empty()) CheckCloudOutputPath(a.map, "-o");
@@ -133,20 +140,22 @@ void RunInspect(const InspectArgs& a) {
   }
   if (!a.log.empty()) RemoveLog(a.log);
   // No navigation from a camera alone: the scanner is held fixed, the vehicle at the origin.
-  mapping::LiveInspection inspection(
-      context.header, a.log, context.T_V_C, mapping::NavigationNoise{}, options,
-      [&live_view](const mapping::MappedFrame& f) {
-        if (!live_view) return;
-        viewer::LiveCloud cloud;
-        cloud.time_s = f.time_s;
-        cloud.points_W.assign(f.points_W.begin(), f.points_W.end());
-        live_view->Push(std::move(cloud));
-      });
-  std::printf("inspect: camera %s (%s %s), %s mode, %dx%d payload; scanner fixed (no navigation), map in the "
-              "vehicle frame; %s\n",
-              a.camera.camera.c_str(), payload.vendor.c_str(), payload.model.c_str(),
-              payload.profile ? "profile" : "image", payload.payload_width_px, payload.payload_height_px,
-              a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
+  mapping::LiveInspection inspection(context.header, a.log, context.T_V_C,
+                                     mapping::NavigationNoise{}, options,
+                                     [&live_view](const mapping::MappedFrame& f) {
+                                       if (!live_view) return;
+                                       viewer::LiveCloud cloud;
+                                       cloud.time_s = f.time_s;
+                                       cloud.points_W.assign(f.points_W.begin(), f.points_W.end());
+                                       live_view->Push(std::move(cloud));
+                                     });
+  std::printf(
+      "inspect: camera %s (%s %s), %s mode, %dx%d payload; scanner fixed (no navigation), map in "
+      "the "
+      "vehicle frame; %s\n",
+      a.camera.camera.c_str(), payload.vendor.c_str(), payload.model.c_str(),
+      payload.profile ? "profile" : "image", payload.payload_width_px, payload.payload_height_px,
+      a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
   std::fflush(stdout);
 
   // The camera is read on its own thread when the view owns this one (VTK's GUI thread).
@@ -160,7 +169,9 @@ void RunInspect(const InspectArgs& a) {
           [&inspection](mapping::FrameRecord&& record, const acq::AcquiredFrame& frame) {
             inspection.Push(ToInspectionFrame(std::move(record), frame));
           },
-          [&inspection](const ReadSummary& r, double now) { PrintStatus(r, inspection.statistics(), now, false); });
+          [&inspection](const ReadSummary& r, double now) {
+            PrintStatus(r, inspection.statistics(), now, false);
+          });
       result = inspection.Finish();
     } catch (...) {
       failure = std::current_exception();
@@ -184,28 +195,35 @@ void RunInspect(const InspectArgs& a) {
   const mapping::InspectionStatistics& s = result.statistics;
   PrintStatus(read, s, read.seconds, true);
   if (!a.map.empty()) perception::WriteCloud(a.map, result.map, !a.ascii);
-  std::printf("inspect: %lld frames received in %.2f s (%.1f frames/s), %lld lost, %lld undecodable; logged %lld; "
-              "mapped %lld, skipped %lld (live queue %d)\n",
-              static_cast<long long>(s.frames_received), read.seconds,
-              read.seconds > 0 ? read.frames / read.seconds : 0.0, static_cast<long long>(read.source.lost_frames),
-              static_cast<long long>(read.undecodable), static_cast<long long>(s.frames_logged),
-              static_cast<long long>(s.frames_mapped), static_cast<long long>(s.frames_skipped), a.live_queue);
+  std::printf(
+      "inspect: %lld frames received in %.2f s (%.1f frames/s), %lld lost, %lld undecodable; "
+      "logged %lld; "
+      "mapped %lld, skipped %lld (live queue %d)\n",
+      static_cast<long long>(s.frames_received), read.seconds,
+      read.seconds > 0 ? read.frames / read.seconds : 0.0,
+      static_cast<long long>(read.source.lost_frames), static_cast<long long>(read.undecodable),
+      static_cast<long long>(s.frames_logged), static_cast<long long>(s.frames_mapped),
+      static_cast<long long>(s.frames_skipped), a.live_queue);
   if (s.frames_without_navigation > 0) {
     std::printf("inspect: %lld frames logged but not mapped: no navigation around their time\n",
                 static_cast<long long>(s.frames_without_navigation));
   }
-  std::printf("inspect: latency to the map, receive -> map median %.2f ms (p95 %.2f, max %.2f)", s.receive_to_map.median_s * 1e3,
-              s.receive_to_map.p95_s * 1e3, s.receive_to_map.max_s * 1e3);
+  std::printf("inspect: latency to the map, receive -> map median %.2f ms (p95 %.2f, max %.2f)",
+              s.receive_to_map.median_s * 1e3, s.receive_to_map.p95_s * 1e3,
+              s.receive_to_map.max_s * 1e3);
   if (s.capture_to_map.frames > 0) {
-    std::printf(", capture -> map median %.2f ms (p95 %.2f, max %.2f)", s.capture_to_map.median_s * 1e3,
-                s.capture_to_map.p95_s * 1e3, s.capture_to_map.max_s * 1e3);
+    std::printf(", capture -> map median %.2f ms (p95 %.2f, max %.2f)",
+                s.capture_to_map.median_s * 1e3, s.capture_to_map.p95_s * 1e3,
+                s.capture_to_map.max_s * 1e3);
   } else {
     std::printf("; capture -> map unknown (the camera's clock is not the host's)");
   }
-  std::printf("\ninspect: map %zu points (%lld points placed) in %d submaps%s%s%s\n", result.map.size(),
-              static_cast<long long>(s.points_mapped), s.submaps, a.map.empty() ? "" : ", written to ",
-              a.map.c_str(),
-              read.stop_signal != 0 ? (read.stop_signal == SIGINT ? "; stopped by SIGINT" : "; stopped by SIGTERM") : "");
+  std::printf("\ninspect: map %zu points (%lld points placed) in %d submaps%s%s%s\n",
+              result.map.size(), static_cast<long long>(s.points_mapped), s.submaps,
+              a.map.empty() ? "" : ", written to ", a.map.c_str(),
+              read.stop_signal != 0
+                  ? (read.stop_signal == SIGINT ? "; stopped by SIGINT" : "; stopped by SIGTERM")
+                  : "");
   if (!a.screenshot.empty()) std::printf("%s: written\n", a.screenshot.c_str());
   if (!a.json.empty()) WriteReport(a, read, result);
 }
@@ -216,35 +234,47 @@ void AddInspectCommand(CLI::App& app) {
   auto a = std::make_shared<InspectArgs>();
   CLI::App* cmd = app.add_subcommand(
       "inspect",
-      "online inspection: a camera's frames logged (never dropped), stripe peaks triangulated and mapped live "
+      "online inspection: a camera's frames logged (never dropped), stripe peaks triangulated and "
+      "mapped live "
       "(the newest frames the mapper keeps up with; skipped ones counted), shown with --view");
   cmd->footer(
-      "Navigation: a camera alone gives none, so the scanner is taken as fixed: the vehicle is held at the origin\n"
-      "(T_W_V = identity at every frame) and the map is in the vehicle frame (the camera frame moved by the\n"
-      "scene's camera mount; identity for a real camera). Sweeps of a static scene land on each other; a moving\n"
+      "Navigation: a camera alone gives none, so the scanner is taken as fixed: the vehicle is "
+      "held at the origin\n"
+      "(T_W_V = identity at every frame) and the map is in the vehicle frame (the camera frame "
+      "moved by the\n"
+      "scene's camera mount; identity for a real camera). Sweeps of a static scene land on each "
+      "other; a moving\n"
       "vehicle is mapped afterwards with `uwscan map` on a log that has its navigation.\n"
-      "Latency is measured to the moment a frame's points are placed in the map: from the host receiving the\n"
-      "frame, and from the camera's exposure when the camera's clock is the host's (PTP, the fake camera).");
+      "Latency is measured to the moment a frame's points are placed in the map: from the host "
+      "receiving the\n"
+      "frame, and from the camera's exposure when the camera's clock is the host's (PTP, the fake "
+      "camera).");
   AddCameraOptions(*cmd, a->camera);
-  cmd->add_option("--log", a->log, "dive log to create (.db): every frame received, each committed");
+  cmd->add_option("--log", a->log,
+                  "dive log to create (.db): every frame received, each committed");
   cmd->add_option("-o,--map", a->map, "map to write at the end (.ply or .pcd), voxelised");
   cmd->add_flag("--ascii", a->ascii, "write the map as ASCII instead of binary");
-  cmd->add_option("--json", a->json, "figures as JSON: frames received, logged, mapped, skipped, latency");
+  cmd->add_option("--json", a->json,
+                  "figures as JSON: frames received, logged, mapped, skipped, latency");
   cmd->add_option("--frames", a->frames, "stop after this many frames")->check(kPositiveNumber);
   cmd->add_option("--seconds", a->seconds, "stop after this long")->check(kPositiveNumber);
   cmd->add_flag("--images", a->images, "image mode: log the images as well as the detected peaks");
   cmd->add_flag("--view", a->view, "show the map live (needs an X display)");
   cmd->add_option("--screenshot", a->screenshot,
-                  "render the live view offscreen and write its last picture to this PNG (with --frames or --seconds)");
+                  "render the live view offscreen and write its last picture to this PNG (with "
+                  "--frames or --seconds)");
   cmd->add_option("--queue-mb", a->queue_mb,
-                  "frames waiting for the disk before the reader waits, MB (then the camera's buffers fill and its "
+                  "frames waiting for the disk before the reader waits, MB (then the camera's "
+                  "buffers fill and its "
                   "frames are lost and counted)")
       ->capture_default_str();
   cmd->add_option("--live-queue", a->live_queue,
                   "frames waiting for the mapper; a newer frame skips the oldest")
       ->capture_default_str()
       ->check(kPositiveNumber);
-  cmd->add_option("--voxel", a->voxel_m, "map voxel, metres")->capture_default_str()->check(kPositiveNumber);
+  cmd->add_option("--voxel", a->voxel_m, "map voxel, metres")
+      ->capture_default_str()
+      ->check(kPositiveNumber);
   cmd->add_option("--sweeps-per-submap", a->sweeps_per_submap, "sweeps grouped into one submap")
       ->capture_default_str()
       ->check(kPositiveNumber);

@@ -45,18 +45,22 @@ nlohmann::json ToJson(const mapping::DiveLogCheck& check) {
 
 void PrintCheck(const std::string& log, const mapping::DiveLogCheck& check) {
   std::printf("%s: schema version %d, %s\n", log.c_str(), check.schema_version,
-              check.checksummed ? "every row checksummed"
-                                : "no checksums (schema before 3): structure and values' types only");
+              check.checksummed
+                  ? "every row checksummed"
+                  : "no checksums (schema before 3): structure and values' types only");
   std::printf("frames: %lld intact of %lld", static_cast<long long>(check.frames_intact),
               static_cast<long long>(check.frames));
   if (check.frames_with_damaged_truth > 0) {
     std::printf(" (%lld of them with ground truth that could not be read)",
                 static_cast<long long>(check.frames_with_damaged_truth));
   }
-  std::printf("; navigation: %lld intact of %lld\n", static_cast<long long>(check.navigation_intact),
+  std::printf("; navigation: %lld intact of %lld\n",
+              static_cast<long long>(check.navigation_intact),
               static_cast<long long>(check.navigation));
-  for (const std::string& line : check.integrity) std::printf("sqlite quick_check: %s\n", line.c_str());
-  for (const mapping::DiveLogDamage& d : check.damage) std::printf("damaged: %s\n", d.message.c_str());
+  for (const std::string& line : check.integrity)
+    std::printf("sqlite quick_check: %s\n", line.c_str());
+  for (const mapping::DiveLogDamage& d : check.damage)
+    std::printf("damaged: %s\n", d.message.c_str());
   std::printf("%s\n", check.ok() ? "ok" : "DAMAGED");
 }
 
@@ -74,11 +78,13 @@ void RunCheck(const CheckArgs& a) {
 
 void RunSalvage(const SalvageArgs& a) {
   CheckOutputPath(a.output, "-o", {a.log});
-  if (fs::exists(a.output)) throw Error("-o " + a.output + ": exists (a dive log is never overwritten)");
+  if (fs::exists(a.output))
+    throw Error("-o " + a.output + ": exists (a dive log is never overwritten)");
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.log, a.output});
   const mapping::DiveLogReader reader(a.log, mapping::DiveLogOpening::kDamaged);
   mapping::DiveLogHeader header = reader.header();
-  header.producer += " (salvaged by uwscan log salvage from " + fs::path(a.log).filename().string() + ")";
+  header.producer +=
+      " (salvaged by uwscan log salvage from " + fs::path(a.log).filename().string() + ")";
 
   // Written under a temporary name and renamed when complete: the output is never a half.
   const fs::path partial = TemporaryBeside(a.output);
@@ -110,13 +116,14 @@ void RunSalvage(const SalvageArgs& a) {
     throw;
   }
   PrintCheck(a.log, check);
-  const std::string without_truth =
-      check.frames_with_damaged_truth == 0
-          ? ""
-          : " (" + std::to_string(check.frames_with_damaged_truth) + " without ground truth, which could not be read)";
-  std::printf("salvaged into %s: %lld frames%s, %lld navigation samples%s (frames renumbered from 0)\n",
-              a.output.c_str(), static_cast<long long>(check.frames_intact), without_truth.c_str(),
-              static_cast<long long>(check.navigation_intact), mount_copied ? ", the vehicle mount" : "");
+  const std::string without_truth = check.frames_with_damaged_truth == 0
+                                        ? ""
+                                        : " (" + std::to_string(check.frames_with_damaged_truth) +
+                                              " without ground truth, which could not be read)";
+  std::printf(
+      "salvaged into %s: %lld frames%s, %lld navigation samples%s (frames renumbered from 0)\n",
+      a.output.c_str(), static_cast<long long>(check.frames_intact), without_truth.c_str(),
+      static_cast<long long>(check.navigation_intact), mount_copied ? ", the vehicle mount" : "");
   if (!a.json.empty()) {
     nlohmann::json json = ToJson(check);
     json["salvaged"] = {{"output", a.output},
@@ -131,23 +138,29 @@ void RunSalvage(const SalvageArgs& a) {
 }  // namespace
 
 void AddLogCommands(CLI::App& app) {
-  CLI::App* log = app.add_subcommand("log", "check a dive log for damage, or salvage its intact frames");
+  CLI::App* log =
+      app.add_subcommand("log", "check a dive log for damage, or salvage its intact frames");
   log->require_subcommand(1);
 
   auto check = std::make_shared<CheckArgs>();
   CLI::App* check_cmd = log->add_subcommand(
-      "check", "verify every frame's and navigation sample's checksums and SQLite's own structure "
-               "(exit 1 when anything is damaged)");
+      "check",
+      "verify every frame's and navigation sample's checksums and SQLite's own structure "
+      "(exit 1 when anything is damaged)");
   check_cmd->add_option("log", check->log, "dive log (.db)")->required()->check(CLI::ExistingFile);
   check_cmd->add_option("--json", check->json, "also write the findings as JSON");
   check_cmd->callback([check] { RunCheck(*check); });
 
   auto salvage = std::make_shared<SalvageArgs>();
-  CLI::App* salvage_cmd = log->add_subcommand(
-      "salvage", "copy every intact frame (with its ground truth when that is intact) and navigation sample of a "
-                 "damaged log into a new one");
-  salvage_cmd->add_option("log", salvage->log, "damaged dive log (.db)")->required()->check(CLI::ExistingFile);
-  salvage_cmd->add_option("-o,--output", salvage->output, "new dive log to write (.db)")->required();
+  CLI::App* salvage_cmd = log->add_subcommand("salvage",
+                                              "copy every intact frame (with its ground truth when "
+                                              "that is intact) and navigation sample of a "
+                                              "damaged log into a new one");
+  salvage_cmd->add_option("log", salvage->log, "damaged dive log (.db)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  salvage_cmd->add_option("-o,--output", salvage->output, "new dive log to write (.db)")
+      ->required();
   salvage_cmd->add_option("--json", salvage->json, "also write what was kept and dropped as JSON");
   salvage_cmd->callback([salvage] { RunSalvage(*salvage); });
 }

@@ -49,7 +49,8 @@ nlohmann::json Optional(const std::optional<T>& value) {
 }
 
 // The map report (format in docs/formats.md, "Map report"): what the viewer reads.
-nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& log, const std::string& map) {
+nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& log,
+                             const std::string& map) {
   const mapping::MapSummary s = mapping::Summarise(m);
   // Both absolute: the report may be read from anywhere.
   const auto absolute = [](const std::string& path) {
@@ -57,7 +58,8 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
   };
   nlohmann::json report = {{"uwscan_format", 1}, {"kind", "map_report"}, {"log", absolute(log)}};
   report["map"] = absolute(map);
-  report["trajectories"] = {{"slam", TumRows(m.slam)}, {"dead_reckoning", TumRows(m.dead_reckoning)}};
+  report["trajectories"] = {{"slam", TumRows(m.slam)},
+                            {"dead_reckoning", TumRows(m.dead_reckoning)}};
   if (!m.truth.empty()) report["trajectories"]["truth"] = TumRows(m.truth);
   nlohmann::json covariance = nlohmann::json::array(), deviation = nlohmann::json::array();
   for (std::size_t i = 0; i < m.covariances.size(); ++i) {
@@ -74,14 +76,19 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
     const Eigen::Matrix<double, 6, 1> std = mapping::PoseStd(m.covariances[i]);
     deviation.push_back({m.slam[i].time_s, std(0), std(1), std(2), std(3), std(4), std(5)});
   }
-  report["pose_covariance"] = covariance;  // [t, 36 values, (x, y, z (m), roll, pitch, yaw (rad)) row-major]
-  report["pose_std"] = deviation;          // [t, x, y, z (m), roll, pitch, yaw (rad)]
+  report["pose_covariance"] =
+      covariance;  // [t, 36 values, (x, y, z (m), roll, pitch, yaw (rad)) row-major]
+  report["pose_std"] = deviation;  // [t, x, y, z (m), roll, pitch, yaw (rad)]
   nlohmann::json loops = nlohmann::json::array();
   for (const mapping::LoopClosure& l : m.loops) {
     const Eigen::Quaterniond q(l.T_from_to.linear());
     const Eigen::Vector3d& t = l.T_from_to.translation();
-    loops.push_back({{"from_submap", l.from}, {"to_submap", l.to}, {"accepted", l.accepted},
-                     {"reason", l.reason}, {"fitness", l.fitness}, {"chi2", l.chi2},
+    loops.push_back({{"from_submap", l.from},
+                     {"to_submap", l.to},
+                     {"accepted", l.accepted},
+                     {"reason", l.reason},
+                     {"fitness", l.fitness},
+                     {"chi2", l.chi2},
                      {"constrained_directions", l.constrained_directions},
                      {"T_from_to", {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}}});
   }
@@ -94,7 +101,8 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
                        {"seconds", m.seconds},
                        {"real_time_factor", s.real_time_factor},
                        {"registrations", m.stats.registrations},
-                       {"registrations_left_to_navigation", m.stats.registrations_failed + m.stats.registrations_inconsistent},
+                       {"registrations_left_to_navigation",
+                        m.stats.registrations_failed + m.stats.registrations_inconsistent},
                        {"registrations_inconsistent", m.stats.registrations_inconsistent},
                        {"dead_reckoning_scale_error", m.calibration.scale_error},
                        {"dead_reckoning_misalignment_rad", m.calibration.misalignment_rad},
@@ -119,8 +127,10 @@ void RequireOutput(const std::string& path, const char* option, const std::strin
 }
 
 void RunMap(const MapArgs& a) {
-  for (const auto& [path, option] : {std::pair{a.output, "-o"}, {a.trajectory, "--trajectory"},
-                                     {a.dead_reckoning, "--dead-reckoning"}, {a.truth, "--truth"},
+  for (const auto& [path, option] : {std::pair{a.output, "-o"},
+                                     {a.trajectory, "--trajectory"},
+                                     {a.dead_reckoning, "--dead-reckoning"},
+                                     {a.truth, "--truth"},
                                      {a.json, "--json"}}) {
     RequireOutput(path, option, a.log);
   }
@@ -135,7 +145,8 @@ void RunMap(const MapArgs& a) {
   const mapping::DiveLogReader log(a.log);
   // Refused before anything is mapped or written: a real log has no truth to write.
   if (!a.truth.empty() && log.frame_count() > 0 && !log.ReadGroundTruth(0)) {
-    throw Error("--truth " + a.truth + ": the log " + a.log + " holds no ground truth (not simulated)");
+    throw Error("--truth " + a.truth + ": the log " + a.log +
+                " holds no ground truth (not simulated)");
   }
   mapping::DiveMapping m;
   {
@@ -146,38 +157,50 @@ void RunMap(const MapArgs& a) {
   if (!a.trajectory.empty()) mapping::WriteTum(a.trajectory, m.slam);
   if (!a.dead_reckoning.empty()) mapping::WriteTum(a.dead_reckoning, m.dead_reckoning);
   if (!a.truth.empty()) {
-    if (m.truth.empty()) throw Error("--truth " + a.truth + ": the log holds no ground truth (not simulated)");
+    if (m.truth.empty())
+      throw Error("--truth " + a.truth + ": the log holds no ground truth (not simulated)");
     mapping::WriteTum(a.truth, m.truth);
   }
   const mapping::MapSummary s = mapping::Summarise(m);
-  std::printf("%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
-              a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
+  std::printf(
+      "%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
+      a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
   if (m.stats.frames_without_navigation > 0) {
-    std::printf("%lld of %lld frames left out: not between navigation samples at most %g s apart "
-                "(--max-navigation-gap)\n",
-                static_cast<long long>(m.stats.frames_without_navigation),
-                static_cast<long long>(m.stats.frames_without_navigation + m.stats.frames), a.max_navigation_gap_s);
+    std::printf(
+        "%lld of %lld frames left out: not between navigation samples at most %g s apart "
+        "(--max-navigation-gap)\n",
+        static_cast<long long>(m.stats.frames_without_navigation),
+        static_cast<long long>(m.stats.frames_without_navigation + m.stats.frames),
+        a.max_navigation_gap_s);
   }
-  std::printf("registrations %d (%d left to navigation, %d of them inconsistent with it), loops accepted %d, rejected %d\n",
-              m.stats.registrations, m.stats.registrations_failed + m.stats.registrations_inconsistent,
-              m.stats.registrations_inconsistent, s.loops_accepted, s.loops_rejected);
+  std::printf(
+      "registrations %d (%d left to navigation, %d of them inconsistent with it), loops accepted "
+      "%d, rejected %d\n",
+      m.stats.registrations, m.stats.registrations_failed + m.stats.registrations_inconsistent,
+      m.stats.registrations_inconsistent, s.loops_accepted, s.loops_rejected);
   std::printf("dead reckoning as estimated: speed scale error %+.2f %%, misalignment %+.2f mrad\n",
               100.0 * m.calibration.scale_error, 1000.0 * m.calibration.misalignment_rad);
-  std::printf("time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, graph %.2f s\n",
-              m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s, m.stats.graph_s);
+  std::printf(
+      "time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, "
+      "graph %.2f s\n",
+      m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s,
+      m.stats.graph_s);
   if (m.expected_map_error_m) {
     std::printf("expected map error from the poses' uncertainty: %.2f mm RMS along the normals\n",
                 *m.expected_map_error_m * 1e3);
   }
   if (m.expected_position_error_m) {
-    std::printf("expected position error from the poses' uncertainty: %.2f mm RMS (what the ATE should come to)\n",
-                *m.expected_position_error_m * 1e3);
+    std::printf(
+        "expected position error from the poses' uncertainty: %.2f mm RMS (what the ATE should "
+        "come to)\n",
+        *m.expected_position_error_m * 1e3);
   }
   if (m.navigation_noise_assumed) {
     std::printf("navigation noise: not recorded in the log (schema 1), a typical AUV's assumed\n");
   }
   if (s.ate_slam_m) {
-    std::printf("against the truth: ATE dead reckoning %.4f m, SLAM %.4f m", *s.ate_dead_reckoning_m, *s.ate_slam_m);
+    std::printf("against the truth: ATE dead reckoning %.4f m, SLAM %.4f m",
+                *s.ate_dead_reckoning_m, *s.ate_slam_m);
     if (s.nees_mean) std::printf(", NEES %.2f (6 for a consistent covariance)", *s.nees_mean);
     std::printf("\n");
   }
@@ -189,24 +212,34 @@ void RunMap(const MapArgs& a) {
 void AddMapCommand(CLI::App& app) {
   auto args = std::make_shared<MapArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "map", "scan-matching SLAM over a dive log: map, trajectories, per-pose uncertainty, loop closures");
+      "map",
+      "scan-matching SLAM over a dive log: map, trajectories, per-pose uncertainty, loop closures");
   cmd->add_option("log", args->log, "dive log (.db)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", args->output, "map to write (.ply or .pcd), voxelised")->required();
-  cmd->add_option("--trajectory", args->trajectory, "SLAM trajectory to write (TUM: t tx ty tz qx qy qz qw)");
-  cmd->add_option("--dead-reckoning", args->dead_reckoning, "the navigation at the same times (TUM)");
-  cmd->add_option("--truth", args->truth, "the true trajectory at the same times (TUM; simulated logs)");
-  cmd->add_option("--json", args->json,
-                  "report: trajectories, per-pose covariance and standard deviations, loops, figures");
-  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")->capture_default_str()->check(kPositiveNumber);
+  cmd->add_option("-o,--output", args->output, "map to write (.ply or .pcd), voxelised")
+      ->required();
+  cmd->add_option("--trajectory", args->trajectory,
+                  "SLAM trajectory to write (TUM: t tx ty tz qx qy qz qw)");
+  cmd->add_option("--dead-reckoning", args->dead_reckoning,
+                  "the navigation at the same times (TUM)");
+  cmd->add_option("--truth", args->truth,
+                  "the true trajectory at the same times (TUM; simulated logs)");
+  cmd->add_option(
+      "--json", args->json,
+      "report: trajectories, per-pose covariance and standard deviations, loops, figures");
+  cmd->add_option("--voxel", args->voxel_m, "map voxel, metres")
+      ->capture_default_str()
+      ->check(kPositiveNumber);
   cmd->add_option("--sweeps-per-submap", args->sweeps_per_submap, "sweeps grouped into one submap")
       ->capture_default_str()
       ->check(kPositiveNumber);
-  cmd->add_option("--max-navigation-gap", args->max_navigation_gap_s,
-                  "seconds: frames between navigation samples farther apart, or outside them, are left out "
-                  "(and counted)")
+  cmd->add_option(
+         "--max-navigation-gap", args->max_navigation_gap_s,
+         "seconds: frames between navigation samples farther apart, or outside them, are left out "
+         "(and counted)")
       ->capture_default_str()
       ->check(kPositiveNumber);
-  cmd->add_option("--threads", args->threads, "threads (0: all cores); the output does not depend on it")
+  cmd->add_option("--threads", args->threads,
+                  "threads (0: all cores); the output does not depend on it")
       ->check(kNonNegativeNumber);
   cmd->callback([args] { RunMap(*args); });
 }

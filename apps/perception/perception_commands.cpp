@@ -67,10 +67,11 @@ void RunRegister(const RegisterArgs& a) {
   perception::CloudReadStats source_stats, target_stats;
   const perception::PointCloud source = perception::ReadCloud(a.source, &source_stats);
   const perception::PointCloud target = perception::ReadCloud(a.target, &target_stats);
-  for (const auto& [file, stats] : {std::pair{&a.source, &source_stats}, {&a.target, &target_stats}}) {
+  for (const auto& [file, stats] :
+       {std::pair{&a.source, &source_stats}, {&a.target, &target_stats}}) {
     if (stats->num_dropped_non_finite == 0) continue;
-    std::printf("%s: %zu of its %zu points dropped (a NaN or infinite coordinate or normal)\n", file->c_str(),
-                stats->num_dropped_non_finite, stats->num_in_file);
+    std::printf("%s: %zu of its %zu points dropped (a NaN or infinite coordinate or normal)\n",
+                file->c_str(), stats->num_dropped_non_finite, stats->num_in_file);
   }
   const double size = perception::BoundingBoxDiagonal(target);
   if (a.voxel_set && !(a.voxel_m > 0.0)) throw Error("--voxel: must be > 0 metres");
@@ -78,16 +79,18 @@ void RunRegister(const RegisterArgs& a) {
     throw Error(a.target + ": the target cloud has no extent (give --voxel)");
   }
   // Without an extent (one point) the object's size is taken from the voxel.
-  perception::RegistrationPipelineOptions options = perception::RegistrationPipelineOptions::ForObjectSize(
-      size > 0.0 ? size : 50.0 * a.voxel_m, a.seed, a.threads, a.voxel_set ? a.voxel_m : 0.0);
+  perception::RegistrationPipelineOptions options =
+      perception::RegistrationPipelineOptions::ForObjectSize(
+          size > 0.0 ? size : 50.0 * a.voxel_m, a.seed, a.threads, a.voxel_set ? a.voxel_m : 0.0);
   std::optional<Eigen::Isometry3d> init;
   if (!a.init.empty()) init = ParsePose(a.init);
   perception::RegistrationPipelineResult r;
   try {
     r = perception::RegisterClouds(source, target, options, init);
   } catch (const Error& e) {
-    throw Error("register " + a.source + " onto " + a.target + " (" + std::to_string(source.size()) + " and " +
-                std::to_string(target.size()) + " points): " + e.what());
+    throw Error("register " + a.source + " onto " + a.target + " (" +
+                std::to_string(source.size()) + " and " + std::to_string(target.size()) +
+                " points): " + e.what());
   }
   const Eigen::Matrix4d T = r.fine.T_target_source.matrix();
   std::printf("T_target_source =\n");
@@ -96,25 +99,32 @@ void RunRegister(const RegisterArgs& a) {
   }
   // ICP's figures are over the voxelised clouds; the user's clouds are judged whole.
   const double within_m = options.icp.max_correspondence_distance_m.back();
-  const perception::CloudFit whole = perception::FitOnTarget(source, target, r.fine.T_target_source, within_m);
-  std::printf("%.1f %% of the source within %.6f m of the target, RMS %.6f m (every point of both clouds)\n",
-              100.0 * whole.fitness, within_m, whole.inlier_rmse_m);
+  const perception::CloudFit whole =
+      perception::FitOnTarget(source, target, r.fine.T_target_source, within_m);
+  std::printf(
+      "%.1f %% of the source within %.6f m of the target, RMS %.6f m (every point of both "
+      "clouds)\n",
+      100.0 * whole.fitness, within_m, whole.inlier_rmse_m);
   const bool coarse_failed = !init && !r.coarse.converged;
   if (coarse_failed) {
     // RegisterClouds returns the coarse result as the fine one then: ICP never ran.
-    std::printf("coarse alignment on the %.6f m voxels: no convincing pose (fitness %.4f after %d RANSAC iterations), "
-                "ICP not run\n",
-                options.voxel_m, r.coarse.fitness, r.coarse.iterations);
+    std::printf(
+        "coarse alignment on the %.6f m voxels: no convincing pose (fitness %.4f after %d RANSAC "
+        "iterations), "
+        "ICP not run\n",
+        options.voxel_m, r.coarse.fitness, r.coarse.iterations);
   } else {
-    std::printf("ICP on the %.6f m voxels: fitness %.4f, inlier RMSE %.6f m, %d iterations, %s\n", options.voxel_m,
-                r.fine.fitness, r.fine.inlier_rmse, r.fine.iterations, r.fine.converged ? "converged" : "NOT converged");
+    std::printf("ICP on the %.6f m voxels: fitness %.4f, inlier RMSE %.6f m, %d iterations, %s\n",
+                options.voxel_m, r.fine.fitness, r.fine.inlier_rmse, r.fine.iterations,
+                r.fine.converged ? "converged" : "NOT converged");
   }
   if (!a.output.empty()) {
     perception::WriteCloud(a.output, perception::Transformed(source, r.fine.T_target_source));
   }
   if (!a.json.empty()) {
     nlohmann::json j = ResultJson(r.fine);
-    j["whole_clouds"] = {{"within_m", within_m}, {"fitness", whole.fitness}, {"inlier_rmse_m", whole.inlier_rmse_m}};
+    j["whole_clouds"] = {
+        {"within_m", within_m}, {"fitness", whole.fitness}, {"inlier_rmse_m", whole.inlier_rmse_m}};
     if (!init) j["coarse"] = ResultJson(r.coarse);
     j["stage_seconds"] = r.stage_seconds;
     WriteJsonFile(a.json, j);
@@ -150,11 +160,14 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
     ProgressBar bar;
     r = bench::RunRegistrationBenchmark(o, bar.Callback());
   }
-  std::printf("Registration on %d pairs (%d threads): success = rotation < 2 deg and translation "
-              "< 1 %% of the object size; ADD-S success = mean distance to the nearest truly placed "
-              "point < 1 %% of the object size (a symmetric object's equivalent poses pass)\n\n",
-              r.pipelines.at("uwscan").pairs, a.threads);
-  std::printf("| pipeline | success | ADD-S success | s/pair | downsample | normals | features | coarse | icp |\n");
+  std::printf(
+      "Registration on %d pairs (%d threads): success = rotation < 2 deg and translation "
+      "< 1 %% of the object size; ADD-S success = mean distance to the nearest truly placed "
+      "point < 1 %% of the object size (a symmetric object's equivalent poses pass)\n\n",
+      r.pipelines.at("uwscan").pairs, a.threads);
+  std::printf(
+      "| pipeline | success | ADD-S success | s/pair | downsample | normals | features | coarse | "
+      "icp |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json pipelines = nlohmann::json::object();
   for (const auto& [name, s] : r.pipelines) {
@@ -163,8 +176,9 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
       return it == s.stage_seconds_per_pair.end() ? 0.0 : it->second;
     };
     std::printf("| %s | %d/%d | %d/%d | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n", name.c_str(),
-                s.successes, s.pairs, s.symmetric_successes, s.pairs, s.seconds_per_pair, stage("downsample"),
-                stage("normals"), stage("features"), stage("coarse"), stage("icp"));
+                s.successes, s.pairs, s.symmetric_successes, s.pairs, s.seconds_per_pair,
+                stage("downsample"), stage("normals"), stage("features"), stage("coarse"),
+                stage("icp"));
     pipelines[name] = {{"success_rate", s.success_rate},
                        {"symmetric_success_rate", s.symmetric_success_rate},
                        {"seconds_per_pair", s.seconds_per_pair},
@@ -192,13 +206,14 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
   }
   nlohmann::json sweep = nlohmann::json::array();
   if (!r.voxel_sweep.empty()) {
-    std::printf("\nuwscan's pipeline by voxel size (radii and distances scale with it)\n\n"
-                "| voxel / object size | success | ADD-S success | s/pair |\n|---:|---:|---:|---:|\n");
+    std::printf(
+        "\nuwscan's pipeline by voxel size (radii and distances scale with it)\n\n"
+        "| voxel / object size | success | ADD-S success | s/pair |\n|---:|---:|---:|---:|\n");
   }
   for (const bench::VoxelSweepRow& row : r.voxel_sweep) {
     const bench::PipelineSummary& s = row.summary;
-    std::printf("| %.4f | %d/%d | %d/%d | %.3f |\n", row.voxel_fraction, s.successes, s.pairs, s.symmetric_successes,
-                s.pairs, s.seconds_per_pair);
+    std::printf("| %.4f | %d/%d | %d/%d | %.3f |\n", row.voxel_fraction, s.successes, s.pairs,
+                s.symmetric_successes, s.pairs, s.seconds_per_pair);
     sweep.push_back({{"voxel_fraction", row.voxel_fraction},
                      {"success_rate", s.success_rate},
                      {"symmetric_success_rate", s.symmetric_success_rate},
@@ -272,7 +287,8 @@ void AddPerceptionBenchCommands(CLI::App& bench) {
   reg->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
   reg->add_flag("--no-real-scans", a->no_real_scans, "only the mesh pairs");
   reg->add_option("--sweep-voxel", a->sweep_voxel,
-                  "also run uwscan's pipeline at these voxel sizes, fractions of the object size (e.g. 0.01 0.02 0.04)");
+                  "also run uwscan's pipeline at these voxel sizes, fractions of the object size "
+                  "(e.g. 0.01 0.02 0.04)");
   reg->add_option("--json", a->json, "write the figures as JSON");
   reg->callback([a] { RunRegistrationBench(*a); });
 

@@ -70,20 +70,22 @@ void RunBuildDb(const BuildDbArgs& a) {
   for (const std::string& name : a.objects) {
     const std::filesystem::path sidecar = perception::GraspSidecarPath(name);
     if (std::filesystem::exists(name) && !std::filesystem::exists(sidecar)) {
-      std::printf("  %s: no %s beside it, so no grasp frames (recognize gives its pose only)\n", name.c_str(),
-                  sidecar.filename().c_str());
+      std::printf("  %s: no %s beside it, so no grasp frames (recognize gives its pose only)\n",
+                  name.c_str(), sidecar.filename().c_str());
     }
   }
   for (const perception::ObjectModel& o : db.objects) {
     std::string symmetries;
     for (const perception::SymmetryAxis& s : o.symmetries) {
-      symmetries += (symmetries.empty() ? "" : ", ") +
-                    (s.continuous() ? std::string("continuous") : std::to_string(s.order) + "-fold");
+      symmetries +=
+          (symmetries.empty() ? "" : ", ") +
+          (s.continuous() ? std::string("continuous") : std::to_string(s.order) + "-fold");
     }
-    std::printf("  %-14s %3zu views, diameter %.3f m, %zu model points, %zu grasps, symmetries: %s%s\n",
-                o.id.c_str(), o.views.size(), o.diameter_m, o.model.size(), o.grasps.size(),
-                symmetries.empty() ? "none" : symmetries.c_str(),
-                o.symmetries_declared ? " (declared)" : "");
+    std::printf(
+        "  %-14s %3zu views, diameter %.3f m, %zu model points, %zu grasps, symmetries: %s%s\n",
+        o.id.c_str(), o.views.size(), o.diameter_m, o.model.size(), o.grasps.size(),
+        symmetries.empty() ? "none" : symmetries.c_str(),
+        o.symmetries_declared ? " (declared)" : "");
   }
 }
 
@@ -97,7 +99,10 @@ struct RecognizeArgs {
 // `path` as seen from the folder `file` is in.
 std::string RelativeToFolderOf(const std::string& path, const std::string& file) {
   const std::filesystem::path folder = std::filesystem::absolute(file).parent_path();
-  return std::filesystem::absolute(path).lexically_normal().lexically_relative(folder.lexically_normal()).string();
+  return std::filesystem::absolute(path)
+      .lexically_normal()
+      .lexically_relative(folder.lexically_normal())
+      .string();
 }
 
 void RunRecognize(const RecognizeArgs& a) {
@@ -125,13 +130,14 @@ void RunRecognize(const RecognizeArgs& a) {
                   o.centroid_S.x(), o.centroid_S.y(), o.centroid_S.z());
       continue;
     }
-    std::printf("  %-14s %6zu points, score %.2f, chi2 %.3f (margin %.3f), at (%.4f, %.4f, %.4f) m, "
-                "%zu free directions, %zu grasps\n",
-                o.object_id.c_str(), o.segment.size(), o.score, o.chi_square, o.margin, t.x(), t.y(),
-                t.z(), o.free_directions.size(), o.grasps_S.size());
+    std::printf(
+        "  %-14s %6zu points, score %.2f, chi2 %.3f (margin %.3f), at (%.4f, %.4f, %.4f) m, "
+        "%zu free directions, %zu grasps\n",
+        o.object_id.c_str(), o.segment.size(), o.score, o.chi_square, o.margin, t.x(), t.y(), t.z(),
+        o.free_directions.size(), o.grasps_S.size());
     if (!o.equivalent_poses_S.empty()) {
-      std::printf("    %zu other pose%s fit as well (--json: equivalent_poses)\n", o.equivalent_poses_S.size(),
-                  o.equivalent_poses_S.size() > 1 ? "s" : "");
+      std::printf("    %zu other pose%s fit as well (--json: equivalent_poses)\n",
+                  o.equivalent_poses_S.size(), o.equivalent_poses_S.size() > 1 ? "s" : "");
     }
     for (const auto& [id, T_S_O] : o.equivalent_objects_S) {
       std::printf("    or %s: the scan fits it as well\n", id.c_str());
@@ -161,12 +167,15 @@ void AddBuildDbCommand(CLI::App& app) {
                   "valve_wheel, valve_lever")
       ->required();
   cmd->add_option("-o,--output", a->output, "object database to write")->required();
-  cmd->add_option("--views", a->views, "views per object over the sphere of directions")->capture_default_str()
+  cmd->add_option("--views", a->views, "views per object over the sphere of directions")
+      ->capture_default_str()
       ->check(CLI::Range(1, 10000));
-  cmd->add_option("--standoff-m", a->standoffs_m, "camera distances used in turn, metres")->capture_default_str();
+  cmd->add_option("--standoff-m", a->standoffs_m, "camera distances used in turn, metres")
+      ->capture_default_str();
   cmd->add_option("--scanner", a->scanner, "scanner file (default: the galvanometer scanner)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--voxel", a->voxel_m, "voxel of views, models and scans, metres")->capture_default_str()
+  cmd->add_option("--voxel", a->voxel_m, "voxel of views, models and scans, metres")
+      ->capture_default_str()
       ->check(kPositiveNumber);
   cmd->add_option("--seed", a->seed, "scan noise and ESF sampling seed")->capture_default_str();
   cmd->add_option("--threads", a->threads, "threads (0: all)")->check(kNonNegativeNumber);
@@ -180,10 +189,12 @@ void AddRecognizeCommand(CLI::App& app) {
       "find the database's objects in a scan (sensor frame): id, pose, free directions, "
       "covariance, grasp poses");
   cmd->add_option("scan", a->scan,
-                  "PLY, PCD or XYZ cloud, or a dive log (one sweep, placed with its navigation when it has some)")
+                  "PLY, PCD or XYZ cloud, or a dive log (one sweep, placed with its navigation "
+                  "when it has some)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--sweep", a->sweep, "the sweep of a dive log of several to recognise objects in");
+  cmd->add_option("--sweep", a->sweep,
+                  "the sweep of a dive log of several to recognise objects in");
   cmd->add_option("--db", a->db, "object database from `uwscan build-db`")->required();
   cmd->add_option("--json", a->json, "write every object, candidate and grasp as JSON");
   cmd->add_option("--seed", a->seed, "RANSAC and ESF seed");

@@ -20,7 +20,8 @@ nlohmann::json Pose(const Eigen::Isometry3d& T) {
           {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
-nlohmann::json ObjectJson(const perception::RecognizedObject& o, const std::vector<std::size_t>& rows) {
+nlohmann::json ObjectJson(const perception::RecognizedObject& o,
+                          const std::vector<std::size_t>& rows) {
   std::vector<std::size_t> segment_rows;
   segment_rows.reserve(o.segment.size());
   for (std::size_t i : o.segment) segment_rows.push_back(rows.at(i));
@@ -30,17 +31,19 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o, const std::vect
                       {"centroid_m", Vector(o.centroid_S)}};
   nlohmann::json candidates = nlohmann::json::array();
   for (const perception::RecognitionCandidate& c : o.candidates) {
-    candidates.push_back({{"id", c.object_id},
-                          {"chi_square", c.chi_square},
-                          {"view", c.view},
-                          {"fitness", c.fitness},
-                          {"close", c.close},
-                          {"missing", c.missing},
-                          {"buried", c.buried},
-                          {"clearance_m", std::isfinite(c.clearance_m) ? nlohmann::json(c.clearance_m) : nlohmann::json()},
-                          {"rmse_m", c.rmse_m},
-                          {"score", c.score},
-                          {"verified", c.verified}});
+    candidates.push_back(
+        {{"id", c.object_id},
+         {"chi_square", c.chi_square},
+         {"view", c.view},
+         {"fitness", c.fitness},
+         {"close", c.close},
+         {"missing", c.missing},
+         {"buried", c.buried},
+         {"clearance_m",
+          std::isfinite(c.clearance_m) ? nlohmann::json(c.clearance_m) : nlohmann::json()},
+         {"rmse_m", c.rmse_m},
+         {"score", c.score},
+         {"verified", c.verified}});
   }
   j["candidates"] = candidates;
   if (o.object_id == "unknown") return j;
@@ -90,10 +93,11 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o, const std::vect
 
 }  // namespace
 
-nlohmann::json RecognitionJson(const perception::RecognitionResult& result, const std::vector<std::size_t>& rows,
-                               std::size_t rows_in_file) {
+nlohmann::json RecognitionJson(const perception::RecognitionResult& result,
+                               const std::vector<std::size_t>& rows, std::size_t rows_in_file) {
   nlohmann::json objects = nlohmann::json::array();
-  for (const perception::RecognizedObject& o : result.objects) objects.push_back(ObjectJson(o, rows));
+  for (const perception::RecognizedObject& o : result.objects)
+    objects.push_back(ObjectJson(o, rows));
   return {{"uwscan_format", 1},
           {"kind", "recognition_report"},
           {"scan_points", rows_in_file},

@@ -1,8 +1,7 @@
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "perception/recognition/object_recognizer.hpp"
@@ -18,7 +17,7 @@ namespace uwscan::app {
 // The caller adds "scan" and "database" (paths relative to the report's folder) and, for a
 // sweep of a dive log, "scan_sweep", which `uwscan view` reads. Documented in
 // perception/README.md.
-nlohmann::json RecognitionJson(const perception::RecognitionResult& result, const std::vector<std::size_t>& rows,
-                               std::size_t rows_in_file);
+nlohmann::json RecognitionJson(const perception::RecognitionResult& result,
+                               const std::vector<std::size_t>& rows, std::size_t rows_in_file);
 
 }  // namespace uwscan::app

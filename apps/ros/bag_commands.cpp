@@ -94,11 +94,11 @@ void RunExport(const ExportArgs& a) {
         static_cast<long long>(s.anchors));
   }
   if (s.scan_points > 0) {
-    std::printf("bag export: a scan of %lld points on %s; %lld objects on %s, %s and %lld grasps on %s\n",
-                static_cast<long long>(s.scan_points), a.topics.sweeps.c_str(),
-                static_cast<long long>(s.objects), a.topics.objects.c_str(),
-                a.topics.object_poses.c_str(), static_cast<long long>(s.grasps),
-                a.topics.grasps.c_str());
+    std::printf(
+        "bag export: a scan of %lld points on %s; %lld objects on %s, %s and %lld grasps on %s\n",
+        static_cast<long long>(s.scan_points), a.topics.sweeps.c_str(),
+        static_cast<long long>(s.objects), a.topics.objects.c_str(), a.topics.object_poses.c_str(),
+        static_cast<long long>(s.grasps), a.topics.grasps.c_str());
   }
   std::printf("bag export: written to %s\n", a.bag.c_str());
   if (s.time_origin_s != 0.0)
@@ -156,7 +156,9 @@ void AddBagCommands(CLI::App& app) {
                    "forward-left-up vehicle: REP 103's default); the mount is read in them too")
       ->check(CLI::IsMember({"ned", "enu"}))
       ->capture_default_str();
-  import->add_option("--odom-frame", in->frames.odom, "the navigation's world frame (--navigation tf)")
+  import
+      ->add_option("--odom-frame", in->frames.odom,
+                   "the navigation's world frame (--navigation tf)")
       ->capture_default_str();
   import->add_option("--base-frame", in->frames.base_link, "the vehicle's frame (--navigation tf)")
       ->capture_default_str();
@@ -170,7 +172,9 @@ CLI::App* exp =
                         "and RViz: a log's frames, odometry, TF and dive description; a map "
                         "report's map, paths, poses and map -> odom; a recognition report's "
                         "scan, object poses, grasps and markers");
-exp->add_option("inputs", out->inputs, "dive logs (.db), map reports (map --json) and recognition reports (recognize --json)")
+exp->add_option(
+       "inputs", out->inputs,
+       "dive logs (.db), map reports (map --json) and recognition reports (recognize --json)")
     ->required()
     ->check(CLI::ExistingFile);
 exp->add_option("-o,--output", out->bag, "bag to create (.bag)")->required();

@@ -77,7 +77,8 @@ class RssSampler {
       std::string line;
       while (std::getline(status, line)) {
         if (line.rfind("VmRSS:", 0) != 0) continue;
-        const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double t =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         samples_.emplace_back(t, std::stoll(line.substr(6)) * 1024);
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -203,7 +204,8 @@ InspectFigures DirectInspect(const RosBenchArgs& a, const fs::path& folder) {
   WaitFor(
       [&folder] {
         std::ifstream log(folder / "camera.log");
-        const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+        const std::string text((std::istreambuf_iterator<char>(log)),
+                               std::istreambuf_iterator<char>());
         return text.find("fake-camera: serving") != std::string::npos;
       },
       1800, "the fake camera did not start serving (see " + (folder / "camera.log").string() + ")");
@@ -240,11 +242,12 @@ nlohmann::json MemoryJson(const NodeFigures& f) {
   const double dive_minutes = (end.first - quarter.first) * f.rate / 60.0;
   nlohmann::json samples = nlohmann::json::array();
   for (const auto& [t, bytes] : f.rss) samples.push_back({t, bytes});
-  return {{"rss_at_quarter_bytes", quarter.second},
-          {"rss_at_end_bytes", end.second},
-          {"growth_bytes_per_dive_minute",
-           dive_minutes > 0 ? static_cast<double>(end.second - quarter.second) / dive_minutes : 0.0},
-          {"samples_s_bytes", samples}};
+  return {
+      {"rss_at_quarter_bytes", quarter.second},
+      {"rss_at_end_bytes", end.second},
+      {"growth_bytes_per_dive_minute",
+       dive_minutes > 0 ? static_cast<double>(end.second - quarter.second) / dive_minutes : 0.0},
+      {"samples_s_bytes", samples}};
 }
 
 nlohmann::json NodeJson(const NodeFigures& f) {
@@ -287,7 +290,8 @@ void RunRosBench(RosBenchArgs a) {
     std::printf(
         "bench ros: rate %.2f: %.0f frames/s through the node, %lld lost, sweep latency median "
         "%.1f ms "
-        "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB, RSS %.0f -> %.0f MB from a quarter of "
+        "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB, RSS %.0f -> %.0f MB from a quarter "
+        "of "
         "the replay to its end\n",
         f.rate, f.frames_per_s, static_cast<long long>(f.frames_in_bag - f.frames_received),
         f.sweep_latency_median_s * 1e3, f.sweep_latency_p95_s * 1e3,

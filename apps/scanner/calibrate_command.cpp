@@ -28,7 +28,8 @@ struct CalibrateArgs {
 };
 
 void RunCalibrate(const CalibrateArgs& a) {
-  CheckOutputPath(a.output, "-o", {a.dataset, a.from, std::filesystem::path(a.dataset) / "manifest.yaml"});
+  CheckOutputPath(a.output, "-o",
+                  {a.dataset, a.from, std::filesystem::path(a.dataset) / "manifest.yaml"});
   const scanner::calibration::CalibrationDataset dataset =
       scanner::calibration::LoadCalibrationDataset(a.dataset);
   std::filesystem::path initial;
@@ -37,7 +38,8 @@ void RunCalibrate(const CalibrateArgs& a) {
   } else if (dataset.scanner_file) {
     initial = *dataset.scanner_file;
   } else {
-    throw Error(a.dataset + ": the manifest names no scanner file to start from; give --from SCANNER.yaml");
+    throw Error(a.dataset +
+                ": the manifest names no scanner file to start from; give --from SCANNER.yaml");
   }
   scanner::calibration::CalibrationStepOutcome outcome;
   {
@@ -78,10 +80,13 @@ void RunImportIntrinsics(const ImportArgs& a) {
   calibrated.camera().camera = camera;
   scanner::StepRecord record;
   record.step = "intrinsics";
-  record.dataset = "imported from " + std::filesystem::absolute(a.opencv_yaml).lexically_normal().string();
+  record.dataset =
+      "imported from " + std::filesystem::absolute(a.opencv_yaml).lexically_normal().string();
   record.residual_unit = "px";
-  record.params = {{"fx_px", camera.fx_px, 0.0}, {"fy_px", camera.fy_px, 0.0},
-                   {"cx_px", camera.cx_px, 0.0}, {"cy_px", camera.cy_px, 0.0}};
+  record.params = {{"fx_px", camera.fx_px, 0.0},
+                   {"fy_px", camera.fy_px, 0.0},
+                   {"cx_px", camera.cx_px, 0.0},
+                   {"cy_px", camera.cy_px, 0.0}};
   record.date_utc = scanner::calibration::NowUtc();
   scanner::SetStepRecord(&calibrated, record);
   WriteTextAtomically(a.output, scanner::ScannerToYaml(calibrated));
@@ -95,11 +100,15 @@ void RunImportIntrinsics(const ImportArgs& a) {
 void AddImportIntrinsicsCommand(CLI::App& app) {
   auto args = std::make_shared<ImportArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "import-intrinsics", "put intrinsics from OpenCV's calibration YAML or XML into a scanner file");
-  cmd->add_option("opencv_yaml", args->opencv_yaml, "camera_matrix + distortion_coefficients (OpenCV)")
+      "import-intrinsics",
+      "put intrinsics from OpenCV's calibration YAML or XML into a scanner file");
+  cmd->add_option("opencv_yaml", args->opencv_yaml,
+                  "camera_matrix + distortion_coefficients (OpenCV)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--into", args->into, "scanner file to take everything else from")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--into", args->into, "scanner file to take everything else from")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output, "calibration file to write")->required();
   cmd->callback([args] { RunImportIntrinsics(*args); });
 }
@@ -107,12 +116,15 @@ void AddImportIntrinsicsCommand(CLI::App& app) {
 void AddCalibrateCommand(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();
   CLI::App* cmd = app.add_subcommand("calibrate", "run one calibration step on a dataset folder");
-  cmd->add_option("step", args->step, "intrinsics, viewport, laser, laser_viewport or mems")->required();
+  cmd->add_option("step", args->step, "intrinsics, viewport, laser, laser_viewport or mems")
+      ->required();
   cmd->add_option("dataset", args->dataset, "dataset folder (manifest.yaml + images)")->required();
-  cmd->add_option("-o,--output", args->output, "calibration file to write (a scanner YAML with a calibration record)")
+  cmd->add_option("-o,--output", args->output,
+                  "calibration file to write (a scanner YAML with a calibration record)")
       ->required();
   cmd->add_option("--from", args->from,
-                  "scanner file to start from (CAD values or an earlier step's output; default: the manifest's)");
+                  "scanner file to start from (CAD values or an earlier step's output; default: "
+                  "the manifest's)");
   cmd->add_flag("--refine-thickness", args->options.refine_thickness,
                 "viewport steps: also estimate the viewport thickness (weakly observable)");
   cmd->add_flag("--refine-water-index", args->options.refine_water_index,

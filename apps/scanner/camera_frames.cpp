@@ -16,8 +16,10 @@ namespace uwscan::app {
 namespace acq = scanner::acquisition;
 
 void AddCameraOptions(CLI::App& cmd, CameraArgs& a) {
-  cmd.add_option("--camera", a.camera, "camera IPv4 address (opened directly, never discovered)")->required();
-  cmd.add_option("--scene", a.scene, "simulated camera: the scene it serves (scanner and scan pattern)")
+  cmd.add_option("--camera", a.camera, "camera IPv4 address (opened directly, never discovered)")
+      ->required();
+  cmd.add_option("--scene", a.scene,
+                 "simulated camera: the scene it serves (scanner and scan pattern)")
       ->check(CLI::ExistingFile);
   cmd.add_option("--scanner", a.scanner_file, "real camera: the scanner (calibration) file")
       ->check(CLI::ExistingFile);
@@ -25,19 +27,24 @@ void AddCameraOptions(CLI::App& cmd, CameraArgs& a) {
       ->capture_default_str();
   cmd.add_option("--trigger", a.trigger, "free, software or line (Line0)")->capture_default_str();
   cmd.add_option("--pixel-format", a.pixel_format, "mono8 or mono16 (default: the camera's)");
-  cmd.add_option("--packet-size", a.packet_size, "GigE Vision packet size, bytes (default: the camera's)");
+  cmd.add_option("--packet-size", a.packet_size,
+                 "GigE Vision packet size, bytes (default: the camera's)");
   cmd.add_option("--fps", a.fps, "frame rate in free run (default: the camera's)");
-  cmd.add_option("--exposure-us", a.exposure_us, "exposure time, microseconds (default: the camera's)");
+  cmd.add_option("--exposure-us", a.exposure_us,
+                 "exposure time, microseconds (default: the camera's)");
   cmd.add_option("--gain", a.gain, "gain, camera units (default: the camera's)");
   cmd.add_option("--roi", a.roi, "region of interest x,y,width,height (pixels)")->delimiter(',');
-  cmd.add_option("--buffers", a.buffers, "Aravis buffers (frames the driver holds)")->capture_default_str();
-  cmd.add_option("--watchdog-s", a.watchdog_s, "reopen a camera silent this long, seconds")->capture_default_str();
+  cmd.add_option("--buffers", a.buffers, "Aravis buffers (frames the driver holds)")
+      ->capture_default_str();
+  cmd.add_option("--watchdog-s", a.watchdog_s, "reopen a camera silent this long, seconds")
+      ->capture_default_str();
 }
 
 acq::CameraSettings MakeCameraSettings(const CameraArgs& a) {
   if (a.scene.empty() == a.scanner_file.empty()) {
-    throw Error("give --scene (a simulated camera: the scene's scanner and scan pattern) or --scanner "
-                "(the scanner file of a real camera)");
+    throw Error(
+        "give --scene (a simulated camera: the scene's scanner and scan pattern) or --scanner "
+        "(the scanner file of a real camera)");
   }
   acq::CameraSettings settings;
   settings.address = a.camera;
@@ -47,9 +54,12 @@ acq::CameraSettings MakeCameraSettings(const CameraArgs& a) {
   const std::optional<acq::TriggerMode> trigger = acq::TriggerModeFromString(a.trigger);
   if (!trigger) throw Error("--trigger: unknown '" + a.trigger + "' (use free, software or line)");
   settings.trigger = *trigger;
-  if (a.pixel_format == "mono8") settings.pixel_format = scanner::PixelFormat::kMono8;
-  else if (a.pixel_format == "mono16") settings.pixel_format = scanner::PixelFormat::kMono16;
-  else if (!a.pixel_format.empty()) throw Error("--pixel-format: unknown '" + a.pixel_format + "' (use mono8 or mono16)");
+  if (a.pixel_format == "mono8")
+    settings.pixel_format = scanner::PixelFormat::kMono8;
+  else if (a.pixel_format == "mono16")
+    settings.pixel_format = scanner::PixelFormat::kMono16;
+  else if (!a.pixel_format.empty())
+    throw Error("--pixel-format: unknown '" + a.pixel_format + "' (use mono8 or mono16)");
   if (!a.roi.empty()) {
     if (a.roi.size() != 4) throw Error("--roi: expected x,y,width,height");
     settings.roi_x_px = a.roi[0];
@@ -70,19 +80,22 @@ acq::CameraSettings MakeCameraSettings(const CameraArgs& a) {
 AcquisitionContext MakeContext(const CameraArgs& a, const acq::PayloadDescription& payload,
                                const std::string& command) {
   if (a.scene.empty() == a.scanner_file.empty()) {
-    throw Error("give --scene (a simulated camera: the scene's scanner and scan pattern) or --scanner "
-                "(the scanner file of a real camera)");
+    throw Error(
+        "give --scene (a simulated camera: the scene's scanner and scan pattern) or --scanner "
+        "(the scanner file of a real camera)");
   }
   return mapping::MakeAcquisitionContext(a.scene, a.scanner_file, payload,
-                                         "uwscan " + command + " " + UWSCAN_VERSION + " (camera " + a.camera +
-                                             ", " + payload.vendor + " " + payload.model + ")");
+                                         "uwscan " + command + " " + UWSCAN_VERSION + " (camera " +
+                                             a.camera + ", " + payload.vendor + " " +
+                                             payload.model + ")");
 }
 
 void CheckNewLogPath(const std::string& path, bool force, const std::string& option) {
   CheckOutputPath(path, option);
   if (std::filesystem::exists(path)) {
     if (!force) throw Error(path + ": exists (a dive log is never overwritten; use --force)");
-    if (!std::filesystem::is_regular_file(path)) throw Error(path + ": exists and is not a file; not replaced");
+    if (!std::filesystem::is_regular_file(path))
+      throw Error(path + ": exists and is not a file; not replaced");
   }
 }
 
@@ -92,22 +105,28 @@ void RemoveLog(const std::string& path) {
   std::filesystem::remove(path + "-shm");
 }
 
-ReadSummary ReadFrames(acq::FrameSource& source, CameraFrameDecoder& decoder, const ReadLimits& limits,
-                       const std::string& name,
-                       const std::function<void(mapping::FrameRecord&&, const acq::AcquiredFrame&)>& consume,
-                       const std::function<void(const ReadSummary&, double now_s)>& status) {
+ReadSummary ReadFrames(
+    acq::FrameSource& source, CameraFrameDecoder& decoder, const ReadLimits& limits,
+    const std::string& name,
+    const std::function<void(mapping::FrameRecord&&, const acq::AcquiredFrame&)>& consume,
+    const std::function<void(const ReadSummary&, double now_s)>& status) {
   mapping::ReadCallbacks callbacks;
   callbacks.consume = consume;
   if (status) {
-    callbacks.status = [&status](const mapping::ReadSummary& s, double now) { status(ReadSummary{s, 0}, now); };
+    callbacks.status = [&status](const mapping::ReadSummary& s, double now) {
+      status(ReadSummary{s, 0}, now);
+    };
   }
   callbacks.gap = [&name](const acq::CameraGap& g) {
     if (g.resumed_at_s >= 0.0) {
-      std::fprintf(stderr, "%s%s: camera silent after %.2f s; reopened (%d attempts), frames again at %.2f s\n",
-                   isatty(2) ? "\n" : "", name.c_str(), g.silent_after_s, g.reopen_attempts, g.resumed_at_s);
+      std::fprintf(
+          stderr,
+          "%s%s: camera silent after %.2f s; reopened (%d attempts), frames again at %.2f s\n",
+          isatty(2) ? "\n" : "", name.c_str(), g.silent_after_s, g.reopen_attempts, g.resumed_at_s);
     } else {
-      std::fprintf(stderr, "%s: camera silent since %.2f s (%d reopen attempts), not back when stopped\n", name.c_str(),
-                   g.silent_after_s, g.reopen_attempts);
+      std::fprintf(stderr,
+                   "%s: camera silent since %.2f s (%d reopen attempts), not back when stopped\n",
+                   name.c_str(), g.silent_after_s, g.reopen_attempts);
     }
   };
   callbacks.stop_requested = [] { return StopRequested(); };

@@ -52,7 +52,8 @@ using mapping::ToInspectionFrame;
 
 // `command`: "acquire", "inspect" (the log's producer names it). Throws uwscan::Error when the
 // scene or the scanner file cannot be read.
-AcquisitionContext MakeContext(const CameraArgs& args, const scanner::acquisition::PayloadDescription& payload,
+AcquisitionContext MakeContext(const CameraArgs& args,
+                               const scanner::acquisition::PayloadDescription& payload,
                                const std::string& command);
 
 // A new dive log's path, checked before the camera is opened: its folder exists; an existing
@@ -69,9 +70,11 @@ struct ReadSummary : mapping::ReadSummary {
 
 // mapping::ReadFrames until the limits or a stop signal (stop_signal.hpp); camera gaps (watchdog
 // reopens) reported on stderr, prefixed by `name`.
-ReadSummary ReadFrames(scanner::acquisition::FrameSource& source, CameraFrameDecoder& decoder,
-                       const ReadLimits& limits, const std::string& name,
-                       const std::function<void(mapping::FrameRecord&&, const scanner::acquisition::AcquiredFrame&)>& consume,
-                       const std::function<void(const ReadSummary&, double now_s)>& status);
+ReadSummary ReadFrames(
+    scanner::acquisition::FrameSource& source, CameraFrameDecoder& decoder,
+    const ReadLimits& limits, const std::string& name,
+    const std::function<void(mapping::FrameRecord&&, const scanner::acquisition::AcquiredFrame&)>&
+        consume,
+    const std::function<void(const ReadSummary&, double now_s)>& status);
 
 }  // namespace uwscan::app

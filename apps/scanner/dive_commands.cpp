@@ -51,20 +51,24 @@ void RunSimulateCalibration(const SimulateArgs& a) {
   // A dataset is a folder: an existing one is checked below; a new one needs a writable parent.
   if (!std::filesystem::exists(a.output)) CheckOutputPath(a.output, "-o", {a.scene});
   if (std::filesystem::exists(a.output)) {
-    if (!a.force) throw Error(a.output + ": exists (a dataset folder is never overwritten; use --force)");
+    if (!a.force)
+      throw Error(a.output + ": exists (a dataset folder is never overwritten; use --force)");
     // --force replaces a dataset, never an arbitrary folder.
     if (!std::filesystem::is_regular_file(std::filesystem::path(a.output) / "manifest.yaml")) {
-      throw Error(a.output + ": exists and is not a calibration dataset (no manifest.yaml); not replaced");
+      throw Error(a.output +
+                  ": exists and is not a calibration dataset (no manifest.yaml); not replaced");
     }
-    scanner::calibration::LoadCalibrationScene(a.scene);  // a bad scene fails before anything is removed
+    scanner::calibration::LoadCalibrationScene(
+        a.scene);  // a bad scene fails before anything is removed
     std::filesystem::remove_all(a.output);
   }
   {
     ProgressBar bar;
-    scanner::calibration::SimulateCalibrationDataset(a.scene, a.output,
-                                                     [&bar](double f) { bar.Update("simulate", f); });
+    scanner::calibration::SimulateCalibrationDataset(
+        a.scene, a.output, [&bar](double f) { bar.Update("simulate", f); });
   }
-  std::printf("%s: calibration dataset written (manifest.yaml, images, truth.yaml)\n", a.output.c_str());
+  std::printf("%s: calibration dataset written (manifest.yaml, images, truth.yaml)\n",
+              a.output.c_str());
 }
 
 void RunSimulate(const SimulateArgs& a) {
@@ -96,7 +100,8 @@ void RunSimulate(const SimulateArgs& a) {
     summary = mapping::SimulateDive(simulator, ReadText(a.scene), partial, options,
                                     [&bar](double f) { bar.Update("simulate", f); });
     // A stray WAL of an earlier log at the output would be replayed into the new one.
-    for (const char* suffix : {"-wal", "-shm", "-journal"}) std::filesystem::remove(a.output + suffix);
+    for (const char* suffix : {"-wal", "-shm", "-journal"})
+      std::filesystem::remove(a.output + suffix);
     ReplaceWithTemporary(partial, a.output);
   } catch (...) {
     std::error_code ignored;
@@ -131,7 +136,8 @@ void RunReconstruct(const ReconstructArgs& a) {
   mapping::ReconstructionOptions options;
   if (!a.method.empty()) {
     options.method = scanner::ParseTriangulationMethod(a.method);
-    if (!options.method) throw Error("--method: unknown '" + a.method + "' (use plane, cone or ray)");
+    if (!options.method)
+      throw Error("--method: unknown '" + a.method + "' (use plane, cone or ray)");
   }
   options.use_navigation = !a.scanner_frame;
   if (!a.no_table_cache) options.table_cache = TableCache();
@@ -146,7 +152,8 @@ void RunReconstruct(const ReconstructArgs& a) {
   }
   if (r.points.empty()) throw Error(a.log + ": no frame gave a point; nothing to write");
   perception::WriteCloud(a.output, perception::MakeCloud(r.points), !a.ascii);
-  const double rate = r.triangulation_seconds > 0.0 ? r.points.size() / r.triangulation_seconds : 0.0;
+  const double rate =
+      r.triangulation_seconds > 0.0 ? r.points.size() / r.triangulation_seconds : 0.0;
   std::printf("%s: %zu points from %lld frames (%lld peaks), %s, %s frame\n", a.output.c_str(),
               r.points.size(), static_cast<long long>(r.frames), static_cast<long long>(r.peaks),
               scanner::ToString(r.method), r.world_frame ? "world" : "scanner");
@@ -160,11 +167,16 @@ void RunReconstruct(const ReconstructArgs& a) {
                          {"table_seconds", r.table_seconds},
                          {"triangulation_seconds", r.triangulation_seconds}};
   if (const std::optional<mapping::TruthError> e = mapping::CompareToTruth(r)) {
-    std::printf("error against ground truth (%lld points): mean %.4g mm, std %.4g mm, rms %.4g mm, max %.4g mm\n",
-                static_cast<long long>(e->points), e->mean_m * 1e3, e->std_m * 1e3,
-                e->rms_m * 1e3, e->max_m * 1e3);
-    json["truth_error"] = {{"points", e->points}, {"mean_m", e->mean_m}, {"std_m", e->std_m},
-                           {"rms_m", e->rms_m}, {"max_m", e->max_m}};
+    std::printf(
+        "error against ground truth (%lld points): mean %.4g mm, std %.4g mm, rms %.4g mm, max "
+        "%.4g mm\n",
+        static_cast<long long>(e->points), e->mean_m * 1e3, e->std_m * 1e3, e->rms_m * 1e3,
+        e->max_m * 1e3);
+    json["truth_error"] = {{"points", e->points},
+                           {"mean_m", e->mean_m},
+                           {"std_m", e->std_m},
+                           {"rms_m", e->rms_m},
+                           {"max_m", e->max_m}};
   }
   if (!a.json.empty()) WriteJsonFile(a.json, json);
 }
@@ -173,11 +185,15 @@ void RunReconstruct(const ReconstructArgs& a) {
 
 void AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "simulate", "simulate a scene into a new dive log (SQLite), or a calibration scene into a dataset folder");
-  cmd->add_option("scene", args->scene, "scene YAML (data/scenes/*.yaml)")->required()->check(CLI::ExistingFile);
+  CLI::App* cmd = app.add_subcommand("simulate",
+                                     "simulate a scene into a new dive log (SQLite), or a "
+                                     "calibration scene into a dataset folder");
+  cmd->add_option("scene", args->scene, "scene YAML (data/scenes/*.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output, "dive log to create (.db)")->required();
-  cmd->add_flag("--images", args->images, "store the rendered frames in the log (image effects on)");
+  cmd->add_flag("--images", args->images,
+                "store the rendered frames in the log (image effects on)");
   cmd->add_flag("--force", args->force, "replace an existing log at the output path");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
       ->check(kNonNegativeNumber);
@@ -192,15 +208,17 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_option("--method", args->method,
                   "plane, cone or ray (default: cone for the galvanometer, plane for MEMS)");
   cmd->add_option("--json", args->json, "also write the figures as JSON");
-  cmd->add_option("--calibration", args->calibration,
-                  "calibration file (from `calibrate`) to triangulate with instead of the log's scanner")
+  cmd->add_option(
+         "--calibration", args->calibration,
+         "calibration file (from `calibrate`) to triangulate with instead of the log's scanner")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--ascii", args->ascii, "write an ASCII cloud instead of binary");
   cmd->add_flag("--scanner-frame", args->scanner_frame,
                 "keep points in the camera frame even when the log has navigation");
-  cmd->add_flag("--no-table-cache", args->no_table_cache,
-                "fit the cone table again instead of reusing the one kept for this calibration "
-                "($UWSCAN_TABLE_CACHE, else $XDG_CACHE_HOME/uwscan/tables, else ~/.cache/uwscan/tables)");
+  cmd->add_flag(
+      "--no-table-cache", args->no_table_cache,
+      "fit the cone table again instead of reusing the one kept for this calibration "
+      "($UWSCAN_TABLE_CACHE, else $XDG_CACHE_HOME/uwscan/tables, else ~/.cache/uwscan/tables)");
   cmd->callback([args] { RunReconstruct(*args); });
 }
 

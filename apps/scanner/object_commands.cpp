@@ -173,23 +173,20 @@ void AddMakeObjectCommand(CLI::App& app) {
       ->check(kObjectLengthMetres);
   cmd->add_option("--radius-m", a->radius_m, "sphere or cylinder radius; pipe outer radius")
       ->check(kObjectLengthMetres);
-  cmd->add_option("--wall-m", a->wall_m, "pipe wall thickness")
-      ->check(kObjectLengthMetres);
+  cmd->add_option("--wall-m", a->wall_m, "pipe wall thickness")->check(kObjectLengthMetres);
   cmd->add_option("--size-m", a->size_m, "plane: X Y; box: X Y Z")
       ->expected(2, 3)
       ->check(kObjectLengthMetres);
   cmd->add_option("--bend-radius-m", a->bend_radius_m, "elbow: radius of the centre line's bend")
       ->check(kObjectLengthMetres);
   cmd->add_option("--bend-angle-rad", a->bend_angle_rad, "elbow: bend angle");
-  cmd->add_option("--branch-length-m", a->branch_length_m,
-                  "tee: branch length from the run's axis")
+  cmd->add_option("--branch-length-m", a->branch_length_m, "tee: branch length from the run's axis")
       ->check(kObjectLengthMetres);
   cmd->add_option("--flange-radius-m", a->flange_radius_m, "flange: outer radius of the disc")
       ->check(kObjectLengthMetres);
   cmd->add_option("--flange-thickness-m", a->flange_thickness_m, "flange: thickness of the disc")
       ->check(kObjectLengthMetres);
-  cmd->add_option("--bolts", a->bolts, "flange: number of bolt heads")
-      ->check(kNonNegativeNumber);
+  cmd->add_option("--bolts", a->bolts, "flange: number of bolt heads")->check(kNonNegativeNumber);
   cmd->add_option("--handle", a->handle, "valve: wheel or lever")
       ->check(CLI::IsMember({"wheel", "lever"}));
   cmd->add_option("--handle-radius-m", a->handle_radius_m, "valve: wheel radius or lever reach")

@@ -35,7 +35,8 @@ constexpr int kPanelHeightPx = 560;
 // Writes the charts of a bench JSON; returns which bench it was.
 std::string PlotFile(const fs::path& json, const fs::path& png) {
   const viewer::BenchPlots plots = viewer::ReadBenchPlots(json);
-  viewer::SavePlotsPng(plots.plots, png, kPanelWidthPx * static_cast<int>(plots.plots.size()), kPanelHeightPx);
+  viewer::SavePlotsPng(plots.plots, png, kPanelWidthPx * static_cast<int>(plots.plots.size()),
+                       kPanelHeightPx);
   return plots.bench;
 }
 
@@ -88,7 +89,8 @@ std::pair<int, std::string> RunSelf(const std::string& arguments) {
   if (pipe == nullptr) throw Error("report: cannot start " + command);
   std::string output;
   std::array<char, 4096> buffer;
-  while (const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  while (const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe))
+    output.append(buffer.data(), n);
   const int status = pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
@@ -102,23 +104,27 @@ struct ReportArgs {
 void RunReport(const ReportArgs& a) {
   viewer::RequireDisplay();
   fs::create_directories(a.output);
-  std::string index = "# uwscan trade-offs\n\nEach section: the bench's quick form (`uwscan report`), its table "
-                      "as the bench printed it, and its chart (`uwscan plot`).\n";
+  std::string index =
+      "# uwscan trade-offs\n\nEach section: the bench's quick form (`uwscan report`), its table "
+      "as the bench printed it, and its chart (`uwscan plot`).\n";
   int failed = 0;
   for (const BenchRun& bench : QuickBenches(a.data)) {
-    if (!a.only.empty() && std::find(a.only.begin(), a.only.end(), bench.name) == a.only.end()) continue;
+    if (!a.only.empty() && std::find(a.only.begin(), a.only.end(), bench.name) == a.only.end())
+      continue;
     const fs::path json = fs::path(a.output) / (bench.name + ".json");
     const fs::path png = fs::path(a.output) / (bench.name + ".png");
     const std::string arguments = "bench " + bench.arguments + " --json " + Quoted(json.string());
     std::fprintf(stderr, "report: uwscan %s\n", arguments.c_str());
     const auto start = std::chrono::steady_clock::now();
     const auto [code, output] = RunSelf(arguments);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     index += "\n## " + bench.name + "\n\n`uwscan bench " + bench.arguments + "` (" +
              std::to_string(static_cast<int>(std::lround(seconds))) + " s)\n\n";
     std::string failure;
     if (code != 0) {
-      failure = output.empty() ? "exit code " + std::to_string(code) : output.substr(0, output.find_last_not_of('\n') + 1);
+      failure = output.empty() ? "exit code " + std::to_string(code)
+                               : output.substr(0, output.find_last_not_of('\n') + 1);
     } else {
       try {
         PlotFile(json, png);
@@ -133,7 +139,8 @@ void RunReport(const ReportArgs& a) {
       index += "**Not drawn**: " + failure + "\n";
       ++failed;
     }
-    std::printf("%s: %s (%.0f s)\n", bench.name.c_str(), failure.empty() ? png.string().c_str() : "failed", seconds);
+    std::printf("%s: %s (%.0f s)\n", bench.name.c_str(),
+                failure.empty() ? png.string().c_str() : "failed", seconds);
   }
   const fs::path index_path = fs::path(a.output) / "index.md";
   {
@@ -142,7 +149,9 @@ void RunReport(const ReportArgs& a) {
     if (!out.flush()) throw Error(index_path.string() + ": cannot write");
   }
   std::printf("%s: written\n", index_path.string().c_str());
-  if (failed > 0) throw Error("report: " + std::to_string(failed) + " bench(es) failed; see " + index_path.string());
+  if (failed > 0)
+    throw Error("report: " + std::to_string(failed) + " bench(es) failed; see " +
+                index_path.string());
 }
 
 struct ViewerBenchArgs {
@@ -163,14 +172,16 @@ void RunViewerBench(const ViewerBenchArgs& a) {
     ProgressBar bar;
     rows = viewer::RunViewerBenchmark(o, [&bar](double f) { bar.Update("render", f); });
   }
-  std::printf("Viewer, %dx%d offscreen, vtkPointGaussianMapper points coloured by height%s\n\n", o.width_px,
-              o.height_px, o.eye_dome_lighting ? ", Eye-Dome Lighting" : "");
-  std::printf("| points | first picture s | per frame s (median) | fastest frame s | RSS MB | held by the view MB |\n");
+  std::printf("Viewer, %dx%d offscreen, vtkPointGaussianMapper points coloured by height%s\n\n",
+              o.width_px, o.height_px, o.eye_dome_lighting ? ", Eye-Dome Lighting" : "");
+  std::printf(
+      "| points | first picture s | per frame s (median) | fastest frame s | RSS MB | held by the "
+      "view MB |\n");
   std::printf("|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json json_rows = nlohmann::json::array();
   for (const viewer::ViewerBenchRow& r : rows) {
-    std::printf("| %zu | %.3f | %.3f | %.3f | %.0f | %.0f |\n", r.points, r.first_picture_s, r.frame_s, r.frame_min_s,
-                r.rss_shown_mb, r.held_mb());
+    std::printf("| %zu | %.3f | %.3f | %.3f | %.0f | %.0f |\n", r.points, r.first_picture_s,
+                r.frame_s, r.frame_min_s, r.rss_shown_mb, r.held_mb());
     json_rows.push_back({{"points", r.points},
                          {"first_picture_s", r.first_picture_s},
                          {"frame_s", r.frame_s},
@@ -191,8 +202,11 @@ void RunViewerBench(const ViewerBenchArgs& a) {
 
 void AddPlotCommand(CLI::App& app) {
   auto a = std::make_shared<PlotArgs>();
-  CLI::App* cmd = app.add_subcommand("plot", "draw a bench's JSON (uwscan bench NAME --json) as trade-off charts");
-  cmd->add_option("report", a->report, "JSON written by `uwscan bench ... --json`")->required()->check(CLI::ExistingFile);
+  CLI::App* cmd = app.add_subcommand(
+      "plot", "draw a bench's JSON (uwscan bench NAME --json) as trade-off charts");
+  cmd->add_option("report", a->report, "JSON written by `uwscan bench ... --json`")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", a->output, "PNG to write")->required();
   cmd->callback([a] { RunPlot(*a); });
 }
@@ -200,21 +214,24 @@ void AddPlotCommand(CLI::App& app) {
 void AddReportCommand(CLI::App& app) {
   auto a = std::make_shared<ReportArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "report", "run the benches in their quick forms; write DIR/index.md with each table and its chart");
+      "report",
+      "run the benches in their quick forms; write DIR/index.md with each table and its chart");
   cmd->add_option("-o,--output", a->output, "folder to write (created)")->required();
   cmd->add_option(
       "--data", a->data,
       "the data folder (scanners, scenes) of the accuracy, calibration and slam benches "
       "(default: `uwscan --data-dir`)");
-  cmd->add_option("--only", a->only, "only these benches (triangulation stripe deformation accuracy calibration "
-                                     "registration recognition slam viewer)");
+  cmd->add_option("--only", a->only,
+                  "only these benches (triangulation stripe deformation accuracy calibration "
+                  "registration recognition slam viewer)");
   cmd->callback([a] { RunReport(*a); });
 }
 
 void AddViewerBenchCommand(CLI::App& bench) {
   auto a = std::make_shared<ViewerBenchArgs>();
   CLI::App* cmd = bench.add_subcommand(
-      "viewer", "time to the first picture and per frame, and memory, for big clouds (needs an X display)");
+      "viewer",
+      "time to the first picture and per frame, and memory, for big clouds (needs an X display)");
   cmd->add_option("--points", a->points, "point counts (default 1000000 5000000)");
   cmd->add_option("--frames", a->frames, "frames timed per count")->check(kPositiveNumber);
   cmd->add_flag("--edl", a->edl, "with Eye-Dome Lighting");

@@ -65,7 +65,8 @@ std::pair<int, int> ParseSize(const std::string& text) {
 
 bool ShowsARecognitionReport(const ViewArgs& a) {
   for (const std::string& file : a.files) {
-    if (std::filesystem::path(file).extension() == ".json" && std::filesystem::is_regular_file(file) &&
+    if (std::filesystem::path(file).extension() == ".json" &&
+        std::filesystem::is_regular_file(file) &&
         viewer::KindOfFile(file) == viewer::FileKind::kRecognitionReport) {
       return true;
     }
@@ -78,8 +79,8 @@ viewer::RenderOptions RenderOptionsFrom(const ViewArgs& a) {
   // A recognition report's scan is in the sensor's frame (y down): by default it is coloured by
   // object (a segment and its model share a colour) and shown upright as the sensor saw it.
   const bool recognition = ShowsARecognitionReport(a);
-  const std::string colour_name = !a.colour.empty() ? a.colour
-                                  : recognition     ? "object"
+  const std::string colour_name = !a.colour.empty()  ? a.colour
+                                  : recognition      ? "object"
                                   : !a.scene.empty() ? "error"
                                                      : "height";
   const std::optional<viewer::ColourMode> colour = viewer::ParseColourMode(colour_name);
@@ -102,7 +103,8 @@ viewer::RenderOptions RenderOptionsFrom(const ViewArgs& a) {
   try {
     o.Check();
   } catch (const Error& e) {
-    throw Error(std::string(e.what()) + " (check --range, --point-size, --size, --max-points, --up)");
+    throw Error(std::string(e.what()) +
+                " (check --range, --point-size, --size, --max-points, --up)");
   }
   return o;
 }
@@ -125,7 +127,8 @@ void RunFollow(const ViewArgs& a, const viewer::RenderOptions& render) {
   live.decay_s = a.decay_s;
   live.offscreen = !a.screenshot.empty();
   if (live.offscreen && a.frames <= 0 && a.timeout_s <= 0.0) {
-    throw Error("--follow --screenshot: say when to take the picture with --frames N (or --timeout S)");
+    throw Error(
+        "--follow --screenshot: say when to take the picture with --frames N (or --timeout S)");
   }
   viewer::LiveView view(live);
   if (!a.screenshot.empty()) view.SetFinalScreenshot(a.screenshot);
@@ -141,31 +144,39 @@ void RunFollow(const ViewArgs& a, const viewer::RenderOptions& render) {
   }
   if (!status.error.empty()) throw Error(status.error);
   const viewer::LiveViewStats stats = view.stats();
-  std::printf("%s: followed %lld frames, %lld points (%zu held, %lld clouds dropped by the budget or decay)\n",
-              a.files[0].c_str(), static_cast<long long>(status.frames), static_cast<long long>(status.points),
-              stats.points_held, static_cast<long long>(stats.clouds_dropped));
+  std::printf(
+      "%s: followed %lld frames, %lld points (%zu held, %lld clouds dropped by the budget or "
+      "decay)\n",
+      a.files[0].c_str(), static_cast<long long>(status.frames),
+      static_cast<long long>(status.points), stats.points_held,
+      static_cast<long long>(stats.clouds_dropped));
   if (!a.screenshot.empty()) std::printf("%s: written\n", a.screenshot.c_str());
 }
 
 // A scene alone: its objects' surfaces, each where the scene places it.
-void AddSceneObjects(const scanner::sim::Scene& loaded, const std::string& file, viewer::Scene& scene) {
+void AddSceneObjects(const scanner::sim::Scene& loaded, const std::string& file,
+                     viewer::Scene& scene) {
   std::size_t spheres = 0;
   for (const scanner::sim::SceneObject& object : loaded.objects) {
-    if (object.shape == scanner::sim::ObjectShape::kSphere) {  // ray cast exactly: it has no triangles
+    if (object.shape ==
+        scanner::sim::ObjectShape::kSphere) {  // ray cast exactly: it has no triangles
       ++spheres;
       continue;
     }
     scene.meshes.push_back({object.name, object.mesh, object.T_W_O});
   }
-  if (scene.meshes.empty()) throw Error(file + ": no object with a surface to draw (spheres are not drawn)");
-  std::printf("%s: %zu object%s drawn", file.c_str(), scene.meshes.size(), scene.meshes.size() == 1 ? "" : "s");
+  if (scene.meshes.empty())
+    throw Error(file + ": no object with a surface to draw (spheres are not drawn)");
+  std::printf("%s: %zu object%s drawn", file.c_str(), scene.meshes.size(),
+              scene.meshes.size() == 1 ? "" : "s");
   if (spheres > 0) std::printf(" (%zu sphere%s not drawn)", spheres, spheres == 1 ? "" : "s");
   std::printf("\n");
 }
 
 void RunView(const ViewArgs& a) {
   if (a.files.empty() && a.scene.empty()) {
-    throw CLI::RequiredError("files to show (or --scene SCENE.yaml alone, to show a scene's objects)");
+    throw CLI::RequiredError(
+        "files to show (or --scene SCENE.yaml alone, to show a scene's objects)");
   }
   const viewer::RenderOptions render = RenderOptionsFrom(a);
   if (!a.screenshot.empty()) {  // before minutes of reading and reconstructing, not after
@@ -175,7 +186,8 @@ void RunView(const ViewArgs& a) {
   }
   viewer::RequireDisplay();  // so is the display
   if (a.follow) {
-    if (!a.scene.empty()) throw Error("--scene: not with --follow (a followed log carries its own truth)");
+    if (!a.scene.empty())
+      throw Error("--scene: not with --follow (a followed log carries its own truth)");
     return RunFollow(a, render);
   }
   viewer::Scene scene;
@@ -187,7 +199,9 @@ void RunView(const ViewArgs& a) {
       const viewer::DiveLogSummary s = viewer::AddDiveLog(file, log_options, scene);
       std::printf("%s: %zu points from %lld frames, %s frame%s\n", file.c_str(), s.points,
                   static_cast<long long>(s.frames), s.world_frame ? "world" : "camera",
-                  s.has_truth ? (", mean error against truth " + std::to_string(s.truth_mean_error_m * 1e3) + " mm").c_str()
+                  s.has_truth ? (", mean error against truth " +
+                                 std::to_string(s.truth_mean_error_m * 1e3) + " mm")
+                                    .c_str()
                               : "");
     } else {
       viewer::AddFile(file, log_options, map_drawing, scene);
@@ -200,9 +214,11 @@ void RunView(const ViewArgs& a) {
     const std::size_t filled = viewer::SetSurfaceError(truth, kSurfaceSearch_m, scene);
     const std::size_t own = scene.clouds.size() - filled;
     const std::string kept =
-        own == 0 ? "" : ", " + std::to_string(own) + " keep the error they carry (a simulated log's, from its truth)";
-    std::printf("%s: %zu cloud%s coloured by the distance to its surfaces%s\n", a.scene.c_str(), filled,
-                filled == 1 ? "" : "s", kept.c_str());
+        own == 0 ? ""
+                 : ", " + std::to_string(own) +
+                       " keep the error they carry (a simulated log's, from its truth)";
+    std::printf("%s: %zu cloud%s coloured by the distance to its surfaces%s\n", a.scene.c_str(),
+                filled, filled == 1 ? "" : "s", kept.c_str());
   }
   if (a.screenshot.empty()) {
     viewer::ShowScene(scene, render, "uwscan view");
@@ -223,35 +239,46 @@ void RunView(const ViewArgs& a) {
 void AddViewCommand(CLI::App& app) {
   auto a = std::make_shared<ViewArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "view", std::string("show clouds (.ply .pcd .xyz), meshes (.ply .off .stl .obj), TUM trajectories "
-                          "(.txt .tum), dive logs (.db), map and recognition reports (.json); keys: ") + viewer::kViewKeys);
+      "view",
+      std::string("show clouds (.ply .pcd .xyz), meshes (.ply .off .stl .obj), TUM trajectories "
+                  "(.txt .tum), dive logs (.db), map and recognition reports (.json); keys: ") +
+          viewer::kViewKeys);
   cmd->add_option("files", a->files, "files to show (none with --scene: the scene's objects)");
-  cmd->add_option("--colour,--color", a->colour,
-                  "height, error (simulated dive logs, or clouds given --scene), intensity or object (default: "
-                  "object with a recognition report, error with --scene, else height)");
-  cmd->add_option("--range", a->range, "fixed colour range LOW HIGH (metres for height and error)")->expected(2);
+  cmd->add_option(
+      "--colour,--color", a->colour,
+      "height, error (simulated dive logs, or clouds given --scene), intensity or object (default: "
+      "object with a recognition report, error with --scene, else height)");
+  cmd->add_option("--range", a->range, "fixed colour range LOW HIGH (metres for height and error)")
+      ->expected(2);
   cmd->add_option("--point-size", a->point_size_px, "point size in pixels");
-  cmd->add_flag("--edl", a->edl, "Eye-Dome Lighting: shades points by depth so shapes read without colour");
+  cmd->add_flag("--edl", a->edl,
+                "Eye-Dome Lighting: shades points by depth so shapes read without colour");
   cmd->add_option("--camera", a->camera, "fit, top or side");
   cmd->add_option("--size", a->size, "window or picture size WIDTHxHEIGHT (default 1280x960)");
   cmd->add_option("--max-points", a->max_points,
                   "point budget: above it every k-th point is drawn; with --follow, points held");
-  cmd->add_option("--up", a->up,
-                  "the world's up direction X Y Z (default 0 0 -1: NED; 0 -1 0 with a recognition report, "
-                  "whose scan is in the sensor's frame)")
+  cmd->add_option(
+         "--up", a->up,
+         "the world's up direction X Y Z (default 0 0 -1: NED; 0 -1 0 with a recognition report, "
+         "whose scan is in the sensor's frame)")
       ->expected(3);
   cmd->add_option("--method", a->method, "dive logs: plane, cone or ray (default: the scanner's)");
   cmd->add_option("--scene", a->scene,
-                  "a simulated scene (.yaml): colour the clouds (e.g. a map of a dive simulated from it) by their "
+                  "a simulated scene (.yaml): colour the clouds (e.g. a map of a dive simulated "
+                  "from it) by their "
                   "distance to its true surfaces; alone, draw its objects")
       ->check(CLI::ExistingFile);
   cmd->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
   cmd->add_flag("--no-colour-bar", a->no_colour_bar, "no colour bar");
-  cmd->add_option("--ellipsoid-every", a->ellipsoid_every, "map reports: a 3-sigma ellipsoid every N poses")
+  cmd->add_option("--ellipsoid-every", a->ellipsoid_every,
+                  "map reports: a 3-sigma ellipsoid every N poses")
       ->check(kPositiveNumber);
-  cmd->add_flag("--follow", a->follow, "show a dive log while it is written (waits for it to appear)");
-  cmd->add_option("--frames", a->frames, "--follow: stop once the log holds N frames")->check(kNonNegativeNumber);
-  cmd->add_option("--timeout", a->timeout_s, "--follow: fail after S seconds without the log or a new frame")
+  cmd->add_flag("--follow", a->follow,
+                "show a dive log while it is written (waits for it to appear)");
+  cmd->add_option("--frames", a->frames, "--follow: stop once the log holds N frames")
+      ->check(kNonNegativeNumber);
+  cmd->add_option("--timeout", a->timeout_s,
+                  "--follow: fail after S seconds without the log or a new frame")
       ->check(kNonNegativeNumber);
   cmd->add_option("--decay", a->decay_s, "--follow: drop points older than S seconds (0: keep)")
       ->check(kNonNegativeNumber);

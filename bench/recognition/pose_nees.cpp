@@ -4,7 +4,8 @@
 
 namespace uwscan::bench {
 
-std::optional<double> PoseNeesPerPinnedDirection(const Eigen::Isometry3d& T_S_O, const Eigen::Isometry3d& T_S_O_true,
+std::optional<double> PoseNeesPerPinnedDirection(const Eigen::Isometry3d& T_S_O,
+                                                 const Eigen::Isometry3d& T_S_O_true,
                                                  const Eigen::Vector3d& centre_O,
                                                  const Eigen::Matrix<double, 6, 6>& covariance) {
   const Eigen::Isometry3d delta = T_S_O_true.inverse() * T_S_O;

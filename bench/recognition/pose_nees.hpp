@@ -12,7 +12,8 @@ namespace uwscan::bench {
 // The error is the motion x -> x + w x (x - c) + v taking the truth to the estimate, in the
 // object frame, ordered [w (rad), v (m)] as RecognizedObject::covariance is, c = centre_O.
 // nullopt when the covariance pins no direction.
-std::optional<double> PoseNeesPerPinnedDirection(const Eigen::Isometry3d& T_S_O, const Eigen::Isometry3d& T_S_O_true,
+std::optional<double> PoseNeesPerPinnedDirection(const Eigen::Isometry3d& T_S_O,
+                                                 const Eigen::Isometry3d& T_S_O_true,
                                                  const Eigen::Vector3d& centre_O,
                                                  const Eigen::Matrix<double, 6, 6>& covariance);
 

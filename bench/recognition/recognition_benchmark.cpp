@@ -42,7 +42,8 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 // The pose resting an object on the seabed (z = 0, up +z): its y_O up (valve stems), its z_O
 // axis horizontal at `yaw_rad`, at (x, y), lowest vertex on the seabed.
-Eigen::Isometry3d RestingPose(const scanner::TriangleMesh& mesh, double yaw_rad, double x, double y) {
+Eigen::Isometry3d RestingPose(const scanner::TriangleMesh& mesh, double yaw_rad, double x,
+                              double y) {
   Eigen::Matrix3d lay;
   lay << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // x_O -> x, y_O -> z, z_O -> -y
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -87,25 +88,31 @@ Scene MakeScene(int index, const std::vector<perception::ObjectSource>& catalogu
   const std::size_t first = static_cast<std::size_t>(index) % catalogue.size();
   std::vector<std::pair<std::size_t, Eigen::Vector2d>> placed = {{first, {0.0, 0.0}}};
   if (unit(rng) < 0.5) {
-    const std::size_t second = (first + 1 + static_cast<std::size_t>(unit(rng) * (catalogue.size() - 1))) % catalogue.size();
+    const std::size_t second =
+        (first + 1 + static_cast<std::size_t>(unit(rng) * (catalogue.size() - 1))) %
+        catalogue.size();
     const double touching = unit(rng) < 0.33;
-    const double gap = 0.5 * (catalogue[first].mesh.BoundingBoxDiagonal() +
-                              catalogue[second].mesh.BoundingBoxDiagonal()) * (touching ? 0.55 : 1.0);
+    const double gap = 0.5 *
+                       (catalogue[first].mesh.BoundingBoxDiagonal() +
+                        catalogue[second].mesh.BoundingBoxDiagonal()) *
+                       (touching ? 0.55 : 1.0);
     const double angle = 2.0 * std::numbers::pi * unit(rng);
     placed.push_back({second, gap * Eigen::Vector2d(std::cos(angle), std::sin(angle))});
   }
   for (const auto& [k, xy] : placed) {
-    scene.objects.push_back(Object(catalogue[k].id, catalogue[k].mesh,
-                                   RestingPose(catalogue[k].mesh, 2.0 * std::numbers::pi * unit(rng), xy.x(), xy.y())));
+    scene.objects.push_back(
+        Object(catalogue[k].id, catalogue[k].mesh,
+               RestingPose(catalogue[k].mesh, 2.0 * std::numbers::pi * unit(rng), xy.x(), xy.y())));
     scene.classes.push_back(catalogue[k].id);
   }
   if (!foreign.empty()) {
     const scanner::TriangleMesh& mesh = foreign[static_cast<std::size_t>(index) % foreign.size()];
     const double angle = 2.0 * std::numbers::pi * unit(rng);
     const double distance = 0.25 + 0.5 * catalogue[first].mesh.BoundingBoxDiagonal();
-    scene.objects.push_back(Object("foreign", mesh,
-                                   RestingPose(mesh, 2.0 * std::numbers::pi * unit(rng),
-                                               distance * std::cos(angle), distance * std::sin(angle))));
+    scene.objects.push_back(
+        Object("foreign", mesh,
+               RestingPose(mesh, 2.0 * std::numbers::pi * unit(rng), distance * std::cos(angle),
+                           distance * std::sin(angle))));
     scene.classes.push_back("foreign");
   }
   // The camera 0.5-1.5 m from the target, 35-90 degrees above the seabed.
@@ -115,9 +122,10 @@ Scene MakeScene(int index, const std::vector<perception::ObjectSource>& catalogu
   const Eigen::Vector3d target = scene.objects[1].T_W_O.translation();
   const Eigen::Vector3d eye =
       target + range * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
-                                       std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
-  const Eigen::Vector3d up = std::abs(std::sin(elevation)) > 0.99 ? Eigen::Vector3d::UnitX()
-                                                                  : Eigen::Vector3d::UnitZ();
+                                       std::cos(elevation) * std::sin(azimuth),
+                                       std::sin(elevation));
+  const Eigen::Vector3d up =
+      std::abs(std::sin(elevation)) > 0.99 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
   scene.T_W_C = sim::LookAt(eye, target, up);
   return scene;
 }
@@ -125,7 +133,8 @@ Scene MakeScene(int index, const std::vector<perception::ObjectSource>& catalogu
 // The database's models as the peers take them, with the views scanned again for their points.
 std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
                                     const std::vector<perception::ObjectSource>& catalogue,
-                                    const sim::VirtualScanner& scanner, std::uint64_t seed, int threads) {
+                                    const sim::VirtualScanner& scanner, std::uint64_t seed,
+                                    int threads) {
   std::vector<PeerObject> peers(db.objects.size());
   for (std::size_t k = 0; k < db.objects.size(); ++k) {
     peers[k].id = db.objects[k].id;
@@ -136,9 +145,11 @@ std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int v = 0; v < static_cast<int>(views.size()); ++v) {
       const Eigen::Isometry3d T_O_C = db.objects[k].views[static_cast<std::size_t>(v)].T_O_C;
-      const sim::VirtualScan scan = scanner.Scan(scene, T_O_C, seed + static_cast<std::uint64_t>(v));
-      const PointCloud cloud = perception::VoxelDownsample(
-          perception::MakeCloud(scan.points_C), perception::VoxelFilterOptions{db.parameters.voxel_m});
+      const sim::VirtualScan scan =
+          scanner.Scan(scene, T_O_C, seed + static_cast<std::uint64_t>(v));
+      const PointCloud cloud =
+          perception::VoxelDownsample(perception::MakeCloud(scan.points_C),
+                                      perception::VoxelFilterOptions{db.parameters.voxel_m});
       perception::EsfResult esf;
 #pragma omp critical(pcl_esf)
       esf = perception::ComputePclEsf(cloud);  // PCL's ESF uses the global rand()
@@ -156,9 +167,12 @@ std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
 }
 
 // The offset left once the translation along the answer's reported free slides is taken out.
-Eigen::Vector3d OffsetAcrossFreeSlides(Eigen::Vector3d offset, const perception::RecognizedObject& reported) {
+Eigen::Vector3d OffsetAcrossFreeSlides(Eigen::Vector3d offset,
+                                       const perception::RecognizedObject& reported) {
   for (const perception::FreeDirection& f : reported.free_directions) {
-    if (f.kind == perception::FreeKind::kUnconstrained && f.motion == perception::FreeMotion::kTranslation) offset -= offset.dot(f.axis_S) * f.axis_S;
+    if (f.kind == perception::FreeKind::kUnconstrained &&
+        f.motion == perception::FreeMotion::kTranslation)
+      offset -= offset.dot(f.axis_S) * f.axis_S;
   }
   return offset;
 }
@@ -168,16 +182,18 @@ Eigen::Vector3d OffsetAcrossFreeSlides(Eigen::Vector3d offset, const perception:
 bool PosedButForFreeSlides(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
                            const perception::RecognizedObject& reported) {
   return e.rotation_rad <= 2.0 * kDeg &&
-         OffsetAcrossFreeSlides(T_S_O.translation() - e.T_symmetric.translation(), reported).norm() <= 0.005;
+         OffsetAcrossFreeSlides(T_S_O.translation() - e.T_symmetric.translation(), reported)
+                 .norm() <= 0.005;
 }
 
 // Whether a pose off the truth is right but for what its answer reports it cannot tell: one of
 // the equivalent poses is within 5 mm and 2 degrees (modulo symmetry), or the pose is once the
 // translation along its reported free slides is left out and it is turned about one of its
 // reported free rotation axes (searched by the degree over a full turn).
-bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
-                               const Eigen::Isometry3d& T_S_O_true, const std::vector<Eigen::Vector3d>& points,
-                               const ObjectModel& model, const perception::RecognizedObject* reported) {
+bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e,
+                               const Eigen::Isometry3d& T_S_O, const Eigen::Isometry3d& T_S_O_true,
+                               const std::vector<Eigen::Vector3d>& points, const ObjectModel& model,
+                               const perception::RecognizedObject* reported) {
   if (reported == nullptr) return false;
   for (const Eigen::Isometry3d& T : reported->equivalent_poses_S) {
     const perception::SymmetricPoseError other =
@@ -186,10 +202,13 @@ bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Ei
   }
   if (PosedButForFreeSlides(e, T_S_O, *reported)) return true;
   for (const perception::FreeDirection& f : reported->free_directions) {
-    if (f.kind != perception::FreeKind::kUnconstrained || f.motion != perception::FreeMotion::kRotation) continue;
+    if (f.kind != perception::FreeKind::kUnconstrained ||
+        f.motion != perception::FreeMotion::kRotation)
+      continue;
     for (int degrees = -180; degrees < 180; ++degrees) {
       const Eigen::Isometry3d turn = Eigen::Translation3d(f.point_S) *
-                                     Eigen::AngleAxisd(degrees * kDeg, f.axis_S) * Eigen::Translation3d(-f.point_S);
+                                     Eigen::AngleAxisd(degrees * kDeg, f.axis_S) *
+                                     Eigen::Translation3d(-f.point_S);
       const Eigen::Isometry3d turned = turn * T_S_O;
       const perception::SymmetricPoseError t =
           perception::PoseErrorModuloSymmetry(turned, T_S_O_true, points, model.symmetries);
@@ -201,7 +220,8 @@ bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e, const Ei
 
 // The database's model named `id`, or none (a foreign mesh).
 const ObjectModel* ModelNamed(const ObjectDatabase& db, const std::string& id) {
-  const auto model = std::find_if(db.objects.begin(), db.objects.end(), [&](const ObjectModel& o) { return o.id == id; });
+  const auto model = std::find_if(db.objects.begin(), db.objects.end(),
+                                  [&](const ObjectModel& o) { return o.id == id; });
   return model == db.objects.end() ? nullptr : &*model;
 }
 
@@ -215,19 +235,21 @@ std::vector<Eigen::Vector3d> ErrorPoints(const ObjectModel& model) {
 // The pose error modulo symmetry (rotation rad, translation m) of a candidate for a true object
 // `truth`; (-1, -1) when the candidate is another object's, was never posed, or `truth` is not
 // in the database (a foreign mesh).
-std::pair<double, double> CandidateError(const perception::RecognitionCandidate& c, const std::string& truth,
-                                         const Eigen::Isometry3d& T_S_O_true, const ObjectDatabase& db) {
+std::pair<double, double> CandidateError(const perception::RecognitionCandidate& c,
+                                         const std::string& truth,
+                                         const Eigen::Isometry3d& T_S_O_true,
+                                         const ObjectDatabase& db) {
   const ObjectModel* model = ModelNamed(db, truth);
   if (model == nullptr || c.object_id != truth || c.fitness <= 0.0) return {-1.0, -1.0};
-  const perception::SymmetricPoseError e =
-      perception::PoseErrorModuloSymmetry(c.T_S_O, T_S_O_true, ErrorPoints(*model), model->symmetries);
+  const perception::SymmetricPoseError e = perception::PoseErrorModuloSymmetry(
+      c.T_S_O, T_S_O_true, ErrorPoints(*model), model->symmetries);
   return {e.rotation_rad, e.translation_m};
 }
 
 // ObjectOutcome::why_wrong of a wrong answer `ours`, given the true object checked at its true
 // pose on the same segment.
-std::string WhyWrong(const perception::RecognitionCandidate& truth, const perception::RecognizedObject& ours,
-                     double score_tie) {
+std::string WhyWrong(const perception::RecognitionCandidate& truth,
+                     const perception::RecognizedObject& ours, double score_tie) {
   if (!truth.verified) return "unverified";
   if (ours.object_id == "unknown" || truth.score > ours.score + score_tie) return "missed";
   if (truth.score < ours.score - score_tie) return "outscored";
@@ -237,10 +259,11 @@ std::string WhyWrong(const perception::RecognitionCandidate& truth, const percep
 // Scores one answer for a true object; `T_S_O_true` is the truth in the scan frame. Returns
 // the pose error modulo symmetry when the answer is right.
 // `reported`: uwscan's answer, for its equivalent poses and free slides (none for the peers).
-std::optional<perception::SymmetricPoseError> Score(const std::string& truth, const std::string& answer,
-           const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
-           const ObjectDatabase& db, PipelineFigures& figures,
-           const perception::RecognizedObject* reported = nullptr) {
+std::optional<perception::SymmetricPoseError> Score(
+    const std::string& truth, const std::string& answer,
+    const std::optional<Eigen::Isometry3d>& T_S_O, const Eigen::Isometry3d& T_S_O_true,
+    const ObjectDatabase& db, PipelineFigures& figures,
+    const perception::RecognizedObject* reported = nullptr) {
   figures.confusion[truth][answer] += 1;
   if (truth == "foreign") {
     ++figures.foreign;
@@ -249,8 +272,9 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
   }
   ++figures.objects;
   const bool reported_as_equivalent =
-      reported != nullptr && std::any_of(reported->equivalent_objects_S.begin(), reported->equivalent_objects_S.end(),
-                                         [&](const auto& e) { return e.first == truth; });
+      reported != nullptr &&
+      std::any_of(reported->equivalent_objects_S.begin(), reported->equivalent_objects_S.end(),
+                  [&](const auto& e) { return e.first == truth; });
   if (answer != truth || !T_S_O) {
     figures.recognised_or_reported += reported_as_equivalent;
     return std::nullopt;
@@ -265,10 +289,12 @@ std::optional<perception::SymmetricPoseError> Score(const std::string& truth, co
   figures.translation_errors_m.push_back(e.translation_m);
   const bool posed = e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005;
   figures.pose_success += posed;
-  figures.pose_or_reported += posed || PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, reported);
+  figures.pose_or_reported +=
+      posed || PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, reported);
   if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
   if (reported != nullptr && e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
-    if (const auto nees = PoseNeesPerPinnedDirection(*T_S_O, e.T_symmetric, model.model.origin, reported->covariance)) {
+    if (const auto nees = PoseNeesPerPinnedDirection(*T_S_O, e.T_symmetric, model.model.origin,
+                                                     reported->covariance)) {
       figures.pose_nees_per_dimension.push_back(*nees);
       figures.pose_nees_by_class[truth].push_back(*nees);
     }
@@ -315,9 +341,11 @@ sim::VirtualScan ScanOf(const Scene& scene, int s, const sim::VirtualScanner& sc
                         const RecognitionBenchOptions& options) {
   const CachedScanKey key = KeyOf(scene, s, options);
   if (!options.scan_cache.empty()) {
-    if (std::optional<sim::VirtualScan> cached = LoadCachedScan(options.scan_cache, key)) return std::move(*cached);
+    if (std::optional<sim::VirtualScan> cached = LoadCachedScan(options.scan_cache, key))
+      return std::move(*cached);
   }
-  sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, options.seed + 1000 + static_cast<std::uint64_t>(s));
+  sim::VirtualScan scan =
+      scanner.Scan(scene.objects, scene.T_W_C, options.seed + 1000 + static_cast<std::uint64_t>(s));
   if (!options.scan_cache.empty()) SaveCachedScan(options.scan_cache, key, scan);
   return scan;
 }
@@ -358,9 +386,10 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   build.views = options.views;
   build.seed = options.seed;
   build.threads = options.threads;
-  const ObjectDatabase db = perception::BuildObjectDatabase(
-      catalogue, db_scanner, build,
-      [&](double f) { if (progress) progress("object database", f); });
+  const ObjectDatabase db =
+      perception::BuildObjectDatabase(catalogue, db_scanner, build, [&](double f) {
+        if (progress) progress("object database", f);
+      });
   result.database_seconds = Seconds(start);
   for (const perception::ObjectModel& o : db.objects) result.object_ids.push_back(o.id);
 
@@ -368,7 +397,8 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   if (options.images) {
     sim::SimulationEffects& e = scene_scan.effects;
     e.peak_noise.on = false;
-    e.image.on = e.beam.on = e.sensor_noise.on = e.speckle.on = e.backscatter.on = e.ambient.on = true;
+    e.image.on = e.beam.on = e.sensor_noise.on = e.speckle.on = e.backscatter.on = e.ambient.on =
+        true;
     e.attenuation = true;
   }
   sim::Water water;
@@ -379,7 +409,8 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   std::optional<PclEsfPeer> pcl_peer;
   std::optional<PpfPeer> ppf_peer;
   if (options.run_peers) {
-    std::vector<PeerObject> peers = PeerObjects(db, catalogue, db_scanner, options.seed, options.threads);
+    std::vector<PeerObject> peers =
+        PeerObjects(db, catalogue, db_scanner, options.seed, options.threads);
     if (options.run_ppf) {
       ppf_peer.emplace(peers);
       result.ppf_training_seconds = ppf_peer->training_seconds();
@@ -392,7 +423,9 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   recognition.seed = options.seed;
   recognition.threads = options.threads;
   for (int s = 0; s < options.scans; ++s) {
-    if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), s) == options.only.end()) continue;
+    if (!options.only.empty() &&
+        std::find(options.only.begin(), options.only.end(), s) == options.only.end())
+      continue;
     ++result.scans;
     const Scene scene = MakeScene(s, catalogue, foreign, options.seed);
     start = std::chrono::steady_clock::now();
@@ -402,9 +435,11 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
     const PointCloud cloud = perception::MakeCloud(scan.points_C);
 
     start = std::chrono::steady_clock::now();
-    const perception::RecognitionResult answer = perception::RecognizeObjects(cloud, db, cache, recognition);
+    const perception::RecognitionResult answer =
+        perception::RecognizeObjects(cloud, db, cache, recognition);
     result.pipelines["uwscan"].seconds += Seconds(start);
-    for (const auto& [stage, seconds] : answer.stage_seconds) result.uwscan_stage_seconds[stage] += seconds;
+    for (const auto& [stage, seconds] : answer.stage_seconds)
+      result.uwscan_stage_seconds[stage] += seconds;
 
     // Each object of the scene with enough points, and the segment holding most of them.
     for (std::size_t o = 1; o < scene.objects.size(); ++o) {
@@ -414,46 +449,81 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
       int best_segment = -1, best_count = 0;
       for (std::size_t k = 0; k < answer.objects.size(); ++k) {
         int count = 0;
-        for (std::size_t i : answer.objects[k].segment) count += scan.object_index[i] == static_cast<int>(o);
+        for (std::size_t i : answer.objects[k].segment)
+          count += scan.object_index[i] == static_cast<int>(o);
         if (count > best_count) best_count = count, best_segment = static_cast<int>(k);
       }
       const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
       const std::string& truth = scene.classes[o];
       if (best_segment < 0) {
-        result.outcomes.push_back({s, truth, "unknown", visible, 0, 0, -1.0, -1.0, {}, 0, {}, 0, 0, {},
-                                   truth == "foreign" ? "" : "no segment", std::nullopt});
+        result.outcomes.push_back({s,
+                                   truth,
+                                   "unknown",
+                                   visible,
+                                   0,
+                                   0,
+                                   -1.0,
+                                   -1.0,
+                                   {},
+                                   0,
+                                   {},
+                                   0,
+                                   0,
+                                   {},
+                                   truth == "foreign" ? "" : "no segment",
+                                   std::nullopt});
         Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
         if (options.run_peers) {
           Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
-          if (ppf_peer) Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["opencv_ppf"]);
+          if (ppf_peer)
+            Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["opencv_ppf"]);
         }
         continue;
       }
-      const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
-      ObjectOutcome outcome{s, truth, ours.object_id, visible, best_count, static_cast<int>(ours.segment.size()),
-                            -1.0, -1.0, ours.candidates, static_cast<int>(ours.equivalent_poses_S.size()), {}, 0, 0, {}, "", std::nullopt};
-      for (const auto& [id, T] : ours.equivalent_objects_S) outcome.equivalent_objects.push_back(id);
+      const perception::RecognizedObject& ours =
+          answer.objects[static_cast<std::size_t>(best_segment)];
+      ObjectOutcome outcome{s,
+                            truth,
+                            ours.object_id,
+                            visible,
+                            best_count,
+                            static_cast<int>(ours.segment.size()),
+                            -1.0,
+                            -1.0,
+                            ours.candidates,
+                            static_cast<int>(ours.equivalent_poses_S.size()),
+                            {},
+                            0,
+                            0,
+                            {},
+                            "",
+                            std::nullopt};
+      for (const auto& [id, T] : ours.equivalent_objects_S)
+        outcome.equivalent_objects.push_back(id);
       for (const perception::RecognitionCandidate& c : ours.candidates) {
         outcome.candidate_errors.push_back(CandidateError(c, truth, T_S_O_true, db));
       }
       for (const perception::FreeDirection& f : ours.free_directions) {
         if (f.kind != perception::FreeKind::kUnconstrained) continue;
-        ++(f.motion == perception::FreeMotion::kTranslation ? outcome.free_slides : outcome.free_turns);
+        ++(f.motion == perception::FreeMotion::kTranslation ? outcome.free_slides
+                                                            : outcome.free_turns);
       }
-      if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db, result.pipelines["uwscan"], &ours)) {
+      if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db,
+                               result.pipelines["uwscan"], &ours)) {
         outcome.rotation_error_rad = e->rotation_rad;
         outcome.translation_error_m = e->translation_m;
       }
       if (ours.object_id != truth && truth != "foreign") {
-        const perception::RecognitionCandidate checked =
-            perception::CheckObjectPose(cloud, ours.segment, db, cache, truth, T_S_O_true, recognition);
+        const perception::RecognitionCandidate checked = perception::CheckObjectPose(
+            cloud, ours.segment, db, cache, truth, T_S_O_true, recognition);
         outcome.why_wrong = WhyWrong(checked, ours, recognition.score_tie);
         outcome.truth_check = checked;
       }
       result.outcomes.push_back(std::move(outcome));
       if (!options.run_peers) continue;
-      const PointCloud segment = perception::VoxelDownsample(
-          perception::Subset(cloud, ours.segment), perception::VoxelFilterOptions{db.parameters.voxel_m});
+      const PointCloud segment =
+          perception::VoxelDownsample(perception::Subset(cloud, ours.segment),
+                                      perception::VoxelFilterOptions{db.parameters.voxel_m});
       start = std::chrono::steady_clock::now();
       const PeerAnswer pcl = pcl_peer->Recognize(segment);
       result.pipelines["pcl_esf"].seconds += Seconds(start);

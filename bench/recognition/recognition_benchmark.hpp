@@ -18,11 +18,11 @@ namespace uwscan::bench {
 // from 0.5-1.5 m, under water, with the image stages on. uwscan's recogniser and two peers
 // on the same segments.
 struct RecognitionBenchOptions {
-  int scans = 100;                 // scenes, each scanned once, >= 1
-  std::vector<int> only;           // when not empty, only these scenes of the `scans` (to look at a case)
-  int views = 24;                  // database views per object, >= 1
-  bool images = true;              // render and detect frames (else exact peaks + 0.1 px noise)
-  int galvo_stride = 2;            // mirror steps per frame, >= 1 (2: 101 frames per sweep)
+  int scans = 100;        // scenes, each scanned once, >= 1
+  std::vector<int> only;  // when not empty, only these scenes of the `scans` (to look at a case)
+  int views = 24;         // database views per object, >= 1
+  bool images = true;     // render and detect frames (else exact peaks + 0.1 px noise)
+  int galvo_stride = 2;   // mirror steps per frame, >= 1 (2: 101 frames per sweep)
   std::uint64_t seed = 1;
   int threads = 2;
   bool run_peers = true;
@@ -38,21 +38,21 @@ struct RecognitionBenchOptions {
 };
 
 struct PipelineFigures {
-  int objects = 0;              // catalogue objects in the scans (the rate's denominator)
-  int recognised = 0;           // with the right id
+  int objects = 0;     // catalogue objects in the scans (the rate's denominator)
+  int recognised = 0;  // with the right id
   // ...or with another id, but the right one among the objects the answer reports fit as well
   // (equivalent_objects_S; peers report none: the same as recognised)
   int recognised_or_reported = 0;
-  int pose_success = 0;         // of those: within 5 mm and 2 degrees modulo symmetry
+  int pose_success = 0;  // of those: within 5 mm and 2 degrees modulo symmetry
   // ...or wrong only in what the answer says it cannot tell: one of its equivalent poses is
   // within 5 mm and 2 degrees, or the pose is once its reported free slides are left out and it
   // is turned about one of its reported free rotation axes (peers report neither: the same as
   // pose_success)
   int pose_or_reported = 0;
-  int mssd_success = 0;         // of those: MSSD below 0.1 x diameter
-  int grasp_success = 0;        // of those: grasp within 5 mm and 3 degrees
+  int mssd_success = 0;                  // of those: MSSD below 0.1 x diameter
+  int grasp_success = 0;                 // of those: grasp within 5 mm and 3 degrees
   int foreign = 0, foreign_unknown = 0;  // foreign meshes, and those called "unknown"
-  double seconds = 0.0;         // recognition of every scan (segmentation included for uwscan)
+  double seconds = 0.0;  // recognition of every scan (segmentation included for uwscan)
   std::vector<double> rotation_errors_rad, translation_errors_m, grasp_position_errors_m,
       grasp_angle_errors_rad;
   // uwscan's reported pose covariance against its error (modulo symmetry): the NEES over the
@@ -68,14 +68,14 @@ struct PipelineFigures {
 // What uwscan made of one object of one scan, for reading failures one by one.
 struct ObjectOutcome {
   int scan = 0;
-  std::string truth;   // catalogue id or "foreign"
-  std::string answer;  // uwscan's id or "unknown"
-  int points = 0;      // scan points on the object
+  std::string truth;          // catalogue id or "foreign"
+  std::string answer;         // uwscan's id or "unknown"
+  int points = 0;             // scan points on the object
   int points_in_segment = 0;  // of those, in the segment uwscan answered for it
   int segment_points = 0;     // scan points in that segment
   double rotation_error_rad = -1.0, translation_error_m = -1.0;  // modulo symmetry; -1: no pose
-  std::vector<perception::RecognitionCandidate> candidates;  // uwscan's, best first
-  int equivalent_poses = 0;   // other poses uwscan reported as fitting as well
+  std::vector<perception::RecognitionCandidate> candidates;      // uwscan's, best first
+  int equivalent_poses = 0;                     // other poses uwscan reported as fitting as well
   std::vector<std::string> equivalent_objects;  // other objects uwscan reported as fitting as well
   int free_slides = 0, free_turns = 0;  // directions uwscan reported unconstrained by the scan
   // Per candidate of the true object, its pose error modulo symmetry (rotation rad, translation
@@ -97,7 +97,7 @@ struct RecognitionBenchResult {
   double database_seconds = 0.0;
   double simulation_seconds = 0.0;
   std::vector<std::string> object_ids;  // the database's objects, the answers a pipeline can give
-  std::map<std::string, PipelineFigures> pipelines;  // uwscan, pcl_esf, opencv_ppf
+  std::map<std::string, PipelineFigures> pipelines;    // uwscan, pcl_esf, opencv_ppf
   std::map<std::string, double> uwscan_stage_seconds;  // summed over scans
   double ppf_training_seconds = 0.0;
   std::vector<ObjectOutcome> outcomes;  // uwscan's, in scan order

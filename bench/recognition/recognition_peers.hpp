@@ -15,7 +15,7 @@
 namespace uwscan::bench {
 
 struct PeerView {
-  perception::EsfDescriptor esf;   // the peer's own descriptor of the view's points
+  perception::EsfDescriptor esf;  // the peer's own descriptor of the view's points
   Eigen::Isometry3d T_O_C = Eigen::Isometry3d::Identity();
   Eigen::Vector3d centroid_C = Eigen::Vector3d::Zero();  // of the view's points, camera frame
 };

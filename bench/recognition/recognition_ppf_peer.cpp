@@ -1,8 +1,7 @@
+#include <chrono>
 #include <opencv2/core.hpp>
 #include <opencv2/surface_matching.hpp>
 #include <opencv2/surface_matching/ppf_helpers.hpp>
-
-#include <chrono>
 
 #include "bench/recognition/recognition_peers.hpp"
 
@@ -29,7 +28,8 @@ cv::Mat ToMat(const perception::PointCloud& cloud, const Eigen::Vector3d& origin
 // 2^(levels-1), and 8 levels leave a handful of points to solve 6 degrees of freedom from. On 14
 // of the bench's seed-2 scans the sample's way moved the poses 0.73 m (median) from the truth and
 // posed none within 5 mm / 2 degrees; this way 0.15 m and 2 of 17 (PPF alone: 32 degrees, 4 mm).
-Eigen::Matrix4d RefinedModelToScene(const cv::Mat& model, const cv::Mat& scene, const cv::ppf_match_3d::Pose3D& ppf) {
+Eigen::Matrix4d RefinedModelToScene(const cv::Mat& model, const cv::Mat& scene,
+                                    const cv::ppf_match_3d::Pose3D& ppf) {
   const cv::Matx44d scene_to_model = ppf.pose.inv();
   const cv::Mat moved = cv::ppf_match_3d::transformPCPose(scene, scene_to_model);
   cv::ppf_match_3d::ICP icp(100, 0.005f, 2.5f, 3);
@@ -91,7 +91,8 @@ PeerAnswer PpfPeer::Recognize(const perception::PointCloud& segment) const {
     if (votes <= best_votes) continue;
     best_votes = votes;
     answer.id = m.id;
-    answer.T_S_O = Eigen::Translation3d(centroid) * Eigen::Isometry3d(RefinedModelToScene(m.points, scene, *results.front()));
+    answer.T_S_O = Eigen::Translation3d(centroid) *
+                   Eigen::Isometry3d(RefinedModelToScene(m.points, scene, *results.front()));
   }
   return answer;
 }

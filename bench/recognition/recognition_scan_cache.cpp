@@ -35,26 +35,31 @@ void Append(std::string& bytes, const T* data, std::size_t count) {
 
 }  // namespace
 
-std::optional<scanner::sim::VirtualScan> LoadCachedScan(const std::filesystem::path& folder, const CachedScanKey& key) {
+std::optional<scanner::sim::VirtualScan> LoadCachedScan(const std::filesystem::path& folder,
+                                                        const CachedScanKey& key) {
   const std::filesystem::path file = FileOf(folder, key);
   std::ifstream in(file, std::ios::binary);
   if (!in) return std::nullopt;
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   auto damaged = [&](const std::string& what) {
-    return Error("scan cache " + file.string() + ": " + what + " (delete the file to simulate the scan again)");
+    return Error("scan cache " + file.string() + ": " + what +
+                 " (delete the file to simulate the scan again)");
   };
   Header h;
   if (bytes.size() < sizeof(Header) + sizeof(std::uint64_t)) throw damaged("truncated");
   std::memcpy(&h, bytes.data(), sizeof(Header));
-  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) throw damaged("not a scan cache of this format version");
-  if (h.key != key.key) return std::nullopt;  // a scan of other settings: simulated again and replaced
+  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0)
+    throw damaged("not a scan cache of this format version");
+  if (h.key != key.key)
+    return std::nullopt;  // a scan of other settings: simulated again and replaced
   const std::size_t body = h.points * (3 * sizeof(double) + sizeof(std::int32_t));
   if (h.points > bytes.size() || bytes.size() != sizeof(Header) + body + sizeof(std::uint64_t)) {
     throw damaged("size does not match its point count");
   }
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + bytes.size() - sizeof stored, sizeof stored);
-  if (stored != Fnv1a64(bytes.data(), bytes.size() - sizeof stored)) throw damaged("checksum mismatch");
+  if (stored != Fnv1a64(bytes.data(), bytes.size() - sizeof stored))
+    throw damaged("checksum mismatch");
   scanner::sim::VirtualScan scan;
   scan.points_C.resize(h.points);
   scan.object_index.resize(h.points);
@@ -67,10 +72,12 @@ std::optional<scanner::sim::VirtualScan> LoadCachedScan(const std::filesystem::p
   return scan;
 }
 
-void SaveCachedScan(const std::filesystem::path& folder, const CachedScanKey& key, const scanner::sim::VirtualScan& scan) {
+void SaveCachedScan(const std::filesystem::path& folder, const CachedScanKey& key,
+                    const scanner::sim::VirtualScan& scan) {
   std::error_code error;
   std::filesystem::create_directories(folder, error);
-  if (error) throw Error("scan cache " + folder.string() + ": cannot create the folder: " + error.message());
+  if (error)
+    throw Error("scan cache " + folder.string() + ": cannot create the folder: " + error.message());
   if (scan.object_index.size() != scan.points_C.size()) {
     throw Error("scan cache: a scan with " + std::to_string(scan.points_C.size()) + " points has " +
                 std::to_string(scan.object_index.size()) + " object indices");
@@ -93,7 +100,8 @@ void SaveCachedScan(const std::filesystem::path& folder, const CachedScanKey& ke
     if (!out) throw Error("scan cache " + partial.string() + ": cannot write");
   }
   std::filesystem::rename(partial, file, error);
-  if (error) throw Error("scan cache " + file.string() + ": cannot rename into place: " + error.message());
+  if (error)
+    throw Error("scan cache " + file.string() + ": cannot rename into place: " + error.message());
 }
 
 }  // namespace uwscan::bench

@@ -26,10 +26,12 @@ struct CachedScanKey {
 
 // The cached scan, or none when there is no file for it. Throws uwscan::Error naming the file
 // when it is there but truncated, damaged or of another format version.
-std::optional<scanner::sim::VirtualScan> LoadCachedScan(const std::filesystem::path& folder, const CachedScanKey& key);
+std::optional<scanner::sim::VirtualScan> LoadCachedScan(const std::filesystem::path& folder,
+                                                        const CachedScanKey& key);
 
 // Writes the scan (to a temporary file renamed into place: a reader sees a whole file or none).
 // Throws uwscan::Error when the folder cannot be written.
-void SaveCachedScan(const std::filesystem::path& folder, const CachedScanKey& key, const scanner::sim::VirtualScan& scan);
+void SaveCachedScan(const std::filesystem::path& folder, const CachedScanKey& key,
+                    const scanner::sim::VirtualScan& scan);
 
 }  // namespace uwscan::bench

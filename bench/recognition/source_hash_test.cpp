@@ -23,20 +23,23 @@ void Write(const fs::path& path, const std::string& text) {
 }
 
 // The hash HashSources.cmake gives the files `relative` under `root` (its output in `work`).
-std::string HashOf(const fs::path& root, const std::vector<std::string>& relative, const fs::path& work) {
+std::string HashOf(const fs::path& root, const std::vector<std::string>& relative,
+                   const fs::path& work) {
   const fs::path list = work / "list.txt", output = work / "hash.cpp";
   std::ofstream out(list);
   for (const std::string& r : relative) out << (root / r).string() << "\n";
   out.close();
   const std::string script = std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/cmake/HashSources.cmake";
-  const std::string command = "cmake -DROOT='" + root.string() + "' -DLIST='" + list.string() + "' -DOUTPUT='" +
-                              output.string() + "' -DSYMBOL=kTestHash -P '" + script + "'";
+  const std::string command = "cmake -DROOT='" + root.string() + "' -DLIST='" + list.string() +
+                              "' -DOUTPUT='" + output.string() + "' -DSYMBOL=kTestHash -P '" +
+                              script + "'";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   std::stringstream text;
   text << std::ifstream(output).rdbuf();
   std::smatch match;
   const std::string source = text.str();
-  EXPECT_TRUE(std::regex_search(source, match, std::regex("kTestHash = \"([0-9a-f]{64})\";"))) << source;
+  EXPECT_TRUE(std::regex_search(source, match, std::regex("kTestHash = \"([0-9a-f]{64})\";")))
+      << source;
   return match.size() > 1 ? match[1].str() : "";
 }
 

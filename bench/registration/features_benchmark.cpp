@@ -56,10 +56,10 @@ FeaturesBenchResult RunFeaturesBenchmark(const FeaturesBenchOptions& o, const Pr
     other_seed.seed = 2;
     const perception::EsfResult resampled = perception::ComputeEsf(view, other_seed);
     if (ours.ok && pcl.ok && resampled.ok) {
-      r.esf_chi2_to_pcl += perception::ChiSquareDistance(ours.histogram.data(),
-                                                          pcl.histogram.data(), 640);
-      r.esf_chi2_seed_to_seed += perception::ChiSquareDistance(ours.histogram.data(),
-                                                                resampled.histogram.data(), 640);
+      r.esf_chi2_to_pcl +=
+          perception::ChiSquareDistance(ours.histogram.data(), pcl.histogram.data(), 640);
+      r.esf_chi2_seed_to_seed +=
+          perception::ChiSquareDistance(ours.histogram.data(), resampled.histogram.data(), 640);
       ++esf_pairs;
     }
     ++r.clouds;

@@ -24,7 +24,7 @@ struct FeaturesBenchResult {
   double fpfh_pcl_s = 0.0;
   double esf_uwscan_s = 0.0;
   double esf_pcl_s = 0.0;
-  double esf_chi2_to_pcl = 0.0;       // mean chi-square(uwscan, PCL)
+  double esf_chi2_to_pcl = 0.0;        // mean chi-square(uwscan, PCL)
   double esf_chi2_seed_to_seed = 0.0;  // mean chi-square(uwscan seed 1, uwscan seed 2)
 };
 

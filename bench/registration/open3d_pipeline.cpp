@@ -70,15 +70,16 @@ PipelineRun RunOpen3dPipeline(const RegistrationPair& pair, const PipelineParame
   const reg::CorrespondenceCheckerBasedOnEdgeLength edge_check(0.9);
   const reg::CorrespondenceCheckerBasedOnDistance distance_check(p.inlier_distance_m);
   const reg::RegistrationResult coarse = reg::RegistrationRANSACBasedOnFeatureMatching(
-      *source.cloud, *target.cloud, *source.features, *target.features, true,
-      p.inlier_distance_m, reg::TransformationEstimationPointToPoint(false), 3,
-      {edge_check, distance_check}, reg::RANSACConvergenceCriteria(p.ransac_iterations, 0.999));
+      *source.cloud, *target.cloud, *source.features, *target.features, true, p.inlier_distance_m,
+      reg::TransformationEstimationPointToPoint(false), 3, {edge_check, distance_check},
+      reg::RANSACConvergenceCriteria(p.ransac_iterations, 0.999));
   run.stage_seconds["coarse"] += Since(start);
 
   start = Clock::now();
-  const reg::RegistrationResult fine = reg::RegistrationICP(
-      *source.cloud, *target.cloud, p.icp_distance_m, coarse.transformation_,
-      reg::TransformationEstimationPointToPoint(false), reg::ICPConvergenceCriteria(1e-10, 1e-10, 50));
+  const reg::RegistrationResult fine =
+      reg::RegistrationICP(*source.cloud, *target.cloud, p.icp_distance_m, coarse.transformation_,
+                           reg::TransformationEstimationPointToPoint(false),
+                           reg::ICPConvergenceCriteria(1e-10, 1e-10, 50));
   run.stage_seconds["icp"] += Since(start);
 
   Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();

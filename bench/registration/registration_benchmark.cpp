@@ -14,7 +14,8 @@ void RegistrationBenchOptions::Check() const {
   }
   pairs.Check();
   for (const double f : sweep_voxel_fractions) {
-    if (!(f > 0.0 && f < 1.0)) throw Error("bench registration: a swept voxel fraction must be in (0, 1)");
+    if (!(f > 0.0 && f < 1.0))
+      throw Error("bench registration: a swept voxel fraction must be in (0, 1)");
   }
 }
 
@@ -25,26 +26,29 @@ using Runner = std::function<PipelineRun(const RegistrationPair&, const Pipeline
 // One pipeline over every pair; voxel_fraction > 0 sets the leaf to that fraction of each
 // object's size (0: the default, size / 50).
 PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
-                            const std::vector<RegistrationPair>& pairs, const RegistrationBenchOptions& o,
-                            double voxel_fraction, std::vector<PairOutcome>* outcomes, const Progress& progress) {
+                            const std::vector<RegistrationPair>& pairs,
+                            const RegistrationBenchOptions& o, double voxel_fraction,
+                            std::vector<PairOutcome>* outcomes, const Progress& progress) {
   PipelineSummary summary;
   double total_seconds = 0.0;
   for (size_t i = 0; i < pairs.size(); ++i) {
     const RegistrationPair& pair = pairs[i];
-    const PipelineParameters parameters =
-        ParametersFor(pair.object_size_m, o.pairs.seed + i, o.threads, voxel_fraction * pair.object_size_m);
+    const PipelineParameters parameters = ParametersFor(
+        pair.object_size_m, o.pairs.seed + i, o.threads, voxel_fraction * pair.object_size_m);
     const PipelineRun run = run_pipeline(pair, parameters);
-    const PoseError error = ComparePoses(run.T_target_source, pair.T_target_source_true, pair.source.origin);
+    const PoseError error =
+        ComparePoses(run.T_target_source, pair.T_target_source_true, pair.source.origin);
     const double limit_m = o.max_translation_fraction * pair.object_size_m;
     PairOutcome outcome;
     outcome.pair = pair.name;
     outcome.pipeline = name;
     outcome.rotation_error_rad = error.rotation_rad;
     outcome.translation_error_m = error.translation_m;
-    outcome.symmetric_error_m = SymmetricSurfaceError(pair.source, pair.surface, run.T_target_source,
-                                                     pair.T_target_source_true);
+    outcome.symmetric_error_m = SymmetricSurfaceError(
+        pair.source, pair.surface, run.T_target_source, pair.T_target_source_true);
     outcome.seconds = run.seconds;
-    outcome.success = error.rotation_rad < o.max_rotation_error_rad && error.translation_m < limit_m;
+    outcome.success =
+        error.rotation_rad < o.max_rotation_error_rad && error.translation_m < limit_m;
     outcome.symmetric_success = outcome.symmetric_error_m < limit_m;
     summary.successes += outcome.success ? 1 : 0;
     summary.symmetric_successes += outcome.symmetric_success ? 1 : 0;
@@ -79,11 +83,13 @@ RegistrationBenchResult RunRegistrationBenchmark(const RegistrationBenchOptions&
 
   RegistrationBenchResult result;
   for (const auto& [name, run_pipeline] : pipelines) {
-    result.pipelines[name] = RunPipeline(name, run_pipeline, pairs, o, 0.0, &result.outcomes, progress);
+    result.pipelines[name] =
+        RunPipeline(name, run_pipeline, pairs, o, 0.0, &result.outcomes, progress);
   }
   for (const double fraction : o.sweep_voxel_fractions) {
     const std::string what = "uwscan at voxel " + std::to_string(fraction) + " x size";
-    result.voxel_sweep.push_back({fraction, RunPipeline(what, RunUwscanPipeline, pairs, o, fraction, nullptr, progress)});
+    result.voxel_sweep.push_back(
+        {fraction, RunPipeline(what, RunUwscanPipeline, pairs, o, fraction, nullptr, progress)});
   }
   return result;
 }

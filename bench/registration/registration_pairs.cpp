@@ -12,7 +12,7 @@
 namespace uwscan::bench {
 namespace {
 
-constexpr const char* kMeshes[] = {"anchor", "cylinder", "joint", "rotor", "spool",
+constexpr const char* kMeshes[] = {"anchor",  "cylinder",     "joint",         "rotor",  "spool",
                                    "turbine", "pinion_small", "fandisk_large", "bunny00"};
 
 Eigen::Isometry3d RandomMotion(std::mt19937_64& rng, double max_translation_m) {
@@ -55,7 +55,8 @@ std::vector<Eigen::Vector3d> Resampled(const std::vector<Eigen::Vector3d>& point
   std::normal_distribution<double> noise(0.0, sigma_m);
   std::vector<Eigen::Vector3d> out;
   for (const Eigen::Vector3d& p : points) {
-    if (unit(rng) < keep) out.push_back(T * (p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
+    if (unit(rng) < keep)
+      out.push_back(T * (p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
   }
   return out;
 }
@@ -98,7 +99,8 @@ void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOpti
       pair.source = perception::MakeCloud(source);
       std::vector<Eigen::Vector3d> surface_in_source;
       surface_in_source.reserve(other.points.size());
-      for (const Eigen::Vector3d& p : other.points) surface_in_source.push_back(T_source_target * p);
+      for (const Eigen::Vector3d& p : other.points)
+        surface_in_source.push_back(T_source_target * p);
       pair.surface = perception::MakeCloud(surface_in_source);
       pair.T_target_source_true = T_source_target.inverse();
       pair.object_size_m = perception::BoundingBoxDiagonal(pair.target);
@@ -107,7 +109,8 @@ void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOpti
   }
 }
 
-void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng, std::vector<RegistrationPair>* pairs) {
+void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng,
+                  std::vector<RegistrationPair>* pairs) {
   struct Scan {
     const char* file;
     double keep;  // fraction of the scan's points in each view
@@ -122,10 +125,11 @@ void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng, std:
     pair.target = perception::MakeCloud(
         Resampled(points, scan.keep, 0.0, Eigen::Isometry3d::Identity(), rng));
     const Eigen::Isometry3d T_source_target = RandomMotion(rng, size);
-    pair.source = perception::MakeCloud(
-        Resampled(points, scan.keep, 1e-3 * size, T_source_target, rng));
+    pair.source =
+        perception::MakeCloud(Resampled(points, scan.keep, 1e-3 * size, T_source_target, rng));
     pair.source_viewpoint = T_source_target * Eigen::Vector3d::Zero();  // the scanner's origin
-    std::vector<Eigen::Vector3d> surface_in_source;  // every point, no draw: the pairs stay as they were
+    std::vector<Eigen::Vector3d>
+        surface_in_source;  // every point, no draw: the pairs stay as they were
     surface_in_source.reserve(points.size());
     for (const Eigen::Vector3d& p : points) surface_in_source.push_back(T_source_target * p);
     pair.surface = perception::MakeCloud(surface_in_source);
@@ -161,17 +165,21 @@ PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3
   return PoseError{std::acos(cos_angle), (estimate * at_point - truth * at_point).norm()};
 }
 
-double SymmetricSurfaceError(const perception::PointCloud& source, const perception::PointCloud& surface,
+double SymmetricSurfaceError(const perception::PointCloud& source,
+                             const perception::PointCloud& surface,
                              const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth,
                              std::size_t max_points) {
-  if (source.empty() || surface.empty()) throw Error("SymmetricSurfaceError: empty source or surface");
+  if (source.empty() || surface.empty())
+    throw Error("SymmetricSurfaceError: empty source or surface");
   // Coordinates relative to where the truth puts the source's origin keep the floats small.
   const Eigen::Vector3d centre = truth * source.origin;
   std::vector<Eigen::Vector3f> true_points;
   true_points.reserve(surface.size());
-  for (std::size_t i = 0; i < surface.size(); ++i) true_points.push_back((truth * surface.Point(i) - centre).cast<float>());
+  for (std::size_t i = 0; i < surface.size(); ++i)
+    true_points.push_back((truth * surface.Point(i) - centre).cast<float>());
   const perception::KnnIndex index(true_points);
-  const std::size_t stride = std::max<std::size_t>(1, (source.size() + max_points - 1) / std::max<std::size_t>(1, max_points));
+  const std::size_t stride = std::max<std::size_t>(
+      1, (source.size() + max_points - 1) / std::max<std::size_t>(1, max_points));
   std::vector<std::uint32_t> nearest;
   std::vector<float> squared_m2;
   double sum = 0.0;

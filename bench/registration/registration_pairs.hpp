@@ -26,13 +26,13 @@ struct RegistrationPair {
 };
 
 struct RegistrationPairOptions {
-  int mesh_samples = 40000;           // surface samples per mesh before the views are cut
-  double mesh_size_m = 0.5;           // meshes are scaled to this bounding-box diagonal
-  double noise_sigma_m = 0.0005;      // Gaussian noise added to every view
-  double view_separation_rad = 0.6;   // angle between the two viewpoints of a mesh pair
+  int mesh_samples = 40000;          // surface samples per mesh before the views are cut
+  double mesh_size_m = 0.5;          // meshes are scaled to this bounding-box diagonal
+  double noise_sigma_m = 0.0005;     // Gaussian noise added to every view
+  double view_separation_rad = 0.6;  // angle between the two viewpoints of a mesh pair
   int pairs_per_mesh = 2;
   std::uint64_t seed = 1;
-  bool real_scans = true;             // add pairs built from bun0.pcd and table_scene_lms400.pcd
+  bool real_scans = true;  // add pairs built from bun0.pcd and table_scene_lms400.pcd
 
   void Check() const;
 };
@@ -40,8 +40,8 @@ struct RegistrationPairOptions {
 // Pairs from the cached real data (scripts/fetch_data.sh): CGAL meshes sampled into two
 // partial views each (independent surface samplings, back faces culled, different
 // viewpoints, so the overlap is partial), and the real scans against randomly resampled,
-// noisy copies of themselves (full overlap: these test real noise and density, not overlap). Every source is
-// moved by a random rigid motion (any rotation, translation up to the object size).
+// noisy copies of themselves (full overlap: these test real noise and density, not overlap). Every
+// source is moved by a random rigid motion (any rotation, translation up to the object size).
 // Throws uwscan::Error naming the missing file when the cache is incomplete.
 std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,
                                                     const RegistrationPairOptions& options);
@@ -60,7 +60,8 @@ PoseError ComparePoses(const Eigen::Isometry3d& estimate, const Eigen::Isometry3
 // (source frame) moved by `truth` (at most `max_points` source points, evenly spaced, are
 // measured). A pose that differs from the truth by a symmetry of the surface scores (near)
 // zero, where the rotation error does not.
-double SymmetricSurfaceError(const perception::PointCloud& source, const perception::PointCloud& surface,
+double SymmetricSurfaceError(const perception::PointCloud& source,
+                             const perception::PointCloud& surface,
                              const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth,
                              std::size_t max_points = 2000);
 

@@ -21,7 +21,8 @@ struct PipelineParameters {
   int threads = 1;
 };
 // voxel_m > 0: that leaf (and the radii and distances scaled to it) instead of size / 50.
-PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads, double voxel_m = 0.0);
+PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads,
+                                 double voxel_m = 0.0);
 
 // What one pipeline produced on one pair, and the time each stage took.
 struct PipelineRun {

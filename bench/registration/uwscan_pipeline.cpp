@@ -5,7 +5,8 @@
 
 namespace uwscan::bench {
 
-PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads, double voxel_m) {
+PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int threads,
+                                 double voxel_m) {
   const perception::RegistrationPipelineOptions o =
       perception::RegistrationPipelineOptions::ForObjectSize(object_size_m, seed, threads, voxel_m);
   PipelineParameters p;
@@ -22,8 +23,8 @@ PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int t
 
 PipelineRun RunUwscanPipeline(const RegistrationPair& pair, const PipelineParameters& p) {
   perception::RegistrationPipelineOptions o =
-      perception::RegistrationPipelineOptions::ForObjectSize(pair.object_size_m, p.seed,
-                                                             p.threads, p.voxel_m);
+      perception::RegistrationPipelineOptions::ForObjectSize(pair.object_size_m, p.seed, p.threads,
+                                                             p.voxel_m);
   o.source_viewpoint = pair.source_viewpoint;
   o.target_viewpoint = pair.target_viewpoint;
   const perception::RegistrationPipelineResult result =

@@ -67,7 +67,9 @@ std::size_t ReadBag(const fs::path& path) {
   ros::BagVisitor visitor;
   visitor.image = [&](const std::string&, ros::ImageMessage&&) { ++messages; };
   visitor.odometry = [&](const std::string&, ros::OdometryMessage&&) { ++messages; };
-  visitor.transforms = [&](const std::string&, std::vector<ros::TransformMessage>&&) { ++messages; };
+  visitor.transforms = [&](const std::string&, std::vector<ros::TransformMessage>&&) {
+    ++messages;
+  };
   visitor.text = [&](const std::string&, ros::StringMessage&&) { ++messages; };
   reader.Read(topics, visitor);
   return messages;

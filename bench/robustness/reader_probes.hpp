@@ -25,9 +25,11 @@ const ReaderProbe& FindReaderProbe(const std::string& name);
 // A folder where mutated inputs are read as a user's files would be: `scanners/` holds copies
 // of data_dir/scanners (scenes name them as ../scanners/NAME.yaml) and `inputs/` three small
 // greyscale images that calibration manifests may name (v0.png .. v2.png).
-void PrepareReaderWorkspace(const std::filesystem::path& workspace, const std::filesystem::path& data_dir);
+void PrepareReaderWorkspace(const std::filesystem::path& workspace,
+                            const std::filesystem::path& data_dir);
 // Where `probe`'s input goes in a workspace: inputs/input.EXT, or inputs/NAME for a probe whose
 // extension is a whole file name (manifest.yaml).
-std::filesystem::path ReaderInputPath(const ReaderProbe& probe, const std::filesystem::path& workspace);
+std::filesystem::path ReaderInputPath(const ReaderProbe& probe,
+                                      const std::filesystem::path& workspace);
 
 }  // namespace uwscan::bench

@@ -1,9 +1,10 @@
 #include "bench/robustness/reader_seeds.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <fstream>
 #include <string>
 #include <vector>
-#include <yaml-cpp/yaml.h>
 
 #include "mapping/log/dive_log.hpp"
 #include "mapping/log/dive_simulation.hpp"
@@ -54,17 +55,21 @@ void WriteMeshSeeds(const fs::path& folder) {
   const scanner::TriangleMesh mesh = Tetrahedron();
   std::string off = "OFF\n4 4 0\n", obj, stl = "solid seed\n";
   for (const Eigen::Vector3d& v : mesh.vertices) {
-    const std::string xyz = std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z());
+    const std::string xyz =
+        std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z());
     off += xyz + "\n";
     obj += "v " + xyz + "\n";
   }
   for (const Eigen::Vector3i& t : mesh.triangles) {
-    off += "3 " + std::to_string(t.x()) + " " + std::to_string(t.y()) + " " + std::to_string(t.z()) + "\n";
-    obj += "f " + std::to_string(t.x() + 1) + " " + std::to_string(t.y() + 1) + " " + std::to_string(t.z() + 1) + "\n";
+    off += "3 " + std::to_string(t.x()) + " " + std::to_string(t.y()) + " " +
+           std::to_string(t.z()) + "\n";
+    obj += "f " + std::to_string(t.x() + 1) + " " + std::to_string(t.y() + 1) + " " +
+           std::to_string(t.z() + 1) + "\n";
     stl += " facet normal 0 0 0\n  outer loop\n";
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d& v = mesh.vertices[std::size_t(t[k])];
-      stl += "   vertex " + std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z()) + "\n";
+      stl += "   vertex " + std::to_string(v.x()) + " " + std::to_string(v.y()) + " " +
+             std::to_string(v.z()) + "\n";
     }
     stl += "  endloop\n endfacet\n";
   }
@@ -91,7 +96,9 @@ void WriteDiveLogSeed(const fs::path& path) {
     mapping::GroundTruthRecord truth;
     truth.points_W = {{0.1, 0.2, 1.0}, {0.1, 0.21, 1.0}};
     truth.object_ids = {0, 1};
-    if (i == 1) frame.image = mapping::LogImage{4, 3, mapping::LogPixelFormat::kMono8, std::vector<std::uint8_t>(12, 7)};
+    if (i == 1)
+      frame.image = mapping::LogImage{4, 3, mapping::LogPixelFormat::kMono8,
+                                      std::vector<std::uint8_t>(12, 7)};
     writer.AppendFrame(frame, &truth);
     writer.AppendNavigation({0.01 * i, Eigen::Isometry3d(Eigen::Translation3d(0.1 * i, 0.0, 5.0))});
   }
@@ -143,35 +150,48 @@ void WriteCalibrationSeeds(const fs::path& folder) {
             "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
             "   data: [ -0.1, 0.05, 0.001, -0.001, 0. ]\n");
   // The same in OpenCV's XML layout (read by content, whatever the file's name).
-  WriteText(folder / "opencv_intrinsics" / "seed_1.yaml",
-            "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>2048</image_width>\n"
-            "<image_height>1088</image_height>\n<camera_matrix type_id=\"opencv-matrix\">\n  <rows>3</rows>\n"
-            "  <cols>3</cols>\n  <dt>d</dt>\n  <data>\n    2400. 0. 1024. 0. 2400. 544. 0. 0. 1.</data></camera_matrix>\n"
-            "<distortion_coefficients type_id=\"opencv-matrix\">\n  <rows>5</rows>\n  <cols>1</cols>\n"
-            "  <dt>d</dt>\n  <data>\n    -0.1 0.05 0.001 -0.001 0.</data></distortion_coefficients>\n"
-            "</opencv_storage>\n");
+  WriteText(
+      folder / "opencv_intrinsics" / "seed_1.yaml",
+      "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>2048</image_width>\n"
+      "<image_height>1088</image_height>\n<camera_matrix type_id=\"opencv-matrix\">\n  "
+      "<rows>3</rows>\n"
+      "  <cols>3</cols>\n  <dt>d</dt>\n  <data>\n    2400. 0. 1024. 0. 2400. 544. 0. 0. "
+      "1.</data></camera_matrix>\n"
+      "<distortion_coefficients type_id=\"opencv-matrix\">\n  <rows>5</rows>\n  <cols>1</cols>\n"
+      "  <dt>d</dt>\n  <data>\n    -0.1 0.05 0.001 -0.001 0.</data></distortion_coefficients>\n"
+      "</opencv_storage>\n");
 }
 
 void WriteReportSeeds(const fs::path& folder) {
-  const std::string tum = "# t tx ty tz qx qy qz qw\n0.0 1 2 3 0 0 0 1\n0.5 1.1 2 3 0 0 0.0998334 0.9950042\n";
+  const std::string tum =
+      "# t tx ty tz qx qy qz qw\n0.0 1 2 3 0 0 0 1\n0.5 1.1 2 3 0 0 0.0998334 0.9950042\n";
   WriteText(folder / "tum_trajectory" / "seed_0.tum", tum);
   std::string covariance = "[0.5";
   for (int i = 0; i < 36; ++i) covariance += i % 7 == 0 ? ", 0.0001" : ", 0";
   covariance += "]";
-  WriteText(folder / "map_report" / "seed_0.json",
-            "{\"uwscan_format\": 1, \"kind\": \"map_report\", \"log\": \"dive.db\",\n"
-            " \"trajectories\": {\"slam\": [[0, 1, 2, 3, 0, 0, 0, 1], [0.5, 1.1, 2, 3, 0, 0, 0, 1]],\n"
-            "                  \"dead_reckoning\": [[0, 1, 2, 3, 0, 0, 0, 1]]},\n"
-            " \"pose_covariance\": [" + covariance + "],\n"
-            " \"loops\": [{\"from_submap\": 0, \"to_submap\": 7, \"accepted\": true, \"reason\": \"\"}]}\n");
-  const std::string pose = "{\"matrix\": [[1, 0, 0, 0.2], [0, 0, -1, 0.05], [0, 1, 0, 1.0], [0, 0, 0, 1]]}";
+  WriteText(
+      folder / "map_report" / "seed_0.json",
+      "{\"uwscan_format\": 1, \"kind\": \"map_report\", \"log\": \"dive.db\",\n"
+      " \"trajectories\": {\"slam\": [[0, 1, 2, 3, 0, 0, 0, 1], [0.5, 1.1, 2, 3, 0, 0, 0, 1]],\n"
+      "                  \"dead_reckoning\": [[0, 1, 2, 3, 0, 0, 0, 1]]},\n"
+      " \"pose_covariance\": [" +
+          covariance +
+          "],\n"
+          " \"loops\": [{\"from_submap\": 0, \"to_submap\": 7, \"accepted\": true, \"reason\": "
+          "\"\"}]}\n");
+  const std::string pose =
+      "{\"matrix\": [[1, 0, 0, 0.2], [0, 0, -1, 0.05], [0, 1, 0, 1.0], [0, 0, 0, 1]]}";
   WriteText(folder / "recognition_report" / "seed_0.json",
             "{\"uwscan_format\": 1, \"kind\": \"recognition_report\", \"scan\": \"scan.ply\",\n"
             " \"database\": \"objects.db\", \"scan_points\": 40,\n"
-            " \"objects\": [{\"id\": \"valve_wheel\", \"segment\": [3, 4, 5, 9], \"centroid_m\": [0.2, 0.05, 1],\n"
-            "   \"score\": 0.9, \"T_S_O\": " + pose + ",\n"
-            "   \"grasps\": [{\"name\": \"rim\", \"matrix\": [[1, 0, 0, 0.2], [0, 1, 0, 0], [0, 0, 1, 0.9], [0, 0, 0, 1]]}]},\n"
-            "  {\"id\": \"unknown\", \"segment\": [0, 1], \"centroid_m\": [0, 0, 1.2]}]}\n");
+            " \"objects\": [{\"id\": \"valve_wheel\", \"segment\": [3, 4, 5, 9], \"centroid_m\": "
+            "[0.2, 0.05, 1],\n"
+            "   \"score\": 0.9, \"T_S_O\": " +
+                pose +
+                ",\n"
+                "   \"grasps\": [{\"name\": \"rim\", \"matrix\": [[1, 0, 0, 0.2], [0, 1, 0, 0], "
+                "[0, 0, 1, 0.9], [0, 0, 0, 1]]}]},\n"
+                "  {\"id\": \"unknown\", \"segment\": [0, 1], \"centroid_m\": [0, 0, 1.2]}]}\n");
 }
 
 void RemoveLog(const fs::path& log) {
@@ -191,7 +211,8 @@ void SimulateSeedDive(const fs::path& data_dir, const fs::path& log) {
   const scanner::sim::Simulator simulator(
       scanner::sim::ParseScene(text, scene_path.string(), scene_path.parent_path()));
   mapping::DiveSimulationOptions options;
-  options.threads = 1;  // five frames: no use for OpenMP's threads in the process that forks the readers
+  options.threads =
+      1;  // five frames: no use for OpenMP's threads in the process that forks the readers
   options.producer = "uwscan bench robustness";
   RemoveLog(log);
   mapping::SimulateDive(simulator, text, log, options);
@@ -208,30 +229,51 @@ void WriteBagSeeds(const fs::path& data_dir, const fs::path& folder) {
   options.producer = "uwscan bench robustness";
   ros::ExportToBag({log}, bag, options);
   RemoveLog(log);
-  ros::WriteCompressedCopy(bag.string(), (folder / "seed_1.bag").string(), ros::BagCompression::kLz4);
-  ros::WriteCompressedCopy(bag.string(), (folder / "seed_2.bag").string(), ros::BagCompression::kBz2);
+  ros::WriteCompressedCopy(bag.string(), (folder / "seed_1.bag").string(),
+                           ros::BagCompression::kLz4);
+  ros::WriteCompressedCopy(bag.string(), (folder / "seed_2.bag").string(),
+                           ros::BagCompression::kBz2);
 }
 
 }  // namespace
 
 void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
-  for (const char* reader :
-       {"cloud_ply", "cloud_pcd", "cloud_xyz", "mesh_off", "mesh_stl", "mesh_obj", "mesh_ply",
-        "scene_yaml", "scanner_yaml", "scan_pattern_yaml", "calibration_scene_yaml",
-        "calibration_manifest", "calibration_truth", "opencv_intrinsics", "dive_log",
-        "object_database", "descriptor_database", "map_report", "recognition_report", "tum_trajectory", "bag"}) {
+  for (const char* reader : {"cloud_ply",
+                             "cloud_pcd",
+                             "cloud_xyz",
+                             "mesh_off",
+                             "mesh_stl",
+                             "mesh_obj",
+                             "mesh_ply",
+                             "scene_yaml",
+                             "scanner_yaml",
+                             "scan_pattern_yaml",
+                             "calibration_scene_yaml",
+                             "calibration_manifest",
+                             "calibration_truth",
+                             "opencv_intrinsics",
+                             "dive_log",
+                             "object_database",
+                             "descriptor_database",
+                             "map_report",
+                             "recognition_report",
+                             "tum_trajectory",
+                             "bag"}) {
     fs::create_directories(folder / reader);
   }
   perception::WriteCloud(folder / "cloud_ply" / "seed_0.ply", SeedCloud(true), true);
   perception::WriteCloud(folder / "cloud_ply" / "seed_1.ply", SeedCloud(false), false);
   perception::WriteCloud(folder / "cloud_pcd" / "seed_0.pcd", SeedCloud(true), true);
   perception::WriteCloud(folder / "cloud_pcd" / "seed_1.pcd", SeedCloud(false), false);
-  WriteText(folder / "cloud_xyz" / "seed_0.xyz", "# x y z\n0.1 0.2 1.0\n0.11 0.2 1.01 7\n\n0.12 0.21 1.0\n");
+  WriteText(folder / "cloud_xyz" / "seed_0.xyz",
+            "# x y z\n0.1 0.2 1.0\n0.11 0.2 1.01 7\n\n0.12 0.21 1.0\n");
   WriteMeshSeeds(folder);
 
   int n = 0;
-  for (const char* scene : {"default.yaml", "inspection_short.yaml", "mems_plane.yaml", "camera_image.yaml"}) {
-    fs::copy_file(data_dir / "scenes" / scene, folder / "scene_yaml" / ("seed_" + std::to_string(n++) + ".yaml"),
+  for (const char* scene :
+       {"default.yaml", "inspection_short.yaml", "mems_plane.yaml", "camera_image.yaml"}) {
+    fs::copy_file(data_dir / "scenes" / scene,
+                  folder / "scene_yaml" / ("seed_" + std::to_string(n++) + ".yaml"),
                   fs::copy_options::overwrite_existing);
   }
   n = 0;
@@ -242,7 +284,8 @@ void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
   }
   n = 0;
   for (const char* file : {"galvo_default.yaml", "mems_default.yaml"}) {
-    fs::copy_file(data_dir / "scanners" / file, folder / "scanner_yaml" / ("seed_" + std::to_string(n++) + ".yaml"),
+    fs::copy_file(data_dir / "scanners" / file,
+                  folder / "scanner_yaml" / ("seed_" + std::to_string(n++) + ".yaml"),
                   fs::copy_options::overwrite_existing);
   }
   scanner::ScanPattern galvo, mems;

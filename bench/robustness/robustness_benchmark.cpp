@@ -31,16 +31,22 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 enum class Mutation { kTruncated, kBytesFlipped, kCountsInflated, kNanInf, kWrongTypes };
-constexpr std::array kMutations = {Mutation::kTruncated, Mutation::kBytesFlipped, Mutation::kCountsInflated,
-                                   Mutation::kNanInf, Mutation::kWrongTypes};
+constexpr std::array kMutations = {Mutation::kTruncated, Mutation::kBytesFlipped,
+                                   Mutation::kCountsInflated, Mutation::kNanInf,
+                                   Mutation::kWrongTypes};
 
 const char* ToString(Mutation m) {
   switch (m) {
-    case Mutation::kTruncated: return "truncated";
-    case Mutation::kBytesFlipped: return "bytes flipped";
-    case Mutation::kCountsInflated: return "count inflated";
-    case Mutation::kNanInf: return "NaN/Inf injected";
-    case Mutation::kWrongTypes: return "wrong type";
+    case Mutation::kTruncated:
+      return "truncated";
+    case Mutation::kBytesFlipped:
+      return "bytes flipped";
+    case Mutation::kCountsInflated:
+      return "count inflated";
+    case Mutation::kNanInf:
+      return "NaN/Inf injected";
+    case Mutation::kWrongTypes:
+      return "wrong type";
   }
   return "?";
 }
@@ -58,8 +64,10 @@ bool IsText(const std::string& bytes) { return bytes.find('\0') == std::string::
 bool ReplaceNumber(std::string& text, const std::string& replacement, std::mt19937_64& rng) {
   static const std::regex number(R"([-+]?[0-9]*\.?[0-9]+([eE][-+]?[0-9]+)?)");
   std::vector<std::pair<std::size_t, std::size_t>> spans;
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator(); ++it) {
-    spans.emplace_back(static_cast<std::size_t>(it->position()), static_cast<std::size_t>(it->length()));
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), number);
+       it != std::sregex_iterator(); ++it) {
+    spans.emplace_back(static_cast<std::size_t>(it->position()),
+                       static_cast<std::size_t>(it->length()));
   }
   if (spans.empty()) return false;
   const auto [at, length] = spans[rng() % spans.size()];
@@ -89,13 +97,17 @@ std::string Mutate(const std::string& seed, Mutation mutation, std::mt19937_64& 
       break;
     case Mutation::kBytesFlipped: {
       const int count = 1 + static_cast<int>(rng() % 16);
-      for (int k = 0; k < count && !bytes.empty(); ++k) bytes[rng() % bytes.size()] = static_cast<char>(rng());
+      for (int k = 0; k < count && !bytes.empty(); ++k)
+        bytes[rng() % bytes.size()] = static_cast<char>(rng());
       break;
     }
     case Mutation::kCountsInflated:
       if (text) {
-        ReplaceNumber(bytes, Pick(std::array{"4294967295", "2147483648", "99999999999999999999", "-1", "0",
-                                             "1000000000"}, rng), rng);
+        ReplaceNumber(bytes,
+                      Pick(std::array{"4294967295", "2147483648", "99999999999999999999", "-1", "0",
+                                      "1000000000"},
+                           rng),
+                      rng);
       } else if (rng() % 2) {
         Overwrite<std::uint32_t>(bytes, rng() % 2 ? 0xFFFFFFFFu : 0x7FFFFFFFu, rng);
       } else {
@@ -104,20 +116,33 @@ std::string Mutate(const std::string& seed, Mutation mutation, std::mt19937_64& 
       break;
     case Mutation::kNanInf:
       if (text) {
-        ReplaceNumber(bytes, Pick(std::array{"nan", ".nan", "NaN", "inf", "-inf", ".inf", "1e999", "-1e999"}, rng), rng);
+        ReplaceNumber(
+            bytes,
+            Pick(std::array{"nan", ".nan", "NaN", "inf", "-inf", ".inf", "1e999", "-1e999"}, rng),
+            rng);
       } else if (rng() % 2) {
-        Overwrite<float>(bytes, rng() % 2 ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity(), rng);
+        Overwrite<float>(bytes,
+                         rng() % 2 ? std::numeric_limits<float>::quiet_NaN()
+                                   : std::numeric_limits<float>::infinity(),
+                         rng);
       } else {
-        Overwrite<double>(bytes, rng() % 2 ? std::numeric_limits<double>::quiet_NaN() : -std::numeric_limits<double>::infinity(), rng);
+        Overwrite<double>(bytes,
+                          rng() % 2 ? std::numeric_limits<double>::quiet_NaN()
+                                    : -std::numeric_limits<double>::infinity(),
+                          rng);
       }
       break;
     case Mutation::kWrongTypes:
       if (text) {
-        ReplaceNumber(bytes, Pick(std::array{"abc", "[1, 2]", "{a: 1}", "true", "\"7\"", "~", "null", "[]"}, rng), rng);
+        ReplaceNumber(
+            bytes,
+            Pick(std::array{"abc", "[1, 2]", "{a: 1}", "true", "\"7\"", "~", "null", "[]"}, rng),
+            rng);
       } else if (!bytes.empty()) {
         const std::string word = "uwscan";
         const std::size_t at = rng() % bytes.size();
-        bytes.replace(at, std::min(word.size(), bytes.size() - at), word.substr(0, bytes.size() - at));
+        bytes.replace(at, std::min(word.size(), bytes.size() - at),
+                      word.substr(0, bytes.size() - at));
       }
       break;
   }
@@ -181,8 +206,10 @@ ChildResult ReadInChild(const std::function<void()>& read, double timeout_s) {
   char buffer[256];
   while (::read(output[0], buffer, sizeof(buffer)) > 0) result.printed = true;
   ::close(output[0]);
-  if (WIFEXITED(status) && WEXITSTATUS(status) == kExitAccepted) result.outcome = Outcome::kAccepted;
-  if (WIFEXITED(status) && WEXITSTATUS(status) == kExitCleanError) result.outcome = Outcome::kCleanError;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kExitAccepted)
+    result.outcome = Outcome::kAccepted;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kExitCleanError)
+    result.outcome = Outcome::kCleanError;
   return result;
 }
 
@@ -190,17 +217,26 @@ void Count(ReaderOutcomes& outcomes, const ChildResult& result, const std::strin
   ++outcomes.tried;
   if (result.printed) ++outcomes.noisy;
   switch (result.outcome) {
-    case Outcome::kAccepted: ++outcomes.accepted; break;
-    case Outcome::kCleanError: ++outcomes.clean_error; break;
-    case Outcome::kCrash: ++outcomes.crash; break;
-    case Outcome::kHang: ++outcomes.hang; break;
+    case Outcome::kAccepted:
+      ++outcomes.accepted;
+      break;
+    case Outcome::kCleanError:
+      ++outcomes.clean_error;
+      break;
+    case Outcome::kCrash:
+      ++outcomes.crash;
+      break;
+    case Outcome::kHang:
+      ++outcomes.hang;
+      break;
   }
   const bool failure = result.outcome == Outcome::kCrash || result.outcome == Outcome::kHang;
   if (failure && outcomes.first_failure.empty()) outcomes.first_failure = what;
 }
 
-ReaderOutcomes MeasureReader(const ReaderProbe& probe, const std::vector<fs::path>& seeds, const fs::path& workspace,
-                             const RobustnessOptions& options, std::mt19937_64& rng) {
+ReaderOutcomes MeasureReader(const ReaderProbe& probe, const std::vector<fs::path>& seeds,
+                             const fs::path& workspace, const RobustnessOptions& options,
+                             std::mt19937_64& rng) {
   ReaderOutcomes outcomes;
   const fs::path input = ReaderInputPath(probe, workspace);
   for (const fs::path& seed_path : seeds) {
@@ -209,7 +245,8 @@ ReaderOutcomes MeasureReader(const ReaderProbe& probe, const std::vector<fs::pat
       for (int k = 0; k < options.mutants_per_kind; ++k) {
         WriteBytes(input, Mutate(seed, mutation, rng));
         const ChildResult result = ReadInChild([&] { probe.read(input); }, options.timeout_s);
-        Count(outcomes, result, seed_path.filename().string() + ", " + ToString(mutation) + " #" + std::to_string(k));
+        Count(outcomes, result,
+              seed_path.filename().string() + ", " + ToString(mutation) + " #" + std::to_string(k));
       }
     }
   }
@@ -248,7 +285,8 @@ OriginalLog WriteOriginalLog(const fs::path& path) {
       truth.object_ids.push_back(k % 3);
     }
     writer.AppendFrame(frame, &truth);
-    const mapping::NavigationRecord nav{kNavigationStep_s * i, Eigen::Isometry3d(Eigen::Translation3d(0.001 * i, 0.0, 5.0))};
+    const mapping::NavigationRecord nav{
+        kNavigationStep_s * i, Eigen::Isometry3d(Eigen::Translation3d(0.001 * i, 0.0, 5.0))};
     writer.AppendNavigation(nav);
     log.frames.push_back(std::move(frame));
     log.truths.push_back(std::move(truth));
@@ -258,8 +296,8 @@ OriginalLog WriteOriginalLog(const fs::path& path) {
 }
 
 bool SameFrame(const mapping::FrameRecord& a, const mapping::FrameRecord& b) {
-  return a.time_s == b.time_s && a.command == b.command && a.sweep == b.sweep && a.peaks_px == b.peaks_px &&
-         a.image.has_value() == b.image.has_value();
+  return a.time_s == b.time_s && a.command == b.command && a.sweep == b.sweep &&
+         a.peaks_px == b.peaks_px && a.image.has_value() == b.image.has_value();
 }
 
 bool SameTruth(const mapping::GroundTruthRecord* a, const mapping::GroundTruthRecord& b) {
@@ -270,10 +308,12 @@ bool SameTruth(const mapping::GroundTruthRecord* a, const mapping::GroundTruthRe
 // A copy of a version 3 log as a version 2 writer would have made it: no checksums.
 void StripChecksums(const fs::path& path) {
   sqlite3* db = nullptr;
-  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) throw Error("cannot open '" + path.string() + "'");
+  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK)
+    throw Error("cannot open '" + path.string() + "'");
   const char* sql =
       "ALTER TABLE header DROP COLUMN checksums; ALTER TABLE frames DROP COLUMN checksums;"
-      "ALTER TABLE ground_truth DROP COLUMN checksums; ALTER TABLE navigation DROP COLUMN checksums;"
+      "ALTER TABLE ground_truth DROP COLUMN checksums; ALTER TABLE navigation DROP COLUMN "
+      "checksums;"
       "UPDATE meta SET value = 2 WHERE key = 'schema_version'; VACUUM;";
   const int rc = sqlite3_exec(db, sql, nullptr, nullptr, nullptr);
   sqlite3_close(db);
@@ -302,7 +342,8 @@ DiveLogDamage CountDamage(const fs::path& damaged, const OriginalLog& original, 
               [&](const mapping::FrameRecord& frame, const mapping::GroundTruthRecord* truth) {
                 ++frames_back;
                 const std::size_t i = static_cast<std::size_t>(frame.index);
-                const bool same = i < original.frames.size() && SameFrame(frame, original.frames[i]) &&
+                const bool same = i < original.frames.size() &&
+                                  SameFrame(frame, original.frames[i]) &&
                                   SameTruth(truth, original.truths[i]);
                 if (!same) ++silent;
               },
@@ -323,7 +364,8 @@ DiveLogDamage CountDamage(const fs::path& damaged, const OriginalLog& original, 
         const int refused = rows - frames_back - navigation_back;
         damage.damaged_rows = refused + silent;
         damage.detected = refused;
-        if (::write(report[1], &damage, sizeof(damage)) != sizeof(damage)) ::_exit(kExitOtherException);
+        if (::write(report[1], &damage, sizeof(damage)) != sizeof(damage))
+          ::_exit(kExitOtherException);
       },
       timeout_s);
   ::close(report[1]);
@@ -332,7 +374,8 @@ DiveLogDamage CountDamage(const fs::path& damaged, const OriginalLog& original, 
   ::close(report[0]);
   if (result.outcome != Outcome::kAccepted || !reported) {
     throw Error("bench robustness: checking a damaged dive log " +
-                std::string(result.outcome == Outcome::kHang ? "hung" : "crashed") + " ('" + damaged.string() + "')");
+                std::string(result.outcome == Outcome::kHang ? "hung" : "crashed") + " ('" +
+                damaged.string() + "')");
   }
   return damage;
 }
@@ -341,7 +384,8 @@ DiveLogDamage MeasureDiveLogDamage(const fs::path& original_path, const Original
                                    const RobustnessOptions& options, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   DiveLogDamage total;
-  const fs::path copy = original_path.parent_path() / ("damaged_" + original_path.filename().string());
+  const fs::path copy =
+      original_path.parent_path() / ("damaged_" + original_path.filename().string());
   for (int trial = 0; trial < options.dive_log_trials; ++trial) {
     DamageCopy(original_path, copy, options.damaged_bytes, rng);
     const DiveLogDamage damage = CountDamage(copy, original, options.timeout_s);
@@ -359,7 +403,8 @@ void RobustnessOptions::Check() const {
   if (dive_log_trials < 0) throw Error("robustness: dive_log_trials must be >= 0");
   if (damaged_bytes < 1) throw Error("robustness: damaged_bytes must be >= 1");
   if (!fs::is_directory(data_dir / "scanners") || !fs::is_directory(data_dir / "scenes")) {
-    throw Error("robustness: data folder '" + data_dir.string() + "' has no scanners/ and scenes/ (use --data)");
+    throw Error("robustness: data folder '" + data_dir.string() +
+                "' has no scanners/ and scenes/ (use --data)");
   }
 }
 
@@ -378,7 +423,8 @@ RobustnessResult RunRobustnessBenchmark(const RobustnessOptions& options, const 
   for (std::size_t p = 0; p < probes.size(); ++p) {
     if (progress) progress("mutated files", double(p) / double(probes.size()));
     std::vector<fs::path> files;
-    for (const fs::directory_entry& entry : fs::directory_iterator(seeds / probes[p].name)) files.push_back(entry.path());
+    for (const fs::directory_entry& entry : fs::directory_iterator(seeds / probes[p].name))
+      files.push_back(entry.path());
     std::sort(files.begin(), files.end());
     result.readers[probes[p].name] = MeasureReader(probes[p], files, workspace, options, rng);
   }
@@ -392,7 +438,8 @@ RobustnessResult RunRobustnessBenchmark(const RobustnessOptions& options, const 
     const fs::path v2 = scratch / "dive_v2.uwlog";
     fs::copy_file(v3, v2);
     StripChecksums(v2);
-    result.dive_log_without_checksums = MeasureDiveLogDamage(v2, original, options, options.seed + 1);
+    result.dive_log_without_checksums =
+        MeasureDiveLogDamage(v2, original, options, options.seed + 1);
     if (progress) progress("damaged dive logs", 1.0);
   }
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -3,7 +3,6 @@
 #include <omp.h>
 
 #include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -50,7 +49,8 @@ Scene BaseScene(const std::filesystem::path& scanner_path, const scanner::Scanne
   return scene;
 }
 
-Eigen::Isometry3d Pose(const Eigen::Vector3d& t, const Eigen::Matrix3d& r = Eigen::Matrix3d::Identity()) {
+Eigen::Isometry3d Pose(const Eigen::Vector3d& t,
+                       const Eigen::Matrix3d& r = Eigen::Matrix3d::Identity()) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = r;
   T.translation() = t;
@@ -62,12 +62,15 @@ class TriangulatorCache {
  public:
   // The triangulator of the simulated scanner, or of `calibration` when it is given (a
   // calibration estimated for the same scanner).
-  const scanner::Triangulator& For(const Simulator& simulator, const scanner::Scanner* calibration = nullptr) {
+  const scanner::Triangulator& For(const Simulator& simulator,
+                                   const scanner::Scanner* calibration = nullptr) {
     const scanner::ScanPattern pattern = simulator.scan_pattern();
     const scanner::Scanner& used = calibration ? *calibration : simulator.scanner();
     // Keyed by the scanner's file text: two equal scanners share one set of tables.
-    const std::string key = scanner::ScannerToYaml(used) + "\n#pattern\n" +
-                            (pattern.kind == scanner::ScannerKind::kMems ? scanner::ScanPatternToYaml(pattern) : "galvo");
+    const std::string key =
+        scanner::ScannerToYaml(used) + "\n#pattern\n" +
+        (pattern.kind == scanner::ScannerKind::kMems ? scanner::ScanPatternToYaml(pattern)
+                                                     : "galvo");
     std::unique_ptr<scanner::Triangulator>& slot = cache_[key];
     if (!slot) {
       // A MEMS calibration triangulates on the lines the simulated scanner designed and drove.
@@ -75,7 +78,8 @@ class TriangulatorCache {
       if (calibration && pattern.kind == scanner::ScannerKind::kMems) {
         build.driven_with = simulator.scanner().mems().functions;
       }
-      slot = scanner::MakeTriangulator(used, pattern, scanner::DefaultTriangulationMethod(pattern.kind), build);
+      slot = scanner::MakeTriangulator(used, pattern,
+                                       scanner::DefaultTriangulationMethod(pattern.kind), build);
     }
     return *slot;
   }
@@ -86,10 +90,9 @@ class TriangulatorCache {
 
 // Every frame simulated (in parallel) and triangulated: points per frame, in peak order, world
 // frame. The peaks' errors are appended to `peak_errors_px` in frame order when it is given.
-std::vector<std::vector<Eigen::Vector3d>> SimulateAndTriangulate(const Simulator& simulator,
-                                                                 const scanner::Triangulator& triangulator,
-                                                                 int threads,
-                                                                 std::vector<double>* peak_errors_px = nullptr) {
+std::vector<std::vector<Eigen::Vector3d>> SimulateAndTriangulate(
+    const Simulator& simulator, const scanner::Triangulator& triangulator, int threads,
+    std::vector<double>* peak_errors_px = nullptr) {
   const std::int64_t count = simulator.frame_count();
   std::vector<std::vector<Eigen::Vector3d>> points(static_cast<size_t>(count));
   std::vector<std::vector<double>> errors(static_cast<size_t>(count));
@@ -100,10 +103,13 @@ std::vector<std::vector<Eigen::Vector3d>> SimulateAndTriangulate(const Simulator
     for (const scanner::TriangulatedPoint& p : out) {
       if (p.ok()) points[static_cast<size_t>(i)].push_back(frame.T_W_C * p.p_C);
     }
-    if (peak_errors_px) errors[static_cast<size_t>(i)] = scanner::sim::PeakErrorsPx(frame, simulator.scene().detector.axis);
+    if (peak_errors_px)
+      errors[static_cast<size_t>(i)] =
+          scanner::sim::PeakErrorsPx(frame, simulator.scene().detector.axis);
   });
   if (peak_errors_px) {
-    for (const std::vector<double>& e : errors) peak_errors_px->insert(peak_errors_px->end(), e.begin(), e.end());
+    for (const std::vector<double>& e : errors)
+      peak_errors_px->insert(peak_errors_px->end(), e.begin(), e.end());
   }
   return points;
 }
@@ -234,15 +240,16 @@ class AccuracyRun {
     const int total = o_.gauge_positions * static_cast<int>(o_.gauge_lengths_m.size());
     int done = 0;
     for (int i = 0; i < o_.gauge_positions; ++i) {
-      const double t = o_.gauge_positions > 1 ? static_cast<double>(i) / (o_.gauge_positions - 1) : 0.0;
+      const double t =
+          o_.gauge_positions > 1 ? static_cast<double>(i) / (o_.gauge_positions - 1) : 0.0;
       const Eigen::Vector3d position(0.06 * std::sin(1.7 * i), 0.04 * std::cos(2.3 * i),
                                      o_.gauge_near_m + t * (o_.gauge_far_m - o_.gauge_near_m));
       // Turned about the gauge's own length (y): the stripe still runs along it.
       const Eigen::Matrix3d yaw =
-          Eigen::AngleAxisd(0.35 * std::sin(0.9 * i + 0.3), Eigen::Vector3d::UnitY()).toRotationMatrix();
+          Eigen::AngleAxisd(0.35 * std::sin(0.9 * i + 0.3), Eigen::Vector3d::UnitY())
+              .toRotationMatrix();
       for (double length : o_.gauge_lengths_m) {
-        Scene scene = BaseScene(o_.galvo_scanner, galvo_,
-                                underwater ? kWaterIndex : kAirIndex,
+        Scene scene = BaseScene(o_.galvo_scanner, galvo_, underwater ? kWaterIndex : kAirIndex,
                                 underwater ? o_.water_attenuation_per_m : 0.0,
                                 o_.seed + static_cast<std::uint64_t>(1000 * i) +
                                     static_cast<std::uint64_t>(length * 1e4));
@@ -260,8 +267,9 @@ class AccuracyRun {
           scene.scanner.galvo = *steps;
           if (realistic) scene.effects = scanner::sim::RealisticImageEffects(underwater);
           const Simulator simulator(scene);
-          measured = MeasureGaugeLength(SimulateAndTriangulate(simulator, cache_.For(simulator, calibration), threads_,
-                                                               realistic && underwater ? &gauge_peak_errors_px_ : nullptr));
+          measured = MeasureGaugeLength(
+              SimulateAndTriangulate(simulator, cache_.For(simulator, calibration), threads_,
+                                     realistic && underwater ? &gauge_peak_errors_px_ : nullptr));
         }
         if (measured) {
           errors.push_back(*measured - length);
@@ -275,8 +283,7 @@ class AccuracyRun {
   }
 
   Scene MemsScene(int waypoints, std::uint64_t seed, bool realistic) const {
-    Scene scene = BaseScene(o_.mems_scanner, mems_, kWaterIndex,
-                            o_.water_attenuation_per_m, seed);
+    Scene scene = BaseScene(o_.mems_scanner, mems_, kWaterIndex, o_.water_attenuation_per_m, seed);
     scene.scanner.mems.lines = o_.mems_lines;
     scene.scanner.mems.waypoints_per_line = waypoints;
     if (realistic) scene.effects = scanner::sim::RealisticImageEffects(true);
@@ -302,9 +309,10 @@ class AccuracyRun {
       scene.objects.push_back(PlaneAt(d));
       const Simulator simulator(scene);
       std::vector<double> peak_errors_px;
-      const std::vector<Eigen::Vector3d> points =
-          Flatten(SimulateAndTriangulate(simulator, cache_.For(simulator), threads_, &peak_errors_px));
-      plane_peak_errors_px_.insert(plane_peak_errors_px_.end(), peak_errors_px.begin(), peak_errors_px.end());
+      const std::vector<Eigen::Vector3d> points = Flatten(
+          SimulateAndTriangulate(simulator, cache_.For(simulator), threads_, &peak_errors_px));
+      plane_peak_errors_px_.insert(plane_peak_errors_px_.end(), peak_errors_px.begin(),
+                                   peak_errors_px.end());
       PlaneRow row;
       row.distance_m = d;
       row.points = static_cast<std::int64_t>(points.size());
@@ -365,7 +373,8 @@ class AccuracyRun {
         }
       }
       rows.push_back(row);
-      if (progress_) progress_("waypoints", static_cast<double>(k + 1) / o_.waypoints_per_line.size());
+      if (progress_)
+        progress_("waypoints", static_cast<double>(k + 1) / o_.waypoints_per_line.size());
     }
     return rows;
   }
@@ -399,7 +408,8 @@ void AccuracyBenchOptions::Check() const {
     if (!(d > 0.0)) throw Error("bench accuracy: plane distances must be > 0 m");
   }
   for (double d : sphere_distances_m) {
-    if (!(d > sphere_radius_m)) throw Error("bench accuracy: sphere distances must exceed the radius");
+    if (!(d > sphere_radius_m))
+      throw Error("bench accuracy: sphere distances must exceed the radius");
   }
   for (int m : waypoints_per_line) {
     if (m < 2) throw Error("bench accuracy: waypoints per line must be >= 2");
@@ -409,7 +419,8 @@ void AccuracyBenchOptions::Check() const {
 }
 
 GaugeFigures RunGaugeExperiment(const AccuracyBenchOptions& options, bool underwater,
-                                const std::optional<scanner::Scanner>& calibration, const Progress& progress) {
+                                const std::optional<scanner::Scanner>& calibration,
+                                const Progress& progress) {
   options.Check();
   AccuracyRun run(options, progress);
   return run.Gauges(underwater, true, underwater ? "gauges in water" : "gauges in air",

@@ -26,14 +26,16 @@ double Seconds(Clock::time_point since) {
 }
 
 // The true values of the parameters a step records, by name.
-std::map<std::string, double> TrueValues(const std::string& step, const scanner::Scanner& true_scanner) {
+std::map<std::string, double> TrueValues(const std::string& step,
+                                         const scanner::Scanner& true_scanner) {
   std::vector<scanner::ParameterEstimate> list;
   if (step == "mems") return {};
   const scanner::GalvoScannerModel& truth = true_scanner.galvo();
   if (step == "intrinsics") list = cal::CameraParameters(truth.camera.camera);
   if (step == "viewport") list = cal::ViewportParameters("camera_viewport", truth.camera.viewport);
   if (step == "laser") list = cal::GalvoLaserParameters(truth.laser);
-  if (step == "laser_viewport") list = cal::ViewportParameters("laser_viewport", truth.laser.viewport);
+  if (step == "laser_viewport")
+    list = cal::ViewportParameters("laser_viewport", truth.laser.viewport);
   std::map<std::string, double> values;
   for (const scanner::ParameterEstimate& p : list) values[p.name] = p.value;
   return values;
@@ -42,8 +44,8 @@ std::map<std::string, double> TrueValues(const std::string& step, const scanner:
 // Largest distance, at 0.8 and 1.5 m deep, between the estimated MEMS beams and the true ones,
 // at the voltage pairs the dataset saw on two planes or more (where the functions were fitted;
 // beyond them a polynomial extrapolates).
-double MemsBeamError(const scanner::Scanner& estimated_scanner, const scanner::Scanner& true_scanner,
-                     const cal::CalibrationDataset& dataset) {
+double MemsBeamError(const scanner::Scanner& estimated_scanner,
+                     const scanner::Scanner& true_scanner, const cal::CalibrationDataset& dataset) {
   const scanner::MemsScannerModel& estimated = estimated_scanner.mems();
   const scanner::MemsScannerModel& truth = true_scanner.mems();
   std::map<std::pair<double, double>, int> planes_of;
@@ -72,7 +74,8 @@ double MemsBeamError(const scanner::Scanner& estimated_scanner, const scanner::S
 double FanError(const scanner::Scanner& true_scanner, const scanner::Scanner& estimated_scanner,
                 const std::optional<double>& water_index) {
   const scanner::GalvoScannerModel truth = cal::ScannerInMedium(true_scanner, water_index).galvo();
-  const scanner::GalvoScannerModel estimated = cal::ScannerInMedium(estimated_scanner, water_index).galvo();
+  const scanner::GalvoScannerModel estimated =
+      cal::ScannerInMedium(estimated_scanner, water_index).galvo();
   double worst = 0.0;
   const double max_tan = truth.laser.MaxFanTan();
   for (int step = truth.laser.step_min; step <= truth.laser.step_max; step += 20) {
@@ -97,7 +100,8 @@ void CalibrationBenchOptions::Check() const {
   if (gauge_positions < 1) throw Error("bench calibration: gauge_positions must be >= 1");
   if (threads < 0) throw Error("bench calibration: threads must be >= 0");
   if (!std::filesystem::is_directory(data_dir / "scenes")) {
-    throw Error("bench calibration: " + (data_dir / "scenes").string() + " is not a folder (give --data)");
+    throw Error("bench calibration: " + (data_dir / "scenes").string() +
+                " is not a folder (give --data)");
   }
 }
 
@@ -107,7 +111,8 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
   const Clock::time_point start = Clock::now();
   ScratchFolder scratch("bench-calibration");
   CalibrationBenchResult result;
-  std::optional<scanner::Scanner> galvo_chain;  // the galvanometer calibration as it grows step by step
+  std::optional<scanner::Scanner>
+      galvo_chain;  // the galvanometer calibration as it grows step by step
   const std::vector<std::string>& steps = cal::CalibrationSteps();
   for (size_t k = 0; k < steps.size(); ++k) {
     const std::string& step = steps[k];
@@ -115,19 +120,21 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
     figures.step = step;
     const std::filesystem::path folder = scratch.path() / step;
     const Clock::time_point simulated = Clock::now();
-    cal::SimulateCalibrationDataset(options.data_dir / "scenes" / ("calib_" + step + ".yaml"), folder,
-                                    [&](double f) {
+    cal::SimulateCalibrationDataset(options.data_dir / "scenes" / ("calib_" + step + ".yaml"),
+                                    folder, [&](double f) {
                                       if (progress) progress("dataset " + step, f);
                                     });
     figures.dataset_seconds = Seconds(simulated);
     const cal::CalibrationDataset dataset = cal::LoadCalibrationDataset(folder);
-    if (!dataset.truth_file) throw Error(folder.string() + ": a simulated dataset must name its truth");
+    if (!dataset.truth_file)
+      throw Error(folder.string() + ": a simulated dataset must name its truth");
     const scanner::Scanner truth = cal::LoadDatasetTruth(*dataset.truth_file).scanner;
     // The galvanometer steps start from the previous step's output, as a user chains them.
     const bool chained = step != "mems" && step != "intrinsics" && galvo_chain.has_value();
     // Intrinsics need no starting values: they are written into the CAD scanner file.
-    const std::filesystem::path start_file =
-        dataset.scanner_file ? *dataset.scanner_file : options.data_dir / "scanners" / "galvo_cad.yaml";
+    const std::filesystem::path start_file = dataset.scanner_file
+                                                 ? *dataset.scanner_file
+                                                 : options.data_dir / "scanners" / "galvo_cad.yaml";
     const scanner::Scanner initial = chained ? *galvo_chain : scanner::LoadScanner(start_file);
     const cal::CalibrationStepOutcome outcome = cal::RunCalibrationStep(
         step, dataset, initial, chained ? "the previous step's output" : start_file.string(),
@@ -143,15 +150,18 @@ CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& op
     const std::map<std::string, double> truth_values = TrueValues(step, truth);
     for (const scanner::ParameterEstimate& p : outcome.record.params) {
       const auto it = truth_values.find(p.name);
-      figures.params.push_back({p.name, it == truth_values.end() ? std::numeric_limits<double>::quiet_NaN() : it->second,
-                                p.value, p.std});
+      figures.params.push_back(
+          {p.name, it == truth_values.end() ? std::numeric_limits<double>::quiet_NaN() : it->second,
+           p.value, p.std});
     }
     if (step == "mems") {
-      figures.params.push_back({"beam_error_max_m", 0.0, MemsBeamError(outcome.scanner, truth, dataset), 0.0});
+      figures.params.push_back(
+          {"beam_error_max_m", 0.0, MemsBeamError(outcome.scanner, truth, dataset), 0.0});
     }
     if (step == "laser" || step == "laser_viewport") {
-      figures.params.push_back(
-          {"fan_error_max_m", 0.0, FanError(truth, outcome.scanner, dataset.water_refractive_index), 0.0});
+      figures.params.push_back({"fan_error_max_m", 0.0,
+                                FanError(truth, outcome.scanner, dataset.water_refractive_index),
+                                0.0});
     }
     result.steps.push_back(figures);
   }

@@ -24,7 +24,7 @@ struct CalibrationBenchOptions {
 
 struct ParameterFigure {
   std::string name;
-  double truth = 0.0;     // NaN when the parameter has no true counterpart
+  double truth = 0.0;  // NaN when the parameter has no true counterpart
   double estimated = 0.0;
   double std = 0.0;
 };

@@ -23,7 +23,7 @@ struct DeformationOptions {
   double projection_distance_m = 1.5;
   int incidence_angles = 21;
   double max_incidence_rad = 0.3839724354387525;  // 22 degrees
-  double source_to_viewport_m = 0.05;  // fan apex to the inner face
+  double source_to_viewport_m = 0.05;             // fan apex to the inner face
   double thickness_m = 0.015;
   scanner::ConeFitOptions cone;
 

@@ -40,7 +40,8 @@ std::vector<std::pair<std::string, std::function<void(SimulationEffects&)>>> Eff
       {"backscatter", [](SimulationEffects& e) { e.backscatter.on = true; }},
       {"ambient", [](SimulationEffects& e) { e.ambient.on = true; }},
   };
-  if (mems) list.emplace_back("mirror_dynamics", [](SimulationEffects& e) { e.mirror_dynamics = true; });
+  if (mems)
+    list.emplace_back("mirror_dynamics", [](SimulationEffects& e) { e.mirror_dynamics = true; });
   return list;
 }
 
@@ -61,8 +62,10 @@ SimulationEffects OffWithParameters() {
 // Times every row's frames in round-robin passes (row 1, row 2, ..., then again), so that a
 // drift of the shared machine's speed does not favour the rows measured first or last; each row
 // keeps its fastest pass.
-std::vector<EffectCost> TimeRows(const Scene& base, const std::vector<std::pair<std::string, SimulationEffects>>& rows,
-                                 const SimulationBenchOptions& o, const std::function<void(double)>& done) {
+std::vector<EffectCost> TimeRows(const Scene& base,
+                                 const std::vector<std::pair<std::string, SimulationEffects>>& rows,
+                                 const SimulationBenchOptions& o,
+                                 const std::function<void(double)>& done) {
   std::vector<std::unique_ptr<scanner::sim::Simulator>> simulators;
   for (const auto& row : rows) {
     Scene scene = base;
@@ -100,11 +103,13 @@ void SimulationBenchOptions::Check() const {
   if (repeats < 1) throw Error("bench simulation: repeats must be >= 1");
 }
 
-SimulationBenchResult RunSimulationBenchmark(const SimulationBenchOptions& o, const Progress& progress) {
+SimulationBenchResult RunSimulationBenchmark(const SimulationBenchOptions& o,
+                                             const Progress& progress) {
   o.Check();
   SimulationBenchResult result;
   result.frames = o.frames;
-  for (const auto& [name, file] : {std::pair{"galvo", "default.yaml"}, std::pair{"mems", "mems_plane.yaml"}}) {
+  for (const auto& [name, file] :
+       {std::pair{"galvo", "default.yaml"}, std::pair{"mems", "mems_plane.yaml"}}) {
     const Scene scene = scanner::sim::LoadScene(o.data_dir / "scenes" / file);
     const bool mems = std::string(name) == "mems";
     std::vector<std::pair<std::string, SimulationEffects>> rows = {{"none", AllOff()}};

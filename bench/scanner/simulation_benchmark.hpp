@@ -16,8 +16,8 @@ namespace uwscan::bench {
 // ray caster's acceleration structure, the scanner's tables) is not timed.
 struct SimulationBenchOptions {
   std::filesystem::path data_dir = "data";  // scenes/default.yaml (galvo), scenes/mems_plane.yaml
-  int frames = 12;     // frames timed per row, evenly spread over the sweep, >= 1
-  int repeats = 3;     // passes per row; the fastest counts, >= 1
+  int frames = 12;  // frames timed per row, evenly spread over the sweep, >= 1
+  int repeats = 3;  // passes per row; the fastest counts, >= 1
   void Check() const;
 };
 

@@ -161,7 +161,8 @@ StripeBenchResult RunStripeBenchmark(const StripeBenchOptions& o, const Progress
   ColumnMaximumPass limit(o.width_px);
   result.limit_frames_per_s = MeasureSpeed(speed_frames, o, limit);
   if (limit.sink() == 0) throw Error("bench stripe: the limit pass saw only black frames");
-  for (auto& [name, f] : result.methods) f.fraction_of_limit = f.frames_per_s / result.limit_frames_per_s;
+  for (auto& [name, f] : result.methods)
+    f.fraction_of_limit = f.frames_per_s / result.limit_frames_per_s;
   return result;
 }
 

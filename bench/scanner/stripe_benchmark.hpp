@@ -40,7 +40,7 @@ struct StripeMethodFigures {
 };
 
 struct StripeBenchResult {
-  std::string default_method;                          // ToString(StripeDetectorOptions{}.method)
+  std::string default_method;  // ToString(StripeDetectorOptions{}.method)
   // The floor of any per-column detector, measured on the same frames in the same run: one
   // pass reading every pixel in row order (the detectors' memory order) that keeps each
   // column's running maximum, and nothing else.

@@ -1,11 +1,11 @@
 #include "bench/scanner/triangulation_benchmark.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <memory>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -95,8 +95,9 @@ std::vector<Frame> MakeFrames(const scanner::GalvoScannerModel& model,
 // machine).
 template <typename TriangulateFrame>
 double TimePasses(const std::vector<Frame>& frames, int repeats,
-                  std::vector<std::vector<scanner::TriangulatedPoint>>* results, const std::string& what,
-                  const Progress& progress, TriangulateFrame&& triangulate_frame) {
+                  std::vector<std::vector<scanner::TriangulatedPoint>>* results,
+                  const std::string& what, const Progress& progress,
+                  TriangulateFrame&& triangulate_frame) {
   results->resize(frames.size());
   for (size_t f = 0; f < frames.size(); ++f) (*results)[f].resize(frames[f].peaks_px.size());
   double best = std::numeric_limits<double>::infinity();
@@ -110,7 +111,8 @@ double TimePasses(const std::vector<Frame>& frames, int repeats,
 }
 
 double RunMethod(const scanner::Triangulator& method, const std::vector<Frame>& frames, int repeats,
-                 std::vector<std::vector<scanner::TriangulatedPoint>>* results, const Progress& progress) {
+                 std::vector<std::vector<scanner::TriangulatedPoint>>* results,
+                 const Progress& progress) {
   return TimePasses(frames, repeats, results, ToString(method.method()), progress,
                     [&](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
                       method.TriangulateFrame(frame.step, frame.peaks_px, out);
@@ -121,7 +123,8 @@ double RunMethod(const scanner::Triangulator& method, const std::vector<Frame>& 
 // table (prefetched ahead, as the methods do) and one multiply-add per coordinate, o + s d,
 // with a per-frame s standing for the surface. No intersection, no tests.
 double RunLimit(const scanner::CameraRayTable& rays, const std::vector<Frame>& frames, int repeats,
-                std::vector<std::vector<scanner::TriangulatedPoint>>* results, const Progress& progress) {
+                std::vector<std::vector<scanner::TriangulatedPoint>>* results,
+                const Progress& progress) {
   return TimePasses(frames, repeats, results, "limit", progress,
                     [&](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
                       const std::vector<Eigen::Vector2d>& px = frame.peaks_px;
@@ -129,11 +132,13 @@ double RunLimit(const scanner::CameraRayTable& rays, const std::vector<Frame>& f
                       scanner::Ray ray;
                       for (size_t i = 0; i < px.size(); ++i) {
                         if (i + scanner::CameraRayTable::kPrefetchAhead < px.size()) {
-                          rays.Prefetch(px[i + scanner::CameraRayTable::kPrefetchAhead].x(), px[i + scanner::CameraRayTable::kPrefetchAhead].y());
+                          rays.Prefetch(px[i + scanner::CameraRayTable::kPrefetchAhead].x(),
+                                        px[i + scanner::CameraRayTable::kPrefetchAhead].y());
                         }
                         const bool in = rays.Lookup(px[i].x(), px[i].y(), &ray);
                         out[i].p_C = ray.origin + s * ray.direction;
-                        out[i].status = in ? scanner::HitStatus::kHit : scanner::HitStatus::kNoIntersection;
+                        out[i].status =
+                            in ? scanner::HitStatus::kHit : scanner::HitStatus::kNoIntersection;
                       }
                     });
 }
@@ -156,7 +161,8 @@ void CompareTo(const std::vector<std::vector<scanner::TriangulatedPoint>>& resul
   figures->triangulated = triangulated;
   if (n == 0) return;
   figures->mean_err_m = sum / n;
-  figures->std_err_m = std::sqrt(std::max(0.0, sum2 / n - figures->mean_err_m * figures->mean_err_m));
+  figures->std_err_m =
+      std::sqrt(std::max(0.0, sum2 / n - figures->mean_err_m * figures->mean_err_m));
   figures->max_err_m = max;
 }
 
@@ -168,7 +174,8 @@ void SetRate(std::int64_t points, MethodFigures* figures) {
 TableResolutionRow MeasureTables(std::shared_ptr<const scanner::CameraRayTable> rays,
                                  std::shared_ptr<const scanner::LightSurfaceTable> surfaces,
                                  const std::vector<Frame>& frames, std::int64_t points,
-                                 const std::vector<std::vector<scanner::TriangulatedPoint>>& exact, int repeats) {
+                                 const std::vector<std::vector<scanner::TriangulatedPoint>>& exact,
+                                 int repeats) {
   TableResolutionRow row;
   std::vector<std::vector<scanner::TriangulatedPoint>> approximate;
   const scanner::RayPlaneTriangulator ray_plane(rays, surfaces);
@@ -183,15 +190,15 @@ TableResolutionRow MeasureTables(std::shared_ptr<const scanner::CameraRayTable> 
 }
 
 // Each table resolution of the options in turn, the other table at its default.
-std::vector<TableResolutionRow> SweepResolutions(const scanner::GalvoScannerModel& model,
-                                                 const TriangulationBenchOptions& o,
-                                                 std::shared_ptr<const scanner::CameraRayTable> default_rays,
-                                                 std::shared_ptr<const scanner::LightSurfaceTable> default_surfaces,
-                                                 const std::vector<Frame>& frames, std::int64_t points,
-                                                 const std::vector<std::vector<scanner::TriangulatedPoint>>& exact,
-                                                 const Progress& progress) {
+std::vector<TableResolutionRow> SweepResolutions(
+    const scanner::GalvoScannerModel& model, const TriangulationBenchOptions& o,
+    std::shared_ptr<const scanner::CameraRayTable> default_rays,
+    std::shared_ptr<const scanner::LightSurfaceTable> default_surfaces,
+    const std::vector<Frame>& frames, std::int64_t points,
+    const std::vector<std::vector<scanner::TriangulatedPoint>>& exact, const Progress& progress) {
   std::vector<TableResolutionRow> rows;
-  const double total = static_cast<double>(o.sweep_camera_grid_px.size() + o.sweep_rays_per_fan.size());
+  const double total =
+      static_cast<double>(o.sweep_camera_grid_px.size() + o.sweep_rays_per_fan.size());
   const auto add = [&](const char* table, int value, double setup_s, TableResolutionRow row) {
     row.table = table;
     row.value = value;
@@ -203,13 +210,15 @@ std::vector<TableResolutionRow> SweepResolutions(const scanner::GalvoScannerMode
     const Clock::time_point start = Clock::now();
     auto rays = std::make_shared<const scanner::CameraRayTable>(model.camera, grid_px);
     const double setup_s = SecondsSince(start);
-    add("camera_rays", grid_px, setup_s, MeasureTables(rays, default_surfaces, frames, points, exact, o.repeats));
+    add("camera_rays", grid_px, setup_s,
+        MeasureTables(rays, default_surfaces, frames, points, exact, o.repeats));
   }
   for (const int rays_per_fan : o.sweep_rays_per_fan) {
     scanner::LightSurfaceTableOptions surface_options = o.surfaces;
     surface_options.rays_per_fan = rays_per_fan;
     const Clock::time_point start = Clock::now();
-    auto surfaces = std::make_shared<const scanner::LightSurfaceTable>(model.laser, surface_options);
+    auto surfaces =
+        std::make_shared<const scanner::LightSurfaceTable>(model.laser, surface_options);
     const double setup_s = SecondsSince(start);
     add("light_surfaces", rays_per_fan, setup_s,
         MeasureTables(default_rays, surfaces, frames, points, exact, o.repeats));
@@ -283,7 +292,8 @@ TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerMo
     SetRate(result.points, &figures);
     figures.fraction_of_limit = figures.points_per_s / result.limit_points_per_s;
   }
-  result.resolution = SweepResolutions(model, o, rays, surfaces, frames, result.points, exact, progress);
+  result.resolution =
+      SweepResolutions(model, o, rays, surfaces, frames, result.points, exact, progress);
   return result;
 }
 

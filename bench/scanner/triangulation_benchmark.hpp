@@ -57,7 +57,7 @@ struct TableResolutionRow {
 
 struct TriangulationBenchResult {
   std::int64_t points = 0;
-  double setup_s = 0.0;              // tables: camera rays, plane and cone fits per step
+  double setup_s = 0.0;               // tables: camera rays, plane and cone fits per step
   double exact_vs_truth_max_m = 0.0;  // ray-ray against the generating points
   std::map<std::string, MethodFigures> methods;  // keyed by ToString(method)
   // The floor of any table method on the same pixels in the same run: per peak the camera-ray

@@ -38,12 +38,14 @@ open3d::geometry::PointCloud ToOpen3d(const perception::PointCloud& cloud) {
 }
 
 // Point-to-plane ICP of source onto target from T_init (target <- source), coarse then fine.
-Eigen::Matrix4d Icp(const open3d::geometry::PointCloud& source, const open3d::geometry::PointCloud& target,
-                    const Eigen::Matrix4d& T_init, Eigen::Matrix6d* information) {
+Eigen::Matrix4d Icp(const open3d::geometry::PointCloud& source,
+                    const open3d::geometry::PointCloud& target, const Eigen::Matrix4d& T_init,
+                    Eigen::Matrix6d* information) {
   const reg::TransformationEstimationPointToPlane point_to_plane;
   Eigen::Matrix4d T = T_init;
   for (double distance : {kCoarse_m, 0.02, kFine_m}) {
-    T = reg::RegistrationICP(source, target, distance, T, point_to_plane, reg::ICPConvergenceCriteria(1e-6, 1e-6, 30))
+    T = reg::RegistrationICP(source, target, distance, T, point_to_plane,
+                             reg::ICPConvergenceCriteria(1e-6, 1e-6, 30))
             .transformation_;
   }
   *information = reg::GetInformationMatrixFromPointClouds(source, target, kFine_m, T);
@@ -66,7 +68,8 @@ std::vector<std::pair<std::size_t, std::size_t>> Pairs(const std::vector<Eigen::
                                                        const std::vector<double>& radii) {
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
   for (std::size_t j = 1; j < centres.size(); ++j) {
-    for (std::size_t i = j > kLocalPairs ? j - kLocalPairs : 0; i < j; ++i) pairs.emplace_back(i, j);
+    for (std::size_t i = j > kLocalPairs ? j - kLocalPairs : 0; i < j; ++i)
+      pairs.emplace_back(i, j);
     std::optional<std::size_t> nearest;
     double nearest_m = 0.0;
     for (std::size_t i = 0; i + kLoopGap <= j; ++i) {
@@ -83,7 +86,8 @@ std::vector<std::pair<std::size_t, std::size_t>> Pairs(const std::vector<Eigen::
 
 bool Open3dMultiwayAvailable() { return true; }
 
-std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& m, int threads, double* seconds) {
+std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& m, int threads,
+                                               double* seconds) {
   (void)threads;  // Open3D's ICP uses its own OpenMP default
   open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
   const auto start = std::chrono::steady_clock::now();
@@ -107,7 +111,8 @@ std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& m, in
   // Edges as in Open3D's multiway tutorial: transformation maps the source (i) into the target
   // (j); consecutive pairs are odometry (certain), the others loop candidates (uncertain).
   for (const auto& [i, j] : Pairs(centres, radii)) {
-    const Eigen::Matrix4d T_init = (m.dead_reckoning[j].T_W_V.inverse() * m.dead_reckoning[i].T_W_V).matrix();
+    const Eigen::Matrix4d T_init =
+        (m.dead_reckoning[j].T_W_V.inverse() * m.dead_reckoning[i].T_W_V).matrix();
     Eigen::Matrix6d information;
     const Eigen::Matrix4d T = Icp(sources[i], targets[j], T_init, &information);
     graph.edges_.emplace_back(static_cast<int>(i), static_cast<int>(j), T, information, j != i + 1);

@@ -1,14 +1,13 @@
 #include "bench/slam/slam_benchmark.hpp"
 
 #include <omp.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
-
-#include <yaml-cpp/yaml.h>
 
 #include "bench/scratch_folder.hpp"
 #include "mapping/log/dive_simulation.hpp"
@@ -35,11 +34,13 @@ std::string ReadText(const std::filesystem::path& path) {
   return text.str();
 }
 
-SurfaceDistance DistanceToScene(const perception::PointCloud& map, const scanner::sim::RayCaster& caster, int threads) {
+SurfaceDistance DistanceToScene(const perception::PointCloud& map,
+                                const scanner::sim::RayCaster& caster, int threads) {
   std::vector<double> distances(map.size());
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(map.size()); ++i) {
-    const std::optional<double> d = caster.DistanceToSurface(map.Point(static_cast<size_t>(i)), kSurfaceSearch_m);
+    const std::optional<double> d =
+        caster.DistanceToSurface(map.Point(static_cast<size_t>(i)), kSurfaceSearch_m);
     distances[static_cast<size_t>(i)] = d.value_or(kSurfaceSearch_m);
   }
   SurfaceDistance out;
@@ -53,7 +54,8 @@ SurfaceDistance DistanceToScene(const perception::PointCloud& map, const scanner
   out.mean_m = sum / static_cast<double>(distances.size());
   out.rms_m = std::sqrt(sum2 / static_cast<double>(distances.size()));
   const std::size_t k = static_cast<std::size_t>(0.95 * static_cast<double>(distances.size() - 1));
-  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(k), distances.end());
+  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(k),
+                   distances.end());
   out.p95_m = distances[k];
   return out;
 }
@@ -62,8 +64,8 @@ SurfaceDistance DistanceToScene(const perception::PointCloud& map, const scanner
 // the map no trajectory estimate can beat, voxelised as the maps it is compared with. What
 // separates it from the true surfaces is the sensor's own error (peak noise, refraction at
 // grazing angles, voxel centroids across edges).
-perception::PointCloud TruePoseMap(const mapping::DiveLogReader& log, const std::filesystem::path& table_cache,
-                                   double voxel_m) {
+perception::PointCloud TruePoseMap(const mapping::DiveLogReader& log,
+                                   const std::filesystem::path& table_cache, double voxel_m) {
   mapping::ReconstructionOptions options;
   options.use_navigation = false;
   options.table_cache = table_cache;
@@ -76,7 +78,9 @@ perception::PointCloud TruePoseMap(const mapping::DiveLogReader& log, const std:
     if (r.frame_of_point[i] != frame) {
       frame = r.frame_of_point[i];
       const std::optional<mapping::GroundTruthRecord> truth = log.ReadGroundTruth(frame);
-      if (!truth) throw Error(log.path().string() + ": frame " + std::to_string(frame) + " has no ground truth");
+      if (!truth)
+        throw Error(log.path().string() + ": frame " + std::to_string(frame) +
+                    " has no ground truth");
       T_W_C = truth->T_W_C;
     }
     points_W.push_back(T_W_C * r.points[i]);
@@ -87,8 +91,8 @@ perception::PointCloud TruePoseMap(const mapping::DiveLogReader& log, const std:
 }
 
 // The dive's submaps placed with other poses (the dead reckoning's, a peer's), voxelised.
-perception::PointCloud PlacedMap(const mapping::DiveMapping& m, const std::vector<mapping::TimedPose>& poses,
-                                 double voxel_m) {
+perception::PointCloud PlacedMap(const mapping::DiveMapping& m,
+                                 const std::vector<mapping::TimedPose>& poses, double voxel_m) {
   std::vector<const perception::PointCloud*> clouds;
   std::vector<Eigen::Isometry3d> placed;
   for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -118,8 +122,8 @@ std::string WithSeed(const std::string& yaml_text, std::uint64_t seed) {
 // Maps the dive's log and measures it against the truth (the scene's surfaces) and the peers,
 // into `f`; the log is closed on return.
 void MapAndMeasure(const std::filesystem::path& log_path, const scanner::sim::Scene& scene,
-                   const SlamBenchOptions& options, const std::string& label, const Progress& progress,
-                   DiveFigures* out) {
+                   const SlamBenchOptions& options, const std::string& label,
+                   const Progress& progress, DiveFigures* out) {
   DiveFigures& f = *out;
   mapping::DiveMappingOptions map_options;
   map_options.mapper.threads = options.threads;
@@ -127,8 +131,9 @@ void MapAndMeasure(const std::filesystem::path& log_path, const scanner::sim::Sc
   map_options.keep_submaps = true;
   omp_set_num_threads(options.threads);
   const mapping::DiveLogReader log(log_path);
-  const mapping::DiveMapping m = mapping::MapDive(
-      log, map_options, [&](double fraction) { if (progress) progress("map " + label, fraction); });
+  const mapping::DiveMapping m = mapping::MapDive(log, map_options, [&](double fraction) {
+    if (progress) progress("map " + label, fraction);
+  });
   if (m.truth.empty()) throw Error(f.name + ": the simulated log has no truth");
   const mapping::MapSummary s = mapping::Summarise(m);
   f.duration_s = m.dive_duration_s;
@@ -145,14 +150,14 @@ void MapAndMeasure(const std::filesystem::path& log_path, const scanner::sim::Sc
   if (progress) progress("surface distances " + label, 0.0);
   f.dead_reckoning.ate_m = *s.ate_dead_reckoning_m;
   f.dead_reckoning.rpe_per_m = s.rpe_dead_reckoning_per_m;
-  f.dead_reckoning.map =
-      DistanceToScene(PlacedMap(m, m.dead_reckoning, map_options.map_voxel_m), caster, options.threads);
+  f.dead_reckoning.map = DistanceToScene(PlacedMap(m, m.dead_reckoning, map_options.map_voxel_m),
+                                         caster, options.threads);
   f.slam.ate_m = *s.ate_slam_m;
   f.slam.rpe_per_m = s.rpe_slam_per_m;
   f.slam.map = DistanceToScene(m.map, caster, options.threads);
   f.slam.seconds = m.seconds;
-  f.true_poses_map = DistanceToScene(TruePoseMap(log, options.table_cache, map_options.map_voxel_m), caster,
-                                     options.threads);
+  f.true_poses_map = DistanceToScene(TruePoseMap(log, options.table_cache, map_options.map_voxel_m),
+                                     caster, options.threads);
   if (options.run_open3d && Open3dMultiwayAvailable()) {
     if (progress) progress("open3d " + label, 0.0);
     TrajectoryFigures o;
@@ -166,8 +171,9 @@ void MapAndMeasure(const std::filesystem::path& log_path, const scanner::sim::Sc
 
 // One dive of a scene with the given seed: simulated into a log in `folder`, mapped, measured;
 // the log is removed afterwards (a long dive's is hundreds of MB).
-DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t seed, const SlamBenchOptions& options,
-                      const std::filesystem::path& folder, const Progress& progress) {
+DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t seed,
+                      const SlamBenchOptions& options, const std::filesystem::path& folder,
+                      const Progress& progress) {
   DiveFigures f;
   f.name = scene_path.stem().string();
   f.seed = seed;
@@ -186,9 +192,10 @@ DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t see
     mapping::DiveSimulationOptions sim_options;
     sim_options.threads = options.threads;
     sim_options.producer = "uwscan bench slam";
-    const mapping::DiveSimulationSummary summary = mapping::SimulateDive(
-        simulator, scene_text, log_path, sim_options,
-        [&](double fraction) { if (progress) progress("simulate " + label, fraction); });
+    const mapping::DiveSimulationSummary summary =
+        mapping::SimulateDive(simulator, scene_text, log_path, sim_options, [&](double fraction) {
+          if (progress) progress("simulate " + label, fraction);
+        });
     f.simulate_seconds = summary.seconds;
   }
   MapAndMeasure(log_path, scene, options, label, progress, &f);
@@ -207,11 +214,13 @@ void SlamBenchOptions::Check() const {
   if (seeds < 1) throw Error("bench slam: seeds must be > 0");
   if (threads < 1) throw Error("bench slam: threads must be > 0");
   if (!(std::isfinite(walk_scale) && walk_scale > 0.0)) {
-    throw Error("bench slam: walk scale must be a finite number > 0, got " + std::to_string(walk_scale));
+    throw Error("bench slam: walk scale must be a finite number > 0, got " +
+                std::to_string(walk_scale));
   }
 }
 
-std::string SceneWithWalkScale(const std::string& yaml_text, double scale, const std::filesystem::path& scene_path) {
+std::string SceneWithWalkScale(const std::string& yaml_text, double scale,
+                               const std::filesystem::path& scene_path) {
   if (scale == 1.0) return yaml_text;
   YAML::Node root;
   try {
@@ -238,8 +247,8 @@ std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Pro
   for (const std::filesystem::path& scene_path : options.scenes) {
     const std::uint64_t first_seed = scanner::sim::LoadScene(scene_path).seed;
     for (int draw = 0; draw < options.seeds; ++draw) {
-      dives.push_back(BenchDive(scene_path, first_seed + static_cast<std::uint64_t>(draw), options, scratch.path(),
-                                progress));
+      dives.push_back(BenchDive(scene_path, first_seed + static_cast<std::uint64_t>(draw), options,
+                                scratch.path(), progress));
     }
   }
   return dives;

@@ -65,19 +65,23 @@ struct DiveFigures {
   double simulate_seconds = 0.0;
 };
 
-std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options, const Progress& progress = {});
+std::vector<DiveFigures> RunSlamBench(const SlamBenchOptions& options,
+                                      const Progress& progress = {});
 
 // A scene's YAML text with its navigation's random walks (position and heading) multiplied by
 // `scale` (SlamBenchOptions::walk_scale), everything else as it was; the text itself when the
 // scale is 1. Throws naming `scene_path` when the text is not YAML or the scene has no navigation
 // drift to scale.
-std::string SceneWithWalkScale(const std::string& yaml_text, double scale, const std::filesystem::path& scene_path);
+std::string SceneWithWalkScale(const std::string& yaml_text, double scale,
+                               const std::filesystem::path& scene_path);
 
 // Open3D's multiway registration (pairwise point-to-plane ICP of each submap with the three
 // before it and with the nearest older one its navigated position overlaps, about the pairs
-// uwscan's mapper tries; then GlobalOptimization with its line process) on the submaps of `mapping`,
-// started from the dead reckoning: the submap poses it finds. Throws when Open3D is not built in.
-std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& mapping, int threads, double* seconds);
+// uwscan's mapper tries; then GlobalOptimization with its line process) on the submaps of
+// `mapping`, started from the dead reckoning: the submap poses it finds. Throws when Open3D is not
+// built in.
+std::vector<mapping::TimedPose> Open3dMultiway(const mapping::DiveMapping& mapping, int threads,
+                                               double* seconds);
 bool Open3dMultiwayAvailable();
 
 }  // namespace uwscan::bench

@@ -13,7 +13,8 @@
 namespace uwscan::bench {
 namespace {
 
-const std::filesystem::path kScenes = std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data" / "scenes";
+const std::filesystem::path kScenes =
+    std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data" / "scenes";
 
 std::string ReadScene(const std::string& name) {
   std::ifstream in(kScenes / name, std::ios::binary);

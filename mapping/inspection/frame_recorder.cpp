@@ -21,7 +21,8 @@ std::size_t FrameBytes(const FrameRecord& f) {
 }
 
 std::size_t RecordBytes(const Record& r) {
-  return std::holds_alternative<FrameRecord>(r) ? FrameBytes(std::get<FrameRecord>(r)) : sizeof(NavigationRecord);
+  return std::holds_alternative<FrameRecord>(r) ? FrameBytes(std::get<FrameRecord>(r))
+                                                : sizeof(NavigationRecord);
 }
 
 }  // namespace
@@ -100,7 +101,9 @@ void FrameRecorder::Push(FrameRecord frame) {
     waited = true;
     m.changed.wait(lock);
   }
-  if (waited) m.stats.blocked_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (waited)
+    m.stats.blocked_s +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (m.failure) std::rethrow_exception(m.failure);
   m.queue.push_back(std::move(frame));
   m.stats.queued_bytes += bytes;

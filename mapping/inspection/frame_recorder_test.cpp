@@ -11,7 +11,8 @@ namespace {
 // A queue far smaller than the frames: Push() waits for the writer, and still every frame
 // pushed is in the log, in order, bit for bit.
 TEST(FrameRecorder, WritesEveryFrameInOrderEvenWithATinyQueue) {
-  const fs::path path = fs::temp_directory_path() / ("uwscan_frame_recorder_" + std::to_string(getpid()) + ".db");
+  const fs::path path =
+      fs::temp_directory_path() / ("uwscan_frame_recorder_" + std::to_string(getpid()) + ".db");
   fs::remove(path);
   const int frames = 60;
   {
@@ -31,13 +32,15 @@ TEST(FrameRecorder, WritesEveryFrameInOrderEvenWithATinyQueue) {
     ASSERT_EQ(f.peaks_px.size(), expected.peaks_px.size());
     EXPECT_EQ(f.time_s, expected.time_s);
     EXPECT_EQ(f.command, expected.command);
-    for (std::size_t k = 0; k < f.peaks_px.size(); ++k) EXPECT_EQ(f.peaks_px[k], expected.peaks_px[k]);
+    for (std::size_t k = 0; k < f.peaks_px.size(); ++k)
+      EXPECT_EQ(f.peaks_px[k], expected.peaks_px[k]);
   }
   fs::remove(path);
 }
 
 TEST(FrameRecorder, AWriteErrorReachesThePusher) {
-  const fs::path path = fs::temp_directory_path() / ("uwscan_frame_recorder_bad_" + std::to_string(getpid()) + ".db");
+  const fs::path path =
+      fs::temp_directory_path() / ("uwscan_frame_recorder_bad_" + std::to_string(getpid()) + ".db");
   fs::remove(path);
   FrameRecorder recorder(DiveLogWriter(path, TestHeader()), 1 << 20);
   FrameRecord bad = TestFrame(0, 3);

@@ -3,9 +3,8 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <cerrno>
-
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -84,7 +83,7 @@ struct LiveInspection::Impl {
 
   mutable std::mutex mutex;
   std::condition_variable changed;
-  std::deque<InspectionFrame> live;  // newest frames waiting for the mapper
+  std::deque<InspectionFrame> live;          // newest frames waiting for the mapper
   std::vector<NavigationRecord> navigation;  // waiting for the mapper
   bool finishing = false;
   bool finished = false;
@@ -103,16 +102,20 @@ struct LiveInspection::Impl {
 
   Impl(const InspectionOptions& o, const DiveLogHeader& header, const Eigen::Isometry3d& T_V_C,
        const NavigationNoise& noise)
-      : options(o), mapper(header.scanner, header.scan_pattern, T_V_C, noise, o.mapper, o.table_cache) {}
+      : options(o),
+        mapper(header.scanner, header.scan_pattern, T_V_C, noise, o.mapper, o.table_cache) {}
 
-  void OnPlaced(const FrameRecord& frame, const Eigen::Isometry3d& T_W_C, std::span<const Eigen::Vector3d> points) {
+  void OnPlaced(const FrameRecord& frame, const Eigen::Isometry3d& T_W_C,
+                std::span<const Eigen::Vector3d> points) {
     const double now = NowUnixSeconds();
     FrameTimes times;
     if (auto it = in_mapper.find(frame.index); it != in_mapper.end()) {
       times = it->second;
       in_mapper.erase(it);
     }
-    if (on_mapped) on_mapped(MappedFrame{frame.index, frame.time_s, frame.sweep, times.receive_time_s, T_W_C, points});
+    if (on_mapped)
+      on_mapped(
+          MappedFrame{frame.index, frame.time_s, frame.sweep, times.receive_time_s, T_W_C, points});
     std::lock_guard<std::mutex> lock(mutex);
     ++stats.frames_mapped;
     --stats.frames_waiting;
@@ -135,7 +138,8 @@ struct LiveInspection::Impl {
   bool Map(InspectionFrame& frame) {
     FrameRecord& f = frame.record;
     if (options.fixed_scanner) {
-      if (last_time_s && (f.time_s + time_offset_s < *last_time_s || f.sweep + sweep_offset < last_sweep)) {
+      if (last_time_s &&
+          (f.time_s + time_offset_s < *last_time_s || f.sweep + sweep_offset < last_sweep)) {
         time_offset_s = *last_time_s - f.time_s;
         sweep_offset = last_sweep + 1 - f.sweep;
         std::lock_guard<std::mutex> lock(mutex);
@@ -161,7 +165,8 @@ struct LiveInspection::Impl {
     const id_t thread_id = static_cast<id_t>(::gettid());
     errno = 0;
     const int nice_now = ::getpriority(PRIO_PROCESS, thread_id);
-    if (errno == 0) ::setpriority(PRIO_PROCESS, thread_id, std::min(19, nice_now + options.mapper_nice));
+    if (errno == 0)
+      ::setpriority(PRIO_PROCESS, thread_id, std::min(19, nice_now + options.mapper_nice));
     std::unique_lock<std::mutex> lock(mutex);
     while (true) {
       changed.wait(lock, [this] { return !live.empty() || !navigation.empty() || finishing; });
@@ -207,7 +212,8 @@ struct LiveInspection::Impl {
 
 LiveInspection::LiveInspection(const DiveLogHeader& header, const std::filesystem::path& log,
                                const Eigen::Isometry3d& T_V_C, const NavigationNoise& noise,
-                               const InspectionOptions& options, std::function<void(const MappedFrame&)> on_mapped) {
+                               const InspectionOptions& options,
+                               std::function<void(const MappedFrame&)> on_mapped) {
   options.Check();
   noise.Check();
   InspectionOptions effective = options;
@@ -222,9 +228,8 @@ LiveInspection::LiveInspection(const DiveLogHeader& header, const std::filesyste
   }
   Impl* m = impl_.get();
   m->mapper.SetFramePlacedCallback(
-      [m](const FrameRecord& f, const Eigen::Isometry3d& T_W_C, std::span<const Eigen::Vector3d> points) {
-        m->OnPlaced(f, T_W_C, points);
-      });
+      [m](const FrameRecord& f, const Eigen::Isometry3d& T_W_C,
+          std::span<const Eigen::Vector3d> points) { m->OnPlaced(f, T_W_C, points); });
   m->mapper.SetFrameLeftOutCallback([m](const FrameRecord& f) { m->OnLeftOut(f); });
   m->thread = std::thread([m] { m->Run(); });
 }

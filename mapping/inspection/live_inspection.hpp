@@ -90,16 +90,16 @@ struct InspectionStatistics {
 
 struct InspectionResult {
   InspectionStatistics statistics;
-  perception::PointCloud map;  // voxelised at map_voxel_m, world frame (SLAM poses)
-  std::vector<TimedPose> slam;  // T_W_V at each submap's anchor, estimated
+  perception::PointCloud map;         // voxelised at map_voxel_m, world frame (SLAM poses)
+  std::vector<TimedPose> slam;        // T_W_V at each submap's anchor, estimated
   std::vector<TimedPose> navigation;  // T_W_V at each submap's anchor, as the navigation gave it
 };
 
 // A frame just placed in the map, for a live view (called on the mapping thread).
 struct MappedFrame {
-  std::int64_t index = 0;  // the frame's index in the log (push order)
-  double time_s = 0.0;     // its capture time (the camera's clock, as logged)
-  int sweep = 0;           // its sweep, as given
+  std::int64_t index = 0;       // the frame's index in the log (push order)
+  double time_s = 0.0;          // its capture time (the camera's clock, as logged)
+  int sweep = 0;                // its sweep, as given
   double receive_time_s = 0.0;  // when it arrived (InspectionFrame::receive_time_s)
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::span<const Eigen::Vector3d> points_W;  // valid during the call
@@ -118,8 +118,9 @@ class LiveInspection {
   // vehicle; `noise`: how far the navigation is trusted (zeros for a fixed scanner).
   // `on_mapped` is called on the mapping thread for every frame placed. Throws uwscan::Error on
   // invalid options, a log that cannot be created, or a scanner that gives no triangulator.
-  LiveInspection(const DiveLogHeader& header, const std::filesystem::path& log, const Eigen::Isometry3d& T_V_C,
-                 const NavigationNoise& noise, const InspectionOptions& options,
+  LiveInspection(const DiveLogHeader& header, const std::filesystem::path& log,
+                 const Eigen::Isometry3d& T_V_C, const NavigationNoise& noise,
+                 const InspectionOptions& options,
                  std::function<void(const MappedFrame&)> on_mapped = {});
   ~LiveInspection();  // stops the threads; call Finish() to see errors and the map
   LiveInspection(const LiveInspection&) = delete;

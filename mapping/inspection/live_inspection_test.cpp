@@ -23,12 +23,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double Now() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
+double Now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
 
 // Nearest-point distances through a hash grid of `cell_m` cells (the 27 around a point).
 class NearestPoints {
  public:
-  NearestPoints(const std::vector<Eigen::Vector3d>& points, double cell_m) : points_(points), cell_m_(cell_m) {
+  NearestPoints(const std::vector<Eigen::Vector3d>& points, double cell_m)
+      : points_(points), cell_m_(cell_m) {
     for (std::size_t i = 0; i < points.size(); ++i) grid_.emplace(Key(points[i], 0, 0, 0), i);
   }
   // Distance to the nearest point, or cell_m when none lies within the neighbouring cells.
@@ -38,7 +41,8 @@ class NearestPoints {
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
           auto [first, last] = grid_.equal_range(Key(p, dx, dy, dz));
-          for (auto it = first; it != last; ++it) best = std::min(best, (points_[it->second] - p).norm());
+          for (auto it = first; it != last; ++it)
+            best = std::min(best, (points_[it->second] - p).norm());
         }
     return best;
   }
@@ -61,8 +65,8 @@ class LiveInspectionTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("uwscan_live_inspection_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
-    const scanner::sim::Simulator simulator(
-        scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/default.yaml"));
+    const scanner::sim::Simulator simulator(scanner::sim::LoadScene(
+        fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/default.yaml"));
     DiveSimulationOptions options;
     options.threads = 2;
     SimulateDive(simulator, "", dir_ / "sim.db", options);
@@ -70,10 +74,12 @@ class LiveInspectionTest : public ::testing::Test {
     header_ = new DiveLogHeader(log.header());
     frames_ = new std::vector<FrameRecord>();
     truth_ = new std::vector<std::vector<Eigen::Vector3d>>();
-    log.ForEachFrame([](const FrameRecord& f, const GroundTruthRecord* t) {
-      frames_->push_back(f);
-      truth_->push_back(t->points_W);
-    }, true);
+    log.ForEachFrame(
+        [](const FrameRecord& f, const GroundTruthRecord* t) {
+          frames_->push_back(f);
+          truth_->push_back(t->points_W);
+        },
+        true);
   }
   static void TearDownTestSuite() {
     delete header_;
@@ -125,10 +131,11 @@ TEST_F(LiveInspectionTest, EveryFrameIsLoggedAndMappedOntoTheTruth) {
   double worst_frame_m = 0.0;
   std::int64_t frames_checked = 0;
   const fs::path log = dir_ / "every.db";
-  LiveInspection inspection(*header_, log, Eigen::Isometry3d::Identity(), NavigationNoise{}, options,
-                            [&](const MappedFrame& f) {
+  LiveInspection inspection(*header_, log, Eigen::Isometry3d::Identity(), NavigationNoise{},
+                            options, [&](const MappedFrame& f) {
                               const NearestPoints truth(Truth(f.index), 0.01);
-                              for (const Eigen::Vector3d& p : f.points_W) worst_frame_m = std::max(worst_frame_m, truth.Distance(p));
+                              for (const Eigen::Vector3d& p : f.points_W)
+                                worst_frame_m = std::max(worst_frame_m, truth.Distance(p));
                               ++frames_checked;
                             });
   for (std::int64_t k = 0; k < n; ++k) inspection.Push(Frame(k));
@@ -183,8 +190,8 @@ TEST_F(LiveInspectionTest, WhenTheMapperIsBehindTheOldestFramesAreSkippedNotLogg
   std::condition_variable changed;
   bool first_placed = false, release = false;
   std::set<std::int64_t> mapped;
-  LiveInspection inspection(*header_, dir_ / "skip.db", Eigen::Isometry3d::Identity(), NavigationNoise{}, options,
-                            [&](const MappedFrame& f) {
+  LiveInspection inspection(*header_, dir_ / "skip.db", Eigen::Isometry3d::Identity(),
+                            NavigationNoise{}, options, [&](const MappedFrame& f) {
                               std::unique_lock<std::mutex> lock(mutex);
                               mapped.insert(f.index);
                               first_placed = true;
@@ -220,7 +227,8 @@ TEST_F(LiveInspectionTest, WhenTheMapperIsBehindTheOldestFramesAreSkippedNotLogg
 TEST_F(LiveInspectionTest, LatencyIsMeasuredFromCaptureAndFromReceive) {
   InspectionOptions options = Options();
   options.live_queue_frames = 1000;
-  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{},
+                            options);
   const std::int64_t n = 30;
   for (std::int64_t k = 0; k < n; ++k) {
     InspectionFrame f = Frame(k);
@@ -243,7 +251,8 @@ TEST_F(LiveInspectionTest, LatencyIsMeasuredFromCaptureAndFromReceive) {
 TEST_F(LiveInspectionTest, AFixedScannerMapsOnWhenTheCameraClockRestarts) {
   InspectionOptions options = Options();
   options.live_queue_frames = 100000;
-  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{},
+                            options);
   const std::int64_t n = static_cast<std::int64_t>(frames_->size());
   for (std::int64_t k = 0; k < n + 10; ++k) inspection.Push(Frame(k));
   for (std::int64_t k = 0; k < 20; ++k) inspection.Push(Frame(k));  // time and sweep from 0 again
@@ -259,7 +268,8 @@ TEST_F(LiveInspectionTest, WithNavigationFramesWaitForItAndOldOnesAreRefused) {
   InspectionOptions options = Options();
   options.fixed_scanner = false;
   options.live_queue_frames = 100000;
-  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{},
+                            options);
   for (std::int64_t k = 0; k < 20; ++k) inspection.Push(Frame(k));
   InspectionFrame old = Frame(3);
   inspection.Push(std::move(old));
@@ -285,7 +295,8 @@ TEST_F(LiveInspectionTest, FramesInANavigationDropoutAreCountedNotMapped) {
   InspectionOptions options = Options();
   options.fixed_scanner = false;
   options.live_queue_frames = 100000;
-  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{},
+                            options);
   const double last_sample_s = Frame(6).record.time_s;
   std::int64_t after = 0;
   for (std::int64_t k = 0; k < 20; ++k) {
@@ -312,7 +323,8 @@ TEST_F(LiveInspectionTest, FramesAfterTheNavigationStoppedAreLeftOutWithoutPilin
   options.fixed_scanner = false;
   options.live_queue_frames = 100000;
   const fs::path log = dir_ / "stopped.db";
-  LiveInspection inspection(*header_, log, Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  LiveInspection inspection(*header_, log, Eigen::Isometry3d::Identity(), NavigationNoise{},
+                            options);
   const double stop_s = 0.5;
   inspection.AddNavigation({0.0, Eigen::Isometry3d::Identity()});
   inspection.AddNavigation({stop_s, Eigen::Isometry3d::Identity()});
@@ -347,7 +359,8 @@ TEST_F(LiveInspectionTest, FramesAfterTheNavigationStoppedAreLeftOutWithoutPilin
 TEST_F(LiveInspectionTest, FramesWithoutAnyNavigationFailClearly) {
   InspectionOptions options = Options();
   options.fixed_scanner = false;
-  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{}, options);
+  LiveInspection inspection(*header_, "", Eigen::Isometry3d::Identity(), NavigationNoise{},
+                            options);
   inspection.Push(Frame(0));
   EXPECT_THROW(inspection.Finish(), Error);
 }

@@ -37,23 +37,23 @@ struct LogImage {
 // simulated dive was given): what mapping weighs navigation against scan matching with. Zero
 // means "exact" (a simulated dive without drift); mapping puts a floor under each value.
 struct NavigationNoise {
-  double position_walk_m_per_sqrt_s = 0.0;  // random-walk density of dead-reckoned x and y
-  double heading_walk_rad_per_sqrt_s = 0.0; // random-walk density of the heading
-  double speed_scale_sigma = 0.0;           // std of the DVL speed scale error (0.01 = 1 %)
-  double heading_bias_sigma_rad = 0.0;      // std of the heading bias
-  double depth_sigma_m = 0.0;               // white noise of the pressure depth
-  double roll_pitch_sigma_rad = 0.0;        // white noise of the AHRS roll and pitch
+  double position_walk_m_per_sqrt_s = 0.0;   // random-walk density of dead-reckoned x and y
+  double heading_walk_rad_per_sqrt_s = 0.0;  // random-walk density of the heading
+  double speed_scale_sigma = 0.0;            // std of the DVL speed scale error (0.01 = 1 %)
+  double heading_bias_sigma_rad = 0.0;       // std of the heading bias
+  double depth_sigma_m = 0.0;                // white noise of the pressure depth
+  double roll_pitch_sigma_rad = 0.0;         // white noise of the AHRS roll and pitch
   // Throws uwscan::Error naming the field when a value is negative or not finite.
   void Check() const;
 };
 
 struct DiveLogHeader {
   int schema_version = kDiveLogSchemaVersion;  // filled by the reader; the writer writes its own
-  scanner::Scanner scanner;          // the scanner (its calibration) the dive was taken with
+  scanner::Scanner scanner;           // the scanner (its calibration) the dive was taken with
   scanner::ScanPattern scan_pattern;  // how the dive was scanned
-  std::string scene_yaml;  // scene text when simulated, empty otherwise (a record, not read back)
-  std::string created_utc;   // ISO 8601 ("2024-05-01T12:34:56Z"), set by the writer
-  std::string producer;      // e.g. "uwscan simulate 0.1.0"
+  std::string scene_yaml;   // scene text when simulated, empty otherwise (a record, not read back)
+  std::string created_utc;  // ISO 8601 ("2024-05-01T12:34:56Z"), set by the writer
+  std::string producer;     // e.g. "uwscan simulate 0.1.0"
   // The navigation's noise model (schema version 2 on); std::nullopt when the log does not
   // say (a version 1 log, or a vehicle whose specifications were not given).
   std::optional<NavigationNoise> navigation_noise;
@@ -163,7 +163,8 @@ class DiveLogReader {
   // log (no `meta` table), of another or a newer schema version, or lacks a table or column;
   // and, when opened as kIntact, when the file is shorter than its own header says (a copy or
   // transfer cut short: `uwscan log salvage` recovers what it holds).
-  explicit DiveLogReader(const std::filesystem::path& path, DiveLogOpening opening = DiveLogOpening::kIntact);
+  explicit DiveLogReader(const std::filesystem::path& path,
+                         DiveLogOpening opening = DiveLogOpening::kIntact);
   ~DiveLogReader();
   DiveLogReader(DiveLogReader&&) noexcept;
   DiveLogReader& operator=(DiveLogReader&&) noexcept;

@@ -43,11 +43,12 @@ TEST_F(DiveLogTest, ChecksumsNameTheRowAndColumnOfDamageThatKeepsTheType) {
       {"UPDATE frames SET time_s = time_s + 1e-9 WHERE frame_index = 3", "frame 3", "time_s"},
       {"UPDATE frames SET command = command + 1 WHERE frame_index = 2", "frame 2", "command"},
       {"UPDATE frames SET sweep = 1 WHERE frame_index = 0", "frame 0", "sweep"},
-      {"UPDATE frames SET image_width_px = 85, image_height_px = 1 WHERE frame_index = 1", "frame 1",
-       "image_width_px"},
+      {"UPDATE frames SET image_width_px = 85, image_height_px = 1 WHERE frame_index = 1",
+       "frame 1", "image_width_px"},
       {"UPDATE ground_truth SET T_W_C_tz = T_W_C_tz + 0.001 WHERE frame_index = 2", "frame 2",
        "T_W_C_tz"},
-      {"UPDATE frames SET checksums = zeroblob(36) WHERE frame_index = 3", "frame 3", "frame_index"},
+      {"UPDATE frames SET checksums = zeroblob(36) WHERE frame_index = 3", "frame 3",
+       "frame_index"},
       {"UPDATE frames SET checksums = x'00' WHERE frame_index = 3", "frame 3", "checksums"},
   };
   int n = 0;
@@ -55,7 +56,8 @@ TEST_F(DiveLogTest, ChecksumsNameTheRowAndColumnOfDamageThatKeepsTheType) {
     const fs::path path = WriteLog(("typed" + std::to_string(n++) + ".uwlog").c_str(), 5, 8);
     RawExec(path, damage.sql);
     const DiveLogReader reader(path);
-    const std::string m = MessageOf([&] { reader.ForEachFrame([](const auto&, const auto*) {}, true); });
+    const std::string m =
+        MessageOf([&] { reader.ForEachFrame([](const auto&, const auto*) {}, true); });
     EXPECT_NE(m.find(path.string()), std::string::npos) << damage.sql << ": " << m;
     EXPECT_NE(m.find(damage.where + ":"), std::string::npos) << damage.sql << ": " << m;
     EXPECT_NE(m.find("column " + damage.column), std::string::npos) << damage.sql << ": " << m;
@@ -72,8 +74,9 @@ TEST_F(DiveLogTest, ChecksumsNameTheRowAndColumnOfDamageThatKeepsTheType) {
             std::string::npos);
   const fs::path points = WriteLog("points.uwlog", 5, 8);
   FlipBlobBit(points, "ground_truth", "points_W", "frame_index = 4", 100);
-  EXPECT_NE(MessageOf([&] { DiveLogReader(points).ReadGroundTruth(4); }).find("frame 4: column points_W"),
-            std::string::npos);
+  EXPECT_NE(
+      MessageOf([&] { DiveLogReader(points).ReadGroundTruth(4); }).find("frame 4: column points_W"),
+      std::string::npos);
 
   // The navigation, the vehicle mount and the header.
   const fs::path nav = WriteLog("nav.uwlog", 2, 8);
@@ -82,11 +85,13 @@ TEST_F(DiveLogTest, ChecksumsNameTheRowAndColumnOfDamageThatKeepsTheType) {
             std::string::npos);
   const fs::path mount = WriteLog("mount.uwlog", 2, 8);
   RawExec(mount, "UPDATE header SET T_V_C_ty = T_V_C_ty + 0.01");
-  EXPECT_NE(MessageOf([&] { DiveLogReader reader(mount); }).find("column T_V_C_ty"), std::string::npos);
+  EXPECT_NE(MessageOf([&] { DiveLogReader reader(mount); }).find("column T_V_C_ty"),
+            std::string::npos);
   const fs::path header = WriteLog("header.uwlog", 2, 8);
   RawExec(header, "UPDATE header SET scanner_yaml = replace(scanner_yaml, '2400.5', '2401.5')");
-  EXPECT_NE(MessageOf([&] { DiveLogReader reader(header); }).find("table header: column scanner_yaml"),
-            std::string::npos);
+  EXPECT_NE(
+      MessageOf([&] { DiveLogReader reader(header); }).find("table header: column scanner_yaml"),
+      std::string::npos);
 }
 
 TEST_F(DiveLogTest, LogsOfEarlierSchemaVersionsStillRead) {

@@ -1,9 +1,8 @@
-#include "mapping/log/dive_log.hpp"
-
 #include <gtest/gtest.h>
 
 #include <set>
 
+#include "mapping/log/dive_log.hpp"
 #include "mapping/log/dive_log_test_support.hpp"
 
 // Reading damaged, foreign and still-growing logs, and a writer killed mid-write.
@@ -21,9 +20,10 @@ TEST_F(DiveLogTest, ATruncatedLogIsNamedAsSuchAndItsFramesCanBeRecovered) {
   fs::resize_file(cut, size / 2);
 
   const std::string message = MessageOf([&] { DiveLogReader reader(cut); });
-  EXPECT_NE(message.find("dive log '" + cut.string() + "' is truncated: " + std::to_string(size / 2) +
-                         " bytes of the " + std::to_string(size) + " its header gives"),
-            std::string::npos)
+  EXPECT_NE(
+      message.find("dive log '" + cut.string() + "' is truncated: " + std::to_string(size / 2) +
+                   " bytes of the " + std::to_string(size) + " its header gives"),
+      std::string::npos)
       << message;
   EXPECT_NE(message.find("uwscan log salvage"), std::string::npos) << message;
 
@@ -51,7 +51,8 @@ TEST_F(DiveLogTest, ATruncatedLogIsNamedAsSuchAndItsFramesCanBeRecovered) {
   for (const std::int64_t index : without_truth) EXPECT_EQ(truth_damaged.count(index), 1u) << index;
   EXPECT_FALSE(check.ok());
   ASSERT_FALSE(check.integrity.empty());
-  EXPECT_EQ(check.integrity.front().rfind("the file is truncated: ", 0), 0u) << check.integrity.front();
+  EXPECT_EQ(check.integrity.front().rfind("the file is truncated: ", 0), 0u)
+      << check.integrity.front();
   EXPECT_EQ(recovered, check.frames_intact);
   EXPECT_GT(recovered, 20);
   EXPECT_LT(recovered, 200);
@@ -84,10 +85,12 @@ TEST_F(DiveLogTest, ReaderNamesTheFileAndWhatIsWrong) {
 
   const fs::path newer = WriteLog("newer.uwlog", 2, 3);
   const int next = kDiveLogSchemaVersion + 1;
-  RawExec(newer, "UPDATE meta SET value = " + std::to_string(next) + " WHERE key = 'schema_version'");
+  RawExec(newer,
+          "UPDATE meta SET value = " + std::to_string(next) + " WHERE key = 'schema_version'");
   const std::string message = MessageOf([&] { DiveLogReader reader(newer); });
-  EXPECT_EQ(message, "dive log '" + newer.string() + "' has schema version " + std::to_string(next) +
-                         ", this uwscan reads 1 to " + std::to_string(kDiveLogSchemaVersion));
+  EXPECT_EQ(message, "dive log '" + newer.string() + "' has schema version " +
+                         std::to_string(next) + ", this uwscan reads 1 to " +
+                         std::to_string(kDiveLogSchemaVersion));
 
   const fs::path no_noise = WriteLog("no_noise.uwlog", 2, 3);
   RawExec(no_noise, "DROP TABLE navigation_noise");

@@ -31,16 +31,17 @@ std::string Checksums(const char* table, bool checksummed) {
 // checksums cover (dive_log_format.hpp), then the checksums.
 std::string FrameColumns(bool checksummed) {
   return "f.frame_index, f.time_s, f.command, f.sweep, f.peaks_px, f.image_width_px, "
-         "f.image_height_px, f.image_format, f.image, " + Checksums("f", checksummed);
+         "f.image_height_px, f.image_format, f.image, " +
+         Checksums("f", checksummed);
 }
 constexpr int kNumFrameColumns = 10;
 // Selected by ground truth queries and decoded by DecodeTruth, in this order (frame_index is
 // NULL when the frame has no ground truth).
 std::string TruthColumns(bool checksummed) {
   return "g.frame_index, g.T_W_C_tx, g.T_W_C_ty, g.T_W_C_tz, g.T_W_C_qx, g.T_W_C_qy, "
-         "g.T_W_C_qz, g.T_W_C_qw, g.points_W, g.object_ids, " + Checksums("g", checksummed);
+         "g.T_W_C_qz, g.T_W_C_qw, g.points_W, g.object_ids, " +
+         Checksums("g", checksummed);
 }
-
 
 // FrameColumns from column 0; the row's context names the frame.
 FrameRecord DecodeFrame(const Row& row, std::int64_t index, bool checksummed) {
@@ -91,8 +92,8 @@ std::optional<std::string> Truncation(const fs::path& path) {
   unsigned char h[100];
   if (!in.read(reinterpret_cast<char*>(h), sizeof(h))) return std::nullopt;
   const auto be32 = [&h](int at) {
-    return (std::uint32_t(h[at]) << 24) | (std::uint32_t(h[at + 1]) << 16) | (std::uint32_t(h[at + 2]) << 8) |
-           std::uint32_t(h[at + 3]);
+    return (std::uint32_t(h[at]) << 24) | (std::uint32_t(h[at + 1]) << 16) |
+           (std::uint32_t(h[at + 2]) << 8) | std::uint32_t(h[at + 3]);
   };
   const std::uint32_t raw_page = (std::uint32_t(h[16]) << 8) | h[17];
   const std::uint64_t page_bytes = raw_page == 1 ? 65536 : raw_page;
@@ -101,8 +102,9 @@ std::optional<std::string> Truncation(const fs::path& path) {
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec || size >= pages * page_bytes) return std::nullopt;
-  return "truncated: " + std::to_string(size) + " bytes of the " + std::to_string(pages * page_bytes) +
-         " its header gives (" + std::to_string(pages - size / page_bytes) + " of " + std::to_string(pages) +
+  return "truncated: " + std::to_string(size) + " bytes of the " +
+         std::to_string(pages * page_bytes) + " its header gives (" +
+         std::to_string(pages - size / page_bytes) + " of " + std::to_string(pages) +
          " pages missing)";
 }
 
@@ -141,7 +143,8 @@ struct DiveLogReader::Impl {
       // Looked at only once SQLite has failed: a raw read of a log whose writer is checkpointing
       // can see the header's new page count before the pages that extend the file.
       if (const std::optional<std::string> truncation = Truncation(path)) {
-        throw Error(name + " is " + *truncation + "; `uwscan log salvage` copies what it holds into a new log");
+        throw Error(name + " is " + *truncation +
+                    "; `uwscan log salvage` copies what it holds into a new log");
       }
       sqlite::Fail(name, "cannot read the list of tables", db.get());
     };
@@ -184,8 +187,10 @@ struct DiveLogReader::Impl {
     // Parsed here, once: the rest of uwscan takes the scanner and the pattern as values.
     const std::string kind = row.Text(0);
     header.scanner = scanner::ParseScanner(row.Text(1), name + ", header.scanner_yaml");
-    header.scan_pattern = scanner::ParseScanPattern(row.Text(2), name + ", header.scan_pattern_yaml");
-    if (kind != scanner::ToString(header.scanner.kind()) || header.scan_pattern.kind != header.scanner.kind()) {
+    header.scan_pattern =
+        scanner::ParseScanPattern(row.Text(2), name + ", header.scan_pattern_yaml");
+    if (kind != scanner::ToString(header.scanner.kind()) ||
+        header.scan_pattern.kind != header.scanner.kind()) {
       throw Error(name + ": header.scanner_kind '" + kind + "', the scanner (" +
                   scanner::ToString(header.scanner.kind()) + ") and the scan pattern (" +
                   scanner::ToString(header.scan_pattern.kind) + ") disagree");
@@ -200,10 +205,10 @@ struct DiveLogReader::Impl {
 
   // Version 2 on: the navigation's noise model, when the writer had one.
   void ReadNavigationNoise() {
-    Statement select = Prepare(std::string("SELECT ") + kNoiseChecksumColumns + ", " +
-                                   Checksums("navigation_noise", checksummed()) +
-                                   " FROM navigation_noise",
-                               0);
+    Statement select =
+        Prepare(std::string("SELECT ") + kNoiseChecksumColumns + ", " +
+                    Checksums("navigation_noise", checksummed()) + " FROM navigation_noise",
+                0);
     const int rc = sqlite3_step(select.get());
     if (rc == SQLITE_DONE) return;
     if (rc != SQLITE_ROW) sqlite::Fail(name, "cannot read the navigation noise", db.get());
@@ -268,8 +273,8 @@ DiveLogReader::DiveLogReader(const std::filesystem::path& path, DiveLogOpening o
   if (r.header.schema_version >= 2) r.ReadNavigationNoise();
 
   const bool checksummed = r.checksummed();
-  r.frame_by_index = r.Prepare("SELECT " + FrameColumns(checksummed) +
-                               " FROM frames f WHERE f.frame_index = ?");
+  r.frame_by_index =
+      r.Prepare("SELECT " + FrameColumns(checksummed) + " FROM frames f WHERE f.frame_index = ?");
   // length() reads a blob's size from the record header, without reading the blob.
   r.truth_by_index = r.Prepare("SELECT length(f.peaks_px), " + TruthColumns(checksummed) +
                                " FROM frames f LEFT JOIN ground_truth g"
@@ -279,7 +284,8 @@ DiveLogReader::DiveLogReader(const std::filesystem::path& path, DiveLogOpening o
   r.mount = r.SelectHeader();
   r.navigation = r.Prepare(
       "SELECT nav_id, time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, T_W_V_qz, "
-      "T_W_V_qw, " + Checksums("navigation", checksummed) + " FROM navigation ORDER BY time_s, nav_id");
+      "T_W_V_qw, " +
+      Checksums("navigation", checksummed) + " FROM navigation ORDER BY time_s, nav_id");
 }
 
 DiveLogReader::~DiveLogReader() = default;
@@ -319,7 +325,8 @@ FrameRecord DiveLogReader::ReadFrame(std::int64_t index) const {
     ResetOnExit reset(s);
     sqlite3_bind_int64(s, 1, index);
     const int rc = sqlite3_step(s);
-    if (rc == SQLITE_ROW) return DecodeFrame(Row(s, r.name, FrameName(index)), index, r.checksummed());
+    if (rc == SQLITE_ROW)
+      return DecodeFrame(Row(s, r.name, FrameName(index)), index, r.checksummed());
     if (rc != SQLITE_DONE) sqlite::Fail(r.name, "cannot read " + FrameName(index), r.db.get());
   }
   r.NoSuchFrame(index, frame_count());
@@ -338,7 +345,8 @@ std::optional<GroundTruthRecord> DiveLogReader::ReadGroundTruth(std::int64_t ind
       if (peak_bytes % std::int64_t{sizeof(Eigen::Vector2d)} != 0) {
         row.Corrupt(0, "is " + std::to_string(peak_bytes) + ", not a multiple of 16");
       }
-      return DecodeTruth(row, 1, std::size_t(peak_bytes) / sizeof(Eigen::Vector2d), r.checksummed());
+      return DecodeTruth(row, 1, std::size_t(peak_bytes) / sizeof(Eigen::Vector2d),
+                         r.checksummed());
     }
     if (rc != SQLITE_DONE) {
       sqlite::Fail(r.name, "cannot read the ground truth of " + FrameName(index), r.db.get());
@@ -401,9 +409,11 @@ namespace {
 
 // Runs a read-only statement, handing each row's column 0 as an integer to `row`; returns
 // SQLite's message when stepping fails half-way ("" when it ends cleanly).
-std::string ForEachInteger(sqlite3* db, const std::string& sql, const std::function<void(std::int64_t)>& row) {
+std::string ForEachInteger(sqlite3* db, const std::string& sql,
+                           const std::function<void(std::int64_t)>& row) {
   sqlite3_stmt* raw = nullptr;
-  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) return sqlite3_errmsg(db);
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &raw, nullptr) != SQLITE_OK)
+    return sqlite3_errmsg(db);
   const Statement statement(raw);
   int rc;
   while ((rc = sqlite3_step(raw)) == SQLITE_ROW) row(sqlite3_column_int64(raw, 0));
@@ -439,17 +449,20 @@ void CheckFrames(const DiveLogReader& log, sqlite3* db, const std::string& name,
                  const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
                  DiveLogCheck& check) {
   std::vector<std::int64_t> indices;
-  const std::string listing = ForEachInteger(db, "SELECT frame_index FROM frames ORDER BY frame_index",
-                                             [&](std::int64_t index) { indices.push_back(index); });
+  const std::string listing =
+      ForEachInteger(db, "SELECT frame_index FROM frames ORDER BY frame_index",
+                     [&](std::int64_t index) { indices.push_back(index); });
   if (!listing.empty()) {
-    check.damage.push_back({"file", -1, name + ": cannot list the frames past " + std::to_string(indices.size()) +
-                                            " (" + listing + ")"});
+    check.damage.push_back({"file", -1,
+                            name + ": cannot list the frames past " +
+                                std::to_string(indices.size()) + " (" + listing + ")"});
   }
   check.frames = static_cast<std::int64_t>(indices.size());
   std::int64_t expected = 0;
   for (std::int64_t index : indices) {
     for (; expected < index; ++expected) {
-      check.damage.push_back({"frames", expected, name + ": " + FrameName(expected) + " is missing"});
+      check.damage.push_back(
+          {"frames", expected, name + ": " + FrameName(expected) + " is missing"});
     }
     expected = index + 1;
     std::optional<FrameRecord> record;
@@ -473,7 +486,8 @@ void CheckFrames(const DiveLogReader& log, sqlite3* db, const std::string& name,
 
 // Navigation row by row, in the order it was appended, from `s` (nav_id, time, pose, checksums).
 void CheckNavigation(sqlite3_stmt* s, sqlite3* db, const std::string& name, bool checksummed,
-                     const std::function<void(const NavigationRecord&)>& navigation, DiveLogCheck& check) {
+                     const std::function<void(const NavigationRecord&)>& navigation,
+                     DiveLogCheck& check) {
   int rc;
   while ((rc = sqlite3_step(s)) == SQLITE_ROW) {
     ++check.navigation;
@@ -489,9 +503,10 @@ void CheckNavigation(sqlite3_stmt* s, sqlite3* db, const std::string& name, bool
     }
   }
   if (rc != SQLITE_DONE) {
-    check.damage.push_back({"file", -1, name + ": cannot read the navigation past " +
-                                            std::to_string(check.navigation) + " samples (" + sqlite3_errmsg(db) +
-                                            ")"});
+    check.damage.push_back({"file", -1,
+                            name + ": cannot read the navigation past " +
+                                std::to_string(check.navigation) + " samples (" +
+                                sqlite3_errmsg(db) + ")"});
   }
 }
 
@@ -516,7 +531,9 @@ DiveLogCheck DiveLogReader::Check(
   CheckFrames(*this, r.db.get(), r.name, frame, check);
   const Statement statement = r.Prepare(
       "SELECT nav_id, time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, T_W_V_qz, "
-      "T_W_V_qw, " + Checksums("navigation", r.checksummed()) + " FROM navigation ORDER BY nav_id", 0);
+      "T_W_V_qw, " +
+          Checksums("navigation", r.checksummed()) + " FROM navigation ORDER BY nav_id",
+      0);
   CheckNavigation(statement.get(), r.db.get(), r.name, r.checksummed(), navigation, check);
   return check;
 }

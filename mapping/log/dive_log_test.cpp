@@ -44,7 +44,8 @@ TEST_F(DiveLogTest, RoundTripsHeaderFramesTruthAndNavigation) {
 
   const DiveLogReader reader(path);
   EXPECT_EQ(reader.header().schema_version, kDiveLogSchemaVersion);
-  EXPECT_EQ(scanner::ScannerToYaml(reader.header().scanner), scanner::ScannerToYaml(header.scanner));
+  EXPECT_EQ(scanner::ScannerToYaml(reader.header().scanner),
+            scanner::ScannerToYaml(header.scanner));
   EXPECT_EQ(reader.header().scanner.calibration.at(0).dataset, "/data/ümlaut, tab\there");
   EXPECT_EQ(reader.header().scan_pattern.kind, scanner::ScannerKind::kGalvo);
   EXPECT_EQ(reader.header().scan_pattern.galvo.step_stride, 5);

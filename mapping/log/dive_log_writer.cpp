@@ -73,8 +73,9 @@ void CheckHeader(const DiveLogHeader& header, const std::string& name) {
     throw Error(name + ": invalid header: " + e.what());
   }
   if (header.scan_pattern.kind != header.scanner.kind()) {
-    throw Error(name + ": header.scan_pattern is for a " + scanner::ToString(header.scan_pattern.kind) +
-                " scanner, header.scanner is " + scanner::ToString(header.scanner.kind()));
+    throw Error(name + ": header.scan_pattern is for a " +
+                scanner::ToString(header.scan_pattern.kind) + " scanner, header.scanner is " +
+                scanner::ToString(header.scanner.kind()));
   }
 }
 
@@ -130,7 +131,8 @@ void CheckTruth(const GroundTruthRecord& truth, std::size_t peaks, const std::st
 }
 
 // Everything about a frame that would make its row unreadable, checked before its transaction.
-void CheckFrame(const FrameRecord& frame, const GroundTruthRecord* truth, const std::string& where) {
+void CheckFrame(const FrameRecord& frame, const GroundTruthRecord* truth,
+                const std::string& where) {
   if (!std::isfinite(frame.time_s)) throw Error(where + ": time_s is not finite");
   for (std::size_t i = 0; i < frame.peaks_px.size(); ++i) {
     if (!frame.peaks_px[i].allFinite()) {
@@ -266,7 +268,8 @@ struct DiveLogWriter::Impl {
       checksums.Number(value);
     }
     const std::size_t num_peaks = frame.peaks_px.size();
-    const void* peaks = sqlite::LittleEndianBytes(Coordinates(frame.peaks_px), 2 * num_peaks, scratch[0]);
+    const void* peaks =
+        sqlite::LittleEndianBytes(Coordinates(frame.peaks_px), 2 * num_peaks, scratch[0]);
     bind(sqlite::BindBlob(s, 5, peaks, num_peaks * sizeof(Eigen::Vector2d)));
     checksums.Bytes(peaks, num_peaks * sizeof(Eigen::Vector2d));
     if (frame.image) {
@@ -276,7 +279,8 @@ struct DiveLogWriter::Impl {
     }
     bind(sqlite::BindBlob(s, 10, checksums.blob().data(), checksums.blob().size()));
     if (rc != SQLITE_OK) sqlite::Fail(name, "cannot bind " + FrameName(index), db.get());
-    if (sqlite3_step(s) != SQLITE_DONE) sqlite::Fail(name, "cannot insert " + FrameName(index), db.get());
+    if (sqlite3_step(s) != SQLITE_DONE)
+      sqlite::Fail(name, "cannot insert " + FrameName(index), db.get());
   }
 
   // Columns 6-9 of a frame's row.
@@ -313,7 +317,8 @@ struct DiveLogWriter::Impl {
     bind(sqlite::BindPose(t, 2, truth.T_W_C));
     checksums.Number(double(index));
     for (double value : sqlite::PoseColumns(truth.T_W_C)) checksums.Number(value);
-    const void* points = sqlite::LittleEndianBytes(Coordinates(truth.points_W), 3 * num_peaks, scratch[2]);
+    const void* points =
+        sqlite::LittleEndianBytes(Coordinates(truth.points_W), 3 * num_peaks, scratch[2]);
     const void* ids = sqlite::LittleEndianBytes(truth.object_ids.data(), num_peaks, scratch[3]);
     bind(sqlite::BindBlob(t, 9, points, num_peaks * sizeof(Eigen::Vector3d)));
     bind(sqlite::BindBlob(t, 10, ids, num_peaks * sizeof(std::int32_t)));
@@ -336,13 +341,17 @@ struct DiveLogWriter::Impl {
     Statement head = Prepare(
         "INSERT INTO header (id, scanner_kind, scanner_yaml, scan_pattern_yaml, scene_yaml, "
         "created_utc, producer, checksums) VALUES (1, ?, ?, ?, ?, ?, ?, ?)");
-    header_texts = {scanner::ToString(header.scanner.kind()), scanner::ScannerToYaml(header.scanner),
-                    scanner::ScanPatternToYaml(header.scan_pattern), header.scene_yaml, UtcNow(),
+    header_texts = {scanner::ToString(header.scanner.kind()),
+                    scanner::ScannerToYaml(header.scanner),
+                    scanner::ScanPatternToYaml(header.scan_pattern),
+                    header.scene_yaml,
+                    UtcNow(),
                     header.producer};
     int column = 1;
     for (const std::string& text : header_texts) {
       // Unbound (too long) text would stay NULL and fail the NOT NULL constraint.
-      sqlite3_bind_text64(head.get(), column++, text.data(), text.size(), SQLITE_STATIC, SQLITE_UTF8);
+      sqlite3_bind_text64(head.get(), column++, text.data(), text.size(), SQLITE_STATIC,
+                          SQLITE_UTF8);
     }
     const RowChecksums checksums = HeaderChecksums(nullptr);
     sqlite::BindBlob(head.get(), column, checksums.blob().data(), checksums.blob().size());
@@ -365,8 +374,10 @@ struct DiveLogWriter::Impl {
 
   void WriteNavigationNoise(const NavigationNoise& noise) {
     Statement insert = Prepare(
-        "INSERT INTO navigation_noise (id, position_walk_m_per_sqrt_s, heading_walk_rad_per_sqrt_s, "
-        "speed_scale_sigma, heading_bias_sigma_rad, depth_sigma_m, roll_pitch_sigma_rad, checksums) "
+        "INSERT INTO navigation_noise (id, position_walk_m_per_sqrt_s, "
+        "heading_walk_rad_per_sqrt_s, "
+        "speed_scale_sigma, heading_bias_sigma_rad, depth_sigma_m, roll_pitch_sigma_rad, "
+        "checksums) "
         "VALUES (1, ?, ?, ?, ?, ?, ?, ?)");
     int column = 1;
     RowChecksums checksums;

@@ -68,7 +68,8 @@ DiveSimulationSummary SimulateDive(const scanner::sim::Simulator& simulator,
   writer.SetVehicleMount(scene.trajectory.T_V_C);
 
   DiveSimulationSummary summary;
-  for (const scanner::sim::NavigationSample& nav : simulator.Navigation(options.navigation_rate_hz)) {
+  for (const scanner::sim::NavigationSample& nav :
+       simulator.Navigation(options.navigation_rate_hz)) {
     writer.AppendNavigation(NavigationRecord{nav.time_s, nav.T_W_V});
     ++summary.navigation_records;
   }

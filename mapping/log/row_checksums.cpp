@@ -16,12 +16,11 @@ std::uint32_t Checksum(const void* data, std::size_t size, Kind kind) {
   return static_cast<std::uint32_t>(XXH3_64bits_withSeed(data, size, kind));
 }
 
-
-
 }  // namespace
 
 void RowChecksums::Add(std::uint32_t checksum) {
-  for (int byte = 0; byte < 4; ++byte) blob_.push_back(static_cast<std::uint8_t>(checksum >> (8 * byte)));
+  for (int byte = 0; byte < 4; ++byte)
+    blob_.push_back(static_cast<std::uint8_t>(checksum >> (8 * byte)));
 }
 
 void RowChecksums::Number(double value) {
@@ -59,7 +58,8 @@ int RowChecksums::FirstMismatch(const void* stored, std::size_t stored_bytes) co
   if (stored == nullptr || stored_bytes != blob_.size()) return static_cast<int>(size());
   const auto* bytes = static_cast<const std::uint8_t*>(stored);
   for (std::size_t column = 0; column < size(); ++column) {
-    if (std::memcmp(bytes + 4 * column, blob_.data() + 4 * column, 4) != 0) return static_cast<int>(column);
+    if (std::memcmp(bytes + 4 * column, blob_.data() + 4 * column, 4) != 0)
+      return static_cast<int>(column);
   }
   return -1;
 }

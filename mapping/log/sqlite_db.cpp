@@ -78,9 +78,9 @@ void Row::Corrupt(int column, const std::string& what) const {
 void Row::VerifyChecksums(int first, int count, int checksum_column) const {
   RowChecksums computed;
   for (int column = first; column < first + count; ++column) computed.Column(statement_, column);
-  const int mismatch =
-      computed.FirstMismatch(sqlite3_column_blob(statement_, checksum_column),
-                             static_cast<std::size_t>(sqlite3_column_bytes(statement_, checksum_column)));
+  const int mismatch = computed.FirstMismatch(
+      sqlite3_column_blob(statement_, checksum_column),
+      static_cast<std::size_t>(sqlite3_column_bytes(statement_, checksum_column)));
   if (mismatch == count) {
     Corrupt(checksum_column, "does not hold " + std::to_string(count) + " checksums (damaged)");
   }

@@ -7,7 +7,8 @@
 
 namespace uwscan::mapping {
 
-IncrementalReconstructor::IncrementalReconstructor(const DiveLogReader& log, const ReconstructionOptions& options)
+IncrementalReconstructor::IncrementalReconstructor(const DiveLogReader& log,
+                                                   const ReconstructionOptions& options)
     : log_(log), options_(options) {
   triangulator_ = MakeLogTriangulator(log, options);
 }
@@ -40,7 +41,8 @@ std::vector<ReconstructedFrame> IncrementalReconstructor::Poll(std::int64_t max_
   for (; next_frame_ < end; ++next_frame_) {
     const FrameRecord frame = log_.ReadFrame(next_frame_);
     const std::optional<GroundTruthRecord> truth = log_.ReadGroundTruth(next_frame_);
-    if (options_.use_navigation && world_frame_.value_or(true)) UpdateNavigation(frame.time_s, navigation_read);
+    if (options_.use_navigation && world_frame_.value_or(true))
+      UpdateNavigation(frame.time_s, navigation_read);
     if (!world_frame_) world_frame_ = navigation_.has_value();
 
     ReconstructedFrame r;
@@ -50,7 +52,8 @@ std::vector<ReconstructedFrame> IncrementalReconstructor::Poll(std::int64_t max_
     r.T_out_C = *world_frame_ ? navigation_->T_W_C(frame.time_s) : Eigen::Isometry3d::Identity();
     if (truth) r.true_T_W_C = truth->T_W_C;
     // Truth is stored in the world frame: bring it to the output frame.
-    const Eigen::Isometry3d T_out_W = *world_frame_ || !truth ? Eigen::Isometry3d::Identity() : truth->T_W_C.inverse();
+    const Eigen::Isometry3d T_out_W =
+        *world_frame_ || !truth ? Eigen::Isometry3d::Identity() : truth->T_W_C.inverse();
     triangulated.resize(frame.peaks_px.size());
     triangulator_->TriangulateFrame(frame.command, frame.peaks_px, triangulated);
     for (std::size_t i = 0; i < triangulated.size(); ++i) {
@@ -58,7 +61,8 @@ std::vector<ReconstructedFrame> IncrementalReconstructor::Poll(std::int64_t max_
       r.points.push_back(r.T_out_C * triangulated[i].p_C);
       if (!truth) continue;
       const bool has_truth = i < truth->points_W.size() && truth->points_W[i].allFinite();
-      r.truth.push_back(has_truth ? Eigen::Vector3d(T_out_W * truth->points_W[i]) : Eigen::Vector3d::Constant(nan));
+      r.truth.push_back(has_truth ? Eigen::Vector3d(T_out_W * truth->points_W[i])
+                                  : Eigen::Vector3d::Constant(nan));
       r.object_ids.push_back(i < truth->object_ids.size() ? truth->object_ids[i] : -1);
     }
     out.push_back(std::move(r));

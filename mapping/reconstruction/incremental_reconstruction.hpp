@@ -19,9 +19,9 @@ struct ReconstructedFrame {
   double time_s = 0.0;
   int sweep = 0;
   Eigen::Isometry3d T_out_C = Eigen::Isometry3d::Identity();  // camera pose in the output frame
-  std::optional<Eigen::Isometry3d> true_T_W_C;                 // simulated logs
-  std::vector<Eigen::Vector3d> points;  // in the output frame (world with navigation, else {C})
-  std::vector<Eigen::Vector3d> truth;   // empty, or one per point (NaN where a peak has none)
+  std::optional<Eigen::Isometry3d> true_T_W_C;                // simulated logs
+  std::vector<Eigen::Vector3d> points;   // in the output frame (world with navigation, else {C})
+  std::vector<Eigen::Vector3d> truth;    // empty, or one per point (NaN where a peak has none)
   std::vector<std::int32_t> object_ids;  // empty, or one per point (scene object of its peak)
 };
 

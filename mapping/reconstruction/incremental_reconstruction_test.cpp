@@ -14,11 +14,12 @@ namespace uwscan::mapping {
 namespace {
 
 TEST(IncrementalReconstruction, SamePointsTruthAndFramesAsReconstruct) {
-  const scanner::sim::Scene scene =
-      scanner::sim::LoadScene(std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/default.yaml");
+  const scanner::sim::Scene scene = scanner::sim::LoadScene(
+      std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/default.yaml");
   const scanner::sim::Simulator simulator(scene);
-  const std::filesystem::path path = std::filesystem::temp_directory_path() /
-                                     ("uwscan_incremental_test_" + std::to_string(::getpid()) + ".db");
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("uwscan_incremental_test_" + std::to_string(::getpid()) + ".db");
   std::filesystem::remove(path);
   SimulateDive(simulator, "", path, DiveSimulationOptions{});
   const DiveLogReader log(path);

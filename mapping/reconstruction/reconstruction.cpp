@@ -46,11 +46,12 @@ std::unique_ptr<scanner::Triangulator> MakeLogTriangulator(const DiveLogReader& 
     build.driven_with = header.scanner.mems().functions;
   }
   try {
-    return scanner::MakeTriangulator(options.calibration.value_or(header.scanner), pattern,
-                                     options.method.value_or(scanner::DefaultTriangulationMethod(pattern.kind)),
-                                     build);
+    return scanner::MakeTriangulator(
+        options.calibration.value_or(header.scanner), pattern,
+        options.method.value_or(scanner::DefaultTriangulationMethod(pattern.kind)), build);
   } catch (const Error& e) {
-    throw Error(log.path().string() + (options.calibration ? " with the calibration given" : "") + ": " + e.what());
+    throw Error(log.path().string() + (options.calibration ? " with the calibration given" : "") +
+                ": " + e.what());
   }
 }
 

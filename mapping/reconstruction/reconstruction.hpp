@@ -43,11 +43,11 @@ struct Reconstruction {
   std::vector<Eigen::Vector3d> points;
   std::vector<std::int64_t> frame_of_point;
   std::vector<Eigen::Vector3d> truth;  // empty when the log holds no ground truth
-  std::int64_t frames = 0;                // reconstructed (of the sweep chosen, if one is)
-  std::vector<int> sweeps;                // every sweep of the log, ascending, chosen or not
-  std::int64_t peaks = 0;                 // peaks read; peaks - points.size() had no point
-  double table_seconds = 0.0;             // building the per-calibration tables, once
-  double triangulation_seconds = 0.0;     // the triangulation itself, all frames
+  std::int64_t frames = 0;             // reconstructed (of the sweep chosen, if one is)
+  std::vector<int> sweeps;             // every sweep of the log, ascending, chosen or not
+  std::int64_t peaks = 0;              // peaks read; peaks - points.size() had no point
+  double table_seconds = 0.0;          // building the per-calibration tables, once
+  double triangulation_seconds = 0.0;  // the triangulation itself, all frames
 };
 
 // Distance of each reconstructed point from its truth (points without truth are skipped).

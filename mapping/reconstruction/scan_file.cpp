@@ -41,12 +41,13 @@ ScanFile ReadScanFile(const std::filesystem::path& path, ReconstructionOptions o
                 "; recognition takes one: choose it with --sweep");
   }
   if (options.sweep && r.frames == 0) {
-    throw Error(path.string() + ": the dive log has no sweep " + std::to_string(*options.sweep) + " (it holds " +
-                SweepRange(r.sweeps) + ")");
+    throw Error(path.string() + ": the dive log has no sweep " + std::to_string(*options.sweep) +
+                " (it holds " + SweepRange(r.sweeps) + ")");
   }
   if (r.points.empty()) {
-    const std::string what =
-        options.sweep ? "sweep " + std::to_string(*options.sweep) + " of the dive log" : std::string("the dive log");
+    const std::string what = options.sweep
+                                 ? "sweep " + std::to_string(*options.sweep) + " of the dive log"
+                                 : std::string("the dive log");
     throw Error(path.string() + ": " + what + " holds no triangulated point");
   }
   scan.cloud = perception::MakeCloud(r.points);

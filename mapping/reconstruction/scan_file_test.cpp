@@ -18,8 +18,8 @@ class ScanFileTest : public DiveLogTest {
  protected:
   // The short inspection dive's first four sweeps, the vehicle moving 0.2 m/s, navigation exact.
   fs::path MovingDive() {
-    scanner::sim::Scene scene =
-        scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_short.yaml");
+    scanner::sim::Scene scene = scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) /
+                                                        "data/scenes/inspection_short.yaml");
     scene.scanner.sweeps = 4;
     scene.effects.navigation_drift.on = false;
     scene.effects.peak_noise.on = false;
@@ -46,7 +46,8 @@ TEST_F(ScanFileTest, ACloudFileSaysWhichRowEachFinitePointCameFrom) {
 
   ReconstructionOptions options;
   options.sweep = 0;
-  EXPECT_NE(MessageOf([&] { ReadScanFile(path, options); }).find("this is a cloud file"), std::string::npos);
+  EXPECT_NE(MessageOf([&] { ReadScanFile(path, options); }).find("this is a cloud file"),
+            std::string::npos);
 }
 
 // A sweep taken while the vehicle moves 10 cm: each frame placed with the navigation, the
@@ -55,13 +56,16 @@ TEST_F(ScanFileTest, ACloudFileSaysWhichRowEachFinitePointCameFrom) {
 // would be smeared by the motion.
 TEST_F(ScanFileTest, ASweepOfAMovingDiveIsPlacedWithItsNavigation) {
   const fs::path path = MovingDive();
-  EXPECT_NE(MessageOf([&] { ReadScanFile(path); })
-                .find("holds 4 sweeps, 0 to 3; recognition takes one: choose it with --sweep"),
+  EXPECT_NE(MessageOf([&] {
+              ReadScanFile(path);
+            }).find("holds 4 sweeps, 0 to 3; recognition takes one: choose it with --sweep"),
             std::string::npos)
       << MessageOf([&] { ReadScanFile(path); });
   ReconstructionOptions options;
   options.sweep = 7;
-  EXPECT_NE(MessageOf([&] { ReadScanFile(path, options); }).find("has no sweep 7 (it holds 4 sweeps, 0 to 3)"),
+  EXPECT_NE(MessageOf([&] {
+              ReadScanFile(path, options);
+            }).find("has no sweep 7 (it holds 4 sweeps, 0 to 3)"),
             std::string::npos);
 
   options.sweep = 2;

@@ -19,8 +19,8 @@ struct DeadReckoningCalibration {
   // misalignment and divided by the scale, its vertical part (from pressure) kept. Valid in the
   // world frame and in a level vehicle frame (the turn is about the down axis in both).
   template <typename T>
-  static Eigen::Matrix<T, 3, 1> Correct(const Eigen::Matrix<T, 3, 1>& displacement, const T& scale_error,
-                                        const T& misalignment_rad) {
+  static Eigen::Matrix<T, 3, 1> Correct(const Eigen::Matrix<T, 3, 1>& displacement,
+                                        const T& scale_error, const T& misalignment_rad) {
     using std::cos;
     using std::sin;
     const T c = cos(misalignment_rad);

@@ -19,7 +19,8 @@ Eigen::Isometry3d Pose(double x, double y, double yaw) {
 }
 
 // A dead-reckoned motion as a DVL with this calibration reports the true one T_a_b.
-Eigen::Isometry3d DeadReckoned(const Eigen::Isometry3d& T_a_b, double scale_error, double misalignment) {
+Eigen::Isometry3d DeadReckoned(const Eigen::Isometry3d& T_a_b, double scale_error,
+                               double misalignment) {
   Eigen::Isometry3d out = T_a_b;
   const Eigen::Vector3d t = T_a_b.translation();
   const Eigen::Vector2d turned = Eigen::Rotation2Dd(misalignment) * t.head<2>();
@@ -30,8 +31,8 @@ Eigen::Isometry3d DeadReckoned(const Eigen::Isometry3d& T_a_b, double scale_erro
 TEST(DeadReckoningCalibration, CorrectUndoesTheScaleAndTheMisalignment) {
   const Eigen::Isometry3d truth = Pose(0.4, -0.2, 0.3);
   const DeadReckoningCalibration calibration{0.02, -0.015};
-  const Eigen::Isometry3d corrected =
-      calibration.CorrectMotion(DeadReckoned(truth, calibration.scale_error, calibration.misalignment_rad));
+  const Eigen::Isometry3d corrected = calibration.CorrectMotion(
+      DeadReckoned(truth, calibration.scale_error, calibration.misalignment_rad));
   EXPECT_LT((corrected.translation() - truth.translation()).norm(), 1e-12);
   EXPECT_LT((corrected.linear() - truth.linear()).norm(), 1e-12);
 }
@@ -47,7 +48,7 @@ TEST(PoseGraph, EstimatesTheDeadReckoningsScaleErrorAndMisalignment) {
   PoseGraph graph;
   graph.EstimateDeadReckoningCalibration(0.01, 0.01);
   Matrix6d odometry = Matrix6d::Zero();
-  odometry(2, 2) = 1e8;                                   // heading, 0.1 mrad
+  odometry(2, 2) = 1e8;                                       // heading, 0.1 mrad
   odometry(3, 3) = odometry(4, 4) = 1.0 / (0.0005 * 0.0005);  // x, y: 0.5 mm
   Eigen::Isometry3d believed = truth[0];
   for (std::size_t i = 0; i < truth.size(); ++i) {
@@ -61,10 +62,12 @@ TEST(PoseGraph, EstimatesTheDeadReckoningsScaleErrorAndMisalignment) {
     graph.AddGravity({static_cast<int>(i), Eigen::Vector3d::UnitZ(), 0.0005});
     if (i == 0) continue;
     const int from = static_cast<int>(i) - 1, to = static_cast<int>(i);
-    graph.AddEdge({from, to, DeadReckoned(truth[i - 1].inverse() * truth[i], scale_error, misalignment), odometry,
-                   false, 3.0, true});
+    graph.AddEdge({from, to,
+                   DeadReckoned(truth[i - 1].inverse() * truth[i], scale_error, misalignment),
+                   odometry, false, 3.0, true});
     if (i % 5 == 0) {  // a scan match now and then
-      graph.AddEdge({from, to, truth[i - 1].inverse() * truth[i], Matrix6d::Identity() * 1e8, false, 3.0});
+      graph.AddEdge(
+          {from, to, truth[i - 1].inverse() * truth[i], Matrix6d::Identity() * 1e8, false, 3.0});
     }
   }
   Matrix6d start = Matrix6d::Identity() * 1e10;
@@ -74,7 +77,8 @@ TEST(PoseGraph, EstimatesTheDeadReckoningsScaleErrorAndMisalignment) {
   EXPECT_NEAR(graph.calibration().scale_error, scale_error, 3e-4);
   EXPECT_NEAR(graph.calibration().misalignment_rad, misalignment, 2.4e-4);
   for (std::size_t i = 0; i < truth.size(); ++i) {
-    EXPECT_LT((graph.pose(static_cast<int>(i)).translation() - truth[i].translation()).norm(), 1e-3) << "node " << i;
+    EXPECT_LT((graph.pose(static_cast<int>(i)).translation() - truth[i].translation()).norm(), 1e-3)
+        << "node " << i;
   }
 }
 

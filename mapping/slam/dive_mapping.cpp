@@ -31,81 +31,120 @@ NavigationNoise AssumedNavigationNoise() {
   return noise;
 }
 
-DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
-                    const std::function<void(double)>& progress) {
-  options.Check();
-  const auto start = std::chrono::steady_clock::now();
-  const std::string name = "dive log '" + log.path().string() + "'";
-  const std::vector<NavigationRecord> navigation = log.ReadNavigation();
+namespace {
+
+void RequireMappable(const DiveLogReader& log, const std::vector<NavigationRecord>& navigation,
+                     const std::string& name) {
   if (navigation.empty()) {
-    throw Error(name + " has no navigation: mapping places each frame with the vehicle's navigation");
+    throw Error(name +
+                " has no navigation: mapping places each frame with the vehicle's navigation");
   }
   const std::int64_t frame_count = log.frame_count();
   if (frame_count < 2) {
-    throw Error(name + " has " + std::to_string(frame_count) + " frame" + (frame_count == 1 ? "" : "s") +
-                ": mapping needs at least a sweep of frames");
+    throw Error(name + " has " + std::to_string(frame_count) + " frame" +
+                (frame_count == 1 ? "" : "s") + ": mapping needs at least a sweep of frames");
   }
-  const DiveLogHeader& header = log.header();
-  DiveMapping result;
-  result.navigation_noise_assumed = !header.navigation_noise.has_value();
-  const Eigen::Isometry3d T_V_C = log.vehicle_mount().value_or(Eigen::Isometry3d::Identity());
-  Mapper mapper(header.scanner, header.scan_pattern, T_V_C, header.navigation_noise.value_or(AssumedNavigationNoise()),
-                options.mapper, options.table_cache);
+}
 
-  // Replayed as the vehicle delivered it: each navigation sample before the frames it precedes.
+struct FrameSpan {
+  double first_s = 0.0, last_s = 0.0;
+};
+
+// The log replayed as the vehicle delivered it: each navigation sample before the frames it
+// precedes.
+FrameSpan Replay(const DiveLogReader& log, const std::vector<NavigationRecord>& navigation,
+                 Mapper& mapper, const std::function<void(double)>& progress) {
+  const double frame_count = static_cast<double>(log.frame_count());
   std::size_t next_nav = 0;
   std::int64_t done = 0;
-  double first_time = 0.0, last_time = 0.0;
+  FrameSpan span;
   log.ForEachFrame(
       [&](const FrameRecord& frame, const GroundTruthRecord*) {
         while (next_nav < navigation.size() && navigation[next_nav].time_s <= frame.time_s) {
           mapper.AddNavigation(navigation[next_nav++]);
         }
         mapper.AddFrame(frame);
-        if (done == 0) first_time = frame.time_s;
-        last_time = frame.time_s;
+        if (done == 0) span.first_s = frame.time_s;
+        span.last_s = frame.time_s;
         ++done;
-        if (progress) progress(static_cast<double>(done) / static_cast<double>(frame_count));
+        if (progress) progress(static_cast<double>(done) / frame_count);
       },
       /*with_truth=*/false);
   while (next_nav < navigation.size()) mapper.AddNavigation(navigation[next_nav++]);
   mapper.Finish();
+  return span;
+}
+
+void RequireMapped(const Mapper& mapper, const std::vector<NavigationRecord>& navigation,
+                   const FrameSpan& span, double max_navigation_gap_s, const std::string& name) {
   if (mapper.stats().frames == 0) {
     throw Error(name + ": no frame lies within its navigation (samples from " +
-                std::to_string(navigation.front().time_s) + " to " + std::to_string(navigation.back().time_s) +
-                " s, at most " + std::to_string(options.mapper.max_navigation_gap_s) + " s apart; frames from " +
-                std::to_string(first_time) + " to " + std::to_string(last_time) + " s)");
+                std::to_string(navigation.front().time_s) + " to " +
+                std::to_string(navigation.back().time_s) + " s, at most " +
+                std::to_string(max_navigation_gap_s) + " s apart; frames from " +
+                std::to_string(span.first_s) + " to " + std::to_string(span.last_s) + " s)");
   }
   if (mapper.submap_count() == 0) throw Error(name + ": no frame gave points to map");
+}
 
-  result.submaps = mapper.submap_count();
+// The SLAM, dead-reckoned and (simulated dives) true vehicle poses at the submaps' anchors.
+void AddTrajectories(const DiveLogReader& log, const Mapper& mapper, const Eigen::Isometry3d& T_V_C,
+                     bool keep_submaps, DiveMapping& result) {
   const Eigen::Isometry3d T_C_V = T_V_C.inverse();
   for (int i = 0; i < mapper.submap_count(); ++i) {
     const Submap& s = mapper.submap(i);
     result.slam.push_back({s.anchor_time_s, mapper.pose(i)});
     result.dead_reckoning.push_back({s.anchor_time_s, s.T_W_V_nav});
-    if (options.keep_submaps) result.submap_clouds.push_back(s.cloud);
+    if (keep_submaps) result.submap_clouds.push_back(s.cloud);
     if (const std::optional<GroundTruthRecord> truth = log.ReadGroundTruth(s.anchor_frame)) {
       result.truth.push_back({s.anchor_time_s, truth->T_W_C * T_C_V});
     }
   }
   if (result.truth.size() != result.slam.size()) result.truth.clear();
-  if (const std::optional<Mapper::SubmapCovariances> covariances = mapper.Covariances()) {
-    result.covariances = covariances->anchors;
-    result.expected_position_error_m = ExpectedPositionErrorRms(covariances->anchors);
-    std::vector<const perception::PointCloud*> clouds;
-    std::vector<Eigen::Isometry3d> placed;
-    for (int i = 0; i < mapper.submap_count(); ++i) {
-      clouds.push_back(&mapper.submap(i).cloud);
-      placed.push_back(mapper.scan_pose(i));
-    }
-    result.expected_map_error_m = ExpectedSurfaceErrorRms(clouds, placed, covariances->scans, kExpectedErrorStride);
+}
+
+// What the poses' covariances say the trajectory's and the map's errors come to.
+void AddExpectedErrors(const Mapper& mapper, DiveMapping& result) {
+  const std::optional<Mapper::SubmapCovariances> covariances = mapper.Covariances();
+  if (!covariances) return;
+  result.covariances = covariances->anchors;
+  result.expected_position_error_m = ExpectedPositionErrorRms(covariances->anchors);
+  std::vector<const perception::PointCloud*> clouds;
+  std::vector<Eigen::Isometry3d> placed;
+  for (int i = 0; i < mapper.submap_count(); ++i) {
+    clouds.push_back(&mapper.submap(i).cloud);
+    placed.push_back(mapper.scan_pose(i));
   }
+  result.expected_map_error_m =
+      ExpectedSurfaceErrorRms(clouds, placed, covariances->scans, kExpectedErrorStride);
+}
+
+}  // namespace
+
+DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
+                    const std::function<void(double)>& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::string name = "dive log '" + log.path().string() + "'";
+  const std::vector<NavigationRecord> navigation = log.ReadNavigation();
+  RequireMappable(log, navigation, name);
+  const DiveLogHeader& header = log.header();
+  DiveMapping result;
+  result.navigation_noise_assumed = !header.navigation_noise.has_value();
+  const Eigen::Isometry3d T_V_C = log.vehicle_mount().value_or(Eigen::Isometry3d::Identity());
+  Mapper mapper(header.scanner, header.scan_pattern, T_V_C,
+                header.navigation_noise.value_or(AssumedNavigationNoise()), options.mapper,
+                options.table_cache);
+  const FrameSpan span = Replay(log, navigation, mapper, progress);
+  RequireMapped(mapper, navigation, span, options.mapper.max_navigation_gap_s, name);
+  result.submaps = mapper.submap_count();
+  AddTrajectories(log, mapper, T_V_C, options.keep_submaps, result);
+  AddExpectedErrors(mapper, result);
   result.loops = mapper.loops();
   result.map = mapper.Map(options.map_voxel_m);
   result.stats = mapper.stats();
   result.calibration = mapper.calibration();
-  result.dive_duration_s = last_time - first_time;
+  result.dive_duration_s = span.last_s - span.first_s;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

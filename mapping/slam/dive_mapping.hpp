@@ -16,7 +16,7 @@ namespace uwscan::mapping {
 
 struct DiveMappingOptions {
   MapperOptions mapper;
-  double map_voxel_m = 0.005;  // the output map's voxel, > 0
+  double map_voxel_m = 0.005;         // the output map's voxel, > 0
   std::filesystem::path table_cache;  // triangulation tables kept between runs ("" = none)
   bool keep_submaps = false;          // fill DiveMapping::submap_clouds
   void Check() const;
@@ -37,12 +37,12 @@ struct DiveMapping {
   // come to, ExpectedPositionErrorRms); empty with them.
   std::optional<double> expected_position_error_m;
   std::vector<LoopClosure> loops;
-  perception::PointCloud map;             // voxelised, world frame (SLAM poses)
+  perception::PointCloud map;  // voxelised, world frame (SLAM poses)
   // Each submap's cloud in its own frame (normals attached), for peers that take the same
   // submaps; filled only when DiveMappingOptions::keep_submaps.
   std::vector<perception::PointCloud> submap_clouds;
   MapperStats stats;
-  DeadReckoningCalibration calibration;  // the DVL's scale error and misalignment as estimated
+  DeadReckoningCalibration calibration;   // the DVL's scale error and misalignment as estimated
   bool navigation_noise_assumed = false;  // the log did not record it (schema 1)
   double dive_duration_s = 0.0;
   double seconds = 0.0;  // processing time, reading the log included

@@ -1,13 +1,11 @@
 #include "mapping/slam/dive_mapping.hpp"
 
 #include <gtest/gtest.h>
-
-#include <Eigen/Eigenvalues>
-
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -28,7 +26,8 @@ namespace uwscan::mapping::test {
 namespace {
 
 scanner::sim::Scene ShortScene() {
-  return scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_short.yaml");
+  return scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) /
+                                 "data/scenes/inspection_short.yaml");
 }
 
 class DiveMappingTest : public DiveLogTest {
@@ -54,19 +53,22 @@ void ExpectSameBits(const DiveMapping& a, const DiveMapping& b) {
   for (std::size_t i = 0; i < a.slam.size(); ++i) ExpectSamePose(a.slam[i].T_W_V, b.slam[i].T_W_V);
   ASSERT_EQ(a.map.size(), b.map.size());
   for (std::size_t i = 0; i < a.map.size(); ++i) {
-    for (int k = 0; k < 3; ++k) EXPECT_EQ(std::bit_cast<std::uint32_t>(a.map.points[i][k]),
-                                          std::bit_cast<std::uint32_t>(b.map.points[i][k]));
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(a.map.points[i][k]),
+                std::bit_cast<std::uint32_t>(b.map.points[i][k]));
   }
   ASSERT_EQ(a.loops.size(), b.loops.size());
   ASSERT_EQ(a.covariances.size(), b.covariances.size());
   for (std::size_t i = 0; i < a.covariances.size(); ++i) {
     for (int k = 0; k < 36; ++k) {
-      EXPECT_EQ(std::bit_cast<std::uint64_t>(a.covariances[i](k)), std::bit_cast<std::uint64_t>(b.covariances[i](k)))
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(a.covariances[i](k)),
+                std::bit_cast<std::uint64_t>(b.covariances[i](k)))
           << "pose " << i;
     }
   }
   ASSERT_TRUE(a.expected_map_error_m && b.expected_map_error_m);
-  EXPECT_EQ(std::bit_cast<std::uint64_t>(*a.expected_map_error_m), std::bit_cast<std::uint64_t>(*b.expected_map_error_m));
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(*a.expected_map_error_m),
+            std::bit_cast<std::uint64_t>(*b.expected_map_error_m));
 }
 
 TEST_F(DiveMappingTest, WithoutDriftTheMapLiesOnTheTruth) {
@@ -93,10 +95,12 @@ TEST_F(DiveMappingTest, SameBitsForOneAndTwoThreadsAndOnlineOrOffline) {
   Mapper mapper(reader.header().scanner, reader.header().scan_pattern, *reader.vehicle_mount(),
                 *reader.header().navigation_noise, options, dir_ / "tables");
   for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
-  reader.ForEachFrame([&](const FrameRecord& frame, const GroundTruthRecord*) { mapper.AddFrame(frame); }, false);
+  reader.ForEachFrame(
+      [&](const FrameRecord& frame, const GroundTruthRecord*) { mapper.AddFrame(frame); }, false);
   mapper.Finish();
   ASSERT_EQ(mapper.submap_count(), two.submaps);
-  for (int i = 0; i < mapper.submap_count(); ++i) ExpectSamePose(two.slam[static_cast<size_t>(i)].T_W_V, mapper.pose(i));
+  for (int i = 0; i < mapper.submap_count(); ++i)
+    ExpectSamePose(two.slam[static_cast<size_t>(i)].T_W_V, mapper.pose(i));
   // The same loops and the same map, point for point.
   ASSERT_EQ(mapper.loops().size(), two.loops.size());
   for (std::size_t k = 0; k < two.loops.size(); ++k) {
@@ -107,7 +111,8 @@ TEST_F(DiveMappingTest, SameBitsForOneAndTwoThreadsAndOnlineOrOffline) {
   ASSERT_EQ(online_map.size(), two.map.size());
   for (std::size_t i = 0; i < online_map.size(); ++i) {
     for (int k = 0; k < 3; ++k) {
-      EXPECT_EQ(std::bit_cast<std::uint32_t>(online_map.points[i][k]), std::bit_cast<std::uint32_t>(two.map.points[i][k]))
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(online_map.points[i][k]),
+                std::bit_cast<std::uint32_t>(two.map.points[i][k]))
           << "map point " << i;
     }
   }
@@ -123,8 +128,10 @@ TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
   for (const Matrix6d& c : m.covariances) EXPECT_GT(PoseStd(c).head<2>().minCoeff(), 0.0);
   // The ATE is what the covariance predicts for it (one dive: one draw of the errors).
   ASSERT_TRUE(m.expected_position_error_m.has_value() && s.ate_slam_m.has_value());
-  EXPECT_GT(*s.ate_slam_m, 0.5 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
-  EXPECT_LT(*s.ate_slam_m, 2.0 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
+  EXPECT_GT(*s.ate_slam_m, 0.5 * *m.expected_position_error_m)
+      << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
+  EXPECT_LT(*s.ate_slam_m, 2.0 * *m.expected_position_error_m)
+      << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
 }
 
 // The MEMS scanner's dive (the same lap, pre-curved lines instead of a galvanometer's fan):
@@ -132,8 +139,8 @@ TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
 // with the navigation and the covariance is honest. (One lap has no loop to beat dead
 // reckoning with: the looping MEMS dive is in bench slam.)
 TEST_F(DiveMappingTest, AMemsDiveMapsAsAGalvanometerDiveDoes) {
-  scanner::sim::Scene scene =
-      scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_mems.yaml");
+  scanner::sim::Scene scene = scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) /
+                                                      "data/scenes/inspection_mems.yaml");
   ASSERT_EQ(scene.scanner.model.kind(), scanner::ScannerKind::kMems);
   {
     scanner::sim::Scene exact = scene;
@@ -148,8 +155,10 @@ TEST_F(DiveMappingTest, AMemsDiveMapsAsAGalvanometerDiveDoes) {
   EXPECT_LE(m.stats.registrations_inconsistent, m.submaps / 10);
   EXPECT_GE(m.stats.registrations, 3 * m.submaps / 4);
   ASSERT_TRUE(s.ate_slam_m && s.nees_mean && m.expected_position_error_m);
-  EXPECT_GT(*s.ate_slam_m, 0.5 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
-  EXPECT_LT(*s.ate_slam_m, 2.0 * *m.expected_position_error_m) << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
+  EXPECT_GT(*s.ate_slam_m, 0.5 * *m.expected_position_error_m)
+      << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
+  EXPECT_LT(*s.ate_slam_m, 2.0 * *m.expected_position_error_m)
+      << *s.ate_slam_m << " m, " << *m.expected_position_error_m;
   EXPECT_EQ(s.loops_false.value_or(-1), 0);
   EXPECT_GT(*s.nees_mean, 0.5 * 6.0);
   EXPECT_LT(*s.nees_mean, 3.0 * 6.0);
@@ -169,35 +178,41 @@ TEST_F(DiveMappingTest, TheMapsExpectedErrorIsWhatItsDistanceToTheTruthComesTo) 
     ++count;
   }
   const double measured = std::sqrt(sum / static_cast<double>(count));
-  EXPECT_GT(measured, 0.6 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
-  EXPECT_LT(measured, 1.5 * *m.expected_map_error_m) << measured << " m measured, " << *m.expected_map_error_m;
+  EXPECT_GT(measured, 0.6 * *m.expected_map_error_m)
+      << measured << " m measured, " << *m.expected_map_error_m;
+  EXPECT_LT(measured, 1.5 * *m.expected_map_error_m)
+      << measured << " m measured, " << *m.expected_map_error_m;
 }
 
 TEST_F(DiveMappingTest, AlongASinglePipeTheMapFollowsTheNavigation) {
   // Out along the pipe only: scan matching sees a pipe on a plane, free along the pipe (x).
-  scanner::sim::Scene scene =
-      scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_pipe.yaml");
+  scanner::sim::Scene scene = scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) /
+                                                      "data/scenes/inspection_pipe.yaml");
   scene.scanner.sweeps = 40;
   const DiveMapping m = Map(Simulate(scene, "pipe.db"));
   ASSERT_EQ(m.truth.size(), m.slam.size());
   for (std::size_t i = 0; i < m.slam.size(); ++i) {
-    const double slam_x = std::abs(m.slam[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
-    const double dr_x = std::abs(m.dead_reckoning[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
+    const double slam_x =
+        std::abs(m.slam[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
+    const double dr_x =
+        std::abs(m.dead_reckoning[i].T_W_V.translation().x() - m.truth[i].T_W_V.translation().x());
     EXPECT_LT(slam_x, dr_x + 0.01) << "submap " << i;
   }
-  EXPECT_LE(AbsoluteTrajectoryError(m.slam, m.truth), AbsoluteTrajectoryError(m.dead_reckoning, m.truth) + 0.005);
+  EXPECT_LE(AbsoluteTrajectoryError(m.slam, m.truth),
+            AbsoluteTrajectoryError(m.dead_reckoning, m.truth) + 0.005);
 }
 
 TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {
   // The pipe dive, out 3 m instead of 8 and back: coming back over the pipe closes loops that
   // see it without its ends. They are kept in the five directions they pin and bring the
   // sideways drift of the dead reckoning back onto the pipe; along it they claim nothing.
-  scanner::sim::Scene scene =
-      scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/inspection_pipe.yaml");
+  scanner::sim::Scene scene = scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) /
+                                                      "data/scenes/inspection_pipe.yaml");
   std::vector<scanner::sim::TrajectoryPose>& poses = scene.trajectory.poses;
   ASSERT_EQ(poses.size(), 5u);  // out, turning (two), back
   const double shift_s = 20.0;  // 8 m at 0.25 m/s is 32 s; 3 m is 12 s
-  for (std::size_t i = 1; i < poses.size(); ++i) poses[i].time_s -= i == 4 ? 2.0 * shift_s : shift_s;
+  for (std::size_t i = 1; i < poses.size(); ++i)
+    poses[i].time_s -= i == 4 ? 2.0 * shift_s : shift_s;
   for (std::size_t i = 1; i < 4; ++i) poses[i].T_W_V.translation().x() = 3.0;
   scene.scanner.sweeps = static_cast<int>(poses.back().time_s / 70.0 * scene.scanner.sweeps);
   const DiveMapping m = Map(Simulate(scene, "pipe_loop.db"));
@@ -252,8 +267,8 @@ TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
 // A log of the short dive's first `frames` frames, with the navigation samples `keep` accepts.
 // The navigation the simulator gives at 20 Hz (the samples `keep` passes) and its first
 // `frames` frames, appended to `writer` as a recorder would.
-void AppendDive(const scanner::sim::Simulator& simulator, DiveLogWriter& writer, std::int64_t frames,
-                const std::function<bool(double)>& keep) {
+void AppendDive(const scanner::sim::Simulator& simulator, DiveLogWriter& writer,
+                std::int64_t frames, const std::function<bool(double)>& keep) {
   writer.SetVehicleMount(simulator.scene().trajectory.T_V_C);
   for (const scanner::sim::NavigationSample& n : simulator.Navigation(20.0)) {
     if (keep(n.time_s)) writer.AppendNavigation({n.time_s, n.T_W_V});
@@ -277,8 +292,8 @@ DiveLogHeader HeaderWithNavigationNoise(const scanner::sim::Simulator& simulator
   return header;
 }
 
-fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const fs::path& path, std::int64_t frames,
-                                const std::function<bool(double)>& keep) {
+fs::path WriteLogWithNavigation(const scanner::sim::Simulator& simulator, const fs::path& path,
+                                std::int64_t frames, const std::function<bool(double)>& keep) {
   DiveLogWriter writer(path, HeaderWithNavigationNoise(simulator));
   AppendDive(simulator, writer, frames, keep);
   return path;
@@ -288,7 +303,8 @@ TEST_F(DiveMappingTest, ALogCutShortMapsUpToItsLastFrame) {
   // A recorder that died mid-sweep: every navigation sample, the frames up to the crash.
   const scanner::sim::Simulator simulator(ShortScene());
   const std::int64_t kept = simulator.frame_count() / 2 + 7;
-  const fs::path path = WriteLogWithNavigation(simulator, dir_ / "cut.db", kept, [](double) { return true; });
+  const fs::path path =
+      WriteLogWithNavigation(simulator, dir_ / "cut.db", kept, [](double) { return true; });
   const DiveMapping m = Map(path);
   EXPECT_TRUE(m.truth.empty());
   ASSERT_GT(m.submaps, 2);
@@ -326,7 +342,8 @@ TEST_F(DiveMappingTest, ALogWhoseRecorderWasKilledMapsUpToItsLastFrame) {
   int status = 0;
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   ASSERT_TRUE(reported) << "the recorder process stopped before writing its frames";
-  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "the recorder exited " << status;
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)
+      << "the recorder exited " << status;
   ASSERT_TRUE(fs::exists(path.string() + "-wal"));  // never closed: its frames are in the WAL
 
   const DiveMapping m = Map(path);
@@ -354,7 +371,8 @@ TEST_F(DiveMappingTest, FramesTheNavigationDoesNotCoverAreLeftOutAndCounted) {
     const double t = simulator.Frame(i).time_s;
     const auto after = std::lower_bound(samples.begin(), samples.end(), t);
     const bool covered =
-        after != samples.end() && (*after == t || (after != samples.begin() && *after - *(after - 1) <= 1.0));
+        after != samples.end() &&
+        (*after == t || (after != samples.begin() && *after - *(after - 1) <= 1.0));
     uncovered += covered ? 0 : 1;
   }
   ASSERT_GT(uncovered, frames / 3);
@@ -364,14 +382,17 @@ TEST_F(DiveMappingTest, FramesTheNavigationDoesNotCoverAreLeftOutAndCounted) {
   EXPECT_EQ(m.stats.frames + m.stats.frames_without_navigation, frames);
   for (const TimedPose& p : m.slam) {
     EXPECT_LE(p.time_s, 9.0);
-    EXPECT_FALSE(p.time_s > 3.0 && p.time_s < 6.0) << "a submap anchored in the dropout, at " << p.time_s << " s";
+    EXPECT_FALSE(p.time_s > 3.0 && p.time_s < 6.0)
+        << "a submap anchored in the dropout, at " << p.time_s << " s";
   }
 
   // With every frame after the navigation's end nothing can be placed, and the error says why.
-  const fs::path late = WriteLogWithNavigation(simulator, dir_ / "late.db", static_cast<std::int64_t>(2.0 / period),
-                                               [](double t) { return t >= 5.0; });
-  EXPECT_NE(MessageOf([&] { Map(late); }).find("no frame lies within its navigation (samples from 5.0"),
-            std::string::npos)
+  const fs::path late =
+      WriteLogWithNavigation(simulator, dir_ / "late.db", static_cast<std::int64_t>(2.0 / period),
+                             [](double t) { return t >= 5.0; });
+  EXPECT_NE(
+      MessageOf([&] { Map(late); }).find("no frame lies within its navigation (samples from 5.0"),
+      std::string::npos)
       << MessageOf([&] { Map(late); });
 }
 
@@ -394,7 +415,8 @@ TEST_F(DiveMappingTest, UnusableLogsGiveAClearError) {
   const std::string next = std::to_string(kDiveLogSchemaVersion + 1);
   RawExec(one, "UPDATE meta SET value = " + next + " WHERE key = 'schema_version'");
   EXPECT_NE(MessageOf([&] { Map(one); })
-                .find("schema version " + next + ", this uwscan reads 1 to " + std::to_string(kDiveLogSchemaVersion)),
+                .find("schema version " + next + ", this uwscan reads 1 to " +
+                      std::to_string(kDiveLogSchemaVersion)),
             std::string::npos);
 }
 
@@ -403,7 +425,8 @@ TEST_F(DiveMappingTest, VersionOneLogsOpenAndMapWithAnAssumedNoise) {
   scene.scanner.sweeps = 12;
   const fs::path path = Simulate(scene, "v1.db");
   EXPECT_TRUE(DiveLogReader(path).header().navigation_noise.has_value());
-  RawExec(path, "DROP TABLE navigation_noise; UPDATE meta SET value = 1 WHERE key = 'schema_version'");
+  RawExec(path,
+          "DROP TABLE navigation_noise; UPDATE meta SET value = 1 WHERE key = 'schema_version'");
   const DiveLogReader reader(path);
   EXPECT_EQ(reader.header().schema_version, 1);
   EXPECT_FALSE(reader.header().navigation_noise.has_value());
@@ -417,7 +440,8 @@ TEST(PoseGraph, ACovarianceIsTheInverseOfItsOnlyPrior) {
   const Eigen::Isometry3d T = TestPose(3);
   graph.AddNode(T);
   Matrix6d information = Matrix6d::Zero();
-  information.diagonal() << 1e4, 4e4, 9e4, 1e2, 4e2, 9e2;  // 0.01, 0.005, 0.0033 rad; 0.1, 0.05, 0.033 m
+  information.diagonal() << 1e4, 4e4, 9e4, 1e2, 4e2,
+      9e2;  // 0.01, 0.005, 0.0033 rad; 0.1, 0.05, 0.033 m
   information(0, 3) = information(3, 0) = 50.0;
   graph.AddPrior({0, T, information});
   graph.Solve({});
@@ -451,17 +475,21 @@ TEST(PoseGraph, ACovarianceCarriesThePriorAndTheEdgeAlongTheLever) {
   A.block<3, 3>(3, 0) << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;  // -[t]x
   const Matrix6d expected = A * (prior.inverse() + edge.inverse()) * A.transpose();
   EXPECT_LT(((*covariance)[0] - prior.inverse()).norm(), 1e-9 * prior.inverse().norm());
-  EXPECT_LT(((*covariance)[1] - expected).norm(), 1e-9 * expected.norm()) << (*covariance)[1] << "\n\n" << expected;
+  EXPECT_LT(((*covariance)[1] - expected).norm(), 1e-9 * expected.norm())
+      << (*covariance)[1] << "\n\n"
+      << expected;
 }
 
 TEST(PoseGraph, RecoversAChainFromExactEdgesAndAPrior) {
   PoseGraph graph;
   std::vector<Eigen::Isometry3d> truth;
   for (int i = 0; i < 5; ++i) truth.push_back(TestPose(10 + static_cast<std::uint64_t>(i)));
-  for (int i = 0; i < 5; ++i) graph.AddNode(i == 0 ? truth[0] : TestPose(100 + static_cast<std::uint64_t>(i)));
+  for (int i = 0; i < 5; ++i)
+    graph.AddNode(i == 0 ? truth[0] : TestPose(100 + static_cast<std::uint64_t>(i)));
   graph.AddPrior({0, truth[0], Matrix6d::Identity() * 1e6});
   for (int i = 0; i + 1 < 5; ++i) {
-    graph.AddEdge({i, i + 1, truth[static_cast<size_t>(i)].inverse() * truth[static_cast<size_t>(i) + 1],
+    graph.AddEdge({i, i + 1,
+                   truth[static_cast<size_t>(i)].inverse() * truth[static_cast<size_t>(i) + 1],
                    Matrix6d::Identity() * 1e4, false, 3.0});
   }
   EXPECT_TRUE(graph.Solve({}).converged);

@@ -29,7 +29,8 @@ struct SelectedInverse {
     const auto it = std::lower_bound(begin, end, i);
     // Every entry read lies on the pattern (a column's rows are a clique of the factor's graph;
     // the blocks were made structural): a miss is a broken invariant, never wrong numbers.
-    if (it == end || *it != i) throw std::logic_error("InverseBlocks: an entry off the factor's pattern");
+    if (it == end || *it != i)
+      throw std::logic_error("InverseBlocks: an entry off the factor's pattern");
     return z[static_cast<size_t>(it - rows.begin())];
   }
 };
@@ -66,11 +67,14 @@ void FillInverseOnPattern(SelectedInverse& s, const Eigen::VectorXd& d) {
     const int end = s.column_start[static_cast<size_t>(j) + 1];
     for (int p = begin; p < end; ++p) {
       double sum = 0.0;
-      for (int q = begin; q < end; ++q) sum += s.At(s.rows[static_cast<size_t>(p)], s.rows[static_cast<size_t>(q)]) * s.l[static_cast<size_t>(q)];
+      for (int q = begin; q < end; ++q)
+        sum += s.At(s.rows[static_cast<size_t>(p)], s.rows[static_cast<size_t>(q)]) *
+               s.l[static_cast<size_t>(q)];
       s.z[static_cast<size_t>(p)] = -sum;
     }
     double sum = 0.0;
-    for (int p = begin; p < end; ++p) sum += s.z[static_cast<size_t>(p)] * s.l[static_cast<size_t>(p)];
+    for (int p = begin; p < end; ++p)
+      sum += s.z[static_cast<size_t>(p)] * s.l[static_cast<size_t>(p)];
     s.z_diagonal[j] = 1.0 / d[j] - sum;
   }
 }
@@ -85,8 +89,8 @@ std::optional<std::vector<Eigen::MatrixXd>> InverseBlocks(Eigen::SparseMatrix<do
   std::vector<Eigen::Triplet<double>> structural;
   for (const IndexRange& b : blocks) {
     if (b.start < 0 || b.size < 1 || b.start > n || b.size > n - b.start) {
-      throw Error("InverseBlocks: block [" + std::to_string(b.start) + ", +" + std::to_string(b.size) +
-                  ") outside a " + std::to_string(n) + "-row matrix");
+      throw Error("InverseBlocks: block [" + std::to_string(b.start) + ", +" +
+                  std::to_string(b.size) + ") outside a " + std::to_string(n) + "-row matrix");
     }
     for (int a = b.start; a < b.start + b.size; ++a) {
       for (int c = b.start; c < b.start + b.size; ++c) structural.emplace_back(a, c, 0.0);
@@ -96,7 +100,8 @@ std::optional<std::vector<Eigen::MatrixXd>> InverseBlocks(Eigen::SparseMatrix<do
   zeros.setFromTriplets(structural.begin(), structural.end());
   information += zeros;  // explicit zeros stay stored: the blocks' entries are on L's pattern
 
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(information);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(
+      information);
   if (ldlt.info() != Eigen::Success) return std::nullopt;
   const Eigen::VectorXd d = ldlt.vectorD();
   // P H P^T = L D L^T with (P x)[perm[a]] = x[a]: H^-1(a, c) = Z(perm[a], perm[c]).
@@ -118,7 +123,8 @@ std::optional<std::vector<Eigen::MatrixXd>> InverseBlocks(Eigen::SparseMatrix<do
   for (const IndexRange& b : blocks) {
     Eigen::MatrixXd block(b.size, b.size);
     for (int a = 0; a < b.size; ++a) {
-      for (int c = 0; c < b.size; ++c) block(a, c) = inverse.At(perm[b.start + a], perm[b.start + c]);
+      for (int c = 0; c < b.size; ++c)
+        block(a, c) = inverse.At(perm[b.start + a], perm[b.start + c]);
     }
     out.push_back(std::move(block));
   }

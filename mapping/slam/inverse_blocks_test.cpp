@@ -52,7 +52,8 @@ TEST(InverseBlocks, EqualTheDenseInverseOnAGraphWithLoops) {
   ASSERT_TRUE(got.has_value());
   ASSERT_EQ(got->size(), blocks.size());
   for (std::size_t k = 0; k < blocks.size(); ++k) {
-    const Eigen::MatrixXd expected = reference.block(blocks[k].start, blocks[k].start, blocks[k].size, blocks[k].size);
+    const Eigen::MatrixXd expected =
+        reference.block(blocks[k].start, blocks[k].start, blocks[k].size, blocks[k].size);
     EXPECT_LT(((*got)[k] - expected).norm(), 1e-9 * expected.norm()) << "block " << k;
   }
 }

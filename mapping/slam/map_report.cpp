@@ -1,9 +1,10 @@
 #include "mapping/slam/map_report.hpp"
-#include "scanner/common/symmetrized.hpp"
 
-#include <algorithm>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 
@@ -13,7 +14,8 @@ namespace {
 // the slide, where its pose is only the prediction and may be off by the drift.
 // Exact when the free direction is a pure translation (a slide, mapper.cpp); a loop without a
 // usable information is judged whole.
-Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& error, const Matrix6d& information) {
+Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& error,
+                                         const Matrix6d& information) {
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(Symmetrized(information));
   const double largest = eigen.eigenvalues()(5);
   if (!information.allFinite() || !(largest > 0.0)) return error;
@@ -42,8 +44,10 @@ MapSummary Summarise(const DiveMapping& m) {
     if (!loop.accepted) continue;
     const Eigen::Isometry3d truth = m.truth[static_cast<size_t>(loop.from)].T_W_V.inverse() *
                                     m.truth[static_cast<size_t>(loop.to)].T_W_V;
-    const Eigen::Matrix<double, 6, 1> error = MeasuredPart(PoseError(loop.T_from_to, truth), loop.information);
-    if (error.tail<3>().norm() > kFalseLoopTranslation_m || error.head<3>().norm() > kFalseLoopRotation_rad) {
+    const Eigen::Matrix<double, 6, 1> error =
+        MeasuredPart(PoseError(loop.T_from_to, truth), loop.information);
+    if (error.tail<3>().norm() > kFalseLoopTranslation_m ||
+        error.head<3>().norm() > kFalseLoopRotation_rad) {
       ++false_loops;
     }
   }

@@ -8,8 +8,8 @@
 namespace uwscan::mapping {
 
 double ExpectedSurfaceErrorRms(const std::vector<const perception::PointCloud*>& clouds_V,
-                               const std::vector<Eigen::Isometry3d>& T_W_V, const std::vector<Matrix6d>& covariances,
-                               std::size_t stride) {
+                               const std::vector<Eigen::Isometry3d>& T_W_V,
+                               const std::vector<Matrix6d>& covariances, std::size_t stride) {
   if (clouds_V.size() != T_W_V.size() || clouds_V.size() != covariances.size()) {
     throw Error("expected surface error: " + std::to_string(clouds_V.size()) + " clouds, " +
                 std::to_string(T_W_V.size()) + " poses and " + std::to_string(covariances.size()) +
@@ -21,7 +21,8 @@ double ExpectedSurfaceErrorRms(const std::vector<const perception::PointCloud*>&
   for (std::size_t s = 0; s < clouds_V.size(); ++s) {
     const perception::PointCloud& cloud = *clouds_V[s];
     if (cloud.empty()) continue;
-    if (!cloud.has_normals()) throw Error("expected surface error: submap " + std::to_string(s) + " has no normals");
+    if (!cloud.has_normals())
+      throw Error("expected surface error: submap " + std::to_string(s) + " has no normals");
     const Eigen::Isometry3d& T = T_W_V[s];
     for (std::size_t i = 0; i < cloud.size(); i += stride) {
       const Eigen::Vector3d n_W = T.linear() * cloud.normals[i].cast<double>();

@@ -18,8 +18,8 @@ namespace uwscan::mapping {
 // allow no better. Every `stride`-th point of each cloud is used (clouds need normals).
 // Throws uwscan::Error when the sizes differ, a cloud has no normals, or stride is 0.
 double ExpectedSurfaceErrorRms(const std::vector<const perception::PointCloud*>& clouds_V,
-                               const std::vector<Eigen::Isometry3d>& T_W_V, const std::vector<Matrix6d>& covariances,
-                               std::size_t stride = 1);
+                               const std::vector<Eigen::Isometry3d>& T_W_V,
+                               const std::vector<Matrix6d>& covariances, std::size_t stride = 1);
 
 // How far the poses are expected to lie from the true ones from their covariance alone: the
 // square root of the mean over the poses of their position variance (the trace of the position

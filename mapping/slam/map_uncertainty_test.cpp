@@ -16,7 +16,8 @@ perception::PointCloud Seabed() {
   perception::PointCloud cloud;
   for (int i = 0; i <= 30; ++i) {
     for (int j = 0; j <= 20; ++j) {
-      cloud.points.emplace_back(0.02f * static_cast<float>(i) - 0.3f, 0.02f * static_cast<float>(j) - 0.2f, 1.0f);
+      cloud.points.emplace_back(0.02f * static_cast<float>(i) - 0.3f,
+                                0.02f * static_cast<float>(j) - 0.2f, 1.0f);
       cloud.normals.emplace_back(0.0f, 0.0f, -1.0f);
     }
   }
@@ -39,10 +40,11 @@ TEST(ExpectedSurfaceError, DepthMovesASeabedAlongItsNormalAndHeadingDoesNot) {
 TEST(ExpectedSurfaceError, AgreesWithPosesDrawnFromTheCovariance) {
   const perception::PointCloud seabed = Seabed();
   Eigen::Isometry3d T_W_V = Eigen::Isometry3d::Identity();
-  T_W_V.linear() = Eigen::AngleAxisd(0.8, Eigen::Vector3d(0.2, 0.3, 1.0).normalized()).toRotationMatrix();
+  T_W_V.linear() =
+      Eigen::AngleAxisd(0.8, Eigen::Vector3d(0.2, 0.3, 1.0).normalized()).toRotationMatrix();
   T_W_V.translation() = Eigen::Vector3d(3.0, -2.0, 9.0);
   Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Random();
-  A.topRows<3>() *= 0.003;   // rad
+  A.topRows<3>() *= 0.003;     // rad
   A.bottomRows<3>() *= 0.004;  // m
   const Matrix6d covariance = A * A.transpose();
   const double expected = ExpectedSurfaceErrorRms({&seabed}, {T_W_V}, {covariance});
@@ -70,7 +72,8 @@ TEST(ExpectedSurfaceError, AgreesWithPosesDrawnFromTheCovariance) {
     }
   }
   const double sampled = std::sqrt(sum / static_cast<double>(count));
-  EXPECT_NEAR(expected / sampled, 1.0, 0.05) << expected << " m predicted, " << sampled << " m sampled";
+  EXPECT_NEAR(expected / sampled, 1.0, 0.05)
+      << expected << " m predicted, " << sampled << " m sampled";
 }
 
 // The message of the uwscan::Error `call` throws ("" when it throws none).
@@ -90,12 +93,15 @@ TEST(ExpectedSurfaceError, MismatchedInputsGiveAClearError) {
   bare.normals.clear();
   const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   const auto says = [](const std::string& message, const char* what) {
-    EXPECT_NE(message.find(what), std::string::npos) << "'" << message << "' does not say '" << what << "'";
+    EXPECT_NE(message.find(what), std::string::npos)
+        << "'" << message << "' does not say '" << what << "'";
   };
   says(ErrorOf([&] { ExpectedSurfaceErrorRms({&seabed}, {}, {Matrix6d::Identity()}); }),
        "1 clouds, 0 poses and 1 covariances");
-  says(ErrorOf([&] { ExpectedSurfaceErrorRms({&bare}, {pose}, {Matrix6d::Identity()}); }), "submap 0 has no normals");
-  says(ErrorOf([&] { ExpectedSurfaceErrorRms({&seabed}, {pose}, {Matrix6d::Identity()}, 0); }), "stride must be > 0");
+  says(ErrorOf([&] { ExpectedSurfaceErrorRms({&bare}, {pose}, {Matrix6d::Identity()}); }),
+       "submap 0 has no normals");
+  says(ErrorOf([&] { ExpectedSurfaceErrorRms({&seabed}, {pose}, {Matrix6d::Identity()}, 0); }),
+       "stride must be > 0");
 }
 
 TEST(ExpectedPositionError, IsTheRmsOfPositionErrorsDrawnFromTheCovariancesAndIgnoresRotation) {
@@ -127,17 +133,22 @@ TEST(ExpectedPositionError, IsTheRmsOfPositionErrorsDrawnFromTheCovariancesAndIg
     }
   }
   const double sampled = std::sqrt(sum / (2.0 * draws));
-  EXPECT_NEAR(expected / sampled, 1.0, 0.02) << expected << " m predicted, " << sampled << " m sampled";
+  EXPECT_NEAR(expected / sampled, 1.0, 0.02)
+      << expected << " m predicted, " << sampled << " m sampled";
 }
 
 TEST(ExpectedPositionError, NoCovarianceOrABrokenOneGivesAClearError) {
   const auto says = [](const std::string& message, const char* what) {
-    EXPECT_NE(message.find(what), std::string::npos) << "'" << message << "' does not say '" << what << "'";
+    EXPECT_NE(message.find(what), std::string::npos)
+        << "'" << message << "' does not say '" << what << "'";
   };
   says(ErrorOf([] { ExpectedPositionErrorRms({}); }), "no pose covariances");
   Matrix6d broken = Matrix6d::Identity();
   broken(4, 4) = std::nan("");
-  says(ErrorOf([&] { ExpectedPositionErrorRms({Matrix6d::Identity(), broken}); }), "pose 1 has position variance");
+  says(ErrorOf([&] {
+         ExpectedPositionErrorRms({Matrix6d::Identity(), broken});
+       }),
+       "pose 1 has position variance");
 }
 
 }  // namespace

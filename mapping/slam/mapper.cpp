@@ -13,15 +13,17 @@
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/triangulation/triangulator_factory.hpp"
 #include "scanner/common/symmetrized.hpp"
+#include "scanner/triangulation/triangulator_factory.hpp"
 
 namespace uwscan::mapping {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+double Since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 // Frames waiting for navigation beyond this many mean the navigation has stopped.
 constexpr std::size_t kMaxWaitingFrames = 20000;
@@ -30,7 +32,8 @@ constexpr double kStartSigma_m = 0.001;
 constexpr double kStartSigma_rad = 0.001;
 
 // Appends `cloud` (points and normals) moved by T to `out`, whose origin is 0.
-void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isometry3d& T, perception::PointCloud* out) {
+void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isometry3d& T,
+                 perception::PointCloud* out) {
   const Eigen::Matrix3f R = T.linear().cast<float>();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     out->points.push_back((T * cloud.Point(i)).cast<float>());
@@ -57,11 +60,13 @@ Eigen::Matrix3d PositionCovariance(const Matrix6d& covariance, const Eigen::Vect
 }
 
 double LargestStd(const Eigen::Matrix3d& covariance) {
-  return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
+  return std::sqrt(
+      std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
 }
 
 // The ICP of a registration with the given stages, as MapperOptions sets it.
-perception::IcpOptions RegistrationIcp(const MapperOptions& o, const std::vector<double>& distances) {
+perception::IcpOptions RegistrationIcp(const MapperOptions& o,
+                                       const std::vector<double>& distances) {
   perception::IcpOptions icp;
   icp.method = perception::IcpMethod::kPointToPlane;
   icp.max_correspondence_distance_m = distances;
@@ -91,15 +96,20 @@ void MapperOptions::Check() const {
   if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
   if (loop_every_submaps < 1) fail("loop_every_submaps", "> 0");
   if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
-  if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0)) fail("loop_overlap_ratio", "in (0, 1]");
+  if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0))
+    fail("loop_overlap_ratio", "in (0, 1]");
   if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
   if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
   if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
-  if (!(running_solve_tolerance > 0.0 && running_solve_tolerance < 1.0)) fail("running_solve_tolerance", "in (0, 1)");
-  if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0)) fail("weak_direction_ratio", "in [0, 1)");
+  if (!(running_solve_tolerance > 0.0 && running_solve_tolerance < 1.0))
+    fail("running_solve_tolerance", "in (0, 1)");
+  if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0))
+    fail("weak_direction_ratio", "in [0, 1)");
   if (!(slide_sigma_m >= 0.0)) fail("slide_sigma_m", ">= 0 m");
-  if (!(max_navigation_gap_s > 0.0 && std::isfinite(max_navigation_gap_s))) fail("max_navigation_gap_s", "> 0 s");
-  if (!(navigation_latency_s >= 0.0 && std::isfinite(navigation_latency_s))) fail("navigation_latency_s", ">= 0 s");
+  if (!(max_navigation_gap_s > 0.0 && std::isfinite(max_navigation_gap_s)))
+    fail("max_navigation_gap_s", "> 0 s");
+  if (!(navigation_latency_s >= 0.0 && std::isfinite(navigation_latency_s)))
+    fail("navigation_latency_s", ">= 0 s");
   if (threads < 0) fail("threads", ">= 0");
   if (icp_max_iterations < 1) fail("icp_max_iterations", "> 0");
   if (icp_max_iterations_per_stage < 1) fail("icp_max_iterations_per_stage", "> 0");
@@ -139,7 +149,8 @@ struct Mapper::Impl {
   // edge ties them (SubmapDistortionCovariance). Bending is then a bounded offset per submap,
   // not a step that accumulates along a chain of registrations.
   std::vector<Submap> submaps;
-  std::vector<Matrix6d> increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
+  std::vector<Matrix6d>
+      increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
   PoseGraph graph;
   std::vector<LoopClosure> loops;
   MapperStats stats;
@@ -154,8 +165,22 @@ struct Mapper::Impl {
   void Place(const FrameRecord& frame);
   void CloseSubmap();
   void AddToGraph(Submap submap);
-  perception::RegistrationResult Register(const Submap& source, const perception::PointCloud& target,
-                                          const Eigen::Isometry3d& T_init, const Matrix6d& prior_covariance,
+  // A submap registered to the ones before it (AddToGraph), step by step.
+  struct ConsecutiveRegistration {
+    Eigen::Isometry3d anchor_initial = Eigen::Isometry3d::Identity();  // where its nodes start
+    Eigen::Isometry3d scan_initial = Eigen::Isometry3d::Identity();
+    Matrix6d increment_cov = Matrix6d::Zero();     // of the scan's motion since the previous one
+    std::optional<RelativePoseEdge> registration;  // when it was kept
+    Matrix6d slides = Matrix6d::Zero();            // how loosely the scan is tied along free slides
+  };
+  ConsecutiveRegistration RegisterToPrevious(const Submap& submap, int k);
+  perception::PointCloud LocalMap(int k) const;
+  void AddNodesAndEdges(const Submap& submap, int k, const ConsecutiveRegistration& c);
+  void CloseLoopsAndSolve(int k);
+  perception::RegistrationResult Register(const Submap& source,
+                                          const perception::PointCloud& target,
+                                          const Eigen::Isometry3d& T_init,
+                                          const Matrix6d& prior_covariance,
                                           const std::vector<double>& distances) const;
   // The registration's own information (its pairs), weak directions removed. It relates the
   // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
@@ -171,14 +196,16 @@ struct Mapper::Impl {
   Matrix6d ChainCovariance(int from, int to) const;
   // Loop closures (TryLoopClosures), step by step.
   struct LoopCandidate {
-    int j;            // the earlier submap
-    double distance;  // between the two centres, as the graph places them now
+    int j;                // the earlier submap
+    double distance;      // between the two centres, as the graph places them now
     Matrix6d covariance;  // of T_j_k, predicted along the chain between them
   };
   void TryLoopClosures(int k);
   std::vector<LoopCandidate> LoopCandidates(int k) const;
-  perception::PointCloud LoopTarget(int j, int k) const;  // submap j with its neighbours, in j's frame
-  std::vector<double> LoopIcpDistances(const LoopCandidate& c, const Eigen::Isometry3d& T_pred) const;
+  perception::PointCloud LoopTarget(int j,
+                                    int k) const;  // submap j with its neighbours, in j's frame
+  std::vector<double> LoopIcpDistances(const LoopCandidate& c,
+                                       const Eigen::Isometry3d& T_pred) const;
   LoopClosure JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c, int k,
                         const Eigen::Isometry3d& T_pred) const;
   std::string LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
@@ -190,14 +217,15 @@ struct Mapper::Impl {
   Eigen::Isometry3d AnchorPose(int submap) const { return graph.pose(AnchorNode(submap)); }
   Eigen::Isometry3d ScanPose(int submap) const { return graph.pose(ScanNode(submap)); }
   SystematicErrors systematic() const {
-    return options.estimate_dead_reckoning_calibration ? SystematicErrors::kEstimated : SystematicErrors::kAsNoise;
+    return options.estimate_dead_reckoning_calibration ? SystematicErrors::kEstimated
+                                                       : SystematicErrors::kAsNoise;
   }
   // The navigation at t (held at its ends) with its motion since the submap's first frame
   // corrected by the placement calibration.
   Eigen::Isometry3d PlacementPose(double time_s) const {
-    Eigen::Isometry3d T_W_V =
-        navigation.T_W_V(navigation.HeldTime(time_s));
-    T_W_V.translation() = placement_origin_W + placement.Correct(T_W_V.translation() - placement_origin_W);
+    Eigen::Isometry3d T_W_V = navigation.T_W_V(navigation.HeldTime(time_s));
+    T_W_V.translation() =
+        placement_origin_W + placement.Correct(T_W_V.translation() - placement_origin_W);
     return T_W_V;
   }
 };
@@ -211,7 +239,8 @@ void Mapper::Impl::Drain(bool finishing) {
     } else if (navigation.empty() || t > navigation.last_time_s()) {
       // Waits for the navigation to reach it, unless it cannot be placed whatever comes: at the
       // end, or when frames much newer arrived (MapperOptions::navigation_latency_s).
-      const bool hopeless = waiting.back().time_s - t > options.max_navigation_gap_s + options.navigation_latency_s;
+      const bool hopeless =
+          waiting.back().time_s - t > options.max_navigation_gap_s + options.navigation_latency_s;
       if (!finishing && !hopeless) break;
     }  // else: before the first sample, never covered
     if (place) {
@@ -229,9 +258,7 @@ void Mapper::Impl::Place(const FrameRecord& frame) {
   if (frames.empty()) {
     first_sweep = frame.sweep;
     placement = graph.calibration();
-    placement_origin_W = navigation
-                             .T_W_V(navigation.HeldTime(frame.time_s))
-                             .translation();
+    placement_origin_W = navigation.T_W_V(navigation.HeldTime(frame.time_s)).translation();
   }
   const Clock::time_point start = Clock::now();
   triangulated.resize(frame.peaks_px.size());
@@ -264,9 +291,7 @@ void Mapper::Impl::CloseSubmap() {
   submap.end_s = frames.back().second;
   const double t = navigation.HeldTime(anchor.second);
   submap.T_W_V_nav = navigation.T_W_V(t);
-  const auto held_pose = [&](double time) {
-    return navigation.T_W_V(navigation.HeldTime(time));
-  };
+  const auto held_pose = [&](double time) { return navigation.T_W_V(navigation.HeldTime(time)); };
   submap.T_W_V_start = held_pose(submap.start_s);
   submap.T_W_V_end = held_pose(submap.end_s);
   // The points in the anchor's frame as the corrected navigation placed it.
@@ -288,7 +313,8 @@ void Mapper::Impl::CloseSubmap() {
   AddToGraph(std::move(submap));
 }
 
-perception::RegistrationResult Mapper::Impl::Register(const Submap& source, const perception::PointCloud& target,
+perception::RegistrationResult Mapper::Impl::Register(const Submap& source,
+                                                      const perception::PointCloud& target,
                                                       const Eigen::Isometry3d& T_init,
                                                       const Matrix6d& prior_covariance,
                                                       const std::vector<double>& distances) const {
@@ -302,15 +328,17 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source, cons
   return perception::AlignIcp(source.sparse, target, T_init, icp);
 }
 
-Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
-                                               const Submap& source, KeptDirections* kept) const {
+Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r,
+                                               const Submap& target, const Submap& source,
+                                               KeptDirections* kept) const {
   const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
-  KeptDirections points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse, r.T_target_source,
-                                                 options.weak_direction_ratio);
+  KeptDirections points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse,
+                                                r.T_target_source, options.weak_direction_ratio);
   // The pairs' residuals are not independent: what the navigation bent in each submap beyond a
   // rigid offset stays in every pair. Both submaps' bending floors the registration's covariance.
-  const Matrix6d floor = uncertainty.BendingCovariance(target.end_s - target.start_s, target.rms_radius_m) +
-                         uncertainty.BendingCovariance(source.end_s - source.start_s, source.rms_radius_m);
+  const Matrix6d floor =
+      uncertainty.BendingCovariance(target.end_s - target.start_s, target.rms_radius_m) +
+      uncertainty.BendingCovariance(source.end_s - source.start_s, source.rms_radius_m);
   const Matrix6d information = InformationOfSum(points.information, floor);
   if (kept) *kept = std::move(points);
   return information;
@@ -332,7 +360,8 @@ Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b) const 
   const Eigen::Isometry3d T_a_b = a.T_W_V_nav.inverse() * b.T_W_V_nav;
   const Matrix6d ad = Adjoint(T_a_b);
   const Matrix6d covariance =
-      uncertainty.IncrementCovariance(a.T_W_V_nav, b.T_W_V_nav, b.anchor_time_s - a.anchor_time_s, systematic_errors) +
+      uncertainty.IncrementCovariance(a.T_W_V_nav, b.T_W_V_nav, b.anchor_time_s - a.anchor_time_s,
+                                      systematic_errors) +
       Distortion(a, systematic_errors) + ad * Distortion(b, systematic_errors) * ad.transpose();
   return Symmetrized(covariance);
 }
@@ -350,55 +379,76 @@ Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
 void Mapper::Impl::AddToGraph(Submap submap) {
   const int k = static_cast<int>(submaps.size());
   submap.index = k;
-  const NavigationNoise& noise = uncertainty.noise();
-  Eigen::Isometry3d anchor_initial = submap.T_W_V_nav;
-  Eigen::Isometry3d scan_initial = submap.T_W_V_nav;
-  Matrix6d increment_cov = Matrix6d::Zero();
-  std::optional<RelativePoseEdge> registration;
-  Matrix6d slides = Matrix6d::Zero();
-  if (k > 0) {
-    const Submap& previous = submaps.back();
-    const Eigen::Isometry3d T_nav =
-        graph.calibration().CorrectMotion(previous.T_W_V_nav.inverse() * submap.T_W_V_nav);
-    // The registration starts from the corrected navigation, and is judged against it, with
-    // everything the navigation may be off by (the calibration may still be settling).
-    increment_cov = MotionCovariance(previous, submap);
-    // The scan's motion as the navigation predicts it, from the previous scan's offset.
-    const Eigen::Isometry3d T_predicted = ScanPose(k - 1).inverse() * AnchorPose(k - 1) * T_nav;
-    anchor_initial = AnchorPose(k - 1) * T_nav;
-    scan_initial = anchor_initial;
+  const ConsecutiveRegistration c = RegisterToPrevious(submap, k);
+  AddNodesAndEdges(submap, k, c);
+  submaps.push_back(std::move(submap));
+  increment_covariance.push_back(Symmetrized(c.increment_cov));
+  CloseLoopsAndSolve(k);
+}
 
-    const Clock::time_point start = Clock::now();
-    perception::PointCloud local;
-    const Eigen::Isometry3d T_prev_W = ScanPose(k - 1).inverse();
-    for (int j = std::max(0, k - options.local_map_submaps); j < k; ++j) {
-      AppendMoved(submaps[static_cast<size_t>(j)].cloud, T_prev_W * ScanPose(j), &local);
-    }
-    const perception::RegistrationResult r =
-        Register(submap, local, T_predicted, increment_cov, options.icp_distances_m);
-    stats.registration_s += Since(start);
-    KeptDirections kept;
-    const Matrix6d information = RegistrationInformation(r, previous, submap, &kept);
-    const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
-    const double chi2 = innovation.dot(InformationOfSum(information, increment_cov) * innovation);
-    // Along a slide the registration measures nothing, so the test has as many degrees of
-    // freedom as directions it pins.
-    if (r.fitness >= options.min_fitness && chi2 <= Chi2Quantile999(kept.count)) {
-      registration = RelativePoseEdge{
-          .from = ScanNode(k - 1), .to = ScanNode(k), .T_from_to = r.T_target_source, .information = information};
-      slides = SlideCovariance(kept.slides, r.T_target_source, options.slide_sigma_m);
-      scan_initial = ScanPose(k - 1) * r.T_target_source;
-      const Matrix6d combined = (increment_cov.inverse() + information).inverse();
-      increment_cov = combined;
-      ++stats.registrations;
-    } else {
-      ++(r.fitness >= options.min_fitness ? stats.registrations_inconsistent : stats.registrations_failed);
-    }
+Mapper::Impl::ConsecutiveRegistration Mapper::Impl::RegisterToPrevious(const Submap& submap,
+                                                                       int k) {
+  ConsecutiveRegistration c;
+  c.anchor_initial = submap.T_W_V_nav;
+  c.scan_initial = submap.T_W_V_nav;
+  if (k == 0) return c;
+  const Submap& previous = submaps.back();
+  const Eigen::Isometry3d T_nav =
+      graph.calibration().CorrectMotion(previous.T_W_V_nav.inverse() * submap.T_W_V_nav);
+  // The registration starts from the corrected navigation, and is judged against it, with
+  // everything the navigation may be off by (the calibration may still be settling).
+  c.increment_cov = MotionCovariance(previous, submap);
+  // The scan's motion as the navigation predicts it, from the previous scan's offset.
+  const Eigen::Isometry3d T_predicted = ScanPose(k - 1).inverse() * AnchorPose(k - 1) * T_nav;
+  c.anchor_initial = AnchorPose(k - 1) * T_nav;
+  c.scan_initial = c.anchor_initial;
+
+  const Clock::time_point start = Clock::now();
+  const perception::RegistrationResult r =
+      Register(submap, LocalMap(k), T_predicted, c.increment_cov, options.icp_distances_m);
+  stats.registration_s += Since(start);
+  KeptDirections kept;
+  const Matrix6d information = RegistrationInformation(r, previous, submap, &kept);
+  const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
+  const double chi2 = innovation.dot(InformationOfSum(information, c.increment_cov) * innovation);
+  // Along a slide the registration measures nothing, so the test has as many degrees of
+  // freedom as directions it pins.
+  if (r.fitness >= options.min_fitness && chi2 <= Chi2Quantile999(kept.count)) {
+    c.registration = RelativePoseEdge{.from = ScanNode(k - 1),
+                                      .to = ScanNode(k),
+                                      .T_from_to = r.T_target_source,
+                                      .information = information};
+    c.slides = SlideCovariance(kept.slides, r.T_target_source, options.slide_sigma_m);
+    c.scan_initial = ScanPose(k - 1) * r.T_target_source;
+    const Matrix6d combined = (c.increment_cov.inverse() + information).inverse();
+    c.increment_cov = combined;
+    ++stats.registrations;
+  } else {
+    ++(r.fitness >= options.min_fitness ? stats.registrations_inconsistent
+                                        : stats.registrations_failed);
   }
-  const int anchor = graph.AddNode(anchor_initial);
-  const int scan = graph.AddNode(scan_initial);
-  if (anchor != AnchorNode(k) || scan != ScanNode(k)) throw Error("mapper: graph nodes out of step with submaps");
-  const Matrix6d distortion_information = (Distortion(submap, systematic()) + slides).inverse();
+  return c;
+}
+
+// The last local_map_submaps submaps before k, in the frame of the one just before it.
+perception::PointCloud Mapper::Impl::LocalMap(int k) const {
+  perception::PointCloud local;
+  const Eigen::Isometry3d T_prev_W = ScanPose(k - 1).inverse();
+  for (int j = std::max(0, k - options.local_map_submaps); j < k; ++j) {
+    AppendMoved(submaps[static_cast<size_t>(j)].cloud, T_prev_W * ScanPose(j), &local);
+  }
+  return local;
+}
+
+// Submap k's anchor and scan nodes, the distortion edge between them, the start prior or the
+// odometry edge (and the registration) from the previous anchor, depth and gravity.
+void Mapper::Impl::AddNodesAndEdges(const Submap& submap, int k, const ConsecutiveRegistration& c) {
+  const NavigationNoise& noise = uncertainty.noise();
+  const int anchor = graph.AddNode(c.anchor_initial);
+  const int scan = graph.AddNode(c.scan_initial);
+  if (anchor != AnchorNode(k) || scan != ScanNode(k))
+    throw Error("mapper: graph nodes out of step with submaps");
+  const Matrix6d distortion_information = (Distortion(submap, systematic()) + c.slides).inverse();
   graph.AddEdge({.from = anchor, .to = scan, .information = Symmetrized(distortion_information)});
   if (k == 0) {
     graph.AddPrior({.node = anchor, .T_W_V = submap.T_W_V_nav, .information = StartInformation()});
@@ -407,23 +457,28 @@ void Mapper::Impl::AddToGraph(Submap submap) {
     graph.AddEdge({.from = AnchorNode(k - 1),
                    .to = anchor,
                    .T_from_to = previous.T_W_V_nav.inverse() * submap.T_W_V_nav,
-                   .information = uncertainty.OdometryInformation(previous.T_W_V_nav, submap.T_W_V_nav,
-                                                                  submap.anchor_time_s - previous.anchor_time_s,
-                                                                  systematic()),
+                   .information = uncertainty.OdometryInformation(
+                       previous.T_W_V_nav, submap.T_W_V_nav,
+                       submap.anchor_time_s - previous.anchor_time_s, systematic()),
                    .dead_reckoned = options.estimate_dead_reckoning_calibration});
-    if (registration) graph.AddEdge(*registration);
+    if (c.registration) graph.AddEdge(*c.registration);
   }
-  graph.AddDepth({.node = anchor, .z_m = submap.T_W_V_nav.translation().z(), .sigma_m = noise.depth_sigma_m});
+  graph.AddDepth(
+      {.node = anchor, .z_m = submap.T_W_V_nav.translation().z(), .sigma_m = noise.depth_sigma_m});
   graph.AddGravity({.node = anchor,
                     .down_in_V = submap.T_W_V_nav.linear().transpose() * Eigen::Vector3d::UnitZ(),
                     .sigma_rad = noise.roll_pitch_sigma_rad});
-  submaps.push_back(std::move(submap));
-  increment_covariance.push_back(Symmetrized(increment_cov));
+}
 
-  const std::size_t loops_before = std::count_if(loops.begin(), loops.end(), [](const LoopClosure& l) { return l.accepted; });
+// A solve after an accepted loop, else every solve_every_submaps submaps.
+void Mapper::Impl::CloseLoopsAndSolve(int k) {
+  const auto accepted = [this] {
+    return std::count_if(loops.begin(), loops.end(),
+                         [](const LoopClosure& l) { return l.accepted; });
+  };
+  const std::ptrdiff_t loops_before = accepted();
   TryLoopClosures(k);
-  const std::size_t loops_after = std::count_if(loops.begin(), loops.end(), [](const LoopClosure& l) { return l.accepted; });
-  if (loops_after > loops_before || ++since_solve >= options.solve_every_submaps) Solve();
+  if (accepted() > loops_before || ++since_solve >= options.solve_every_submaps) Solve();
 }
 
 // Loop closures for submap k: the earlier submaps whose overlap with it is plausible, nearest
@@ -434,8 +489,9 @@ void Mapper::Impl::TryLoopClosures(int k) {
   const Clock::time_point start = Clock::now();
   for (const LoopCandidate& c : LoopCandidates(k)) {
     const Eigen::Isometry3d T_pred = ScanPose(c.j).inverse() * ScanPose(k);
-    const perception::RegistrationResult r = Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), T_pred,
-                                                      c.covariance, LoopIcpDistances(c, T_pred));
+    const perception::RegistrationResult r =
+        Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), T_pred, c.covariance,
+                 LoopIcpDistances(c, T_pred));
     const LoopClosure loop = JudgeLoop(r, c, k, T_pred);
     if (loop.accepted) {
       graph.AddEdge({.from = ScanNode(c.j),
@@ -462,13 +518,15 @@ std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) con
     const Matrix6d covariance = ChainCovariance(j, k);
     const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
     const Eigen::Vector3d gap_m = centre_k_in_j - old.centroid_V;
-    if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <= options.gate_sigmas)) {
+    if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <=
+          options.gate_sigmas)) {
       continue;
     }
     candidates.push_back({j, distance, covariance});
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const LoopCandidate& a, const LoopCandidate& b) { return a.distance < b.distance; });
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const LoopCandidate& a, const LoopCandidate& b) { return a.distance < b.distance; });
   if (candidates.size() > static_cast<size_t>(options.max_loop_candidates)) {
     candidates.resize(static_cast<size_t>(options.max_loop_candidates));
   }
@@ -478,31 +536,34 @@ std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) con
 perception::PointCloud Mapper::Impl::LoopTarget(int j, int k) const {
   perception::PointCloud target;
   for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
-    AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i), &target);
+    AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i),
+                &target);
   }
   return target;
 }
 
-std::vector<double> Mapper::Impl::LoopIcpDistances(const LoopCandidate& c, const Eigen::Isometry3d& T_pred) const {
+std::vector<double> Mapper::Impl::LoopIcpDistances(const LoopCandidate& c,
+                                                   const Eigen::Isometry3d& T_pred) const {
   // The first stage reaches as far as the prediction may be off: three times the largest
   // position std of the scan's origin (the gate asked the narrower question, whether the two
   // centres can meet at all).
   std::vector<double> distances = options.loop_icp_distances_m;
-  const double reach = options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, T_pred.translation()));
+  const double reach =
+      options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, T_pred.translation()));
   if (reach > distances.front()) distances.insert(distances.begin(), reach);
   return distances;
 }
 
-LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c, int k,
-                                    const Eigen::Isometry3d& T_pred) const {
+LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c,
+                                    int k, const Eigen::Isometry3d& T_pred) const {
   LoopClosure loop;
   loop.from = c.j;
   loop.to = k;
   loop.fitness = r.fitness;
   loop.T_from_to = r.T_target_source;
   KeptDirections kept;
-  loop.information =
-      RegistrationInformation(r, submaps[static_cast<size_t>(c.j)], submaps[static_cast<size_t>(k)], &kept);
+  loop.information = RegistrationInformation(r, submaps[static_cast<size_t>(c.j)],
+                                             submaps[static_cast<size_t>(k)], &kept);
   loop.constrained_directions = kept.count;
   loop.reason = LoopRejection(r, kept, loop.information, c.covariance, T_pred, &loop.chi2);
   loop.accepted = loop.reason.empty();
@@ -512,27 +573,30 @@ LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, con
 // Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
 // others, as for consecutive submaps, are left to the navigation), and the registration must be
 // certain and consistent with the prediction in them. "" when it is.
-std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
-                                        const Matrix6d& information, const Matrix6d& prediction_covariance,
+std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r,
+                                        const KeptDirections& kept, const Matrix6d& information,
+                                        const Matrix6d& prediction_covariance,
                                         const Eigen::Isometry3d& T_pred, double* chi2) const {
   const int constrained = kept.count;
   const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
   const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
   if (r.fitness < options.loop_min_fitness) {
-    return "fitness " + std::to_string(r.fitness) + " below " + std::to_string(options.loop_min_fitness);
+    return "fitness " + std::to_string(r.fitness) + " below " +
+           std::to_string(options.loop_min_fitness);
   }
   if (constrained < options.loop_min_directions) {
     return "degenerate: the scans pin " + std::to_string(constrained) + " directions, fewer than " +
            std::to_string(options.loop_min_directions);
   }
   if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
-    return "uncertain: registration std " + std::to_string(sigma_m) + " m, " + std::to_string(sigma_rad) + " rad";
+    return "uncertain: registration std " + std::to_string(sigma_m) + " m, " +
+           std::to_string(sigma_rad) + " rad";
   }
   const Vector6d innovation = PoseError(r.T_target_source, T_pred);
   *chi2 = innovation.dot(InformationOfSum(information, prediction_covariance) * innovation);
   if (!(*chi2 <= Chi2Quantile999(constrained))) {
-    return "inconsistent with the prediction: chi2 " + std::to_string(*chi2) + " in " + std::to_string(constrained) +
-           " directions";
+    return "inconsistent with the prediction: chi2 " + std::to_string(*chi2) + " in " +
+           std::to_string(constrained) + " directions";
   }
   return "";
 }
@@ -546,25 +610,30 @@ void Mapper::Impl::Solve(bool last) {
   stats.graph_s += Since(start);
 }
 
-Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern, const Eigen::Isometry3d& T_V_C,
-               const NavigationNoise& noise, const MapperOptions& options,
-               const std::filesystem::path& table_cache)
+Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern,
+               const Eigen::Isometry3d& T_V_C, const NavigationNoise& noise,
+               const MapperOptions& options, const std::filesystem::path& table_cache)
     : impl_(std::make_unique<Impl>(options, T_V_C, noise)) {
   options.Check();
   if (impl_->options.estimate_dead_reckoning_calibration) {
     const NavigationNoise& floored = impl_->uncertainty.noise();
-    impl_->graph.EstimateDeadReckoningCalibration(floored.speed_scale_sigma, floored.heading_bias_sigma_rad);
+    impl_->graph.EstimateDeadReckoningCalibration(floored.speed_scale_sigma,
+                                                  floored.heading_bias_sigma_rad);
   }
   scanner::TriangulatorBuildOptions build;
   build.table_cache = table_cache;
-  impl_->triangulator =
-      scanner::MakeTriangulator(scanner, pattern, scanner::DefaultTriangulationMethod(pattern.kind), build);
+  impl_->triangulator = scanner::MakeTriangulator(
+      scanner, pattern, scanner::DefaultTriangulationMethod(pattern.kind), build);
 }
 
 Mapper::~Mapper() = default;
 
-void Mapper::SetFramePlacedCallback(FramePlacedCallback callback) { impl_->on_placed = std::move(callback); }
-void Mapper::SetFrameLeftOutCallback(FrameLeftOutCallback callback) { impl_->on_left_out = std::move(callback); }
+void Mapper::SetFramePlacedCallback(FramePlacedCallback callback) {
+  impl_->on_placed = std::move(callback);
+}
+void Mapper::SetFrameLeftOutCallback(FrameLeftOutCallback callback) {
+  impl_->on_left_out = std::move(callback);
+}
 
 void Mapper::AddNavigation(const NavigationRecord& record) {
   if (impl_->finished) throw Error("mapper: navigation added after Finish");
@@ -576,12 +645,15 @@ void Mapper::AddFrame(const FrameRecord& frame) {
   Impl& m = *impl_;
   if (m.finished) throw Error("mapper: frame added after Finish");
   if (!m.waiting.empty() && frame.time_s < m.waiting.back().time_s) {
-    throw Error("mapper: frame " + std::to_string(frame.index) + " is older than the one before it");
+    throw Error("mapper: frame " + std::to_string(frame.index) +
+                " is older than the one before it");
   }
   if (m.waiting.size() >= kMaxWaitingFrames) {
     throw Error("mapper: " + std::to_string(m.waiting.size()) +
                 " frames wait for navigation that does not come (last sample at " +
-                (m.navigation.empty() ? std::string("none") : std::to_string(m.navigation.last_time_s()) + " s") + ")");
+                (m.navigation.empty() ? std::string("none")
+                                      : std::to_string(m.navigation.last_time_s()) + " s") +
+                ")");
   }
   FrameRecord copy;
   copy.index = frame.index;
@@ -604,13 +676,17 @@ void Mapper::Finish() {
 }
 
 int Mapper::submap_count() const { return static_cast<int>(impl_->submaps.size()); }
-const Submap& Mapper::submap(int index) const { return impl_->submaps.at(static_cast<size_t>(index)); }
+const Submap& Mapper::submap(int index) const {
+  return impl_->submaps.at(static_cast<size_t>(index));
+}
 Eigen::Isometry3d Mapper::pose(int index) const {
-  if (index < 0 || index >= submap_count()) throw Error("mapper: no submap " + std::to_string(index));
+  if (index < 0 || index >= submap_count())
+    throw Error("mapper: no submap " + std::to_string(index));
   return impl_->AnchorPose(index);
 }
 Eigen::Isometry3d Mapper::scan_pose(int index) const {
-  if (index < 0 || index >= submap_count()) throw Error("mapper: no submap " + std::to_string(index));
+  if (index < 0 || index >= submap_count())
+    throw Error("mapper: no submap " + std::to_string(index));
   return impl_->ScanPose(index);
 }
 const std::vector<LoopClosure>& Mapper::loops() const { return impl_->loops; }

@@ -3,8 +3,8 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
-#include <memory>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -23,9 +23,9 @@
 namespace uwscan::mapping {
 
 struct MapperOptions {
-  int sweeps_per_submap = 1;            // sweeps grouped into one submap, > 0
-  SubmapCloudOptions clouds;            // voxel sizes, normals
-  int local_map_submaps = 3;            // previous submaps the new one is registered to, > 0
+  int sweeps_per_submap = 1;  // sweeps grouped into one submap, > 0
+  SubmapCloudOptions clouds;  // voxel sizes, normals
+  int local_map_submaps = 3;  // previous submaps the new one is registered to, > 0
   // ICP stages (metres, non-increasing) for consecutive submaps and for loop closures.
   std::vector<double> icp_distances_m = {0.04, 0.02, 0.01};
   std::vector<double> loop_icp_distances_m = {0.10, 0.04, 0.02, 0.01};
@@ -92,7 +92,7 @@ struct MapperOptions {
   // last one before the frame, so the frame would be left out anyway. Frames then never pile up
   // waiting for a navigation that stopped.
   double navigation_latency_s = 1.0;
-  int threads = 0;                    // OpenMP threads of ICP and normals, 0 = default
+  int threads = 0;  // OpenMP threads of ICP and normals, 0 = default
   void Check() const;
 };
 
@@ -102,7 +102,7 @@ struct LoopClosure {
   bool accepted = false;
   std::string reason;  // why it was rejected ("" when accepted)
   double fitness = 0.0;
-  double chi2 = 0.0;   // of the registration against the prediction
+  double chi2 = 0.0;               // of the registration against the prediction
   int constrained_directions = 0;  // directions the registration pins (the rest are left free)
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
   // What it measures ([w, v] in `from`'s frame, pose_graph.hpp): zero along the directions it
@@ -114,8 +114,8 @@ struct MapperStats {
   std::int64_t frames = 0;                     // placed
   std::int64_t frames_without_navigation = 0;  // left out: no navigation around their time
   std::int64_t points = 0;
-  int registrations = 0;         // consecutive submaps registered (fitness above the floor)
-  int registrations_failed = 0;  // left to odometry alone: fitness below the floor
+  int registrations = 0;               // consecutive submaps registered (fitness above the floor)
+  int registrations_failed = 0;        // left to odometry alone: fitness below the floor
   int registrations_inconsistent = 0;  // left to odometry alone: too far from the navigation
   double triangulation_s = 0.0;
   double submap_s = 0.0;  // voxels and normals
@@ -127,17 +127,17 @@ struct MapperStats {
 // Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until
 // the navigation covers their time, then triangulated and placed with the navigation
 // interpolated at their own time (frames the navigation does not cover are left out and
-// counted, MapperOptions::max_navigation_gap_s); every `sweeps_per_submap` sweeps close a submap, which is
-// registered (point-to-plane ICP with the navigation increment as start and prior) to the last
-// few submaps, added to the graph with its odometry and registration edges and its depth and
+// counted, MapperOptions::max_navigation_gap_s); every `sweeps_per_submap` sweeps close a submap,
+// which is registered (point-to-plane ICP with the navigation increment as start and prior) to the
+// last few submaps, added to the graph with its odometry and registration edges and its depth and
 // roll/pitch priors, and checked for loop closures against older submaps. The graph is
 // re-solved when a loop closes (and every few submaps). Memory: the voxelised submaps and the
 // graph, not the frames. Deterministic: the same inputs give the same bits for any thread count.
 class Mapper {
  public:
   // T_V_C: the camera on the vehicle. Throws uwscan::Error on invalid options.
-  Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern, const Eigen::Isometry3d& T_V_C,
-         const NavigationNoise& noise, const MapperOptions& options,
+  Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern,
+         const Eigen::Isometry3d& T_V_C, const NavigationNoise& noise, const MapperOptions& options,
          const std::filesystem::path& table_cache = {});
   ~Mapper();
   Mapper(const Mapper&) = delete;

@@ -51,22 +51,26 @@ void NavigationBuffer::RequireCovered(double time_s) const {
 
 double NavigationBuffer::GapAround(double time_s) const {
   RequireCovered(time_s);
-  const auto after = std::lower_bound(samples_.begin(), samples_.end(), time_s,
-                                      [](const NavigationRecord& r, double t) { return r.time_s < t; });
+  const auto after =
+      std::lower_bound(samples_.begin(), samples_.end(), time_s,
+                       [](const NavigationRecord& r, double t) { return r.time_s < t; });
   if (after->time_s == time_s) return 0.0;
   return after->time_s - (after - 1)->time_s;
 }
 
 Eigen::Isometry3d NavigationBuffer::T_W_V(double time_s) const {
   RequireCovered(time_s);
-  const auto after = std::lower_bound(samples_.begin(), samples_.end(), time_s,
-                                      [](const NavigationRecord& r, double t) { return r.time_s < t; });
+  const auto after =
+      std::lower_bound(samples_.begin(), samples_.end(), time_s,
+                       [](const NavigationRecord& r, double t) { return r.time_s < t; });
   if (after->time_s == time_s || after == samples_.begin()) return after->T_W_V;
   const NavigationRecord& a = *(after - 1);
   const NavigationRecord& b = *after;
   const double s = (time_s - a.time_s) / (b.time_s - a.time_s);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(a.T_W_V.linear()).slerp(s, Eigen::Quaterniond(b.T_W_V.linear())).toRotationMatrix();
+  T.linear() = Eigen::Quaterniond(a.T_W_V.linear())
+                   .slerp(s, Eigen::Quaterniond(b.T_W_V.linear()))
+                   .toRotationMatrix();
   T.translation() = (1.0 - s) * a.T_W_V.translation() + s * b.T_W_V.translation();
   return T;
 }

@@ -19,7 +19,8 @@ NavigationRecord At(double time_s, double x_m) {
 
 TEST(NavigationBuffer, InterpolatesBetweenSamplesAndMeasuresTheGapAcross) {
   NavigationBuffer nav;
-  for (const auto& [t, x] : {std::pair{0.0, 0.0}, {0.05, 0.01}, {0.10, 0.02}, {3.10, 0.62}}) nav.Add(At(t, x));
+  for (const auto& [t, x] : {std::pair{0.0, 0.0}, {0.05, 0.01}, {0.10, 0.02}, {3.10, 0.62}})
+    nav.Add(At(t, x));
   EXPECT_NEAR(nav.T_W_V(0.075).translation().x(), 0.015, 1e-12);
   EXPECT_DOUBLE_EQ(nav.GapAround(0.05), 0.0);  // at a sample: nothing to bridge
   EXPECT_NEAR(nav.GapAround(0.07), 0.05, 1e-12);
@@ -36,7 +37,9 @@ TEST(NavigationBuffer, OutsideItsSpanItSaysWhereItsSamplesAre) {
     nav.GapAround(2.5);
     FAIL() << "no error after the last sample";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("navigation spans 1.000000 to 2.000000 s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("navigation spans 1.000000 to 2.000000 s"),
+              std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(nav.T_W_V(0.5), Error);
 }

@@ -1,7 +1,8 @@
 #include "mapping/slam/navigation_uncertainty.hpp"
-#include "scanner/common/symmetrized.hpp"
 
 #include <algorithm>
+
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -30,7 +31,8 @@ Matrix6d WorldAxesToFrame(const Matrix6d& in_world_axes, const Eigen::Matrix3d& 
 
 // The information in heading, x and y (about the world's axes) of a covariance of a motion
 // from a (in a's frame), zero in depth, roll and pitch.
-Matrix6d HeadingAndPositionInformation(const Matrix6d& covariance_in_a, const Eigen::Isometry3d& T_W_a) {
+Matrix6d HeadingAndPositionInformation(const Matrix6d& covariance_in_a,
+                                       const Eigen::Isometry3d& T_W_a) {
   // Heading, x and y (world axes 2, 3, 4) inverted together; the other three carry nothing.
   const Matrix6d world_cov = WorldAxesToFrame(covariance_in_a, T_W_a.linear().transpose());
   const int kept[3] = {2, 3, 4};
@@ -61,7 +63,8 @@ Matrix6d Adjoint(const Eigen::Isometry3d& T) {
 
 NavigationUncertainty::NavigationUncertainty(const NavigationNoise& noise) : noise_(noise) {
   noise_.Check();
-  noise_.position_walk_m_per_sqrt_s = std::max(noise_.position_walk_m_per_sqrt_s, kFloorWalk_m_per_sqrt_s);
+  noise_.position_walk_m_per_sqrt_s =
+      std::max(noise_.position_walk_m_per_sqrt_s, kFloorWalk_m_per_sqrt_s);
   noise_.heading_walk_rad_per_sqrt_s =
       std::max(noise_.heading_walk_rad_per_sqrt_s, kFloorHeadingWalk_rad_per_sqrt_s);
   noise_.speed_scale_sigma = std::max(noise_.speed_scale_sigma, kFloorScale);
@@ -70,8 +73,9 @@ NavigationUncertainty::NavigationUncertainty(const NavigationNoise& noise) : noi
   noise_.roll_pitch_sigma_rad = std::max(noise_.roll_pitch_sigma_rad, kFloorRollPitch_rad);
 }
 
-Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
-                                                    double dt_s, SystematicErrors systematic) const {
+Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W_a,
+                                                    const Eigen::Isometry3d& T_W_b, double dt_s,
+                                                    SystematicErrors systematic) const {
   const double dt = std::max(dt_s, 0.0);
   const Eigen::Vector2d moved = (T_W_b.translation() - T_W_a.translation()).head<2>();
   const double distance = moved.norm();
@@ -97,7 +101,8 @@ Matrix6d NavigationUncertainty::IncrementCovariance(const Eigen::Isometry3d& T_W
 Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const SweepPlacement& sweep,
                                                            SystematicErrors systematic) const {
   const double span_s = std::max(sweep.span_s, 0.0);
-  const double walk2 = noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * span_s;
+  const double walk2 =
+      noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * span_s;
   const double radius = std::max(sweep.footprint_radius_m, kMinFootprintRadius_m);
   // About the footprint's centre, along the world's axes.
   Matrix6d at_centre = Matrix6d::Zero();
@@ -112,7 +117,8 @@ Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const SweepPlacement&
   // Position: the walk since the anchor averaged over the span (a third of its variance at the
   // ends, the rigid fit's share of a Brownian path pinned at the middle, with margin).
   Eigen::Matrix2d xy = Eigen::Matrix2d::Identity() * (walk2 / 3.0);
-  const Eigen::Vector2d moved = (sweep.T_W_end.translation() - sweep.T_W_start.translation()).head<2>();
+  const Eigen::Vector2d moved =
+      (sweep.T_W_end.translation() - sweep.T_W_start.translation()).head<2>();
   const double distance = moved.norm();
   if (distance > 0.0 && systematic == SystematicErrors::kAsNoise) {
     // Stretched by the scale error and sheared by the misalignment about the middle.
@@ -128,23 +134,28 @@ Matrix6d NavigationUncertainty::SubmapDistortionCovariance(const SweepPlacement&
   Matrix6d about_origin = Matrix6d::Identity();
   about_origin.bottomLeftCorner<3, 3>() = Skew(sweep.footprint_centre_V);
   const Eigen::Matrix3d& R_W_anchor = sweep.T_W_anchor.linear();
-  Matrix6d covariance = about_origin * WorldAxesToFrame(at_centre, R_W_anchor) * about_origin.transpose();
+  Matrix6d covariance =
+      about_origin * WorldAxesToFrame(at_centre, R_W_anchor) * about_origin.transpose();
   // The heading's own walk turns the frames about the vehicle, not about the footprint.
   Matrix6d own_heading = Matrix6d::Zero();
-  own_heading(2, 2) = noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * span_s;
+  own_heading(2, 2) =
+      noise_.heading_walk_rad_per_sqrt_s * noise_.heading_walk_rad_per_sqrt_s * span_s;
   covariance += WorldAxesToFrame(own_heading, R_W_anchor);
   // A submap of one frame is not bent at all; its covariance still has to be invertible.
   for (int k = 0; k < 6; ++k) {
-    covariance(k, k) += k < 3 ? kFloorHeadingBias_rad * kFloorHeadingBias_rad : kFloorDepth_m * kFloorDepth_m;
+    covariance(k, k) +=
+        k < 3 ? kFloorHeadingBias_rad * kFloorHeadingBias_rad : kFloorDepth_m * kFloorDepth_m;
   }
   return covariance;
 }
 
 Matrix6d NavigationUncertainty::BendingCovariance(double span_s, double footprint_radius_m) const {
-  const double bridge2 = 0.25 * noise_.position_walk_m_per_sqrt_s * noise_.position_walk_m_per_sqrt_s * std::max(span_s, 0.0);
+  const double bridge2 = 0.25 * noise_.position_walk_m_per_sqrt_s *
+                         noise_.position_walk_m_per_sqrt_s * std::max(span_s, 0.0);
   const double radius = std::max(footprint_radius_m, kMinFootprintRadius_m);
   Matrix6d covariance = Matrix6d::Zero();
-  covariance.diagonal() << Eigen::Vector3d::Constant(bridge2 / (radius * radius)), Eigen::Vector3d::Constant(bridge2);
+  covariance.diagonal() << Eigen::Vector3d::Constant(bridge2 / (radius * radius)),
+      Eigen::Vector3d::Constant(bridge2);
   return covariance;
 }
 
@@ -155,8 +166,9 @@ Matrix6d InformationOfSum(const Matrix6d& information_a, const Matrix6d& covaria
   return Symmetrized(sum);
 }
 
-Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
-                                                    double dt_s, SystematicErrors systematic) const {
+Matrix6d NavigationUncertainty::OdometryInformation(const Eigen::Isometry3d& T_W_a,
+                                                    const Eigen::Isometry3d& T_W_b, double dt_s,
+                                                    SystematicErrors systematic) const {
   return HeadingAndPositionInformation(IncrementCovariance(T_W_a, T_W_b, dt_s, systematic), T_W_a);
 }
 

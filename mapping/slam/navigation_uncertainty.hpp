@@ -13,8 +13,8 @@ struct SweepPlacement {
   Eigen::Isometry3d T_W_start = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_W_anchor = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_W_end = Eigen::Isometry3d::Identity();
-  double span_s = 0.0;                // first to last frame
-  double footprint_radius_m = 0.0;    // RMS distance of its points from their centre
+  double span_s = 0.0;              // first to last frame
+  double footprint_radius_m = 0.0;  // RMS distance of its points from their centre
   Eigen::Vector3d footprint_centre_V = Eigen::Vector3d::Zero();  // in the anchor's frame
 };
 
@@ -37,7 +37,8 @@ class NavigationUncertainty {
   // x, y and heading from the dead reckoning (random walks over dt and, kAsNoise, the speed
   // scale error along the motion and the misalignment across it); depth, roll and pitch
   // differences from the absolute sensors (twice their variance).
-  Matrix6d IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b, double dt_s,
+  Matrix6d IncrementCovariance(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
+                               double dt_s,
                                SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
   // How far from its anchor's pose a submap, bent by the navigation that placed its frames, is
@@ -50,8 +51,8 @@ class NavigationUncertainty {
   // anchor's origin sideways; the heading's own walk turns it about the origin. As the
   // [w, v] of T_anchor_scan, in the anchor's frame. The graph's nodes are the effective poses:
   // this covariance goes into the navigation's edges and priors, not the registrations'.
-  Matrix6d SubmapDistortionCovariance(const SweepPlacement& sweep,
-                                      SystematicErrors systematic = SystematicErrors::kAsNoise) const;
+  Matrix6d SubmapDistortionCovariance(
+      const SweepPlacement& sweep, SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
   // What a rigid pose cannot take out of that bending: the random walk's departure from a
   // straight path over the span (half its spread at the middle), as a shift, and as a turn
@@ -60,7 +61,8 @@ class NavigationUncertainty {
 
   // Information of the same motion in x, y and heading only, zero in depth, roll and pitch:
   // the odometry edge of the graph, where absolute priors hold those three.
-  Matrix6d OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b, double dt_s,
+  Matrix6d OdometryInformation(const Eigen::Isometry3d& T_W_a, const Eigen::Isometry3d& T_W_b,
+                               double dt_s,
                                SystematicErrors systematic = SystematicErrors::kAsNoise) const;
 
  private:

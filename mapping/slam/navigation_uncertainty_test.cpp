@@ -52,7 +52,8 @@ std::vector<Vector6d> FittedOffsets(const WalkingSweep& g, double walk_m_per_sqr
   for (int trial = 0; trial < trials; ++trial) {
     std::vector<Eigen::Vector2d> walk(static_cast<size_t>(g.frames), Eigen::Vector2d::Zero());
     for (int k = 1; k < g.frames; ++k) {
-      walk[static_cast<size_t>(k)] = walk[static_cast<size_t>(k - 1)] + step * Eigen::Vector2d(normal(rng), normal(rng));
+      walk[static_cast<size_t>(k)] =
+          walk[static_cast<size_t>(k - 1)] + step * Eigen::Vector2d(normal(rng), normal(rng));
     }
     const Eigen::Vector2d anchor = walk[static_cast<size_t>(g.frames / 2)];
     Eigen::Matrix3Xd placed(3, static_cast<Eigen::Index>(truth.size())), actual(3, placed.cols());
@@ -92,11 +93,13 @@ TEST(NavigationUncertainty, SubmapDistortionMatchesTheRigidFitOfAWalkingSweep) {
   sweep.footprint_radius_m = RmsRadius(points, g.centre);
   sweep.footprint_centre_V = g.centre;
   const Matrix6d predicted = model.SubmapDistortionCovariance(sweep, SystematicErrors::kEstimated);
-  const Matrix6d measured = SampleCovariance(FittedOffsets(g, noise.position_walk_m_per_sqrt_s, 4000));
+  const Matrix6d measured =
+      SampleCovariance(FittedOffsets(g, noise.position_walk_m_per_sqrt_s, 4000));
 
   // The turn the fit takes from the sideways walk, within a quarter of the model's.
   const double yaw_measured = std::sqrt(measured(2, 2)), yaw_predicted = std::sqrt(predicted(2, 2));
-  EXPECT_NEAR(yaw_measured / yaw_predicted, 1.0, 0.25) << yaw_measured << " rad measured, " << yaw_predicted;
+  EXPECT_NEAR(yaw_measured / yaw_predicted, 1.0, 0.25)
+      << yaw_measured << " rad measured, " << yaw_predicted;
   // The turn happens about the footprint's centre: at the vehicle's origin, 0.7 m behind it, a
   // turn comes with a sideways shift of the opposite sign (v_y = -c_x w_z).
   const double corr_measured = measured(2, 4) / std::sqrt(measured(2, 2) * measured(4, 4));

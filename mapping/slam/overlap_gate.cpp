@@ -1,9 +1,10 @@
 #include "mapping/slam/overlap_gate.hpp"
-#include "scanner/common/symmetrized.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
+
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -11,7 +12,8 @@ namespace {
 constexpr double kNoVariance_m2 = 1e-300;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-// In C's eigenbasis (variances s, gap g): the part of the gap left for lambda, |g_i / (1 + lambda s_i)|.
+// In C's eigenbasis (variances s, gap g): the part of the gap left for lambda, |g_i / (1 + lambda
+// s_i)|.
 double Left(const Eigen::Vector3d& g, const Eigen::Vector3d& s, double lambda) {
   return g.cwiseQuotient((Eigen::Vector3d::Ones() + lambda * s)).norm();
 }
@@ -29,7 +31,8 @@ double ErrorNorm(const Eigen::Vector3d& g, const Eigen::Vector3d& s, double lamb
 
 }  // namespace
 
-double MahalanobisGapToOverlap(const Eigen::Vector3d& gap_m, double overlap_m, const Eigen::Matrix3d& covariance) {
+double MahalanobisGapToOverlap(const Eigen::Vector3d& gap_m, double overlap_m,
+                               const Eigen::Matrix3d& covariance) {
   if (!gap_m.allFinite() || !covariance.allFinite() || !std::isfinite(overlap_m)) return kInfinity;
   if (gap_m.norm() <= overlap_m) return 0.0;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(Symmetrized(covariance));

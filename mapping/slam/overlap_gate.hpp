@@ -15,6 +15,7 @@ namespace uwscan::mapping {
 // Solved in C's eigenbasis: the minimiser is d = -(I + lambda C)^-1 lambda C gap for the
 // lambda >= 0 that puts gap + d on the sphere, found by bisection (|gap + d| falls as lambda
 // grows). A direction with no variance (eigenvalue <= 1e-300 m^2) cannot move.
-double MahalanobisGapToOverlap(const Eigen::Vector3d& gap_m, double overlap_m, const Eigen::Matrix3d& covariance);
+double MahalanobisGapToOverlap(const Eigen::Vector3d& gap_m, double overlap_m,
+                               const Eigen::Matrix3d& covariance);
 
 }  // namespace uwscan::mapping

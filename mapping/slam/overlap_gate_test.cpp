@@ -22,7 +22,8 @@ double BruteForce(const Eigen::Vector3d& gap, double r, const Eigen::Matrix3d& C
     for (int j = 0; j < 2 * n; ++j) {
       const double azimuth = std::numbers::pi * j / n;
       const Eigen::Vector3d y =
-          r * Eigen::Vector3d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+          r * Eigen::Vector3d(std::sin(polar) * std::cos(azimuth),
+                              std::sin(polar) * std::sin(azimuth), std::cos(polar));
       best = std::min(best, (y - gap).dot(inverse * (y - gap)));
     }
   }
@@ -62,17 +63,21 @@ TEST(MahalanobisGapToOverlap, MatchesABruteForceSearchOnRandomCases) {
 TEST(MahalanobisGapToOverlap, ADirectionWithoutVarianceCannotCloseTheGap) {
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
   C(0, 0) = C(1, 1) = 0.05 * 0.05;  // z known exactly
-  EXPECT_EQ(MahalanobisGapToOverlap({0.0, 0.0, 0.5}, 0.2, C), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(MahalanobisGapToOverlap({0.0, 0.0, 0.5}, 0.2, C),
+            std::numeric_limits<double>::infinity());
   // Within the overlap along z, the rest closes through x: (0.5 - sqrt(0.2^2 - 0.1^2)) / 0.05.
-  EXPECT_NEAR(MahalanobisGapToOverlap({0.5, 0.0, 0.1}, 0.2, C), (0.5 - std::sqrt(0.03)) / 0.05, 1e-6);
+  EXPECT_NEAR(MahalanobisGapToOverlap({0.5, 0.0, 0.1}, 0.2, C), (0.5 - std::sqrt(0.03)) / 0.05,
+              1e-6);
 }
 
 TEST(MahalanobisGapToOverlap, FailsClosedOnWhatIsNotANumberAndClosesAGapOfTinyVariance) {
-  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity(),
+               nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(MahalanobisGapToOverlap({0.5, 0.0, 0.0}, 0.2, Eigen::Matrix3d::Constant(nan)), inf);
   EXPECT_EQ(MahalanobisGapToOverlap({nan, 0.0, 0.0}, 0.2, Eigen::Matrix3d::Identity()), inf);
   // Variances of 1e-200 m^2 still measure: 0.3 m is 3e99 sigmas.
-  const double m = MahalanobisGapToOverlap({0.5, 0.0, 0.0}, 0.2, Eigen::Matrix3d::Identity() * 1e-200);
+  const double m =
+      MahalanobisGapToOverlap({0.5, 0.0, 0.0}, 0.2, Eigen::Matrix3d::Identity() * 1e-200);
   EXPECT_NEAR(m / 3e99, 1.0, 1e-9);
 }
 

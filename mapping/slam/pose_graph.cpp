@@ -20,8 +20,10 @@ namespace {
 
 // The left-perturbation error of a predicted relative pose against a measured one, for Jets.
 template <typename T>
-Eigen::Matrix<T, 6, 1> LeftError(const Eigen::Quaternion<T>& q_hat, const Eigen::Matrix<T, 3, 1>& t_hat,
-                                 const Eigen::Quaterniond& q_meas, const Eigen::Matrix<T, 3, 1>& t_meas) {
+Eigen::Matrix<T, 6, 1> LeftError(const Eigen::Quaternion<T>& q_hat,
+                                 const Eigen::Matrix<T, 3, 1>& t_hat,
+                                 const Eigen::Quaterniond& q_meas,
+                                 const Eigen::Matrix<T, 3, 1>& t_meas) {
   Eigen::Quaternion<T> q_delta = q_hat * q_meas.conjugate().cast<T>();
   // q and -q are the same rotation: take the one with w >= 0, so the error is the short way.
   if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
@@ -59,14 +61,15 @@ struct DeadReckonedCost {
   Matrix6d sqrt_information;
 
   template <typename T>
-  bool operator()(const T* q_a_raw, const T* p_a_raw, const T* q_b_raw, const T* p_b_raw, const T* c,
-                  T* residual_raw) const {
+  bool operator()(const T* q_a_raw, const T* p_a_raw, const T* q_b_raw, const T* p_b_raw,
+                  const T* c, T* residual_raw) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_a_raw), q_b(q_b_raw);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_a_raw), p_b(p_b_raw);
     const Eigen::Matrix<T, 3, 1> t_true =
         DeadReckoningCalibration::Correct<T>(t_meas.cast<T>(), c[0], c[1]);
     const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
-    const Eigen::Matrix<T, 6, 1> e = LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_true);
+    const Eigen::Matrix<T, 6, 1> e =
+        LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_true);
     Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
     residual = sqrt_information.cast<T>() * e;
     return true;
@@ -203,8 +206,8 @@ struct PoseGraph::Impl {
     double cost = 0.0;
     if (!problem->Evaluate(options, &cost, nullptr, nullptr, &crs)) return std::nullopt;
     const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
-        crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
-        crs.values.data());
+        crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
+        crs.cols.data(), crs.values.data());
     const Eigen::SparseMatrix<double> J = jacobian;
     return Eigen::SparseMatrix<double>(J.transpose()) * J;
   }
@@ -233,9 +236,11 @@ void PoseGraph::AddEdge(const RelativePoseEdge& edge) {
   m.RequireNode(edge.to, "AddEdge");
   RequireRigid(edge.T_from_to, "AddEdge");
   RequireInformation(edge.information, "AddEdge");
-  if (edge.robust && !(edge.huber_scale > 0.0)) throw Error("pose graph: AddEdge: huber_scale must be > 0");
+  if (edge.robust && !(edge.huber_scale > 0.0))
+    throw Error("pose graph: AddEdge: huber_scale must be > 0");
   if (edge.dead_reckoned && !m.calibration) {
-    throw Error("pose graph: AddEdge: a dead-reckoned edge needs EstimateDeadReckoningCalibration first");
+    throw Error(
+        "pose graph: AddEdge: a dead-reckoned edge needs EstimateDeadReckoningCalibration first");
   }
   // The problem owns each loss (one per edge: Ceres deletes them one by one).
   ceres::LossFunction* loss = edge.robust ? new ceres::HuberLoss(edge.huber_scale) : nullptr;
@@ -243,16 +248,18 @@ void PoseGraph::AddEdge(const RelativePoseEdge& edge) {
   if (edge.dead_reckoned) {
     auto* cost = new ceres::AutoDiffCostFunction<DeadReckonedCost, 6, 4, 3, 4, 3, 2>(
         new DeadReckonedCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
-    m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to), m.p(edge.to),
-                                m.calibration->data());
+    m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to),
+                                m.p(edge.to), m.calibration->data());
     return;
   }
   auto* cost = new ceres::AutoDiffCostFunction<RelativeCost, 6, 4, 3, 4, 3>(
       new RelativeCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
-  m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to), m.p(edge.to));
+  m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to),
+                              m.p(edge.to));
 }
 
-void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma, double misalignment_sigma_rad) {
+void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma,
+                                                 double misalignment_sigma_rad) {
   Impl& m = *impl_;
   if (m.calibration) throw Error("pose graph: EstimateDeadReckoningCalibration: called twice");
   if (!(scale_sigma > 0.0 && std::isfinite(scale_sigma)) ||
@@ -279,19 +286,21 @@ void PoseGraph::AddDepth(const DepthPrior& prior) {
   if (!std::isfinite(prior.z_m) || !(prior.sigma_m > 0.0)) {
     throw Error("pose graph: AddDepth: expected a finite depth and sigma_m > 0");
   }
-  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<DepthCost, 1, 3>(new DepthCost{prior.z_m, prior.sigma_m}),
-                              nullptr, m.p(prior.node));
+  m.problem->AddResidualBlock(
+      new ceres::AutoDiffCostFunction<DepthCost, 1, 3>(new DepthCost{prior.z_m, prior.sigma_m}),
+      nullptr, m.p(prior.node));
 }
 
 void PoseGraph::AddGravity(const GravityPrior& prior) {
   Impl& m = *impl_;
   m.RequireNode(prior.node, "AddGravity");
-  if (!prior.down_in_V.allFinite() || std::abs(prior.down_in_V.norm() - 1.0) > 1e-6 || !(prior.sigma_rad > 0.0)) {
+  if (!prior.down_in_V.allFinite() || std::abs(prior.down_in_V.norm() - 1.0) > 1e-6 ||
+      !(prior.sigma_rad > 0.0)) {
     throw Error("pose graph: AddGravity: expected a unit down vector and sigma_rad > 0");
   }
-  m.problem->AddResidualBlock(
-      new ceres::AutoDiffCostFunction<GravityCost, 3, 4>(new GravityCost{prior.down_in_V, prior.sigma_rad}), nullptr,
-      m.q(prior.node));
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<GravityCost, 3, 4>(
+                                  new GravityCost{prior.down_in_V, prior.sigma_rad}),
+                              nullptr, m.q(prior.node));
 }
 
 void PoseGraph::AddPrior(const PosePrior& prior) {
@@ -300,8 +309,8 @@ void PoseGraph::AddPrior(const PosePrior& prior) {
   RequireRigid(prior.T_W_V, "AddPrior");
   RequireInformation(prior.information, "AddPrior");
   m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 6, 4, 3>(new PriorCost{
-                                  Eigen::Quaterniond(prior.T_W_V.linear()), prior.T_W_V.translation(),
-                                  SqrtPsd(prior.information)}),
+                                  Eigen::Quaterniond(prior.T_W_V.linear()),
+                                  prior.T_W_V.translation(), SqrtPsd(prior.information)}),
                               nullptr, m.q(prior.node), m.p(prior.node));
 }
 
@@ -362,7 +371,8 @@ std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(const std::vector<in
   to_radians << 2.0, 2.0, 2.0, 1.0, 1.0, 1.0;
   std::vector<Matrix6d> out;
   out.reserve(nodes.size());
-  for (const Eigen::MatrixXd& c : *tangent) out.push_back(to_radians.asDiagonal() * c * to_radians.asDiagonal());
+  for (const Eigen::MatrixXd& c : *tangent)
+    out.push_back(to_radians.asDiagonal() * c * to_radians.asDiagonal());
   return out;
 }
 

@@ -42,7 +42,7 @@ struct DepthPrior {
 struct GravityPrior {
   int node = 0;
   Eigen::Vector3d down_in_V = Eigen::Vector3d::UnitZ();  // unit
-  double sigma_rad = 0.0;                                 // > 0
+  double sigma_rad = 0.0;                                // > 0
 };
 // A full pose prior, e.g. the fix the dive starts from. Error [w, p - p_prior]: the rotation
 // vector of R R_prior^T and the position error, both along the world's axes.

@@ -1,10 +1,11 @@
 #include "mapping/slam/registration_information.hpp"
-#include "scanner/common/symmetrized.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
+
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -15,7 +16,8 @@ constexpr double kSlideShare = 0.9;
 
 // The map N taking [w, v] about the target origin to normalised coordinates (rotation about the
 // source's centroid in the target frame, scaled by its RMS radius): normalised = N^T info N.
-Matrix6d Normaliser(const perception::PointCloud& source, const Eigen::Isometry3d& T_target_source) {
+Matrix6d Normaliser(const perception::PointCloud& source,
+                    const Eigen::Isometry3d& T_target_source) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < source.size(); ++i) centroid += T_target_source * source.Point(i);
   centroid /= static_cast<double>(source.size());
@@ -27,7 +29,8 @@ Matrix6d Normaliser(const perception::PointCloud& source, const Eigen::Isometry3
   // [w, v_origin] = A [w, v_centroid]: a rotation about the centroid moves the origin by -w x c.
   Matrix6d A = Matrix6d::Identity();
   Eigen::Matrix3d skew;
-  skew << 0.0, -centroid.z(), centroid.y(), centroid.z(), 0.0, -centroid.x(), -centroid.y(), centroid.x(), 0.0;
+  skew << 0.0, -centroid.z(), centroid.y(), centroid.z(), 0.0, -centroid.x(), -centroid.y(),
+      centroid.x(), 0.0;
   A.bottomLeftCorner<3, 3>() = skew;
   Matrix6d S = Matrix6d::Identity();
   S.topLeftCorner<3, 3>() /= std::max(radius, 1e-3);
@@ -36,7 +39,8 @@ Matrix6d Normaliser(const perception::PointCloud& source, const Eigen::Isometry3
 
 }  // namespace
 
-KeptDirections WithoutWeakDirections(const Matrix6d& information, const perception::PointCloud& source,
+KeptDirections WithoutWeakDirections(const Matrix6d& information,
+                                     const perception::PointCloud& source,
                                      const Eigen::Isometry3d& T_target_source, double ratio) {
   const Matrix6d N = Normaliser(source, T_target_source);
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(N.transpose() * information * N);
@@ -48,8 +52,8 @@ KeptDirections WithoutWeakDirections(const Matrix6d& information, const percepti
   }
   KeptDirections out;
   out.count = static_cast<int>((values.array() > 0.0).count());
-  const Matrix6d c = N * eigen.eigenvectors() * inverse_values.asDiagonal() * eigen.eigenvectors().transpose() *
-                     N.transpose();
+  const Matrix6d c = N * eigen.eigenvectors() * inverse_values.asDiagonal() *
+                     eigen.eigenvectors().transpose() * N.transpose();
   out.covariance = Symmetrized(c);
   const Matrix6d N_inverse = N.inverse();
   const Matrix6d kept = N_inverse.transpose() * eigen.eigenvectors() * values.asDiagonal() *
@@ -76,8 +80,8 @@ KeptDirections WithoutWeakDirections(const Matrix6d& information, const percepti
   return out;
 }
 
-Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides, const Eigen::Isometry3d& T_target_source,
-                         double sigma_m) {
+Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides,
+                         const Eigen::Isometry3d& T_target_source, double sigma_m) {
   Matrix6d covariance = Matrix6d::Zero();
   for (const Eigen::Vector3d& slide : slides) {
     const Eigen::Vector3d in_source = T_target_source.linear().transpose() * slide;
@@ -87,7 +91,8 @@ Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides, const Eigen
 }
 
 double Chi2Quantile999(int dof) {
-  static constexpr std::array<double, 6> kQuantiles = {10.828, 13.816, 16.266, 18.467, 20.515, 22.458};
+  static constexpr std::array<double, 6> kQuantiles = {10.828, 13.816, 16.266,
+                                                       18.467, 20.515, 22.458};
   return kQuantiles.at(static_cast<std::size_t>(std::clamp(dof, 1, 6) - 1));
 }
 

@@ -16,7 +16,7 @@ struct KeptDirections {
   Matrix6d information = Matrix6d::Zero();  // weak directions removed, slides exactly
   int count = 0;                            // directions kept (0 to 6)
   Matrix6d covariance = Matrix6d::Zero();   // of what the kept directions measure, 0 elsewhere
-  std::vector<Eigen::Vector3d> slides;      // pure translations taken out, orthonormal, target frame
+  std::vector<Eigen::Vector3d> slides;  // pure translations taken out, orthonormal, target frame
 };
 
 // The information with its weakly constrained directions removed: a normalised eigenvalue
@@ -25,7 +25,8 @@ struct KeptDirections {
 // the pairs still sum to something there, but ICP's answer is the noise's, not the scene's; the
 // navigation decides those. A removed direction that is mostly translation (a slide) is taken
 // out exactly.
-KeptDirections WithoutWeakDirections(const Matrix6d& information, const perception::PointCloud& source,
+KeptDirections WithoutWeakDirections(const Matrix6d& information,
+                                     const perception::PointCloud& source,
                                      const Eigen::Isometry3d& T_target_source, double ratio);
 
 // Where a registration leaves a slide free (a pipe seen without its ends), the scan's position
@@ -33,8 +34,8 @@ KeptDirections WithoutWeakDirections(const Matrix6d& information, const percepti
 // what the pairs leak along the slide moves the scan and not the vehicle (through the anchor,
 // the dead reckoning's scale error would take it up). `slides` in the target's frame, the
 // covariance in the source's.
-Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides, const Eigen::Isometry3d& T_target_source,
-                         double sigma_m);
+Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides,
+                         const Eigen::Isometry3d& T_target_source, double sigma_m);
 
 // The 99.9 % quantile of the chi-square distribution with `dof` degrees of freedom (1 to 6).
 double Chi2Quantile999(int dof);

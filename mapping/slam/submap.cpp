@@ -14,13 +14,14 @@ namespace uwscan::mapping {
 
 void SubmapCloudOptions::Check() const {
   if (!(map_voxel_m > 0.0)) throw Error("SubmapCloudOptions.map_voxel_m: expected > 0 m");
-  if (!(registration_voxel_m > 0.0)) throw Error("SubmapCloudOptions.registration_voxel_m: expected > 0 m");
+  if (!(registration_voxel_m > 0.0))
+    throw Error("SubmapCloudOptions.registration_voxel_m: expected > 0 m");
   if (normal_neighbours < 3) throw Error("SubmapCloudOptions.normal_neighbours: expected >= 3");
   if (threads < 0) throw Error("SubmapCloudOptions.threads: expected >= 0");
 }
 
-void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const SubmapCloudOptions& options,
-                       Submap* submap) {
+void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V,
+                       const SubmapCloudOptions& options, Submap* submap) {
   options.Check();
   submap->cloud = {};
   submap->sparse = {};
@@ -83,7 +84,8 @@ void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const Subma
 }
 
 perception::PointCloud MergeClouds(const std::vector<const perception::PointCloud*>& clouds,
-                                   const std::vector<Eigen::Isometry3d>& T_W_cloud, double voxel_m) {
+                                   const std::vector<Eigen::Isometry3d>& T_W_cloud,
+                                   double voxel_m) {
   if (clouds.size() != T_W_cloud.size()) throw Error("MergeClouds: one pose per cloud expected");
   perception::PointCloud all;
   if (clouds.empty()) return all;
@@ -91,7 +93,8 @@ perception::PointCloud MergeClouds(const std::vector<const perception::PointClou
   for (std::size_t c = 0; c < clouds.size(); ++c) {
     // Relative to the merged origin in double, then stored in float.
     const Eigen::Isometry3d T = Eigen::Translation3d(-all.origin) * T_W_cloud[c];
-    for (std::size_t i = 0; i < clouds[c]->size(); ++i) all.points.push_back((T * clouds[c]->Point(i)).cast<float>());
+    for (std::size_t i = 0; i < clouds[c]->size(); ++i)
+      all.points.push_back((T * clouds[c]->Point(i)).cast<float>());
   }
   return perception::VoxelDownsample(all, {voxel_m});
 }

@@ -24,14 +24,14 @@ struct Submap {
   perception::PointCloud cloud;   // voxelised at the map voxel, with normals (ICP target)
   perception::PointCloud sparse;  // voxelised at the registration voxel (ICP source)
   Eigen::Vector3d centroid_V = Eigen::Vector3d::Zero();  // of the cloud, in {V_k}
-  double radius_m = 0.0;          // largest distance of a point from the centroid
-  double rms_radius_m = 0.0;      // root mean square distance of the points from the centroid
+  double radius_m = 0.0;      // largest distance of a point from the centroid
+  double rms_radius_m = 0.0;  // root mean square distance of the points from the centroid
 };
 
 struct SubmapCloudOptions {
-  double map_voxel_m = 0.005;           // > 0
-  double registration_voxel_m = 0.015;  // > 0
-  int normal_neighbours = 15;           // >= 3
+  double map_voxel_m = 0.005;                             // > 0
+  double registration_voxel_m = 0.015;                    // > 0
+  int normal_neighbours = 15;                             // >= 3
   Eigen::Vector3d viewpoint_V = Eigen::Vector3d::Zero();  // normals face it (the camera)
   int threads = 0;
   void Check() const;
@@ -40,8 +40,8 @@ struct SubmapCloudOptions {
 // Fills cloud, sparse, centroid and radius of `submap` from its points in {V_k} (double).
 // Points whose normal is undefined (isolated) are left out of the cloud. Leaves the cloud
 // empty when fewer than 10 points remain.
-void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V, const SubmapCloudOptions& options,
-                       Submap* submap);
+void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V,
+                       const SubmapCloudOptions& options, Submap* submap);
 
 // The clouds placed in the world by their poses (T_W_cloud, one per cloud) and voxelised at
 // voxel_m into one cloud, its origin at the first pose's position (normals dropped).

@@ -10,7 +10,8 @@
 namespace uwscan::mapping {
 namespace {
 
-void RequireSameLength(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth) {
+void RequireSameLength(const std::vector<TimedPose>& estimate,
+                       const std::vector<TimedPose>& truth) {
   if (estimate.size() != truth.size() || estimate.empty()) {
     throw Error("trajectory metrics: expected two non-empty trajectories of the same length, got " +
                 std::to_string(estimate.size()) + " and " + std::to_string(truth.size()));
@@ -19,7 +20,8 @@ void RequireSameLength(const std::vector<TimedPose>& estimate, const std::vector
 
 }  // namespace
 
-double AbsoluteTrajectoryError(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth) {
+double AbsoluteTrajectoryError(const std::vector<TimedPose>& estimate,
+                               const std::vector<TimedPose>& truth) {
   RequireSameLength(estimate, truth);
   double sum = 0.0;
   for (std::size_t i = 0; i < estimate.size(); ++i) {
@@ -33,7 +35,8 @@ std::optional<double> RelativeErrorPerMetre(const std::vector<TimedPose>& estima
   RequireSameLength(estimate, truth);
   std::vector<double> along(truth.size(), 0.0);  // true path length from the first pose
   for (std::size_t i = 1; i < truth.size(); ++i) {
-    along[i] = along[i - 1] + (truth[i].T_W_V.translation() - truth[i - 1].T_W_V.translation()).norm();
+    along[i] =
+        along[i - 1] + (truth[i].T_W_V.translation() - truth[i - 1].T_W_V.translation()).norm();
   }
   double sum = 0.0;
   int count = 0;
@@ -54,12 +57,15 @@ std::optional<double> RelativeErrorPerMetre(const std::vector<TimedPose>& estima
 double MeanNees(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth,
                 const std::vector<Matrix6d>& covariances) {
   RequireSameLength(estimate, truth);
-  if (covariances.size() != estimate.size()) throw Error("trajectory metrics: one covariance per pose expected");
+  if (covariances.size() != estimate.size())
+    throw Error("trajectory metrics: one covariance per pose expected");
   double sum = 0.0;
   for (std::size_t i = 0; i < estimate.size(); ++i) {
-    const Eigen::AngleAxisd rotation(estimate[i].T_W_V.linear() * truth[i].T_W_V.linear().transpose());
+    const Eigen::AngleAxisd rotation(estimate[i].T_W_V.linear() *
+                                     truth[i].T_W_V.linear().transpose());
     Vector6d e;
-    e << rotation.angle() * rotation.axis(), estimate[i].T_W_V.translation() - truth[i].T_W_V.translation();
+    e << rotation.angle() * rotation.axis(),
+        estimate[i].T_W_V.translation() - truth[i].T_W_V.translation();
     sum += e.dot(covariances[i].ldlt().solve(e));
   }
   return sum / static_cast<double>(estimate.size());
@@ -71,8 +77,8 @@ void WriteTum(const std::filesystem::path& path, const std::vector<TimedPose>& p
   for (const TimedPose& p : poses) {
     const Eigen::Quaterniond q(p.T_W_V.linear());
     const Eigen::Vector3d& t = p.T_W_V.translation();
-    std::snprintf(line, sizeof(line), "%.9f %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", p.time_s, t.x(), t.y(), t.z(),
-                  q.x(), q.y(), q.z(), q.w());
+    std::snprintf(line, sizeof(line), "%.9f %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", p.time_s,
+                  t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
     text += line;
   }
   WriteTextAtomically(path, text);

@@ -16,13 +16,15 @@ struct TimedPose {
 
 // Absolute trajectory error: RMS of the position errors, metres, without any alignment (the
 // estimate and the truth share the world frame). Same length and order required.
-double AbsoluteTrajectoryError(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth);
+double AbsoluteTrajectoryError(const std::vector<TimedPose>& estimate,
+                               const std::vector<TimedPose>& truth);
 
 // Relative pose error per metre travelled: for each pose, the first later one at least
 // `segment_m` further along the true path; the translation error of the estimated motion
 // between them over the true path length, averaged. std::nullopt when the path is shorter.
 std::optional<double> RelativeErrorPerMetre(const std::vector<TimedPose>& estimate,
-                                            const std::vector<TimedPose>& truth, double segment_m = 1.0);
+                                            const std::vector<TimedPose>& truth,
+                                            double segment_m = 1.0);
 
 // Normalised estimation error squared of each pose, e^T P^-1 e with e = [rotation vector of
 // R_est R_true^T, p_est - p_true] and P its 6x6 covariance (pose_graph.hpp's convention); the

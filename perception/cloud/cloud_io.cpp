@@ -246,9 +246,9 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   for (std::size_t i = 0; i < raw.points.size(); ++i) {
     // A normal must be a direction: non-finite or (near) zero-length ones drop their point;
     // the others are made exactly unit, as PointCloud requires.
-    const bool usable = raw.points[i].allFinite() &&
-                        (raw.normals.empty() ||
-                         (raw.normals[i].allFinite() && raw.normals[i].norm() > 1e-6));
+    const bool usable =
+        raw.points[i].allFinite() &&
+        (raw.normals.empty() || (raw.normals[i].allFinite() && raw.normals[i].norm() > 1e-6));
     if (!usable) continue;
     if (stats) local.rows.push_back(i);
     points.push_back(raw.points[i]);

@@ -48,7 +48,8 @@ class CloudReadersTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  void ExpectSamePoints(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals) {
+  void ExpectSamePoints(const std::vector<Eigen::Vector3d>& points,
+                        const std::vector<Eigen::Vector3d>& normals) {
     ASSERT_EQ(points.size(), cloud_.size());
     ASSERT_EQ(normals.size(), cloud_.size());
     for (std::size_t i = 0; i < cloud_.size(); ++i) {
@@ -149,7 +150,8 @@ TEST_F(CloudReadersTest, ReadsIntensityFromPclPcdAndPlyAndKeepsItOnWrite) {
   const fs::path cloud_compare = dir_ / "cc.ply";
   {
     std::ofstream out(cloud_compare);
-    out << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+    out << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty "
+           "float z\n"
            "property float scalar_Intensity\nend_header\n0 0 1 0.25\n1 0 1 nan\n";
   }
   const PointCloud cc = ReadCloud(cloud_compare);
@@ -165,17 +167,22 @@ TEST_F(CloudReadersTest, BrokenFilesGiveOneErrorAndPrintNothing) {
   const std::vector<std::pair<std::string, std::string>> files = {
       {"empty.pcd", ""},
       {"noheader.pcd", "1 2 3\n4 5 6\n"},
-      {"huge.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4000000000\nHEIGHT 1\nDATA binary\n\x01\x02"},
-      {"short.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nDATA ascii\n1 2 3\n4 5\n"},
+      {"huge.pcd",
+       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4000000000\nHEIGHT 1\nDATA binary\n\x01\x02"},
+      {"short.pcd",
+       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nDATA ascii\n1 2 3\n4 "
+       "5\n"},
       {"mismatch.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n1 2 3\n"},
       {"noxyz.pcd", "FIELDS a b\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n1 2\n"},
       {"empty.ply", ""},
       {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"},
-      {"huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 999999999999\nproperty float x\n"
-                   "property float y\nproperty float z\nend_header\n\x01"},
+      {"huge.ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 999999999999\nproperty float x\n"
+       "property float y\nproperty float z\nend_header\n\x01"},
       {"badtype.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n1\n"},
-      {"cut.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-                  "property float z\nend_header\n1 2 3\n4\n"},
+      {"cut.ply",
+       "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n1 2 3\n4\n"},
   };
   for (const auto& [name, text] : files) {
     const fs::path path = dir_ / name;
@@ -188,7 +195,8 @@ TEST_F(CloudReadersTest, BrokenFilesGiveOneErrorAndPrintNothing) {
     } catch (const Error& e) {
       message = e.what();
     }
-    const std::string printed = testing::internal::GetCapturedStderr() + testing::internal::GetCapturedStdout();
+    const std::string printed =
+        testing::internal::GetCapturedStderr() + testing::internal::GetCapturedStdout();
     EXPECT_NE(message.find(path.string()), std::string::npos) << name << ": '" << message << "'";
     EXPECT_EQ(message.find('\n'), std::string::npos) << name;
     EXPECT_EQ(printed, "") << name;

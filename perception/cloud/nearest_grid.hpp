@@ -43,24 +43,29 @@ class NearestGrid {
   double max_radius_m() const { return max_radius_m_; }
 
  private:
+  // The constructor's steps, once the grid's extent is set.
+  void SortByCell(std::span<const Eigen::Vector3f> points, std::uint64_t cells);
+  void MeasureEmptyRings(std::uint64_t cells);
   std::uint64_t Key(int x, int y, int z) const {
-    return (static_cast<std::uint64_t>(x) * static_cast<std::uint64_t>(n_.y()) + static_cast<std::uint64_t>(y)) *
+    return (static_cast<std::uint64_t>(x) * static_cast<std::uint64_t>(n_.y()) +
+            static_cast<std::uint64_t>(y)) *
                static_cast<std::uint64_t>(n_.z()) +
            static_cast<std::uint64_t>(z);
   }
 
   double cell_m_ = 0.0, inverse_cell_m_ = 0.0, max_radius_m_ = 0.0;
-  int max_rings_ = 0;                            // rings that cover max_radius_m
+  int max_rings_ = 0;                              // rings that cover max_radius_m
   Eigen::Array3i first_ = Eigen::Array3i::Zero();  // cell coordinates of the grid's corner cell
   Eigen::Array3i n_ = Eigen::Array3i::Zero();      // cells along each axis
   std::vector<std::uint32_t> cell_start_;          // per cell (+1): its points' sorted positions
-  std::vector<std::uint8_t> empty_rings_;          // per cell: rings out to an occupied cell (capped)
-  std::vector<float> x_, y_, z_;                   // points sorted by cell
-  std::vector<std::uint32_t> index_;               // original index of each sorted point
+  std::vector<std::uint8_t> empty_rings_;  // per cell: rings out to an occupied cell (capped)
+  std::vector<float> x_, y_, z_;           // points sorted by cell
+  std::vector<std::uint32_t> index_;       // original index of each sorted point
 };
 
 template <typename Accept>
-std::int64_t NearestGrid::Nearest(const Eigen::Vector3f& q, float radius_sq_m2, Accept&& accept) const {
+std::int64_t NearestGrid::Nearest(const Eigen::Vector3f& q, float radius_sq_m2,
+                                  Accept&& accept) const {
   assert(std::sqrt(static_cast<double>(radius_sq_m2)) <= max_radius_m_ * (1.0 + 1e-6));
   if (index_.empty() || !q.allFinite()) return -1;
   const Eigen::Array<double, 3, 1> scaled = q.cast<double>().array() * inverse_cell_m_;
@@ -74,7 +79,9 @@ std::int64_t NearestGrid::Nearest(const Eigen::Vector3f& q, float radius_sq_m2, 
   const Eigen::Array<double, 3, 1> frac = scaled - floor;
   const double face_m = std::min(frac.min(1.0 - frac).minCoeff(), 1.0) * cell_m_;
   const double radius_m = std::sqrt(static_cast<double>(radius_sq_m2));
-  auto ring_bound_m = [&](int k) { return k == 0 ? 0.0 : (k - 1) * cell_m_ + face_m - 1e-5 * cell_m_; };
+  auto ring_bound_m = [&](int k) {
+    return k == 0 ? 0.0 : (k - 1) * cell_m_ + face_m - 1e-5 * cell_m_;
+  };
   const int first_ring = empty_rings_[Key(ci.x(), ci.y(), ci.z())];
   float best = radius_sq_m2;
   std::int64_t found = -1;

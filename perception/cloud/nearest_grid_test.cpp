@@ -14,8 +14,8 @@ namespace {
 // The brute-force answer with the grid's rules: FLANN's float distance, strictly within the
 // radius, the lowest index among equally near accepted points.
 template <typename Accept>
-std::int64_t BruteNearest(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& q, float radius_sq,
-                          Accept accept) {
+std::int64_t BruteNearest(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& q,
+                          float radius_sq, Accept accept) {
   float best = radius_sq;
   std::int64_t found = -1;
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -56,14 +56,16 @@ TEST(NearestGrid, FindsWhatBruteForceFindsAtEveryRadiusWithAndWithoutAGate) {
     // Half near the surface (an ICP near convergence), half anywhere around it.
     const Eigen::Vector3f q = i % 2 == 0 ? points[static_cast<std::size_t>(i) % points.size()] +
                                                Eigen::Vector3f(off(rng), off(rng), off(rng))
-                                         : Eigen::Vector3f(0.3f, -0.1f, 1.2f) + Eigen::Vector3f(box(rng), box(rng), box(rng));
+                                         : Eigen::Vector3f(0.3f, -0.1f, 1.2f) +
+                                               Eigen::Vector3f(box(rng), box(rng), box(rng));
     for (float radius : {0.02f, 0.01f, 0.0075f, 0.003f}) {
       const float radius_sq = radius * radius;
       const auto all = [](std::size_t) { return true; };
       const auto odd = [](std::size_t j) { return j % 2 == 1; };  // a gate refusing half the points
       const std::int64_t expected = BruteNearest(points, q, radius_sq, all);
       ASSERT_EQ(grid.Nearest(q, radius_sq, all), expected) << "query " << i << " radius " << radius;
-      ASSERT_EQ(grid.Nearest(q, radius_sq, odd), BruteNearest(points, q, radius_sq, odd)) << "query " << i;
+      ASSERT_EQ(grid.Nearest(q, radius_sq, odd), BruteNearest(points, q, radius_sq, odd))
+          << "query " << i;
       (expected >= 0 ? matched : unmatched) += 1;
     }
   }
@@ -73,19 +75,26 @@ TEST(NearestGrid, FindsWhatBruteForceFindsAtEveryRadiusWithAndWithoutAGate) {
 
 TEST(NearestGrid, TakesTheLowestIndexOfEquallyNearPointsAndRefusesTheRadiusItself) {
   // Duplicates and points exactly on cell faces.
-  const std::vector<Eigen::Vector3f> points = {{0.01f, 0.0f, 0.0f}, {0.0f, 0.01f, 0.0f}, {0.01f, 0.0f, 0.0f},
-                                               {-0.01f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.02f}};
+  const std::vector<Eigen::Vector3f> points = {{0.01f, 0.0f, 0.0f},
+                                               {0.0f, 0.01f, 0.0f},
+                                               {0.01f, 0.0f, 0.0f},
+                                               {-0.01f, 0.0f, 0.0f},
+                                               {0.0f, 0.0f, 0.02f}};
   const NearestGrid grid(points, 0.005, 0.02);
   const auto all = [](std::size_t) { return true; };
   EXPECT_EQ(grid.Nearest(Eigen::Vector3f::Zero(), 0.0004f, all), 0);
-  EXPECT_EQ(grid.Nearest(Eigen::Vector3f::Zero(), 0.0004f, [](std::size_t j) { return j != 0; }), 1);
-  EXPECT_EQ(grid.Nearest(Eigen::Vector3f(0.01f, 0.0f, 0.0f), 0.0004f, [](std::size_t j) { return j > 0; }), 2);
+  EXPECT_EQ(grid.Nearest(Eigen::Vector3f::Zero(), 0.0004f, [](std::size_t j) { return j != 0; }),
+            1);
+  EXPECT_EQ(grid.Nearest(Eigen::Vector3f(0.01f, 0.0f, 0.0f), 0.0004f,
+                         [](std::size_t j) { return j > 0; }),
+            2);
   // Strictly within: a radius equal to the distance finds nothing.
   const float d = 0.01f;
   float d_sq = 0.0f;
   d_sq += d * d;
   EXPECT_EQ(grid.Nearest(Eigen::Vector3f::Zero(), d_sq, all), -1);
-  EXPECT_EQ(grid.Nearest(Eigen::Vector3f(5.0f, 5.0f, 5.0f), 0.0004f, all), -1);  // far outside the grid
+  EXPECT_EQ(grid.Nearest(Eigen::Vector3f(5.0f, 5.0f, 5.0f), 0.0004f, all),
+            -1);  // far outside the grid
   EXPECT_EQ(grid.Nearest(Eigen::Vector3f(NAN, 0.0f, 0.0f), 0.0004f, all), -1);
 }
 

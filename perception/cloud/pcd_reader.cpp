@@ -29,10 +29,10 @@ constexpr std::uint64_t kMaxInflation = 90;
 
 struct Field {
   std::string name;
-  int size = 0;    // bytes per value
-  char type = 0;   // 'I', 'U' or 'F'
-  int count = 1;   // values per point
-  std::size_t offset = 0;  // within a binary point
+  int size = 0;                 // bytes per value
+  char type = 0;                // 'I', 'U' or 'F'
+  int count = 1;                // values per point
+  std::size_t offset = 0;       // within a binary point
   std::size_t first_value = 0;  // among an ascii point's values
 };
 
@@ -165,7 +165,8 @@ Header ParseHeader(const std::string& file, const std::string& name) {
   HeaderLines lines;
   std::size_t at = 0;
   for (int number = 1; lines.data.empty(); ++number) {
-    if (at >= file.size() || at > kMaxHeaderBytes) throw Error(name + ": no DATA line: not a PCD file");
+    if (at >= file.size() || at > kMaxHeaderBytes)
+      throw Error(name + ": no DATA line: not a PCD file");
     std::size_t end = file.find('\n', at);
     if (end == std::string::npos) end = file.size();
     std::istringstream stream(file.substr(at, end - at));
@@ -203,11 +204,15 @@ double Decode(const Field& field, const char* bytes) {
   };
   switch (field.type) {
     case 'I':
-      return field.size == 1 ? as(std::int8_t{}) : field.size == 2 ? as(std::int16_t{})
-                             : field.size == 4 ? as(std::int32_t{}) : as(std::int64_t{});
+      return field.size == 1   ? as(std::int8_t{})
+             : field.size == 2 ? as(std::int16_t{})
+             : field.size == 4 ? as(std::int32_t{})
+                               : as(std::int64_t{});
     case 'U':
-      return field.size == 1 ? as(std::uint8_t{}) : field.size == 2 ? as(std::uint16_t{})
-                             : field.size == 4 ? as(std::uint32_t{}) : as(std::uint64_t{});
+      return field.size == 1   ? as(std::uint8_t{})
+             : field.size == 2 ? as(std::uint16_t{})
+             : field.size == 4 ? as(std::uint32_t{})
+                               : as(std::uint64_t{});
     default:
       return field.size == 4 ? as(float{}) : as(double{});
   }
@@ -222,7 +227,8 @@ class PointValues {
   double Value(const Field& field, std::uint64_t point) const {
     if (soa_) {
       // binary_compressed: each field's values for all points together, in field order.
-      return Decode(field, bytes_.data() + field.offset * header_.points + point * std::size_t(field.size) * std::size_t(field.count));
+      return Decode(field, bytes_.data() + field.offset * header_.points +
+                               point * std::size_t(field.size) * std::size_t(field.count));
     }
     return Decode(field, bytes_.data() + point * header_.point_step + field.offset);
   }
@@ -235,8 +241,10 @@ class PointValues {
 
 // `value(field, point)` gives a field's first value at a point.
 template <typename Value>
-void Extract(const Header& header, const std::string& name, PcdContent& content, const Value& value) {
-  const Field* xyz[3] = {FindField(header, {"x"}), FindField(header, {"y"}), FindField(header, {"z"})};
+void Extract(const Header& header, const std::string& name, PcdContent& content,
+             const Value& value) {
+  const Field* xyz[3] = {FindField(header, {"x"}), FindField(header, {"y"}),
+                         FindField(header, {"z"})};
   const Field* n[3] = {FindField(header, {"normal_x", "nx"}), FindField(header, {"normal_y", "ny"}),
                        FindField(header, {"normal_z", "nz"})};
   if (!xyz[0] || !xyz[1] || !xyz[2]) throw Error(name + " has no x, y and z fields");
@@ -252,13 +260,14 @@ void Extract(const Header& header, const std::string& name, PcdContent& content,
   }
 }
 
-void ReadAscii(const std::string& file, const Header& header, const std::string& name, PcdContent& content) {
+void ReadAscii(const std::string& file, const Header& header, const std::string& name,
+               PcdContent& content) {
   std::size_t values_per_point = 0;
   for (const Field& field : header.fields) values_per_point += std::size_t(field.count);
   const std::size_t left = file.size() - header.body_offset;
   if (header.points > left / (2 * values_per_point) + 1) {
-    throw Error(name + ": " + std::to_string(header.points) + " points cannot fit in the " + std::to_string(left) +
-                " bytes of ascii data");
+    throw Error(name + ": " + std::to_string(header.points) + " points cannot fit in the " +
+                std::to_string(left) + " bytes of ascii data");
   }
   std::vector<double> values;
   values.reserve(header.points * values_per_point);
@@ -295,11 +304,13 @@ PcdContent ReadPcd(const fs::path& path) {
   const std::string_view body(file.data() + header.body_offset, file.size() - header.body_offset);
   if (header.data == "binary") {
     if (header.point_step == 0 || header.points > body.size() / header.point_step) {
-      throw Error(name + ": " + std::to_string(header.points) + " points of " + std::to_string(header.point_step) +
-                  " bytes do not fit in the " + std::to_string(body.size()) + " bytes of binary data");
+      throw Error(name + ": " + std::to_string(header.points) + " points of " +
+                  std::to_string(header.point_step) + " bytes do not fit in the " +
+                  std::to_string(body.size()) + " bytes of binary data");
     }
     const PointValues values(body, header, false);
-    Extract(header, name, content, [&](const Field& f, std::uint64_t i) { return values.Value(f, i); });
+    Extract(header, name, content,
+            [&](const Field& f, std::uint64_t i) { return values.Value(f, i); });
     return content;
   }
   // binary_compressed: uint32 compressed size, uint32 inflated size, then LZF data.
@@ -311,19 +322,21 @@ PcdContent ReadPcd(const fs::path& path) {
     sizes[1] = __builtin_bswap32(sizes[1]);
   }
   const std::uint64_t expected = header.points * header.point_step;
-  if (header.points != 0 && expected / header.points != header.point_step) throw Error(name + ": the point count overflows");
+  if (header.points != 0 && expected / header.points != header.point_step)
+    throw Error(name + ": the point count overflows");
   if (sizes[0] > body.size() - sizeof(sizes) || sizes[1] != expected ||
       sizes[1] > kMaxInflation * std::uint64_t(sizes[0]) + 1024) {
-    throw Error(name + ": binary_compressed sizes (" + std::to_string(sizes[0]) + " -> " + std::to_string(sizes[1]) +
-                " bytes) do not match the header or the file");
+    throw Error(name + ": binary_compressed sizes (" + std::to_string(sizes[0]) + " -> " +
+                std::to_string(sizes[1]) + " bytes) do not match the header or the file");
   }
   std::string inflated(sizes[1], '\0');
-  if (sizes[1] > 0 &&
-      pcl::lzfDecompress(body.data() + sizeof(sizes), sizes[0], inflated.data(), sizes[1]) != sizes[1]) {
+  if (sizes[1] > 0 && pcl::lzfDecompress(body.data() + sizeof(sizes), sizes[0], inflated.data(),
+                                         sizes[1]) != sizes[1]) {
     throw Error(name + ": binary_compressed data does not inflate to its size (damaged)");
   }
   const PointValues values(inflated, header, true);
-  Extract(header, name, content, [&](const Field& f, std::uint64_t i) { return values.Value(f, i); });
+  Extract(header, name, content,
+          [&](const Field& f, std::uint64_t i) { return values.Value(f, i); });
   return content;
 }
 

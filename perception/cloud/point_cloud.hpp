@@ -34,8 +34,8 @@ PointCloud MakeCloud(std::span<const Eigen::Vector3d> points);
 void RequireValidCloud(const PointCloud& cloud, const std::string& what,
                        std::size_t min_points = 1);
 
-// The cloud moved rigidly by T (points and normals; intensities kept); the origin moves, the float offsets only
-// rotate, so no precision is lost to large translations.
+// The cloud moved rigidly by T (points and normals; intensities kept); the origin moves, the float
+// offsets only rotate, so no precision is lost to large translations.
 PointCloud Transformed(const PointCloud& cloud, const Eigen::Isometry3d& T);
 
 // Mean of the points, metres. Throws uwscan::Error for an empty cloud.

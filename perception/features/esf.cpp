@@ -1,8 +1,7 @@
 #include "perception/features/esf.hpp"
 
-#include <pcl/features/esf.h>
-
 #include <omp.h>
+#include <pcl/features/esf.h>
 
 #include <algorithm>
 #include <array>

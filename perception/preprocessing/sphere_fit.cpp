@@ -62,7 +62,8 @@ SphereFit FitSphere(std::span<const Eigen::Vector3d> points) {
       const Eigen::Vector3d q = (points[static_cast<size_t>(i)] - mean) / scale;
       const Eigen::Vector3d diff = q - c;
       const double dist = diff.norm();
-      const Eigen::Vector3d unit = dist > 0.0 ? Eigen::Vector3d(diff / dist) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d unit =
+          dist > 0.0 ? Eigen::Vector3d(diff / dist) : Eigen::Vector3d::Zero();
       j.row(i) << -unit.x(), -unit.y(), -unit.z(), -1.0;
       d(i) = dist - r;
     }

@@ -19,8 +19,8 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 // this share of its motion is a slide (locally, a rotation about an axis that far away is one).
 constexpr double kTranslationShare = 0.1;
 
-void Check(const Matrix6d& information, const Matrix6d& patch_spread, const Eigen::Vector3d& centre_O,
-           double sigma_m, double radius_m, double tolerance_m) {
+void Check(const Matrix6d& information, const Matrix6d& patch_spread,
+           const Eigen::Vector3d& centre_O, double sigma_m, double radius_m, double tolerance_m) {
   if (!information.allFinite() || !information.isApprox(information.transpose(), 1e-9)) {
     throw Error("free directions: the information must be a finite, symmetric 6x6 matrix");
   }
@@ -28,14 +28,17 @@ void Check(const Matrix6d& information, const Matrix6d& patch_spread, const Eige
     throw Error("free directions: the patch spread must be a finite, symmetric 6x6 matrix");
   }
   if (!centre_O.allFinite()) throw Error("free directions: the centre must be finite");
-  if (!(sigma_m > 0.0 && std::isfinite(sigma_m))) throw Error("free directions: sigma_m must be positive");
-  if (!(radius_m > 0.0 && std::isfinite(radius_m))) throw Error("free directions: radius_m must be positive");
+  if (!(sigma_m > 0.0 && std::isfinite(sigma_m)))
+    throw Error("free directions: sigma_m must be positive");
+  if (!(radius_m > 0.0 && std::isfinite(radius_m)))
+    throw Error("free directions: radius_m must be positive");
   if (!(tolerance_m > 0.0 && std::isfinite(tolerance_m))) {
     throw Error("free directions: tolerance_m must be positive");
   }
 }
 
-FreeDirection Free(FreeMotion motion, const Eigen::Vector3d& axis_O, const Eigen::Vector3d& point_O) {
+FreeDirection Free(FreeMotion motion, const Eigen::Vector3d& axis_O,
+                   const Eigen::Vector3d& point_O) {
   FreeDirection f;
   f.kind = FreeKind::kUnconstrained;
   f.motion = motion;
@@ -62,10 +65,12 @@ std::pair<Vector6d, Vector6d> PureRotations(const Vector6d& a, const Vector6d& b
   };
   Eigen::Matrix2d Q;
   Q << pitch(a, a), pitch(a, b), pitch(a, b), pitch(b, b);
-  const double scale = std::max(a.head<3>().norm() * a.tail<3>().norm(), b.head<3>().norm() * b.tail<3>().norm());
+  const double scale =
+      std::max(a.head<3>().norm() * a.tail<3>().norm(), b.head<3>().norm() * b.tail<3>().norm());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(Q);
   const double low = eigen.eigenvalues()[0], high = eigen.eigenvalues()[1];
-  if (std::max(std::abs(low), std::abs(high)) <= 1e-9 * scale || !(low < 0.0 && high > 0.0)) return {a, b};
+  if (std::max(std::abs(low), std::abs(high)) <= 1e-9 * scale || !(low < 0.0 && high > 0.0))
+    return {a, b};
   // x = cos(t) e_low + sin(t) e_high with low cos^2 + high sin^2 = 0.
   const double t = std::atan(std::sqrt(-low / high));
   const Eigen::Vector2d e_low = eigen.eigenvectors().col(0), e_high = eigen.eigenvectors().col(1);
@@ -77,10 +82,11 @@ std::pair<Vector6d, Vector6d> PureRotations(const Vector6d& a, const Vector6d& b
 }  // namespace
 
 PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix6d& patch_spread,
-                                       const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
-                                       double tolerance_m, double floor_std_m) {
+                                       const Eigen::Vector3d& centre_O, double sigma_m,
+                                       double radius_m, double tolerance_m, double floor_std_m) {
   Check(information, patch_spread, centre_O, sigma_m, radius_m, tolerance_m);
-  if (!(floor_std_m >= 0.0 && std::isfinite(floor_std_m))) throw Error("free directions: floor_std_m must be >= 0");
+  if (!(floor_std_m >= 0.0 && std::isfinite(floor_std_m)))
+    throw Error("free directions: floor_std_m must be >= 0");
   // Rotations scaled by the radius: both halves in metres, so one tolerance judges both.
   Matrix6d D = Matrix6d::Identity();
   D.topLeftCorner<3, 3>() *= 1.0 / radius_m;
@@ -105,8 +111,10 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
       free.col(free.cols() - 1) = u;
     }
   }
-  out.covariance =
-      D * (sigma_m * sigma_m * inverse + inverse * spread * inverse + floor_std_m * floor_std_m * pinned) * D;
+  out.covariance = D *
+                   (sigma_m * sigma_m * inverse + inverse * spread * inverse +
+                    floor_std_m * floor_std_m * pinned) *
+                   D;
   if (free.cols() == 0) return out;
 
   // Combinations of the free directions by how much they turn: the right singular vectors of
@@ -126,7 +134,8 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
     for (const Eigen::Vector3d& s : slides) axis -= axis.dot(s) * s;  // orthonormal slides
     if (axis.norm() > 1e-6) slides.push_back(axis.normalized());
   }
-  for (const Eigen::Vector3d& s : slides) out.free_O.push_back(Free(FreeMotion::kTranslation, s, centre_O));
+  for (const Eigen::Vector3d& s : slides)
+    out.free_O.push_back(Free(FreeMotion::kTranslation, s, centre_O));
   // A free slide can be added to any rotation: taken out, the rotation's axis is the one that
   // moves least, e.g. a pipe's roll about its own axis rather than a screw along it.
   for (Vector6d& r : rotations) {
@@ -140,7 +149,9 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
   return out;
 }
 
-std::string ToString(FreeKind kind) { return kind == FreeKind::kSymmetry ? "symmetry" : "unconstrained"; }
+std::string ToString(FreeKind kind) {
+  return kind == FreeKind::kSymmetry ? "symmetry" : "unconstrained";
+}
 
 std::string ToString(FreeMotion motion) {
   return motion == FreeMotion::kRotation ? "rotation" : "translation";

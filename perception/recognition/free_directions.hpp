@@ -56,7 +56,8 @@ struct PoseConstraints {
 // floor is negative.
 PoseConstraints AnalysePoseConstraints(const Eigen::Matrix<double, 6, 6>& information,
                                        const Eigen::Matrix<double, 6, 6>& patch_spread,
-                                       const Eigen::Vector3d& centre_O, double sigma_m, double radius_m,
-                                       double tolerance_m, double floor_std_m = 0.0);
+                                       const Eigen::Vector3d& centre_O, double sigma_m,
+                                       double radius_m, double tolerance_m,
+                                       double floor_std_m = 0.0);
 
 }  // namespace uwscan::perception

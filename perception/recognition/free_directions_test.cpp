@@ -38,7 +38,8 @@ Matrix6d Information(const Surface& s, const Eigen::Vector3d& centre) {
   return info;
 }
 
-double DistanceToLine(const Eigen::Vector3d& p, const Eigen::Vector3d& on_line, const Eigen::Vector3d& axis) {
+double DistanceToLine(const Eigen::Vector3d& p, const Eigen::Vector3d& on_line,
+                      const Eigen::Vector3d& axis) {
   const Eigen::Vector3d d = p - on_line;
   return (d - d.dot(axis.normalized()) * axis.normalized()).norm();
 }
@@ -67,7 +68,8 @@ TEST(FreeDirections, APipeWithoutEndsSlidesAndRollsAboutItsOwnAxis) {
     }
   }
   const Eigen::Vector3d centre = pipe.Centroid();  // off the axis: half the circumference
-  const PoseConstraints c = AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, 0.2, 1e-3);
+  const PoseConstraints c =
+      AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, 0.2, 1e-3);
   ASSERT_EQ(c.free_O.size(), 2u);
   const auto slides = Of(c, FreeMotion::kTranslation), rolls = Of(c, FreeMotion::kRotation);
   ASSERT_EQ(slides.size(), 1u);
@@ -82,8 +84,8 @@ TEST(FreeDirections, APipeWithoutEndsSlidesAndRollsAboutItsOwnAxis) {
   // nothing along the free ones. (The roll, about the axis off the centre, moves the centre along
   // `across`; the shift along `third` and the tilt about `across` are pinned and apart from it.)
   const double floor_m = 1e-4, radius_m = 0.2;
-  const PoseConstraints floored =
-      AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, radius_m, 1e-3, floor_m);
+  const PoseConstraints floored = AnalysePoseConstraints(Information(pipe, centre), kNoSpread,
+                                                         centre, 5e-4, radius_m, 1e-3, floor_m);
   ASSERT_EQ(floored.free_O.size(), 2u);
   const Matrix6d added = floored.covariance - c.covariance;
   Vector6d shift, tilt, slide;
@@ -93,7 +95,9 @@ TEST(FreeDirections, APipeWithoutEndsSlidesAndRollsAboutItsOwnAxis) {
   EXPECT_NEAR(shift.dot(added * shift), floor_m * floor_m, 1e-15);
   EXPECT_NEAR(tilt.dot(added * tilt), floor_m * floor_m / (radius_m * radius_m), 1e-15);
   EXPECT_LT(std::abs(slide.dot(floored.covariance * slide)), 1e-15);
-  EXPECT_THROW(AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, radius_m, 1e-3, -1e-4), Error);
+  EXPECT_THROW(AnalysePoseConstraints(Information(pipe, centre), kNoSpread, centre, 5e-4, radius_m,
+                                      1e-3, -1e-4),
+               Error);
 }
 
 // A 90-degree elbow seen without its ends turns about its bend axis, and only about it: the
@@ -107,13 +111,15 @@ TEST(FreeDirections, AnElbowWithoutEndsTurnsAboutItsBendAxis) {
     const Eigen::Vector3d radial(std::cos(phi), std::sin(phi), 0.0);
     for (int k = 0; k < 72; ++k) {
       const double psi = 2.0 * kPi * k / 72.0;
-      const Eigen::Vector3d normal = std::cos(psi) * radial + std::sin(psi) * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d normal =
+          std::cos(psi) * radial + std::sin(psi) * Eigen::Vector3d::UnitZ();
       elbow.normals.push_back(normal);
       elbow.points.push_back(bend_centre + bend * radial + tube * normal);
     }
   }
   const Eigen::Vector3d centre = elbow.Centroid();
-  const PoseConstraints c = AnalysePoseConstraints(Information(elbow, centre), kNoSpread, centre, 1e-4, 0.2, 1e-3);
+  const PoseConstraints c =
+      AnalysePoseConstraints(Information(elbow, centre), kNoSpread, centre, 1e-4, 0.2, 1e-3);
   ASSERT_EQ(c.free_O.size(), 1u);
   const FreeDirection& turn = c.free_O[0];
   EXPECT_EQ(turn.motion, FreeMotion::kRotation);
@@ -127,7 +133,8 @@ TEST(FreeDirections, TwoFreeRotationsComeBackAboutTheirOwnAxes) {
   const double radius = 0.25;
   const Eigen::Vector3d centre(0.02, 0.03, -0.01);
   const Eigen::Vector3d point_a(0.1, 0.0, 0.0), axis_a = Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d point_b(0.0, 0.2, 0.05), axis_b = Eigen::Vector3d(1.0, 0.0, 0.3).normalized();
+  const Eigen::Vector3d point_b(0.0, 0.2, 0.05),
+      axis_b = Eigen::Vector3d(1.0, 0.0, 0.3).normalized();
   const auto twist = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& axis) {
     Vector6d t;  // scaled: rotation in metres at the radius
     t << radius * axis, axis.cross(centre - point);
@@ -143,14 +150,16 @@ TEST(FreeDirections, TwoFreeRotationsComeBackAboutTheirOwnAxes) {
   D_inverse.topLeftCorner<3, 3>() *= radius;
   const Matrix6d information = D_inverse * scaled * D_inverse;
 
-  const PoseConstraints c = AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, radius, 1e-3);
+  const PoseConstraints c =
+      AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, radius, 1e-3);
   const auto rotations = Of(c, FreeMotion::kRotation);
   ASSERT_EQ(c.free_O.size(), 2u);
   ASSERT_EQ(rotations.size(), 2u);
   for (const auto& [point, axis] : {std::pair(point_a, axis_a), std::pair(point_b, axis_b)}) {
     int found = 0;
     for (const FreeDirection& r : rotations) {
-      found += std::abs(r.axis_S.dot(axis)) > 1.0 - 1e-9 && DistanceToLine(r.point_S, point, axis) < 1e-9;
+      found += std::abs(r.axis_S.dot(axis)) > 1.0 - 1e-9 &&
+               DistanceToLine(r.point_S, point, axis) < 1e-9;
     }
     EXPECT_EQ(found, 1) << "axis " << axis.transpose();
   }
@@ -166,7 +175,8 @@ TEST(FreeDirections, APlaneSlidesInItselfAndTurnsAboutItsNormal) {
     }
   }
   const Eigen::Vector3d centre = plane.Centroid();
-  const PoseConstraints c = AnalysePoseConstraints(Information(plane, centre), kNoSpread, centre, 1e-4, 0.1, 1e-3);
+  const PoseConstraints c =
+      AnalysePoseConstraints(Information(plane, centre), kNoSpread, centre, 1e-4, 0.1, 1e-3);
   const auto slides = Of(c, FreeMotion::kTranslation), turns = Of(c, FreeMotion::kRotation);
   ASSERT_EQ(slides.size(), 2u);
   ASSERT_EQ(turns.size(), 1u);
@@ -188,7 +198,8 @@ TEST(FreeDirections, ABoxCornerIsPinnedAndItsCovarianceIsTheInverse) {
   const Eigen::Vector3d centre = corner.Centroid();
   const Matrix6d information = Information(corner, centre);
   const double sigma = 3e-4;
-  const PoseConstraints c = AnalysePoseConstraints(information, kNoSpread, centre, sigma, 0.1, 1e-3);
+  const PoseConstraints c =
+      AnalysePoseConstraints(information, kNoSpread, centre, sigma, 0.1, 1e-3);
   EXPECT_TRUE(c.free_O.empty());
   const Matrix6d expected = sigma * sigma * information.inverse();
   EXPECT_LT((c.covariance - expected).norm(), 1e-9 * expected.norm());
@@ -197,7 +208,8 @@ TEST(FreeDirections, ABoxCornerIsPinnedAndItsCovarianceIsTheInverse) {
   Vector6d push;
   push << 0.3, -0.1, 0.2, 1e-3, 2e-3, -1e-3;
   const Matrix6d spread = 1e-8 * push * push.transpose();
-  const PoseConstraints patched = AnalysePoseConstraints(information, spread, centre, sigma, 0.1, 1.0);
+  const PoseConstraints patched =
+      AnalysePoseConstraints(information, spread, centre, sigma, 0.1, 1.0);
   const Matrix6d sandwich = expected + information.inverse() * spread * information.inverse();
   EXPECT_LT((patched.covariance - sandwich).norm(), 1e-9 * sandwich.norm());
 }
@@ -210,10 +222,12 @@ TEST(FreeDirections, ResidualsCorrelatedOverPatchesLoosenTheDirectionTheyPush) {
   const double lambda = 1.0;  // slide along z: std sigma = 1 mm, pinned alone
   information(5, 5) = lambda;
   const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  EXPECT_TRUE(AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance).free_O.empty());
+  EXPECT_TRUE(AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance)
+                  .free_O.empty());
   Matrix6d spread = Matrix6d::Zero();
   spread(5, 5) = 4e-6 * lambda * lambda;  // adds (2 mm)^2
-  const PoseConstraints c = AnalysePoseConstraints(information, spread, centre, sigma, radius, tolerance);
+  const PoseConstraints c =
+      AnalysePoseConstraints(information, spread, centre, sigma, radius, tolerance);
   ASSERT_EQ(c.free_O.size(), 1u);
   EXPECT_EQ(c.free_O[0].motion, FreeMotion::kTranslation);
   EXPECT_NEAR(std::abs(c.free_O[0].axis_S.z()), 1.0, 1e-12);
@@ -231,10 +245,12 @@ TEST(FreeDirections, TheToleranceIsAStandardDeviationInMetres) {
     return info;
   };
   const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  EXPECT_TRUE(AnalysePoseConstraints(information_for(0.9 * tolerance, 0.9 * tolerance), kNoSpread, centre, sigma, radius,
-                                     tolerance).free_O.empty());
+  EXPECT_TRUE(AnalysePoseConstraints(information_for(0.9 * tolerance, 0.9 * tolerance), kNoSpread,
+                                     centre, sigma, radius, tolerance)
+                  .free_O.empty());
   const PoseConstraints loose =
-      AnalysePoseConstraints(information_for(1.1 * tolerance, 1.1 * tolerance), kNoSpread, centre, sigma, radius, tolerance);
+      AnalysePoseConstraints(information_for(1.1 * tolerance, 1.1 * tolerance), kNoSpread, centre,
+                             sigma, radius, tolerance);
   EXPECT_EQ(Of(loose, FreeMotion::kTranslation).size(), 1u);
   EXPECT_EQ(Of(loose, FreeMotion::kRotation).size(), 1u);
 }
@@ -251,7 +267,8 @@ TEST(FreeDirections, BadInputIsRefused) {
   EXPECT_THROW(AnalysePoseConstraints(information, kNoSpread, centre, 1e-3, 0.1, 1e-3), Error);
   Matrix6d spread = Matrix6d::Zero();
   spread(2, 3) = 1.0;  // not symmetric
-  EXPECT_THROW(AnalysePoseConstraints(Matrix6d::Identity(), spread, centre, 1e-3, 0.1, 1e-3), Error);
+  EXPECT_THROW(AnalysePoseConstraints(Matrix6d::Identity(), spread, centre, 1e-3, 0.1, 1e-3),
+               Error);
 }
 
 }  // namespace

@@ -53,8 +53,8 @@ ObjectSource Elbow() {
   const Eigen::Vector3d centre(r, 0, 0);
   const Eigen::Vector3d on_line(r * (1.0 - std::cos(a)), 0, r * std::sin(a));
   const Eigen::Vector3d outward = (on_line - centre).normalized();
-  o.grasps.push_back(Grasp("bend", on_line + shape.outer_radius_m * outward, -outward,
-                           Eigen::Vector3d(0, 1, 0)));
+  o.grasps.push_back(
+      Grasp("bend", on_line + shape.outer_radius_m * outward, -outward, Eigen::Vector3d(0, 1, 0)));
   // A half turn about the bend's bisector (through the bend's centre and the middle of the
   // centre line) swaps the two ends.
   o.symmetries = std::vector<SymmetryAxis>{{centre, outward, 2}};
@@ -65,7 +65,8 @@ ObjectSource Tee() {
   sim::TeeShape shape;
   ObjectSource o{"tee", "procedural: tee", sim::MakeTee(shape), {}, std::nullopt};
   // On the run, a quarter of its length from the branch, approaching from the side opposite it.
-  o.grasps.push_back(Grasp("run", Eigen::Vector3d(-shape.outer_radius_m, 0, 0.25 * shape.run_length_m),
+  o.grasps.push_back(Grasp("run",
+                           Eigen::Vector3d(-shape.outer_radius_m, 0, 0.25 * shape.run_length_m),
                            Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)));
   // A half turn about the branch swaps the run's ends.
   o.symmetries = std::vector<SymmetryAxis>{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 2}};
@@ -80,7 +81,8 @@ ObjectSource Flange() {
   o.grasps.push_back(Grasp("rim", Eigen::Vector3d(shape.flange_radius_m, 0, z),
                            Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 0, 1)));
   // The bolts make it N-fold, not continuous: declared, as it is by construction.
-  o.symmetries = std::vector<SymmetryAxis>{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), shape.bolts}};
+  o.symmetries =
+      std::vector<SymmetryAxis>{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), shape.bolts}};
   return o;
 }
 
@@ -91,14 +93,14 @@ ObjectSource Valve(sim::ValveHandle handle) {
   const std::string id = wheel ? "valve_wheel" : "valve_lever";
   ObjectSource o{id, "procedural: " + id, sim::MakeValve(shape), {}, std::nullopt};
   // The handle from above: the wheel's rim, or the lever's end, fingers across the bar.
-  o.grasps.push_back(Grasp("handle",
-                           Eigen::Vector3d(0, shape.stem_length_m, shape.handle_radius_m),
-                           Eigen::Vector3d(0, -1, 0), wheel ? Eigen::Vector3d(0, 0, 1)
-                                                            : Eigen::Vector3d(1, 0, 0)));
+  o.grasps.push_back(Grasp("handle", Eigen::Vector3d(0, shape.stem_length_m, shape.handle_radius_m),
+                           Eigen::Vector3d(0, -1, 0),
+                           wheel ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(1, 0, 0)));
   // The wheel (two crossed spokes) turns a half turn about the stem with the body; the
   // one-sided lever has no symmetry.
-  o.symmetries = wheel ? std::vector<SymmetryAxis>{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 2}}
-                       : std::vector<SymmetryAxis>{};
+  o.symmetries =
+      wheel ? std::vector<SymmetryAxis>{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 2}}
+            : std::vector<SymmetryAxis>{};
   return o;
 }
 

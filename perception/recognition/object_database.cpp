@@ -122,7 +122,8 @@ ObjectModel GetObject(ByteReader& in) {
   o.diameter_m = GetFinite(in, "diameter");
   if (!(o.diameter_m > 0.0)) in.Fail("object '" + o.id + "' has no positive diameter");
   o.model = GetCloud(in);
-  if (!o.model.has_normals() || o.model.empty()) in.Fail("object '" + o.id + "' has no model normals");
+  if (!o.model.has_normals() || o.model.empty())
+    in.Fail("object '" + o.id + "' has no model normals");
   const std::size_t features = in.GetCount("features", 8 + 33 * 4);
   for (std::size_t i = 0; i < features; ++i) {
     const std::uint64_t index = in.Get<std::uint64_t>("feature index");

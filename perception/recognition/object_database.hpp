@@ -22,8 +22,8 @@ struct GraspFrame {
 // One partial view of an object by the virtual scanner.
 struct ObjectView {
   Eigen::Isometry3d T_O_C = Eigen::Isometry3d::Identity();  // the camera in the object frame
-  EsfDescriptor esf = EsfDescriptor::Zero();  // of the view's voxelised points
-  int points = 0;                             // voxelised points of the view
+  EsfDescriptor esf = EsfDescriptor::Zero();                // of the view's voxelised points
+  int points = 0;                                           // voxelised points of the view
   // The view's voxelised points in its camera frame: what the pose's coarse stage matches a
   // segment against (a partial scan like the segment, unlike the whole model, whose thin walls
   // and inner bores give FPFH neighbourhoods no scan sees).
@@ -34,10 +34,10 @@ struct ObjectView {
 // its size, its symmetries and grasp frames, and the ESF of each view for its identity.
 struct ObjectModel {
   std::string id;
-  std::string source;         // mesh file or procedural shape it was built from
-  double diameter_m = 0.0;    // largest distance between two model points
-  PointCloud model;           // surface samples with outward normals, object frame, voxelised
-  FpfhFeatures features;      // at every model point
+  std::string source;       // mesh file or procedural shape it was built from
+  double diameter_m = 0.0;  // largest distance between two model points
+  PointCloud model;         // surface samples with outward normals, object frame, voxelised
+  FpfhFeatures features;    // at every model point
   std::vector<SymmetryAxis> symmetries;
   bool symmetries_declared = false;  // declared beside the mesh, not found from it
   std::vector<GraspFrame> grasps;

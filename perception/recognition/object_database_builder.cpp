@@ -26,9 +26,9 @@ std::uint64_t Mix(std::uint64_t a, std::uint64_t b) {
   return z ^ (z >> 31);
 }
 
-// Surface samples with the mesh's outward normals, seen from outside, one per voxel and facing: in each voxel,
-// for each of the six directions a normal can mostly point along, the sample nearest the
-// centroid of those samples. A real sample stays on the surface, where a centroid would sit
+// Surface samples with the mesh's outward normals, seen from outside, one per voxel and facing: in
+// each voxel, for each of the six directions a normal can mostly point along, the sample nearest
+// the centroid of those samples. A real sample stays on the surface, where a centroid would sit
 // between the outer and inner walls of a thin pipe (5 mm apart, one voxel) and pull every ICP
 // on the model a few millimetres inwards; splitting by facing keeps both walls.
 PointCloud ModelCloud(const std::string& id, const scanner::TriangleMesh& mesh, double voxel_m,
@@ -40,7 +40,8 @@ PointCloud ModelCloud(const std::string& id, const scanner::TriangleMesh& mesh, 
                       .cross(mesh.vertices[static_cast<std::size_t>(t[2])] - a)
                       .norm();
   }
-  const int count = static_cast<int>(std::clamp(16.0 * area / (voxel_m * voxel_m), 2000.0, 400000.0));
+  const int count =
+      static_cast<int>(std::clamp(16.0 * area / (voxel_m * voxel_m), 2000.0, 400000.0));
   const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, count, seed);
   // Key: voxel indices and facing (0-5); ordered, so the cloud does not depend on hashing.
   std::map<std::array<long, 4>, std::vector<std::size_t>> groups;
@@ -79,7 +80,8 @@ PointCloud ModelCloud(const std::string& id, const scanner::TriangleMesh& mesh, 
     // whole, a bore's, is dropped without casting for every sample).
     std::vector<std::size_t> order = members;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return (samples.points[a] - centroid).squaredNorm() < (samples.points[b] - centroid).squaredNorm();
+      return (samples.points[a] - centroid).squaredNorm() <
+             (samples.points[b] - centroid).squaredNorm();
     });
     order.resize(std::min<std::size_t>(order.size(), 4));
     const auto seen = std::find_if(order.begin(), order.end(), visible);
@@ -119,8 +121,10 @@ EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t se
   return ComputeEsf(VoxelDownsample(cloud, VoxelFilterOptions{voxel_m}), options);
 }
 
-Eigen::Isometry3d ViewPose(int index, int count, const Eigen::Vector3d& centre_O, double standoff_m) {
-  const Eigen::Vector3d direction = scanner::sim::SphereDirections(count)[static_cast<std::size_t>(index)];
+Eigen::Isometry3d ViewPose(int index, int count, const Eigen::Vector3d& centre_O,
+                           double standoff_m) {
+  const Eigen::Vector3d direction =
+      scanner::sim::SphereDirections(count)[static_cast<std::size_t>(index)];
   const Eigen::Vector3d up =
       std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
   return scanner::sim::LookAt(centre_O + standoff_m * direction, centre_O, up);
@@ -163,7 +167,8 @@ ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
     std::vector<std::optional<ObjectView>> views(static_cast<std::size_t>(options.views));
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int v = 0; v < options.views; ++v) {
-      const double standoff = options.standoffs_m[static_cast<std::size_t>(v) % options.standoffs_m.size()];
+      const double standoff =
+          options.standoffs_m[static_cast<std::size_t>(v) % options.standoffs_m.size()];
       const Eigen::Isometry3d T_O_C = ViewPose(v, options.views, centre, standoff);
       const std::uint64_t seed = Mix(Mix(options.seed, k), static_cast<std::uint64_t>(v));
       const scanner::sim::VirtualScan scan = scanner.Scan(scene, T_O_C, seed);
@@ -183,7 +188,8 @@ ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
       if (v) model.views.push_back(*v);
     }
     if (model.views.empty()) {
-      throw Error("build-db: no view of '" + source.id + "' holds " + std::to_string(kMinViewPoints) +
+      throw Error("build-db: no view of '" + source.id + "' holds " +
+                  std::to_string(kMinViewPoints) +
                   " points (is it far smaller or larger than the scanner's field of view?)");
     }
     db.objects.push_back(std::move(model));

@@ -38,6 +38,7 @@ ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,
                                    const std::function<void(double)>& progress = {});
 
 // The camera pose of view `index` of `count` around a point (object frame), at `standoff_m`.
-Eigen::Isometry3d ViewPose(int index, int count, const Eigen::Vector3d& centre_O, double standoff_m);
+Eigen::Isometry3d ViewPose(int index, int count, const Eigen::Vector3d& centre_O,
+                           double standoff_m);
 
 }  // namespace uwscan::perception

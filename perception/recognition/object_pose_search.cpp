@@ -29,7 +29,8 @@ const ViewFeatures& RecognitionCache::View(std::size_t object, std::size_t view,
   const std::lock_guard<std::mutex> lock(mutex_);
   std::unique_ptr<ViewFeatures>& slot = described_[{object, view}];
   if (!slot) {
-    slot = std::make_unique<ViewFeatures>(DescribeView(db_.objects.at(object).views.at(view), db_.parameters, threads));
+    slot = std::make_unique<ViewFeatures>(
+        DescribeView(db_.objects.at(object).views.at(view), db_.parameters, threads));
   }
   return *slot;
 }
@@ -89,8 +90,9 @@ IcpOptions FineIcpLastStage(double diameter_m, const ObjectDatabaseParameters& p
 
 // Starting poses T_O_S of a segment on one object: FPFH + RANSAC onto its nearest view (when
 // RANSAC finds one), then each of its nearest views rolled about the line of sight.
-std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhFeatures& segment_features,
-                                          std::size_t object, const std::vector<std::pair<double, int>>& views,
+std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment,
+                                          const FpfhFeatures& segment_features, std::size_t object,
+                                          const std::vector<std::pair<double, int>>& views,
                                           RecognitionCache& cache, const ObjectDatabase& db,
                                           const RecognitionOptions& options) {
   const ObjectModel& model = db.objects[object];
@@ -110,7 +112,8 @@ std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhF
       AlignCoarse(segment, segment_features, described.cloud, described.features, coarse);
   if (rough.converged) starts.push_back(nearest.T_O_C * rough.T_target_source);
   for (int v = 0; v < std::min<int>(options.pose_views, std::ssize(views)); ++v) {
-    const ObjectView& view = model.views[static_cast<std::size_t>(views[static_cast<std::size_t>(v)].second)];
+    const ObjectView& view =
+        model.views[static_cast<std::size_t>(views[static_cast<std::size_t>(v)].second)];
     for (const Eigen::Isometry3d& T_O_S : ViewPoseHypotheses(segment, view, options.pose_rolls)) {
       starts.push_back(T_O_S);
     }
@@ -118,11 +121,13 @@ std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhF
   return starts;
 }
 
-double SiftReach(double diameter_m, double voxel_m) { return std::max(0.1 * diameter_m, 8.0 * voxel_m); }
+double SiftReach(double diameter_m, double voxel_m) {
+  return std::max(0.1 * diameter_m, 8.0 * voxel_m);
+}
 
 std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTarget& target,
-                                          const std::vector<Eigen::Isometry3d>& starts, double diameter_m,
-                                          const ObjectDatabaseParameters& p,
+                                          const std::vector<Eigen::Isometry3d>& starts,
+                                          double diameter_m, const ObjectDatabaseParameters& p,
                                           const RecognitionOptions& options) {
   std::vector<Eigen::Isometry3d> kept;
   const std::size_t sift = static_cast<std::size_t>(options.sift_points);
@@ -134,7 +139,8 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
   IcpOptions icp;
   icp.method = IcpMethod::kPointToPlane;
   // From the sift's reach down to the fine ICP's start.
-  icp.max_correspondence_distance_m = {SiftReach(diameter_m, p.voxel_m), 4.0 * p.voxel_m, 2.0 * p.voxel_m};
+  icp.max_correspondence_distance_m = {SiftReach(diameter_m, p.voxel_m), 4.0 * p.voxel_m,
+                                       2.0 * p.voxel_m};
   icp.max_iterations_per_stage = 8;
   icp.max_iterations = 20;
   icp.translation_tolerance_m = 0.1 * p.voxel_m;
@@ -149,7 +155,8 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
     fitness.resize(first + from.size(), 0.0);
     moved.resize(first + from.size());
     RunParallelTasks(std::ssize(from), options.threads, [&](std::ptrdiff_t s) {
-      const RegistrationResult quick = AlignIcp(subset, target, from[static_cast<std::size_t>(s)], icp);
+      const RegistrationResult quick =
+          AlignIcp(subset, target, from[static_cast<std::size_t>(s)], icp);
       fitness[first + static_cast<std::size_t>(s)] = quick.fitness;
       moved[first + static_cast<std::size_t>(s)] = quick.T_target_source;
     });
@@ -159,10 +166,11 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
   quick_icp(starts, fitness, moved);
   // The best pose turned half a turn about each principal axis of the model: a nearly
   // symmetric object (a valve's body) fits either way, and only a detail (its handle) decides.
-  const std::size_t best = static_cast<std::size_t>(
-      std::max_element(fitness.begin(), fitness.end()) - fitness.begin());
+  const std::size_t best =
+      static_cast<std::size_t>(std::max_element(fitness.begin(), fitness.end()) - fitness.begin());
   std::vector<Eigen::Isometry3d> flipped;
-  for (const Eigen::Isometry3d& half_turn : HalfTurns(target.cloud())) flipped.push_back(half_turn * moved[best]);
+  for (const Eigen::Isometry3d& half_turn : HalfTurns(target.cloud()))
+    flipped.push_back(half_turn * moved[best]);
   quick_icp(flipped, fitness, moved);
   std::vector<std::size_t> order(moved.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -181,19 +189,22 @@ std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTa
   return kept;
 }
 
-double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
-                         const Eigen::Isometry3d& T_O_S, double voxel_m) {
+double TruncatedResidual(const PointCloud& sample, const ObjectModel& model,
+                         const NearestGrid& model_grid, const Eigen::Isometry3d& T_O_S,
+                         double voxel_m) {
   const double cap = voxel_m * voxel_m;
   double sum = 0.0;
   for (std::size_t i = 0; i < sample.size(); ++i) {
     const Eigen::Vector3d x_O = T_O_S * sample.Point(i);
-    const std::int64_t j = model_grid.Nearest((x_O - model.model.origin).cast<float>(), static_cast<float>(cap));
+    const std::int64_t j =
+        model_grid.Nearest((x_O - model.model.origin).cast<float>(), static_cast<float>(cap));
     if (j < 0) {
       sum += cap;
       continue;
     }
     const std::size_t nearest = static_cast<std::size_t>(j);
-    const double along_normal = model.model.normals[nearest].cast<double>().dot(x_O - model.model.Point(nearest));
+    const double along_normal =
+        model.model.normals[nearest].cast<double>().dot(x_O - model.model.Point(nearest));
     sum += std::min(along_normal * along_normal, cap);
   }
   return sum;
@@ -210,20 +221,24 @@ struct PhaseProfile {
   std::vector<double> residual;
 };
 
-Eigen::Isometry3d TurnedAbout(const SymmetryAxis& axis, double angle_rad, const Eigen::Isometry3d& T_O_S) {
-  return Eigen::Translation3d(axis.point_O) * Eigen::AngleAxisd(angle_rad, axis.axis_O.normalized()) *
+Eigen::Isometry3d TurnedAbout(const SymmetryAxis& axis, double angle_rad,
+                              const Eigen::Isometry3d& T_O_S) {
+  return Eigen::Translation3d(axis.point_O) *
+         Eigen::AngleAxisd(angle_rad, axis.axis_O.normalized()) *
          Eigen::Translation3d(-axis.point_O) * T_O_S;
 }
 
-PhaseProfile SymmetryPhaseProfile(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
-                                  const SymmetryAxis& axis, const Eigen::Isometry3d& T_O_S, double voxel_m) {
+PhaseProfile SymmetryPhaseProfile(const PointCloud& sample, const ObjectModel& model,
+                                  const NearestGrid& model_grid, const SymmetryAxis& axis,
+                                  const Eigen::Isometry3d& T_O_S, double voxel_m) {
   PhaseProfile profile;
   const double period = 2.0 * std::numbers::pi / axis.order;
-  profile.step_rad = std::min(period / 8.0, 0.5 * voxel_m / std::max(0.5 * model.diameter_m, voxel_m));
+  profile.step_rad =
+      std::min(period / 8.0, 0.5 * voxel_m / std::max(0.5 * model.diameter_m, voxel_m));
   profile.steps = static_cast<int>(std::ceil(0.5 * period / profile.step_rad));
   for (int k = -profile.steps; k <= profile.steps; ++k) {
-    profile.residual.push_back(
-        TruncatedResidual(sample, model, model_grid, TurnedAbout(axis, k * profile.step_rad, T_O_S), voxel_m));
+    profile.residual.push_back(TruncatedResidual(
+        sample, model, model_grid, TurnedAbout(axis, k * profile.step_rad, T_O_S), voxel_m));
   }
   return profile;
 }
@@ -234,13 +249,17 @@ bool HasPhase(const PointCloud& sample, const ObjectModel& model, const Symmetry
 
 }  // namespace
 
-std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, const ObjectModel& model,
-                                                   const NearestGrid& model_grid, const SymmetryAxis& axis,
+std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample,
+                                                   const ObjectModel& model,
+                                                   const NearestGrid& model_grid,
+                                                   const SymmetryAxis& axis,
                                                    const Eigen::Isometry3d& T_O_S, double voxel_m) {
   if (!HasPhase(sample, model, axis)) return {};
-  const PhaseProfile profile = SymmetryPhaseProfile(sample, model, model_grid, axis, T_O_S, voxel_m);
+  const PhaseProfile profile =
+      SymmetryPhaseProfile(sample, model, model_grid, axis, T_O_S, voxel_m);
   const std::vector<double>& residual = profile.residual;
-  const std::size_t lowest = static_cast<std::size_t>(std::min_element(residual.begin(), residual.end()) - residual.begin());
+  const std::size_t lowest = static_cast<std::size_t>(
+      std::min_element(residual.begin(), residual.end()) - residual.begin());
   const double near = residual[lowest] + 0.5 * voxel_m * voxel_m;
   std::size_t first = lowest, last = lowest;
   while (first > 0 && residual[first - 1] <= near) --first;
@@ -248,17 +267,20 @@ std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, con
   std::vector<Eigen::Isometry3d> starts;
   const double lowest_turn = static_cast<double>(lowest) - profile.steps;
   const double middle_turn = std::round(0.5 * static_cast<double>(first + last)) - profile.steps;
-  if (lowest_turn != 0.0) starts.push_back(TurnedAbout(axis, lowest_turn * profile.step_rad, T_O_S));
+  if (lowest_turn != 0.0)
+    starts.push_back(TurnedAbout(axis, lowest_turn * profile.step_rad, T_O_S));
   if (middle_turn != 0.0 && middle_turn != lowest_turn) {
     starts.push_back(TurnedAbout(axis, middle_turn * profile.step_rad, T_O_S));
   }
   return starts;
 }
 
-bool SymmetryPhasePinned(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
-                         const SymmetryAxis& axis, const Eigen::Isometry3d& T_O_S, double voxel_m, double min_points) {
+bool SymmetryPhasePinned(const PointCloud& sample, const ObjectModel& model,
+                         const NearestGrid& model_grid, const SymmetryAxis& axis,
+                         const Eigen::Isometry3d& T_O_S, double voxel_m, double min_points) {
   if (!HasPhase(sample, model, axis)) return true;
-  const std::vector<double> residual = SymmetryPhaseProfile(sample, model, model_grid, axis, T_O_S, voxel_m).residual;
+  const std::vector<double> residual =
+      SymmetryPhaseProfile(sample, model, model_grid, axis, T_O_S, voxel_m).residual;
   const auto [low, high] = std::minmax_element(residual.begin(), residual.end());
   return *high - *low >= min_points * voxel_m * voxel_m;
 }

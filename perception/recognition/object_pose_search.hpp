@@ -75,8 +75,9 @@ IcpOptions FineIcpLastStage(double diameter_m, const ObjectDatabaseParameters& p
 // Starting poses T_O_S of a segment on one object: FPFH + RANSAC onto its nearest view (when
 // RANSAC finds one), then each of its nearest `options.pose_views` views rolled about the line
 // of sight. `views`: (chi-square, view index) of the object's nearest views, nearest first.
-std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhFeatures& segment_features,
-                                          std::size_t object, const std::vector<std::pair<double, int>>& views,
+std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment,
+                                          const FpfhFeatures& segment_features, std::size_t object,
+                                          const std::vector<std::pair<double, int>>& views,
                                           RecognitionCache& cache, const ObjectDatabase& db,
                                           const RecognitionOptions& options);
 
@@ -88,15 +89,16 @@ std::vector<Eigen::Isometry3d> PoseStarts(const PointCloud& segment, const FpfhF
 // valve's body) fits either way, and only a detail (its handle) decides. Parallel over starts,
 // chosen in a fixed order: the same for any thread count.
 std::vector<Eigen::Isometry3d> SiftStarts(const PointCloud& segment, const IcpTarget& target,
-                                          const std::vector<Eigen::Isometry3d>& starts, double diameter_m,
-                                          const ObjectDatabaseParameters& p,
+                                          const std::vector<Eigen::Isometry3d>& starts,
+                                          double diameter_m, const ObjectDatabaseParameters& p,
                                           const RecognitionOptions& options);
 
 // Sum over `sample` (segment frame) of the squared point-to-plane distances to the nearest
 // points of the model posed by T_O_S, each at most voxel_m^2: a point farther than a voxel from
 // every model point counts the cap, as no pair at all. `model_grid` holds model.model's points.
-double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
-                         const Eigen::Isometry3d& T_O_S, double voxel_m);
+double TruncatedResidual(const PointCloud& sample, const ObjectModel& model,
+                         const NearestGrid& model_grid, const Eigen::Isometry3d& T_O_S,
+                         double voxel_m);
 
 // Phases worth trying about one of the model's symmetry axes of order N >= 3 (a surface of
 // revolution whose details repeat N times: a flange's bolt heads): the pose turned about the
@@ -106,8 +108,10 @@ double TruncatedResidual(const PointCloud& sample, const ObjectModel& model, con
 // steps), those other than the pose itself. ICP alone does not find that phase: the details
 // stand off the surface beyond its pairing distance unless they already overlap. T_O_S as ICP
 // gives it (segment to object), and the same for the results.
-std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, const ObjectModel& model,
-                                                   const NearestGrid& model_grid, const SymmetryAxis& axis,
+std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample,
+                                                   const ObjectModel& model,
+                                                   const NearestGrid& model_grid,
+                                                   const SymmetryAxis& axis,
                                                    const Eigen::Isometry3d& T_O_S, double voxel_m);
 
 // Whether the data pins the pose's phase about one of the model's symmetry axes of order N >= 3:
@@ -117,7 +121,8 @@ std::vector<Eigen::Isometry3d> SymmetryPhaseStarts(const PointCloud& sample, con
 // which the ICP's information does not show (the faceted model and its estimated normals are not
 // quite a surface of revolution, which makes the turn look pinned). True for an axis of lower
 // order, which has no phase.
-bool SymmetryPhasePinned(const PointCloud& sample, const ObjectModel& model, const NearestGrid& model_grid,
-                         const SymmetryAxis& axis, const Eigen::Isometry3d& T_O_S, double voxel_m, double min_points);
+bool SymmetryPhasePinned(const PointCloud& sample, const ObjectModel& model,
+                         const NearestGrid& model_grid, const SymmetryAxis& axis,
+                         const Eigen::Isometry3d& T_O_S, double voxel_m, double min_points);
 
 }  // namespace uwscan::perception

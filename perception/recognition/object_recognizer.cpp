@@ -37,8 +37,8 @@ constexpr double kDegree = std::numbers::pi / 180.0;
 
 // Whether two rotation axes are the same line: the same direction (within a degree) through the
 // same points (within 2 mm), both given in one frame.
-bool SameAxis(const Eigen::Vector3d& axis_a, const Eigen::Vector3d& point_a, const Eigen::Vector3d& axis_b,
-              const Eigen::Vector3d& point_b) {
+bool SameAxis(const Eigen::Vector3d& axis_a, const Eigen::Vector3d& point_a,
+              const Eigen::Vector3d& axis_b, const Eigen::Vector3d& point_b) {
   if (std::abs(axis_a.dot(axis_b)) < std::cos(kDegree)) return false;
   const Eigen::Vector3d d = point_a - point_b;
   return (d - d.dot(axis_b) * axis_b).norm() < 0.002;
@@ -55,7 +55,8 @@ bool IsContinuousSymmetry(const FreeDirection& rotation_O, const ObjectModel& mo
 // Whether `rotation_O` turns about the same axis as a rotation among `free_O`.
 bool AlreadyFree(const FreeDirection& rotation_O, const std::vector<FreeDirection>& free_O) {
   return std::any_of(free_O.begin(), free_O.end(), [&](const FreeDirection& f) {
-    return f.motion == FreeMotion::kRotation && SameAxis(rotation_O.axis_S, rotation_O.point_S, f.axis_S, f.point_S);
+    return f.motion == FreeMotion::kRotation &&
+           SameAxis(rotation_O.axis_S, rotation_O.point_S, f.axis_S, f.point_S);
   });
 }
 
@@ -65,8 +66,9 @@ bool AlreadyFree(const FreeDirection& rotation_O, const std::vector<FreeDirectio
 void AddUnpinnedPhases(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
                        const ScanContext& ctx, PoseConstraints& c) {
   for (const SymmetryAxis& axis : model.symmetries) {
-    if (SymmetryPhasePinned(fitted, model, ctx.cache.Model(posed.object).nearest(), axis, posed.fine.T_target_source,
-                            ctx.db.parameters.voxel_m, ctx.options.min_phase_points)) {
+    if (SymmetryPhasePinned(fitted, model, ctx.cache.Model(posed.object).nearest(), axis,
+                            posed.fine.T_target_source, ctx.db.parameters.voxel_m,
+                            ctx.options.min_phase_points)) {
       continue;
     }
     FreeDirection turn;
@@ -88,18 +90,18 @@ void AddUnpinnedPhases(const PosedObject& posed, const PointCloud& fitted, const
 // The directions the fine ICP on `fitted` leaves free (those the object's continuous symmetries
 // already name left out), and the phases the data leaves free about its N-fold axes, in the scan
 // frame, and the covariance over the others.
-void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
-                        const ScanContext& ctx, RecognizedObject& out) {
+void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted,
+                        const ObjectModel& model, const ScanContext& ctx, RecognizedObject& out) {
   const double radius_m = 0.5 * model.diameter_m;
   const double pair_distance_m =
       FineIcp(model.diameter_m, ctx.db.parameters, 1).max_correspondence_distance_m.back();
-  const Eigen::Matrix<double, 6, 6> spread =
-      ResidualPatchSpread(fitted, posed.fine.T_target_source, model.model, ctx.cache.Model(posed.object).nearest(),
-                          pair_distance_m, model.model.origin, ctx.options.residual_patch_m);
+  const Eigen::Matrix<double, 6, 6> spread = ResidualPatchSpread(
+      fitted, posed.fine.T_target_source, model.model, ctx.cache.Model(posed.object).nearest(),
+      pair_distance_m, model.model.origin, ctx.options.residual_patch_m);
   PoseConstraints c =
       AnalysePoseConstraints(posed.fine.information, spread, model.model.origin,
-                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m,
-                             ctx.options.pose_floor_std_m);
+                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m,
+                             ctx.options.free_direction_std_m, ctx.options.pose_floor_std_m);
   AddUnpinnedPhases(posed, fitted, model, ctx, c);
   const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
   for (FreeDirection f : c.free_O) {
@@ -117,15 +119,19 @@ void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted, cons
 // says which the segment looks more like (a pipe or a tee whose branch the sweep did not reach).
 void BreakTie(double tie, double resting_m, std::vector<PosedObject>& ranked) {
   if (ranked.empty() || !ranked.front().candidate.verified) return;
-  auto key = [&](const RecognitionCandidate& c) { return std::make_pair(c.clearance_m > resting_m, c.chi_square); };
+  auto key = [&](const RecognitionCandidate& c) {
+    return std::make_pair(c.clearance_m > resting_m, c.chi_square);
+  };
   std::size_t pick = 0;
   for (std::size_t k = 1; k < ranked.size(); ++k) {
     const RecognitionCandidate& c = ranked[k].candidate;
-    if (c.verified && c.score >= ranked.front().candidate.score - tie && key(c) < key(ranked[pick].candidate)) {
+    if (c.verified && c.score >= ranked.front().candidate.score - tie &&
+        key(c) < key(ranked[pick].candidate)) {
       pick = k;
     }
   }
-  std::rotate(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(pick), ranked.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
+  std::rotate(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(pick),
+              ranked.begin() + static_cast<std::ptrdiff_t>(pick) + 1);
 }
 
 // The verified candidates of `posed` that could still rank first placed along the directions their
@@ -135,10 +141,11 @@ void BreakTie(double tie, double resting_m, std::vector<PosedObject>& ranked) {
 // within score_tie of the best with nothing missing: placing it changes that share, not the
 // others much. One that misses surface is first tried turned by its model's half turns
 // (TurnToBetterHalfTurn): a flange posed end for end misses its rim where the scan shows its neck.
-void PlaceContendersAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
-                                        std::vector<PosedObject>& posed) {
+void PlaceContendersAlongFreeDirections(const PointCloud& segment, const SceneAround& around,
+                                        const ScanContext& ctx, std::vector<PosedObject>& posed) {
   double best = 0.0;
-  for (const PosedObject& q : posed) best = std::max(best, q.candidate.verified ? q.candidate.score : 0.0);
+  for (const PosedObject& q : posed)
+    best = std::max(best, q.candidate.verified ? q.candidate.score : 0.0);
   for (PosedObject& q : posed) {
     const RecognitionCandidate& c = q.candidate;
     if (c.verified && c.close * (1.0 - c.buried) >= best - ctx.options.score_tie) {
@@ -152,8 +159,8 @@ void PlaceContendersAlongFreeDirections(const PointCloud& segment, const SceneAr
 }
 
 // The other verified objects BreakTie chose among: scoring within `tie` of the best score.
-std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(const std::vector<PosedObject>& ranked,
-                                                                         double tie) {
+std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(
+    const std::vector<PosedObject>& ranked, double tie) {
   double top = -std::numeric_limits<double>::infinity();
   for (const PosedObject& p : ranked) {
     if (p.candidate.verified) top = std::max(top, p.candidate.score);
@@ -167,14 +174,16 @@ std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(const s
 }
 
 // The recognised object's identity, pose, free directions, covariance and grasps.
-void Accept(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model, double other_chi_square,
-            const ScanContext& ctx, RecognizedObject& object) {
+void Accept(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
+            double other_chi_square, const ScanContext& ctx, RecognizedObject& object) {
   const RecognitionCandidate& best = posed.candidate;
   object.object_id = best.object_id;
   object.score = best.score;
   object.chi_square = best.chi_square;
   object.T_S_O = best.T_S_O;
-  object.margin = std::isfinite(other_chi_square) && std::isfinite(best.chi_square) ? other_chi_square - best.chi_square : 0.0;
+  object.margin = std::isfinite(other_chi_square) && std::isfinite(best.chi_square)
+                      ? other_chi_square - best.chi_square
+                      : 0.0;
   for (const SymmetryAxis& s : model.symmetries) {
     FreeDirection f;
     f.kind = FreeKind::kSymmetry;
@@ -185,12 +194,13 @@ void Accept(const PosedObject& posed, const PointCloud& fitted, const ObjectMode
     object.free_directions.push_back(f);
   }
   AddPoseConstraints(posed, fitted, model, ctx, object);
-  for (const GraspFrame& g : model.grasps) object.grasps_S.emplace_back(g.name, best.T_S_O * g.T_O_G);
+  for (const GraspFrame& g : model.grasps)
+    object.grasps_S.emplace_back(g.name, best.T_S_O * g.T_O_G);
 }
 
 // indices[i] for the positions i listed in `positions` (increasing), and for the others.
-std::pair<std::vector<std::size_t>, std::vector<std::size_t>> Partition(const std::vector<std::size_t>& indices,
-                                                                        const std::vector<std::size_t>& positions) {
+std::pair<std::vector<std::size_t>, std::vector<std::size_t>> Partition(
+    const std::vector<std::size_t>& indices, const std::vector<std::size_t>& positions) {
   std::pair<std::vector<std::size_t>, std::vector<std::size_t>> split;
   std::size_t k = 0;
   for (std::size_t i = 0; i < indices.size(); ++i) {
@@ -218,8 +228,9 @@ struct PendingSegment {
 };
 
 // Clusters of `indices` (into `cloud`) with at least min_segment_points, as pending segments.
-void QueueClusters(const PointCloud& cloud, const std::vector<std::size_t>& indices, int objects_before,
-                   const RecognitionOptions& options, std::deque<PendingSegment>& pending) {
+void QueueClusters(const PointCloud& cloud, const std::vector<std::size_t>& indices,
+                   int objects_before, const RecognitionOptions& options,
+                   std::deque<PendingSegment>& pending) {
   if (indices.size() < static_cast<std::size_t>(options.min_segment_points)) return;
   const PointCloud rest = Subset(cloud, indices);
   ClusteringOptions clustering;
@@ -412,7 +423,8 @@ SegmentOutcome RecognizeDescribed(const SegmentInView& seg, const EsfDescriptor&
 
 // One segment of the plane-free cloud `remaining` recognised: its candidates posed and verified,
 // the best accepted, or, when none is verified, the part one object explains split off it.
-SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& remaining, const ScanContext& ctx) {
+SegmentOutcome RecognizeSegment(const PendingSegment& next, const PointCloud& remaining,
+                                const ScanContext& ctx) {
   const PointCloud segment = Subset(remaining, next.indices);
   const SceneAround around = SceneAroundOf(segment, ctx);
   const DescribedSegment described = DescribeSegment(segment, ctx);
@@ -437,11 +449,14 @@ std::size_t ObjectIndex(const ObjectDatabase& db, const std::string& id) {
 
 // Whether `object` (posed as `T_S_O`) has at least `share` of `part`'s points (indices into
 // `remaining`) within 1.5 voxels of its model.
-bool ExplainsPart(const PointCloud& remaining, const std::vector<std::size_t>& part, std::size_t object,
-                  const Eigen::Isometry3d& T_S_O, double share, const ScanContext& ctx) {
+bool ExplainsPart(const PointCloud& remaining, const std::vector<std::size_t>& part,
+                  std::size_t object, const Eigen::Isometry3d& T_S_O, double share,
+                  const ScanContext& ctx) {
   const PointCloud cloud = Subset(remaining, part);
-  const std::size_t on = PointsOnModel(cloud, ctx.db.objects[object], ctx.cache.Model(object).nearest(),
-                                       T_S_O.inverse(), 1.5 * ctx.db.parameters.voxel_m).size();
+  const std::size_t on =
+      PointsOnModel(cloud, ctx.db.objects[object], ctx.cache.Model(object).nearest(),
+                    T_S_O.inverse(), 1.5 * ctx.db.parameters.voxel_m)
+          .size();
   return static_cast<double>(on) >= share * static_cast<double>(cloud.size());
 }
 
@@ -452,8 +467,8 @@ bool ExplainsPart(const PointCloud& remaining, const std::vector<std::size_t>& p
 // (scoring under `weak_score`: a split that gave most of a flange to a tee, which fit it with a
 // sixth of its model in the seabed, and the rest to the flange). Pairs of recognised segments are
 // taken once (a < b).
-bool WorthJoining(const RecognizedObject& a, const RecognizedObject& b, std::size_t ia, std::size_t ib,
-                  double weak_score) {
+bool WorthJoining(const RecognizedObject& a, const RecognizedObject& b, std::size_t ia,
+                  std::size_t ib, double weak_score) {
   if (a.object_id == "unknown") return b.object_id != "unknown";
   if (b.object_id == "unknown" || ib < ia) return false;
   return b.object_id == a.object_id || a.score < weak_score || b.score < weak_score;
@@ -461,13 +476,16 @@ bool WorthJoining(const RecognizedObject& a, const RecognizedObject& b, std::siz
 
 // Segment `k` joined with the nearest other WorthJoining it (see JoinSegmentsOneObjectExplains):
 // the entry that holds the union (the pair's first; the second is dropped), or none.
-std::optional<std::size_t> JoinNearest(const PointCloud& remaining, double largest_object_m, const ScanContext& ctx,
-                                       std::size_t k, std::vector<bool>& dropped, std::vector<RecognizedObject>& objects,
+std::optional<std::size_t> JoinNearest(const PointCloud& remaining, double largest_object_m,
+                                       const ScanContext& ctx, std::size_t k,
+                                       std::vector<bool>& dropped,
+                                       std::vector<RecognizedObject>& objects,
                                        std::vector<std::vector<std::size_t>>& points) {
   if (dropped[k] || points[k].empty()) return std::nullopt;
   std::vector<Segment> others(objects.size());
   for (std::size_t j = 0; j < objects.size(); ++j) {
-    if (j != k && !dropped[j] && WorthJoining(objects[k], objects[j], k, j, ctx.options.weak_score)) {
+    if (j != k && !dropped[j] &&
+        WorthJoining(objects[k], objects[j], k, j, ctx.options.weak_score)) {
       others[j].indices = points[j];
     }
   }
@@ -478,7 +496,8 @@ std::optional<std::size_t> JoinNearest(const PointCloud& remaining, double large
   std::sort(both.begin(), both.end());
   const double diameter = Diameter(Subset(remaining, both));
   if (diameter > largest_object_m) return std::nullopt;
-  SegmentOutcome joined = RecognizeSegment({both, diameter, ctx.options.max_objects_per_segment - 1}, remaining, ctx);
+  SegmentOutcome joined =
+      RecognizeSegment({both, diameter, ctx.options.max_objects_per_segment - 1}, remaining, ctx);
   if (joined.object.object_id == "unknown") return std::nullopt;
   const double apart = (objects[k].score * static_cast<double>(points[k].size()) +
                         objects[to].score * static_cast<double>(points[to].size())) /
@@ -506,17 +525,19 @@ std::optional<std::size_t> JoinNearest(const PointCloud& remaining, double large
 // (an unknown one's counting 0): a wheel valve whose handwheel was cut off then comes out whole
 // and posed where its body alone fitted the lever valve as well. `objects` and `points` (indices
 // into `remaining`) stay in order, the pair's second entry dropped.
-void JoinSegmentsOneObjectExplains(const PointCloud& remaining, double largest_object_m, const ScanContext& ctx,
-                                   std::vector<RecognizedObject>& objects,
+void JoinSegmentsOneObjectExplains(const PointCloud& remaining, double largest_object_m,
+                                   const ScanContext& ctx, std::vector<RecognizedObject>& objects,
                                    std::vector<std::vector<std::size_t>>& points) {
   // The stages of the segments recognised here are timed as one, "join".
   std::map<std::string, double> untimed;
   StageClock clock(untimed);
-  const ScanContext join_ctx{ctx.db, ctx.options, ctx.cache, ctx.down, ctx.down_index, ctx.planes, clock};
+  const ScanContext join_ctx{ctx.db,         ctx.options, ctx.cache, ctx.down,
+                             ctx.down_index, ctx.planes,  clock};
   std::vector<bool> dropped(objects.size(), false);
   std::size_t k = 0;
   while (k < objects.size()) {
-    const std::optional<std::size_t> into = JoinNearest(remaining, largest_object_m, join_ctx, k, dropped, objects, points);
+    const std::optional<std::size_t> into =
+        JoinNearest(remaining, largest_object_m, join_ctx, k, dropped, objects, points);
     if (into != k) ++k;  // else the grown segment may join another
   }
   std::size_t kept = 0;
@@ -545,11 +566,12 @@ void RecognitionOptions::Check() const {
     throw Error("recognition: attach_distance_m must be >= 0");
   }
   if (min_segment_points < 10) throw Error("recognition: min_segment_points must be >= 10");
-  if (max_candidates < 1) throw Error("recognition: max_candidates must be >= 1, got " + std::to_string(max_candidates));
+  if (max_candidates < 1)
+    throw Error("recognition: max_candidates must be >= 1, got " + std::to_string(max_candidates));
   auto in_range = [](const char* field, int value, int lo, int hi) {
     if (value < lo || value > hi) {
-      throw Error(std::string("recognition: ") + field + " must be in [" + std::to_string(lo) + ", " +
-                  std::to_string(hi) + "], got " + std::to_string(value));
+      throw Error(std::string("recognition: ") + field + " must be in [" + std::to_string(lo) +
+                  ", " + std::to_string(hi) + "], got " + std::to_string(value));
     }
   };
   in_range("pose_views", pose_views, 0, 64);
@@ -564,8 +586,10 @@ void RecognitionOptions::Check() const {
       !(min_close >= 0.0 && min_close <= 1.0)) {
     throw Error("recognition: min_fitness, min_close and max_missing must be in [0, 1]");
   }
-  if (!(min_part_share >= 0.0 && min_part_share <= 1.0)) throw Error("recognition: min_part_share must be in [0, 1]");
-  if (!(weak_score >= 0.0 && weak_score <= 1.0)) throw Error("recognition: weak_score must be in [0, 1]");
+  if (!(min_part_share >= 0.0 && min_part_share <= 1.0))
+    throw Error("recognition: min_part_share must be in [0, 1]");
+  if (!(weak_score >= 0.0 && weak_score <= 1.0))
+    throw Error("recognition: weak_score must be in [0, 1]");
   if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
   if (split_candidates < 1) throw Error("recognition: split_candidates must be >= 1");
   if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
@@ -589,10 +613,11 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   return RecognizeObjects(scan, db, cache, options);
 }
 
-RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, RecognitionCache& cache,
-                                   const RecognitionOptions& options) {
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
+                                   RecognitionCache& cache, const RecognitionOptions& options) {
   options.Check();
-  if (&cache.db() != &db) throw Error("recognition: the RecognitionCache was made for another object database");
+  if (&cache.db() != &db)
+    throw Error("recognition: the RecognitionCache was made for another object database");
   RequireValidCloud(scan, "scan", 1);
   if (db.objects.empty()) throw Error("recognition: the object database is empty");
   const ObjectDatabaseParameters& p = db.parameters;
@@ -606,7 +631,8 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
   clock.Lap("preprocess");
 
   std::deque<PendingSegment> pending;
-  for (Segment& s : Segments(removed.remaining, largest_object_m, options)) pending.push_back({std::move(s.indices), s.core_diameter_m, 0});
+  for (Segment& s : Segments(removed.remaining, largest_object_m, options))
+    pending.push_back({std::move(s.indices), s.core_diameter_m, 0});
   clock.Lap("segment");
 
   const KnnIndex down_index(down.points);
@@ -619,13 +645,15 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
     object_points.push_back(std::move(outcome.kept));
     result.objects.push_back(std::move(outcome.object));
   }
-  JoinSegmentsOneObjectExplains(removed.remaining, largest_object_m, ctx, result.objects, object_points);
+  JoinSegmentsOneObjectExplains(removed.remaining, largest_object_m, ctx, result.objects,
+                                object_points);
   clock.Lap("join");
 
   // Every scan point goes to the object of the voxel point nearest to it.
   std::vector<int> object_of_down(down.size(), -1);
   for (std::size_t k = 0; k < object_points.size(); ++k) {
-    for (std::size_t i : object_points[k]) object_of_down[removed.remaining_indices[i]] = static_cast<int>(k);
+    for (std::size_t i : object_points[k])
+      object_of_down[removed.remaining_indices[i]] = static_cast<int>(k);
   }
   if (!object_points.empty()) {
     std::vector<std::uint32_t> nearest;

@@ -14,7 +14,7 @@
 namespace uwscan::perception {
 
 struct RecognitionOptions {
-  double plane_distance_m = 0.01;      // seabed / wall inliers, metres
+  double plane_distance_m = 0.01;  // seabed / wall inliers, metres
   // A plane is removed while it holds this share of the scan: the dominant one (the seabed),
   // then up to two more wider both ways than any object of the database (walls), never an
   // object's own flat face.
@@ -115,7 +115,7 @@ struct RecognitionOptions {
   // scans, seed 2); with 0.1 mm, 0.89 (0.97 on those, which were not used to choose it).
   double pose_floor_std_m = 0.0001;
   std::uint64_t seed = 1;
-  int threads = 0;  // OpenMP threads, 0 = OpenMP's default; the answer does not depend on it
+  int threads = 0;     // OpenMP threads, 0 = OpenMP's default; the answer does not depend on it
   void Check() const;  // throws uwscan::Error naming the field
 };
 
@@ -128,9 +128,11 @@ struct RecognitionCandidate {
   double close = 0.0;       // share of the segment within close_distance_m of its surface
   double missing = 1.0;     // share of the surface it should have seen that the sensor saw through
   double buried = 0.0;      // share of the model beyond a support plane (SupportContact)
-  double clearance_m = std::numeric_limits<double>::infinity();  // over the support planes (SupportContact)
-  double rmse_m = 0.0;      // point-to-plane RMS of the final ICP
-  double score = 0.0;       // close x (1 - missing) x (1 - buried); the best verified one wins (score_tie)
+  double clearance_m =
+      std::numeric_limits<double>::infinity();  // over the support planes (SupportContact)
+  double rmse_m = 0.0;                          // point-to-plane RMS of the final ICP
+  double score =
+      0.0;  // close x (1 - missing) x (1 - buried); the best verified one wins (score_tie)
   bool verified = false;
   Eigen::Isometry3d T_S_O = Eigen::Isometry3d::Identity();
 };
@@ -167,7 +169,7 @@ struct RecognizedObject {
 struct RecognitionResult {
   // One per segment, largest segment first, then the parts split off segments in that order.
   std::vector<RecognizedObject> objects;
-  std::size_t plane_points = 0;           // removed as planes
+  std::size_t plane_points = 0;  // removed as planes
   // preprocess, segment, describe, match, then the pose: coarse (starts), sift, refine, final,
   // free (the accepted pose along the directions its fit leaves free);
   // equivalents (other poses that fit as well); split (a segment no object explains searched
@@ -176,16 +178,16 @@ struct RecognitionResult {
   std::map<std::string, double> stage_seconds;
 };
 
-// Plane removal (RemoveSupportPlanes), Euclidean segments, ESF against every view by chi-square, then for the best
-// few objects a pose: starts from FPFH + RANSAC (correspondences restricted to the model
-// surface the matched view saw) and from the nearest views rolled about the line of sight,
-// sifted by a short ICP, the best refined by point-to-plane ICP of the segment onto the whole
-// model and verified by fit and by model surface that should have been seen. A segment no
+// Plane removal (RemoveSupportPlanes), Euclidean segments, ESF against every view by chi-square,
+// then for the best few objects a pose: starts from FPFH + RANSAC (correspondences restricted to
+// the model surface the matched view saw) and from the nearest views rolled about the line of
+// sight, sifted by a short ICP, the best refined by point-to-plane ICP of the segment onto the
+// whole model and verified by fit and by model surface that should have been seen. A segment no
 // object explains is searched for the object explaining the largest part of it (each of its
 // halves recognised as a segment for pose candidates), which is taken out, and the rest is
 // recognised again; so is what a recognised object leaves unexplained. The scan is in the
-// sensor's frame (the sensor at its origin), metres. Deterministic for any thread count. Throws uwscan::Error on an
-// invalid scan (NaN) or options.
+// sensor's frame (the sensor at its origin), metres. Deterministic for any thread count. Throws
+// uwscan::Error on an invalid scan (NaN) or options.
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
                                    const RecognitionOptions& options = {});
 
@@ -193,7 +195,7 @@ RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase&
 // structures) in `cache` for the next scans: the answer is the same, only faster. Throws
 // uwscan::Error when `cache` was made for another database.
 class RecognitionCache;
-RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db, RecognitionCache& cache,
-                                   const RecognitionOptions& options = {});
+RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,
+                                   RecognitionCache& cache, const RecognitionOptions& options = {});
 
 }  // namespace uwscan::perception

@@ -50,10 +50,10 @@ std::vector<Eigen::Isometry3d> SymmetryTransforms(std::span<const SymmetryAxis> 
   std::vector<Eigen::Isometry3d> transforms = {Eigen::Isometry3d::Identity()};
   for (const SymmetryAxis& axis : axes) {
     if (axis.order == 1 || axis.order < 0) throw Error("symmetries: an order must be 0 or >= 2");
-    const int steps = axis.continuous()
-                          ? std::max(2, static_cast<int>(std::ceil(2.0 * std::numbers::pi /
-                                                                   continuous_step_rad)))
-                          : axis.order;
+    const int steps =
+        axis.continuous()
+            ? std::max(2, static_cast<int>(std::ceil(2.0 * std::numbers::pi / continuous_step_rad)))
+            : axis.order;
     std::vector<Eigen::Isometry3d> product;
     for (const Eigen::Isometry3d& T : transforms) {
       for (int k = 0; k < steps; ++k) {
@@ -78,7 +78,8 @@ std::vector<SymmetryAxis> DetectSymmetries(const scanner::TriangleMesh& mesh,
                                            const SymmetryDetectionOptions& options) {
   options.Check();
   if (mesh.triangles.empty()) throw Error("symmetry detection: the mesh has no triangles");
-  const scanner::SurfaceSamples surface = scanner::SampleSurface(mesh, options.samples, options.seed);
+  const scanner::SurfaceSamples surface =
+      scanner::SampleSurface(mesh, options.samples, options.seed);
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& p : surface.points) centroid += p;
   centroid /= static_cast<double>(surface.points.size());
@@ -94,8 +95,7 @@ std::vector<SymmetryAxis> DetectSymmetries(const scanner::TriangleMesh& mesh,
   for (std::size_t i = 0; i < relative.size(); i += stride) test_points.push_back(relative[i]);
 
   const double spacing = std::sqrt(SurfaceArea(mesh) / options.samples);
-  const double tolerance =
-      2.0 * spacing + options.tolerance_fraction * mesh.BoundingBoxDiagonal();
+  const double tolerance = 2.0 * spacing + options.tolerance_fraction * mesh.BoundingBoxDiagonal();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal(scatter);
   std::vector<SymmetryAxis> found;
   for (int a = 2; a >= 0; --a) {

@@ -25,9 +25,9 @@ std::vector<Eigen::Isometry3d> SymmetryTransforms(std::span<const SymmetryAxis> 
                                                   double continuous_step_rad = 0.0872664626);
 
 struct SymmetryDetectionOptions {
-  int samples = 60000;          // surface samples of the mesh, >= 1000
-  int test_points = 3000;       // samples moved and compared per tested rotation, >= 100
-  int max_order = 12;           // largest N-fold symmetry looked for, >= 2
+  int samples = 60000;                // surface samples of the mesh, >= 1000
+  int test_points = 3000;             // samples moved and compared per tested rotation, >= 100
+  int max_order = 12;                 // largest N-fold symmetry looked for, >= 2
   double tolerance_fraction = 0.005;  // of the diameter, added to twice the sample spacing
   std::uint64_t seed = 1;
   void Check() const;  // throws uwscan::Error naming the field
@@ -43,10 +43,11 @@ std::vector<SymmetryAxis> DetectSymmetries(const scanner::TriangleMesh& mesh,
 // An estimated object pose against the truth, modulo the object's symmetries (DESIGN.md's
 // evaluation conventions): the symmetric equivalent of the truth nearest the estimate by MSSD.
 struct SymmetricPoseError {
-  double mssd_m = 0.0;        // max over model points of |T_est x - T_true S x|, min over S
-  double rotation_rad = 0.0;  // angle of (T_true S)^-1 T_est for that S
-  double translation_m = 0.0; // |t_est - t_(T_true S)|
-  Eigen::Isometry3d T_symmetric = Eigen::Isometry3d::Identity();  // T_true S, the truth measured against
+  double mssd_m = 0.0;         // max over model points of |T_est x - T_true S x|, min over S
+  double rotation_rad = 0.0;   // angle of (T_true S)^-1 T_est for that S
+  double translation_m = 0.0;  // |t_est - t_(T_true S)|
+  Eigen::Isometry3d T_symmetric =
+      Eigen::Isometry3d::Identity();  // T_true S, the truth measured against
 };
 // `symmetries` as SymmetryTransforms gives them (at least the identity); model points in {O}.
 // Throws uwscan::Error when either is empty.

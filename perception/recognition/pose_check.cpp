@@ -20,7 +20,8 @@ namespace {
 
 // The voxelised scan's points off every support plane that are nearest to a point of `segment`:
 // the segment as recognition's own segmentation would hand it over.
-std::vector<std::size_t> SegmentInVoxels(const PointCloud& scan, const std::vector<std::size_t>& segment,
+std::vector<std::size_t> SegmentInVoxels(const PointCloud& scan,
+                                         const std::vector<std::size_t>& segment,
                                          const PointCloud& down, const KnnIndex& down_index,
                                          const std::vector<DetectedPlane>& planes) {
   std::vector<bool> on_plane(down.size(), false);
@@ -57,23 +58,30 @@ double FitnessAt(const PointCloud& segment, const ObjectModel& model, const Near
 
 }  // namespace
 
-RecognitionCandidate CheckObjectPose(const PointCloud& scan, const std::vector<std::size_t>& segment,
+RecognitionCandidate CheckObjectPose(const PointCloud& scan,
+                                     const std::vector<std::size_t>& segment,
                                      const ObjectDatabase& db, RecognitionCache& cache,
                                      const std::string& object_id, const Eigen::Isometry3d& T_S_O,
                                      const RecognitionOptions& options) {
   options.Check();
-  if (&cache.db() != &db) throw Error("pose check: the RecognitionCache was made for another object database");
+  if (&cache.db() != &db)
+    throw Error("pose check: the RecognitionCache was made for another object database");
   RequireValidCloud(scan, "scan", 1);
   const auto found = std::find_if(db.objects.begin(), db.objects.end(),
                                   [&](const ObjectModel& o) { return o.id == object_id; });
-  if (found == db.objects.end()) throw Error("pose check: object '" + object_id + "' is not in the database");
+  if (found == db.objects.end())
+    throw Error("pose check: object '" + object_id + "' is not in the database");
   if (segment.empty()) throw Error("pose check: the segment is empty");
   for (std::size_t i : segment) {
-    if (i >= scan.size()) throw Error("pose check: a segment index is past the scan's " + std::to_string(scan.size()) + " points");
+    if (i >= scan.size())
+      throw Error("pose check: a segment index is past the scan's " + std::to_string(scan.size()) +
+                  " points");
   }
   const Eigen::Matrix3d R = T_S_O.linear();
-  if (!T_S_O.matrix().allFinite() || !(R.transpose() * R).isIdentity(1e-9) || !(R.determinant() > 0.0)) {
-    throw Error("pose check: T_S_O must be finite, a rotation (orthonormal, det +1) and a translation");
+  if (!T_S_O.matrix().allFinite() || !(R.transpose() * R).isIdentity(1e-9) ||
+      !(R.determinant() > 0.0)) {
+    throw Error(
+        "pose check: T_S_O must be finite, a rotation (orthonormal, det +1) and a translation");
   }
   const std::size_t object = static_cast<std::size_t>(found - db.objects.begin());
 
@@ -87,7 +95,8 @@ RecognitionCandidate CheckObjectPose(const PointCloud& scan, const std::vector<s
   RecognitionCandidate unverified;
   unverified.object_id = object_id;
   unverified.T_S_O = T_S_O;
-  const std::vector<std::size_t> voxels = SegmentInVoxels(scan, segment, down, down_index, removed.planes);
+  const std::vector<std::size_t> voxels =
+      SegmentInVoxels(scan, segment, down, down_index, removed.planes);
   if (voxels.size() < 10) return unverified;  // all on a support plane: nothing left to fit
   const PointCloud part = Subset(down, voxels);
   const SceneAround around = recognition::SceneAroundOf(part, ctx);
@@ -101,7 +110,8 @@ RecognitionCandidate CheckObjectPose(const PointCloud& scan, const std::vector<s
   const ObjectModel& model = db.objects[object];
   const ModelIndexes& indexes = cache.Model(object);
   const IcpOptions fine = FineIcp(model.diameter_m, db.parameters, options.threads);
-  const PointCloud sample = recognition::Strided(described.cloud, static_cast<std::size_t>(options.refine_points));
+  const PointCloud sample =
+      recognition::Strided(described.cloud, static_cast<std::size_t>(options.refine_points));
   RegistrationResult refined = AlignIcp(sample, indexes.target, T_S_O.inverse(), fine);
   refined = AlignIcp(described.cloud, indexes.target, refined.T_target_source,
                      FineIcpLastStage(model.diameter_m, db.parameters, options.threads));

@@ -24,7 +24,8 @@ class RecognitionCache;
 // `segment`: indices into `scan` (RecognizedObject::segment). `object_id` must be in `db`.
 // Throws uwscan::Error on an invalid scan or options, an unknown object, an empty segment, an
 // index out of range or a pose that is not rigid.
-RecognitionCandidate CheckObjectPose(const PointCloud& scan, const std::vector<std::size_t>& segment,
+RecognitionCandidate CheckObjectPose(const PointCloud& scan,
+                                     const std::vector<std::size_t>& segment,
                                      const ObjectDatabase& db, RecognitionCache& cache,
                                      const std::string& object_id, const Eigen::Isometry3d& T_S_O,
                                      const RecognitionOptions& options = {});

@@ -24,7 +24,8 @@ struct FlangeScan {
 };
 const FlangeScan& Flange() {
   static const FlangeScan flange = [] {
-    FlangeScan f{ScanOnSeabed(CatalogueObject("flange").mesh, Eigen::Vector3d(0.4, -0.3, 0.7), 3), {}};
+    FlangeScan f{ScanOnSeabed(CatalogueObject("flange").mesh, Eigen::Vector3d(0.4, -0.3, 0.7), 3),
+                 {}};
     const RecognitionResult r = RecognizeObjects(f.scan.cloud, PipeFlangeValveDb());
     const RecognizedObject* nearest = Nearest(r, f.scan);
     if (nearest != nullptr) f.segment = nearest->segment;
@@ -41,19 +42,25 @@ TEST(PoseCheck, TheTruePoseVerifiesAndOthersScoreBelowIt) {
   ASSERT_GT(f.segment.size(), 1000u);
   const ObjectDatabase& db = PipeFlangeValveDb();
   RecognitionCache cache(db);
-  const RecognitionCandidate truth = CheckObjectPose(f.scan.cloud, f.segment, db, cache, "flange", f.scan.T_S_O);
+  const RecognitionCandidate truth =
+      CheckObjectPose(f.scan.cloud, f.segment, db, cache, "flange", f.scan.T_S_O);
   EXPECT_EQ(truth.object_id, "flange");
   EXPECT_TRUE(truth.verified);
   EXPECT_GT(truth.score, 0.9);
   // Refined from the truth, it stays there (to the data's scale).
   EXPECT_LT((truth.T_S_O.translation() - f.scan.T_S_O.translation()).norm(), 0.003);
-  EXPECT_LT(Eigen::AngleAxisd(truth.T_S_O.linear().transpose() * f.scan.T_S_O.linear()).angle(), 0.02);
+  EXPECT_LT(Eigen::AngleAxisd(truth.T_S_O.linear().transpose() * f.scan.T_S_O.linear()).angle(),
+            0.02);
 
-  const RecognitionCandidate pipe = CheckObjectPose(f.scan.cloud, f.segment, db, cache, "pipe", f.scan.T_S_O);
-  EXPECT_LT(pipe.score, truth.score - 0.05) << "fitness " << pipe.fitness << ", close " << pipe.close;
+  const RecognitionCandidate pipe =
+      CheckObjectPose(f.scan.cloud, f.segment, db, cache, "pipe", f.scan.T_S_O);
+  EXPECT_LT(pipe.score, truth.score - 0.05)
+      << "fitness " << pipe.fitness << ", close " << pipe.close;
 
-  const Eigen::Isometry3d turned = f.scan.T_S_O * Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitX());
-  const RecognitionCandidate off = CheckObjectPose(f.scan.cloud, f.segment, db, cache, "flange", turned);
+  const Eigen::Isometry3d turned =
+      f.scan.T_S_O * Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitX());
+  const RecognitionCandidate off =
+      CheckObjectPose(f.scan.cloud, f.segment, db, cache, "flange", turned);
   EXPECT_FALSE(off.verified && off.score > truth.score - 0.05) << "score " << off.score;
 }
 
@@ -75,10 +82,12 @@ TEST(PoseCheck, BadRequestsAreRefusedNamingWhatIsWrong) {
   EXPECT_NE(message({f.scan.cloud.size()}, "flange").find("past the scan"), std::string::npos);
   Eigen::Isometry3d scaled = f.scan.T_S_O;
   scaled.linear() *= 1.1;
-  EXPECT_NE(message(f.segment, "flange", scaled).find("must be finite, a rotation"), std::string::npos);
+  EXPECT_NE(message(f.segment, "flange", scaled).find("must be finite, a rotation"),
+            std::string::npos);
   Eigen::Isometry3d nan = f.scan.T_S_O;
   nan.translation().x() = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_NE(message(f.segment, "flange", nan).find("must be finite, a rotation"), std::string::npos);
+  EXPECT_NE(message(f.segment, "flange", nan).find("must be finite, a rotation"),
+            std::string::npos);
 }
 
 }  // namespace

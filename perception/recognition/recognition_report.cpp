@@ -13,7 +13,7 @@ using json_fields::Numbers;
 using json_fields::Require;
 using nlohmann::json;
 
-constexpr double kRigidTolerance = 1e-6;         // |R^T R - I|, det(R) - 1
+constexpr double kRigidTolerance = 1e-6;  // |R^T R - I|, det(R) - 1
 
 Eigen::Isometry3d RigidPose(const json& value, const Field& field) {
   if (!value.is_object()) field.Fail("expected an object with a 4x4 \"matrix\"");
@@ -21,12 +21,14 @@ Eigen::Isometry3d RigidPose(const json& value, const Field& field) {
   if (!rows.is_array() || rows.size() != 4) field["matrix"].Fail("expected 4 rows of 4 numbers");
   Eigen::Matrix4d m;
   for (int r = 0; r < 4; ++r) {
-    const std::vector<double> row = Numbers(rows[std::size_t(r)], 4, field["matrix"][std::size_t(r)]);
+    const std::vector<double> row =
+        Numbers(rows[std::size_t(r)], 4, field["matrix"][std::size_t(r)]);
     for (int c = 0; c < 4; ++c) m(r, c) = row[std::size_t(c)];
   }
   const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
   if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > kRigidTolerance ||
-      std::abs(R.determinant() - 1.0) > kRigidTolerance || m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
+      std::abs(R.determinant() - 1.0) > kRigidTolerance ||
+      m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
     field["matrix"].Fail("not a rigid motion");
   }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -54,7 +56,8 @@ ReportedObject Object(const json& value, std::size_t scan_points, const Field& f
   if (!value.is_object()) field.Fail("expected an object");
   ReportedObject o;
   o.id = Text(value, "id", field);
-  const std::vector<double> c = Numbers(Require(value, "centroid_m", field), 3, field["centroid_m"]);
+  const std::vector<double> c =
+      Numbers(Require(value, "centroid_m", field), 3, field["centroid_m"]);
   o.centroid_S = Eigen::Vector3d(c[0], c[1], c[2]);
   const json& segment = Require(value, "segment", field);
   if (!segment.is_array()) field["segment"].Fail("expected an array of point indices");
@@ -70,11 +73,13 @@ ReportedObject Object(const json& value, std::size_t scan_points, const Field& f
   if (!score.is_number()) field["score"].Fail("not a number");
   o.score = score.get<double>();
   o.T_S_O = RigidPose(Require(value, "T_S_O", field), field["T_S_O"]);
-  if (value.contains("covariance")) o.covariance = Covariance(value["covariance"], field["covariance"]);
+  if (value.contains("covariance"))
+    o.covariance = Covariance(value["covariance"], field["covariance"]);
   const json& grasps = Require(value, "grasps", field);
   if (!grasps.is_array()) field["grasps"].Fail("expected an array");
   for (std::size_t i = 0; i < grasps.size(); ++i) {
-    o.grasps_S.emplace_back(Text(grasps[i], "name", field["grasps"][i]), RigidPose(grasps[i], field["grasps"][i]));
+    o.grasps_S.emplace_back(Text(grasps[i], "name", field["grasps"][i]),
+                            RigidPose(grasps[i], field["grasps"][i]));
   }
   return o;
 }

@@ -20,7 +20,7 @@ struct ReportedObject {
   // report has none.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   std::vector<std::pair<std::string, Eigen::Isometry3d>> grasps_S;  // name, T_S_G
-  std::vector<std::size_t> segment;                                  // indices into the scan
+  std::vector<std::size_t> segment;                                 // indices into the scan
   Eigen::Vector3d centroid_S = Eigen::Vector3d::Zero();
   bool recognised() const { return id != "unknown"; }
 };

@@ -31,8 +31,8 @@ namespace sim = scanner::sim;
 // A folder of this test process's own for the files the tests write (two test programs, or the
 // same one built twice, may run at once), removed when the process ends.
 struct OwnTestDir {
-  std::filesystem::path path =
-      std::filesystem::temp_directory_path() / ("uwscan_recognition_test_" + std::to_string(::getpid()));
+  std::filesystem::path path = std::filesystem::temp_directory_path() /
+                               ("uwscan_recognition_test_" + std::to_string(::getpid()));
   OwnTestDir() { std::filesystem::create_directories(path); }
   ~OwnTestDir() {
     std::error_code ignored;
@@ -86,7 +86,8 @@ inline const ObjectDatabase& PipeFlangeValveDb() {
     const std::optional<std::filesystem::path> cache = ::uwscan::test::TestCacheFolder();
     const std::filesystem::path file =
         cache ? *cache / "pipe_flange_valve.db"
-              : std::filesystem::temp_directory_path() / ("uwscan_pipe_flange_valve_" + std::to_string(getpid()) + ".db");
+              : std::filesystem::temp_directory_path() /
+                    ("uwscan_pipe_flange_valve_" + std::to_string(getpid()) + ".db");
     std::filesystem::create_directories(file.parent_path());
     {
       // Tests running side by side wait for the one building it instead of building it too.
@@ -118,7 +119,8 @@ inline std::vector<sim::SceneObject> OnSeabed(const scanner::TriangleMesh& mesh)
   Eigen::Isometry3d T_W_O = Eigen::Isometry3d::Identity();
   T_W_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
   double lowest = 1e9;
-  for (const Eigen::Vector3d& v : mesh.vertices) lowest = std::min(lowest, (T_W_O.linear() * v).z());
+  for (const Eigen::Vector3d& v : mesh.vertices)
+    lowest = std::min(lowest, (T_W_O.linear() * v).z());
   T_W_O.translation() = Eigen::Vector3d(0.0, 0.0, -lowest);
   return {seabed, Placed(mesh, T_W_O)};
 }
@@ -128,11 +130,11 @@ struct Scan {
   PointCloud cloud;
   Eigen::Isometry3d T_S_O;
 };
-inline Scan ScanOnSeabed(const scanner::TriangleMesh& mesh, const Eigen::Vector3d& eye, std::uint64_t seed) {
+inline Scan ScanOnSeabed(const scanner::TriangleMesh& mesh, const Eigen::Vector3d& eye,
+                         std::uint64_t seed) {
   const std::vector<sim::SceneObject> scene = OnSeabed(mesh);
   const Eigen::Isometry3d T_W_O = scene[1].T_W_O;
-  const Eigen::Isometry3d T_W_C =
-      sim::LookAt(eye, T_W_O.translation(), Eigen::Vector3d::UnitZ());
+  const Eigen::Isometry3d T_W_C = sim::LookAt(eye, T_W_O.translation(), Eigen::Vector3d::UnitZ());
   const sim::VirtualScan scan = Scanner().Scan(scene, T_W_C, seed);
   return {MakeCloud(scan.points_C), T_W_C.inverse() * T_W_O};
 }

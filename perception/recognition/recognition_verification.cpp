@@ -11,12 +11,12 @@
 
 namespace uwscan::perception {
 
-SceneAround::SceneAround(const PointCloud& points_in, const KnnIndex& index_in, const Eigen::Vector3d& forward,
-                         double bin_rad_in)
+SceneAround::SceneAround(const PointCloud& points_in, const KnnIndex& index_in,
+                         const Eigen::Vector3d& forward, double bin_rad_in)
     : points(points_in), index(index_in), angles(forward), bin_rad(bin_rad_in) {}
 
-SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
-                               double radius_m, double margin_m) {
+SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index,
+                               const PointCloud& segment, double radius_m, double margin_m) {
   if (segment.empty()) throw Error("verification: the segment is empty");
   const Eigen::Vector3d centroid = Centroid(segment);
   if (!centroid.allFinite()) throw Error("verification: the segment has a non-finite point");
@@ -58,13 +58,15 @@ SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& ind
   around.bin_points.resize(around.bin_start[bins]);
   std::vector<std::uint32_t> filled(around.bin_start.begin(), around.bin_start.end() - 1);
   for (std::size_t i = 0; i < whole_scan.size(); ++i) {
-    if (bin_of[i] >= 0) around.bin_points[filled[static_cast<std::size_t>(bin_of[i])]++] = static_cast<std::uint32_t>(i);
+    if (bin_of[i] >= 0)
+      around.bin_points[filled[static_cast<std::size_t>(bin_of[i])]++] =
+          static_cast<std::uint32_t>(i);
   }
   return around;
 }
 
-bool SceneAround::SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& normal, double lateral_m,
-                              double beyond_m) const {
+bool SceneAround::SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& normal,
+                              double lateral_m, double beyond_m) const {
   const long bin = BinOf(angles(x));
   if (bin < 0) return false;
   const long u0 = bin % columns, v0 = bin / columns;
@@ -87,9 +89,10 @@ bool SceneAround::SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& n
   return false;
 }
 
-SurfaceEvidence ExpectedSurface(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
-                                double radius_m) {
-  std::vector<double> model_depth(scene.nearest_depth.size(), std::numeric_limits<double>::infinity());
+SurfaceEvidence ExpectedSurface(const ObjectModel& o, const Eigen::Isometry3d& T_S_O,
+                                const SceneAround& scene, double radius_m) {
+  std::vector<double> model_depth(scene.nearest_depth.size(),
+                                  std::numeric_limits<double>::infinity());
   struct Facing {
     Eigen::Vector3d x, normal;
     std::size_t bin;
@@ -114,8 +117,8 @@ SurfaceEvidence ExpectedSurface(const ObjectModel& o, const Eigen::Isometry3d& T
   std::size_t& missing = evidence.missing;
   for (const auto& [x, normal, bin] : facing) {
     const double depth = x.norm();
-    if (depth > model_depth[bin] + radius_m) continue;               // hidden by the object itself
-    if (scene.nearest_depth[bin] < depth - radius_m) continue;       // behind something the scan saw
+    if (depth > model_depth[bin] + radius_m) continue;          // hidden by the object itself
+    if (scene.nearest_depth[bin] < depth - radius_m) continue;  // behind something the scan saw
     scene.index.Query((x - scene.points.origin).cast<float>(), 1, nearest, squared);
     if (!nearest.empty() && squared[0] <= radius_m * radius_m) {
       ++expected;  // seen
@@ -135,12 +138,15 @@ double MissingShare(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const 
   return e.expected == 0 ? 1.0 : static_cast<double>(e.missing) / static_cast<double>(e.expected);
 }
 
-std::vector<SupportPlane> SupportPlanesAround(const PointCloud& scan, const std::vector<DetectedPlane>& planes,
-                                              const Eigen::Vector3d& centre, double radius_m, std::size_t min_points) {
+std::vector<SupportPlane> SupportPlanesAround(const PointCloud& scan,
+                                              const std::vector<DetectedPlane>& planes,
+                                              const Eigen::Vector3d& centre, double radius_m,
+                                              std::size_t min_points) {
   std::vector<SupportPlane> around;
   for (const DetectedPlane& plane : planes) {
     std::size_t near = 0;
-    for (std::size_t i : plane.inliers) near += (scan.Point(i) - centre).squaredNorm() <= radius_m * radius_m ? 1 : 0;
+    for (std::size_t i : plane.inliers)
+      near += (scan.Point(i) - centre).squaredNorm() <= radius_m * radius_m ? 1 : 0;
     if (near < min_points) continue;
     // The sensor, at the origin, is at signed distance offset_m: make it positive.
     const double side = plane.offset_m >= 0.0 ? 1.0 : -1.0;
@@ -165,8 +171,8 @@ SupportContact SupportContactOf(const ObjectModel& o, const Eigen::Isometry3d& T
   return contact;
 }
 
-double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const PointCloud& segment_O,
-                  double distance_m, double reach_m) {
+double CloseShare(const PointCloud& model, const NearestGrid& model_grid,
+                  const PointCloud& segment_O, double distance_m, double reach_m) {
   const float reach_sq = static_cast<float>(reach_m * reach_m);
   std::size_t close = 0;
   for (std::size_t i = 0; i < segment_O.size(); ++i) {
@@ -177,7 +183,8 @@ double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const 
     const Eigen::Vector3d n = model.normals[nearest].cast<double>().normalized();
     close += std::abs(n.dot(x - model.Point(nearest))) <= distance_m ? 1 : 0;
   }
-  return segment_O.empty() ? 0.0 : static_cast<double>(close) / static_cast<double>(segment_O.size());
+  return segment_O.empty() ? 0.0
+                           : static_cast<double>(close) / static_cast<double>(segment_O.size());
 }
 
 }  // namespace uwscan::perception

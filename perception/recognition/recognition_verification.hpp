@@ -46,7 +46,8 @@ struct SupportPlane {
 // at the segment covering that window, the scan points in each bin and the nearest depth of
 // any of them.
 struct SceneAround {
-  SceneAround(const PointCloud& points, const KnnIndex& index, const Eigen::Vector3d& forward, double bin_rad);
+  SceneAround(const PointCloud& points, const KnnIndex& index, const Eigen::Vector3d& forward,
+              double bin_rad);
 
   const PointCloud& points;
   const KnnIndex& index;
@@ -54,9 +55,9 @@ struct SceneAround {
   double bin_rad = 0.0;
   Eigen::Vector2d lo, hi;  // the window: the segment's directions, widened by the margin and a bin
   long columns = 0, rows = 0;
-  std::vector<double> nearest_depth;       // per bin, infinity where the scan has no point
-  std::vector<std::uint32_t> bin_start;    // bin b's scan points are bin_points[bin_start[b] ..
-  std::vector<std::uint32_t> bin_points;   // bin_start[b + 1]), indices into points
+  std::vector<double> nearest_depth;         // per bin, infinity where the scan has no point
+  std::vector<std::uint32_t> bin_start;      // bin b's scan points are bin_points[bin_start[b] ..
+  std::vector<std::uint32_t> bin_points;     // bin_start[b + 1]), indices into points
   std::vector<SupportPlane> support_planes;  // the caller's: planes seen around the segment
 
   // The bin of direction a, or -1 outside the window.
@@ -69,19 +70,22 @@ struct SceneAround {
   // Some scan point lies more than `beyond_m` behind the plane through x normal to `normal`, on
   // a line of sight passing within `lateral_m` (at most a bin) of x: the sensor saw through a
   // surface there.
-  bool SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& normal, double lateral_m, double beyond_m) const;
+  bool SeenThrough(const Eigen::Vector3d& x, const Eigen::Vector3d& normal, double lateral_m,
+                   double beyond_m) const;
 };
 
 // The scene around `segment`: `whole_scan` (with its k-d index `index`) over the segment's
 // window of directions widened by `margin_m` at the segment, binned about `radius_m` wide there.
 // Throws uwscan::Error on an empty segment or a non-finite point in it.
-SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index, const PointCloud& segment,
-                               double radius_m, double margin_m = 0.0);
+SceneAround SceneAroundSegment(const PointCloud& whole_scan, const KnnIndex& index,
+                               const PointCloud& segment, double radius_m, double margin_m = 0.0);
 
 // The planes of `planes` (removed from `scan`, their inliers indices into it) with at least
 // `min_points` inliers within `radius_m` of `centre`: those an object there may rest on.
-std::vector<SupportPlane> SupportPlanesAround(const PointCloud& scan, const std::vector<DetectedPlane>& planes,
-                                              const Eigen::Vector3d& centre, double radius_m, std::size_t min_points);
+std::vector<SupportPlane> SupportPlanesAround(const PointCloud& scan,
+                                              const std::vector<DetectedPlane>& planes,
+                                              const Eigen::Vector3d& centre, double radius_m,
+                                              std::size_t min_points);
 
 // How a posed model meets the support planes around it.
 struct SupportContact {
@@ -123,14 +127,14 @@ struct SurfaceEvidence {
   std::size_t expected = 0;
   std::size_t missing = 0;
 };
-SurfaceEvidence ExpectedSurface(const ObjectModel& o, const Eigen::Isometry3d& T_S_O, const SceneAround& scene,
-                                double radius_m);
+SurfaceEvidence ExpectedSurface(const ObjectModel& o, const Eigen::Isometry3d& T_S_O,
+                                const SceneAround& scene, double radius_m);
 
 // Share of the segment (object frame) within `distance_m` of the model's surface: the
 // point-to-plane distance to the nearest model point, when that point is within `reach_m` (about
 // the model's sample spacing, so that a point beside a thin part, on the part's tangent plane but
 // off its surface, does not count; at most model_grid's radius).
-double CloseShare(const PointCloud& model, const NearestGrid& model_grid, const PointCloud& segment_O,
-                  double distance_m, double reach_m);
+double CloseShare(const PointCloud& model, const NearestGrid& model_grid,
+                  const PointCloud& segment_O, double distance_m, double reach_m);
 
 }  // namespace uwscan::perception

@@ -2,11 +2,10 @@
 
 #include <gtest/gtest.h>
 
-#include "scanner/common/error.hpp"
-
 #include <cmath>
 #include <vector>
-#include <vector>
+
+#include "scanner/common/error.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -19,7 +18,8 @@ constexpr double kSeabedZ = 1.0, kPlateZ = 0.9, kPlateHalf = 0.05, kRadius = 0.0
 // `plate_to_x`.
 Eigen::Vector3d Hit(double u, double v, bool plate, double plate_to_x) {
   const Eigen::Vector3d on_plate = kPlateZ * Eigen::Vector3d(u, v, 1.0);
-  if (plate && on_plate.x() >= -kPlateHalf && on_plate.x() <= plate_to_x && std::abs(on_plate.y()) <= kPlateHalf) {
+  if (plate && on_plate.x() >= -kPlateHalf && on_plate.x() <= plate_to_x &&
+      std::abs(on_plate.y()) <= kPlateHalf) {
     return on_plate;
   }
   return kSeabedZ * Eigen::Vector3d(u, v, 1.0);
@@ -30,7 +30,8 @@ Eigen::Vector3d Hit(double u, double v, bool plate, double plate_to_x) {
 PointCloud Scan(bool plate, double line_spacing, double plate_to_x = kPlateHalf) {
   std::vector<Eigen::Vector3d> points;
   for (double v = -0.2; v <= 0.2 + 1e-9; v += line_spacing) {
-    for (double u = -0.2; u <= 0.2 + 1e-9; u += 0.002) points.push_back(Hit(u, v, plate, plate_to_x));
+    for (double u = -0.2; u <= 0.2 + 1e-9; u += 0.002)
+      points.push_back(Hit(u, v, plate, plate_to_x));
   }
   return MakeCloud(points);
 }
@@ -64,8 +65,8 @@ const Eigen::Vector3d kTowardsSensor(0.0, 0.0, -1.0);
 // Whether the scan saw through the plate's surface at (x, y) of the plate.
 bool SeenThrough(const PointCloud& scan, double x, double y) {
   const KnnIndex index(scan.points);
-  return Around(scan, index, kOnPlate).SeenThrough(Eigen::Vector3d(x, y, kPlateZ), kTowardsSensor, 0.5 * kRadius,
-                                                   0.5 * kRadius);
+  return Around(scan, index, kOnPlate)
+      .SeenThrough(Eigen::Vector3d(x, y, kPlateZ), kTowardsSensor, 0.5 * kRadius, 0.5 * kRadius);
 }
 
 TEST(MissingShareTest, APlateTheScanSawIsNotMissing) {
@@ -98,8 +99,12 @@ TEST(MissingShareTest, HalfAPlateIsHalfMissing) {
 // posed 50 mm in front of it, the sensor saw through it.
 TEST(MissingShareTest, APlateJustInFrontOfWhatTheScanSawIsSeen) {
   const PointCloud seabed_only = Scan(false, 0.004);
-  EXPECT_EQ(Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.005))), 0.0);
-  EXPECT_GT(Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.05))), 0.95);
+  EXPECT_EQ(
+      Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.005))),
+      0.0);
+  EXPECT_GT(
+      Missing(seabed_only, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, kSeabedZ - 0.05))),
+      0.95);
 }
 
 // Seen through means the line of sight ends more than `beyond_m` past the surface's plane (along
@@ -142,8 +147,11 @@ TEST(SupportContact, TheSeabedAroundASegmentFacesTheSensor) {
   ASSERT_EQ(around.size(), 1u);
   EXPECT_NEAR(around[0].normal.z(), -1.0, 1e-12);
   EXPECT_NEAR(around[0].offset_m, kSeabedZ, 1e-12);
-  EXPECT_GT(around[0].normal.dot(Eigen::Vector3d::Zero()) + around[0].offset_m, 0.0) << "the sensor's side";
-  EXPECT_TRUE(SupportPlanesAround(scan, {Seabed(scan)}, Eigen::Vector3d(2.0, 0.0, kSeabedZ), 0.05, 20).empty());
+  EXPECT_GT(around[0].normal.dot(Eigen::Vector3d::Zero()) + around[0].offset_m, 0.0)
+      << "the sensor's side";
+  EXPECT_TRUE(
+      SupportPlanesAround(scan, {Seabed(scan)}, Eigen::Vector3d(2.0, 0.0, kSeabedZ), 0.05, 20)
+          .empty());
 }
 
 // The plate stood on its edge across the seabed, sunk by `sunk_m`: its buried share is the share
@@ -160,12 +168,18 @@ TEST(SupportContact, APlateSunkIntoTheSeabedIsBuriedByItsShareBelowIt) {
     T_S_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
     T_S_O.translation() = Eigen::Vector3d(0.0, 0.0, kSeabedZ + sunk_m - kPlateHalf);
     std::size_t deeper = 0;
-    for (std::size_t i = 0; i < plate.model.size(); ++i) deeper += (T_S_O * plate.model.Point(i)).z() > kSeabedZ + 0.01 ? 1 : 0;
+    for (std::size_t i = 0; i < plate.model.size(); ++i)
+      deeper += (T_S_O * plate.model.Point(i)).z() > kSeabedZ + 0.01 ? 1 : 0;
     const SupportContact contact = SupportContactOf(plate, T_S_O, planes, 0.01);
-    EXPECT_DOUBLE_EQ(contact.buried, static_cast<double>(deeper) / static_cast<double>(plate.model.size())) << sunk_m;
+    EXPECT_DOUBLE_EQ(contact.buried,
+                     static_cast<double>(deeper) / static_cast<double>(plate.model.size()))
+        << sunk_m;
     EXPECT_NEAR(contact.clearance_m, -sunk_m, 1e-9) << sunk_m;
   }
-  EXPECT_GT(SupportContactOf(plate, Eigen::Isometry3d(Eigen::Translation3d(0, 0, kSeabedZ + 0.04)), planes, 0.01).buried, 0.99);
+  EXPECT_GT(SupportContactOf(plate, Eigen::Isometry3d(Eigen::Translation3d(0, 0, kSeabedZ + 0.04)),
+                             planes, 0.01)
+                .buried,
+            0.99);
   const SupportContact no_plane = SupportContactOf(plate, Eigen::Isometry3d::Identity(), {}, 0.01);
   EXPECT_EQ(no_plane.buried, 0.0);
   EXPECT_TRUE(std::isinf(no_plane.clearance_m));

@@ -9,9 +9,11 @@
 
 namespace uwscan::perception {
 
-Eigen::Matrix<double, 6, 6> ResidualPatchSpread(const PointCloud& source, const Eigen::Isometry3d& T_target_source,
+Eigen::Matrix<double, 6, 6> ResidualPatchSpread(const PointCloud& source,
+                                                const Eigen::Isometry3d& T_target_source,
                                                 const PointCloud& target, const NearestGrid& grid,
-                                                double max_distance_m, const Eigen::Vector3d& centre_target,
+                                                double max_distance_m,
+                                                const Eigen::Vector3d& centre_target,
                                                 double patch_m) {
   using Vector6d = Eigen::Matrix<double, 6, 1>;
   // Ordered cells, so the sum is the same bits whatever the hashing.

@@ -18,9 +18,11 @@ class NearestGrid;
 // correlated within a patch (a misfit over a bolt head, a facet, a surface the model lacks) and
 // independent between patches, where sigma^2 H^-1 assumes every point independent.
 // `target` needs normals; `grid` is the NearestGrid of target's points relative to its origin.
-Eigen::Matrix<double, 6, 6> ResidualPatchSpread(const PointCloud& source, const Eigen::Isometry3d& T_target_source,
+Eigen::Matrix<double, 6, 6> ResidualPatchSpread(const PointCloud& source,
+                                                const Eigen::Isometry3d& T_target_source,
                                                 const PointCloud& target, const NearestGrid& grid,
-                                                double max_distance_m, const Eigen::Vector3d& centre_target,
+                                                double max_distance_m,
+                                                const Eigen::Vector3d& centre_target,
                                                 double patch_m);
 
 }  // namespace uwscan::perception

@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
-#include <limits>
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/clustering.hpp"
@@ -20,7 +20,8 @@ double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::size_t i : plane.inliers) mean += cloud.Point(i);
   mean /= static_cast<double>(plane.inliers.size());
-  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - plane.normal * plane.normal.transpose();
+  const Eigen::Matrix3d across =
+      Eigen::Matrix3d::Identity() - plane.normal * plane.normal.transpose();
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (std::size_t i : plane.inliers) {
     const Eigen::Vector3d d = across * (cloud.Point(i) - mean);
@@ -28,13 +29,15 @@ double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
   }
   scatter /= static_cast<double>(plane.inliers.size());
   // Eigenvalues ascending: 0 along the normal, then the narrow and the wide in-plane variance.
-  const Eigen::Vector3d variances = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
+  const Eigen::Vector3d variances =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
   return std::sqrt(12.0 * std::max(variances(1), 0.0));
 }
 
 // Each fragment joins the segment nearest to it when within `distance_m`.
-void AttachFragments(const PointCloud& cloud, const std::vector<std::vector<std::size_t>>& fragments,
-                     double distance_m, std::vector<Segment>& segments) {
+void AttachFragments(const PointCloud& cloud,
+                     const std::vector<std::vector<std::size_t>>& fragments, double distance_m,
+                     std::vector<Segment>& segments) {
   if (segments.empty() || fragments.empty()) return;
   std::vector<Eigen::Vector3f> points;
   std::vector<std::size_t> owner;
@@ -62,7 +65,8 @@ void AttachFragments(const PointCloud& cloud, const std::vector<std::vector<std:
 
 // Joins segments within `distance_m` of each other, the smallest first into its nearest, when
 // together they are no wider than `widest_m`.
-void JoinNearbySegments(const PointCloud& cloud, double widest_m, double distance_m, std::vector<Segment>& segments) {
+void JoinNearbySegments(const PointCloud& cloud, double widest_m, double distance_m,
+                        std::vector<Segment>& segments) {
   bool joined = true;
   while (joined && segments.size() > 1) {
     joined = false;
@@ -90,10 +94,13 @@ void JoinNearbySegments(const PointCloud& cloud, double widest_m, double distanc
 // (and are no wider than `widest_m`) become a segment: an object that occlusion cut into pieces
 // each too small to count, with no segment near enough to take them (a lever valve whose own
 // handle's shadow split it in two halves of 110 points). The rest stay fragments.
-void PromoteFragmentGroups(const PointCloud& cloud, double widest_m, const RecognitionOptions& options,
-                           std::vector<std::vector<std::size_t>>& fragments, std::vector<Segment>& segments) {
+void PromoteFragmentGroups(const PointCloud& cloud, double widest_m,
+                           const RecognitionOptions& options,
+                           std::vector<std::vector<std::size_t>>& fragments,
+                           std::vector<Segment>& segments) {
   std::vector<std::size_t> points;  // into cloud
-  for (const std::vector<std::size_t>& part : fragments) points.insert(points.end(), part.begin(), part.end());
+  for (const std::vector<std::size_t>& part : fragments)
+    points.insert(points.end(), part.begin(), part.end());
   if (points.size() < static_cast<std::size_t>(options.min_segment_points)) return;
   ClusteringOptions grouping;
   grouping.tolerance_m = options.attach_distance_m;
@@ -116,8 +123,10 @@ void PromoteFragmentGroups(const PointCloud& cloud, double widest_m, const Recog
 
 }  // namespace
 
-std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std::vector<std::size_t>& part,
-                                              const std::vector<Segment>& segments, std::size_t skip) {
+std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud,
+                                              const std::vector<std::size_t>& part,
+                                              const std::vector<Segment>& segments,
+                                              std::size_t skip) {
   std::vector<Eigen::Vector3f> points;
   std::vector<std::size_t> owner;
   for (std::size_t k = 0; k < segments.size(); ++k) {
@@ -140,7 +149,8 @@ std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std
   return {to, std::sqrt(static_cast<double>(best))};
 }
 
-std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m, const RecognitionOptions& options) {
+std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m,
+                              const RecognitionOptions& options) {
   ClusteringOptions clustering;
   clustering.tolerance_m = options.cluster_tolerance_m;
   std::vector<Segment> segments;
@@ -175,8 +185,9 @@ PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_ob
   for (std::size_t i = 0; i < down.size(); ++i) result.remaining_indices.push_back(i);
   for (int k = 0; k < 3 && !result.remaining.empty(); ++k) {
     // min_fraction is of the cloud handed over; keep it a share of the whole scan.
-    planes.min_fraction = std::min(1.0, options.plane_min_fraction * static_cast<double>(down.size()) /
-                                            static_cast<double>(result.remaining.size()));
+    planes.min_fraction =
+        std::min(1.0, options.plane_min_fraction * static_cast<double>(down.size()) /
+                          static_cast<double>(result.remaining.size()));
     PlaneRemovalResult step = RemovePlanes(result.remaining, planes);
     if (step.planes.empty()) break;
     DetectedPlane& plane = step.planes.front();

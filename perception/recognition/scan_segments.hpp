@@ -36,11 +36,14 @@ PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_ob
 // by its own shadow is too big to attach as a fragment, yet alone it is no object of the
 // database. (Two objects joined by mistake are split again by recognition.) Largest first
 // (equal sizes in cluster order).
-std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m, const RecognitionOptions& options);
+std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m,
+                              const RecognitionOptions& options);
 
 // The segment nearest to `part` (indices into `cloud`) other than segment `skip`: its index and
 // the smallest point-to-point distance, or (0, infinity) when no other segment has a point.
-std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud, const std::vector<std::size_t>& part,
-                                              const std::vector<Segment>& segments, std::size_t skip);
+std::pair<std::size_t, double> NearestSegment(const PointCloud& cloud,
+                                              const std::vector<std::size_t>& part,
+                                              const std::vector<Segment>& segments,
+                                              std::size_t skip);
 
 }  // namespace uwscan::perception

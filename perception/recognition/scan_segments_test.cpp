@@ -11,9 +11,11 @@ namespace {
 
 // A square patch of count x count points `spacing_m` apart in the plane z = `z_m`, its corner at
 // (x_m, y_m).
-void AddPatch(std::vector<Eigen::Vector3d>& points, double x_m, double y_m, double z_m, int count, double spacing_m) {
+void AddPatch(std::vector<Eigen::Vector3d>& points, double x_m, double y_m, double z_m, int count,
+              double spacing_m) {
   for (int i = 0; i < count; ++i) {
-    for (int j = 0; j < count; ++j) points.emplace_back(x_m + i * spacing_m, y_m + j * spacing_m, z_m);
+    for (int j = 0; j < count; ++j)
+      points.emplace_back(x_m + i * spacing_m, y_m + j * spacing_m, z_m);
   }
 }
 

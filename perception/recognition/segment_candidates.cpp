@@ -8,13 +8,13 @@
 namespace uwscan::perception::recognition {
 
 std::vector<std::vector<std::pair<double, int>>> NearestViews(const EsfDescriptor& esf,
-                                                              const ObjectDatabase& db,
-                                                              int count) {
+                                                              const ObjectDatabase& db, int count) {
   std::vector<std::vector<std::pair<double, int>>> nearest;
   for (const ObjectModel& o : db.objects) {
     std::vector<std::pair<double, int>> views;
     for (std::size_t v = 0; v < o.views.size(); ++v) {
-      views.emplace_back(ChiSquareDistance(esf.data(), o.views[v].esf.data(), 640), static_cast<int>(v));
+      views.emplace_back(ChiSquareDistance(esf.data(), o.views[v].esf.data(), 640),
+                         static_cast<int>(v));
     }
     const auto keep = views.begin() + std::min<std::ptrdiff_t>(count, std::ssize(views));
     std::partial_sort(views.begin(), keep, views.end());
@@ -60,7 +60,8 @@ PosedObject PoseCandidate(const DescribedSegment& s, std::size_t i, const Chosen
   return p;
 }
 
-std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
+std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model,
+                                       const NearestGrid& model_grid,
                                        const Eigen::Isometry3d& T_O_S, double distance_m) {
   std::vector<std::size_t> on;
   const float distance_sq = static_cast<float>(distance_m * distance_m);

@@ -16,8 +16,8 @@
 namespace uwscan::perception::recognition {
 
 // The `count` nearest views of each object by chi-square, nearest first: (distance, view index).
-std::vector<std::vector<std::pair<double, int>>> NearestViews(const EsfDescriptor& esf, const ObjectDatabase& db,
-                                                              int count);
+std::vector<std::vector<std::pair<double, int>>> NearestViews(const EsfDescriptor& esf,
+                                                              const ObjectDatabase& db, int count);
 
 // The objects worth posing on a segment: up to max_candidates whose nearest view is within
 // max_chi_square (and within max_chi_square_ratio of the best object's) and that are not smaller
@@ -39,8 +39,10 @@ ChosenObjects ChooseObjects(const EsfDescriptor& esf, double extent_m, const Sca
 PosedObject PoseCandidate(const DescribedSegment& s, std::size_t i, const ChosenObjects& chosen,
                           const SceneAround& around, const ScanContext& ctx);
 
-// The points of `segment` within `distance_m` (at most model_grid's radius) of the posed model's surface points.
-std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
+// The points of `segment` within `distance_m` (at most model_grid's radius) of the posed model's
+// surface points.
+std::vector<std::size_t> PointsOnModel(const PointCloud& segment, const ObjectModel& model,
+                                       const NearestGrid& model_grid,
                                        const Eigen::Isometry3d& T_O_S, double distance_m);
 
 }  // namespace uwscan::perception::recognition

@@ -20,20 +20,24 @@ constexpr std::size_t kSupportPoints = 20;
 // about an axis (a flange's bolts) are out of the ICP's reach when off, and the verification's
 // score barely sees them, so a phase the search found stands unless it scores clearly worse than
 // the pose it turned; of two, the better scoring.
-void SearchSymmetryPhases(const DescribedSegment& s, const PointCloud& sample, const ObjectModel& model,
-                          const IcpTarget& target, const NearestGrid& model_grid, const IcpOptions& fine,
+void SearchSymmetryPhases(const DescribedSegment& s, const PointCloud& sample,
+                          const ObjectModel& model, const IcpTarget& target,
+                          const NearestGrid& model_grid, const IcpOptions& fine,
                           const SceneAround& around, const ScanContext& ctx, PosedObject& best) {
   for (const SymmetryAxis& axis : model.symmetries) {
     const PosedObject before = best;
     bool turned_once = false;
     // Scored on every segment point, not the ICP's sample: the bolt heads are a few percent of
     // the segment, and a sample of 1000 points keeps a handful of them.
-    for (const Eigen::Isometry3d& turned : SymmetryPhaseStarts(s.cloud, model, model_grid, axis,
-                                                               before.fine.T_target_source, ctx.db.parameters.voxel_m)) {
+    for (const Eigen::Isometry3d& turned :
+         SymmetryPhaseStarts(s.cloud, model, model_grid, axis, before.fine.T_target_source,
+                             ctx.db.parameters.voxel_m)) {
       const RegistrationResult refined = AlignIcp(sample, target, turned, fine);
       RecognitionCandidate c = before.candidate;
       Verify(s.cloud, model, model_grid, around, refined, ctx, c);
-      if (c.verified < before.candidate.verified || c.score < before.candidate.score - ctx.options.score_tie) continue;
+      if (c.verified < before.candidate.verified ||
+          c.score < before.candidate.score - ctx.options.score_tie)
+        continue;
       if (turned_once && !Better(c, best.candidate)) continue;
       turned_once = true;
       best.candidate = c;
@@ -43,12 +47,15 @@ void SearchSymmetryPhases(const DescribedSegment& s, const PointCloud& sample, c
 }
 
 // Share of the model's points (every 4th) that `turn` (T_O_O') puts within a voxel of the model.
-double SelfOverlap(const ObjectModel& model, const NearestGrid& model_grid, const Eigen::Isometry3d& turn,
-                   double voxel_m) {
+double SelfOverlap(const ObjectModel& model, const NearestGrid& model_grid,
+                   const Eigen::Isometry3d& turn, double voxel_m) {
   std::size_t on = 0, count = 0;
   for (std::size_t i = 0; i < model.model.size(); i += 4, ++count) {
     const Eigen::Vector3d x = turn * model.model.Point(i);
-    on += model_grid.Nearest((x - model.model.origin).cast<float>(), static_cast<float>(voxel_m * voxel_m)) >= 0 ? 1 : 0;
+    on += model_grid.Nearest((x - model.model.origin).cast<float>(),
+                             static_cast<float>(voxel_m * voxel_m)) >= 0
+              ? 1
+              : 0;
   }
   return count == 0 ? 0.0 : static_cast<double>(on) / static_cast<double>(count);
 }
@@ -59,7 +66,8 @@ double SelfOverlap(const ObjectModel& model, const NearestGrid& model_grid, cons
 // model back on itself (a tee seen as an L, its run's one half and its branch, fits turned about
 // their bisector); without those that are its symmetries or repeat another (within 5 degrees
 // and 2 voxels at its centre): they would end where they started.
-std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, const NearestGrid& model_grid, double voxel_m) {
+std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model,
+                                                 const NearestGrid& model_grid, double voxel_m) {
   std::vector<Eigen::Isometry3d> candidates = HalfTurns(model.model);
   for (int axis = 0; axis < 3; ++axis) {
     candidates.emplace_back(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::Unit(axis)));
@@ -67,7 +75,8 @@ std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, const
   for (int a = 0; a < 3; ++a) {
     for (int b = a + 1; b < 3; ++b) {
       for (double sign : {1.0, -1.0}) {
-        const Eigen::Vector3d bisector = (Eigen::Vector3d::Unit(a) + sign * Eigen::Vector3d::Unit(b)).normalized();
+        const Eigen::Vector3d bisector =
+            (Eigen::Vector3d::Unit(a) + sign * Eigen::Vector3d::Unit(b)).normalized();
         const Eigen::Isometry3d turn(Eigen::AngleAxisd(std::numbers::pi, bisector));
         if (SelfOverlap(model, model_grid, turn, voxel_m) >= 0.5) candidates.push_back(turn);
       }
@@ -82,7 +91,9 @@ std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, const
   std::vector<Eigen::Isometry3d> known = SymmetryTransforms(model.symmetries);
   std::vector<Eigen::Isometry3d> turns;
   for (const Eigen::Isometry3d& turn : candidates) {
-    if (std::any_of(known.begin(), known.end(), [&](const Eigen::Isometry3d& k) { return alike(k, turn); })) continue;
+    if (std::any_of(known.begin(), known.end(),
+                    [&](const Eigen::Isometry3d& k) { return alike(k, turn); }))
+      continue;
     turns.push_back(turn);
     known.push_back(turn);
   }
@@ -91,17 +102,19 @@ std::vector<Eigen::Isometry3d> DistinctHalfTurns(const ObjectModel& model, const
 
 // `posed` turned by each of DistinctHalfTurns, each refined by the fine ICP on a sample of
 // `segment` (one turn per thread) and verified on all of it.
-std::vector<PosedObject> HalfTurnedPoses(const PointCloud& segment, const PosedObject& posed, const SceneAround& around,
-                                         const ScanContext& ctx) {
+std::vector<PosedObject> HalfTurnedPoses(const PointCloud& segment, const PosedObject& posed,
+                                         const SceneAround& around, const ScanContext& ctx) {
   const ObjectModel& model = ctx.db.objects[posed.object];
   const ObjectDatabaseParameters& p = ctx.db.parameters;
   const ModelIndexes& indexes = ctx.cache.Model(posed.object);
   const PointCloud sample = Strided(segment, static_cast<std::size_t>(ctx.options.refine_points));
-  const std::vector<Eigen::Isometry3d> turns = DistinctHalfTurns(model, indexes.nearest(), p.voxel_m);
+  const std::vector<Eigen::Isometry3d> turns =
+      DistinctHalfTurns(model, indexes.nearest(), p.voxel_m);
   std::vector<PosedObject> turned(turns.size(), posed);
   RunParallelTasks(std::ssize(turns), ctx.options.threads, [&](std::ptrdiff_t k) {
     PosedObject& t = turned[static_cast<std::size_t>(k)];
-    t.fine = AlignIcp(sample, indexes.target, turns[static_cast<std::size_t>(k)] * posed.fine.T_target_source,
+    t.fine = AlignIcp(sample, indexes.target,
+                      turns[static_cast<std::size_t>(k)] * posed.fine.T_target_source,
                       FineIcp(model.diameter_m, p, 1));
     Verify(segment, model, indexes.nearest(), around, t.fine, ctx, t.candidate);
   });
@@ -118,16 +131,18 @@ DescribedSegment DescribeSegment(const PointCloud& segment, const ScanContext& c
   d.cloud = AttachNormals(segment, EstimateNormals(segment, normal_options)).cloud;
   std::vector<std::size_t> all(d.cloud.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-  d.features = ComputeFpfh(d.cloud, all, FpfhOptions{ctx.db.parameters.feature_radius_m, ctx.options.threads});
+  d.features = ComputeFpfh(d.cloud, all,
+                           FpfhOptions{ctx.db.parameters.feature_radius_m, ctx.options.threads});
   return d;
 }
 
 SceneAround SceneAroundOf(const PointCloud& segment, const ScanContext& ctx) {
-  SceneAround around = SceneAroundSegment(ctx.down, ctx.down_index, segment, 2.0 * ctx.db.parameters.voxel_m,
-                                          0.5 * ctx.db.LargestDiameter());
+  SceneAround around =
+      SceneAroundSegment(ctx.down, ctx.down_index, segment, 2.0 * ctx.db.parameters.voxel_m,
+                         0.5 * ctx.db.LargestDiameter());
   // SceneAroundSegment refused an empty segment.
-  around.support_planes =
-      SupportPlanesAround(ctx.down, ctx.planes, Centroid(segment), ctx.db.LargestDiameter(), kSupportPoints);
+  around.support_planes = SupportPlanesAround(ctx.down, ctx.planes, Centroid(segment),
+                                              ctx.db.LargestDiameter(), kSupportPoints);
   return around;
 }
 
@@ -141,8 +156,10 @@ void Verify(const PointCloud& segment, const ObjectModel& model, const NearestGr
   c.fitness = refined.fitness;
   c.rmse_m = refined.inlier_plane_rmse;
   c.missing = MissingShare(model, c.T_S_O, around, 2.0 * p.voxel_m);
-  c.close = CloseShare(model.model, model_grid, Transformed(segment, T_O_S), ctx.options.close_distance_m, p.voxel_m);
-  const SupportContact contact = SupportContactOf(model, c.T_S_O, around.support_planes, ctx.options.buried_depth_m);
+  c.close = CloseShare(model.model, model_grid, Transformed(segment, T_O_S),
+                       ctx.options.close_distance_m, p.voxel_m);
+  const SupportContact contact =
+      SupportContactOf(model, c.T_S_O, around.support_planes, ctx.options.buried_depth_m);
   c.buried = contact.buried;
   c.clearance_m = contact.clearance_m;
   c.score = c.close * (1.0 - c.missing) * (1.0 - c.buried);
@@ -168,14 +185,16 @@ PointCloud Strided(const PointCloud& cloud, std::size_t count) {
 // fine ICP on refine_points of the segment's points and verified on all of them; the winner's
 // phase about any N-fold axis is searched, then it is refined once more on all its points (the
 // pose barely moves, but its information is that of every point) and verified again.
-PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const std::vector<Eigen::Isometry3d>& starts,
-                          const SceneAround& around, const ScanContext& ctx) {
+PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object,
+                          const std::vector<Eigen::Isometry3d>& starts, const SceneAround& around,
+                          const ScanContext& ctx) {
   const ObjectModel& model = ctx.db.objects[object];
   const ObjectDatabaseParameters& p = ctx.db.parameters;
   const ModelIndexes& indexes = ctx.cache.Model(object);
   const IcpTarget& target = indexes.target;
   const NearestGrid& model_grid = indexes.nearest();
-  const std::vector<Eigen::Isometry3d> sifted = SiftStarts(s.cloud, target, starts, model.diameter_m, p, ctx.options);
+  const std::vector<Eigen::Isometry3d> sifted =
+      SiftStarts(s.cloud, target, starts, model.diameter_m, p, ctx.options);
   ctx.clock.Lap("sift");
   const IcpOptions fine = FineIcp(model.diameter_m, p, ctx.options.threads);
   const PointCloud sample = Strided(s.cloud, static_cast<std::size_t>(ctx.options.refine_points));
@@ -214,12 +233,13 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
 
 // What a posed model leaves unexplained, in points: model surface the sensor saw through, and
 // segment points off the model's surface (CloseShare's test).
-double Unexplained(const PointCloud& segment, const ObjectModel& model, const NearestGrid& model_grid,
-                   const SceneAround& around, const Eigen::Isometry3d& T_O_S, const ScanContext& ctx) {
+double Unexplained(const PointCloud& segment, const ObjectModel& model,
+                   const NearestGrid& model_grid, const SceneAround& around,
+                   const Eigen::Isometry3d& T_O_S, const ScanContext& ctx) {
   const double voxel_m = ctx.db.parameters.voxel_m;
   const SurfaceEvidence surface = ExpectedSurface(model, T_O_S.inverse(), around, 2.0 * voxel_m);
-  const double close =
-      CloseShare(model.model, model_grid, Transformed(segment, T_O_S), ctx.options.close_distance_m, voxel_m);
+  const double close = CloseShare(model.model, model_grid, Transformed(segment, T_O_S),
+                                  ctx.options.close_distance_m, voxel_m);
   return static_cast<double>(surface.missing) + (1.0 - close) * static_cast<double>(segment.size());
 }
 
@@ -233,7 +253,8 @@ struct SlideMinimum {
   double gain = 0.0;
 };
 template <typename Cost>
-SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, double reach_m, int threads) {
+SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, double reach_m,
+                             int threads) {
   const int steps = static_cast<int>(std::ceil(reach_m / step_m));
   const int n = 2 * steps + 1;
   std::vector<double> raw(static_cast<std::size_t>(n));
@@ -244,17 +265,21 @@ SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, d
   for (int k = 0; k < n; ++k) {
     double sum = 0.0;
     int count = 0;
-    for (int j = std::max(0, k - 1); j <= std::min(n - 1, k + 1); ++j) sum += raw[static_cast<std::size_t>(j)], ++count;
+    for (int j = std::max(0, k - 1); j <= std::min(n - 1, k + 1); ++j)
+      sum += raw[static_cast<std::size_t>(j)], ++count;
     smooth[static_cast<std::size_t>(k)] = sum / count;
   }
   int best = steps;
   for (int k = 0; k < n; ++k) {
-    const double value = smooth[static_cast<std::size_t>(k)], held = smooth[static_cast<std::size_t>(best)];
+    const double value = smooth[static_cast<std::size_t>(k)],
+                 held = smooth[static_cast<std::size_t>(best)];
     if (value < held || (value == held && std::abs(k - steps) < std::abs(best - steps))) best = k;
   }
-  SlideMinimum m{centre_m + (best - steps) * step_m, smooth[static_cast<std::size_t>(steps)] - smooth[static_cast<std::size_t>(best)]};
+  SlideMinimum m{centre_m + (best - steps) * step_m,
+                 smooth[static_cast<std::size_t>(steps)] - smooth[static_cast<std::size_t>(best)]};
   if (best > 0 && best < n - 1) {
-    const double below = smooth[static_cast<std::size_t>(best - 1)], at = smooth[static_cast<std::size_t>(best)],
+    const double below = smooth[static_cast<std::size_t>(best - 1)],
+                 at = smooth[static_cast<std::size_t>(best)],
                  above = smooth[static_cast<std::size_t>(best + 1)];
     const double curvature = below - 2.0 * at + above;
     if (curvature > 0.0) m.offset_m += 0.5 * step_m * (below - above) / curvature;
@@ -262,33 +287,39 @@ SlideMinimum SmoothedMinimum(const Cost& cost, double centre_m, double step_m, d
   return m;
 }
 
-void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed) {
+void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around,
+                              const ScanContext& ctx, PosedObject& posed) {
   const ObjectModel& model = ctx.db.objects[posed.object];
   const ModelIndexes& indexes = ctx.cache.Model(posed.object);
   const NearestGrid& model_grid = indexes.nearest();
   const double voxel_m = ctx.db.parameters.voxel_m, radius_m = 0.5 * model.diameter_m;
-  const PoseConstraints constraints =
-      AnalysePoseConstraints(posed.fine.information, Eigen::Matrix<double, 6, 6>::Zero(), model.model.origin,
-                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
-  const IcpOptions last = FineIcpLastStage(model.diameter_m, ctx.db.parameters, ctx.options.threads);
+  const PoseConstraints constraints = AnalysePoseConstraints(
+      posed.fine.information, Eigen::Matrix<double, 6, 6>::Zero(), model.model.origin,
+      std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m, ctx.options.free_direction_std_m);
+  const IcpOptions last =
+      FineIcpLastStage(model.diameter_m, ctx.db.parameters, ctx.options.threads);
   const double min_gain = std::max(10.0, 0.02 * static_cast<double>(segment.size()));
   for (const FreeDirection& free : constraints.free_O) {
     const bool slide = free.motion == FreeMotion::kTranslation;
-    // The model moved by `offset_m` along the free direction (a turn's arc at the radius), in its frame.
+    // The model moved by `offset_m` along the free direction (a turn's arc at the radius), in its
+    // frame.
     auto motion_O = [&](double offset_m) -> Eigen::Isometry3d {
       if (slide) return Eigen::Isometry3d(Eigen::Translation3d(offset_m * free.axis_S));
-      return Eigen::Translation3d(free.point_S) * Eigen::AngleAxisd(offset_m / radius_m, free.axis_S) *
+      return Eigen::Translation3d(free.point_S) *
+             Eigen::AngleAxisd(offset_m / radius_m, free.axis_S) *
              Eigen::Translation3d(-free.point_S);
     };
     const double reach_m = slide ? radius_m : 0.25 * std::numbers::pi * radius_m;
     const Eigen::Isometry3d T_O_S = posed.fine.T_target_source;
     auto slid = [&](double offset_m) { return motion_O(offset_m).inverse() * T_O_S; };
-    auto cost = [&](double offset_m) { return Unexplained(segment, model, model_grid, around, slid(offset_m), ctx); };
+    auto cost = [&](double offset_m) {
+      return Unexplained(segment, model, model_grid, around, slid(offset_m), ctx);
+    };
     const int threads = ctx.options.threads;
     const SlideMinimum coarse = SmoothedMinimum(cost, 0.0, 2.0 * voxel_m, reach_m, threads);
     if (coarse.gain < min_gain) continue;
-    const SlideMinimum m =
-        SmoothedMinimum(cost, std::round(coarse.offset_m / voxel_m) * voxel_m, 0.5 * voxel_m, 3.0 * voxel_m, threads);
+    const SlideMinimum m = SmoothedMinimum(cost, std::round(coarse.offset_m / voxel_m) * voxel_m,
+                                           0.5 * voxel_m, 3.0 * voxel_m, threads);
     PosedObject moved = posed;
     moved.fine = AlignIcp(segment, indexes.target, slid(m.offset_m), last);
     Verify(segment, model, model_grid, around, moved.fine, ctx, moved.candidate);
@@ -296,8 +327,8 @@ void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& arou
   }
 }
 
-void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
-                          PosedObject& posed) {
+void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around,
+                          const ScanContext& ctx, PosedObject& posed) {
   const std::vector<PosedObject> turned = HalfTurnedPoses(segment, posed, around, ctx);
   const PosedObject* best = &posed;
   for (const PosedObject& t : turned) {
@@ -332,10 +363,12 @@ std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const 
     if (!c.verified || c.score < posed.candidate.score - ctx.options.score_tie) continue;
     bool seen = false;
     for (const Eigen::Isometry3d& other : equivalent) {
-      const SymmetricPoseError e = PoseErrorModuloSymmetry(c.T_S_O, other, points_O, model.symmetries);
+      const SymmetricPoseError e =
+          PoseErrorModuloSymmetry(c.T_S_O, other, points_O, model.symmetries);
       seen |= e.rotation_rad < same_rad && e.translation_m < same_m;
     }
-    const SymmetricPoseError e = PoseErrorModuloSymmetry(c.T_S_O, posed.candidate.T_S_O, points_O, model.symmetries);
+    const SymmetricPoseError e =
+        PoseErrorModuloSymmetry(c.T_S_O, posed.candidate.T_S_O, points_O, model.symmetries);
     seen |= e.rotation_rad < same_rad && e.translation_m < same_m;
     if (!seen) equivalent.push_back(c.T_S_O);
   }

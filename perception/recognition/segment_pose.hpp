@@ -104,8 +104,9 @@ PointCloud Strided(const PointCloud& cloud, std::size_t count);
 // fine ICP on refine_points of the segment's points and verified on all of them; the winner's
 // phase about any N-fold axis is searched, then it is refined once more on all its points (the
 // pose barely moves, but its information is that of every point) and verified again.
-PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const std::vector<Eigen::Isometry3d>& starts,
-                          const SceneAround& around, const ScanContext& ctx);
+PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object,
+                          const std::vector<Eigen::Isometry3d>& starts, const SceneAround& around,
+                          const ScanContext& ctx);
 
 // The accepted pose moved along each direction its fit leaves free to where the model leaves the
 // fewest points unexplained: surface the sensor saw through plus segment points off its surface.
@@ -120,23 +121,26 @@ PosedObject PoseOnSegment(const DescribedSegment& s, std::size_t object, const s
 // pipe explains as much all along, give or take a few points), then is refined by the last stage
 // of the fine ICP and stands if still verified. For every candidate that could still rank first,
 // before they are ranked (RecognizeSegment): left unplaced, a pipe seen with one end lost to a
-// tee or flange fitting the same stretch. The directions stay reported free: the fit does not pin them, the verification's counts do, to
-// about a voxel. `segment` needs its normals (the fine ICP's normal gate).
-void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx, PosedObject& posed);
+// tee or flange fitting the same stretch. The directions stay reported free: the fit does not pin
+// them, the verification's counts do, to about a voxel. `segment` needs its normals (the fine ICP's
+// normal gate).
+void PlaceAlongFreeDirections(const PointCloud& segment, const SceneAround& around,
+                              const ScanContext& ctx, PosedObject& posed);
 
 // The posed object turned by each of DistinctHalfTurns, refined by the fine ICP and verified, and
 // moved to the best of them when that scores better (Better): a candidate that fits the segment
 // but leaves model surface where the sensor saw through may be posed a half turn off (a tee seen
 // as an L, turned about the L's bisector, its branch out where the seabed was seen). `segment`
 // needs its normals (the fine ICP's normal gate).
-void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around, const ScanContext& ctx,
-                          PosedObject& posed);
+void TurnToBetterHalfTurn(const PointCloud& segment, const SceneAround& around,
+                          const ScanContext& ctx, PosedObject& posed);
 
 // Other poses of a posed object the scan cannot tell from its own (RecognizedObject::
 // equivalent_poses_S): its pose turned by each of DistinctHalfTurns (a nearly symmetric object,
-// a valve's body, fits either way; a tee seen as an L fits turned about the L's bisector), refined by the fine ICP and verified like it; kept when
-// verified, scoring within score_tie of it and more than 5 degrees or 2 voxels from it and from
-// each other modulo the object's symmetries. T_S_O each.
+// a valve's body, fits either way; a tee seen as an L fits turned about the L's bisector), refined
+// by the fine ICP and verified like it; kept when verified, scoring within score_tie of it and more
+// than 5 degrees or 2 voxels from it and from each other modulo the object's symmetries. T_S_O
+// each.
 std::vector<Eigen::Isometry3d> EquivalentPoses(const DescribedSegment& s, const PosedObject& posed,
                                                const SceneAround& around, const ScanContext& ctx);
 

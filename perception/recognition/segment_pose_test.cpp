@@ -30,7 +30,8 @@ struct FlangeSegment {
 };
 const FlangeSegment& Flange() {
   static const FlangeSegment f = [] {
-    FlangeSegment s{ScanOnSeabed(CatalogueObject("flange").mesh, Eigen::Vector3d(0.6, 0.1, 0.5), 3), {}, {}};
+    FlangeSegment s{
+        ScanOnSeabed(CatalogueObject("flange").mesh, Eigen::Vector3d(0.6, 0.1, 0.5), 3), {}, {}};
     const ObjectDatabase& db = PipeFlangeValveDb();
     s.down = VoxelDownsample(s.scan.cloud, VoxelFilterOptions{db.parameters.voxel_m});
     s.removed = RemoveSupportPlanes(s.down, db.LargestDiameter(), RecognitionOptions{});
@@ -45,9 +46,10 @@ const FlangeSegment& Flange() {
 TEST(SegmentPose, ACandidatePosedAHalfTurnOffIsTurnedBack) {
   const FlangeSegment& f = Flange();
   const ObjectDatabase& db = PipeFlangeValveDb();
-  const std::size_t flange = static_cast<std::size_t>(
-      std::find_if(db.objects.begin(), db.objects.end(), [](const ObjectModel& o) { return o.id == "flange"; }) -
-      db.objects.begin());
+  const std::size_t flange =
+      static_cast<std::size_t>(std::find_if(db.objects.begin(), db.objects.end(),
+                                            [](const ObjectModel& o) { return o.id == "flange"; }) -
+                               db.objects.begin());
   ASSERT_LT(flange, db.objects.size());
   RecognitionCache cache(db);
   const RecognitionOptions options;
@@ -64,11 +66,14 @@ TEST(SegmentPose, ACandidatePosedAHalfTurnOffIsTurnedBack) {
 
   auto posed_at = [&](const Eigen::Isometry3d& T_O_S) {
     PosedObject posed{flange, {}, {}};
-    posed.fine = AlignIcp(described.cloud, cache.Model(flange).target, T_O_S, FineIcp(model.diameter_m, db.parameters, 1));
-    Verify(described.cloud, model, cache.Model(flange).nearest(), around, posed.fine, ctx, posed.candidate);
+    posed.fine = AlignIcp(described.cloud, cache.Model(flange).target, T_O_S,
+                          FineIcp(model.diameter_m, db.parameters, 1));
+    Verify(described.cloud, model, cache.Model(flange).nearest(), around, posed.fine, ctx,
+           posed.candidate);
     return posed;
   };
-  const Eigen::Isometry3d end_for_end(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX()));
+  const Eigen::Isometry3d end_for_end(
+      Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX()));
   PosedObject flipped = posed_at(end_for_end * f.scan.T_S_O.inverse());
   const double flipped_score = flipped.candidate.verified ? flipped.candidate.score : 0.0;
   TurnToBetterHalfTurn(described.cloud, around, ctx, flipped);
@@ -77,15 +82,16 @@ TEST(SegmentPose, ACandidatePosedAHalfTurnOffIsTurnedBack) {
   // Seen from here the flange's neck leaves its slide along the axis to the ICP's drift, as
   // recognition then places it (it does the same for every contender).
   PlaceAlongFreeDirections(described.cloud, around, ctx, flipped);
-  const SymmetricPoseError e = PoseErrorModuloSymmetry(flipped.fine.T_target_source.inverse(), f.scan.T_S_O, points_O,
-                                                       model.symmetries);
+  const SymmetricPoseError e = PoseErrorModuloSymmetry(flipped.fine.T_target_source.inverse(),
+                                                       f.scan.T_S_O, points_O, model.symmetries);
   EXPECT_LT(e.translation_m, 0.003) << "rotation " << e.rotation_rad;
   EXPECT_LT(e.rotation_rad, 2.0 * std::numbers::pi / 180.0) << "modulo the bolts' phase";
 
   PosedObject right = posed_at(f.scan.T_S_O.inverse());
   const Eigen::Isometry3d before = right.fine.T_target_source;
   TurnToBetterHalfTurn(described.cloud, around, ctx, right);
-  EXPECT_TRUE(right.fine.T_target_source.isApprox(before, 1e-12)) << "a pose no half turn betters stays";
+  EXPECT_TRUE(right.fine.T_target_source.isApprox(before, 1e-12))
+      << "a pose no half turn betters stays";
 }
 
 }  // namespace

@@ -52,8 +52,8 @@ std::vector<Eigen::Isometry3d> ViewPoseHypotheses(const PointCloud& segment_S,
   const Eigen::Matrix3d R_sight =
       Eigen::Quaterniond::FromTwoVectors(stored->sight, seen->sight).toRotationMatrix();
   const Eigen::Vector3d axis = R_sight * stored->major_axis;
-  const double first_roll = std::atan2(axis.cross(seen->major_axis).dot(seen->sight),
-                                       axis.dot(seen->major_axis));
+  const double first_roll =
+      std::atan2(axis.cross(seen->major_axis).dot(seen->sight), axis.dot(seen->major_axis));
   std::vector<Eigen::Isometry3d> starts;
   for (int k = 0; k < rolls; ++k) {
     const double roll = first_roll + 2.0 * std::numbers::pi * k / rolls;

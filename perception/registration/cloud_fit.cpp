@@ -9,12 +9,13 @@
 
 namespace uwscan::perception {
 
-CloudFit FitOnTarget(const PointCloud& source, const PointCloud& target, const Eigen::Isometry3d& T_target_source,
-                     double max_distance_m) {
+CloudFit FitOnTarget(const PointCloud& source, const PointCloud& target,
+                     const Eigen::Isometry3d& T_target_source, double max_distance_m) {
   RequireValidCloud(source, "source", 1);
   RequireValidCloud(target, "target", 1);
   if (!(std::isfinite(max_distance_m) && max_distance_m > 0.0)) {
-    throw Error("cloud fit: max_distance_m must be finite and > 0, got " + std::to_string(max_distance_m));
+    throw Error("cloud fit: max_distance_m must be finite and > 0, got " +
+                std::to_string(max_distance_m));
   }
   const KnnIndex index(target.points);
   std::vector<std::uint32_t> nearest;
@@ -32,7 +33,8 @@ CloudFit FitOnTarget(const PointCloud& source, const PointCloud& target, const E
     ++fit.inliers;
   }
   fit.fitness = static_cast<double>(fit.inliers) / static_cast<double>(source.size());
-  fit.inlier_rmse_m = fit.inliers == 0 ? 0.0 : std::sqrt(sum_squared / static_cast<double>(fit.inliers));
+  fit.inlier_rmse_m =
+      fit.inliers == 0 ? 0.0 : std::sqrt(sum_squared / static_cast<double>(fit.inliers));
   return fit;
 }
 

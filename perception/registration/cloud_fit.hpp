@@ -19,7 +19,7 @@ struct CloudFit {
 // Every point of `source` moved by T_target_source, against its nearest point of `target`,
 // counted when within max_distance_m. Throws uwscan::Error on an empty or non-finite cloud or
 // a distance that is not > 0.
-CloudFit FitOnTarget(const PointCloud& source, const PointCloud& target, const Eigen::Isometry3d& T_target_source,
-                     double max_distance_m);
+CloudFit FitOnTarget(const PointCloud& source, const PointCloud& target,
+                     const Eigen::Isometry3d& T_target_source, double max_distance_m);
 
 }  // namespace uwscan::perception

@@ -21,7 +21,8 @@ PointCloud Grid(double z_m) {
 TEST(FitOnTargetTest, AnExactCopyMovedBackFitsToNothing) {
   const PointCloud target = Grid(0.0);
   const Eigen::Isometry3d T_target_source =
-      Eigen::Translation3d(0.3, -0.2, 0.1) * Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized());
+      Eigen::Translation3d(0.3, -0.2, 0.1) *
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized());
   const PointCloud source = Transformed(target, T_target_source.inverse());
   const CloudFit fit = FitOnTarget(source, target, T_target_source, 0.001);
   EXPECT_EQ(fit.fitness, 1.0);

@@ -246,10 +246,9 @@ double RequiredIterations(double inlier_ratio, double confidence) {
 // unique), so the kept set does not depend on the order hypotheses arrive in.
 void KeepBest(std::vector<Hypothesis>* kept, const Hypothesis& candidate, std::size_t capacity) {
   if (kept->size() == capacity && !candidate.BetterThan(kept->back())) return;
-  const auto at = std::upper_bound(kept->begin(), kept->end(), candidate,
-                                   [](const Hypothesis& a, const Hypothesis& b) {
-                                     return a.BetterThan(b);
-                                   });
+  const auto at =
+      std::upper_bound(kept->begin(), kept->end(), candidate,
+                       [](const Hypothesis& a, const Hypothesis& b) { return a.BetterThan(b); });
   kept->insert(at, candidate);
   if (kept->size() > capacity) kept->pop_back();
 }
@@ -322,10 +321,11 @@ int Overlap(const std::vector<Eigen::Vector3d>& source_points, const KnnIndex& t
 // better-by-inliers one. Evaluated in parallel, chosen in a fixed order: thread-count free.
 Hypothesis MostOverlapping(const std::vector<Hypothesis>& candidates, const PointCloud& source,
                            const PointCloud& target, const CoarseAlignmentOptions& options) {
-  const std::size_t stride =
-      std::max<std::size_t>(1, source.size() / static_cast<std::size_t>(options.verification_points));
+  const std::size_t stride = std::max<std::size_t>(
+      1, source.size() / static_cast<std::size_t>(options.verification_points));
   std::vector<Eigen::Vector3d> points;
-  for (std::size_t i = 0; i < source.size(); i += stride) points.push_back(source.points[i].cast<double>());
+  for (std::size_t i = 0; i < source.size(); i += stride)
+    points.push_back(source.points[i].cast<double>());
   const KnnIndex target_index(target.points);
   std::vector<int> overlap(candidates.size(), 0);
 #pragma omp parallel for num_threads(ThreadCount(options.threads)) schedule(dynamic, 1)

@@ -42,7 +42,8 @@ class NearestWithin : public flann::ResultSet<float> {
     index_ = kNoMatch;
   }
   // Candidates must have normals[index] . normal >= min_cos; normals == nullptr: no gate.
-  void Gate(const std::vector<Eigen::Vector3f>* normals, const Eigen::Vector3f& normal, float min_cos) {
+  void Gate(const std::vector<Eigen::Vector3f>* normals, const Eigen::Vector3f& normal,
+            float min_cos) {
     normals_ = normals;
     normal_ = normal;
     min_cos_ = min_cos;
@@ -80,7 +81,8 @@ class TargetTree {
                flann::KDTreeSingleIndexParams(10)) {
     index_.buildIndex();
     if (grid_radius_m > 0.0) {
-      grid_.emplace(target.points, grid_cell_m > 0.0 ? grid_cell_m : 0.25 * grid_radius_m, grid_radius_m);
+      grid_.emplace(target.points, grid_cell_m > 0.0 ? grid_cell_m : 0.25 * grid_radius_m,
+                    grid_radius_m);
       grid_radius_sq_ = static_cast<float>(grid_radius_m * grid_radius_m);
     }
   }
@@ -89,7 +91,8 @@ class TargetTree {
     const Eigen::Vector3f query = p.cast<float>();
     result.Reset(radius_sq);
     if (grid_ && radius_sq <= grid_radius_sq_) {
-      return static_cast<int>(grid_->Nearest(query, radius_sq, [&](std::uint32_t j) { return result.Accepts(j); }));
+      return static_cast<int>(
+          grid_->Nearest(query, radius_sq, [&](std::uint32_t j) { return result.Accepts(j); }));
     }
     index_.findNeighbors(result, query.data(), exact_);
     return result.index();
@@ -159,7 +162,8 @@ Sums Pass(const std::vector<Eigen::Vector3d>& source_rel, const PointCloud& targ
       for (std::ptrdiff_t i = block * kBlockSize; i < end; ++i) {
         const Eigen::Vector3d p = T_rel * source_rel[static_cast<std::size_t>(i)];
         if (gate.source != nullptr) {
-          const Eigen::Vector3d n = T_rel.linear() * (*gate.source)[static_cast<std::size_t>(i)].cast<double>();
+          const Eigen::Vector3d n =
+              T_rel.linear() * (*gate.source)[static_cast<std::size_t>(i)].cast<double>();
           result.Gate(gate.target, n.cast<float>(), gate.min_cos);
         }
         const int j = tree.Nearest(p, radius_sq, result);
@@ -487,7 +491,8 @@ void IcpOptions::Check() const {
   // A relative change of the whole residual is no tolerance (and would make every iteration a
   // stall, stall_iterations counting a residual as lower only by this fraction).
   if (!(relative_rmse_tolerance < 1.0)) fail("relative_rmse_tolerance", "a value below 1");
-  if (stall_iterations < 0) fail("stall_iterations", ">= 0 (0 = off), got " + std::to_string(stall_iterations));
+  if (stall_iterations < 0)
+    fail("stall_iterations", ">= 0 (0 = off), got " + std::to_string(stall_iterations));
   if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
   if (!(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi)) {
     fail("max_normal_angle_rad", "an angle in [0, pi] rad");
@@ -507,17 +512,21 @@ void IcpOptions::Check() const {
 }
 
 struct IcpTarget::Tree {
-  Tree(const PointCloud& cloud, double grid_radius_m, double grid_cell_m) : tree(cloud, grid_radius_m, grid_cell_m) {}
+  Tree(const PointCloud& cloud, double grid_radius_m, double grid_cell_m)
+      : tree(cloud, grid_radius_m, grid_cell_m) {}
   TargetTree tree;
 };
 
-IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m, double grid_cell_m) : cloud_(cloud) {
+IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m, double grid_cell_m)
+    : cloud_(cloud) {
   RequireValidCloud(cloud, "AlignIcp: target", 3);
   if (!(grid_radius_m >= 0.0 && std::isfinite(grid_radius_m))) {
-    throw Error("IcpTarget: grid_radius_m must be finite and >= 0, got " + std::to_string(grid_radius_m));
+    throw Error("IcpTarget: grid_radius_m must be finite and >= 0, got " +
+                std::to_string(grid_radius_m));
   }
   if (!(grid_cell_m >= 0.0 && grid_cell_m <= grid_radius_m)) {
-    throw Error("IcpTarget: grid_cell_m must be in [0, grid_radius_m], got " + std::to_string(grid_cell_m));
+    throw Error("IcpTarget: grid_cell_m must be in [0, grid_radius_m], got " +
+                std::to_string(grid_cell_m));
   }
   tree_ = std::make_unique<Tree>(cloud, grid_radius_m, grid_cell_m);
   centroid_rel_.setZero();

@@ -194,9 +194,10 @@ TEST_P(IcpMethods, IdenticalWithOneAndTwoThreads) {
 // does one searched through a grid (NearestGrid) at the stages within its radius.
 TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
   const PointCloud target = BumpySurface(8000, 4, -0.25, 0.0005);
-  const PointCloud source = Transformed(BumpySurface(3000, 5, -0.1, 0.0005), KnownMotion().inverse());
+  const PointCloud source =
+      Transformed(BumpySurface(3000, 5, -0.1, 0.0005), KnownMotion().inverse());
   const IcpTarget prepared(target);
-  const IcpTarget gridded(target, 0.02);  // the last two of the three stages
+  const IcpTarget gridded(target, 0.02);              // the last two of the three stages
   const IcpTarget fine_gridded(target, 0.05, 0.002);  // every stage, on small cells
   EXPECT_EQ(prepared.grid(), nullptr);
   ASSERT_NE(gridded.grid(), nullptr);
@@ -214,7 +215,8 @@ TEST_P(IcpMethods, APreparedTargetGivesTheSameAnswerForEveryStart) {
       EXPECT_EQ(plain.fitness, reused.fitness);
       EXPECT_EQ(plain.iterations, reused.iterations);
       EXPECT_TRUE(plain.information == reused.information);
-      EXPECT_LT(TranslationErrorM(reused.T_target_source, KnownMotion()), 0.005);  // independent samples
+      EXPECT_LT(TranslationErrorM(reused.T_target_source, KnownMotion()),
+                0.005);  // independent samples
     }
   }
   EXPECT_THROW(IcpTarget(target, -0.01), Error);
@@ -368,13 +370,14 @@ TEST(IcpSinglePlane, APriorDecidesTheDirectionsThePlaneLeavesFree) {
   source.normals.clear();
   source.origin = Eigen::Vector3d(0.0, 0.0, 0.005);
   IcpPrior prior;
-  prior.T_target_source = Eigen::Translation3d(0.02, -0.01, 0.01) *
-                          Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ());
+  prior.T_target_source =
+      Eigen::Translation3d(0.02, -0.01, 0.01) * Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ());
   prior.information = Eigen::Matrix<double, 6, 6>::Identity() * 1e4;  // 1 cm, 0.01 rad
   prior.point_sigma_m = 0.0005;
   IcpOptions options = Options(IcpMethod::kPointToPlane);
   options.prior = prior;
-  const RegistrationResult result = AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
+  const RegistrationResult result =
+      AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
   EXPECT_TRUE(result.converged);
   const Eigen::Isometry3d& T = result.T_target_source;
   EXPECT_NEAR(T.translation().x(), 0.02, 1e-6);   // free: the prior's
@@ -438,7 +441,8 @@ TEST(IcpNormalGate, KeepsAScanOfAPipesOutsideOffItsBore) {
   options.max_correspondence_distance_m = {0.01, 0.0075};
   auto mean_radius = [&](const RegistrationResult& r) {
     double sum = 0.0;
-    for (std::size_t i = 0; i < scan.size(); ++i) sum += (r.T_target_source * scan.Point(i)).head<2>().norm();
+    for (std::size_t i = 0; i < scan.size(); ++i)
+      sum += (r.T_target_source * scan.Point(i)).head<2>().norm();
     return sum / static_cast<double>(scan.size());
   };
   const RegistrationResult ungated = AlignIcp(scan, model, start, options);
@@ -480,11 +484,13 @@ TEST(IcpStall, AWrongModelStopsCyclingAtItsLowestResidual) {
   options.max_iterations = options.max_iterations_per_stage = 200;
   options.rotation_tolerance_rad = options.translation_tolerance_m = 0.0;
   options.relative_rmse_tolerance = 1e-9;
-  const RegistrationResult cycling = AlignIcp(scan, wrong_model, Eigen::Isometry3d::Identity(), options);
+  const RegistrationResult cycling =
+      AlignIcp(scan, wrong_model, Eigen::Isometry3d::Identity(), options);
   EXPECT_EQ(cycling.iterations, 200);  // the trap: the whole cap spent
   EXPECT_FALSE(cycling.converged);
   options.stall_iterations = 10;
-  const RegistrationResult stalled = AlignIcp(scan, wrong_model, Eigen::Isometry3d::Identity(), options);
+  const RegistrationResult stalled =
+      AlignIcp(scan, wrong_model, Eigen::Isometry3d::Identity(), options);
   EXPECT_LT(stalled.iterations, 40);
   EXPECT_FALSE(stalled.converged);  // stopping is not converging
   EXPECT_LE(stalled.inlier_plane_rmse, cycling.inlier_plane_rmse);
@@ -494,7 +500,8 @@ TEST(IcpStall, AWrongModelStopsCyclingAtItsLowestResidual) {
 // fires: the same bits with it on or off.
 TEST_P(IcpMethods, StallRuleChangesNothingWhereICPConverges) {
   const PointCloud target = BumpySurface(8000, 2);
-  const PointCloud source = Transformed(SubsetWithNoise(target, 0.0, 0.0005, 3), KnownMotion().inverse());
+  const PointCloud source =
+      Transformed(SubsetWithNoise(target, 0.0, 0.0005, 3), KnownMotion().inverse());
   IcpOptions options = Options(GetParam());
   const RegistrationResult off = AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
   options.stall_iterations = 3;

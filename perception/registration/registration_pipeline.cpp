@@ -56,13 +56,15 @@ Prepared Prepare(const PointCloud& cloud, const Eigen::Vector3d& viewpoint,
 
 RegistrationPipelineOptions RegistrationPipelineOptions::ForObjectSize(double size_m,
                                                                        std::uint64_t seed,
-                                                                       int threads, double voxel_m) {
+                                                                       int threads,
+                                                                       double voxel_m) {
   if (!(size_m > 0.0) || !std::isfinite(size_m)) {
-    throw Error("registration: object size must be finite and > 0 (got " +
-                std::to_string(size_m) + " m)");
+    throw Error("registration: object size must be finite and > 0 (got " + std::to_string(size_m) +
+                " m)");
   }
   if (!(voxel_m >= 0.0) || !std::isfinite(voxel_m)) {
-    throw Error("registration: voxel must be finite and >= 0 (0: size / 50; got " + std::to_string(voxel_m) + " m)");
+    throw Error("registration: voxel must be finite and >= 0 (0: size / 50; got " +
+                std::to_string(voxel_m) + " m)");
   }
   RegistrationPipelineOptions o;
   o.voxel_m = voxel_m > 0.0 ? voxel_m : size_m / 50.0;

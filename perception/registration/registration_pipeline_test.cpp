@@ -55,7 +55,8 @@ TEST_P(PartialOverlapRotation, RecoversTheMotionAndReportsConvergence) {
   centre /= static_cast<double>(mesh.vertices.size());
   const Eigen::Vector3d target_viewpoint = centre + Eigen::Vector3d(0.0, 0.0, 0.8);
   const Eigen::Vector3d source_viewpoint =
-      centre + Eigen::AngleAxisd(45.0 * kDeg, Eigen::Vector3d::UnitY()) * Eigen::Vector3d(0, 0, 0.8);
+      centre +
+      Eigen::AngleAxisd(45.0 * kDeg, Eigen::Vector3d::UnitY()) * Eigen::Vector3d(0, 0, 0.8);
   const PointCloud target =
       RangeView(scanner::SampleSurface(mesh, 60000, 1), target_viewpoint, 1e-3, 2);
   const PointCloud view =
@@ -81,7 +82,9 @@ TEST_P(PartialOverlapRotation, RecoversTheMotionAndReportsConvergence) {
   EXPECT_TRUE(r.fine.converged) << r.fine.iterations << " ICP iterations";
 }
 
-INSTANTIATE_TEST_SUITE_P(Bunny, PartialOverlapRotation, ::testing::Values(30.0, 60.0, 90.0, 105.0, 120.0, 135.0, 150.0, 165.0, 180.0));
+INSTANTIATE_TEST_SUITE_P(Bunny, PartialOverlapRotation,
+                         ::testing::Values(30.0, 60.0, 90.0, 105.0, 120.0, 135.0, 150.0, 165.0,
+                                           180.0));
 
 }  // namespace
 }  // namespace uwscan::perception

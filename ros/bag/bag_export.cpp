@@ -59,7 +59,8 @@ std::filesystem::path LogOfReport(const std::filesystem::path& input) {
   const nlohmann::json report = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
   if (!report.is_object()) return {};
   std::filesystem::path log;
-  if (report.value("kind", "") == "map_report" && report.contains("log") && report["log"].is_string()) {
+  if (report.value("kind", "") == "map_report" && report.contains("log") &&
+      report["log"].is_string()) {
     log = report["log"].get<std::string>();
   }
   if (report.value("kind", "") == "recognition_report" && report.contains("scan") &&

@@ -121,8 +121,8 @@ void ReadDive(const BagReader& reader, const std::filesystem::path& bag, const B
   const auto navigation = [&](const std::string& topic, const OdometryMessage& m) {
     navigation_order.Check(topic, m.header.stamp_s, bag);
     if (vehicle_frame.empty()) vehicle_frame = m.child_frame_id;
-    writer.AppendNavigation({m.header.stamp_s - d.time_origin_s,
-                             VehiclePoseInUwscanAxes(m.pose, o.navigation.axes)});
+    writer.AppendNavigation(
+        {m.header.stamp_s - d.time_origin_s, VehiclePoseInUwscanAxes(m.pose, o.navigation.axes)});
     ++summary.navigation;
   };
   if (o.navigation.source == NavigationSource::kOdometry) {
@@ -170,8 +170,8 @@ BagImportSummary ImportBag(const std::filesystem::path& bag, const std::filesyst
                     " transform on " + o.topics.tf + " (the navigation)");
       }
       const std::optional<Eigen::Isometry3d> T_V_C = d.statics.Find(vehicle_frame, camera_frame);
-      writer.SetVehicleMount(MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()),
-                                               o.navigation.axes));
+      writer.SetVehicleMount(
+          MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()), o.navigation.axes));
       summary.mount = T_V_C ? o.topics.tf_static + " " + vehicle_frame + " -> " + camera_frame
                             : "none on " + o.topics.tf_static + " from " + vehicle_frame + " to " +
                                   camera_frame + ": the camera is taken at the vehicle's origin";

@@ -35,22 +35,23 @@ CloudMessage ScanCloud(const perception::RecognitionReport& report, const Header
   CloudMessage message;
   message.header = header;
   message.points.reserve(scan.size());
-  for (std::size_t i = 0; i < scan.size(); ++i) message.points.push_back(scan.Point(i).cast<float>());
+  for (std::size_t i = 0; i < scan.size(); ++i)
+    message.points.push_back(scan.Point(i).cast<float>());
   return message;
 }
 
 }  // namespace
 
-RecognitionExportSummary ExportRecognitionReport(const std::filesystem::path& path,
-                                                 double origin_s, const BagExportOptions& o,
-                                                 BagWriter& bag) {
+RecognitionExportSummary ExportRecognitionReport(const std::filesystem::path& path, double origin_s,
+                                                 const BagExportOptions& o, BagWriter& bag) {
   const perception::RecognitionReport report = perception::ReadRecognitionReport(path);
   const double stamp_s =
       origin_s + (IsDiveLog(report.scan) ? SweepMiddle_s(report.scan, report.scan_sweep) : 0.0);
   const Header header{stamp_s, o.frames.camera};
   const CloudMessage scan = ScanCloud(report, header);
   const perception::ObjectDatabase db = perception::ObjectDatabase::Load(report.database);
-  const ObjectMessages messages = MakeObjectMessages(report.objects, db, header, kDefaultModelMarkerPoints);
+  const ObjectMessages messages =
+      MakeObjectMessages(report.objects, db, header, kDefaultModelMarkerPoints);
   bag.Write(o.topics.sweeps, scan);
   bag.Write(o.topics.objects, messages.markers, stamp_s);
   for (const PoseMessage& pose : messages.poses) bag.Write(o.topics.object_poses, pose);

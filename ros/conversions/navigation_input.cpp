@@ -34,9 +34,12 @@ std::string ToString(NavigationSource source) {
   return source == NavigationSource::kTf ? "tf" : "odometry";
 }
 
-std::string ToString(NavigationAxes axes) { return axes == NavigationAxes::kEnuFlu ? "enu" : "ned"; }
+std::string ToString(NavigationAxes axes) {
+  return axes == NavigationAxes::kEnuFlu ? "enu" : "ned";
+}
 
-Eigen::Isometry3d VehiclePoseInUwscanAxes(const Eigen::Isometry3d& T_odom_base, NavigationAxes axes) {
+Eigen::Isometry3d VehiclePoseInUwscanAxes(const Eigen::Isometry3d& T_odom_base,
+                                          NavigationAxes axes) {
   if (axes == NavigationAxes::kNedFrd) return T_odom_base;
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = NedFromEnu() * T_odom_base.linear() * FrdFromFlu();

@@ -37,7 +37,8 @@ std::string ToString(NavigationSource source);
 std::string ToString(NavigationAxes axes);
 
 // T_odom_base_link in uwscan's axes from one in `axes`.
-Eigen::Isometry3d VehiclePoseInUwscanAxes(const Eigen::Isometry3d& T_odom_base, NavigationAxes axes);
+Eigen::Isometry3d VehiclePoseInUwscanAxes(const Eigen::Isometry3d& T_odom_base,
+                                          NavigationAxes axes);
 // The camera's mount T_base_link_camera with base_link in uwscan's axes (the camera frame is
 // OpenCV's in both).
 Eigen::Isometry3d MountInUwscanAxes(const Eigen::Isometry3d& T_base_camera, NavigationAxes axes);

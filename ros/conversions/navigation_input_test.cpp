@@ -37,10 +37,11 @@ TEST(VehiclePoseInUwscanAxes, TurnsAnEnuFluPoseIntoTheSameVehicleInNedFrd) {
 
 TEST(VehiclePoseInNavigationAxes, UndoesVehiclePoseInUwscanAxes) {
   const Eigen::Isometry3d enu = Pose({1, 2, -3}, 0.7, -0.1, 0.2);
-  const Eigen::Isometry3d back =
-      VehiclePoseInNavigationAxes(VehiclePoseInUwscanAxes(enu, NavigationAxes::kEnuFlu), NavigationAxes::kEnuFlu);
+  const Eigen::Isometry3d back = VehiclePoseInNavigationAxes(
+      VehiclePoseInUwscanAxes(enu, NavigationAxes::kEnuFlu), NavigationAxes::kEnuFlu);
   EXPECT_LT((back.matrix() - enu.matrix()).norm(), 1e-12);
-  EXPECT_TRUE(WorldPointInNavigationAxes({2, 1, 3}, NavigationAxes::kEnuFlu).isApprox(Eigen::Vector3d(1, 2, -3)));
+  EXPECT_TRUE(WorldPointInNavigationAxes({2, 1, 3}, NavigationAxes::kEnuFlu)
+                  .isApprox(Eigen::Vector3d(1, 2, -3)));
   Covariance6d c = Covariance6d::Zero();
   c.diagonal() << 1, 2, 3, 4, 5, 6;  // north, east, down; about north, east, down
   const Covariance6d enu_c = WorldCovarianceInNavigationAxes(c, NavigationAxes::kEnuFlu);
@@ -64,7 +65,8 @@ TEST(NavigationFromTransforms, TakesTheOdomToBaseLinkTransformOnly) {
   TransformMessage correction{{5.0, "map"}, "odom", Eigen::Isometry3d::Identity()};
   TransformMessage navigation{{5.0, "odom"}, "base_link", Pose({1, 2, 3}, 0.3, 0, 0)};
   EXPECT_FALSE(NavigationFromTransforms({correction}, frames));
-  const std::optional<OdometryMessage> m = NavigationFromTransforms({correction, navigation}, frames);
+  const std::optional<OdometryMessage> m =
+      NavigationFromTransforms({correction, navigation}, frames);
   ASSERT_TRUE(m);
   EXPECT_EQ(m->header.stamp_s, 5.0);
   EXPECT_TRUE(m->pose.isApprox(navigation.transform));
@@ -77,7 +79,9 @@ TEST(ParseNavigation, NamesTheChoicesWhenTheValueIsUnknown) {
     ParseNavigationAxes("nwu", "--navigation-axes");
     ADD_FAILURE();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--navigation-axes: 'nwu', expected ned"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--navigation-axes: 'nwu', expected ned"),
+              std::string::npos)
+        << e.what();
   }
 }
 

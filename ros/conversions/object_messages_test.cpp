@@ -69,7 +69,8 @@ TEST(MakeObjectMessages, DrawsEachRecognisedObjectAtItsPoseAndSkipsTheUnknown) {
   objects[0].id = "flange";
   objects[0].T_S_O.translation() = Eigen::Vector3d(0.1, 0.2, 1.0);
   objects[0].covariance = 1e-4 * Eigen::Matrix<double, 6, 6>::Identity();
-  objects[0].grasps_S = {{"rim", Eigen::Isometry3d::Identity()}, {"neck", Eigen::Isometry3d::Identity()}};
+  objects[0].grasps_S = {{"rim", Eigen::Isometry3d::Identity()},
+                         {"neck", Eigen::Isometry3d::Identity()}};
   objects[1].id = "unknown";
   objects[2].id = "valve";
   objects[2].score = 0.8;
@@ -85,7 +86,8 @@ TEST(MakeObjectMessages, DrawsEachRecognisedObjectAtItsPoseAndSkipsTheUnknown) {
   EXPECT_EQ(m.poses[0].header.frame_id, "uwscan_camera");
   EXPECT_DOUBLE_EQ(m.poses[0].header.stamp_s, 12.5);
   const Eigen::Vector3d c = perception::Centroid(db.objects[1].model);
-  EXPECT_TRUE(m.poses[0].covariance.isApprox(ObjectPoseCovariance(objects[0].T_S_O, c, objects[0].covariance)));
+  EXPECT_TRUE(m.poses[0].covariance.isApprox(
+      ObjectPoseCovariance(objects[0].T_S_O, c, objects[0].covariance)));
   EXPECT_EQ(m.grasps.poses.size(), 2u);
   objects[2].id = "pipe";
   try {

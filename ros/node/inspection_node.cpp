@@ -79,10 +79,11 @@ class SetupListener {
         }
       });
     }
-    ros.SubscribeTransforms(o.topics.tf_static, 100, [this](std::vector<TransformMessage>&& transforms) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (const TransformMessage& t : transforms) statics_.Add(t);
-    });
+    ros.SubscribeTransforms(o.topics.tf_static, 100,
+                            [this](std::vector<TransformMessage>&& transforms) {
+                              std::lock_guard<std::mutex> lock(mutex_);
+                              for (const TransformMessage& t : transforms) statics_.Add(t);
+                            });
   }
 
   // Waits for the scanner, then for the mount (or gives up on it). Throws when the scanner
@@ -115,8 +116,8 @@ class SetupListener {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     const RosFrames& f = options_.frames;
-    setup.T_V_C = MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()),
-                                    options_.navigation.axes);
+    setup.T_V_C =
+        MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()), options_.navigation.axes);
     setup.mount = T_V_C ? options_.topics.tf_static + " " + f.base_link + " -> " + f.camera
                         : "none on " + options_.topics.tf_static + " from " + f.base_link + " to " +
                               f.camera + ": the camera is taken at the vehicle's origin";
@@ -320,10 +321,11 @@ class Outlet {
     PublishTrajectory(slam, navigation);
     const int last = m.submap_count() - 1;
     if (const std::optional<mapping::Mapper::SubmapCovariances> c = m.Covariances()) {
-      ros_.Publish(pose_id_,
-                   PoseMessage{Stamp(slam.back().time_s, options_.frames.map), Out(slam.back().T_W_V),
-                               WorldCovarianceInNavigationAxes(
-                                   RosCovariance(c->anchors[static_cast<std::size_t>(last)]), axes())});
+      ros_.Publish(
+          pose_id_,
+          PoseMessage{Stamp(slam.back().time_s, options_.frames.map), Out(slam.back().T_W_V),
+                      WorldCovarianceInNavigationAxes(
+                          RosCovariance(c->anchors[static_cast<std::size_t>(last)]), axes())});
     }
     if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
       ros_.Publish(map_id_, MapMessage(m.Map(options_.inspection.map_voxel_m),
@@ -488,11 +490,11 @@ void Subscribe(Node& node, const InspectionNodeOptions& o) {
     node.ros.SubscribeOdometry(o.topics.odometry, o.frame_queue,
                                [intake](OdometryMessage&& m) { intake->OnOdometry(std::move(m)); });
   } else {
-    node.ros.SubscribeTransforms(o.topics.tf, o.frame_queue,
-                                 [intake, &o](std::vector<TransformMessage>&& ts) {
-      if (std::optional<OdometryMessage> m = NavigationFromTransforms(ts, o.frames))
-        intake->OnOdometry(std::move(*m));
-    });
+    node.ros.SubscribeTransforms(
+        o.topics.tf, o.frame_queue, [intake, &o](std::vector<TransformMessage>&& ts) {
+          if (std::optional<OdometryMessage> m = NavigationFromTransforms(ts, o.frames))
+            intake->OnOdometry(std::move(*m));
+        });
   }
   if (!o.camera) {
     node.ros.SubscribeImages(o.topics.frames, o.frame_queue,

@@ -20,11 +20,12 @@
 namespace uwscan::ros {
 
 struct RecognitionNodeOptions {
-  std::string sweeps_topic = RosTopics{}.sweeps;         // sensor_msgs/PointCloud2, in
-  std::string objects_topic = RosTopics{}.objects;       // visualization_msgs/MarkerArray
-  std::string poses_topic = RosTopics{}.object_poses;    // one PoseWithCovarianceStamped per object
-  std::string grasps_topic = RosTopics{}.grasps;         // geometry_msgs/PoseArray, every grasp of the sweep
-  int min_points = 200;                         // sweeps with fewer points are skipped, >= 1
+  std::string sweeps_topic = RosTopics{}.sweeps;       // sensor_msgs/PointCloud2, in
+  std::string objects_topic = RosTopics{}.objects;     // visualization_msgs/MarkerArray
+  std::string poses_topic = RosTopics{}.object_poses;  // one PoseWithCovarianceStamped per object
+  std::string grasps_topic =
+      RosTopics{}.grasps;  // geometry_msgs/PoseArray, every grasp of the sweep
+  int min_points = 200;    // sweeps with fewer points are skipped, >= 1
   int model_marker_points = kDefaultModelMarkerPoints;  // per object (evenly strided), >= 1
   perception::RecognitionOptions recognition;
   // Stop after this many sweeps recognised (0: no limit), or once no sweep came for idle_stop_s

@@ -23,7 +23,8 @@ std::string CheckMessage(const std::string& address) {
 TEST(CameraSettings, TheCameraIsGivenByItsIpv4AddressOnly) {
   EXPECT_EQ(CheckMessage("127.0.0.1"), "");
   EXPECT_EQ(CheckMessage("192.168.10.20"), "");
-  for (const char* name : {"not-an-ip", "camera-1", "127.0.0", "127.0.0.256", "::1", " 127.0.0.1", "Basler-4711"}) {
+  for (const char* name :
+       {"not-an-ip", "camera-1", "127.0.0", "127.0.0.256", "::1", " 127.0.0.1", "Basler-4711"}) {
     const std::string message = CheckMessage(name);
     EXPECT_NE(message.find("is not an IPv4 address"), std::string::npos) << name << ": " << message;
     EXPECT_NE(message.find(std::string("'") + name + "'"), std::string::npos) << message;

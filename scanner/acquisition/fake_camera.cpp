@@ -45,7 +45,8 @@ double Uniform(std::uint64_t seed, std::uint64_t counter) {
   return static_cast<double>(z >> 11) * 0x1.0p-53;
 }
 
-void WriteString(ArvFakeCamera* camera, guint32 address, const std::string& text, std::size_t length) {
+void WriteString(ArvFakeCamera* camera, guint32 address, const std::string& text,
+                 std::size_t length) {
   std::vector<char> bytes(length, 0);
   std::memcpy(bytes.data(), text.data(), std::min(text.size(), length - 1));
   arv_fake_camera_write_memory(camera, address, static_cast<guint32>(length), bytes.data());
@@ -53,15 +54,21 @@ void WriteString(ArvFakeCamera* camera, guint32 address, const std::string& text
 
 }  // namespace
 
-const char* ToString(FakeCameraMode mode) { return mode == FakeCameraMode::kImage ? "image" : "profile"; }
+const char* ToString(FakeCameraMode mode) {
+  return mode == FakeCameraMode::kImage ? "image" : "profile";
+}
 
 void FakeCameraOptions::Check() const {
   if (address.empty()) throw Error("fake camera: address is empty");
-  if (serial.empty() || serial.size() > 15) throw Error("fake camera: serial must have 1 to 15 characters");
+  if (serial.empty() || serial.size() > 15)
+    throw Error("fake camera: serial must have 1 to 15 characters");
   if (!(frame_rate_hz >= 0.0 && frame_rate_hz <= 1000.0)) {
-    throw Error("fake camera: frame rate must be in (0, 1000] frames/s (Aravis's fake camera's ceiling), or 0");
+    throw Error(
+        "fake camera: frame rate must be in (0, 1000] frames/s (Aravis's fake camera's ceiling), "
+        "or 0");
   }
-  if (!(loss_ratio >= 0.0 && loss_ratio < 1.0)) throw Error("fake camera: loss ratio must be in [0, 1)");
+  if (!(loss_ratio >= 0.0 && loss_ratio < 1.0))
+    throw Error("fake camera: loss ratio must be in [0, 1)");
   if (peak_rows < 1 || peak_rows > 64) throw Error("fake camera: peak_rows must be in [1, 64]");
   if (threads < 0) throw Error("fake camera: threads must be >= 0");
 }
@@ -108,7 +115,8 @@ struct FakeCamera::Impl {
 
   void FillFrame(ArvBuffer* buffer, guint32 exposure_us, ArvPixelFormat pixel_format) {
     const std::uint64_t n = counter++;
-    const std::int64_t index = static_cast<std::int64_t>(n % static_cast<std::uint64_t>(frame_count));
+    const std::int64_t index =
+        static_cast<std::int64_t>(n % static_cast<std::uint64_t>(frame_count));
     const std::uint64_t pass = n / static_cast<std::uint64_t>(frame_count);
     const MirrorCommand command = driver.OnTrigger(n);
     FrameMetadata metadata;
@@ -117,8 +125,9 @@ struct FakeCamera::Impl {
     metadata.sweep = frame_sweeps[static_cast<std::size_t>(index)] +
                      static_cast<int>(pass * static_cast<std::uint64_t>(frames_per_dive_sweeps));
     metadata.exposure_us = exposure_us;
-    const double time_s = frame_times_s[static_cast<std::size_t>(index)] +
-                          static_cast<double>(pass) * static_cast<double>(frame_count) * frame_period_s;
+    const double time_s =
+        frame_times_s[static_cast<std::size_t>(index)] +
+        static_cast<double>(pass) * static_cast<double>(frame_count) * frame_period_s;
     metadata.timestamp_ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, time_s) * 1e9));
 
     // The fill callback gets no payload size from Aravis (arv_buffer_get_data reports 0 here):
@@ -134,7 +143,8 @@ struct FakeCamera::Impl {
     const std::span<std::uint8_t> payload(out, size);
     if (!images.empty()) {
       FillImage(payload, index, width, height, bytes_per_pixel, buffer);
-    } else if (width == profile_layout.lines && height == profile_layout.peak_rows + 1 && bytes_per_pixel == 2) {
+    } else if (width == profile_layout.lines && height == profile_layout.peak_rows + 1 &&
+               bytes_per_pixel == 2) {
       const std::vector<std::uint8_t>& rows = peak_rows[static_cast<std::size_t>(index)];
       std::memcpy(out, rows.data(), rows.size());
       peaks_lost += static_cast<std::uint64_t>(peaks_dropped[static_cast<std::size_t>(index)]);
@@ -187,18 +197,21 @@ struct FakeCamera::Impl {
     const sim::Scene& scene = simulator.scene();
     profile_layout.axis = scene.detector.axis;
     profile_layout.lines = profile_layout.axis == StripeAxis::kRows ? image_height : image_width;
-    profile_layout.line_length_px = profile_layout.axis == StripeAxis::kRows ? image_width : image_height;
+    profile_layout.line_length_px =
+        profile_layout.axis == StripeAxis::kRows ? image_width : image_height;
     profile_layout.peak_rows = options.peak_rows;
     profile_layout.Check();
     const bool image_mode = options.mode == FakeCameraMode::kImage;
     if (image_mode && !scene.effects.AnyImageStage()) {
-      throw Error("fake camera: image mode needs a scene that renders frames (an image effect on); " +
-                  scene.source + " gives exact peaks only (use --mode profile)");
+      throw Error(
+          "fake camera: image mode needs a scene that renders frames (an image effect on); " +
+          scene.source + " gives exact peaks only (use --mode profile)");
     }
     const auto count = static_cast<std::size_t>(frame_count);
     frame_times_s.assign(count, 0.0);
     frame_sweeps.assign(count, 0);
-    if (image_mode) images.assign(count, {});
+    if (image_mode)
+      images.assign(count, {});
     else {
       peak_rows.assign(count, {});
       peaks_dropped.assign(count, 0);
@@ -212,21 +225,24 @@ struct FakeCamera::Impl {
         sim::SimulatedFrame f = simulator.Frame(i);
         const MirrorCommand expected = driver.CommandOf(static_cast<std::uint64_t>(i));
         if (f.command != expected.command || f.sweep != expected.sweep) {
-          throw Error("fake camera: frame " + std::to_string(i) + " was simulated with mirror command " +
-                      std::to_string(f.command) + " (sweep " + std::to_string(f.sweep) +
-                      ") but the mirror driver gives " + std::to_string(expected.command) + " (sweep " +
+          throw Error("fake camera: frame " + std::to_string(i) +
+                      " was simulated with mirror command " + std::to_string(f.command) +
+                      " (sweep " + std::to_string(f.sweep) + ") but the mirror driver gives " +
+                      std::to_string(expected.command) + " (sweep " +
                       std::to_string(expected.sweep) + ")");
         }
         const auto k = static_cast<std::size_t>(i);
         frame_times_s[k] = f.time_s;
         frame_sweeps[k] = f.sweep;
         if (image_mode) {
-          if (!f.image) throw Error("fake camera: frame " + std::to_string(i) + " was not rendered");
+          if (!f.image)
+            throw Error("fake camera: frame " + std::to_string(i) + " was not rendered");
           images[k] = std::move(*f.image);
         } else {
           std::vector<std::uint8_t> payload(profile_layout.payload_bytes());
           const ProfileEncodeResult r = EncodeProfile(profile_layout, f.peaks_px, {}, payload);
-          payload.resize(static_cast<std::size_t>(profile_layout.peak_rows) * profile_layout.lines * 2);
+          payload.resize(static_cast<std::size_t>(profile_layout.peak_rows) * profile_layout.lines *
+                         2);
           peak_rows[k] = std::move(payload);
           peaks_dropped[k] = r.peaks_dropped;
         }
@@ -235,7 +251,8 @@ struct FakeCamera::Impl {
         if (!failure) failure = std::current_exception();
       }
       const std::int64_t finished = ++done;
-      if (progress && omp_get_thread_num() == 0) progress(static_cast<double>(finished) / frame_count);
+      if (progress && omp_get_thread_num() == 0)
+        progress(static_cast<double>(finished) / frame_count);
     }
     if (failure) std::rethrow_exception(failure);
     if (progress) progress(1.0);
@@ -259,14 +276,16 @@ struct FakeCamera::Impl {
     std::filesystem::remove_all(folder, ignored);
     if (gv == nullptr || !arv_gv_fake_camera_is_running(gv)) {
       if (gv != nullptr) g_clear_object(&gv);
-      throw Error("fake camera: cannot answer on " + options.address +
-                  " (no interface with that address or name, or the GigE Vision port 3956 is taken)");
+      throw Error(
+          "fake camera: cannot answer on " + options.address +
+          " (no interface with that address or name, or the GigE Vision port 3956 is taken)");
     }
     ArvFakeCamera* camera = arv_gv_fake_camera_get_fake_camera(gv);
     WriteString(camera, kManufacturerName, "uwscan", 32);
     WriteString(camera, kModelName, "uwscan simulated laser camera", 32);
     const bool image_mode = !images.empty();
-    const guint32 width = image_mode ? static_cast<guint32>(image_width) : static_cast<guint32>(profile_layout.lines);
+    const guint32 width =
+        image_mode ? static_cast<guint32>(image_width) : static_cast<guint32>(profile_layout.lines);
     const guint32 height = image_mode ? static_cast<guint32>(image_height + 1)
                                       : static_cast<guint32>(profile_layout.peak_rows + 1);
     arv_fake_camera_write_register(camera, ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, width);
@@ -280,8 +299,10 @@ struct FakeCamera::Impl {
                                    static_cast<guint32>(std::llround(1e6 / frame_rate)));
     arv_fake_camera_set_trigger_frequency(camera, frame_rate);
     arv_fake_camera_write_register(camera, kRegPayloadMode, image_mode ? 0 : 1);
-    arv_fake_camera_write_register(camera, kRegStripeAxis, profile_layout.axis == StripeAxis::kRows ? 1 : 0);
-    arv_fake_camera_write_register(camera, kRegPeakRows, static_cast<guint32>(profile_layout.peak_rows));
+    arv_fake_camera_write_register(camera, kRegStripeAxis,
+                                   profile_layout.axis == StripeAxis::kRows ? 1 : 0);
+    arv_fake_camera_write_register(camera, kRegPeakRows,
+                                   static_cast<guint32>(profile_layout.peak_rows));
     arv_fake_camera_write_register(camera, kRegImageWidth, static_cast<guint32>(image_width));
     arv_fake_camera_write_register(camera, kRegImageHeight, static_cast<guint32>(image_height));
     arv_fake_camera_set_fill_pattern(camera, &Impl::Fill, this);

@@ -19,7 +19,8 @@ template <typename T>
 void Put(std::uint8_t* at, T value) {
   using U = std::make_unsigned_t<T>;
   U u = static_cast<U>(value);
-  for (std::size_t i = 0; i < sizeof(T); ++i) at[i] = static_cast<std::uint8_t>((u >> (8 * i)) & 0xFF);
+  for (std::size_t i = 0; i < sizeof(T); ++i)
+    at[i] = static_cast<std::uint8_t>((u >> (8 * i)) & 0xFF);
 }
 
 template <typename T>
@@ -45,8 +46,8 @@ const std::uint16_t* Row16(std::span<const std::uint8_t> payload, int width, int
 
 void EncodeMetadata(const FrameMetadata& m, std::span<std::uint8_t> row) {
   if (row.size() < kMetadataBytes) {
-    throw Error("frame metadata: row of " + std::to_string(row.size()) + " bytes, expected at least " +
-                std::to_string(kMetadataBytes));
+    throw Error("frame metadata: row of " + std::to_string(row.size()) +
+                " bytes, expected at least " + std::to_string(kMetadataBytes));
   }
   std::fill(row.begin(), row.end(), std::uint8_t{0});
   std::uint8_t* p = row.data();
@@ -63,7 +64,8 @@ void EncodeMetadata(const FrameMetadata& m, std::span<std::uint8_t> row) {
 std::optional<FrameMetadata> DecodeMetadata(std::span<const std::uint8_t> row) {
   if (row.size() < kMetadataBytes) return std::nullopt;
   const std::uint8_t* p = row.data();
-  if (std::memcmp(p, kMagic, 4) != 0 || Get<std::uint16_t>(p + 4) != kLayoutVersion) return std::nullopt;
+  if (std::memcmp(p, kMagic, 4) != 0 || Get<std::uint16_t>(p + 4) != kLayoutVersion)
+    return std::nullopt;
   if (Get<std::uint64_t>(p + kChecksumOffset) != Checksum(p)) return std::nullopt;
   FrameMetadata m;
   m.frame_counter = Get<std::uint64_t>(p + 8);
@@ -80,7 +82,8 @@ void ProfileLayout::Check() const {
                 ", expected [32, 65535] (the metadata row needs 32 pixels)");
   }
   if (line_length_px < 1 || line_length_px > 65536) {
-    throw Error("profile layout: line_length_px " + std::to_string(line_length_px) + ", expected [1, 65536]");
+    throw Error("profile layout: line_length_px " + std::to_string(line_length_px) +
+                ", expected [1, 65536]");
   }
   if (peak_rows < 1 || peak_rows > 64) {
     throw Error("profile layout: peak_rows " + std::to_string(peak_rows) + ", expected [1, 64]");
@@ -98,8 +101,8 @@ ProfileEncodeResult EncodeProfile(const ProfileLayout& layout,
                                   const FrameMetadata& metadata, std::span<std::uint8_t> payload) {
   layout.Check();
   if (payload.size() != layout.payload_bytes()) {
-    throw Error("profile encoding: payload of " + std::to_string(payload.size()) + " bytes, expected " +
-                std::to_string(layout.payload_bytes()));
+    throw Error("profile encoding: payload of " + std::to_string(payload.size()) +
+                " bytes, expected " + std::to_string(layout.payload_bytes()));
   }
   const bool rows = layout.axis == StripeAxis::kRows;
   const double scale = std::ldexp(1.0, layout.fraction_bits());
@@ -111,12 +114,13 @@ ProfileEncodeResult EncodeProfile(const ProfileLayout& layout,
     const double position = rows ? p.x() : p.y();
     const double line = std::round(line_coord);
     if (std::abs(line_coord - line) > 1e-6) {
-      throw Error("profile encoding: peak (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
-                  ") px is not on a line centre");
+      throw Error("profile encoding: peak (" + std::to_string(p.x()) + ", " +
+                  std::to_string(p.y()) + ") px is not on a line centre");
     }
-    if (line < 0 || line >= layout.lines || position < -0.5 || position > layout.line_length_px - 0.5) {
-      throw Error("profile encoding: peak (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
-                  ") px lies outside the image");
+    if (line < 0 || line >= layout.lines || position < -0.5 ||
+        position > layout.line_length_px - 0.5) {
+      throw Error("profile encoding: peak (" + std::to_string(p.x()) + ", " +
+                  std::to_string(p.y()) + ") px lies outside the image");
     }
     per_line[static_cast<std::size_t>(line)].push_back(position);
   }
@@ -138,7 +142,8 @@ ProfileEncodeResult EncodeProfile(const ProfileLayout& layout,
       ++result.peaks_encoded;
     }
   }
-  EncodeMetadata(metadata, payload.subspan(static_cast<std::size_t>(layout.peak_rows) * layout.lines * 2));
+  EncodeMetadata(metadata,
+                 payload.subspan(static_cast<std::size_t>(layout.peak_rows) * layout.lines * 2));
   return result;
 }
 
@@ -147,8 +152,8 @@ std::optional<DecodedProfile> DecodeProfile(const ProfileLayout& layout,
   layout.Check();
   if (payload.size() < layout.payload_bytes()) return std::nullopt;
   const std::size_t row_bytes = static_cast<std::size_t>(layout.lines) * 2;
-  std::optional<FrameMetadata> metadata =
-      DecodeMetadata(payload.subspan(static_cast<std::size_t>(layout.peak_rows) * row_bytes, row_bytes));
+  std::optional<FrameMetadata> metadata = DecodeMetadata(
+      payload.subspan(static_cast<std::size_t>(layout.peak_rows) * row_bytes, row_bytes));
   if (!metadata) return std::nullopt;
   DecodedProfile out;
   out.metadata = *metadata;
@@ -171,16 +176,17 @@ void ImageLayout::Check() const {
                 " px, expected 1..65535 x 1..65534");
   }
   if (row_bytes() < kMetadataBytes) {
-    throw Error("image layout: a row of " + std::to_string(row_bytes()) + " bytes cannot hold the " +
-                std::to_string(kMetadataBytes) + "-byte metadata row");
+    throw Error("image layout: a row of " + std::to_string(row_bytes()) +
+                " bytes cannot hold the " + std::to_string(kMetadataBytes) + "-byte metadata row");
   }
 }
 
-std::optional<DecodedImage> DecodeImage(const ImageLayout& layout, std::span<const std::uint8_t> payload) {
+std::optional<DecodedImage> DecodeImage(const ImageLayout& layout,
+                                        std::span<const std::uint8_t> payload) {
   layout.Check();
   if (payload.size() < layout.payload_bytes()) return std::nullopt;
-  std::optional<FrameMetadata> metadata = DecodeMetadata(
-      payload.subspan(layout.row_bytes() * static_cast<std::size_t>(layout.height_px), layout.row_bytes()));
+  std::optional<FrameMetadata> metadata = DecodeMetadata(payload.subspan(
+      layout.row_bytes() * static_cast<std::size_t>(layout.height_px), layout.row_bytes()));
   if (!metadata) return std::nullopt;
   DecodedImage out;
   out.metadata = *metadata;

@@ -103,7 +103,9 @@ struct ImageLayout {
   std::size_t row_bytes() const {
     return static_cast<std::size_t>(width_px) * static_cast<std::size_t>(BytesPerPixel(format));
   }
-  std::size_t payload_bytes() const { return row_bytes() * static_cast<std::size_t>(height_px + 1); }
+  std::size_t payload_bytes() const {
+    return row_bytes() * static_cast<std::size_t>(height_px + 1);
+  }
 };
 
 // The image part of an image-mode payload (a view into it) and its metadata.

@@ -24,7 +24,8 @@ FrameMetadata SomeMetadata() {
 TEST(FrameMetadata, RoundTripsEveryField) {
   std::vector<std::uint8_t> row(100, 0xAB);
   EncodeMetadata(SomeMetadata(), row);
-  EXPECT_TRUE(std::all_of(row.begin() + kMetadataBytes, row.end(), [](std::uint8_t b) { return b == 0; }));
+  EXPECT_TRUE(
+      std::all_of(row.begin() + kMetadataBytes, row.end(), [](std::uint8_t b) { return b == 0; }));
   const std::optional<FrameMetadata> back = DecodeMetadata(row);
   ASSERT_TRUE(back);
   EXPECT_EQ(*back, SomeMetadata());
@@ -87,8 +88,9 @@ TEST(ProfileEncoding, RoundTripWithinTheFixedPointStep) {
     EXPECT_EQ(decoded->metadata, SomeMetadata());
     ASSERT_EQ(decoded->peaks_px.size(), peaks.size());
     auto by_line = [axis](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-      return axis == StripeAxis::kRows ? std::make_pair(a.y(), a.x()) < std::make_pair(b.y(), b.x())
-                                       : std::make_pair(a.x(), a.y()) < std::make_pair(b.x(), b.y());
+      return axis == StripeAxis::kRows
+                 ? std::make_pair(a.y(), a.x()) < std::make_pair(b.y(), b.x())
+                 : std::make_pair(a.x(), a.y()) < std::make_pair(b.x(), b.y());
     };
     std::sort(peaks.begin(), peaks.end(), by_line);
     const double step = std::ldexp(1.0, -layout.fraction_bits());
@@ -137,7 +139,8 @@ TEST(ImageEncoding, MetadataRowFollowsTheImage) {
   for (const PixelFormat format : {PixelFormat::kMono8, PixelFormat::kMono16}) {
     ImageLayout layout{64, 8, format};
     std::vector<std::uint8_t> payload(layout.payload_bytes(), 7);
-    EncodeMetadata(SomeMetadata(), std::span<std::uint8_t>(payload).subspan(layout.row_bytes() * 8));
+    EncodeMetadata(SomeMetadata(),
+                   std::span<std::uint8_t>(payload).subspan(layout.row_bytes() * 8));
     const std::optional<DecodedImage> d = DecodeImage(layout, payload);
     ASSERT_TRUE(d);
     EXPECT_EQ(d->metadata, SomeMetadata());

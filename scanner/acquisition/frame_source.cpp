@@ -35,9 +35,12 @@ ArvPixelFormat ToArv(PixelFormat format) {
 
 const char* ToString(TriggerMode mode) {
   switch (mode) {
-    case TriggerMode::kFreeRun: return "free";
-    case TriggerMode::kSoftware: return "software";
-    case TriggerMode::kLine: return "line";
+    case TriggerMode::kFreeRun:
+      return "free";
+    case TriggerMode::kSoftware:
+      return "software";
+    case TriggerMode::kLine:
+      return "line";
   }
   return "?";
 }
@@ -49,7 +52,9 @@ std::optional<TriggerMode> TriggerModeFromString(const std::string& name) {
   return std::nullopt;
 }
 
-const char* ToString(ReceivePath path) { return path == ReceivePath::kPacketSocket ? "packet" : "udp"; }
+const char* ToString(ReceivePath path) {
+  return path == ReceivePath::kPacketSocket ? "packet" : "udp";
+}
 
 std::optional<ReceivePath> ReceivePathFromString(const std::string& name) {
   if (name == "packet") return ReceivePath::kPacketSocket;
@@ -63,13 +68,15 @@ void CameraSettings::Check() const {
   if (inet_pton(AF_INET, address.c_str(), &parsed) != 1) {
     // Aravis takes anything else for a device name and looks for it on every interface.
     throw Error("camera settings: address '" + address +
-                "' is not an IPv4 address (a.b.c.d): cameras are opened by address, never searched for by name");
+                "' is not an IPv4 address (a.b.c.d): cameras are opened by address, never searched "
+                "for by name");
   }
   if (roi_x_px < 0 || roi_y_px < 0 || roi_width_px < 0 || roi_height_px < 0 ||
       (roi_width_px > 0) != (roi_height_px > 0)) {
     throw Error("camera settings: roi must be non-negative, width and height both set or both 0");
   }
-  if (!(exposure_us >= 0.0) || !std::isfinite(exposure_us)) throw Error("camera settings: exposure_us must be >= 0");
+  if (!(exposure_us >= 0.0) || !std::isfinite(exposure_us))
+    throw Error("camera settings: exposure_us must be >= 0");
   if (!std::isfinite(gain)) throw Error("camera settings: gain must be finite");
   if (!(frame_rate_hz >= 0.0 && frame_rate_hz <= 100000.0)) {
     throw Error("camera settings: frame_rate_hz must be in [0, 100000] Hz");
@@ -77,8 +84,10 @@ void CameraSettings::Check() const {
   if (packet_size_bytes != 0 && (packet_size_bytes < 576 || packet_size_bytes > 65000)) {
     throw Error("camera settings: packet_size_bytes must be 0 or in [576, 65000]");
   }
-  if (buffers < 2 || buffers > 100000) throw Error("camera settings: buffers must be in [2, 100000]");
-  if (!(watchdog_s > 0.0 && watchdog_s <= 3600.0)) throw Error("camera settings: watchdog_s must be in (0, 3600] s");
+  if (buffers < 2 || buffers > 100000)
+    throw Error("camera settings: buffers must be in [2, 100000]");
+  if (!(watchdog_s > 0.0 && watchdog_s <= 3600.0))
+    throw Error("camera settings: watchdog_s must be in (0, 3600] s");
   if (!(frame_retention_s > 0.0 && frame_retention_s <= 60.0)) {
     throw Error("camera settings: frame_retention_s must be in (0, 60] s");
   }
@@ -132,10 +141,12 @@ struct FrameSource::Impl {
     GError* error = nullptr;
     camera = arv_camera_new(settings.address.c_str(), &error);
     if (camera == nullptr || error != nullptr) {
-      const std::string message = error != nullptr && error->message != nullptr ? error->message : "no answer";
+      const std::string message =
+          error != nullptr && error->message != nullptr ? error->message : "no answer";
       if (error != nullptr) g_error_free(error);
       if (camera != nullptr) g_clear_object(&camera);
-      throw Error("camera " + settings.address + ": no GigE Vision camera answers there (" + message + ")");
+      throw Error("camera " + settings.address + ": no GigE Vision camera answers there (" +
+                  message + ")");
     }
     try {
       TakeControl(control_wait_s);
@@ -159,8 +170,8 @@ struct FrameSource::Impl {
       if (waited_s >= wait_s) {
         char seconds[32];
         std::snprintf(seconds, sizeof seconds, "%.1f", waited_s);
-        throw Error(where + ": another program controls the camera (control refused, waited " + seconds +
-                    " s; is another acquire running?)");
+        throw Error(where + ": another program controls the camera (control refused, waited " +
+                    seconds + " s; is another acquire running?)");
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(250));
       GError* error = nullptr;
@@ -202,9 +213,15 @@ struct FrameSource::Impl {
       ThrowIf(error, where + ": AcquisitionFrameRate refused");
     }
     switch (settings.trigger) {
-      case TriggerMode::kFreeRun: arv_camera_clear_triggers(camera, &error); break;
-      case TriggerMode::kSoftware: arv_camera_set_trigger(camera, "Software", &error); break;
-      case TriggerMode::kLine: arv_camera_set_trigger(camera, settings.trigger_line.c_str(), &error); break;
+      case TriggerMode::kFreeRun:
+        arv_camera_clear_triggers(camera, &error);
+        break;
+      case TriggerMode::kSoftware:
+        arv_camera_set_trigger(camera, "Software", &error);
+        break;
+      case TriggerMode::kLine:
+        arv_camera_set_trigger(camera, settings.trigger_line.c_str(), &error);
+        break;
     }
     ThrowIf(error, where + ": trigger " + ToString(settings.trigger) + " refused");
     if (settings.packet_size_bytes > 0) {
@@ -227,7 +244,8 @@ struct FrameSource::Impl {
     const ArvPixelFormat format = arv_camera_get_pixel_format(camera, &error);
     ThrowIf(error, where + ": cannot read PixelFormat");
     if (format != ARV_PIXEL_FORMAT_MONO_8 && format != ARV_PIXEL_FORMAT_MONO_16) {
-      throw Error(where + ": pixel format " + std::to_string(format) + " is neither Mono8 nor Mono16");
+      throw Error(where + ": pixel format " + std::to_string(format) +
+                  " is neither Mono8 nor Mono16");
     }
     payload_bytes = arv_camera_get_payload(camera, &error);
     ThrowIf(error, where + ": cannot read PayloadSize");
@@ -247,9 +265,11 @@ struct FrameSource::Impl {
     ThrowIf(error, where + ": cannot read UwscanStripeAxis");
     payload.profile = mode != nullptr && std::strcmp(mode, "Profile") == 0;
     if (payload.profile) {
-      if (payload.format != PixelFormat::kMono16) throw Error(where + ": profile payloads must be Mono16");
+      if (payload.format != PixelFormat::kMono16)
+        throw Error(where + ": profile payloads must be Mono16");
       ProfileLayout& p = payload.profile_layout;
-      p.axis = axis != nullptr && std::strcmp(axis, "Columns") == 0 ? StripeAxis::kColumns : StripeAxis::kRows;
+      p.axis = axis != nullptr && std::strcmp(axis, "Columns") == 0 ? StripeAxis::kColumns
+                                                                    : StripeAxis::kRows;
       p.lines = width;
       p.peak_rows = height - 1;
       const gint64 image_width = arv_camera_get_integer(camera, "UwscanImageWidth", &error);
@@ -259,7 +279,8 @@ struct FrameSource::Impl {
       p.line_length_px = static_cast<int>(p.axis == StripeAxis::kRows ? image_width : image_height);
       p.Check();
     } else {
-      if (height < 2) throw Error(where + ": an image payload needs a metadata row below the image");
+      if (height < 2)
+        throw Error(where + ": an image payload needs a metadata row below the image");
       payload.image_layout = {width, height - 1, payload.format};
       payload.image_layout.Check();
     }
@@ -274,9 +295,11 @@ struct FrameSource::Impl {
       throw Error("camera " + settings.address + ": cannot open a stream");
     }
     if (ARV_IS_GV_STREAM(s)) {
-      g_object_set(s, "frame-retention", static_cast<guint>(settings.frame_retention_s * 1e6), nullptr);
+      g_object_set(s, "frame-retention", static_cast<guint>(settings.frame_retention_s * 1e6),
+                   nullptr);
     }
-    for (int i = 0; i < settings.buffers; ++i) arv_stream_push_buffer(s, arv_buffer_new_allocate(payload_bytes));
+    for (int i = 0; i < settings.buffers; ++i)
+      arv_stream_push_buffer(s, arv_buffer_new_allocate(payload_bytes));
     stream.store(s);
   }
 
@@ -310,14 +333,17 @@ struct FrameSource::Impl {
     if (camera != nullptr) g_clear_object(&camera);
   }
 
-  double Since(Clock::time_point t) const { return std::chrono::duration<double>(t - start_time).count(); }
+  double Since(Clock::time_point t) const {
+    return std::chrono::duration<double>(t - start_time).count();
+  }
 
   // The watchdog: a camera silent for watchdog_s is reopened with the same settings.
   void Watchdog() {
     const Clock::time_point now = Clock::now();
     if (!started) return;
     if (!in_gap) {
-      if (std::chrono::duration<double>(now - last_frame_time).count() < settings.watchdog_s) return;
+      if (std::chrono::duration<double>(now - last_frame_time).count() < settings.watchdog_s)
+        return;
       in_gap = true;
       CameraGap gap;
       gap.silent_after_s = Since(last_frame_time);
@@ -346,9 +372,7 @@ FrameSource::FrameSource(const CameraSettings& settings) : impl_(std::make_uniqu
   impl_->Open(settings.control_wait_s);
 }
 
-FrameSource::~FrameSource() {
-  impl_->Close();
-}
+FrameSource::~FrameSource() { impl_->Close(); }
 
 const PayloadDescription& FrameSource::payload() const { return impl_->payload; }
 const CameraSettings& FrameSource::settings() const { return impl_->settings; }
@@ -370,7 +394,8 @@ std::optional<AcquiredFrame> FrameSource::Next(std::chrono::milliseconds timeout
     ArvBuffer* buffer = nullptr;
     {
       std::unique_lock<std::mutex> lock(m.mutex);
-      const Clock::time_point wake = std::min(deadline, Clock::now() + std::chrono::milliseconds(100));
+      const Clock::time_point wake =
+          std::min(deadline, Clock::now() + std::chrono::milliseconds(100));
       m.ready.wait_until(lock, wake, [&m] { return !m.done.empty(); });
       if (!m.done.empty()) {
         buffer = m.done.front();

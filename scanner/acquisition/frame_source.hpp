@@ -65,8 +65,8 @@ struct CameraSettings {
 
 // What the camera's GenICam features say its payload carries.
 struct PayloadDescription {
-  bool uwscan_layout = false;  // the camera describes its payload with the Uwscan* features
-  bool profile = false;        // profile mode (peaks); else image mode
+  bool uwscan_layout = false;    // the camera describes its payload with the Uwscan* features
+  bool profile = false;          // profile mode (peaks); else image mode
   ProfileLayout profile_layout;  // valid when profile
   ImageLayout image_layout;      // valid when !profile: the image rows (without metadata row)
   bool metadata_row = false;     // the payload's last row is a metadata row
@@ -78,11 +78,11 @@ struct PayloadDescription {
 };
 
 struct AcquiredFrame {
-  std::int64_t sequence = 0;        // frames handed out by this source, 0 first
-  std::uint16_t frame_id = 0;       // the camera's 16-bit GigE Vision block id
-  std::int64_t frame_number = 0;    // unwrapped frame id within the session, 0 first
-  std::int64_t lost_before = 0;     // frames the camera sent that never came, just before this
-  int session = 0;                  // how many times the camera was reopened before this frame
+  std::int64_t sequence = 0;      // frames handed out by this source, 0 first
+  std::uint16_t frame_id = 0;     // the camera's 16-bit GigE Vision block id
+  std::int64_t frame_number = 0;  // unwrapped frame id within the session, 0 first
+  std::int64_t lost_before = 0;   // frames the camera sent that never came, just before this
+  int session = 0;                // how many times the camera was reopened before this frame
   std::uint64_t camera_timestamp_ns = 0;  // the camera's clock
   std::uint64_t host_timestamp_ns = 0;    // the host's clock (real time) when Aravis got it
   std::vector<std::uint8_t> payload;      // a copy of the camera's bytes

@@ -11,7 +11,8 @@ MirrorCommand SimulatedMirrorDriver::CommandOf(std::uint64_t index) const {
   const int in_sweep = static_cast<int>(index % per_sweep);
   MirrorCommand c;
   c.sweep = static_cast<int>(index / per_sweep);
-  c.command = pattern_.kind == ScannerKind::kGalvo ? pattern_.galvo.StepOfFrame(in_sweep) : in_sweep;
+  c.command =
+      pattern_.kind == ScannerKind::kGalvo ? pattern_.galvo.StepOfFrame(in_sweep) : in_sweep;
   return c;
 }
 

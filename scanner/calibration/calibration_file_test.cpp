@@ -21,7 +21,8 @@ TEST(CalibrationFile, ScannerInMediumChangesOnlyTheWaterSide) {
   // A MEMS scanner's fitted projection functions follow its laser into the new medium.
   const Scanner mems = DefaultScanner(ScannerKind::kMems);
   const Scanner mems_in_air = ScannerInMedium(mems, 1.0);
-  EXPECT_NE(mems_in_air.mems().functions.f1.coefficients(), mems.mems().functions.f1.coefficients());
+  EXPECT_NE(mems_in_air.mems().functions.f1.coefficients(),
+            mems.mems().functions.f1.coefficients());
 }
 
 TEST(CalibrationFile, NowUtcIsIso8601) {
@@ -33,7 +34,8 @@ TEST(CalibrationFile, NowUtcIsIso8601) {
 }
 
 TEST(CalibrationFile, AtomicWriteKeepsTheOldFileOnFailure) {
-  const std::filesystem::path path = std::filesystem::temp_directory_path() / "uwscan_calib_atomic.yaml";
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / "uwscan_calib_atomic.yaml";
   WriteTextAtomically(path, "first\n");
   EXPECT_THROW(WriteTextAtomically("/nonexistent/folder/x.yaml", "second\n"), Error);
   std::ifstream in(path);

@@ -52,9 +52,10 @@ Plane BoardPlane(const Eigen::Isometry3d& T_C_O) {
   return plane;
 }
 
-void AddViewportParams(const std::string& key, const FlatViewport& v, double normal_std, double distance_std,
-                       double thickness_std, StepRecord* record) {
-  for (const ParameterEstimate& p : ViewportParameters(key, v, ViewportStds{normal_std, distance_std, thickness_std})) {
+void AddViewportParams(const std::string& key, const FlatViewport& v, double normal_std,
+                       double distance_std, double thickness_std, StepRecord* record) {
+  for (const ParameterEstimate& p :
+       ViewportParameters(key, v, ViewportStds{normal_std, distance_std, thickness_std})) {
     record->params.push_back(p);
   }
 }
@@ -68,7 +69,8 @@ class StepRunner {
   std::vector<PatternObservation> ViewObservations(std::vector<std::string>* missing) const {
     std::vector<PatternObservation> observations;
     for (size_t i = 0; i < dataset_.views.size(); ++i) {
-      std::optional<PatternObservation> found = DetectPattern(dataset_.ImagePath(dataset_.views[i]), dataset_.pattern);
+      std::optional<PatternObservation> found =
+          DetectPattern(dataset_.ImagePath(dataset_.views[i]), dataset_.pattern);
       if (found) {
         found->image = dataset_.views[i];
         observations.push_back(*found);
@@ -137,10 +139,12 @@ class StepRunner {
   const std::function<void(double)>& progress_;
 };
 
-CalibrationStepOutcome Intrinsics(const CalibrationDataset& d, const Scanner& initial, const StepRunner& run) {
+CalibrationStepOutcome Intrinsics(const CalibrationDataset& d, const Scanner& initial,
+                                  const StepRunner& run) {
   std::vector<std::string> missing;
   const std::vector<PatternObservation> views = run.ViewObservations(&missing);
-  const IntrinsicsResult r = CalibrateIntrinsics(d.pattern, views, d.width_px, d.height_px, IntrinsicsOptions{});
+  const IntrinsicsResult r =
+      CalibrateIntrinsics(d.pattern, views, d.width_px, d.height_px, IntrinsicsOptions{});
   CalibrationStepOutcome out;
   out.scanner = initial;
   out.scanner.camera().camera = r.camera;
@@ -152,16 +156,20 @@ CalibrationStepOutcome Intrinsics(const CalibrationDataset& d, const Scanner& in
     rec.residual_max = std::max(rec.residual_max, v.rms_px);
     rejected += v.rejected ? 1 : 0;
   }
-  for (const PatternObservation& v : views) rec.observations += static_cast<int>(v.corners_px.size());
+  for (const PatternObservation& v : views)
+    rec.observations += static_cast<int>(v.corners_px.size());
   const PinholeCamera& c = r.camera;
   rec.params = CameraParameters(c, &r);
-  out.summary.push_back(Format("%.0f views with the pattern, %.0f without, %.0f rejected", views.size(), missing.size(), rejected));
-  out.summary.push_back(Format("reprojection rms %.3f px; fx %.2f px, fy %.2f px", r.rms_px, c.fx_px, c.fy_px));
+  out.summary.push_back(Format("%.0f views with the pattern, %.0f without, %.0f rejected",
+                               views.size(), missing.size(), rejected));
+  out.summary.push_back(
+      Format("reprojection rms %.3f px; fx %.2f px, fy %.2f px", r.rms_px, c.fx_px, c.fy_px));
   return out;
 }
 
-CalibrationStepOutcome Viewport(const CalibrationDataset& d, const Scanner& work, const Scanner& initial,
-                                const StepRunner& run, const CalibrationStepOptions& options) {
+CalibrationStepOutcome Viewport(const CalibrationDataset& d, const Scanner& work,
+                                const Scanner& initial, const StepRunner& run,
+                                const CalibrationStepOptions& options) {
   const RefractiveCamera& camera = work.camera();
   std::vector<std::string> missing;
   const std::vector<PatternObservation> views = run.ViewObservations(&missing);
@@ -173,38 +181,47 @@ CalibrationStepOutcome Viewport(const CalibrationDataset& d, const Scanner& work
       CalibrateCameraViewport(camera.camera, camera.viewport, d.pattern, views, viewport_options);
   CalibrationStepOutcome out;
   out.scanner = initial;
-  out.scanner.camera().viewport = KeepIndices(r.viewport, initial.camera().viewport, options.refine_water_index,
-                                              options.refine_glass_index);
+  out.scanner.camera().viewport =
+      KeepIndices(r.viewport, initial.camera().viewport, options.refine_water_index,
+                  options.refine_glass_index);
   StepRecord& rec = out.record;
   rec.residual_unit = "px";
   rec.residual_rms = r.rms_px;
   rec.residual_max = r.max_px;
-  for (const PatternObservation& v : views) rec.observations += static_cast<int>(v.corners_px.size());
-  AddViewportParams("camera_viewport", r.viewport, r.normal_std_rad, r.distance_std_m, r.thickness_std_m, &rec);
-  if (options.refine_water_index) rec.params.push_back({"camera_viewport.n_water", r.viewport.n_water, r.n_water_std});
-  if (options.refine_glass_index) rec.params.push_back({"camera_viewport.n_glass", r.viewport.n_glass, r.n_glass_std});
-  out.summary.push_back(Format("%.0f views with the pattern, %.0f without; %.0f iterations", views.size(),
-                               missing.size(), r.iterations));
-  out.summary.push_back(Format("refractive reprojection rms %.3f px; viewport distance %.2f mm, thickness %.2f mm",
-                               r.rms_px, r.viewport.distance_m * 1e3, r.viewport.thickness_m * 1e3));
+  for (const PatternObservation& v : views)
+    rec.observations += static_cast<int>(v.corners_px.size());
+  AddViewportParams("camera_viewport", r.viewport, r.normal_std_rad, r.distance_std_m,
+                    r.thickness_std_m, &rec);
+  if (options.refine_water_index)
+    rec.params.push_back({"camera_viewport.n_water", r.viewport.n_water, r.n_water_std});
+  if (options.refine_glass_index)
+    rec.params.push_back({"camera_viewport.n_glass", r.viewport.n_glass, r.n_glass_std});
+  out.summary.push_back(Format("%.0f views with the pattern, %.0f without; %.0f iterations",
+                               views.size(), missing.size(), r.iterations));
+  out.summary.push_back(
+      Format("refractive reprojection rms %.3f px; viewport distance %.2f mm, thickness %.2f mm",
+             r.rms_px, r.viewport.distance_m * 1e3, r.viewport.thickness_m * 1e3));
   return out;
 }
 
 CalibrationStepOutcome Laser(const Scanner& work, const Scanner& initial, const std::string& source,
-                             const StepRunner& run, bool laser_viewport, const CalibrationStepOptions& options) {
+                             const StepRunner& run, bool laser_viewport,
+                             const CalibrationStepOptions& options) {
   if (work.kind() == ScannerKind::kMems) {
     throw Error(source + ": the laser steps calibrate a galvanometer scanner; this one is MEMS");
   }
   const GalvoScannerModel& model = work.galvo();
   const StepRunner::PlaneData planes = run.Planes(model.camera);
-  const std::vector<LaserCalibrationPoint> points = LaserCalibrationPoints(model.camera, planes.planes, planes.stripes);
+  const std::vector<LaserCalibrationPoint> points =
+      LaserCalibrationPoints(model.camera, planes.planes, planes.stripes);
   CalibrationStepOutcome out;
   out.scanner = initial;
   StepRecord& rec = out.record;
   rec.residual_unit = "m";
   rec.observations = static_cast<int>(points.size());
   if (!laser_viewport) {
-    const GalvoLaserCalibrationResult r = CalibrateGalvoLaser(points, model.laser, GalvoLaserCalibrationOptions{});
+    const GalvoLaserCalibrationResult r =
+        CalibrateGalvoLaser(points, model.laser, GalvoLaserCalibrationOptions{});
     GalvoLaser& laser = out.scanner.galvo().laser;
     laser.T_C_L = r.laser.T_C_L;
     laser.T_C_M = r.laser.T_C_M;
@@ -213,22 +230,25 @@ CalibrationStepOutcome Laser(const Scanner& work, const Scanner& initial, const 
     rec.residual_rms = r.residual_rms_m;
     rec.residual_max = r.residual_max_m;
     rec.params = GalvoLaserParameters(r.laser, &r.std_devs);
-    out.summary.push_back(Format("%.0f calibration points on %.0f planes (board poses %.3f px rms)", points.size(),
-                                 planes.planes.size(), planes.pose_rms_px));
-    out.summary.push_back(Format("laser fan residual rms %.4f mm, max %.4f mm; mirror step %.6f rad",
-                                 r.residual_rms_m * 1e3, r.residual_max_m * 1e3, r.laser.mirror_step_rad));
+    out.summary.push_back(Format("%.0f calibration points on %.0f planes (board poses %.3f px rms)",
+                                 points.size(), planes.planes.size(), planes.pose_rms_px));
+    out.summary.push_back(
+        Format("laser fan residual rms %.4f mm, max %.4f mm; mirror step %.6f rad",
+               r.residual_rms_m * 1e3, r.residual_max_m * 1e3, r.laser.mirror_step_rad));
   } else {
     LaserViewportCalibrationOptions viewport_options;
     viewport_options.refine_thickness = options.refine_thickness;
-    const LaserViewportCalibrationResult r = CalibrateLaserViewport(model, points, viewport_options);
+    const LaserViewportCalibrationResult r =
+        CalibrateLaserViewport(model, points, viewport_options);
     out.scanner.laser_viewport() = KeepIndices(r.viewport, initial.laser_viewport(), false, false);
     rec.residual_rms = r.residual_rms_m;
     rec.residual_max = r.residual_max_m;
-    AddViewportParams("laser_viewport", r.viewport, r.normal_std_rad, r.distance_std_m, r.thickness_std_m, &rec);
-    out.summary.push_back(Format("%.0f calibration points on %.0f planes (board poses %.3f px rms)", points.size(),
-                                 planes.planes.size(), planes.pose_rms_px));
-    out.summary.push_back(Format("ray-ray residual rms %.4f mm, max %.4f mm", r.residual_rms_m * 1e3,
-                                 r.residual_max_m * 1e3));
+    AddViewportParams("laser_viewport", r.viewport, r.normal_std_rad, r.distance_std_m,
+                      r.thickness_std_m, &rec);
+    out.summary.push_back(Format("%.0f calibration points on %.0f planes (board poses %.3f px rms)",
+                                 points.size(), planes.planes.size(), planes.pose_rms_px));
+    out.summary.push_back(Format("ray-ray residual rms %.4f mm, max %.4f mm",
+                                 r.residual_rms_m * 1e3, r.residual_max_m * 1e3));
   }
   return out;
 }
@@ -239,7 +259,8 @@ CalibrationStepOutcome Mems(const Scanner& work, const Scanner& initial, const s
     throw Error(source + ": the mems step calibrates a MEMS scanner; this one is a galvanometer");
   }
   const StepRunner::PlaneData planes = run.Planes(work.camera());
-  const MemsCalibrationResult r = CalibrateMemsProjection(work.camera(), planes.planes, planes.dots);
+  const MemsCalibrationResult r =
+      CalibrateMemsProjection(work.camera(), planes.planes, planes.dots);
   CalibrationStepOutcome out;
   out.scanner = initial;
   out.scanner.mems().functions = r.functions;
@@ -250,29 +271,36 @@ CalibrationStepOutcome Mems(const Scanner& work, const Scanner& initial, const s
   for (int i = 0; i < 6; ++i) {
     std::string f = "f";  // built by += : GCC 12 reports a false -Wrestrict on "f" + string
     f += std::to_string(i + 1);
-    rec.params.push_back({f + ".max_percent_error", r.errors[static_cast<size_t>(i)].max_percent, 0.0});
-    rec.params.push_back({f + ".mean_percent_error", r.errors[static_cast<size_t>(i)].mean_percent, 0.0});
+    rec.params.push_back(
+        {f + ".max_percent_error", r.errors[static_cast<size_t>(i)].max_percent, 0.0});
+    rec.params.push_back(
+        {f + ".mean_percent_error", r.errors[static_cast<size_t>(i)].mean_percent, 0.0});
     rec.residual_rms = std::max(rec.residual_rms, r.errors[static_cast<size_t>(i)].mean_percent);
     rec.residual_max = std::max(rec.residual_max, r.errors[static_cast<size_t>(i)].max_percent);
   }
   rec.params.push_back({"line_rms_m", r.line_rms_m, 0.0});
-  out.summary.push_back(Format("%.0f dots, %.0f voltage lines (line rms %.3f mm)", r.dots, r.lines.size(), r.line_rms_m * 1e3));
-  out.summary.push_back(Format("f1..f6 fitting error: worst %.4f %%, mean up to %.4f %%", rec.residual_max, rec.residual_rms));
+  out.summary.push_back(Format("%.0f dots, %.0f voltage lines (line rms %.3f mm)", r.dots,
+                               r.lines.size(), r.line_rms_m * 1e3));
+  out.summary.push_back(Format("f1..f6 fitting error: worst %.4f %%, mean up to %.4f %%",
+                               rec.residual_max, rec.residual_rms));
   return out;
 }
 
 }  // namespace
 
-CalibrationStepOutcome RunCalibrationStep(const std::string& step, const CalibrationDataset& dataset,
-                                          const Scanner& initial, const std::string& initial_source,
+CalibrationStepOutcome RunCalibrationStep(const std::string& step,
+                                          const CalibrationDataset& dataset, const Scanner& initial,
+                                          const std::string& initial_source,
                                           const std::function<void(double)>& progress,
                                           const CalibrationStepOptions& options) {
   const std::vector<std::string>& names = CalibrationSteps();
   if (std::find(names.begin(), names.end(), step) == names.end()) {
-    throw Error("calibrate: unknown step '" + step + "' (intrinsics, viewport, laser, laser_viewport, mems)");
+    throw Error("calibrate: unknown step '" + step +
+                "' (intrinsics, viewport, laser, laser_viewport, mems)");
   }
   if (dataset.step != step) {
-    throw Error(dataset.folder.string() + ": a dataset for step '" + dataset.step + "', not '" + step + "'");
+    throw Error(dataset.folder.string() + ": a dataset for step '" + dataset.step + "', not '" +
+                step + "'");
   }
   const Clock::time_point start = Clock::now();
   const StepRunner run(dataset, progress);

@@ -19,7 +19,7 @@ struct CalibrationStepOptions {
 };
 
 struct CalibrationStepOutcome {
-  Scanner scanner;                   // the scanner with this step's values and record
+  Scanner scanner;  // the scanner with this step's values and record
   StepRecord record;
   std::vector<std::string> summary;  // a few lines for the user (the app prints them)
 };
@@ -27,10 +27,12 @@ struct CalibrationStepOutcome {
 // Runs one step on a dataset: extracts the observations from its images (pattern corners,
 // board poses, stripe peaks, dots), estimates the step's parameters starting from
 // `initial` (CAD values, or the output of the earlier steps; `initial_source` names it in
-// messages) and returns the updated scanner with the step's record. Throws uwscan::Error naming the image or
-// the problem: a dataset of another step, no pattern found in any image, too few usable views.
-CalibrationStepOutcome RunCalibrationStep(const std::string& step, const CalibrationDataset& dataset,
-                                          const Scanner& initial, const std::string& initial_source,
+// messages) and returns the updated scanner with the step's record. Throws uwscan::Error naming the
+// image or the problem: a dataset of another step, no pattern found in any image, too few usable
+// views.
+CalibrationStepOutcome RunCalibrationStep(const std::string& step,
+                                          const CalibrationDataset& dataset, const Scanner& initial,
+                                          const std::string& initial_source,
                                           const std::function<void(double)>& progress = {},
                                           const CalibrationStepOptions& options = {});
 

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/sim/scene_fields.hpp"
 #include "scanner/common/yaml_fields.hpp"
+#include "scanner/sim/scene_fields.hpp"
 
 namespace uwscan::scanner::calibration::calibration_yaml {
 

@@ -14,11 +14,11 @@
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/stripe_extraction.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/lasers/mems_scanner_model.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/lasers/mems_scanner_model.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/simulator.hpp"
-#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

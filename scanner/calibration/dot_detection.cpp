@@ -28,7 +28,8 @@ void DotDetectionOptions::Check() const {
   if (!(threshold_fraction > 0.0 && threshold_fraction < 1.0)) {
     throw Error("dot detection: threshold_fraction must be in (0, 1)");
   }
-  if (min_peak_above_background < 1) throw Error("dot detection: min_peak_above_background must be >= 1");
+  if (min_peak_above_background < 1)
+    throw Error("dot detection: min_peak_above_background must be >= 1");
   if (max_radius_px < 1) throw Error("dot detection: max_radius_px must be >= 1");
 }
 
@@ -48,7 +49,8 @@ std::optional<Eigen::Vector2d> DetectDot(const std::filesystem::path& image_path
   cv::Point at;
   cv::minMaxLoc(image, nullptr, &peak, nullptr, &at);
   if (peak - background < options.min_peak_above_background) return std::nullopt;
-  const float threshold = static_cast<float>(background + options.threshold_fraction * (peak - background));
+  const float threshold =
+      static_cast<float>(background + options.threshold_fraction * (peak - background));
 
   // Flood the blob from the brightest pixel (4-connected), summing background-free intensity.
   cv::Mat visited(image.size(), CV_8U, cv::Scalar(0));
@@ -65,7 +67,8 @@ std::optional<Eigen::Vector2d> DetectDot(const std::filesystem::path& image_path
     sum += w;
     su += w * p.x;
     sv += w * p.y;
-    for (const cv::Point d : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+    for (const cv::Point d :
+         {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
       const cv::Point q = p + d;
       if (visited.at<std::uint8_t>(q) || image.at<float>(q) < threshold) continue;
       visited.at<std::uint8_t>(q) = 1;

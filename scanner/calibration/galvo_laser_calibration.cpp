@@ -18,8 +18,8 @@
 #include "scanner/calibration/galvo_laser_simplified.hpp"
 #include "scanner/calibration/jet_geometry.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/triangulation/light_plane.hpp"
 #include "scanner/optics/refraction.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

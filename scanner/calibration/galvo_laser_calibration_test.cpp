@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/triangulation/light_plane.hpp"
-#include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/common/random_draws.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -62,8 +62,7 @@ std::vector<LaserCalibrationPoint> Points(const GalvoLaser& laser, double noise_
         const RayTrace ray = fan.RayInWater(s);
         const RayHit hit = IntersectRayPlane(ray.ray, planes[i]);
         if (!ray.ok() || !hit.ok()) continue;
-        const Eigen::Vector3d p =
-            hit.point + noise_m * DrawVector3(noise, rng);
+        const Eigen::Vector3d p = hit.point + noise_m * DrawVector3(noise, rng);
         points.push_back(
             LaserCalibrationPoint{static_cast<int>(i), step, Eigen::Vector2d::Zero(), p});
       }

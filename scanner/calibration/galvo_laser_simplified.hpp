@@ -36,7 +36,7 @@ Simplified SimplifiedModel(const PointsByStep& by_step, const GalvoLaser& initia
 // the emitter. A stripe cut short (by the image, or the board's border) ends elsewhere: then
 // the angle between its step's two lines is not the aperture, and that step is not used.
 // std::nullopt when no step qualifies or the lines do not meet (rms gap above 2 mm).
-std::optional<Eigen::Vector3d> EmitterFromEdgeRays(const PointsByStep& by_step, const GalvoLaser& laser,
-                                                   double offset_l);
+std::optional<Eigen::Vector3d> EmitterFromEdgeRays(const PointsByStep& by_step,
+                                                   const GalvoLaser& laser, double offset_l);
 
 }  // namespace uwscan::scanner::calibration::galvo_simplified

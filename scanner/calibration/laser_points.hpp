@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/triangulation/light_plane.hpp"
 #include "scanner/optics/refractive_camera.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 
 namespace uwscan::scanner::calibration {
 

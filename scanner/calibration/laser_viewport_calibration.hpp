@@ -3,8 +3,8 @@
 #include <vector>
 
 #include "scanner/calibration/laser_points.hpp"
-#include "scanner/optics/flat_viewport.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/optics/flat_viewport.hpp"
 
 namespace uwscan::scanner::calibration {
 
@@ -24,7 +24,7 @@ struct LaserViewportCalibrationOptions {
   // against the distance and drifts by many of its standard deviations (15 mm true, 1.9 mm
   // estimated, std 1.5 mm); held at the measured value, the distance lands within 0.1 mm.
   bool refine_thickness = false;
-  int max_iterations = 200;      // Levenberg-Marquardt iterations, > 0
+  int max_iterations = 200;  // Levenberg-Marquardt iterations, > 0
 
   void Check() const;  // throws uwscan::Error naming the field
 };

@@ -12,9 +12,9 @@
 
 #include "scanner/calibration/galvo_laser_calibration.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/random_draws.hpp"
 #include "scanner/triangulation/light_plane.hpp"
 #include "scanner/triangulation/ray_ray_triangulator.hpp"
-#include "scanner/common/random_draws.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -58,8 +58,7 @@ std::vector<LaserCalibrationPoint> Points(const GalvoScannerModel& scanner, doub
         const RayTrace ray = fan.RayInWater(scanner.laser.MaxFanTan() * (-1.0 + 0.02 * k));
         const RayHit hit = IntersectRayPlane(ray.ray, planes[i]);
         if (!ray.ok() || !hit.ok()) continue;
-        const Eigen::Vector3d p =
-            hit.point + noise_m * DrawVector3(noise, rng);
+        const Eigen::Vector3d p = hit.point + noise_m * DrawVector3(noise, rng);
         const std::optional<Eigen::Vector2d> px = scanner.camera.ProjectPointInWater(p);
         if (!px || !scanner.camera.camera.InImage(*px)) continue;
         points.push_back(LaserCalibrationPoint{static_cast<int>(i), step, *px, p});
@@ -156,7 +155,8 @@ TEST(LaserViewportCalibrationTest, ConvergesFromAPoorStart) {
   const GalvoScannerModel truth = DefaultGalvoScannerModel();
   for (double noise_m : {0.0, 1e-4}) {
     const std::vector<LaserCalibrationPoint> points = Points(truth, noise_m, 3);
-    const LaserViewportCalibrationResult from_truth = CalibrateLaserViewport(truth, points, RefineAll());
+    const LaserViewportCalibrationResult from_truth =
+        CalibrateLaserViewport(truth, points, RefineAll());
     for (unsigned seed : {21u, 22u, 23u}) {
       const auto start = std::chrono::steady_clock::now();
       const LaserViewportCalibrationResult from_poor = CalibrateLaserViewport(

@@ -20,7 +20,8 @@ VoltageLine FitLine(const Eigen::Vector2d& volts, const std::vector<Eigen::Vecto
   for (const Eigen::Vector3d& p : points) line.point_C += p;
   line.point_C /= static_cast<double>(points.size());
   Eigen::MatrixXd centred(points.size(), 3);
-  for (size_t i = 0; i < points.size(); ++i) centred.row(static_cast<Eigen::Index>(i)) = (points[i] - line.point_C).transpose();
+  for (size_t i = 0; i < points.size(); ++i)
+    centred.row(static_cast<Eigen::Index>(i)) = (points[i] - line.point_C).transpose();
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeThinV);
   line.direction_C = svd.matrixV().col(0);
   // Away from the scanner: the farther points lie deeper in the camera frame.
@@ -37,9 +38,10 @@ VoltageLine FitLine(const Eigen::Vector2d& volts, const std::vector<Eigen::Vecto
 // The projection plane: normal along the beam of the voltage pair nearest to zero volts,
 // crossing it at `depth_m`; x_P along the camera's x projected onto the plane.
 Eigen::Isometry3d ProjectionPlane(const std::vector<VoltageLine>& lines, double depth_m) {
-  const VoltageLine& centre = *std::min_element(lines.begin(), lines.end(), [](const VoltageLine& a, const VoltageLine& b) {
-    return a.volts.squaredNorm() < b.volts.squaredNorm();
-  });
+  const VoltageLine& centre =
+      *std::min_element(lines.begin(), lines.end(), [](const VoltageLine& a, const VoltageLine& b) {
+        return a.volts.squaredNorm() < b.volts.squaredNorm();
+      });
   const Eigen::Vector3d z = centre.direction_C;
   const double t = (depth_m - centre.point_C.z()) / z.z();
   Eigen::Vector3d x = Eigen::Vector3d::UnitX() - z.x() * z;
@@ -71,8 +73,9 @@ MemsCalibrationResult CalibrateMemsProjection(const RefractiveCamera& camera,
     throw Error("MEMS calibration: " + std::to_string(planes_C.size()) + " planes but dots for " +
                 std::to_string(dots.size()));
   }
-  if (planes_C.size() < 2) throw Error("MEMS calibration: needs dots on at least 2 planes, got " +
-                                       std::to_string(planes_C.size()));
+  if (planes_C.size() < 2)
+    throw Error("MEMS calibration: needs dots on at least 2 planes, got " +
+                std::to_string(planes_C.size()));
   // q_kl: each dot's camera ray meets its plane.
   std::map<VoltsKey, std::vector<Eigen::Vector3d>> points_of;
   MemsCalibrationResult result;
@@ -122,7 +125,7 @@ MemsCalibrationResult CalibrateMemsProjection(const RefractiveCamera& camera,
   result.line_rms_m = std::sqrt(sum2 / fitted);
 
   const double depth = options.projection_plane_depth_m > 0.0 ? options.projection_plane_depth_m
-                                                               : 0.5 * (depth_min + depth_max);
+                                                              : 0.5 * (depth_min + depth_max);
   const Eigen::Isometry3d T_C_P = ProjectionPlane(result.lines, depth);
   const Eigen::Isometry3d T_P_C = T_C_P.inverse();
   std::vector<Eigen::Vector2d> volts, p_P;

@@ -5,9 +5,9 @@
 #include <vector>
 
 #include "scanner/calibration/observations.hpp"
-#include "scanner/triangulation/light_plane.hpp"
 #include "scanner/lasers/projection_functions.hpp"
 #include "scanner/optics/refractive_camera.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 
 namespace uwscan::scanner::calibration {
 
@@ -24,9 +24,9 @@ struct MemsCalibrationOptions {
 // One voltage pair's beam in water, fitted to its dots on the planes (seed eq. 18).
 struct VoltageLine {
   Eigen::Vector2d volts = Eigen::Vector2d::Zero();
-  Eigen::Vector3d point_C = Eigen::Vector3d::Zero();      // centroid of its points
-  Eigen::Vector3d direction_C = Eigen::Vector3d::UnitZ(); // unit, away from the scanner
-  double rms_m = 0.0;  // distance of its points to the line
+  Eigen::Vector3d point_C = Eigen::Vector3d::Zero();       // centroid of its points
+  Eigen::Vector3d direction_C = Eigen::Vector3d::UnitZ();  // unit, away from the scanner
+  double rms_m = 0.0;                                      // distance of its points to the line
   int points = 0;
 };
 
@@ -34,9 +34,9 @@ struct MemsCalibrationResult {
   ProjectionFunctions functions;
   std::array<FitErrorStats, 6> errors;  // percent fitting error of f1..f6 (seed Fig. 8)
   std::vector<VoltageLine> lines;
-  double line_rms_m = 0.0;     // over every dot: distance to its voltage pair's line
-  int dots = 0;                // dots used
-  int skipped_pairs = 0;       // voltage pairs seen on too few planes
+  double line_rms_m = 0.0;  // over every dot: distance to its voltage pair's line
+  int dots = 0;             // dots used
+  int skipped_pairs = 0;    // voltage pairs seen on too few planes
 };
 
 // Seed 001, Sec. III-C: each dot pixel's camera ray in water (through the calibrated camera

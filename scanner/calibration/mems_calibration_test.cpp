@@ -48,7 +48,8 @@ Dataset MakeDataset(const MemsScannerModel& truth, double noise_px, double volts
         if (!px || !truth.camera.camera.InImage(*px)) continue;
         DotObservation dot;
         dot.volts = volts * volts_scale;
-        dot.dot_px = *px + (noise_px > 0 ? Eigen::Vector2d(noise(rng), noise(rng)) : Eigen::Vector2d::Zero());
+        dot.dot_px = *px + (noise_px > 0 ? Eigen::Vector2d(noise(rng), noise(rng))
+                                         : Eigen::Vector2d::Zero());
         d.dots.back().push_back(dot);
       }
     }
@@ -58,12 +59,14 @@ Dataset MakeDataset(const MemsScannerModel& truth, double noise_px, double volts
 
 // Largest distance between the fitted and the true beam at depths 0.8 and 1.5 m, at the
 // calibrated voltage pairs and half-way between neighbouring ones (no extrapolation).
-double WorstBeamError(const MemsScannerModel& truth, const MemsCalibrationResult& r, double volts_scale) {
+double WorstBeamError(const MemsScannerModel& truth, const MemsCalibrationResult& r,
+                      double volts_scale) {
   std::vector<Eigen::Vector2d> probes;
   for (const VoltageLine& a : r.lines) {
     probes.push_back(a.volts / volts_scale);
     for (const VoltageLine& b : r.lines) {
-      if ((a.volts - b.volts).norm() / volts_scale < 2.3) probes.push_back(0.5 * (a.volts + b.volts) / volts_scale);
+      if ((a.volts - b.volts).norm() / volts_scale < 2.3)
+        probes.push_back(0.5 * (a.volts + b.volts) / volts_scale);
     }
   }
   double worst = 0.0;
@@ -112,7 +115,8 @@ TEST(MemsCalibration, VoltsAndMillivoltsGiveTheSameBeams) {
   const MemsScannerModel truth = DefaultMemsScannerModel();
   const Dataset volts = MakeDataset(truth, 0.2, 1.0, 3);
   const Dataset millivolts = MakeDataset(truth, 0.2, 1000.0, 3);
-  const ProjectionFunctions a = CalibrateMemsProjection(truth.camera, volts.planes, volts.dots).functions;
+  const ProjectionFunctions a =
+      CalibrateMemsProjection(truth.camera, volts.planes, volts.dots).functions;
   const ProjectionFunctions b =
       CalibrateMemsProjection(truth.camera, millivolts.planes, millivolts.dots).functions;
   for (const Eigen::Vector2d& v : {Eigen::Vector2d(0.3, -4.0), Eigen::Vector2d(7.9, 8.1)}) {

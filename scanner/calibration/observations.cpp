@@ -15,7 +15,8 @@ void PatternSpec::Check() const {
       throw Error("pattern: marker_m must be in (0, square_m)");
     }
     if (dictionary.rfind("DICT_", 0) != 0) {
-      throw Error("pattern: dictionary '" + dictionary + "' is not an OpenCV ArUco dictionary name");
+      throw Error("pattern: dictionary '" + dictionary +
+                  "' is not an OpenCV ArUco dictionary name");
     }
   }
 }

@@ -16,10 +16,10 @@ namespace uwscan::scanner::calibration {
 enum class PatternType { kChessboard, kCharuco };
 struct PatternSpec {
   PatternType type = PatternType::kChessboard;
-  int columns = 9;            // inner corners along x_O (chessboard); squares along x (ChArUco)
-  int rows = 6;               // inner corners along y_O (chessboard); squares along y (ChArUco)
-  double square_m = 0.03;     // square edge, metres
-  double marker_m = 0.022;    // ChArUco marker edge, metres
+  int columns = 9;          // inner corners along x_O (chessboard); squares along x (ChArUco)
+  int rows = 6;             // inner corners along y_O (chessboard); squares along y (ChArUco)
+  double square_m = 0.03;   // square edge, metres
+  double marker_m = 0.022;  // ChArUco marker edge, metres
   std::string dictionary = "DICT_4X4_50";  // ChArUco ArUco dictionary (OpenCV name)
 
   void Check() const;  // throws uwscan::Error naming the field
@@ -50,7 +50,7 @@ struct DotObservation {
 
 // A projection plane (the pattern board held at one pose) with what was projected onto it.
 struct PlaneObservations {
-  PatternObservation pattern;            // fixes the plane's pose (PnP)
+  PatternObservation pattern;              // fixes the plane's pose (PnP)
   std::vector<StripeObservation> stripes;  // galvanometer steps 3 and 4
   std::vector<DotObservation> dots;        // MEMS step 5
 };

@@ -145,22 +145,24 @@ TEST_F(ImportTest, HandWrittenXmlAndFlowYamlAreRead) {
   // What other tools write in OpenCV's layouts: XML with the data over several lines, and YAML
   // with "1." numbers and the matrix as a flow map.
   const std::filesystem::path xml = dir_ / "hand.xml";
-  std::ofstream(xml) << "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>"
-                        "<image_height> 480 </image_height>\n<camera_matrix type_id=\"opencv-matrix\">"
-                        "<rows>3</rows><cols>3</cols><dt>d</dt>\n<data>\n  500. 0. 320.\n  0. 501. 240."
-                        "\n  0. 0. 1.</data></camera_matrix>\n<distortion_coefficients "
-                        "type_id=\"opencv-matrix\"><rows>1</rows><cols>4</cols><dt>f</dt><data>"
-                        "0.1 -0.2 0 0</data></distortion_coefficients>\n</opencv_storage>\n";
+  std::ofstream(xml)
+      << "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>"
+         "<image_height> 480 </image_height>\n<camera_matrix type_id=\"opencv-matrix\">"
+         "<rows>3</rows><cols>3</cols><dt>d</dt>\n<data>\n  500. 0. 320.\n  0. 501. 240."
+         "\n  0. 0. 1.</data></camera_matrix>\n<distortion_coefficients "
+         "type_id=\"opencv-matrix\"><rows>1</rows><cols>4</cols><dt>f</dt><data>"
+         "0.1 -0.2 0 0</data></distortion_coefficients>\n</opencv_storage>\n";
   const PinholeCamera from_xml = ImportOpenCvCalibration(xml);
   EXPECT_EQ(from_xml.height_px, 480);
   EXPECT_EQ(from_xml.fy_px, 501.0);
   EXPECT_EQ(from_xml.k2, -0.2);
 
   const std::filesystem::path yaml = dir_ / "flow.yaml";
-  std::ofstream(yaml) << "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix "
-                         "{rows: 3, cols: 3, dt: d, data: [500., 0., 320., 0., 501., 240., 0., 0., 1.]}\n"
-                         "distortion_coefficients: !!opencv-matrix\n  rows: 4\n  cols: 1\n  dt: d\n"
-                         "  data: [ 0.1, -0.2, 0., 0. ]\n";
+  std::ofstream(yaml)
+      << "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix "
+         "{rows: 3, cols: 3, dt: d, data: [500., 0., 320., 0., 501., 240., 0., 0., 1.]}\n"
+         "distortion_coefficients: !!opencv-matrix\n  rows: 4\n  cols: 1\n  dt: d\n"
+         "  data: [ 0.1, -0.2, 0., 0. ]\n";
   const PinholeCamera from_yaml = ImportOpenCvCalibration(yaml);
   EXPECT_EQ(from_yaml.cx_px, 320.0);
   EXPECT_EQ(from_yaml.k1, 0.1);
@@ -175,8 +177,10 @@ TEST_F(ImportTest, PerViewNodesOfTheSampleAreIgnored) {
       cv::FileStorage storage(path.string(), cv::FileStorage::WRITE);
       storage << "image_width" << 2048 << "image_height" << 1088;
       storage << "camera_matrix"
-              << (cv::Mat_<double>(3, 3) << 1751.25, 0.0, 1022.75, 0.0, 1749.5, 545.125, 0.0, 0.0, 1.0);
-      storage << "distortion_coefficients" << cv::Mat(std::vector<double>{-0.12, 0.08, 0.0, 0.0, -0.02}, true);
+              << (cv::Mat_<double>(3, 3) << 1751.25, 0.0, 1022.75, 0.0, 1749.5, 545.125, 0.0, 0.0,
+                  1.0);
+      storage << "distortion_coefficients"
+              << cv::Mat(std::vector<double>{-0.12, 0.08, 0.0, 0.0, -0.02}, true);
       storage << "extrinsic_parameters" << cv::Mat(20, 6, CV_64F, cv::Scalar(0.5));
       storage << "image_points" << cv::Mat(20, 54, CV_32FC2, cv::Scalar(100.0f, 200.0f));
     }
@@ -195,38 +199,42 @@ TEST_F(ImportTest, DamagedFilesAreRefused) {
     return path;
   };
   // The input that hung FileStorage (tests/fuzz/regressions/opencv_intrinsics/timeout-*).
-  ExpectErrorMentions(write("hang.yaml", "%YAML:1.x:i! !opencv-matrix\n   row7ro 13 :*:0\n%Y--\nima:"),
-                      {"hang.yaml", "malformed YAML"});
+  ExpectErrorMentions(
+      write("hang.yaml", "%YAML:1.x:i! !opencv-matrix\n   row7ro 13 :*:0\n%Y--\nima:"),
+      {"hang.yaml", "malformed YAML"});
   ExpectErrorMentions(write("deep.yaml", "image_width: " + std::string(100000, '[')),
                       {"deep.yaml", "malformed YAML"});
   std::string nested = "<opencv_storage>";
   for (int i = 0; i < 1000; ++i) nested += "<a>";
   for (int i = 0; i < 1000; ++i) nested += "</a>";
-  ExpectErrorMentions(write("nested.xml", nested + "</opencv_storage>"), {"nested.xml", "malformed XML", "depth"});
+  ExpectErrorMentions(write("nested.xml", nested + "</opencv_storage>"),
+                      {"nested.xml", "malformed XML", "depth"});
   ExpectErrorMentions(
       write("entities.xml",
             "<?xml version=\"1.0\"?><!DOCTYPE a [<!ENTITY a \"aaaaaaaaaa\"><!ENTITY b "
             "\"&a;&a;&a;&a;&a;&a;&a;&a;\">]><opencv_storage><image_width>&b;</image_width>"
             "</opencv_storage>"),
       {"entities.xml", "'image_width' must be an integer"});
-  ExpectErrorMentions(write("root.xml", "<calibration><image_width>640</image_width></calibration>"),
-                      {"root.xml", "<opencv_storage>"});
   ExpectErrorMentions(
-      write("huge_rows.yaml", "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
-                              "  rows: 2000000000\n  cols: 3\n  dt: d\n  data: [1, 2, 3]\n"),
-      {"huge_rows.yaml", "'camera_matrix'", "rows and cols"});
+      write("root.xml", "<calibration><image_width>640</image_width></calibration>"),
+      {"root.xml", "<opencv_storage>"});
+  ExpectErrorMentions(write("huge_rows.yaml",
+                            "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+                            "  rows: 2000000000\n  cols: 3\n  dt: d\n  data: [1, 2, 3]\n"),
+                      {"huge_rows.yaml", "'camera_matrix'", "rows and cols"});
+  ExpectErrorMentions(write("short.yaml",
+                            "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+                            "  rows: 3\n  cols: 3\n  dt: d\n  data: [1, 2, 3]\n"),
+                      {"short.yaml", "data has 3 values, rows x cols = 9"});
+  ExpectErrorMentions(write("nan.yaml",
+                            "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+                            "  rows: 1\n  cols: 3\n  dt: d\n  data: [1, .nan, 3]\n"),
+                      {"nan.yaml", "not a finite number"});
   ExpectErrorMentions(
-      write("short.yaml", "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
-                          "  rows: 3\n  cols: 3\n  dt: d\n  data: [1, 2, 3]\n"),
-      {"short.yaml", "data has 3 values, rows x cols = 9"});
-  ExpectErrorMentions(
-      write("nan.yaml", "image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
-                        "  rows: 1\n  cols: 3\n  dt: d\n  data: [1, .nan, 3]\n"),
-      {"nan.yaml", "not a finite number"});
-  ExpectErrorMentions(
-      write("short.xml", "<opencv_storage><image_width>640</image_width><image_height>480"
-                         "</image_height><camera_matrix type_id=\"opencv-matrix\"><rows>3</rows>"
-                         "<cols>3</cols><dt>d</dt><data>1 2 3</data></camera_matrix></opencv_storage>"),
+      write("short.xml",
+            "<opencv_storage><image_width>640</image_width><image_height>480"
+            "</image_height><camera_matrix type_id=\"opencv-matrix\"><rows>3</rows>"
+            "<cols>3</cols><dt>d</dt><data>1 2 3</data></camera_matrix></opencv_storage>"),
       {"short.xml", "data has 3 values"});
   ExpectErrorMentions(write("binary.yaml", std::string("image_width: 6\x80\x00\n", 16)),
                       {"binary.yaml", "not ASCII text"});

@@ -60,8 +60,8 @@ OpenCvMatrix MakeMatrix(const std::string& name, const OpenCvNode& node) {
     Refuse(where + "dt must be one of u, c, w, s, i, f, d (a single-channel matrix of numbers)");
   }
   if (static_cast<int>(node.values.size()) != *r * *c) {
-    Refuse(where + "data has " + std::to_string(node.values.size()) + " values, rows x cols = " +
-           std::to_string(*r * *c));
+    Refuse(where + "data has " + std::to_string(node.values.size()) +
+           " values, rows x cols = " + std::to_string(*r * *c));
   }
   OpenCvMatrix matrix{*r, *c, {}};
   for (const std::string& text : node.values) {
@@ -214,7 +214,8 @@ std::map<std::string, OpenCvNode> ParseXml(const std::string& text) {
     const xmlError* error = xmlGetLastError();
     std::string what = "malformed XML";
     if (error != nullptr && error->message != nullptr) {
-      what += " at line " + std::to_string(error->line) + ": " + std::string(Trimmed(error->message));
+      what +=
+          " at line " + std::to_string(error->line) + ": " + std::string(Trimmed(error->message));
     }
     xmlResetLastError();
     Refuse(what);

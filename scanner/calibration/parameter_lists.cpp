@@ -20,15 +20,12 @@ void AddVector(const std::string& name, const Eigen::Vector3d& value, const Eige
 }  // namespace
 
 std::vector<ParameterEstimate> CameraParameters(const PinholeCamera& c, const IntrinsicsResult* s) {
-  return {{"fx_px", c.fx_px, s ? s->fx_std : 0.0},
-          {"fy_px", c.fy_px, s ? s->fy_std : 0.0},
-          {"cx_px", c.cx_px, s ? s->cx_std : 0.0},
-          {"cy_px", c.cy_px, s ? s->cy_std : 0.0},
-          {"k1", c.k1, s ? s->distortion_std[0] : 0.0},
-          {"k2", c.k2, s ? s->distortion_std[1] : 0.0},
-          {"p1", c.p1, s ? s->distortion_std[2] : 0.0},
-          {"p2", c.p2, s ? s->distortion_std[3] : 0.0},
-          {"k3", c.k3, s ? s->distortion_std[4] : 0.0}};
+  return {
+      {"fx_px", c.fx_px, s ? s->fx_std : 0.0},      {"fy_px", c.fy_px, s ? s->fy_std : 0.0},
+      {"cx_px", c.cx_px, s ? s->cx_std : 0.0},      {"cy_px", c.cy_px, s ? s->cy_std : 0.0},
+      {"k1", c.k1, s ? s->distortion_std[0] : 0.0}, {"k2", c.k2, s ? s->distortion_std[1] : 0.0},
+      {"p1", c.p1, s ? s->distortion_std[2] : 0.0}, {"p2", c.p2, s ? s->distortion_std[3] : 0.0},
+      {"k3", c.k3, s ? s->distortion_std[4] : 0.0}};
 }
 
 std::vector<ParameterEstimate> ViewportParameters(const std::string& key, const FlatViewport& v,
@@ -43,7 +40,8 @@ std::vector<ParameterEstimate> ViewportParameters(const std::string& key, const 
   return out;
 }
 
-std::vector<ParameterEstimate> GalvoLaserParameters(const GalvoLaser& laser, const GalvoLaserStdDevs* s) {
+std::vector<ParameterEstimate> GalvoLaserParameters(const GalvoLaser& laser,
+                                                    const GalvoLaserStdDevs* s) {
   const Eigen::Matrix3d R_L = laser.T_C_L.linear();
   const Eigen::Matrix3d R_M = laser.T_C_M.linear();
   std::vector<ParameterEstimate> out;
@@ -57,8 +55,10 @@ std::vector<ParameterEstimate> GalvoLaserParameters(const GalvoLaser& laser, con
     }
     position_std = position_std.cwiseSqrt();
     // Turning {L} about x_L moves z_L along y_L; about y_L, along x_L.
-    normal_std = Spread(R_L.col(1), s->laser_rotation_rad.x(), R_L.col(0), s->laser_rotation_rad.y());
-    mirror_position_std = Spread(R_M.col(0), s->mirror_position_m.x(), R_M.col(2), s->mirror_position_m.y());
+    normal_std =
+        Spread(R_L.col(1), s->laser_rotation_rad.x(), R_L.col(0), s->laser_rotation_rad.y());
+    mirror_position_std =
+        Spread(R_M.col(0), s->mirror_position_m.x(), R_M.col(2), s->mirror_position_m.y());
     // Tilting y_M about x_M moves it along z_M; about z_M, along x_M.
     axis_std = Spread(R_M.col(2), s->mirror_axis_rad.x(), R_M.col(0), s->mirror_axis_rad.y());
   }
@@ -67,7 +67,8 @@ std::vector<ParameterEstimate> GalvoLaserParameters(const GalvoLaser& laser, con
   AddVector("laser.mirror_origin_m", laser.T_C_M.translation(), mirror_position_std, &out);
   AddVector("laser.mirror_axis", R_M.col(1), axis_std, &out);
   out.push_back({"laser.mirror_step_rad", laser.mirror_step_rad, s ? s->mirror_step_rad : 0.0});
-  out.push_back({"laser.rotation_distance_m", laser.rotation_distance_m, s ? s->rotation_distance_m : 0.0});
+  out.push_back(
+      {"laser.rotation_distance_m", laser.rotation_distance_m, s ? s->rotation_distance_m : 0.0});
   return out;
 }
 

@@ -23,7 +23,8 @@ struct ViewportStds {
   double distance_m = 0.0;
   double thickness_m = 0.0;
 };
-std::vector<ParameterEstimate> ViewportParameters(const std::string& key, const FlatViewport& viewport,
+std::vector<ParameterEstimate> ViewportParameters(const std::string& key,
+                                                  const FlatViewport& viewport,
                                                   const ViewportStds& stds = {});
 
 // In the camera frame: emitter position, laser-plane normal (z_L), mirror position and axis (y_M),

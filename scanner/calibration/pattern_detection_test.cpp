@@ -288,8 +288,8 @@ TEST_F(DetectPatternTest, NoPatternIsNullopt) {
 // classic detector alone searched such a view for minutes), while the right size still does.
 TEST_F(DetectPatternTest, ABoardOfAnotherSizeIsNotFound) {
   const PatternSpec spec = Chessboard();
-  const Eigen::Matrix3d H = PlaneToImage(
-      Pose((spec.columns - 1) * spec.square_m, (spec.rows - 1) * spec.square_m, 0.6, 0.2, -0.1, 0.1));
+  const Eigen::Matrix3d H = PlaneToImage(Pose(
+      (spec.columns - 1) * spec.square_m, (spec.rows - 1) * spec.square_m, 0.6, 0.2, -0.1, 0.1));
   cv::Mat image = Render(H, ChessboardShade(spec));
   cv::GaussianBlur(image, image, cv::Size(0, 0), 0.7);
   const std::filesystem::path path = Save("board.png", image);

@@ -17,8 +17,8 @@
 
 #include "scanner/calibration/pattern_pose.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/optics/refractive_camera.hpp"
 #include "scanner/common/symmetrized.hpp"
+#include "scanner/optics/refractive_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/optics/refractive_camera.hpp"
-#include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/common/random_draws.hpp"
+#include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/optics/refractive_camera.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -62,8 +62,8 @@ Dataset MakeDataset(const RefractiveCamera& camera, const PatternSpec& spec, int
   while (static_cast<int>(data.observations.size()) < views) {
     const double depth = 1.0 + 0.5 * unit(rng);
     const Eigen::Vector2d centre_px =
-        Eigen::Vector2d(1023.5, 543.5) + 0.8 * Eigen::Vector2d(1024.0, 544.0).cwiseProduct(
-                                                   DrawVector2(unit, rng));
+        Eigen::Vector2d(1023.5, 543.5) +
+        0.8 * Eigen::Vector2d(1024.0, 544.0).cwiseProduct(DrawVector2(unit, rng));
     const Eigen::Vector3d angles = DrawVector3(unit, rng);
     Eigen::Isometry3d T_C_O = Eigen::Isometry3d::Identity();
     T_C_O.linear() = (Eigen::AngleAxisd(35.0 * kDeg * angles.x(), Eigen::Vector3d::UnitX()) *

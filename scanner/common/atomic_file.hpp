@@ -15,7 +15,8 @@ std::filesystem::path TemporaryBeside(const std::filesystem::path& path);
 
 // Flushes `temporary` to disk, renames it over `path` and syncs the folder. On failure removes
 // the temporary and throws uwscan::Error naming `path`.
-void ReplaceWithTemporary(const std::filesystem::path& temporary, const std::filesystem::path& path);
+void ReplaceWithTemporary(const std::filesystem::path& temporary,
+                          const std::filesystem::path& path);
 
 // Writes text to path through TemporaryBeside and ReplaceWithTemporary. Throws uwscan::Error
 // naming the path (and the system's reason: no space left, read-only, ...).

@@ -33,7 +33,8 @@ std::vector<double> Numbers(const json& value, std::size_t count, const Field& f
   }
   std::vector<double> numbers;
   for (std::size_t i = 0; i < count; ++i) {
-    if (!value[i].is_number() || !std::isfinite(value[i].get<double>())) field[i].Fail("not a finite number");
+    if (!value[i].is_number() || !std::isfinite(value[i].get<double>()))
+      field[i].Fail("not a finite number");
     numbers.push_back(value[i].get<double>());
   }
   return numbers;
@@ -49,9 +50,11 @@ std::string ReportKind(const std::filesystem::path& path) {
 void RequireFormatAndKind(const json& root, const std::string& kind, const Field& field) {
   if (!root.is_object()) field.Fail("expected a JSON object");
   const json& format = Require(root, "uwscan_format", field);
-  if (!format.is_number_integer() || format.get<int>() != 1) field["uwscan_format"].Fail("this uwscan reads format 1");
+  if (!format.is_number_integer() || format.get<int>() != 1)
+    field["uwscan_format"].Fail("this uwscan reads format 1");
   const json& k = Require(root, "kind", field);
-  if (!k.is_string() || k.get<std::string>() != kind) field["kind"].Fail("expected \"" + kind + "\"");
+  if (!k.is_string() || k.get<std::string>() != kind)
+    field["kind"].Fail("expected \"" + kind + "\"");
 }
 
 }  // namespace uwscan::json_fields

@@ -15,14 +15,17 @@ struct Field {
   const std::string& file;
   std::string path;
   [[noreturn]] void Fail(const std::string& what) const;
-  Field operator[](const std::string& key) const { return {file, path.empty() ? key : path + "." + key}; }
+  Field operator[](const std::string& key) const {
+    return {file, path.empty() ? key : path + "." + key};
+  }
   Field operator[](std::size_t i) const { return {file, path + "[" + std::to_string(i) + "]"}; }
 };
 
 // The file parsed; throws uwscan::Error naming it when it cannot be read or is not JSON.
 nlohmann::json ParseJsonFile(const std::filesystem::path& path);
 // object[key]; fails naming the field when it is missing.
-const nlohmann::json& Require(const nlohmann::json& object, const std::string& key, const Field& field);
+const nlohmann::json& Require(const nlohmann::json& object, const std::string& key,
+                              const Field& field);
 // An array of exactly `count` finite numbers.
 std::vector<double> Numbers(const nlohmann::json& value, std::size_t count, const Field& field);
 // The "kind" a report says it is; empty when the file is not a JSON object with a string

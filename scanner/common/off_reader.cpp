@@ -68,7 +68,9 @@ TriangleMesh ReadOff(const fs::path& path) {
   Lines lines(text);
   std::string_view line;
   int number = 0;
-  auto at = [&](const std::string& what) { return Error(name + " line " + std::to_string(number) + ": " + what); };
+  auto at = [&](const std::string& what) {
+    return Error(name + " line " + std::to_string(number) + ": " + what);
+  };
 
   if (!lines.Next(line, number)) throw Error(name + ": empty, not an OFF mesh");
   const std::size_t keyword_end = line.find_first_of(" \t\r");
@@ -77,8 +79,9 @@ TriangleMesh ReadOff(const fs::path& path) {
     throw at("expected OFF, not an OFF mesh");
   }
   // The counts may follow the keyword on its line or have a line of their own.
-  std::vector<double> counts =
-      keyword_end == std::string_view::npos ? std::vector<double>{} : Numbers(line.substr(keyword_end), 3);
+  std::vector<double> counts = keyword_end == std::string_view::npos
+                                   ? std::vector<double>{}
+                                   : Numbers(line.substr(keyword_end), 3);
   if (counts.empty()) {
     if (!lines.Next(line, number)) throw at("no vertex and face counts");
     counts = Numbers(line, 3);
@@ -96,22 +99,26 @@ TriangleMesh ReadOff(const fs::path& path) {
   TriangleMesh mesh;
   mesh.vertices.reserve(vertices);
   for (std::size_t v = 0; v < vertices; ++v) {
-    if (!lines.Next(line, number)) throw Error(name + ": cut short after " + std::to_string(v) + " vertices");
+    if (!lines.Next(line, number))
+      throw Error(name + ": cut short after " + std::to_string(v) + " vertices");
     const std::vector<double> xyz = Numbers(line, 3);
     if (xyz.size() != 3) throw at("expected a vertex 'x y z'");
     mesh.vertices.emplace_back(xyz[0], xyz[1], xyz[2]);
   }
   for (std::size_t f = 0; f < faces; ++f) {
-    if (!lines.Next(line, number)) throw Error(name + ": cut short after " + std::to_string(f) + " faces");
+    if (!lines.Next(line, number))
+      throw Error(name + ": cut short after " + std::to_string(f) + " faces");
     const std::vector<double> size = Numbers(line, 1);
-    if (size.size() != 1 || size[0] < 3 || size[0] > double(line.size()) || size[0] != std::floor(size[0])) {
+    if (size.size() != 1 || size[0] < 3 || size[0] > double(line.size()) ||
+        size[0] != std::floor(size[0])) {
       throw at("expected a face 'n i1 .. in' with n >= 3");
     }
     const std::vector<double> face = Numbers(line, 1 + static_cast<std::size_t>(size[0]));
     if (face.size() != 1 + static_cast<std::size_t>(size[0])) throw at("the face is cut short");
     for (std::size_t k = 1; k < face.size(); ++k) {
       if (!(face[k] >= 0.0 && face[k] < double(vertices)) || face[k] != std::floor(face[k])) {
-        throw at("vertex index " + std::to_string(face[k]) + " is not one of the " + std::to_string(vertices));
+        throw at("vertex index " + std::to_string(face[k]) + " is not one of the " +
+                 std::to_string(vertices));
       }
     }
     for (std::size_t k = 2; k + 1 < face.size(); ++k) {

@@ -14,7 +14,8 @@ namespace uwscan {
 template <typename Task>
 void RunParallelTasks(std::ptrdiff_t count, int threads, const Task& task) {
   std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads > 0 ? threads : omp_get_max_threads())
+#pragma omp parallel for schedule(dynamic, 1) \
+    num_threads(threads > 0 ? threads : omp_get_max_threads())
   for (std::ptrdiff_t i = 0; i < count; ++i) {
     try {
       task(i);

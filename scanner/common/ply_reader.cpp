@@ -4,11 +4,11 @@
 #include <bit>
 #include <cctype>
 #include <charconv>
-#include <initializer_list>
-#include <limits>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -69,7 +69,8 @@ class BodyCursor {
     std::uint8_t bytes[8];
     std::memcpy(bytes, body_.data() + at_, std::size_t(type.bytes));
     at_ += std::size_t(type.bytes);
-    const bool swap = (encoding_ == Encoding::kBigEndian) == (std::endian::native == std::endian::little);
+    const bool swap =
+        (encoding_ == Encoding::kBigEndian) == (std::endian::native == std::endian::little);
     if (swap) std::reverse(bytes, bytes + type.bytes);
     value = Decode(type, bytes);
     return true;
@@ -87,9 +88,13 @@ class BodyCursor {
     };
     switch (type.kind) {
       case 'i':
-        return type.bytes == 1 ? as(std::int8_t{}) : type.bytes == 2 ? as(std::int16_t{}) : as(std::int32_t{});
+        return type.bytes == 1   ? as(std::int8_t{})
+               : type.bytes == 2 ? as(std::int16_t{})
+                                 : as(std::int32_t{});
       case 'u':
-        return type.bytes == 1 ? as(std::uint8_t{}) : type.bytes == 2 ? as(std::uint16_t{}) : as(std::uint32_t{});
+        return type.bytes == 1   ? as(std::uint8_t{})
+               : type.bytes == 2 ? as(std::uint16_t{})
+                                 : as(std::uint32_t{});
       default:
         return type.bytes == 4 ? as(float{}) : as(double{});
     }
@@ -127,11 +132,13 @@ Header ParseHeader(const std::string& file, const std::string& name) {
   }
   const std::size_t end = file.find("end_header", 0);
   if (end == std::string::npos || end > kMaxHeaderBytes) {
-    throw Error(name + ": no 'end_header' in the first " + std::to_string(kMaxHeaderBytes) + " bytes");
+    throw Error(name + ": no 'end_header' in the first " + std::to_string(kMaxHeaderBytes) +
+                " bytes");
   }
   Header header;
   header.body_offset = file.find('\n', end);
-  if (header.body_offset == std::string::npos) throw Error(name + ": the header does not end with a new line");
+  if (header.body_offset == std::string::npos)
+    throw Error(name + ": the header does not end with a new line");
   ++header.body_offset;
   std::istringstream lines(file.substr(0, end));
   std::string line;
@@ -141,14 +148,19 @@ Header ParseHeader(const std::string& file, const std::string& name) {
     std::string keyword;
     words >> keyword;
     const std::string where = name + ": header line " + std::to_string(number);
-    if (keyword.empty() || keyword == "ply" || keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword.empty() || keyword == "ply" || keyword == "comment" || keyword == "obj_info")
+      continue;
     if (keyword == "format") {
       std::string encoding, version;
       words >> encoding >> version;
-      if (encoding == "ascii") header.encoding = Encoding::kAscii;
-      else if (encoding == "binary_little_endian") header.encoding = Encoding::kLittleEndian;
-      else if (encoding == "binary_big_endian") header.encoding = Encoding::kBigEndian;
-      else throw Error(where + ": unknown format '" + encoding + "'");
+      if (encoding == "ascii")
+        header.encoding = Encoding::kAscii;
+      else if (encoding == "binary_little_endian")
+        header.encoding = Encoding::kLittleEndian;
+      else if (encoding == "binary_big_endian")
+        header.encoding = Encoding::kBigEndian;
+      else
+        throw Error(where + ": unknown format '" + encoding + "'");
       if (version != "1.0") throw Error(where + ": PLY version '" + version + "', expected 1.0");
       format_seen = true;
     } else if (keyword == "element") {
@@ -156,7 +168,8 @@ Header ParseHeader(const std::string& file, const std::string& name) {
       std::string count;
       words >> element.name >> count;
       const auto parsed = std::from_chars(count.data(), count.data() + count.size(), element.count);
-      if (element.name.empty() || parsed.ec != std::errc() || parsed.ptr != count.data() + count.size()) {
+      if (element.name.empty() || parsed.ec != std::errc() ||
+          parsed.ptr != count.data() + count.size()) {
         throw Error(where + ": expected 'element NAME COUNT', got '" + line.substr(0, 80) + "'");
       }
       header.elements.push_back(element);
@@ -170,8 +183,10 @@ Header ParseHeader(const std::string& file, const std::string& name) {
         words >> count_type >> item_type >> property.name;
         property.list_count = TypeNamed(count_type);
         const std::optional<ScalarType> item = TypeNamed(item_type);
-        if (!property.list_count || property.list_count->kind == 'f' || !item || property.name.empty()) {
-          throw Error(where + ": expected 'property list COUNT_TYPE ITEM_TYPE NAME', got '" + line.substr(0, 80) + "'");
+        if (!property.list_count || property.list_count->kind == 'f' || !item ||
+            property.name.empty()) {
+          throw Error(where + ": expected 'property list COUNT_TYPE ITEM_TYPE NAME', got '" +
+                      line.substr(0, 80) + "'");
         }
         property.type = *item;
       } else {
@@ -204,8 +219,10 @@ int IndexOf(const Element& element, std::initializer_list<const char*> names) {
 std::size_t MinRowBytes(const Element& element, Encoding encoding) {
   std::size_t bytes = 0;
   for (const Property& p : element.properties) {
-    if (encoding == Encoding::kAscii) bytes += 2;  // a digit and a separator
-    else bytes += std::size_t(p.list_count ? p.list_count->bytes : p.type.bytes);
+    if (encoding == Encoding::kAscii)
+      bytes += 2;  // a digit and a separator
+    else
+      bytes += std::size_t(p.list_count ? p.list_count->bytes : p.type.bytes);
   }
   return bytes;
 }

@@ -11,7 +11,7 @@ namespace uwscan::scanner {
 // confidence, ...) are read past and dropped.
 struct PlyContent {
   std::vector<Eigen::Vector3d> vertices;
-  std::vector<Eigen::Vector3d> normals;    // one per vertex when it has nx ny nz, else empty
+  std::vector<Eigen::Vector3d> normals;  // one per vertex when it has nx ny nz, else empty
   // One per vertex when it has an intensity property ("intensity", or CloudCompare's
   // "scalar_intensity" / "scalar_Intensity"), in the file's units; else empty.
   std::vector<double> intensity;

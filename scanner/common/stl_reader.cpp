@@ -47,7 +47,8 @@ class VertexMerger {
   };
   struct Hash {
     std::size_t operator()(const Key& k) const {
-      return static_cast<std::size_t>(Fnv1a64(reinterpret_cast<const char*>(k.bits), sizeof(k.bits)));
+      return static_cast<std::size_t>(
+          Fnv1a64(reinterpret_cast<const char*>(k.bits), sizeof(k.bits)));
     }
   };
   TriangleMesh& mesh_;
@@ -64,13 +65,15 @@ float LittleEndianFloat(const char* bytes) {
 
 std::uint32_t BinaryCount(const std::string& bytes) {
   std::uint32_t count = 0;
-  for (int i = 3; i >= 0; --i) count = (count << 8) | static_cast<unsigned char>(bytes[80 + std::size_t(i)]);
+  for (int i = 3; i >= 0; --i)
+    count = (count << 8) | static_cast<unsigned char>(bytes[80 + std::size_t(i)]);
   return count;
 }
 
 bool IsBinary(const std::string& bytes) {
   return bytes.size() >= kBinaryHeaderBytes &&
-         bytes.size() == kBinaryHeaderBytes + kBinaryTriangleBytes * std::size_t{BinaryCount(bytes)};
+         bytes.size() ==
+             kBinaryHeaderBytes + kBinaryTriangleBytes * std::size_t{BinaryCount(bytes)};
 }
 
 TriangleMesh ReadBinary(const std::string& bytes) {
@@ -78,10 +81,12 @@ TriangleMesh ReadBinary(const std::string& bytes) {
   TriangleMesh mesh;
   VertexMerger merger(mesh);
   for (std::size_t t = 0; t < count; ++t) {
-    const char* corner = bytes.data() + kBinaryHeaderBytes + t * kBinaryTriangleBytes + 12;  // past the normal
+    const char* corner =
+        bytes.data() + kBinaryHeaderBytes + t * kBinaryTriangleBytes + 12;  // past the normal
     int index[3];
     for (int k = 0; k < 3; ++k, corner += 12) {
-      index[k] = merger.Index(LittleEndianFloat(corner), LittleEndianFloat(corner + 4), LittleEndianFloat(corner + 8));
+      index[k] = merger.Index(LittleEndianFloat(corner), LittleEndianFloat(corner + 4),
+                              LittleEndianFloat(corner + 8));
     }
     merger.AddTriangle(index[0], index[1], index[2]);
   }
@@ -112,7 +117,9 @@ class Words {
   }
 
  private:
-  static bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
+  static bool IsSpace(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+  }
   std::string_view text_;
   std::size_t at_ = 0;
   int line_ = 1;
@@ -124,7 +131,8 @@ TriangleMesh ReadAscii(const std::string& text, const std::string& name) {
     return Error(name + " line " + std::to_string(words.line()) + ": " + what);
   };
   std::string_view word;
-  if (!words.Next(word) || word != "solid") throw Error(name + ": neither binary STL (84 + 50 n bytes) nor ASCII STL");
+  if (!words.Next(word) || word != "solid")
+    throw Error(name + ": neither binary STL (84 + 50 n bytes) nor ASCII STL");
   words.SkipLine();
   TriangleMesh mesh;
   VertexMerger merger(mesh);
@@ -137,8 +145,10 @@ TriangleMesh ReadAscii(const std::string& text, const std::string& name) {
       for (float& value : xyz) {
         std::string_view number;
         if (!words.Next(number)) throw at("the file ends inside a vertex");
-        const char* begin = number.data() + (number.front() == '+' ? 1 : 0);  // from_chars takes no '+'
-        const std::from_chars_result parsed = std::from_chars(begin, number.data() + number.size(), value);
+        const char* begin =
+            number.data() + (number.front() == '+' ? 1 : 0);  // from_chars takes no '+'
+        const std::from_chars_result parsed =
+            std::from_chars(begin, number.data() + number.size(), value);
         if (parsed.ec != std::errc() || parsed.ptr != number.data() + number.size()) {
           throw at("expected a vertex 'x y z', got '" + std::string(number.substr(0, 40)) + "'");
         }
@@ -150,7 +160,8 @@ TriangleMesh ReadAscii(const std::string& text, const std::string& name) {
       loop.clear();
     } else if (word == "endloop") {
       if (!in_loop || loop.size() < 3) throw at("a loop of fewer than 3 vertices");
-      for (std::size_t k = 1; k + 1 < loop.size(); ++k) merger.AddTriangle(loop[0], loop[k], loop[k + 1]);
+      for (std::size_t k = 1; k + 1 < loop.size(); ++k)
+        merger.AddTriangle(loop[0], loop[k], loop[k + 1]);
       in_loop = false;
     } else if (word == "endsolid") {
       if (in_loop) throw at("'endsolid' inside a loop");

@@ -78,7 +78,8 @@ class StlReaderTest : public ::testing::Test {
   // triangle, so the options that drop them do not matter here).
   static TriangleMesh ByAssimp(const fs::path& path) {
     Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+    const aiScene* scene =
+        importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
     EXPECT_NE(scene, nullptr) << importer.GetErrorString();
     TriangleMesh mesh;
     if (scene == nullptr) return mesh;
@@ -88,7 +89,8 @@ class StlReaderTest : public ::testing::Test {
     }
     for (unsigned f = 0; f < part->mNumFaces; ++f) {
       const aiFace& face = part->mFaces[f];
-      mesh.triangles.emplace_back(int(face.mIndices[0]), int(face.mIndices[1]), int(face.mIndices[2]));
+      mesh.triangles.emplace_back(int(face.mIndices[0]), int(face.mIndices[1]),
+                                  int(face.mIndices[2]));
     }
     return mesh;
   }
@@ -98,7 +100,8 @@ class StlReaderTest : public ::testing::Test {
     ASSERT_EQ(a.triangles.size(), b.triangles.size());
     for (std::size_t t = 0; t < a.triangles.size(); ++t) {
       for (int k = 0; k < 3; ++k) {
-        EXPECT_EQ(a.vertices[std::size_t(a.triangles[t][k])], b.vertices[std::size_t(b.triangles[t][k])])
+        EXPECT_EQ(a.vertices[std::size_t(a.triangles[t][k])],
+                  b.vertices[std::size_t(b.triangles[t][k])])
             << "triangle " << t << " corner " << k;
       }
     }
@@ -129,40 +132,49 @@ TEST_F(StlReaderTest, BinaryAndAsciiGiveAssimpsTrianglesWithSharedVertices) {
 }
 
 TEST_F(StlReaderTest, LoopsOfMoreCornersAreFannedAndDegenerateTrianglesDropped) {
-  const TriangleMesh mesh = ReadStl(WriteAscii("quad.stl",
-                                               "solid quad\n facet normal 0 0 1\n  outer loop\n"
-                                               "   vertex 0 0 0\n   vertex 1 0 0\n   vertex 1 1 0\n   vertex +0 1e0 0\n"
-                                               "  endloop\n endfacet\n facet normal 0 0 1\n  outer loop\n"
-                                               "   vertex 0 0 0\n   vertex 0 0 0\n   vertex 1 1 0\n"
-                                               "  endloop\n endfacet\nendsolid quad\n"));
+  const TriangleMesh mesh =
+      ReadStl(WriteAscii("quad.stl",
+                         "solid quad\n facet normal 0 0 1\n  outer loop\n"
+                         "   vertex 0 0 0\n   vertex 1 0 0\n   vertex 1 1 0\n   vertex +0 1e0 0\n"
+                         "  endloop\n endfacet\n facet normal 0 0 1\n  outer loop\n"
+                         "   vertex 0 0 0\n   vertex 0 0 0\n   vertex 1 1 0\n"
+                         "  endloop\n endfacet\nendsolid quad\n"));
   EXPECT_EQ(mesh.vertices.size(), 4u);
-  ASSERT_EQ(mesh.triangles.size(), 2u);  // the quad in two; the triangle with a repeated corner gone
+  ASSERT_EQ(mesh.triangles.size(),
+            2u);  // the quad in two; the triangle with a repeated corner gone
   EXPECT_EQ(mesh.triangles[1], Eigen::Vector3i(0, 2, 3));
 
   // Two solids in one file make one mesh; their shared corner is one vertex.
-  const TriangleMesh two = ReadStl(WriteAscii("two_solids.stl",
-                                              "solid a\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-                                              "endloop\nendsolid a\nsolid b\nouter loop\nvertex 0 0 0\n"
-                                              "vertex 0 0 1\nvertex 0 1 0\nendloop\nendsolid b\n"));
+  const TriangleMesh two =
+      ReadStl(WriteAscii("two_solids.stl",
+                         "solid a\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                         "endloop\nendsolid a\nsolid b\nouter loop\nvertex 0 0 0\n"
+                         "vertex 0 0 1\nvertex 0 1 0\nendloop\nendsolid b\n"));
   EXPECT_EQ(two.triangles.size(), 2u);
   EXPECT_EQ(two.vertices.size(), 4u);
 }
 
 TEST_F(StlReaderTest, BrokenFilesNameTheFileAndWhatIsWrong) {
   std::string ascii = AsciiBox();
-  EXPECT_NE(ErrorOf(WriteAscii("cut.stl", ascii.substr(0, ascii.size() / 2))).find("cut short"), std::string::npos);
-  EXPECT_NE(ErrorOf(WriteAscii("two.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
-                                          "endloop\nendfacet\nendsolid s\n"))
-                .find("line 6: a loop of fewer than 3 vertices"),
+  EXPECT_NE(ErrorOf(WriteAscii("cut.stl", ascii.substr(0, ascii.size() / 2))).find("cut short"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(WriteAscii("nan.stl", "solid s\nouter loop\nvertex 0 zero 0\n")).find("line 3: expected a vertex"),
+  EXPECT_NE(
+      ErrorOf(WriteAscii("two.stl",
+                         "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                         "endloop\nendfacet\nendsolid s\n"))
+          .find("line 6: a loop of fewer than 3 vertices"),
+      std::string::npos);
+  EXPECT_NE(ErrorOf(WriteAscii("nan.stl", "solid s\nouter loop\nvertex 0 zero 0\n"))
+                .find("line 3: expected a vertex"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(WriteAscii("junk.stl", std::string(200, '\x7f'))).find("neither binary STL"), std::string::npos);
+  EXPECT_NE(ErrorOf(WriteAscii("junk.stl", std::string(200, '\x7f'))).find("neither binary STL"),
+            std::string::npos);
   // A binary file one byte short of its count is read as ASCII (its header says "solid") and
   // refused.
   std::ifstream in(WriteBinary(), std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(ErrorOf(WriteAscii("short.stl", bytes.substr(0, bytes.size() - 1))).find("short.stl"), std::string::npos);
+  EXPECT_NE(ErrorOf(WriteAscii("short.stl", bytes.substr(0, bytes.size() - 1))).find("short.stl"),
+            std::string::npos);
   EXPECT_NE(ErrorOf(dir_ / "missing.stl").find("missing.stl"), std::string::npos);
 }
 

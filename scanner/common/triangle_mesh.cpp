@@ -52,9 +52,9 @@ std::string LowerExtension(const std::filesystem::path& path) {
 
 TriangleMesh LoadAssimpMesh(const std::filesystem::path& path) {
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(
-      path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                         aiProcess_DropNormals | aiProcess_FindDegenerates);
+  const aiScene* scene =
+      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                           aiProcess_DropNormals | aiProcess_FindDegenerates);
   if (scene == nullptr) {
     throw Error(path.string() + ": cannot read mesh: " + importer.GetErrorString());
   }
@@ -171,10 +171,10 @@ SurfaceSamples SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t 
   samples.normals.reserve(count);
   for (int i = 0; i < count; ++i) {
     const double pick = unit(rng) * total;
-    const size_t k = std::min<size_t>(
-        std::lower_bound(cumulative_area.begin(), cumulative_area.end(), pick) -
-            cumulative_area.begin(),
-        mesh.triangles.size() - 1);
+    const size_t k =
+        std::min<size_t>(std::lower_bound(cumulative_area.begin(), cumulative_area.end(), pick) -
+                             cumulative_area.begin(),
+                         mesh.triangles.size() - 1);
     const Eigen::Vector3i& t = mesh.triangles[k];
     const Eigen::Vector3d &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]],
                           &c = mesh.vertices[t[2]];

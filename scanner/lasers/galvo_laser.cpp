@@ -40,13 +40,14 @@ RayTrace LaserFan::RayInWater(double fan_tan) const {
 void GalvoLaser::Check() const {
   Require(IsRigid(T_C_L), "T_C_L", "a rigid transform");
   Require(IsRigid(T_C_M), "T_C_M", "a rigid transform");
-  Require(std::isfinite(mirror_step_rad) && mirror_step_rad != 0.0 &&
-              std::abs(mirror_step_rad) < 0.1,
-          "mirror_step_rad", "non-zero and below 0.1 rad");
+  Require(
+      std::isfinite(mirror_step_rad) && mirror_step_rad != 0.0 && std::abs(mirror_step_rad) < 0.1,
+      "mirror_step_rad", "non-zero and below 0.1 rad");
   Require(std::isfinite(rotation_distance_m) && std::abs(rotation_distance_m) < 0.1,
           "rotation_distance_m", "finite and below 0.1 m");
-  Require(std::isfinite(aperture_rad) && aperture_rad > 0.0 && aperture_rad < 0.9 * std::numbers::pi,
-          "aperture_rad", "in (0, 0.9 pi)");
+  Require(
+      std::isfinite(aperture_rad) && aperture_rad > 0.0 && aperture_rad < 0.9 * std::numbers::pi,
+      "aperture_rad", "in (0, 0.9 pi)");
   Require(step_min <= step_max, "step_min", "<= step_max");
   viewport.Check();
 }

@@ -39,7 +39,7 @@ struct GalvoLaser {
   double aperture_rad = 0.9599;      // full fan angle (55 degrees)
   int step_min = -100;               // mirror command range, inclusive
   int step_max = 100;
-  FlatViewport viewport;             // the laser viewport, in {C}
+  FlatViewport viewport;  // the laser viewport, in {C}
 
   void Check() const;
 

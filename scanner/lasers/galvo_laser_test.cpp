@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
-#include "scanner/optics/refraction.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/optics/refraction.hpp"
 
 namespace uwscan::scanner {
 namespace {

@@ -88,8 +88,9 @@ std::vector<MemsLine> DesignMemsScanPattern(const ProjectionFunctions& functions
   return lines;
 }
 
-Plane MemsLinePlaneAt(const ProjectionFunctions& functions, const std::vector<Eigen::Vector2d>& volts,
-                      double plane_extension_m, int line) {
+Plane MemsLinePlaneAt(const ProjectionFunctions& functions,
+                      const std::vector<Eigen::Vector2d>& volts, double plane_extension_m,
+                      int line) {
   functions.Check();
   const double slack = kDriveRangeSlack * (functions.volts_max - functions.volts_min).maxCoeff();
   std::vector<Eigen::Vector3d> points_C;
@@ -98,8 +99,8 @@ Plane MemsLinePlaneAt(const ProjectionFunctions& functions, const std::vector<Ei
     if (!functions.InDriveRange(volts[j], slack)) {
       std::ostringstream message;
       message << "scan pattern: line " << line << ", waypoint " << j << " is driven at ("
-              << volts[j].transpose() << ") V, outside the range [" << functions.volts_min.transpose()
-              << "] .. [" << functions.volts_max.transpose()
+              << volts[j].transpose() << ") V, outside the range ["
+              << functions.volts_min.transpose() << "] .. [" << functions.volts_max.transpose()
               << "] V the projection functions were calibrated on (they would be extrapolated)";
       throw Error(message.str());
     }

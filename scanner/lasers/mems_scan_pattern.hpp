@@ -3,8 +3,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "scanner/triangulation/light_plane.hpp"
 #include "scanner/lasers/projection_functions.hpp"
+#include "scanner/triangulation/light_plane.hpp"
 
 namespace uwscan::scanner {
 
@@ -46,7 +46,8 @@ std::vector<MemsLine> DesignMemsScanPattern(const ProjectionFunctions& functions
 // makes of lines designed and driven with an earlier one. Throws uwscan::Error naming the line
 // (`line` in messages) when a voltage pair lies outside the range `functions` were fitted on
 // (they would be extrapolated) or its beam does not leave the viewport.
-Plane MemsLinePlaneAt(const ProjectionFunctions& functions, const std::vector<Eigen::Vector2d>& volts,
-                      double plane_extension_m, int line);
+Plane MemsLinePlaneAt(const ProjectionFunctions& functions,
+                      const std::vector<Eigen::Vector2d>& volts, double plane_extension_m,
+                      int line);
 
 }  // namespace uwscan::scanner

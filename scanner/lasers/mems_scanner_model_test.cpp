@@ -58,8 +58,9 @@ std::string ParseError(const std::string& text) {
 
 TEST(MemsScannerModel, DefaultFileIsTheCompiledInDefault) {
   const MemsScannerModel compiled = DefaultMemsScannerModel();
-  const MemsScannerModel loaded = LoadScanner(
-      std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scanners/mems_default.yaml").mems();
+  const MemsScannerModel loaded = LoadScanner(std::filesystem::path(UWSCAN_SOURCE_DIR_FOR_TESTS) /
+                                              "data/scanners/mems_default.yaml")
+                                      .mems();
   EXPECT_NO_THROW(compiled.Check());
   EXPECT_EQ(compiled.laser.emitter_origin_C, loaded.laser.emitter_origin_C);
   EXPECT_EQ(compiled.laser.T_C_M.matrix(), loaded.laser.T_C_M.matrix());

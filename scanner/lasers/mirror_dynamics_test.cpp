@@ -144,8 +144,8 @@ TEST(MirrorDynamics, DynamicPathStartsSettledAndIsDeterministic) {
   for (std::size_t i = 0; i < a.samples.size(); ++i) {
     worst = std::max(worst, (a.samples[i].tilt_rad - ideal.samples[i].tilt_rad).norm());
   }
-  std::cout << "[ measured ] dynamic vs ideal path, lag-shifted exposure: worst " << worst / travel * 100
-            << " % of the line\n";
+  std::cout << "[ measured ] dynamic vs ideal path, lag-shifted exposure: worst "
+            << worst / travel * 100 << " % of the line\n";
   EXPECT_LT(worst, 0.03 * travel);
   EXPECT_LT((a.samples.back().tilt_rad - ideal.samples.back().tilt_rad).norm(), 0.03 * travel);
 }

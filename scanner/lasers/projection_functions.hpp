@@ -5,9 +5,9 @@
 #include <span>
 #include <vector>
 
-#include "scanner/optics/flat_viewport.hpp"
 #include "scanner/lasers/mems_laser.hpp"
 #include "scanner/lasers/polynomial2d.hpp"
+#include "scanner/optics/flat_viewport.hpp"
 
 namespace uwscan::scanner {
 

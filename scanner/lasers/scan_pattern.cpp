@@ -7,9 +7,7 @@
 
 namespace uwscan::scanner {
 
-const char* ToString(ScannerKind kind) {
-  return kind == ScannerKind::kGalvo ? "galvo" : "mems";
-}
+const char* ToString(ScannerKind kind) { return kind == ScannerKind::kGalvo ? "galvo" : "mems"; }
 
 void GalvoScan::Check() const {
   if (step_stride < 1) throw Error("galvo scan: step_stride must be >= 1");
@@ -51,8 +49,8 @@ std::string ScanPatternToYaml(const ScanPattern& pattern) {
   } else {
     const MemsScan& m = pattern.mems;
     out << "mems: {lines: " << m.lines << ", waypoints_per_line: " << m.waypoints_per_line
-        << ", waypoint_rate_hz: " << m.waypoint_rate_hz << ", fov_fraction: ["
-        << m.fov_fraction_x << ", " << m.fov_fraction_y << "]}\n";
+        << ", waypoint_rate_hz: " << m.waypoint_rate_hz << ", fov_fraction: [" << m.fov_fraction_x
+        << ", " << m.fov_fraction_y << "]}\n";
   }
   return out.str();
 }
@@ -83,7 +81,8 @@ ScanPattern ParseScanPattern(const std::string& yaml_text, const std::string& so
     pattern.kind = ScannerKind::kMems;
     const yaml::Context at = yaml::Enter(where, "mems");
     const YAML::Node m = yaml::Child(where, root, "mems");
-    yaml::RequireKnownKeys(at, m, {"lines", "waypoints_per_line", "waypoint_rate_hz", "fov_fraction"});
+    yaml::RequireKnownKeys(at, m,
+                           {"lines", "waypoints_per_line", "waypoint_rate_hz", "fov_fraction"});
     pattern.mems.lines = yaml::Integer(at, m, "lines");
     pattern.mems.waypoints_per_line = yaml::Integer(at, m, "waypoints_per_line");
     pattern.mems.waypoint_rate_hz = yaml::Number(at, m, "waypoint_rate_hz");

@@ -26,8 +26,8 @@ struct MemsScan {
   int lines = 500;
   int waypoints_per_line = 50;
   double waypoint_rate_hz = 3500.0;  // DAC update rate of the mirror driver
-  double fov_fraction_x = 0.9;       // (0, 1]; the FoV rectangle's corners lie beyond the drive range
-  double fov_fraction_y = 0.9;       // (0, 1]
+  double fov_fraction_x = 0.9;  // (0, 1]; the FoV rectangle's corners lie beyond the drive range
+  double fov_fraction_y = 0.9;  // (0, 1]
 
   void Check() const;
 };
@@ -39,7 +39,9 @@ struct ScanPattern {
   GalvoScan galvo;
   MemsScan mems;
 
-  int frames_per_sweep() const { return kind == ScannerKind::kGalvo ? galvo.frames_per_sweep() : mems.lines; }
+  int frames_per_sweep() const {
+    return kind == ScannerKind::kGalvo ? galvo.frames_per_sweep() : mems.lines;
+  }
   void Check() const;
 };
 

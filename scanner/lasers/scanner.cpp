@@ -35,9 +35,13 @@ FlatViewport& Scanner::laser_viewport() {
   return std::visit([](auto& m) -> FlatViewport& { return m.laser.viewport; }, model);
 }
 
-const GalvoScannerModel& Scanner::galvo() const { return ModelOf<const GalvoScannerModel>(model, "galvanometer"); }
+const GalvoScannerModel& Scanner::galvo() const {
+  return ModelOf<const GalvoScannerModel>(model, "galvanometer");
+}
 GalvoScannerModel& Scanner::galvo() { return ModelOf<GalvoScannerModel>(model, "galvanometer"); }
-const MemsScannerModel& Scanner::mems() const { return ModelOf<const MemsScannerModel>(model, "MEMS"); }
+const MemsScannerModel& Scanner::mems() const {
+  return ModelOf<const MemsScannerModel>(model, "MEMS");
+}
 MemsScannerModel& Scanner::mems() { return ModelOf<MemsScannerModel>(model, "MEMS"); }
 
 void Scanner::Check() const {
@@ -52,11 +56,12 @@ std::vector<std::string> ScannerSections(ScannerKind kind) {
 void CopySection(const Scanner& from, const std::string& section, Scanner* to) {
   const std::vector<std::string> sections = ScannerSections(from.kind());
   if (std::find(sections.begin(), sections.end(), section) == sections.end()) {
-    throw Error("'" + section + "' is not a section of a " + ToString(from.kind()) + " scanner file");
+    throw Error("'" + section + "' is not a section of a " + ToString(from.kind()) +
+                " scanner file");
   }
   if (from.kind() != to->kind()) {
-    throw Error(std::string("cannot copy '") + section + "' from a " + ToString(from.kind()) + " scanner into a " +
-                ToString(to->kind()) + " scanner");
+    throw Error(std::string("cannot copy '") + section + "' from a " + ToString(from.kind()) +
+                " scanner into a " + ToString(to->kind()) + " scanner");
   }
   if (section == "camera") {
     to->camera().camera = from.camera().camera;
@@ -75,8 +80,9 @@ void CopySection(const Scanner& from, const std::string& section, Scanner* to) {
     to->laser_viewport() = viewport;
   } else {
     if (!from.mems().functions_from_file) {
-      throw Error("'projection_functions': the scanner they would come from has none of its own "
-                  "(its functions are fitted to its laser)");
+      throw Error(
+          "'projection_functions': the scanner they would come from has none of its own "
+          "(its functions are fitted to its laser)");
     }
     to->mems().functions = from.mems().functions;
     to->mems().functions_from_file = from.mems().functions_from_file;

@@ -14,16 +14,16 @@ extern const char* const kDefaultMemsScannerYaml;
 namespace {
 
 GalvoScannerModel ReadGalvo(const yaml::Context& top, const YAML::Node& root) {
-  yaml::RequireKnownKeys(top, root,
-                         {"uwscan_format", "camera", "camera_viewport", "laser", "laser_viewport",
-                          "calibration"});
+  yaml::RequireKnownKeys(
+      top, root,
+      {"uwscan_format", "camera", "camera_viewport", "laser", "laser_viewport", "calibration"});
   GalvoScannerModel m;
   m.camera.camera = yaml::ReadCamera(yaml::Enter(top, "camera"), yaml::Child(top, root, "camera"));
-  m.camera.viewport =
-      yaml::ReadViewport(yaml::Enter(top, "camera_viewport"), yaml::Child(top, root, "camera_viewport"));
+  m.camera.viewport = yaml::ReadViewport(yaml::Enter(top, "camera_viewport"),
+                                         yaml::Child(top, root, "camera_viewport"));
   m.laser = yaml::ReadGalvoLaser(yaml::Enter(top, "laser"), yaml::Child(top, root, "laser"));
-  m.laser.viewport =
-      yaml::ReadViewport(yaml::Enter(top, "laser_viewport"), yaml::Child(top, root, "laser_viewport"));
+  m.laser.viewport = yaml::ReadViewport(yaml::Enter(top, "laser_viewport"),
+                                        yaml::Child(top, root, "laser_viewport"));
   yaml::CheckSection(m.camera, top.source, "camera");
   yaml::CheckSection(m.laser, top.source, "laser");
   return m;
@@ -35,11 +35,12 @@ MemsScannerModel ReadMems(const yaml::Context& top, const YAML::Node& root) {
                           "projection_functions", "calibration"});
   MemsScannerModel m;
   m.camera.camera = yaml::ReadCamera(yaml::Enter(top, "camera"), yaml::Child(top, root, "camera"));
-  m.camera.viewport =
-      yaml::ReadViewport(yaml::Enter(top, "camera_viewport"), yaml::Child(top, root, "camera_viewport"));
-  yaml::ReadMemsSection(yaml::Enter(top, "mems"), yaml::Child(top, root, "mems"), &m.laser, &m.dynamics);
-  m.laser.viewport =
-      yaml::ReadViewport(yaml::Enter(top, "laser_viewport"), yaml::Child(top, root, "laser_viewport"));
+  m.camera.viewport = yaml::ReadViewport(yaml::Enter(top, "camera_viewport"),
+                                         yaml::Child(top, root, "camera_viewport"));
+  yaml::ReadMemsSection(yaml::Enter(top, "mems"), yaml::Child(top, root, "mems"), &m.laser,
+                        &m.dynamics);
+  m.laser.viewport = yaml::ReadViewport(yaml::Enter(top, "laser_viewport"),
+                                        yaml::Child(top, root, "laser_viewport"));
   yaml::CheckSection(m.camera, top.source, "camera");
   yaml::CheckSection(m.laser, top.source, "mems");
   yaml::CheckSection(m.dynamics, top.source, "mems.dynamics");
@@ -82,7 +83,8 @@ Scanner ParseScanner(const std::string& yaml_text, const std::string& source_nam
     scanner.model = ReadGalvo(top, root);
   }
   if (root["calibration"].IsDefined()) {
-    scanner.calibration = yaml::ReadStepRecords(yaml::Enter(top, "calibration"), root["calibration"]);
+    scanner.calibration =
+        yaml::ReadStepRecords(yaml::Enter(top, "calibration"), root["calibration"]);
   }
   return scanner;
 }
@@ -108,7 +110,8 @@ std::string ScannerToYaml(const Scanner& scanner, const std::string& comment) {
   if (scanner.kind() == ScannerKind::kMems && scanner.mems().functions_from_file) {
     root["projection_functions"] = yaml::WriteProjectionFunctions(scanner.mems().functions);
   }
-  if (!scanner.calibration.empty()) root["calibration"] = yaml::WriteStepRecords(scanner.calibration);
+  if (!scanner.calibration.empty())
+    root["calibration"] = yaml::WriteStepRecords(scanner.calibration);
 
   YAML::Emitter out;
   out.SetDoublePrecision(17);
@@ -120,7 +123,8 @@ std::string ScannerToYaml(const Scanner& scanner, const std::string& comment) {
 }
 
 Scanner DefaultScanner(ScannerKind kind) {
-  if (kind == ScannerKind::kMems) return ParseScanner(kDefaultMemsScannerYaml, "data/scanners/mems_default.yaml");
+  if (kind == ScannerKind::kMems)
+    return ParseScanner(kDefaultMemsScannerYaml, "data/scanners/mems_default.yaml");
   return ParseScanner(kDefaultScannerYaml, "data/scanners/galvo_default.yaml");
 }
 

@@ -32,14 +32,17 @@ StepRecord SomeRecord(const std::string& step) {
 void ExpectSameNumbers(const std::string& a, const std::string& b) {
   const std::regex number(R"([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)");
   std::vector<double> x, y;
-  for (auto it = std::sregex_iterator(a.begin(), a.end(), number); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(a.begin(), a.end(), number); it != std::sregex_iterator();
+       ++it) {
     x.push_back(std::stod(it->str()));
   }
-  for (auto it = std::sregex_iterator(b.begin(), b.end(), number); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(b.begin(), b.end(), number); it != std::sregex_iterator();
+       ++it) {
     y.push_back(std::stod(it->str()));
   }
   ASSERT_EQ(x.size(), y.size());
-  for (size_t i = 0; i < x.size(); ++i) EXPECT_NEAR(x[i], y[i], 1e-15 * std::max(1.0, std::abs(x[i]))) << i;
+  for (size_t i = 0; i < x.size(); ++i)
+    EXPECT_NEAR(x[i], y[i], 1e-15 * std::max(1.0, std::abs(x[i]))) << i;
 }
 
 void ExpectSamePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -77,12 +80,15 @@ TEST(ScannerFile, MemsScannerWritesOnlyCalibratedFunctions) {
   EXPECT_EQ(fitted.find("projection_functions"), std::string::npos);
   const Scanner refitted = ParseScanner(fitted, "fitted");
   EXPECT_FALSE(refitted.mems().functions_from_file);
-  EXPECT_LT((refitted.mems().functions.f2.coefficients() - s.mems().functions.f2.coefficients()).norm(), 1e-12);
+  EXPECT_LT(
+      (refitted.mems().functions.f2.coefficients() - s.mems().functions.f2.coefficients()).norm(),
+      1e-12);
 
   s.mems().functions_from_file = true;
   const Scanner calibrated = ParseScanner(ScannerToYaml(s), "calibrated");
   EXPECT_TRUE(calibrated.mems().functions_from_file);
-  EXPECT_EQ(calibrated.mems().functions.f5.coefficients(), s.mems().functions.f5.coefficients());  // scalars: exact
+  EXPECT_EQ(calibrated.mems().functions.f5.coefficients(),
+            s.mems().functions.f5.coefficients());  // scalars: exact
   EXPECT_EQ(calibrated.mems().dynamics.resonance_hz, s.mems().dynamics.resonance_hz);
   EXPECT_EQ(calibrated.mems().laser.saturation, s.mems().laser.saturation);
   ExpectSameNumbers(ScannerToYaml(calibrated), ScannerToYaml(s));

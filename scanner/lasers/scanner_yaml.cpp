@@ -30,8 +30,8 @@ Eigen::Vector3d UnitVector3(const Context& where, const YAML::Node& node, const 
 
 MirrorDynamicsOptions ReadDynamics(const Context& where, const YAML::Node& node) {
   RequireKnownKeys(where, node,
-                   {"resonance_hz", "damping_ratio", "lpf_cutoff_hz", "lpf_order", "waypoint_rate_hz",
-                    "settle_s", "sample_rate_hz"});
+                   {"resonance_hz", "damping_ratio", "lpf_cutoff_hz", "lpf_order",
+                    "waypoint_rate_hz", "settle_s", "sample_rate_hz"});
   MirrorDynamicsOptions d;
   d.resonance_hz = Number(where, node, "resonance_hz");
   d.damping_ratio = Number(where, node, "damping_ratio");
@@ -65,8 +65,10 @@ Polynomial2d ReadPolynomial(const Context& where, const YAML::Node& node) {
   }
   const Eigen::Vector2d center = Vector2(where, node, "center");
   const Eigen::Vector2d scale = Vector2(where, node, "scale");
-  if (!(scale.minCoeff() > 0.0)) Fail(Enter(where, "scale"), node["scale"], "expected positive half-ranges");
-  const Eigen::VectorXd coefficients = Vector(where, node, "coefficients", Polynomial2d::TermCount(degree));
+  if (!(scale.minCoeff() > 0.0))
+    Fail(Enter(where, "scale"), node["scale"], "expected positive half-ranges");
+  const Eigen::VectorXd coefficients =
+      Vector(where, node, "coefficients", Polynomial2d::TermCount(degree));
   return Polynomial2d(degree, center, scale, coefficients);
 }
 
@@ -81,7 +83,6 @@ YAML::Node WritePolynomial(const Polynomial2d& f) {
 
 constexpr const char* kFunctionNames[6] = {"f1", "f2", "f3", "f4", "f5", "f6"};
 
-
 }  // namespace
 
 YAML::Node WritePose(const Eigen::Isometry3d& T) {
@@ -94,7 +95,8 @@ YAML::Node WritePose(const Eigen::Isometry3d& T) {
 }
 
 PinholeCamera ReadCamera(const Context& where, const YAML::Node& node) {
-  RequireKnownKeys(where, node, {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px", "distortion"});
+  RequireKnownKeys(where, node,
+                   {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px", "distortion"});
   PinholeCamera c;
   c.width_px = Integer(where, node, "width_px");
   c.height_px = Integer(where, node, "height_px");
@@ -121,7 +123,8 @@ YAML::Node WriteCamera(const PinholeCamera& c) {
 }
 
 FlatViewport ReadViewport(const Context& where, const YAML::Node& node) {
-  RequireKnownKeys(where, node, {"normal", "distance_m", "thickness_m", "n_air", "n_glass", "n_water"});
+  RequireKnownKeys(where, node,
+                   {"normal", "distance_m", "thickness_m", "n_air", "n_glass", "n_water"});
   FlatViewport v;
   v.normal = UnitVector3(where, node, "normal");
   v.distance_m = Number(where, node, "distance_m");
@@ -145,8 +148,8 @@ YAML::Node WriteViewport(const FlatViewport& v) {
 
 GalvoLaser ReadGalvoLaser(const Context& where, const YAML::Node& node) {
   RequireKnownKeys(where, node,
-                   {"T_C_L", "T_C_M", "mirror_step_rad", "rotation_distance_m", "aperture_rad", "step_min",
-                    "step_max"});
+                   {"T_C_L", "T_C_M", "mirror_step_rad", "rotation_distance_m", "aperture_rad",
+                    "step_min", "step_max"});
   GalvoLaser l;
   l.T_C_L = Pose(where, node, "T_C_L");
   l.T_C_M = Pose(where, node, "T_C_M");
@@ -173,8 +176,8 @@ YAML::Node WriteGalvoLaser(const GalvoLaser& l) {
 void ReadMemsSection(const Context& where, const YAML::Node& node, MemsLaser* laser,
                      MirrorDynamicsOptions* dynamics) {
   RequireKnownKeys(where, node,
-                   {"emitter", "T_C_M", "max_volts", "max_tilt_rad", "saturation", "T_C_Lens", "lens_gain",
-                    "dynamics"});
+                   {"emitter", "T_C_M", "max_volts", "max_tilt_rad", "saturation", "T_C_Lens",
+                    "lens_gain", "dynamics"});
   const Context emitter_where = Enter(where, "emitter");
   const YAML::Node emitter = Child(where, node, "emitter");
   RequireKnownKeys(emitter_where, emitter, {"origin_m", "direction"});
@@ -204,14 +207,16 @@ YAML::Node WriteMemsSection(const MemsLaser& laser, const MirrorDynamicsOptions&
 }
 
 ProjectionFunctions ReadProjectionFunctions(const Context& where, const YAML::Node& node) {
-  RequireKnownKeys(where, node, {"T_C_P", "volts_min", "volts_max", "f1", "f2", "f3", "f4", "f5", "f6"});
+  RequireKnownKeys(where, node,
+                   {"T_C_P", "volts_min", "volts_max", "f1", "f2", "f3", "f4", "f5", "f6"});
   ProjectionFunctions f;
   f.T_C_P = Pose(where, node, "T_C_P");
   f.volts_min = Vector2(where, node, "volts_min");
   f.volts_max = Vector2(where, node, "volts_max");
   Polynomial2d* const targets[6] = {&f.f1, &f.f2, &f.f3, &f.f4, &f.f5, &f.f6};
   for (int i = 0; i < 6; ++i) {
-    *targets[i] = ReadPolynomial(Enter(where, kFunctionNames[i]), Child(where, node, kFunctionNames[i]));
+    *targets[i] =
+        ReadPolynomial(Enter(where, kFunctionNames[i]), Child(where, node, kFunctionNames[i]));
   }
   return f;
 }
@@ -237,8 +242,8 @@ std::vector<StepRecord> ReadStepRecords(const Context& where, const YAML::Node& 
     const Context at = Enter(where, r.step);
     const YAML::Node n = entry.second;
     RequireKnownKeys(at, n,
-                     {"dataset", "date_utc", "residual_unit", "residual_rms", "residual_max", "observations",
-                      "seconds", "params"});
+                     {"dataset", "date_utc", "residual_unit", "residual_rms", "residual_max",
+                      "observations", "seconds", "params"});
     r.dataset = Text(at, n, "dataset");
     r.date_utc = Text(at, n, "date_utc");
     r.residual_unit = Text(at, n, "residual_unit");

@@ -37,10 +37,10 @@ class CameraRayTable {
     const double w00 = (1.0 - wu) * (1.0 - wv), w01 = wu * (1.0 - wv);
     const double w10 = (1.0 - wu) * wv, w11 = wu * wv;
     for (int k = 0; k < 3; ++k) {
-      ray->origin[k] = w00 * n00.origin[k] + w01 * n01.origin[k] + w10 * n10.origin[k] +
-                       w11 * n11.origin[k];
-      ray->direction[k] = w00 * n00.direction[k] + w01 * n01.direction[k] +
-                          w10 * n10.direction[k] + w11 * n11.direction[k];
+      ray->origin[k] =
+          w00 * n00.origin[k] + w01 * n01.origin[k] + w10 * n10.origin[k] + w11 * n11.origin[k];
+      ray->direction[k] = w00 * n00.direction[k] + w01 * n01.direction[k] + w10 * n10.direction[k] +
+                          w11 * n11.direction[k];
     }
     return true;
   }

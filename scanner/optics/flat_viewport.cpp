@@ -71,10 +71,8 @@ void FlatViewport::Check() const {
   Require(std::isfinite(thickness_m) && thickness_m >= 0.0 && thickness_m < 1.0, "thickness_m",
           "in [0, 1) metres");
   Require(std::isfinite(n_air) && n_air >= 1.0 && n_air < 3.0, "n_air", "in [1, 3)");
-  Require(std::isfinite(n_glass) && n_glass >= n_air && n_glass < 3.0, "n_glass",
-          "in [n_air, 3)");
-  Require(std::isfinite(n_water) && n_water >= n_air && n_water < 3.0, "n_water",
-          "in [n_air, 3)");
+  Require(std::isfinite(n_glass) && n_glass >= n_air && n_glass < 3.0, "n_glass", "in [n_air, 3)");
+  Require(std::isfinite(n_water) && n_water >= n_air && n_water < 3.0, "n_water", "in [n_air, 3)");
 }
 
 RayTrace TraceOut(const FlatViewport& v, const Ray& ray_in_air) {
@@ -92,8 +90,8 @@ RayTrace TraceOut(const FlatViewport& v, const Ray& ray_in_air) {
   // n_glass, n_water >= n_air (Check), so neither square root can go negative.
   const double cos_glass = std::sqrt(std::max(0.0, 1.0 - eta_glass * eta_glass * sin2_air));
   const double cos_water = std::sqrt(std::max(0.0, 1.0 - eta_water * eta_water * sin2_air));
-  const Eigen::Vector3d exit = ray_in_air.At(t) +
-                               v.thickness_m * ((eta_glass / cos_glass) * along_faces + n);
+  const Eigen::Vector3d exit =
+      ray_in_air.At(t) + v.thickness_m * ((eta_glass / cos_glass) * along_faces + n);
   return RayTrace{HitStatus::kHit, Ray{exit, eta_water * along_faces + cos_water * n}};
 }
 

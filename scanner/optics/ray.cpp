@@ -4,12 +4,18 @@ namespace uwscan::scanner {
 
 const char* ToString(HitStatus status) {
   switch (status) {
-    case HitStatus::kHit: return "hit";
-    case HitStatus::kParallel: return "parallel";
-    case HitStatus::kBehind: return "behind";
-    case HitStatus::kOutsideSurface: return "outside_surface";
-    case HitStatus::kNoIntersection: return "no_intersection";
-    case HitStatus::kTotalInternalReflection: return "total_internal_reflection";
+    case HitStatus::kHit:
+      return "hit";
+    case HitStatus::kParallel:
+      return "parallel";
+    case HitStatus::kBehind:
+      return "behind";
+    case HitStatus::kOutsideSurface:
+      return "outside_surface";
+    case HitStatus::kNoIntersection:
+      return "no_intersection";
+    case HitStatus::kTotalInternalReflection:
+      return "total_internal_reflection";
   }
   return "unknown";
 }

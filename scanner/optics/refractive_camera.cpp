@@ -20,8 +20,7 @@ RayTrace RefractiveCamera::PixelToRayInWater(const Eigen::Vector2d& uv_px) const
 
 std::optional<Eigen::Vector2d> RefractiveCamera::ProjectPointInWater(
     const Eigen::Vector3d& p_C) const {
-  const DirectionResult in_air =
-      DirectionThroughViewport(viewport, Eigen::Vector3d::Zero(), p_C);
+  const DirectionResult in_air = DirectionThroughViewport(viewport, Eigen::Vector3d::Zero(), p_C);
   if (!in_air.ok() || !(in_air.direction.z() > 1e-12)) return std::nullopt;
   return camera.Project(in_air.direction);
 }

@@ -44,19 +44,22 @@ TEST_P(DivePeakNoise, IsTheDetectorsErrorOnTheDivesRenderedStripes) {
   // (up to 3 px away) cannot carry it.
   std::vector<double> deviations;
   for (const double e : errors) deviations.push_back(std::abs(e - mean));
-  std::nth_element(deviations.begin(), deviations.begin() + static_cast<std::ptrdiff_t>(deviations.size() / 2),
+  std::nth_element(deviations.begin(),
+                   deviations.begin() + static_cast<std::ptrdiff_t>(deviations.size() / 2),
                    deviations.end());
   const double robust_px = 1.4826 * deviations[deviations.size() / 2];
-  std::printf("%s: detector error std %.3f px (from the MAD %.3f px) over %zu peaks, the scene's peak noise %.3f px\n",
-              GetParam(), measured_px, robust_px, errors.size(), modelled_px);
+  std::printf(
+      "%s: detector error std %.3f px (from the MAD %.3f px) over %zu peaks, the scene's peak "
+      "noise %.3f px\n",
+      GetParam(), measured_px, robust_px, errors.size(), modelled_px);
   EXPECT_NEAR(measured_px / modelled_px, 1.0, 0.2) << measured_px << " px measured";
   EXPECT_NEAR(robust_px / modelled_px, 1.0, 0.2) << robust_px << " px measured (MAD)";
 }
 
 INSTANTIATE_TEST_SUITE_P(Dives, DivePeakNoise,
-                         ::testing::Values("inspection_short.yaml", "inspection_loop.yaml", "inspection_pipe.yaml",
-                                           "inspection_long.yaml", "inspection_mems.yaml",
-                                           "inspection_loop_mems.yaml"));
+                         ::testing::Values("inspection_short.yaml", "inspection_loop.yaml",
+                                           "inspection_pipe.yaml", "inspection_long.yaml",
+                                           "inspection_mems.yaml", "inspection_loop_mems.yaml"));
 
 }  // namespace
 }  // namespace uwscan::scanner::sim

@@ -33,8 +33,9 @@ void SimulationEffects::Check() const {
   Require(NonNegative(navigation_drift.yaw_walk_rad_per_sqrt_s),
           "navigation_drift.yaw_walk_rad_per_sqrt_s", navigation_drift.yaw_walk_rad_per_sqrt_s,
           ">= 0 rad/sqrt(s)");
-  Require(NonNegative(navigation_drift.speed_scale_sigma) && navigation_drift.speed_scale_sigma < 0.5,
-          "navigation_drift.speed_scale_sigma", navigation_drift.speed_scale_sigma, "in [0, 0.5)");
+  Require(
+      NonNegative(navigation_drift.speed_scale_sigma) && navigation_drift.speed_scale_sigma < 0.5,
+      "navigation_drift.speed_scale_sigma", navigation_drift.speed_scale_sigma, "in [0, 0.5)");
   Require(NonNegative(navigation_drift.heading_bias_sigma_rad),
           "navigation_drift.heading_bias_sigma_rad", navigation_drift.heading_bias_sigma_rad,
           ">= 0 rad");

@@ -10,11 +10,11 @@ namespace uwscan::scanner::sim {
 // stripe peaks; with any image stage on it renders frames and detects the stripe in them.
 struct SimulationEffects {
   // --- Geometry: where the stripe falls ---------------------------------------------------
-  bool refraction = true;       // viewports bend rays; off: both viewports are taken away
-  bool lens_distortion = true;  // off: the camera's distortion coefficients are zeroed
-  bool occlusion = true;        // a laser spot the camera cannot see gives no peak
-  bool mirror_dynamics = false; // MEMS: low-pass filter + resonant mirror between waypoints
-  bool motion = false;          // the vehicle moves during a sweep: each frame at its own pose
+  bool refraction = true;        // viewports bend rays; off: both viewports are taken away
+  bool lens_distortion = true;   // off: the camera's distortion coefficients are zeroed
+  bool occlusion = true;         // a laser spot the camera cannot see gives no peak
+  bool mirror_dynamics = false;  // MEMS: low-pass filter + resonant mirror between waypoints
+  bool motion = false;           // the vehicle moves during a sweep: each frame at its own pose
 
   // Navigation the vehicle believes in, as a vehicle has it: depth (pressure sensor) and roll /
   // pitch (AHRS) absolute with white noise; x, y and heading by dead reckoning (DVL velocity
@@ -29,8 +29,8 @@ struct SimulationEffects {
     double heading_bias_sigma_rad = 0.0;        // std of the constant heading bias
     // Errors of the filtered absolute sensors: std of a slowly wandering error (correlation
     // time 5 s), not a jump per sample.
-    double depth_sigma_m = 0.0;                 // pressure depth
-    double roll_pitch_sigma_rad = 0.0;          // AHRS roll and pitch
+    double depth_sigma_m = 0.0;         // pressure depth
+    double roll_pitch_sigma_rad = 0.0;  // AHRS roll and pitch
   } navigation_drift;
 
   // Exact peaks moved along their image line by Gaussian noise, for long dives where rendering
@@ -45,8 +45,8 @@ struct SimulationEffects {
   struct Image {
     bool on = false;
     PixelFormat format = PixelFormat::kMono8;
-    double peak_level = 180.0;  // stripe peak, image units, white target at 1 m, clear water
-    double blur_sigma_px = 0.7; // optics and pixel blur; the stripe is never narrower
+    double peak_level = 180.0;   // stripe peak, image units, white target at 1 m, clear water
+    double blur_sigma_px = 0.7;  // optics and pixel blur; the stripe is never narrower
   } image;
   struct Beam {  // stripe width from the beam's footprint (seed 001 laser: 1 mm, 1.1 mrad)
     bool on = false;
@@ -55,8 +55,8 @@ struct SimulationEffects {
   } beam;
   struct SensorNoise {
     bool on = false;
-    double read_sigma = 1.0;        // read noise, image units
-    double electrons_per_level = 4; // shot noise: variance = level / electrons_per_level
+    double read_sigma = 1.0;         // read noise, image units
+    double electrons_per_level = 4;  // shot noise: variance = level / electrons_per_level
   } sensor_noise;
   struct Speckle {
     bool on = false;
@@ -73,8 +73,8 @@ struct SimulationEffects {
   } ambient;
 
   bool AnyImageStage() const {
-    return image.on || beam.on || sensor_noise.on || speckle.on || attenuation ||
-           backscatter.on || ambient.on;
+    return image.on || beam.on || sensor_noise.on || speckle.on || attenuation || backscatter.on ||
+           ambient.on;
   }
   // Throws uwscan::Error naming the field when a value is unusable.
   void Check() const;

@@ -117,8 +117,10 @@ void AddGlow(std::vector<float>& image, int width, int height, const GlowSample&
   const double inv2s2 = 1.0 / (2.0 * kGlowSigmaPx * kGlowSigmaPx);
   for (int v = std::max(0, v0 - reach); v <= std::min(height - 1, v0 + reach); ++v) {
     for (int u = std::max(0, u0 - reach); u <= std::min(width - 1, u0 + reach); ++u) {
-      const double d2 = (u - glow.px.x()) * (u - glow.px.x()) + (v - glow.px.y()) * (v - glow.px.y());
-      image[static_cast<size_t>(v) * width + u] += static_cast<float>(glow.level * std::exp(-d2 * inv2s2));
+      const double d2 =
+          (u - glow.px.x()) * (u - glow.px.x()) + (v - glow.px.y()) * (v - glow.px.y());
+      image[static_cast<size_t>(v) * width + u] +=
+          static_cast<float>(glow.level * std::exp(-d2 * inv2s2));
     }
   }
 }
@@ -147,7 +149,8 @@ StripeFrame RenderFrame(const FrameRenderInput& input, const SimulationEffects& 
     if (std::isnan(frame.truth_px[static_cast<size_t>(line)])) {
       frame.truth_px[static_cast<size_t>(line)] = centre;
     }
-    float* start = rows ? &image[static_cast<size_t>(line) * width] : &image[static_cast<size_t>(line)];
+    float* start =
+        rows ? &image[static_cast<size_t>(line) * width] : &image[static_cast<size_t>(line)];
     AddProfile(start, rows ? width : height, rows ? 1 : width, centre,
                StripeSigmaPx(peak, effects, input.focal_px),
                StripeAmplitude(peak, effects, input.attenuation_per_m), effects.speckle.contrast,
@@ -163,9 +166,9 @@ StripeFrame RenderFrame(const FrameRenderInput& input, const SimulationEffects& 
   if (effects.sensor_noise.on) {
     noise_sigma.resize(static_cast<size_t>(max_value) + 1);
     for (int level = 0; level <= max_value; ++level) {
-      noise_sigma[static_cast<size_t>(level)] = static_cast<float>(std::sqrt(
-          level / effects.sensor_noise.electrons_per_level +
-          effects.sensor_noise.read_sigma * effects.sensor_noise.read_sigma));
+      noise_sigma[static_cast<size_t>(level)] = static_cast<float>(
+          std::sqrt(level / effects.sensor_noise.electrons_per_level +
+                    effects.sensor_noise.read_sigma * effects.sensor_noise.read_sigma));
     }
   }
   FastNormal noise(seed * 2 + 2);
@@ -178,10 +181,12 @@ StripeFrame RenderFrame(const FrameRenderInput& input, const SimulationEffects& 
   };
   if (frame.format == PixelFormat::kMono8) {
     frame.mono8.resize(image.size());
-    for (size_t i = 0; i < image.size(); ++i) frame.mono8[i] = static_cast<std::uint8_t>(quantise(image[i]));
+    for (size_t i = 0; i < image.size(); ++i)
+      frame.mono8[i] = static_cast<std::uint8_t>(quantise(image[i]));
   } else {
     frame.mono16.resize(image.size());
-    for (size_t i = 0; i < image.size(); ++i) frame.mono16[i] = static_cast<std::uint16_t>(quantise(image[i]));
+    for (size_t i = 0; i < image.size(); ++i)
+      frame.mono16[i] = static_cast<std::uint16_t>(quantise(image[i]));
   }
   return frame;
 }

@@ -2,10 +2,10 @@
 
 #include <memory>
 
-#include "scanner/optics/refractive_camera.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
 #include "scanner/lasers/mems_scanner_model.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
+#include "scanner/optics/refractive_camera.hpp"
 #include "scanner/sim/stripe_tracer.hpp"
 
 namespace uwscan::scanner::sim {
@@ -24,12 +24,13 @@ class LightSource {
 };
 
 // The galvanometer scanner `model` (seed 000) swept as `scan` says.
-std::unique_ptr<LightSource> MakeGalvoLightSource(const GalvoScannerModel& model, const GalvoScan& scan);
+std::unique_ptr<LightSource> MakeGalvoLightSource(const GalvoScannerModel& model,
+                                                  const GalvoScan& scan);
 
 // The MEMS scanner `model` (seed 001) drawing the scan pattern `scan`, its mirror
 // following the ideal path between waypoints or, with `mirror_dynamics`, its filtered and
 // resonant response.
-std::unique_ptr<LightSource> MakeMemsLightSource(const MemsScannerModel& model, const MemsScan& scan,
-                                                 bool mirror_dynamics);
+std::unique_ptr<LightSource> MakeMemsLightSource(const MemsScannerModel& model,
+                                                 const MemsScan& scan, bool mirror_dynamics);
 
 }  // namespace uwscan::scanner::sim

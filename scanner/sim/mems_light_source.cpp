@@ -56,7 +56,8 @@ class MemsLightSource final : public LightSource {
     auto tilt = std::make_shared<const TiltPath>(
         SimulateLine(model_.laser, lines_.at(static_cast<size_t>(frame_in_sweep)).volts, dynamics_,
                      mirror_dynamics_));
-    if (tilt->samples.size() < 2) throw Error("MEMS simulation: a line yielded fewer than 2 tilt samples");
+    if (tilt->samples.size() < 2)
+      throw Error("MEMS simulation: a line yielded fewer than 2 tilt samples");
     auto laser = std::make_shared<const MemsLaser>(model_.laser);
     LaserPath path;
     const double last = static_cast<double>(tilt->samples.size() - 1);
@@ -84,8 +85,8 @@ class MemsLightSource final : public LightSource {
 
 }  // namespace
 
-std::unique_ptr<LightSource> MakeMemsLightSource(const MemsScannerModel& model, const MemsScan& scan,
-                                                 bool mirror_dynamics) {
+std::unique_ptr<LightSource> MakeMemsLightSource(const MemsScannerModel& model,
+                                                 const MemsScan& scan, bool mirror_dynamics) {
   return std::make_unique<MemsLightSource>(model, scan, mirror_dynamics);
 }
 

@@ -93,7 +93,8 @@ std::optional<double> SphereDistance(const Geometry& g, const QueryContext& q) {
 }
 
 // Distance from p to the closest point of segment [a, b].
-double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
   const double length2 = ab.squaredNorm();
   const double s = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;

@@ -211,8 +211,8 @@ TEST(RayCaster, DistanceToSurfaceMatchesExactFormulas) {
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, 1.0, -0.4).normalized()).matrix();
   const Eigen::Isometry3d T_W_O = Pose({0.1, 0.05, 1.2}, R);
   const Eigen::Vector3d centre(-0.6, 0.2, 1.0);
-  const RayCaster caster({MeshObject("box", ObjectShape::kBox, MakeBox(size), T_W_O, 0.5),
-                          Sphere(centre, 0.15)});
+  const RayCaster caster(
+      {MeshObject("box", ObjectShape::kBox, MakeBox(size), T_W_O, 0.5), Sphere(centre, 0.15)});
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int found = 0;

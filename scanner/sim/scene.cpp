@@ -6,10 +6,10 @@
 #include <sstream>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/yaml_fields.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/scene_fields.hpp"
 #include "scanner/sim/scene_objects.hpp"
-#include "scanner/common/yaml_fields.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {
@@ -157,31 +157,30 @@ using Effects = SimulationEffects;
 
 Effects::NavigationDrift ReadNavigationDrift(const Context& where, const YAML::Node& node) {
   Effects::NavigationDrift drift;
-  drift.on = ReadStage(where, node, "navigation_drift",
-                       {"on", "position_walk_m_per_sqrt_s", "yaw_walk_rad_per_sqrt_s",
-                        "speed_scale_sigma", "heading_bias_sigma_rad", "depth_sigma_m",
-                        "roll_pitch_sigma_rad"},
-                       [&](const Context& at, const YAML::Node& n) {
-                         const auto read = [&](const char* key, double* value) {
-                           *value = Number(at, n, key, Range::kNonNegative, *value);
-                         };
-                         read("position_walk_m_per_sqrt_s", &drift.position_walk_m_per_sqrt_s);
-                         read("yaw_walk_rad_per_sqrt_s", &drift.yaw_walk_rad_per_sqrt_s);
-                         read("speed_scale_sigma", &drift.speed_scale_sigma);
-                         read("heading_bias_sigma_rad", &drift.heading_bias_sigma_rad);
-                         read("depth_sigma_m", &drift.depth_sigma_m);
-                         read("roll_pitch_sigma_rad", &drift.roll_pitch_sigma_rad);
-                       });
+  drift.on =
+      ReadStage(where, node, "navigation_drift",
+                {"on", "position_walk_m_per_sqrt_s", "yaw_walk_rad_per_sqrt_s", "speed_scale_sigma",
+                 "heading_bias_sigma_rad", "depth_sigma_m", "roll_pitch_sigma_rad"},
+                [&](const Context& at, const YAML::Node& n) {
+                  const auto read = [&](const char* key, double* value) {
+                    *value = Number(at, n, key, Range::kNonNegative, *value);
+                  };
+                  read("position_walk_m_per_sqrt_s", &drift.position_walk_m_per_sqrt_s);
+                  read("yaw_walk_rad_per_sqrt_s", &drift.yaw_walk_rad_per_sqrt_s);
+                  read("speed_scale_sigma", &drift.speed_scale_sigma);
+                  read("heading_bias_sigma_rad", &drift.heading_bias_sigma_rad);
+                  read("depth_sigma_m", &drift.depth_sigma_m);
+                  read("roll_pitch_sigma_rad", &drift.roll_pitch_sigma_rad);
+                });
   return drift;
 }
 
 Effects::PeakNoise ReadPeakNoise(const Context& where, const YAML::Node& node) {
   Effects::PeakNoise peak_noise;
-  peak_noise.on = ReadStage(where, node, "peak_noise", {"on", "sigma_px"},
-                            [&](const Context& at, const YAML::Node& n) {
-                              peak_noise.sigma_px =
-                                  Number(at, n, "sigma_px", Range::kNonNegative, peak_noise.sigma_px);
-                            });
+  peak_noise.on = ReadStage(
+      where, node, "peak_noise", {"on", "sigma_px"}, [&](const Context& at, const YAML::Node& n) {
+        peak_noise.sigma_px = Number(at, n, "sigma_px", Range::kNonNegative, peak_noise.sigma_px);
+      });
   return peak_noise;
 }
 
@@ -380,9 +379,9 @@ Scene ParseScene(const std::string& yaml_text, const std::string& source_name,
                            {"uwscan_format", "seed", "water", "scanner", "trajectory", "effects",
                             "detector", "objects"});
   } else {
-    yaml::RequireKnownKeys(top, root,
-                           {"uwscan_format", "seed", "water", "scanner", "effects", "detector",
-                            "calibration"});
+    yaml::RequireKnownKeys(
+        top, root,
+        {"uwscan_format", "seed", "water", "scanner", "effects", "detector", "calibration"});
   }
   Scene scene;
   scene.source = source_name;

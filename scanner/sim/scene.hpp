@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "scanner/common/triangle_mesh.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/lasers/scanner.hpp"
 #include "scanner/sim/effects.hpp"
 #include "scanner/sim/trajectory.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
-#include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::scanner::sim {
 
@@ -37,7 +37,7 @@ struct SceneObject {
   std::string name;  // unique within the scene ("<shape>_<index>" when not given)
   ObjectShape shape = ObjectShape::kPlane;
   Eigen::Isometry3d T_W_O = Eigen::Isometry3d::Identity();  // object pose in the world
-  double reflectance = 0.5;  // diffuse albedo, [0, 1]
+  double reflectance = 0.5;                                 // diffuse albedo, [0, 1]
   // Geometry in {O}: every shape but the sphere is a triangle mesh (counter-clockwise seen
   // from outside); the sphere is kept exact.
   TriangleMesh mesh;
@@ -50,7 +50,8 @@ struct Water {
   double attenuation_per_m = 0.0;  // beam attenuation coefficient c, 1/m
 };
 
-// The scan pattern types live with the scanner (scanner/lasers/scan_pattern.hpp): dive logs keep them.
+// The scan pattern types live with the scanner (scanner/lasers/scan_pattern.hpp): dive logs keep
+// them.
 using ::uwscan::scanner::GalvoScan;
 using ::uwscan::scanner::MemsScan;
 using ::uwscan::scanner::ScannerKind;
@@ -77,7 +78,7 @@ struct Scene {
     d.axis = StripeAxis::kRows;
     return d;
   }();
-  std::uint64_t seed = 1;          // every random effect draws from it
+  std::uint64_t seed = 1;  // every random effect draws from it
 };
 
 // A dive scene has objects (and may have a trajectory); a calibration scene has a

@@ -1,7 +1,7 @@
 #pragma once
 
-// Typed, range-checked fields of scene files, on top of scanner/common/yaml_fields.hpp: every failure
-// names "file:line: field 'a.b': ...". Included only by the scene readers.
+// Typed, range-checked fields of scene files, on top of scanner/common/yaml_fields.hpp: every
+// failure names "file:line: field 'a.b': ...". Included only by the scene readers.
 
 #include <yaml-cpp/yaml.h>
 

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "scanner/sim/scene.hpp"
 #include "scanner/common/yaml_fields.hpp"
+#include "scanner/sim/scene.hpp"
 
 namespace uwscan::scanner::sim {
 

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
-#include "scanner/sim/imr_objects.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
+#include "scanner/sim/imr_objects.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {
@@ -54,7 +54,8 @@ TEST(SceneParse, MinimalSceneTakesDefaults) {
   EXPECT_EQ(s.scanner.galvo.step_min, -100);  // the laser's range
   EXPECT_EQ(s.scanner.galvo.step_max, 100);
   EXPECT_EQ(s.scanner.sweeps, 1);
-  EXPECT_EQ(s.scanner.model.laser_viewport().thickness_m, DefaultGalvoScannerModel().laser.viewport.thickness_m);
+  EXPECT_EQ(s.scanner.model.laser_viewport().thickness_m,
+            DefaultGalvoScannerModel().laser.viewport.thickness_m);
   ASSERT_EQ(s.trajectory.poses.size(), 1u);
   EXPECT_TRUE(s.trajectory.T_W_C(0.0).isApprox(Eigen::Isometry3d::Identity()));
   ASSERT_EQ(s.objects.size(), 1u);

@@ -27,15 +27,17 @@ constexpr double kAbsoluteErrorCorrelation_s = 5.0;
 constexpr std::uint64_t kPeakNoiseStream = 0x9e3779b97f4a7c15ULL;
 
 std::uint64_t FrameSeed(std::uint64_t scene_seed, std::int64_t index) {
-  std::seed_seq seq{static_cast<std::uint32_t>(scene_seed), static_cast<std::uint32_t>(scene_seed >> 32),
-                    static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32)};
+  std::seed_seq seq{static_cast<std::uint32_t>(scene_seed),
+                    static_cast<std::uint32_t>(scene_seed >> 32), static_cast<std::uint32_t>(index),
+                    static_cast<std::uint32_t>(index >> 32)};
   std::uint32_t words[2];
   seq.generate(words, words + 2);
   return (static_cast<std::uint64_t>(words[0]) << 32) | words[1];
 }
 
 std::unique_ptr<LightSource> MakeLightSource(const Scene& scene, const Scanner& scanner) {
-  if (scanner.kind() == ScannerKind::kGalvo) return MakeGalvoLightSource(scanner.galvo(), scene.scanner.galvo);
+  if (scanner.kind() == ScannerKind::kGalvo)
+    return MakeGalvoLightSource(scanner.galvo(), scene.scanner.galvo);
   return MakeMemsLightSource(scanner.mems(), scene.scanner.mems, scene.effects.mirror_dynamics);
 }
 
@@ -166,7 +168,8 @@ SimulatedFrame Simulator::Frame(std::int64_t index) const {
   frame.time_s = m.FrameTime(index);
   // Without the motion stage the scanner holds the pose it had when the sweep began.
   frame.T_W_C = m.scene.trajectory.T_W_C(
-      m.scene.effects.motion ? frame.time_s : m.FrameTime(static_cast<std::int64_t>(frame.sweep) * per_sweep));
+      m.scene.effects.motion ? frame.time_s
+                             : m.FrameTime(static_cast<std::int64_t>(frame.sweep) * per_sweep));
 
   const LaserPath path = m.source->PathOfFrame(in_sweep);
   const std::vector<TracedPeak> exact = m.tracer.Trace(path, frame.T_W_C);
@@ -262,14 +265,16 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
       const double fresh = std::sqrt(1.0 - keep * keep);
       depth_error = keep * depth_error + fresh * drift.depth_sigma_m * normal(rng);
       for (int axis = 0; axis < 2; ++axis) {
-        tilt_error[axis] = keep * tilt_error[axis] + fresh * drift.roll_pitch_sigma_rad * normal(rng);
+        tilt_error[axis] =
+            keep * tilt_error[axis] + fresh * drift.roll_pitch_sigma_rad * normal(rng);
       }
       const double depth_noise = depth_error;
       const Eigen::Vector3d tilt_noise(tilt_error[0], tilt_error[1], 0.0);
       const double tilt_angle = tilt_noise.norm();
       const Eigen::Matrix3d tilt =
-          tilt_angle > 0.0 ? Eigen::AngleAxisd(tilt_angle, tilt_noise / tilt_angle).toRotationMatrix()
-                           : Eigen::Matrix3d::Identity();
+          tilt_angle > 0.0
+              ? Eigen::AngleAxisd(tilt_angle, tilt_noise / tilt_angle).toRotationMatrix()
+              : Eigen::Matrix3d::Identity();
       sample.T_W_V.linear() =
           Eigen::AngleAxisd(heading_walk, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
           truth.linear() * tilt;
@@ -282,13 +287,15 @@ std::vector<NavigationSample> Simulator::Navigation(double rate_hz) const {
 
 std::vector<double> PeakErrorsPx(const SimulatedFrame& frame, StripeAxis axis) {
   if (frame.crossing_px.size() != frame.peaks_px.size()) {
-    throw Error("PeakErrorsPx: frame " + std::to_string(frame.index) + " has " + std::to_string(frame.peaks_px.size()) +
-                " peaks but " + std::to_string(frame.crossing_px.size()) + " crossings");
+    throw Error("PeakErrorsPx: frame " + std::to_string(frame.index) + " has " +
+                std::to_string(frame.peaks_px.size()) + " peaks but " +
+                std::to_string(frame.crossing_px.size()) + " crossings");
   }
   const int along = axis == StripeAxis::kRows ? 0 : 1;
   std::vector<double> errors;
   for (std::size_t k = 0; k < frame.peaks_px.size(); ++k) {
-    if (std::isfinite(frame.crossing_px[k][along])) errors.push_back(frame.peaks_px[k][along] - frame.crossing_px[k][along]);
+    if (std::isfinite(frame.crossing_px[k][along]))
+      errors.push_back(frame.peaks_px[k][along] - frame.crossing_px[k][along]);
   }
   return errors;
 }

@@ -29,7 +29,7 @@ struct SimulatedFrame {
   // peak would be without noise, to measure a detector's error against.
   std::vector<Eigen::Vector2d> crossing_px;
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();  // true camera pose used
-  std::optional<StripeFrame> image;  // when an image stage is on
+  std::optional<StripeFrame> image;                         // when an image stage is on
 };
 
 // Each peak's error along the detection axis (x for kRows), px: detected minus crossing_px, for

@@ -2,15 +2,15 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 #include "scanner/common/error.hpp"
+#include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/triangulation/triangulator_factory.hpp"
-#include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {
@@ -27,7 +27,8 @@ Scene GalvoScene() {
   Scene scene;
   scene.source = "test scene";
   scene.scanner.file = "data/scanners/galvo_default.yaml";
-  scene.scanner.model = LoadScanner(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/galvo_default.yaml");
+  scene.scanner.model =
+      LoadScanner(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/galvo_default.yaml");
   scene.scanner.galvo.step_stride = 10;
   scene.trajectory.poses.push_back({0.0, Eigen::Isometry3d::Identity()});
   scene.detector.axis = StripeAxis::kRows;
@@ -138,9 +139,10 @@ TEST(Simulator, OcclusionRemovesSpotsTheCameraCannotSee) {
     all += static_cast<std::int64_t>(b.peaks_px.size());
     // Every visible spot is among the spots traced without occlusion (solved to 1e-9 px).
     for (const Eigen::Vector2d& p : a.peaks_px) {
-      const bool found = std::any_of(b.peaks_px.begin(), b.peaks_px.end(), [&](const Eigen::Vector2d& q) {
-        return q.y() == p.y() && std::abs(q.x() - p.x()) < 1e-6;
-      });
+      const bool found =
+          std::any_of(b.peaks_px.begin(), b.peaks_px.end(), [&](const Eigen::Vector2d& q) {
+            return q.y() == p.y() && std::abs(q.x() - p.x()) < 1e-6;
+          });
       EXPECT_TRUE(found) << p.transpose();
     }
   }
@@ -216,7 +218,9 @@ TEST(Simulator, PeakNoiseIsGaussianAlongTheDetectionAxisAroundTheExactCrossing) 
   EXPECT_NEAR(std::sqrt(sum2 / n), 0.2, 0.01);
   // Gaussian: 68.3 % within one sigma, 95.4 % within two.
   const auto within = [&](double k) {
-    return static_cast<double>(std::count_if(errors.begin(), errors.end(), [&](double e) { return std::abs(e) <= k * 0.2; })) / n;
+    return static_cast<double>(std::count_if(errors.begin(), errors.end(),
+                                             [&](double e) { return std::abs(e) <= k * 0.2; })) /
+           n;
   };
   EXPECT_NEAR(within(1.0), 0.683, 0.02);
   EXPECT_NEAR(within(2.0), 0.954, 0.01);
@@ -224,7 +228,8 @@ TEST(Simulator, PeakNoiseIsGaussianAlongTheDetectionAxisAroundTheExactCrossing) 
   scene.effects.peak_noise.on = false;
   const SimulatedFrame exact = Simulator(scene).Frame(simulator.frame_count() / 2);
   ASSERT_FALSE(exact.peaks_px.empty());
-  for (std::size_t k = 0; k < exact.peaks_px.size(); ++k) EXPECT_EQ(exact.peaks_px[k], exact.crossing_px[k]);
+  for (std::size_t k = 0; k < exact.peaks_px.size(); ++k)
+    EXPECT_EQ(exact.peaks_px[k], exact.crossing_px[k]);
 }
 
 // Noise that moves a crossing near the sensor's edge off it drops that peak, as no detector
@@ -287,12 +292,24 @@ TEST(Simulator, EveryImageStageChangesTheFrameWhenOn) {
   for (int stage = 0; stage < 6; ++stage) {
     Scene scene = base;
     switch (stage) {
-      case 0: scene.effects.beam.on = true; break;
-      case 1: scene.effects.sensor_noise.on = true; break;
-      case 2: scene.effects.speckle.on = true; break;
-      case 3: scene.effects.attenuation = true; break;
-      case 4: scene.effects.backscatter.on = true; break;
-      case 5: scene.effects.ambient.on = true; break;
+      case 0:
+        scene.effects.beam.on = true;
+        break;
+      case 1:
+        scene.effects.sensor_noise.on = true;
+        break;
+      case 2:
+        scene.effects.speckle.on = true;
+        break;
+      case 3:
+        scene.effects.attenuation = true;
+        break;
+      case 4:
+        scene.effects.backscatter.on = true;
+        break;
+      case 5:
+        scene.effects.ambient.on = true;
+        break;
     }
     const SimulatedFrame frame = Simulator(scene).Frame(10);
     ASSERT_TRUE(frame.image);
@@ -338,7 +355,8 @@ TEST(Simulator, NoRowCarriesTheSameSpotTwice) {
     for (size_t k = 1; k < frame.peaks_px.size(); ++k) {
       const Eigen::Vector2d& p = frame.peaks_px[k - 1];
       const Eigen::Vector2d& q = frame.peaks_px[k];
-      EXPECT_FALSE(p.y() == q.y() && std::abs(p.x() - q.x()) < 1e-3) << "frame " << i << " row " << q.y();
+      EXPECT_FALSE(p.y() == q.y() && std::abs(p.x() - q.x()) < 1e-3)
+          << "frame " << i << " row " << q.y();
     }
   }
 }
@@ -370,7 +388,8 @@ Scene MemsScene(int waypoints_per_line) {
   Scene scene;
   scene.source = "test MEMS scene";
   scene.scanner.file = "data/scanners/mems_default.yaml";
-  scene.scanner.model = LoadScanner(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/mems_default.yaml");
+  scene.scanner.model =
+      LoadScanner(std::string(UWSCAN_SOURCE_DIR_FOR_TESTS) + "/data/scanners/mems_default.yaml");
   scene.scanner.mems.lines = 12;
   scene.scanner.mems.waypoints_per_line = waypoints_per_line;
   scene.trajectory.poses.push_back({0.0, Eigen::Isometry3d::Identity()});
@@ -391,8 +410,9 @@ TEST(SimulatorMems, LinesBecomePlanesInWaterToTheDesignsPrecision) {
   // Seed 001: the pre-curved lines are planes in water up to the pattern's planarity (tens of
   // micrometres here) and the fitted projection functions' error.
   EXPECT_LT(r.max_error_m, 3e-4);
-  EXPECT_THROW(MakeTriangulator(simulator.scanner(), simulator.scan_pattern(), TriangulationMethod::kRayRay),
-               Error);
+  EXPECT_THROW(
+      MakeTriangulator(simulator.scanner(), simulator.scan_pattern(), TriangulationMethod::kRayRay),
+      Error);
 }
 
 TEST(SimulatorMems, MirrorDynamicsStageBendsTheLines) {

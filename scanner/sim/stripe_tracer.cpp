@@ -24,7 +24,7 @@ double MaxNormalisedRadius2(const PinholeCamera& camera) {
   const double w = camera.width_px - 0.5;
   const double h = camera.height_px - 0.5;
   for (const Eigen::Vector2d& corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w, -0.5),
-                                       Eigen::Vector2d(-0.5, h), Eigen::Vector2d(w, h)}) {
+                                        Eigen::Vector2d(-0.5, h), Eigen::Vector2d(w, h)}) {
     const std::optional<Eigen::Vector2d> xy = camera.Undistort(corner);
     if (xy) r2 = std::max(r2, xy->squaredNorm());
   }
@@ -154,8 +154,8 @@ void StripeTracer::Follow(const LaserPath& path, const Eigen::Isometry3d& T_W_C,
 void StripeTracer::AddCrossings(const LaserPath& path, const Eigen::Isometry3d& T_W_C,
                                 const TracedPeak& a, const TracedPeak& b,
                                 std::vector<TracedPeak>* peaks) const {
-  const int line_count = options_.axis == StripeAxis::kRows ? camera_.camera.height_px
-                                                            : camera_.camera.width_px;
+  const int line_count =
+      options_.axis == StripeAxis::kRows ? camera_.camera.height_px : camera_.camera.width_px;
   const double ca = LineCoordinate(a.px, options_.axis);
   const double cb = LineCoordinate(b.px, options_.axis);
   const double lo = std::min(ca, cb);

@@ -22,23 +22,23 @@ struct LaserPath {
 
 struct StripeTraceOptions {
   StripeAxis axis = StripeAxis::kRows;  // kRows: one peak where the stripe crosses a row centre
-  bool occlusion = true;  // drop spots hidden from the camera (by other objects or back faces)
+  bool occlusion = true;      // drop spots hidden from the camera (by other objects or back faces)
   double max_jump_px = 25.0;  // neighbouring samples farther apart belong to different surfaces
 };
 
 // One exact stripe peak: where the image of the lit surface crosses a row (or column) centre,
 // with what the image stages need to render it.
 struct TracedPeak {
-  Eigen::Vector2d px;            // pixel; px.y() (kRows) is an integer row
-  Eigen::Vector3d p_W;           // lit surface point, world frame
-  Eigen::Vector3d normal_W;      // surface normal there
+  Eigen::Vector2d px;        // pixel; px.y() (kRows) is an integer row
+  Eigen::Vector3d p_W;       // lit surface point, world frame
+  Eigen::Vector3d normal_W;  // surface normal there
   int object_index = -1;
   double reflectance = 0.0;
-  double laser_range_m = 0.0;    // laser ray in water, viewport to the spot
-  double camera_range_m = 0.0;   // spot to the camera viewport
-  double cos_incidence = 1.0;    // laser ray against the surface normal
-  double z_C_m = 0.0;            // depth of the spot in the camera frame
-  double s = 0.0;                // path parameter
+  double laser_range_m = 0.0;   // laser ray in water, viewport to the spot
+  double camera_range_m = 0.0;  // spot to the camera viewport
+  double cos_incidence = 1.0;   // laser ray against the surface normal
+  double z_C_m = 0.0;           // depth of the spot in the camera frame
+  double s = 0.0;               // path parameter
 };
 
 // Finds every crossing of the stripe's image with a row (or column) centre: the path is sampled,

@@ -15,7 +15,7 @@ struct TrajectoryPose {
 // interpolated linearly in position and by slerp in rotation, held at the ends.
 struct Trajectory {
   Eigen::Isometry3d T_V_C = Eigen::Isometry3d::Identity();  // camera (scanner) on the vehicle
-  std::vector<TrajectoryPose> poses;  // >= 1, strictly increasing time_s
+  std::vector<TrajectoryPose> poses;                        // >= 1, strictly increasing time_s
 
   bool is_static() const { return poses.size() <= 1; }
   double start_s() const;

@@ -24,8 +24,8 @@ constexpr std::uint16_t kNoBlock = 0xFFFF;
 // Buffers of the column scan, reused from frame to frame.
 template <typename Pixel>
 struct ColumnScratch {
-  std::vector<Pixel> block_max;          // [block * width + u]
-  std::vector<std::uint8_t> block_arg;   // first row in the block reaching block_max, from its start
+  std::vector<Pixel> block_max;         // [block * width + u]
+  std::vector<std::uint8_t> block_arg;  // first row in the block reaching block_max, from its start
   std::vector<Pixel> max;
   std::vector<std::uint16_t> first_block;  // first block reaching max[u]
   std::vector<std::uint16_t> arg;
@@ -264,7 +264,8 @@ void ColumnMaxima(const StripeImage& image, ColumnScratch<Pixel>& scratch) {
 // (at least `threshold` and above ratio * max[u]): one vectorisable pass over the block maxima,
 // so that the per-column check below reads only those blocks.
 template <typename Pixel>
-void SecondPeakCandidates(int width, int blocks, int threshold, double ratio, ColumnScratch<Pixel>& scratch) {
+void SecondPeakCandidates(int width, int blocks, int threshold, double ratio,
+                          ColumnScratch<Pixel>& scratch) {
   constexpr double kTop = static_cast<double>(std::numeric_limits<Pixel>::max());
   for (int u = 0; u < width; ++u) {
     // Integer values c with c >= threshold and c > ratio * top: c >= floor(ratio * top) + 1.
@@ -292,8 +293,8 @@ void SecondPeakCandidates(int width, int blocks, int threshold, double ratio, Co
 // `separation` rows from the brightest pixel arg, at least `threshold` and above ratio * top.
 // Only the candidate blocks are read.
 template <typename Pixel>
-bool HasSecondPeak(const StripeImage& image, const ColumnScratch<Pixel>& scratch, int u, int separation,
-                   double threshold, double ratio) {
+bool HasSecondPeak(const StripeImage& image, const ColumnScratch<Pixel>& scratch, int u,
+                   int separation, double threshold, double ratio) {
   const int first = scratch.first_candidate[u];
   if (first == kNoBlock) return false;
   const int last = scratch.last_candidate[u];
@@ -451,8 +452,8 @@ void StripeDetector::DetectColumns(const StripeImage& image, StripeDetection* re
       ++result->below_threshold;
       continue;
     }
-    if (reject_multiple && HasSecondPeak(image, *scratch, u, options_.min_separation_px, options_.threshold,
-                                         options_.max_second_peak_ratio)) {
+    if (reject_multiple && HasSecondPeak(image, *scratch, u, options_.min_separation_px,
+                                         options_.threshold, options_.max_second_peak_ratio)) {
       ++result->multiple_peaks;
       continue;
     }

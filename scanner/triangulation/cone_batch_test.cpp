@@ -14,7 +14,8 @@ EllipticCone RandomCone(std::mt19937_64& rng, double b) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   EllipticCone cone;
   cone.T_C_Q.linear() =
-      Eigen::AngleAxisd(3.0 * unit(rng), Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized())
+      Eigen::AngleAxisd(3.0 * unit(rng),
+                        Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized())
           .toRotationMatrix();
   cone.T_C_Q.translation() = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
   cone.a = 0.2 + std::abs(unit(rng));
@@ -37,7 +38,8 @@ void ExpectBlockMatchesPerRay(const EllipticCone& cone, std::mt19937_64& rng, in
       ray.origin = 2.0 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
       // Aim half of the rays at points of the cone so that hits are common.
       if (lane % 2 == 0) {
-        const Eigen::Vector3d target = cone.Point(0.2 + std::abs(gauss(rng)), 3.2 * std::abs(unit(rng)));
+        const Eigen::Vector3d target =
+            cone.Point(0.2 + std::abs(gauss(rng)), 3.2 * std::abs(unit(rng)));
         ray.direction = (target - ray.origin).normalized();
       } else {
         ray.direction = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
@@ -45,7 +47,8 @@ void ExpectBlockMatchesPerRay(const EllipticCone& cone, std::mt19937_64& rng, in
       if (lane == 5) ray.origin = cone.T_C_Q.translation();  // from the apex
       if (lane == 7) ray.direction *= 3.0;                   // not unit length
       per_ray[lane] = ray;
-      rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(), rays.oz[lane] = ray.origin.z();
+      rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(),
+      rays.oz[lane] = ray.origin.z();
       rays.dx[lane] = ray.direction.x(), rays.dy[lane] = ray.direction.y();
       rays.dz[lane] = ray.direction.z();
     }
@@ -64,8 +67,9 @@ void ExpectBlockMatchesPerRay(const EllipticCone& cone, std::mt19937_64& rng, in
       if (expected.ok()) {
         ++hits;
         EXPECT_NEAR(block.t[lane], expected.t, 1e-12 * (1.0 + std::abs(expected.t)));
-        EXPECT_LT((Eigen::Vector3d(block.x[lane], block.y[lane], block.z[lane]) - expected.point).norm(),
-                  1e-12 * (1.0 + expected.point.norm()) * (1.0 + expected.t));
+        EXPECT_LT(
+            (Eigen::Vector3d(block.x[lane], block.y[lane], block.z[lane]) - expected.point).norm(),
+            1e-12 * (1.0 + expected.point.norm()) * (1.0 + expected.t));
       }
     }
   }

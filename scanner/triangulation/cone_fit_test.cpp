@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/random_draws.hpp"
+#include "scanner/optics/ray.hpp"
 #include "scanner/triangulation/light_cone.hpp"
 #include "scanner/triangulation/light_plane.hpp"
-#include "scanner/optics/ray.hpp"
-#include "scanner/common/random_draws.hpp"
 
 namespace uwscan::scanner {
 namespace {

@@ -95,7 +95,8 @@ std::vector<char> Inputs(const GalvoLaser& laser, const LightSurfaceTableOptions
   for (double x : {v.distance_m, v.thickness_m, v.n_air, v.n_glass, v.n_water}) b.Put(x);
   for (double x : {o.depth_min_m, o.depth_max_m}) b.Put(x);
   for (int x : {o.rays_per_fan, o.points_per_ray, o.cone.max_iterations}) b.Put(x);
-  for (double x : {o.cone.function_tolerance, o.cone.parameter_tolerance, o.cone.beta_margin_rad}) b.Put(x);
+  for (double x : {o.cone.function_tolerance, o.cone.parameter_tolerance, o.cone.beta_margin_rad})
+    b.Put(x);
   for (bool x : {o.fit_cones, o.cone.algebraic_start}) b.Put(x);
   return std::move(b.data());
 }
@@ -116,8 +117,8 @@ LightSurfaces GetSurfaces(Reader* r) {
   s.plane.normal = r->GetVector();
   s.plane.offset_m = r->Get<double>();
   s.cone.T_C_Q = r->GetPose();
-  for (double* x : {&s.cone.a, &s.cone.b, &s.cone.beta_min_rad, &s.cone.beta_max_rad, &s.cone.h_min_m,
-                    &s.plane_rms_m, &s.cone_rms_m}) {
+  for (double* x : {&s.cone.a, &s.cone.b, &s.cone.beta_min_rad, &s.cone.beta_max_rad,
+                    &s.cone.h_min_m, &s.plane_rms_m, &s.cone_rms_m}) {
     *x = r->Get<double>();
   }
   s.cone_converged = r->Get<bool>();
@@ -142,7 +143,8 @@ std::vector<char> Serialize(const std::vector<char>& inputs, const LightSurfaceT
 std::shared_ptr<const LightSurfaceTable> Deserialize(const std::vector<char>& data,
                                                      const std::vector<char>& inputs) {
   constexpr std::size_t kChecksum = sizeof(std::uint64_t);
-  if (data.size() < sizeof(kMagic) + 8 + kChecksum || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
+  if (data.size() < sizeof(kMagic) + 8 + kChecksum ||
+      std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
     return nullptr;
   }
   std::uint64_t stored = 0;
@@ -177,8 +179,9 @@ void WriteFileAtomically(const std::filesystem::path& path, const std::vector<ch
   std::error_code ec;
   std::filesystem::create_directories(path.parent_path(), ec);
   // Unique per process and thread, so that writers of the same table never share a temp file.
-  const std::filesystem::path temp = path.string() + ".part" + std::to_string(::getpid()) + "_" +
-                                     std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id()));
+  const std::filesystem::path temp =
+      path.string() + ".part" + std::to_string(::getpid()) + "_" +
+      std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id()));
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     if (!out) return;
@@ -194,7 +197,8 @@ void WriteFileAtomically(const std::filesystem::path& path, const std::vector<ch
 
 }  // namespace
 
-CachedTable LoadOrBuildLightSurfaceTable(const GalvoLaser& laser, const LightSurfaceTableOptions& options,
+CachedTable LoadOrBuildLightSurfaceTable(const GalvoLaser& laser,
+                                         const LightSurfaceTableOptions& options,
                                          const std::filesystem::path& folder) {
   laser.Check();
   options.Check();
@@ -204,7 +208,8 @@ CachedTable LoadOrBuildLightSurfaceTable(const GalvoLaser& laser, const LightSur
                 static_cast<unsigned long long>(Fnv1a64(inputs.data(), inputs.size())));
   const std::filesystem::path path = folder / name;
   if (const std::optional<std::vector<char>> data = ReadFile(path)) {
-    if (std::shared_ptr<const LightSurfaceTable> table = Deserialize(*data, inputs)) return {table, true};
+    if (std::shared_ptr<const LightSurfaceTable> table = Deserialize(*data, inputs))
+      return {table, true};
   }
   auto table = std::make_shared<const LightSurfaceTable>(laser, options);
   WriteFileAtomically(path, Serialize(inputs, *table));

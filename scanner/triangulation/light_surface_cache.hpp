@@ -22,7 +22,8 @@ struct CachedTable {
 // The table of (laser, options), read from `folder` when a file of the same inputs is there,
 // else computed and stored there (the folder is created). A folder that cannot be written only
 // costs the saving: the computed table is returned all the same.
-CachedTable LoadOrBuildLightSurfaceTable(const GalvoLaser& laser, const LightSurfaceTableOptions& options,
+CachedTable LoadOrBuildLightSurfaceTable(const GalvoLaser& laser,
+                                         const LightSurfaceTableOptions& options,
                                          const std::filesystem::path& folder);
 
 }  // namespace uwscan::scanner

@@ -23,7 +23,8 @@ GalvoLaser TestLaser() {
 }
 
 fs::path Folder(const std::string& name) {
-  const fs::path folder = fs::temp_directory_path() / ("uwscan_table_cache_" + std::to_string(::getpid()) + name);
+  const fs::path folder =
+      fs::temp_directory_path() / ("uwscan_table_cache_" + std::to_string(::getpid()) + name);
   fs::remove_all(folder);
   return folder;
 }
@@ -79,7 +80,8 @@ TEST(LightSurfaceCache, DamagedOrForeignFilesAreRebuiltNotTrusted) {
   const CachedTable first = LoadOrBuildLightSurfaceTable(laser, {}, folder);
   ASSERT_EQ(std::distance(fs::directory_iterator(folder), fs::directory_iterator{}), 1);
   const fs::path file = fs::directory_iterator(folder)->path();
-  for (const std::string& damage : {std::string("flip"), std::string("truncate"), std::string("foreign")}) {
+  for (const std::string& damage :
+       {std::string("flip"), std::string("truncate"), std::string("foreign")}) {
     {
       std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
       if (damage == "flip") {
@@ -92,7 +94,8 @@ TEST(LightSurfaceCache, DamagedOrForeignFilesAreRebuiltNotTrusted) {
     const CachedTable again = LoadOrBuildLightSurfaceTable(laser, {}, folder);
     EXPECT_FALSE(again.from_cache) << damage;
     ExpectSameTables(*first.table, *again.table);
-    EXPECT_TRUE(LoadOrBuildLightSurfaceTable(laser, {}, folder).from_cache) << damage;  // rewritten whole
+    EXPECT_TRUE(LoadOrBuildLightSurfaceTable(laser, {}, folder).from_cache)
+        << damage;  // rewritten whole
   }
   fs::remove_all(folder);
 }

@@ -35,8 +35,8 @@ FanSamples SampleFan(const LaserFan& fan, double max_fan_tan,
     const RayTrace trace = fan.RayInWater(std::tan(angle));
     if (!trace.ok() || trace.ray.direction.z() <= 1e-6) continue;
     for (int j = 0; j < options.points_per_ray; ++j) {
-      const double depth = options.depth_min_m + (options.depth_max_m - options.depth_min_m) *
-                                                     j / (options.points_per_ray - 1);
+      const double depth = options.depth_min_m + (options.depth_max_m - options.depth_min_m) * j /
+                                                     (options.points_per_ray - 1);
       const double t = (depth - trace.ray.origin.z()) / trace.ray.direction.z();
       if (t > 0.0) samples.points_C.push_back(trace.ray.At(t));
     }
@@ -63,8 +63,8 @@ LightSurfaceTable::LightSurfaceTable(const GalvoLaser& laser,
     surfaces.plane = plane.plane;
     surfaces.plane_rms_m = plane.rms_m;
     if (options.fit_cones) {
-      const ConeFit cone = FitCone(samples.points_C, samples.propagation_dir_C,
-                                   samples.apex_hint_C, options.cone);
+      const ConeFit cone =
+          FitCone(samples.points_C, samples.propagation_dir_C, samples.apex_hint_C, options.cone);
       surfaces.cone = cone.cone;
       surfaces.cone_rms_m = cone.rms_m;
       surfaces.cone_converged = cone.converged;
@@ -72,7 +72,8 @@ LightSurfaceTable::LightSurfaceTable(const GalvoLaser& laser,
   });
 }
 
-LightSurfaceTable::LightSurfaceTable(int step_min, std::vector<LightSurfaces> surfaces, bool has_cones)
+LightSurfaceTable::LightSurfaceTable(int step_min, std::vector<LightSurfaces> surfaces,
+                                     bool has_cones)
     : step_min_(step_min),
       step_max_(step_min + static_cast<int>(surfaces.size()) - 1),
       surfaces_(std::move(surfaces)),

@@ -2,8 +2,8 @@
 
 #include <vector>
 
-#include "scanner/triangulation/cone_fit.hpp"
 #include "scanner/lasers/galvo_laser.hpp"
+#include "scanner/triangulation/cone_fit.hpp"
 #include "scanner/triangulation/light_cone.hpp"
 #include "scanner/triangulation/light_plane.hpp"
 
@@ -16,7 +16,8 @@ struct LightSurfaceTableOptions {
   double depth_max_m = 1.6;  // ... and of the farthest
   int rays_per_fan = 35;     // seed: 35 model rays
   int points_per_ray = 5;    // seed: 5 points per ray
-  bool fit_cones = true;     // false: planes only (all ray-plane needs; the cone fits are ~all the cost)
+  bool fit_cones =
+      true;  // false: planes only (all ray-plane needs; the cone fits are ~all the cost)
   ConeFitOptions cone;
 
   void Check() const;

@@ -45,12 +45,14 @@ TEST(MemsCalibratedLines, ACalibrationTriangulatesTheLinesTheScannerDrove) {
   const auto own = MakeTriangulator(scanner, pattern, TriangulationMethod::kRayPlane);
   TriangulatorBuildOptions driven;
   driven.driven_with = scanner.mems().functions;
-  const auto on_driven_lines = MakeTriangulator(calibration, pattern, TriangulationMethod::kRayPlane, driven);
+  const auto on_driven_lines =
+      MakeTriangulator(calibration, pattern, TriangulationMethod::kRayPlane, driven);
   const auto redesigned = MakeTriangulator(calibration, pattern, TriangulationMethod::kRayPlane);
   double worst_driven_m = 0.0, worst_redesigned_m = 0.0;
   int compared = 0;
   for (int line : {0, 7, 20, 39}) {
-    const std::vector<TriangulatedPoint> a = Triangulate(*own, line), b = Triangulate(*on_driven_lines, line),
+    const std::vector<TriangulatedPoint> a = Triangulate(*own, line),
+                                         b = Triangulate(*on_driven_lines, line),
                                          c = Triangulate(*redesigned, line);
     for (std::size_t i = 0; i < a.size(); ++i) {
       if (!a[i].ok()) continue;
@@ -63,10 +65,12 @@ TEST(MemsCalibratedLines, ACalibrationTriangulatesTheLinesTheScannerDrove) {
   ASSERT_GT(compared, 20);
   EXPECT_LT(worst_driven_m, 0.0005);
   EXPECT_GT(worst_redesigned_m, 0.005);
-  std::printf("[mems lines] driven: %.4f mm, redesigned: %.1f mm\n", worst_driven_m * 1e3, worst_redesigned_m * 1e3);
+  std::printf("[mems lines] driven: %.4f mm, redesigned: %.1f mm\n", worst_driven_m * 1e3,
+              worst_redesigned_m * 1e3);
 }
 
-// Voltages outside the range a calibration was fitted on would extrapolate its polynomials: refused.
+// Voltages outside the range a calibration was fitted on would extrapolate its polynomials:
+// refused.
 TEST(MemsCalibratedLines, LinesDrivenBeyondTheCalibratedRangeAreRefused) {
   const Scanner scanner = DefaultScanner(ScannerKind::kMems);
   Scanner narrow = scanner;

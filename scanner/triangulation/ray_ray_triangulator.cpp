@@ -28,7 +28,8 @@ TriangulatedPoint MidpointOfCommonPerpendicular(const Ray& cam, const Ray& laser
   const double d = cam.direction.dot(w);
   const double e = laser.direction.dot(w);
   const double sin2 = 1.0 - b * b;
-  if (sin2 <= min_sin2_angle) return TriangulatedPoint{Eigen::Vector3d::Zero(), HitStatus::kParallel};
+  if (sin2 <= min_sin2_angle)
+    return TriangulatedPoint{Eigen::Vector3d::Zero(), HitStatus::kParallel};
   const double t_cam = (b * e - d) / sin2;
   const double t_laser = (e - b * d) / sin2;
   if (t_cam < 0.0 || t_laser < 0.0) {

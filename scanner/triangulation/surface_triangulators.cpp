@@ -4,8 +4,8 @@
 #include <cassert>
 #include <cmath>
 
-#include "scanner/triangulation/cone_batch.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/triangulation/cone_batch.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -109,7 +109,8 @@ void RayConeTriangulator::TriangulateFrame(int mirror_step,
       }
       in_image[lane] = lane < count && rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray);
       if (!in_image[lane]) ray = Ray{};
-      rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(), rays.oz[lane] = ray.origin.z();
+      rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(),
+      rays.oz[lane] = ray.origin.z();
       rays.dx[lane] = ray.direction.x(), rays.dy[lane] = ray.direction.y();
       rays.dz[lane] = ray.direction.z();
     }

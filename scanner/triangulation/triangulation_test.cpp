@@ -20,8 +20,8 @@ namespace uwscan::scanner {
 namespace {
 
 // An exact point of the laser fan at a given camera depth.
-std::optional<Eigen::Vector3d> FanPoint(const GalvoScannerModel& model, int step, double fan_angle_rad,
-                                        double depth_m) {
+std::optional<Eigen::Vector3d> FanPoint(const GalvoScannerModel& model, int step,
+                                        double fan_angle_rad, double depth_m) {
   const RayTrace ray = model.laser.FanAtStep(step).RayInWater(std::tan(fan_angle_rad));
   if (!ray.ok() || ray.ray.direction.z() <= 0.0) return std::nullopt;
   return ray.ray.At((depth_m - ray.ray.origin.z()) / ray.ray.direction.z());
@@ -32,7 +32,8 @@ Ray ExactCameraRay(const GalvoScannerModel& model, const Eigen::Vector3d& p_C) {
   const DirectionResult dir =
       DirectionThroughViewport(model.camera.viewport, Eigen::Vector3d::Zero(), p_C);
   EXPECT_TRUE(dir.ok());
-  const RayTrace trace = TraceOut(model.camera.viewport, Ray{Eigen::Vector3d::Zero(), dir.direction});
+  const RayTrace trace =
+      TraceOut(model.camera.viewport, Ray{Eigen::Vector3d::Zero(), dir.direction});
   EXPECT_TRUE(trace.ok());
   return trace.ray;
 }
@@ -45,9 +46,11 @@ class TriangulationTest : public ::testing::Test {
     // Under CTest each test runs in its own process: the table is fitted by the first and read
     // back by the others, all with the same default thread count. Outside CTest it is fitted here.
     if (const std::optional<std::filesystem::path> folder = test::TestCacheFolder()) {
-      surfaces_ = LoadOrBuildLightSurfaceTable(model_->laser, LightSurfaceTableOptions{}, *folder).table;
+      surfaces_ =
+          LoadOrBuildLightSurfaceTable(model_->laser, LightSurfaceTableOptions{}, *folder).table;
     } else {
-      surfaces_ = std::make_shared<const LightSurfaceTable>(model_->laser, LightSurfaceTableOptions{});
+      surfaces_ =
+          std::make_shared<const LightSurfaceTable>(model_->laser, LightSurfaceTableOptions{});
     }
   }
   static void TearDownTestSuite() {
@@ -89,7 +92,8 @@ TEST_F(TriangulationTest, RayRayRecoversExactPointsToNumericalPrecision) {
     std::vector<TriangulatedPoint> out(px.size());
     ray_ray.TriangulateFrame(step, px, out);
     for (size_t i = 0; i < px.size(); ++i) {
-      ASSERT_TRUE(out[i].ok()) << "step " << step << " point " << i << " " << ToString(out[i].status);
+      ASSERT_TRUE(out[i].ok()) << "step " << step << " point " << i << " "
+                               << ToString(out[i].status);
       worst = std::max(worst, (out[i].p_C - truth[i]).norm());
     }
   }
@@ -165,9 +169,9 @@ TEST_F(TriangulationTest, StepOutsideTheSweepIsReportedNotGuessed) {
   const RayConeTriangulator ray_cone(rays_, surfaces_);
   const RayRayTriangulator ray_ray(*model_);
   const std::vector<Eigen::Vector2d> px = {{1000.0, 500.0}, {1200.0, 20.0}};
-  for (const Triangulator* t : {static_cast<const Triangulator*>(&ray_plane),
-                                static_cast<const Triangulator*>(&ray_cone),
-                                static_cast<const Triangulator*>(&ray_ray)}) {
+  for (const Triangulator* t :
+       {static_cast<const Triangulator*>(&ray_plane), static_cast<const Triangulator*>(&ray_cone),
+        static_cast<const Triangulator*>(&ray_ray)}) {
     std::vector<TriangulatedPoint> out(px.size());
     t->TriangulateFrame(model_->laser.step_max + 1, px, out);
     for (const TriangulatedPoint& p : out) {
@@ -200,9 +204,9 @@ TEST_F(TriangulationTest, EveryMethodAppliesTheMinimumAngleAlike) {
   std::vector<Eigen::Vector2d> px;
   std::vector<Eigen::Vector3d> truth;
   MakeFrame(40, 20, 11, &px, &truth);
-  for (const Triangulator* t : {static_cast<const Triangulator*>(&ray_plane),
-                                static_cast<const Triangulator*>(&ray_cone),
-                                static_cast<const Triangulator*>(&ray_ray)}) {
+  for (const Triangulator* t :
+       {static_cast<const Triangulator*>(&ray_plane), static_cast<const Triangulator*>(&ray_cone),
+        static_cast<const Triangulator*>(&ray_ray)}) {
     std::vector<TriangulatedPoint> out(px.size());
     t->TriangulateFrame(40, px, out);
     for (const TriangulatedPoint& p : out) {
@@ -299,7 +303,8 @@ TEST_F(TriangulationTest, CameraRayTableMatchesExactRays) {
 TEST_F(TriangulationTest, ResultsAreIdenticalRunToRunAndForAnyThreadCount) {
   const RayRayTriangulator a(*model_), b(*model_);
   const int threads = omp_get_max_threads();
-  // The suite's table was built with `threads` (the default, here or in the process that cached it).
+  // The suite's table was built with `threads` (the default, here or in the process that cached
+  // it).
   omp_set_num_threads(threads == 1 ? 2 : 1);
   const LightSurfaceTable again(model_->laser, LightSurfaceTableOptions{});
   omp_set_num_threads(threads);

@@ -4,9 +4,12 @@ namespace uwscan::scanner {
 
 const char* ToString(TriangulationMethod method) {
   switch (method) {
-    case TriangulationMethod::kRayPlane: return "ray_plane";
-    case TriangulationMethod::kRayCone: return "ray_cone";
-    case TriangulationMethod::kRayRay: return "ray_ray";
+    case TriangulationMethod::kRayPlane:
+      return "ray_plane";
+    case TriangulationMethod::kRayCone:
+      return "ray_cone";
+    case TriangulationMethod::kRayRay:
+      return "ray_ray";
   }
   return "unknown";
 }

@@ -1,7 +1,7 @@
-// One libFuzzer target for every reader of outside data (bench/robustness/reader_probes.hpp): the reader is
-// chosen by the environment variable UWSCAN_FUZZ_READER, so one sanitized link serves them all.
-// An input may end in a clean uwscan::Error or be accepted; any other exception, a crash, a hang
-// or a leak is a finding (libFuzzer stops and keeps the input).
+// One libFuzzer target for every reader of outside data (bench/robustness/reader_probes.hpp): the
+// reader is chosen by the environment variable UWSCAN_FUZZ_READER, so one sanitized link serves
+// them all. An input may end in a clean uwscan::Error or be accepted; any other exception, a crash,
+// a hang or a leak is a finding (libFuzzer stops and keeps the input).
 #include <unistd.h>
 
 #include <cstdint>

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "scanner/common/error.hpp"
@@ -15,7 +15,8 @@ using nlohmann::json;
 
 double Number(const json& j, const char* key, const std::string& file) {
   const auto it = j.find(key);
-  if (it == j.end() || !it->is_number()) throw Error(file + ": field '" + key + "' missing or not a number");
+  if (it == j.end() || !it->is_number())
+    throw Error(file + ": field '" + key + "' missing or not a number");
   return it->get<double>();
 }
 
@@ -52,13 +53,21 @@ PlotSeries VerticalLine(const std::string& label, double x, const std::vector<Pl
 // The resolution sweep: ray-cone error against what the table took to build, one line per
 // table (the other table at its default), a point per resolution.
 PlotSpec TableResolution(const json& rows, const std::string& file) {
-  PlotSpec p{"Table resolution: ray-cone error against build time", "table build time (s)", "mean error (mm)", true,
-             true, {}, {}, {}};
+  PlotSpec p{"Table resolution: ray-cone error against build time",
+             "table build time (s)",
+             "mean error (mm)",
+             true,
+             true,
+             {},
+             {},
+             {}};
   PlotSeries camera{"camera-ray table, grid px", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
-  PlotSeries surfaces{"light-surface fits, rays per fan", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
+  PlotSeries surfaces{
+      "light-surface fits, rays per fan", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
   for (const json& row : rows) {
     PlotSeries& s = row.at("table").get<std::string>() == "camera_rays" ? camera : surfaces;
-    s.label.push_back(' ');  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on " " + string
+    s.label.push_back(
+        ' ');  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on " " + string
     s.label.append(std::to_string(static_cast<int>(Number(row, "value", file))));
     s.x.push_back(Number(row, "setup_s", file));
     s.y.push_back(Number(row.at("ray_cone"), "mean_err_m", file) * 1e3);
@@ -70,7 +79,14 @@ PlotSpec TableResolution(const json& rows, const std::string& file) {
 }
 
 std::vector<PlotSpec> Triangulation(const json& j, const std::string& file) {
-  PlotSpec p{"Triangulation: accuracy against time (one core)", "time per point (ns)", "mean error (mm)", true, true, {}, {}, {}};
+  PlotSpec p{"Triangulation: accuracy against time (one core)",
+             "time per point (ns)",
+             "mean error (mm)",
+             true,
+             true,
+             {},
+             {},
+             {}};
   int colour = 0;
   for (const auto& [name, m] : j.at("methods").items()) {
     double err_mm = Number(m, "mean_err_m", file) * 1e3;
@@ -85,7 +101,8 @@ std::vector<PlotSpec> Triangulation(const json& j, const std::string& file) {
   }
   const PlotSeries front = FrontOf(p.series, 1.0);
   if (const auto limit = j.find("limit"); limit != j.end()) {
-    p.series.push_back(VerticalLine("limit: table lookup + multiply-add", 1e9 / Number(*limit, "points_per_s", file), p.series));
+    p.series.push_back(VerticalLine("limit: table lookup + multiply-add",
+                                    1e9 / Number(*limit, "points_per_s", file), p.series));
   }
   p.series.push_back(front);
   std::vector<PlotSpec> plots = {p};
@@ -96,26 +113,42 @@ std::vector<PlotSpec> Triangulation(const json& j, const std::string& file) {
 }
 
 std::vector<PlotSpec> Stripe(const json& j, const std::string& file) {
-  PlotSpec p{"Stripe detectors: sub-pixel error against time (2048x1088, one core)", "time per frame (us)",
-             "RMSE at sigma 1.5 px", true, true, {}, {}, {}};
+  PlotSpec p{"Stripe detectors: sub-pixel error against time (2048x1088, one core)",
+             "time per frame (us)",
+             "RMSE at sigma 1.5 px",
+             true,
+             true,
+             {},
+             {},
+             {}};
   int colour = 0;
   for (const auto& [name, m] : j.at("methods").items()) {
-    p.series.push_back(Point(name, 1e6 / Number(m, "frames_per_s", file), Number(m, "rmse_px_sigma1_5", file), colour++));
+    p.series.push_back(Point(name, 1e6 / Number(m, "frames_per_s", file),
+                             Number(m, "rmse_px_sigma1_5", file), colour++));
   }
   const PlotSeries front = FrontOf(p.series, 1.0);
   if (const auto limit = j.find("limit"); limit != j.end()) {
-    p.series.push_back(VerticalLine("limit: one pass, column maximum", 1e6 / Number(*limit, "frames_per_s", file), p.series));
+    p.series.push_back(VerticalLine("limit: one pass, column maximum",
+                                    1e6 / Number(*limit, "frames_per_s", file), p.series));
   }
   p.series.push_back(front);
   return {p};
 }
 
 std::vector<PlotSpec> Registration(const json& j, const std::string& file) {
-  PlotSpec p{"Registration: success against time", "seconds per pair", "success rate", true, false, {}, {}, {}};
+  PlotSpec p{"Registration: success against time",
+             "seconds per pair",
+             "success rate",
+             true,
+             false,
+             {},
+             {},
+             {}};
   p.y_range = {{0.0, 1.05}};
   int colour = 0;
   for (const auto& [name, s] : j.at("pipelines").items()) {
-    p.series.push_back(Point(name, Number(s, "seconds_per_pair", file), Number(s, "success_rate", file), colour++));
+    p.series.push_back(Point(name, Number(s, "seconds_per_pair", file),
+                             Number(s, "success_rate", file), colour++));
   }
   p.series.push_back(FrontOf(p.series, -1.0));  // higher success is better
   // Judged modulo symmetry (ADD-S), where the bench reports it, in the next colours.
@@ -126,12 +159,26 @@ std::vector<PlotSpec> Registration(const json& j, const std::string& file) {
   }
   std::vector<PlotSpec> plots = {p};
   if (const auto sweep = j.find("voxel_sweep"); sweep != j.end() && !sweep->empty()) {
-    PlotSpec v{"Registration: voxel size (uwscan)", "voxel / object size", "success rate", true, false, {}, {}, {}};
+    PlotSpec v{"Registration: voxel size (uwscan)",
+               "voxel / object size",
+               "success rate",
+               true,
+               false,
+               {},
+               {},
+               {}};
     v.y_range = {{0.0, 1.05}};
-    PlotSeries plain{"success (rotation and translation)", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
+    PlotSeries plain{
+        "success (rotation and translation)", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
     PlotSeries adds{"ADD-S success", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
-    PlotSpec t{"Registration: time against voxel size (uwscan)", "voxel / object size", "seconds per pair", true, true,
-               {}, {}, {}};
+    PlotSpec t{"Registration: time against voxel size (uwscan)",
+               "voxel / object size",
+               "seconds per pair",
+               true,
+               true,
+               {},
+               {},
+               {}};
     PlotSeries seconds{"seconds per pair", {}, {}, SeriesStyle::kLine, CategoricalColour(2)};
     for (const json& row : *sweep) {
       const double f = Number(row, "voxel_fraction", file);
@@ -158,8 +205,10 @@ std::vector<PlotSpec> Recognition(const json& j, const std::string& file) {
   int colour = 0;
   for (const auto& [name, s] : j.at("pipelines").items()) {
     const double seconds = Number(s, "seconds_per_scan", file);
-    p.series.push_back(Point(name + ": recognised", seconds, Number(s, "recognition_rate", file), colour));
-    p.series.push_back(Point(name + ": pose within 5 mm, 2 deg", seconds, Number(s, "pose_success_rate", file),
+    p.series.push_back(
+        Point(name + ": recognised", seconds, Number(s, "recognition_rate", file), colour));
+    p.series.push_back(Point(name + ": pose within 5 mm, 2 deg", seconds,
+                             Number(s, "pose_success_rate", file),
                              colour + 3));  // the three pipelines' recognition points take 0..2
     ++colour;
   }
@@ -169,7 +218,14 @@ std::vector<PlotSpec> Recognition(const json& j, const std::string& file) {
 // SLAM: each dive's trajectory error for dead reckoning, SLAM and Open3D's multiway
 // registration against the time each took (dead reckoning at the time SLAM took, for reference).
 std::vector<PlotSpec> Slam(const json& j, const std::string& file) {
-  PlotSpec p{"SLAM: trajectory error against processing time", "seconds", "ATE (m)", true, true, {}, {}, {}};
+  PlotSpec p{"SLAM: trajectory error against processing time",
+             "seconds",
+             "ATE (m)",
+             true,
+             true,
+             {},
+             {},
+             {}};
   int colour = 0;
   for (const json& dive : j.at("dives")) {
     const std::string name = dive.at("name").get<std::string>();
@@ -192,8 +248,22 @@ std::vector<PlotSpec> Slam(const json& j, const std::string& file) {
 std::vector<PlotSpec> Accuracy(const json& j, const std::string& file) {
   std::vector<PlotSpec> plots;
   if (const auto w = j.find("waypoints"); w != j.end() && !w->empty()) {
-    PlotSpec rms{"MEMS: plane residual against waypoints per line", "waypoints per line", "plane rms (mm)", true, true, {}, {}, {}};
-    PlotSpec speed{"MEMS: lines per second against waypoints per line", "waypoints per line", "lines/s", true, true, {}, {}, {}};
+    PlotSpec rms{"MEMS: plane residual against waypoints per line",
+                 "waypoints per line",
+                 "plane rms (mm)",
+                 true,
+                 true,
+                 {},
+                 {},
+                 {}};
+    PlotSpec speed{"MEMS: lines per second against waypoints per line",
+                   "waypoints per line",
+                   "lines/s",
+                   true,
+                   true,
+                   {},
+                   {},
+                   {}};
     PlotSeries real{"realistic", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
     PlotSeries exact{"exact peaks", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
     PlotSeries lines{"lines/s", {}, {}, SeriesStyle::kLine, CategoricalColour(2)};
@@ -212,7 +282,14 @@ std::vector<PlotSpec> Accuracy(const json& j, const std::string& file) {
     plots.push_back(speed);
   }
   if (const auto plane = j.find("plane"); plane != j.end() && !plane->empty()) {
-    PlotSpec p{"MEMS: plane residual against range", "range (m)", "plane rms (mm)", false, false, {}, {}, {}};
+    PlotSpec p{"MEMS: plane residual against range",
+               "range (m)",
+               "plane rms (mm)",
+               false,
+               false,
+               {},
+               {},
+               {}};
     PlotSeries s{"plane rms", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
     for (const json& row : *plane) {
       s.x.push_back(Number(row, "distance_m", file));
@@ -238,7 +315,14 @@ std::vector<PlotSpec> Calibration(const json& j, const std::string& file) {
 }
 
 std::vector<PlotSpec> Deformation(const json& j, const std::string& file) {
-  PlotSpec p{"Refracted laser fan: plane and cone fit residual", "incidence (deg)", "fit rms (mm)", false, true, {}, {}, {}};
+  PlotSpec p{"Refracted laser fan: plane and cone fit residual",
+             "incidence (deg)",
+             "fit rms (mm)",
+             false,
+             true,
+             {},
+             {},
+             {}};
   PlotSeries plane{"plane", {}, {}, SeriesStyle::kLine, CategoricalColour(3)};
   PlotSeries cone{"elliptic cone", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
   for (const json& row : j.at("rows")) {
@@ -253,7 +337,14 @@ std::vector<PlotSpec> Deformation(const json& j, const std::string& file) {
 }
 
 std::vector<PlotSpec> Viewer(const json& j, const std::string& file) {
-  PlotSpec p{"Viewer: render time against points (Xvfb, software)", "points", "seconds", true, true, {}, {}, {}};
+  PlotSpec p{"Viewer: render time against points (Xvfb, software)",
+             "points",
+             "seconds",
+             true,
+             true,
+             {},
+             {},
+             {}};
   PlotSeries first{"time to first picture", {}, {}, SeriesStyle::kLine, CategoricalColour(0)};
   PlotSeries frame{"per frame", {}, {}, SeriesStyle::kLine, CategoricalColour(1)};
   for (const json& row : j.at("rows")) {
@@ -283,7 +374,8 @@ BenchPlots ReadBenchPlots(const std::filesystem::path& path) {
   try {
     if (j.contains("exact_vs_truth_max_m")) return {"triangulation", Triangulation(j, file)};
     if (j.contains("methods") && j.contains("image")) return {"stripe", Stripe(j, file)};
-    if (j.contains("pipelines") && j.contains("confusion")) return {"recognition", Recognition(j, file)};
+    if (j.contains("pipelines") && j.contains("confusion"))
+      return {"recognition", Recognition(j, file)};
     if (j.contains("pipelines")) return {"registration", Registration(j, file)};
     if (j.contains("dives")) return {"slam", Slam(j, file)};
     // The calibration bench reports gauges too: its "steps" tell it from the accuracy bench.
@@ -294,8 +386,10 @@ BenchPlots ReadBenchPlots(const std::filesystem::path& path) {
   } catch (const json::exception& e) {
     throw Error(file + ": a field has the wrong type or is missing (" + e.what() + ")");
   }
-  throw Error(file + ": not the JSON of a bench this uwscan can plot (triangulation, stripe, registration, "
-              "recognition, slam, accuracy, calibration, deformation, viewer)");
+  throw Error(
+      file +
+      ": not the JSON of a bench this uwscan can plot (triangulation, stripe, registration, "
+      "recognition, slam, accuracy, calibration, deformation, viewer)");
 }
 
 }  // namespace uwscan::viewer

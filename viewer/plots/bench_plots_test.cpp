@@ -17,7 +17,8 @@ namespace {
 namespace fs = std::filesystem;
 
 BenchPlots PlotsOf(const std::string& json) {
-  const fs::path path = fs::temp_directory_path() / ("uwscan_bench_plots_test_" + std::to_string(::getpid()) + ".json");
+  const fs::path path = fs::temp_directory_path() /
+                        ("uwscan_bench_plots_test_" + std::to_string(::getpid()) + ".json");
   std::ofstream(path) << json;
   BenchPlots plots = ReadBenchPlots(path);
   fs::remove(path);
@@ -68,7 +69,8 @@ TEST(BenchPlots, RecognitionAndSlamAreTellApartFromRegistration) {
   EXPECT_EQ(SeriesNamed(recognition.plots[0], "uwscan: recognised").y, std::vector<double>{0.25});
   EXPECT_EQ(SeriesNamed(recognition.plots[0], "uwscan: pose").y, std::vector<double>{0.5});
 
-  const BenchPlots slam = PlotsOf(R"({"dives": [{"name": "loop", "dr": {"ate_m": 0.07, "seconds": 0},
+  const BenchPlots slam =
+      PlotsOf(R"({"dives": [{"name": "loop", "dr": {"ate_m": 0.07, "seconds": 0},
     "slam": {"ate_m": 0.06, "seconds": 8}, "open3d": {"ate_m": 0.2, "seconds": 30}},
     {"name": "pipe", "dr": {"ate_m": 0.05}, "slam": {"ate_m": 0.04, "seconds": 5}, "open3d": null}]})");
   EXPECT_EQ(slam.bench, "slam");
@@ -77,7 +79,9 @@ TEST(BenchPlots, RecognitionAndSlamAreTellApartFromRegistration) {
   EXPECT_EQ(SeriesNamed(slam.plots[0], "loop: Open3D").x, std::vector<double>{30});
   EXPECT_THROW(SeriesNamed(slam.plots[0], "pipe: Open3D"), std::runtime_error);
 
-  EXPECT_THROW(PlotsOf(R"({"dives": [{"name": "loop", "dr": {}, "slam": {"ate_m": 1, "seconds": 1}}]})"), Error);
+  EXPECT_THROW(
+      PlotsOf(R"({"dives": [{"name": "loop", "dr": {}, "slam": {"ate_m": 1, "seconds": 1}}]})"),
+      Error);
 }
 
 TEST(BenchPlots, CalibrationWithGaugesIsNotTakenForTheAccuracyBench) {

@@ -83,7 +83,9 @@ void FillChart(vtkChartXY& chart, const PlotSpec& spec) {
     if (table->GetNumberOfRows() == 0) continue;
     // A line of one point is drawn as that point (VTK refuses to paint it and says so).
     const bool line = s.style == SeriesStyle::kLine && table->GetNumberOfRows() >= 2;
-    const int type = s.style == SeriesStyle::kBars ? vtkChart::BAR : line ? vtkChart::LINE : vtkChart::POINTS;
+    const int type = s.style == SeriesStyle::kBars ? vtkChart::BAR
+                     : line                        ? vtkChart::LINE
+                                                   : vtkChart::POINTS;
     vtkPlot* plot = chart.AddPlot(type);
     plot->SetInputData(table, 0, 1);
     plot->SetColor(s.colour.r, s.colour.g, s.colour.b, 255);
@@ -96,7 +98,8 @@ void FillChart(vtkChartXY& chart, const PlotSpec& spec) {
     ++drawn;
   }
   if (drawn == 0) throw Error("plot '" + spec.title + "': no point to draw");
-  if (spec.y_range) FixRange(*chart.GetAxis(vtkAxis::LEFT), spec.y_range->first, spec.y_range->second);
+  if (spec.y_range)
+    FixRange(*chart.GetAxis(vtkAxis::LEFT), spec.y_range->first, spec.y_range->second);
   WidenIfDegenerate(*chart.GetAxis(vtkAxis::BOTTOM), spec.series, spec.log_x);
   if (!spec.x_tick_labels.empty()) {
     vtkNew<vtkDoubleArray> positions;
@@ -114,16 +117,17 @@ void FillChart(vtkChartXY& chart, const PlotSpec& spec) {
   const LegendPlace place = PlaceLegend(spec);
   const bool left = place == LegendPlace::kTopLeft || place == LegendPlace::kBottomLeft;
   const bool top = place != LegendPlace::kBottomLeft && place != LegendPlace::kBottomRight;
-  chart.GetLegend()->SetHorizontalAlignment(place == LegendPlace::kTopCentre ? vtkChartLegend::CENTER
-                                            : left                           ? vtkChartLegend::LEFT
-                                                                             : vtkChartLegend::RIGHT);
+  chart.GetLegend()->SetHorizontalAlignment(place == LegendPlace::kTopCentre
+                                                ? vtkChartLegend::CENTER
+                                            : left ? vtkChartLegend::LEFT
+                                                   : vtkChartLegend::RIGHT);
   chart.GetLegend()->SetVerticalAlignment(top ? vtkChartLegend::TOP : vtkChartLegend::BOTTOM);
 }
 
 }  // namespace
 
-void SavePlotsPng(const std::vector<PlotSpec>& plots, const std::filesystem::path& png_path, int width_px,
-                  int height_px) {
+void SavePlotsPng(const std::vector<PlotSpec>& plots, const std::filesystem::path& png_path,
+                  int width_px, int height_px) {
   if (plots.empty()) throw Error(png_path.string() + ": no plot to draw");
   if (width_px < 64 || height_px < 64 || width_px > 8192 || height_px > 8192) {
     throw Error(png_path.string() + ": picture size must be in [64, 8192] pixels");

@@ -62,13 +62,16 @@ LegendPlace PlaceLegend(const PlotSpec& spec) {
     return std::clamp(static_cast<int>(3.0 * (v - lo[a]) / (hi[a] - lo[a])), 0, 2);
   };
   std::array<std::array<int, 3>, 3> count{};  // [row from the bottom][column from the left]
-  for (const auto& p : samples) ++count[static_cast<std::size_t>(third(p[1], 1))][static_cast<std::size_t>(third(p[0], 0))];
-  const std::array<std::pair<LegendPlace, int>, 5> places{{{LegendPlace::kTopRight, count[2][2]},
-                                                           {LegendPlace::kTopLeft, count[2][0]},
-                                                           {LegendPlace::kTopCentre, count[2][1]},
-                                                           {LegendPlace::kBottomRight, count[0][2]},
-                                                           {LegendPlace::kBottomLeft, count[0][0]}}};
-  return std::min_element(places.begin(), places.end(), [](const auto& a, const auto& b) { return a.second < b.second; })
+  for (const auto& p : samples)
+    ++count[static_cast<std::size_t>(third(p[1], 1))][static_cast<std::size_t>(third(p[0], 0))];
+  const std::array<std::pair<LegendPlace, int>, 5> places{
+      {{LegendPlace::kTopRight, count[2][2]},
+       {LegendPlace::kTopLeft, count[2][0]},
+       {LegendPlace::kTopCentre, count[2][1]},
+       {LegendPlace::kBottomRight, count[0][2]},
+       {LegendPlace::kBottomLeft, count[0][0]}}};
+  return std::min_element(places.begin(), places.end(),
+                          [](const auto& a, const auto& b) { return a.second < b.second; })
       ->first;
 }
 

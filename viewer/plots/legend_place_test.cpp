@@ -5,7 +5,9 @@
 namespace uwscan::viewer {
 namespace {
 
-PlotSeries Points(std::vector<double> x, std::vector<double> y) { return {"p", std::move(x), std::move(y), SeriesStyle::kPoints, {}}; }
+PlotSeries Points(std::vector<double> x, std::vector<double> y) {
+  return {"p", std::move(x), std::move(y), SeriesStyle::kPoints, {}};
+}
 
 TEST(PlaceLegend, TakesTheEmptiestThirdInItsOrderOfPreference) {
   PlotSpec spec;

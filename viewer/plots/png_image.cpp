@@ -31,7 +31,8 @@ RgbImage ReadPng(const std::filesystem::path& path) {
   const auto* in = static_cast<const unsigned char*>(data->GetScalarPointer());
   for (int row = 0; row < dims[1]; ++row) {
     // VTK's images start at the bottom row.
-    const unsigned char* src = in + static_cast<std::size_t>(dims[1] - 1 - row) * dims[0] * channels;
+    const unsigned char* src =
+        in + static_cast<std::size_t>(dims[1] - 1 - row) * dims[0] * channels;
     std::uint8_t* dst = image.rgb.data() + static_cast<std::size_t>(row) * dims[0] * 3;
     for (int x = 0; x < dims[0]; ++x) {
       for (int c = 0; c < 3; ++c) dst[3 * x + c] = src[x * channels + (channels >= 3 ? c : 0)];

@@ -27,8 +27,8 @@ RgbImage ReadPng(const std::filesystem::path& path);
 
 // How two pictures of the same size differ.
 struct ImageDifference {
-  double mean_abs = 0.0;           // mean over every channel of every pixel, 0..255
-  double fraction_over = 0.0;      // pixels with a channel differing by more than `threshold`
+  double mean_abs = 0.0;       // mean over every channel of every pixel, 0..255
+  double fraction_over = 0.0;  // pixels with a channel differing by more than `threshold`
   int max_abs = 0;
 };
 // Throws uwscan::Error when the sizes differ.

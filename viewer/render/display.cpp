@@ -27,7 +27,8 @@ void RequireDisplay() {
   const char* name = std::getenv("DISPLAY");
   if (name == nullptr || *name == '\0') {
     throw Error(std::string("no X display: $DISPLAY is not set; VTK renders only through X "
-                            "here, even offscreen; ") + kHowTo);
+                            "here, even offscreen; ") +
+                kHowTo);
   }
   Display* display = XOpenDisplay(name);
   if (display == nullptr) {

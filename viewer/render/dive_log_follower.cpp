@@ -35,7 +35,8 @@ LiveCloud ToLiveCloud(mapping::ReconstructedFrame& frame) {
 void FollowOptions::Check() const {
   if (!(poll_s > 0.0 && poll_s <= 60.0)) throw Error("follow: poll_s must be in (0, 60] s");
   if (stop_after_frames < 0) throw Error("follow: stop_after_frames must be >= 0");
-  if (!(timeout_s >= 0.0 && std::isfinite(timeout_s))) throw Error("follow: timeout_s must be >= 0");
+  if (!(timeout_s >= 0.0 && std::isfinite(timeout_s)))
+    throw Error("follow: timeout_s must be >= 0");
 }
 
 struct DiveLogFollower::Impl {
@@ -47,10 +48,12 @@ struct DiveLogFollower::Impl {
   FollowStatus status;
   std::thread thread;
 
-  Impl(std::filesystem::path p, const FollowOptions& o, LiveView& v) : path(std::move(p)), options(o), view(v) {}
+  Impl(std::filesystem::path p, const FollowOptions& o, LiveView& v)
+      : path(std::move(p)), options(o), view(v) {}
 
   bool TimedOut(Clock::time_point since) const {
-    return options.timeout_s > 0.0 && std::chrono::duration<double>(Clock::now() - since).count() > options.timeout_s;
+    return options.timeout_s > 0.0 &&
+           std::chrono::duration<double>(Clock::now() - since).count() > options.timeout_s;
   }
   void Sleep() const { std::this_thread::sleep_for(std::chrono::duration<double>(options.poll_s)); }
 
@@ -67,8 +70,8 @@ struct DiveLogFollower::Impl {
         }
       }
       if (TimedOut(start)) {
-        throw Error(path.string() + ": no readable dive log after " + std::to_string(options.timeout_s) + " s (" +
-                    last_error + ")");
+        throw Error(path.string() + ": no readable dive log after " +
+                    std::to_string(options.timeout_s) + " s (" + last_error + ")");
       }
       Sleep();
     }
@@ -94,10 +97,11 @@ struct DiveLogFollower::Impl {
         status.points += static_cast<std::int64_t>(n);
       }
       if (!frames.empty()) last_news = Clock::now();
-      if (options.stop_after_frames > 0 && reconstructor.frames_done() >= options.stop_after_frames) return;
+      if (options.stop_after_frames > 0 && reconstructor.frames_done() >= options.stop_after_frames)
+        return;
       if (TimedOut(last_news)) {
-        throw Error(path.string() + ": no new frame for " + std::to_string(options.timeout_s) + " s (" +
-                    std::to_string(reconstructor.frames_done()) + " frames so far)");
+        throw Error(path.string() + ": no new frame for " + std::to_string(options.timeout_s) +
+                    " s (" + std::to_string(reconstructor.frames_done()) + " frames so far)");
       }
       if (frames.empty()) Sleep();
     }
@@ -120,7 +124,8 @@ struct DiveLogFollower::Impl {
   }
 };
 
-DiveLogFollower::DiveLogFollower(const std::filesystem::path& log, const FollowOptions& options, LiveView& view) {
+DiveLogFollower::DiveLogFollower(const std::filesystem::path& log, const FollowOptions& options,
+                                 LiveView& view) {
   options.Check();
   impl_ = std::make_unique<Impl>(log, options, view);
   impl_->thread = std::thread([impl = impl_.get()] { impl->Run(); });

@@ -25,8 +25,8 @@ struct FollowOptions {
 struct FollowStatus {
   std::int64_t frames = 0;  // frames reconstructed and handed to the view
   std::int64_t points = 0;
-  bool finished = false;    // the thread has ended (stop, error or timeout)
-  std::string error;        // why it ended, when it failed
+  bool finished = false;  // the thread has ended (stop, error or timeout)
+  std::string error;      // why it ended, when it failed
 };
 
 // A producer thread for a LiveView: waits for the dive log to exist and hold its header (a

@@ -12,7 +12,8 @@ void ShowScene(const Scene& scene, const RenderOptions& options_in, const std::s
   RequireDisplay();
   RenderOptions options = options_in;
   internal::VtkScene vtk = internal::BuildVtkScene(scene, options);
-  vtkSmartPointer<vtkRenderWindow> window = internal::MakeRenderWindow(options, /*offscreen=*/false);
+  vtkSmartPointer<vtkRenderWindow> window =
+      internal::MakeRenderWindow(options, /*offscreen=*/false);
   window->SetWindowName(title.c_str());
   window->AddRenderer(vtk.renderer);
   vtkSmartPointer<vtkTextActor> text = internal::CornerText(options.background);
@@ -23,8 +24,9 @@ void ShowScene(const Scene& scene, const RenderOptions& options_in, const std::s
   vtkNew<vtkRenderWindowInteractor> interactor;
   interactor->SetRenderWindow(window);
   internal::InstallViewControls(
-      *interactor, *vtk.renderer, [&vtk]() -> const std::vector<internal::DrawnCloud>& { return vtk.clouds; },
-      options.colour, options, *text);
+      *interactor, *vtk.renderer,
+      [&vtk]() -> const std::vector<internal::DrawnCloud>& { return vtk.clouds; }, options.colour,
+      options, *text);
   window->Render();
   interactor->Start();
 }

@@ -54,7 +54,8 @@ void RequireSize(const std::vector<T>& values, std::size_t points, const char* w
 
 // The clouds of a snapshot as one layer (render anchor as origin), keeping a per-point array
 // only when every cloud has it.
-CloudLayer Combine(const std::vector<std::shared_ptr<const LiveCloud>>& clouds, const Eigen::Vector3d& anchor_W) {
+CloudLayer Combine(const std::vector<std::shared_ptr<const LiveCloud>>& clouds,
+                   const Eigen::Vector3d& anchor_W) {
   CloudLayer layer;
   layer.name = "live";
   layer.origin = anchor_W;
@@ -68,10 +69,13 @@ CloudLayer Combine(const std::vector<std::shared_ptr<const LiveCloud>>& clouds, 
   }
   layer.points.reserve(n);
   for (const auto& c : clouds) {
-    for (const Eigen::Vector3d& p : c->points_W) layer.points.push_back((p - anchor_W).cast<float>());
+    for (const Eigen::Vector3d& p : c->points_W)
+      layer.points.push_back((p - anchor_W).cast<float>());
     if (errors) layer.error_m.insert(layer.error_m.end(), c->error_m.begin(), c->error_m.end());
-    if (intensities) layer.intensity.insert(layer.intensity.end(), c->intensity.begin(), c->intensity.end());
-    if (ids) layer.object_ids.insert(layer.object_ids.end(), c->object_ids.begin(), c->object_ids.end());
+    if (intensities)
+      layer.intensity.insert(layer.intensity.end(), c->intensity.begin(), c->intensity.end());
+    if (ids)
+      layer.object_ids.insert(layer.object_ids.end(), c->object_ids.begin(), c->object_ids.end());
   }
   return layer;
 }
@@ -82,7 +86,8 @@ void LiveViewOptions::Check() const {
   render.Check();
   if (point_budget < 1) throw Error("live view: point_budget must be >= 1");
   if (!(decay_s >= 0.0 && std::isfinite(decay_s))) throw Error("live view: decay_s must be >= 0");
-  if (!(refresh_s > 0.0 && refresh_s <= 60.0)) throw Error("live view: refresh_s must be in (0, 60] s");
+  if (!(refresh_s > 0.0 && refresh_s <= 60.0))
+    throw Error("live view: refresh_s must be in (0, 60] s");
 }
 
 struct LiveView::Impl {
@@ -98,9 +103,11 @@ struct LiveView::Impl {
       shared.clouds.pop_front();
       ++shared.stats.clouds_dropped;
     };
-    while (shared.clouds.size() > 1 && shared.stats.points_held > options.point_budget) drop_front();
+    while (shared.clouds.size() > 1 && shared.stats.points_held > options.point_budget)
+      drop_front();
     if (options.decay_s > 0.0) {
-      while (!shared.clouds.empty() && shared.clouds.front()->time_s < shared.newest_time_s - options.decay_s) {
+      while (!shared.clouds.empty() &&
+             shared.clouds.front()->time_s < shared.newest_time_s - options.decay_s) {
         drop_front();
       }
     }
@@ -108,8 +115,12 @@ struct LiveView::Impl {
 
   Snapshot Take() const {
     const std::lock_guard<std::mutex> lock(mutex);
-    return Snapshot{{shared.clouds.begin(), shared.clouds.end()}, shared.tracks, shared.objects,
-                    shared.version, shared.stop, shared.stats};
+    return Snapshot{{shared.clouds.begin(), shared.clouds.end()},
+                    shared.tracks,
+                    shared.objects,
+                    shared.version,
+                    shared.stop,
+                    shared.stats};
   }
 };
 
@@ -189,7 +200,8 @@ class LiveScene {
     window_.AddRenderer(renderer_);
   }
 
-  static constexpr const char* kLiveKeys = "p: pick a point; f / t / s: fit / top / side; + / -: point size; e: EDL";
+  static constexpr const char* kLiveKeys =
+      "p: pick a point; f / t / s: fit / top / side; + / -: point size; e: EDL";
 
   vtkRenderer& renderer() { return *renderer_; }
   RenderOptions& render_options() { return render_; }
@@ -224,7 +236,8 @@ class LiveScene {
     if (!camera_placed_) {
       std::vector<vtkActor*> actors;
       for (const internal::DrawnCloud& cloud : drawn_) actors.push_back(cloud.actor);
-      internal::ApplyCameraPreset(*renderer_, render_.camera, render_.up, internal::UnionBounds(actors));
+      internal::ApplyCameraPreset(*renderer_, render_.camera, render_.up,
+                                  internal::UnionBounds(actors));
       camera_placed_ = true;
     } else {
       renderer_->ResetCameraClippingRange();
@@ -237,33 +250,38 @@ class LiveScene {
     if (clouds.empty()) return;
     layer_ = Combine(clouds, *anchor_);
     const std::size_t stride = PointStride(layer_.size(), options_.point_budget);
-    std::vector<float> scalars = PointScalars(layer_, render_.colour, render_.up.normalized(), stride);
+    std::vector<float> scalars =
+        PointScalars(layer_, render_.colour, render_.up.normalized(), stride);
     const ScalarRange range = SceneRange({scalars}, render_);
     const bool ids = layer_.object_ids.size() == layer_.size();
     std::vector<Rgb> colours;
     colours.reserve(layer_.size() / stride + 1);
     for (std::size_t i = 0, j = 0; i < layer_.size(); i += stride, ++j) {
-      colours.push_back(PointColour(render_.colour, scalars.empty() ? 0.0f : scalars[j], range, 0,
-                                    ids ? std::optional<std::int32_t>(layer_.object_ids[i]) : std::nullopt));
+      colours.push_back(
+          PointColour(render_.colour, scalars.empty() ? 0.0f : scalars[j], range, 0,
+                      ids ? std::optional<std::int32_t>(layer_.object_ids[i]) : std::nullopt));
     }
     internal::DrawnCloud drawn;
-    drawn.actor = internal::PointActor(internal::PointPolyData(Eigen::Vector3d::Zero(), layer_.points, stride, colours),
-                                       render_.point_size_px);
+    drawn.actor = internal::PointActor(
+        internal::PointPolyData(Eigen::Vector3d::Zero(), layer_.points, stride, colours),
+        render_.point_size_px);
     drawn.layer = &layer_;
     drawn.stride = stride;
     drawn.scalars = std::move(scalars);
     props_.push_back(drawn.actor);
     drawn_.push_back(std::move(drawn));
     if (IsContinuous(render_.colour) && render_.colour_bar) {
-      props_.push_back(internal::ColourBar(range, std::string(ToString(render_.colour)) +
-                                                      (render_.colour == ColourMode::kIntensity ? "" : " m")));
+      props_.push_back(
+          internal::ColourBar(range, std::string(ToString(render_.colour)) +
+                                         (render_.colour == ColourMode::kIntensity ? "" : " m")));
     }
   }
 
   static std::string Status(const LiveViewStats& s) {
-    return std::to_string(s.points_held) + " points held, " + std::to_string(s.points_received) + " received in " +
-           std::to_string(s.clouds_received) + " clouds (" + std::to_string(s.clouds_dropped) + " dropped), " +
-           std::to_string(s.poses_received) + " poses";
+    return std::to_string(s.points_held) + " points held, " + std::to_string(s.points_received) +
+           " received in " + std::to_string(s.clouds_received) + " clouds (" +
+           std::to_string(s.clouds_dropped) + " dropped), " + std::to_string(s.poses_received) +
+           " poses";
   }
 
   const LiveViewOptions& options_;
@@ -284,7 +302,8 @@ class LiveScene {
 void LiveView::Run(const std::string& title) {
   RequireDisplay();
   const LiveViewOptions& options = impl_->options;
-  vtkSmartPointer<vtkRenderWindow> window = internal::MakeRenderWindow(options.render, options.offscreen);
+  vtkSmartPointer<vtkRenderWindow> window =
+      internal::MakeRenderWindow(options.render, options.offscreen);
   window->SetWindowName(title.c_str());
   LiveScene scene(options, *window);
   auto redraw = [this, &scene, &window] {
@@ -304,7 +323,8 @@ void LiveView::Run(const std::string& title) {
     vtkNew<vtkRenderWindowInteractor> interactor;
     interactor->SetRenderWindow(window);
     internal::InstallViewControls(
-        *interactor, scene.renderer(), [&scene]() -> const std::vector<internal::DrawnCloud>& { return scene.clouds(); },
+        *interactor, scene.renderer(),
+        [&scene]() -> const std::vector<internal::DrawnCloud>& { return scene.clouds(); },
         options.render.colour, scene.render_options(), scene.pick_text());
     interactor->Initialize();
     // The timer is where the queue is drained: on this thread, between VTK's own events.
@@ -319,7 +339,8 @@ void LiveView::Run(const std::string& title) {
       if (c->redraw()) c->interactor->TerminateApp();
     });
     interactor->AddObserver(vtkCommand::TimerEvent, on_timer);
-    interactor->CreateRepeatingTimer(static_cast<unsigned long>(std::lround(options.refresh_s * 1000.0)));
+    interactor->CreateRepeatingTimer(
+        static_cast<unsigned long>(std::lround(options.refresh_s * 1000.0)));
     window->Render();
     interactor->Start();
   }

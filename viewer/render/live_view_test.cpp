@@ -24,7 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempPath(const std::string& name) {
-  return fs::temp_directory_path() / ("uwscan_live_view_test_" + std::to_string(::getpid()) + "_" + name);
+  return fs::temp_directory_path() /
+         ("uwscan_live_view_test_" + std::to_string(::getpid()) + "_" + name);
 }
 
 LiveCloud Cloud(double time_s, int n) {
@@ -73,7 +74,8 @@ TEST(DiveLogFollower, PicksUpFramesAppendedAfterItStarted) {
   const scanner::sim::Scene scene =
       scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "data/scenes/default.yaml");
   const scanner::sim::Simulator simulator(scene);
-  const fs::path source = TempPath("source.db"), growing = TempPath("growing.db"), png = TempPath("live.png");
+  const fs::path source = TempPath("source.db"), growing = TempPath("growing.db"),
+                 png = TempPath("live.png");
   fs::remove(source);
   fs::remove(growing);
   mapping::SimulateDive(simulator, "", source, mapping::DiveSimulationOptions{});
@@ -136,7 +138,8 @@ TEST(DiveLogFollower, PicksUpFramesAppendedAfterItStarted) {
   const RgbImage image = ReadPng(png);
   int drawn = 0;
   for (int row = 40; row < image.height_px; ++row) {
-    for (int col = 0; col < image.width_px; ++col) drawn += !(image.At(col, row) == options.render.background);
+    for (int col = 0; col < image.width_px; ++col)
+      drawn += !(image.At(col, row) == options.render.background);
   }
   EXPECT_GT(drawn, 2000);
   fs::remove(source);

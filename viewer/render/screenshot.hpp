@@ -16,7 +16,7 @@ struct PictureInfo {
   int width_px = 0;
   int height_px = 0;
   Eigen::Matrix4d ndc_from_world = Eigen::Matrix4d::Identity();  // the camera, world to NDC
-  std::size_t points_drawn = 0;  // after the point budget
+  std::size_t points_drawn = 0;                                  // after the point budget
   std::size_t points_total = 0;
   std::optional<ScalarRange> range;  // the colour map's range (continuous modes)
 

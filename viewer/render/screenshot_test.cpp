@@ -40,7 +40,8 @@ Scene CubeScene() {
   cube.origin = Eigen::Vector3d(1000.0, -2000.0, 50.0);
   for (int i = 0; i < 5; ++i) {
     for (int j = 0; j < 5; ++j) {
-      for (int k = 0; k < 5; ++k) cube.points.emplace_back(0.1f * i - 0.2f, 0.1f * j - 0.2f, 0.1f * k - 0.2f);
+      for (int k = 0; k < 5; ++k)
+        cube.points.emplace_back(0.1f * i - 0.2f, 0.1f * j - 0.2f, 0.1f * k - 0.2f);
     }
   }
   scene.clouds.push_back(cube);
@@ -90,14 +91,15 @@ TEST(Screenshot, CubeOfPointsHasItsHeightColoursWherePointsProjectAndBackgroundE
       // A point covered by a nearer point's square may show that point's colour: skip it.
       bool covered = false;
       for (std::size_t j = 0; j < cube.size() && !covered; ++j) {
-        covered = j != i && (pixels[j] - pixels[i]).cwiseAbs().maxCoeff() <= 8 && depth[j] < depth[i];
+        covered =
+            j != i && (pixels[j] - pixels[i]).cwiseAbs().maxCoeff() <= 8 && depth[j] < depth[i];
       }
       if (covered) continue;
       const Rgb expected = ContinuousColour(info.range->Normalise(up.dot(cube.Point(i))));
       const Rgb seen = image.At(pixels[i].x(), pixels[i].y());
       EXPECT_TRUE(Near(seen, expected, 3))
-          << "point " << i << " at pixel " << pixels[i].transpose() << ": seen " << int(seen.r) << ","
-          << int(seen.g) << "," << int(seen.b) << " expected " << int(expected.r) << ","
+          << "point " << i << " at pixel " << pixels[i].transpose() << ": seen " << int(seen.r)
+          << "," << int(seen.g) << "," << int(seen.b) << " expected " << int(expected.r) << ","
           << int(expected.g) << "," << int(expected.b);
       ++checked;
     }
@@ -172,7 +174,8 @@ TEST(Screenshot, MatchesTheStoredBaselineWithinTolerance) {
   RenderOptions options = SmallPicture(CameraPreset::kFit);
   options.colour_bar = true;
   options.eye_dome_lighting = true;
-  const fs::path baseline = fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "viewer/testdata/cube_baseline.png";
+  const fs::path baseline =
+      fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "viewer/testdata/cube_baseline.png";
   const char* update = std::getenv("UWSCAN_UPDATE_BASELINES");
   if (update != nullptr && std::string(update) == "1") SaveScreenshot(scene, options, baseline);
   const fs::path png = TempPng("baseline");
@@ -190,7 +193,8 @@ TEST(Screenshot, DifferentSceneDoesNotMatchTheBaseline) {
   RenderOptions options = SmallPicture(CameraPreset::kSide);
   const fs::path png = TempPng("other");
   SaveScreenshot(scene, options, png);
-  const fs::path baseline = fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "viewer/testdata/cube_baseline.png";
+  const fs::path baseline =
+      fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) / "viewer/testdata/cube_baseline.png";
   const ImageDifference d = CompareImages(ReadPng(png), ReadPng(baseline), 40);
   EXPECT_GT(d.fraction_over, 0.01);
   fs::remove(png);
@@ -210,7 +214,8 @@ TEST(Screenshot, IntensityFromAPlyFileColoursEachPoint) {
       for (int j = 0; j < 5; ++j) {
         grid.emplace_back(0.2 * i, 0.2 * j, 3.0);  // a flat grid seen from above: nothing hidden
         intensity.push_back(static_cast<float>(10 * (i * 5 + j)));
-        out << grid.back().x() << " " << grid.back().y() << " " << grid.back().z() << " " << intensity.back() << "\n";
+        out << grid.back().x() << " " << grid.back().y() << " " << grid.back().z() << " "
+            << intensity.back() << "\n";
       }
     }
   }
@@ -232,9 +237,9 @@ TEST(Screenshot, IntensityFromAPlyFileColoursEachPoint) {
     ASSERT_TRUE(px.has_value()) << i;
     const Rgb expected = ContinuousColour(intensity[i] / 240.0);
     const Rgb seen = image.At(px->x(), px->y());
-    EXPECT_TRUE(Near(seen, expected, 3)) << "point " << i << ": seen " << int(seen.r) << "," << int(seen.g) << ","
-                                         << int(seen.b) << " expected " << int(expected.r) << ","
-                                         << int(expected.g) << "," << int(expected.b);
+    EXPECT_TRUE(Near(seen, expected, 3))
+        << "point " << i << ": seen " << int(seen.r) << "," << int(seen.g) << "," << int(seen.b)
+        << " expected " << int(expected.r) << "," << int(expected.g) << "," << int(expected.b);
   }
 }
 

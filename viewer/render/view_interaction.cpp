@@ -51,21 +51,22 @@ std::string PickText(const DrawnCloud& cloud, std::size_t j, ColourMode colour) 
   const std::size_t i = j * cloud.stride;
   const Eigen::Vector3d p = cloud.layer->Point(i);
   char line[256];
-  std::snprintf(line, sizeof line, "%s  point %zu  x %.4f  y %.4f  z %.4f m", cloud.layer->name.c_str(), i,
-                p.x(), p.y(), p.z());
+  std::snprintf(line, sizeof line, "%s  point %zu  x %.4f  y %.4f  z %.4f m",
+                cloud.layer->name.c_str(), i, p.x(), p.y(), p.z());
   std::string text = line;
   if (j < cloud.scalars.size()) {
     std::snprintf(line, sizeof line, "  %s %.6g%s", ToString(colour), cloud.scalars[j],
                   colour == ColourMode::kIntensity ? "" : " m");
     text += line;
   }
-  if (i < cloud.layer->object_ids.size()) text += "  object " + std::to_string(cloud.layer->object_ids[i]);
+  if (i < cloud.layer->object_ids.size())
+    text += "  object " + std::to_string(cloud.layer->object_ids[i]);
   return text;
 }
 
 void InstallViewControls(vtkRenderWindowInteractor& interactor, vtkRenderer& renderer,
-                         const std::function<const std::vector<DrawnCloud>&()>& clouds, ColourMode colour,
-                         RenderOptions& options, vtkTextActor& text) {
+                         const std::function<const std::vector<DrawnCloud>&()>& clouds,
+                         ColourMode colour, RenderOptions& options, vtkTextActor& text) {
   vtkNew<KeyStyle> style;
   vtkNew<vtkPointPicker> picker;
   picker->SetTolerance(kPickTolerance);
@@ -80,7 +81,8 @@ void InstallViewControls(vtkRenderWindowInteractor& interactor, vtkRenderer& ren
     vtkActor* actor = raw_picker->GetActor();
     std::string message = "no point there";
     for (const DrawnCloud& cloud : clouds()) {
-      if (id >= 0 && cloud.actor.GetPointer() == actor) message = PickText(cloud, static_cast<std::size_t>(id), colour);
+      if (id >= 0 && cloud.actor.GetPointer() == actor)
+        message = PickText(cloud, static_cast<std::size_t>(id), colour);
     }
     raw_text->SetInput(message.c_str());
     raw_interactor->Render();
@@ -89,18 +91,22 @@ void InstallViewControls(vtkRenderWindowInteractor& interactor, vtkRenderer& ren
 
   vtkRenderer* raw_renderer = &renderer;
   RenderOptions* raw_options = &options;
-  style->on_key = [raw_renderer, raw_options, raw_interactor, clouds, observer](const std::string& key) {
+  style->on_key = [raw_renderer, raw_options, raw_interactor, clouds,
+                   observer](const std::string& key) {
     (void)observer;  // kept alive as long as the style
     RenderOptions& o = *raw_options;
     if (key == "f" || key == "t" || key == "s") {
       std::vector<vtkActor*> actors;
       for (const DrawnCloud& cloud : clouds()) actors.push_back(cloud.actor);
-      const CameraPreset preset = key == "f" ? CameraPreset::kFit : key == "t" ? CameraPreset::kTop : CameraPreset::kSide;
+      const CameraPreset preset = key == "f"   ? CameraPreset::kFit
+                                  : key == "t" ? CameraPreset::kTop
+                                               : CameraPreset::kSide;
       ApplyCameraPreset(*raw_renderer, preset, o.up, UnionBounds(actors));
     } else if (key == "plus" || key == "minus" || key == "KP_Add" || key == "KP_Subtract") {
       const bool bigger = key == "plus" || key == "KP_Add";
       o.point_size_px = std::clamp(o.point_size_px + (bigger ? 1.0 : -1.0), 1.0, kMaxPointSizePx);
-      for (const DrawnCloud& cloud : clouds()) cloud.actor->GetProperty()->SetPointSize(static_cast<float>(o.point_size_px));
+      for (const DrawnCloud& cloud : clouds())
+        cloud.actor->GetProperty()->SetPointSize(static_cast<float>(o.point_size_px));
     } else if (key == "e") {
       o.eye_dome_lighting = !o.eye_dome_lighting;
       if (o.eye_dome_lighting) {

@@ -22,7 +22,7 @@ class KeyStyle : public vtkInteractorStyleTrackballCamera {
  public:
   static KeyStyle* New();
   vtkTypeMacro(KeyStyle, vtkInteractorStyleTrackballCamera)
-  std::function<bool(const std::string& key)> on_key;
+      std::function<bool(const std::string& key)> on_key;
   void OnChar() override;
 };
 
@@ -33,9 +33,8 @@ vtkSmartPointer<vtkTextActor> CornerText(const Rgb& background);
 // `clouds` are the drawn clouds a pick can land on (read at each pick, so the live view can
 // change them). `options` is changed by the keys (point size, EDL).
 void InstallViewControls(vtkRenderWindowInteractor& interactor, vtkRenderer& renderer,
-                         const std::function<const std::vector<DrawnCloud>&()>& clouds, ColourMode colour,
-                         RenderOptions& options,
-                         vtkTextActor& text);
+                         const std::function<const std::vector<DrawnCloud>&()>& clouds,
+                         ColourMode colour, RenderOptions& options, vtkTextActor& text);
 
 // "name  x y z  height -49.8 m" for drawn point `j` of `cloud`.
 std::string PickText(const DrawnCloud& cloud, std::size_t j, ColourMode colour);

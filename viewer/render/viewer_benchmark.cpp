@@ -18,7 +18,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+double Since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 // Resident memory of this process (VmRSS), megabytes.
 double ResidentMb() {
@@ -46,7 +48,8 @@ Scene Seabed(std::size_t n, std::uint64_t seed) {
   layer.origin = Eigen::Vector3d(0.0, 0.0, 5.0);
   layer.points.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const float x = step * static_cast<float>(i % side) - 5.0f, y = step * static_cast<float>(i / side) - 5.0f;
+    const float x = step * static_cast<float>(i % side) - 5.0f,
+                y = step * static_cast<float>(i / side) - 5.0f;
     layer.points.emplace_back(x, y, 0.3f * std::sin(0.7f * x) * std::cos(0.5f * y) + noise(rng));
   }
   Scene scene;

@@ -22,8 +22,8 @@ struct ViewerBenchRow {
   double first_picture_s = 0.0;  // VTK objects built, window opened, first frame finished
   double frame_s = 0.0;          // median per frame, camera turned 5 deg between frames
   double frame_min_s = 0.0;
-  double rss_before_mb = 0.0;    // process resident memory with the scene in uwscan's types
-  double rss_shown_mb = 0.0;     // ... and while it is shown (VTK arrays, driver buffers)
+  double rss_before_mb = 0.0;  // process resident memory with the scene in uwscan's types
+  double rss_shown_mb = 0.0;   // ... and while it is shown (VTK arrays, driver buffers)
   double held_mb() const { return rss_shown_mb - rss_before_mb; }
 };
 

@@ -1,8 +1,8 @@
 #include "viewer/render/vtk_scene.hpp"
 
 #include <vtkCamera.h>
-#include <vtkCellData.h>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkEDLShading.h>
 #include <vtkFloatArray.h>
 #include <vtkIdTypeArray.h>
@@ -100,16 +100,19 @@ vtkSmartPointer<vtkPoints> FloatPoints(std::size_t n) {
   return points;
 }
 
-void AddCloud(const CloudLayer& layer, int layer_index, std::size_t stride, std::vector<float> scalars,
-              const ScalarRange& range, const RenderOptions& options, VtkScene& out) {
+void AddCloud(const CloudLayer& layer, int layer_index, std::size_t stride,
+              std::vector<float> scalars, const ScalarRange& range, const RenderOptions& options,
+              VtkScene& out) {
   std::vector<Rgb> colours;
   colours.reserve(layer.size() / stride + 1);
   const bool ids = layer.object_ids.size() == layer.size();
   for (std::size_t i = 0, j = 0; i < layer.size(); i += stride, ++j) {
-    colours.push_back(PointColour(options.colour, scalars.empty() ? 0.0f : scalars[j], range, layer_index,
-                                  ids ? std::optional<std::int32_t>(layer.object_ids[i]) : std::nullopt));
+    colours.push_back(
+        PointColour(options.colour, scalars.empty() ? 0.0f : scalars[j], range, layer_index,
+                    ids ? std::optional<std::int32_t>(layer.object_ids[i]) : std::nullopt));
   }
-  vtkSmartPointer<vtkPolyData> data = PointPolyData(layer.origin - out.anchor_W, layer.points, stride, colours);
+  vtkSmartPointer<vtkPolyData> data =
+      PointPolyData(layer.origin - out.anchor_W, layer.points, stride, colours);
   DrawnCloud drawn;
   drawn.actor = PointActor(data, options.point_size_px);
   drawn.layer = &layer;
@@ -122,7 +125,8 @@ void AddCloud(const CloudLayer& layer, int layer_index, std::size_t stride, std:
 
 // A unit sphere stretched along the covariance's principal axes to `sigmas` deviations.
 void AddEllipsoid(const UncertaintyEllipsoid& e, vtkPolyDataMapper* sphere, VtkScene& out) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(0.5 * (e.covariance_m2 + e.covariance_m2.transpose()));
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(
+      0.5 * (e.covariance_m2 + e.covariance_m2.transpose()));
   Eigen::Matrix3d axes = solver.eigenvectors();
   if (axes.determinant() < 0.0) axes.col(0) = -axes.col(0);
   const Eigen::Vector3d radii = e.sigmas * solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
@@ -157,7 +161,8 @@ std::string BarTitle(ColourMode mode) {
 
 }  // namespace
 
-vtkSmartPointer<vtkActor> MeshActor(const MeshLayer& layer, const Rgb& colour, const Eigen::Vector3d& anchor_W) {
+vtkSmartPointer<vtkActor> MeshActor(const MeshLayer& layer, const Rgb& colour,
+                                    const Eigen::Vector3d& anchor_W) {
   auto points = FloatPoints(layer.mesh.vertices.size());
   for (std::size_t i = 0; i < layer.mesh.vertices.size(); ++i) {
     const Eigen::Vector3d p = layer.T_W_M * layer.mesh.vertices[i] - anchor_W;
@@ -293,10 +298,12 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
   const Eigen::Vector3d up = options.up.normalized();
 
   std::vector<std::vector<float>> scalars;
-  for (const CloudLayer& layer : scene.clouds) scalars.push_back(PointScalars(layer, options.colour, up, stride));
+  for (const CloudLayer& layer : scene.clouds)
+    scalars.push_back(PointScalars(layer, options.colour, up, stride));
   const ScalarRange range = SceneRange(scalars, options);
   for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
-    AddCloud(scene.clouds[i], static_cast<int>(i), stride, std::move(scalars[i]), range, options, out);
+    AddCloud(scene.clouds[i], static_cast<int>(i), stride, std::move(scalars[i]), range, options,
+             out);
   }
   // Meshes and trajectories continue the categorical colours after the clouds', so no two
   // things of one scene share a colour when clouds are coloured by file.
@@ -304,7 +311,8 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
   for (const DrawnCloud& cloud : out.clouds) fitted.push_back(cloud.actor);
   int next_colour = static_cast<int>(scene.clouds.size());
   for (const MeshLayer& mesh : scene.meshes) {
-    vtkSmartPointer<vtkActor> actor = MeshActor(mesh, CategoricalColour(next_colour++), out.anchor_W);
+    vtkSmartPointer<vtkActor> actor =
+        MeshActor(mesh, CategoricalColour(next_colour++), out.anchor_W);
     out.renderer->AddActor(actor);
     fitted.push_back(actor);
   }
@@ -312,7 +320,8 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
   for (const TrajectoryLayer& trajectory : scene.trajectories) {
     const Rgb colour = trajectory.colour.value_or(CategoricalColour(next_colour));
     ++next_colour;
-    if (!trajectory.positions_W.empty()) out.renderer->AddActor(TrajectoryActor(trajectory, colour, out.anchor_W));
+    if (!trajectory.positions_W.empty())
+      out.renderer->AddActor(TrajectoryActor(trajectory, colour, out.anchor_W));
   }
   if (!scene.ellipsoids.empty()) {
     vtkNew<vtkSphereSource> sphere;

@@ -57,7 +57,8 @@ vtkSmartPointer<vtkPolyData> PointPolyData(const Eigen::Vector3d& origin_render,
 // coordinates (world minus anchor_W).
 vtkSmartPointer<vtkActor> TrajectoryActor(const TrajectoryLayer& layer, const Rgb& colour,
                                           const Eigen::Vector3d& anchor_W);
-vtkSmartPointer<vtkActor> MeshActor(const MeshLayer& layer, const Rgb& colour, const Eigen::Vector3d& anchor_W);
+vtkSmartPointer<vtkActor> MeshActor(const MeshLayer& layer, const Rgb& colour,
+                                    const Eigen::Vector3d& anchor_W);
 // An unlit point actor (vtkPointGaussianMapper drawing plain points): exact colours.
 vtkSmartPointer<vtkActor> PointActor(vtkPolyData* points, double point_size_px);
 // The scalar bar of the continuous colour map over `range`.

@@ -64,7 +64,8 @@ ScalarRange RobustRange(std::span<const float> values) {
   }
   if (finite.empty()) return {};
   auto percentile = [&finite](double p) {
-    const auto k = static_cast<std::ptrdiff_t>(std::floor(p * static_cast<double>(finite.size() - 1)));
+    const auto k =
+        static_cast<std::ptrdiff_t>(std::floor(p * static_cast<double>(finite.size() - 1)));
     std::nth_element(finite.begin(), finite.begin() + k, finite.end());
     return static_cast<double>(finite[static_cast<std::size_t>(k)]);
   };

@@ -51,7 +51,8 @@ LoopClosure Loop(const json& value, const Field& field) {
   loop.from_submap = from.get<int>();
   loop.to_submap = to.get<int>();
   loop.accepted = accepted.get<bool>();
-  if (const auto it = value.find("reason"); it != value.end() && it->is_string()) loop.reason = it->get<std::string>();
+  if (const auto it = value.find("reason"); it != value.end() && it->is_string())
+    loop.reason = it->get<std::string>();
   return loop;
 }
 
@@ -75,7 +76,8 @@ MapReport ReadMapReport(const std::filesystem::path& path) {
   json_fields::RequireFormatAndKind(j, "map_report", root);
 
   MapReport report;
-  if (const auto it = j.find("log"); it != j.end() && it->is_string()) report.log = it->get<std::string>();
+  if (const auto it = j.find("log"); it != j.end() && it->is_string())
+    report.log = it->get<std::string>();
   if (const auto it = j.find("map"); it != j.end() && !it->is_null()) {
     if (!it->is_string()) root["map"].Fail("expected a file name");
     report.map = path.parent_path() / it->get<std::string>();
@@ -93,14 +95,16 @@ MapReport ReadMapReport(const std::filesystem::path& path) {
   }
   if (const auto it = j.find("loops"); it != j.end()) {
     if (!it->is_array()) root["loops"].Fail("expected an array");
-    for (std::size_t i = 0; i < it->size(); ++i) report.loops.push_back(Loop((*it)[i], root["loops"][i]));
+    for (std::size_t i = 0; i < it->size(); ++i)
+      report.loops.push_back(Loop((*it)[i], root["loops"][i]));
   }
   return report;
 }
 
 void MapReportDrawing::Check() const {
   if (ellipsoid_every < 1) throw Error("map report drawing: ellipsoid_every must be >= 1");
-  if (!(sigmas > 0.0 && std::isfinite(sigmas))) throw Error("map report drawing: sigmas must be > 0");
+  if (!(sigmas > 0.0 && std::isfinite(sigmas)))
+    throw Error("map report drawing: sigmas must be > 0");
 }
 
 void AddMapReport(const MapReport& report, const MapReportDrawing& drawing, Scene& scene) {
@@ -109,18 +113,21 @@ void AddMapReport(const MapReport& report, const MapReportDrawing& drawing, Scen
   int other = 0;
   for (const auto& [name, poses] : report.trajectories) {
     TrajectoryLayer layer = TrajectoryFromPoses(name, poses);
-    layer.colour = TrajectoryColour(name, name == "slam" || name == "dead_reckoning" || name == "truth" ? 0 : other++);
+    layer.colour = TrajectoryColour(
+        name, name == "slam" || name == "dead_reckoning" || name == "truth" ? 0 : other++);
     scene.trajectories.push_back(std::move(layer));
   }
   const auto slam = report.trajectories.find("slam");
   if (slam == report.trajectories.end() || slam->second.empty()) return;
   const std::vector<StampedPose>& poses = slam->second;
-  for (std::size_t i = 0; i < report.pose_covariance.size(); i += static_cast<std::size_t>(drawing.ellipsoid_every)) {
+  for (std::size_t i = 0; i < report.pose_covariance.size();
+       i += static_cast<std::size_t>(drawing.ellipsoid_every)) {
     const PoseCovariance& c = report.pose_covariance[i];
     // The pose the covariance belongs to: the SLAM pose nearest its time.
-    const auto nearest = std::min_element(poses.begin(), poses.end(), [&c](const StampedPose& a, const StampedPose& b) {
-      return std::abs(a.time_s - c.time_s) < std::abs(b.time_s - c.time_s);
-    });
+    const auto nearest = std::min_element(
+        poses.begin(), poses.end(), [&c](const StampedPose& a, const StampedPose& b) {
+          return std::abs(a.time_s - c.time_s) < std::abs(b.time_s - c.time_s);
+        });
     UncertaintyEllipsoid e;
     e.centre_W = nearest->T_W_B.translation();
     e.covariance_m2 = c.covariance.topLeftCorner<3, 3>();

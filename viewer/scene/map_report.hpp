@@ -27,9 +27,10 @@ struct LoopClosure {
 };
 
 struct MapReport {
-  std::string log;                            // the dive log it was made from
+  std::string log;                           // the dive log it was made from
   std::optional<std::filesystem::path> map;  // the map cloud, resolved against the report's folder
-  std::map<std::string, std::vector<StampedPose>> trajectories;  // "slam", "dead_reckoning", "truth"
+  std::map<std::string, std::vector<StampedPose>>
+      trajectories;  // "slam", "dead_reckoning", "truth"
   std::vector<PoseCovariance> pose_covariance;
   std::vector<LoopClosure> loops;
 };

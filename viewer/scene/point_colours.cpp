@@ -16,9 +16,10 @@ std::vector<float> PointScalars(const CloudLayer& layer, ColourMode mode, const 
   const std::vector<float>* values = nullptr;
   if (mode == ColourMode::kError) {
     if (layer.error_m.size() != layer.size()) {
-      throw Error("colour by error: " + layer.name +
-                  " has no ground truth (simulated dive logs have it; give any other cloud of a simulated "
-                  "scene its scene with --scene)");
+      throw Error(
+          "colour by error: " + layer.name +
+          " has no ground truth (simulated dive logs have it; give any other cloud of a simulated "
+          "scene its scene with --scene)");
     }
     values = &layer.error_m;
   } else if (mode == ColourMode::kIntensity) {
@@ -31,8 +32,9 @@ std::vector<float> PointScalars(const CloudLayer& layer, ColourMode mode, const 
   // Height is taken in double from the absolute position: float offsets would lose the origin.
   const double origin_height = up.dot(layer.origin);
   for (std::size_t i = 0; i < layer.size(); i += stride) {
-    scalars.push_back(values ? (*values)[i]
-                             : static_cast<float>(origin_height + up.dot(layer.points[i].cast<double>())));
+    scalars.push_back(
+        values ? (*values)[i]
+               : static_cast<float>(origin_height + up.dot(layer.points[i].cast<double>())));
   }
   return scalars;
 }
@@ -44,7 +46,8 @@ Rgb PointColour(ColourMode mode, float scalar, const ScalarRange& range, int lay
   return *object_id < 0 ? kNoValue : CategoricalColour(*object_id);
 }
 
-ScalarRange SceneRange(const std::vector<std::vector<float>>& scalars, const RenderOptions& options) {
+ScalarRange SceneRange(const std::vector<std::vector<float>>& scalars,
+                       const RenderOptions& options) {
   if (options.range) return *options.range;
   std::vector<float> all;
   for (const std::vector<float>& s : scalars) all.insert(all.end(), s.begin(), s.end());

@@ -35,6 +35,7 @@ Rgb PointColour(ColourMode mode, float scalar, const ScalarRange& range, int lay
 
 // The range a scene's colours span: `options.range` when set, else RobustRange over every
 // drawn point's scalar.
-ScalarRange SceneRange(const std::vector<std::vector<float>>& scalars, const RenderOptions& options);
+ScalarRange SceneRange(const std::vector<std::vector<float>>& scalars,
+                       const RenderOptions& options);
 
 }  // namespace uwscan::viewer

@@ -12,14 +12,14 @@
 namespace uwscan::viewer {
 namespace {
 
-constexpr double kGraspAxisFraction = 0.25;      // of the object's diameter
+constexpr double kGraspAxisFraction = 0.25;  // of the object's diameter
 constexpr double kMinGraspAxis_m = 0.02;
-constexpr double kLabelOffsetFraction = 0.6;     // of the diameter, towards the sensor
+constexpr double kLabelOffsetFraction = 0.6;  // of the diameter, towards the sensor
 
 }  // namespace
 
-void AddRecognitionReport(const RecognitionReport& report, const mapping::ReconstructionOptions& log_options,
-                          Scene& scene) {
+void AddRecognitionReport(const RecognitionReport& report,
+                          const mapping::ReconstructionOptions& log_options, Scene& scene) {
   // `recognize` triangulates a dive log with the scanner's default method: so must the viewer,
   // or the segments' indices would fall on other points.
   mapping::ReconstructionOptions scan_options = log_options;
@@ -61,10 +61,12 @@ void AddRecognitionReport(const RecognitionReport& report, const mapping::Recons
   for (std::size_t k = 0; k < report.objects.size(); ++k) {
     const ReportedObject& o = report.objects[k];
     if (!o.recognised()) continue;
-    const auto model = std::find_if(db.objects.begin(), db.objects.end(),
-                                    [&o](const perception::ObjectModel& m) { return m.id == o.id; });
+    const auto model =
+        std::find_if(db.objects.begin(), db.objects.end(),
+                     [&o](const perception::ObjectModel& m) { return m.id == o.id; });
     if (model == db.objects.end()) {
-      throw Error(report.database.string() + ": has no object '" + o.id + "' (the recognition report names it)");
+      throw Error(report.database.string() + ": has no object '" + o.id +
+                  "' (the recognition report names it)");
     }
     const perception::PointCloud placed = perception::Transformed(model->model, o.T_S_O);
     CloudLayer layer;
@@ -75,11 +77,13 @@ void AddRecognitionReport(const RecognitionReport& report, const mapping::Recons
     scene.clouds.push_back(std::move(layer));
 
     const double axis_m = std::max(kMinGraspAxis_m, kGraspAxisFraction * model->diameter_m);
-    for (const auto& [name, T_S_G] : o.grasps_S) scene.frames.push_back({o.id + " " + name, T_S_G, axis_m});
+    for (const auto& [name, T_S_G] : o.grasps_S)
+      scene.frames.push_back({o.id + " " + name, T_S_G, axis_m});
     char text[96];
     std::snprintf(text, sizeof(text), "%s %.2f", o.id.c_str(), o.score);
     // In front of the object, towards the sensor (the scan's -z), so the object does not hide it.
-    const Eigen::Vector3d front = o.T_S_O.translation() - kLabelOffsetFraction * model->diameter_m * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d front =
+        o.T_S_O.translation() - kLabelOffsetFraction * model->diameter_m * Eigen::Vector3d::UnitZ();
     scene.labels.push_back({front, text, CategoricalColour(static_cast<int>(k))});
   }
 }

@@ -32,7 +32,8 @@ json Matrix(const Eigen::Isometry3d& T) {
 }
 
 bool Near(const Rgb& a, const Rgb& b, int tolerance) {
-  return std::abs(a.r - b.r) <= tolerance && std::abs(a.g - b.g) <= tolerance && std::abs(a.b - b.b) <= tolerance;
+  return std::abs(a.r - b.r) <= tolerance && std::abs(a.g - b.g) <= tolerance &&
+         std::abs(a.b - b.b) <= tolerance;
 }
 
 // A flat 10 cm square object ("tile") in a database file, a scan of it lying on a wall 20 cm
@@ -40,7 +41,8 @@ bool Near(const Rgb& a, const Rgb& b, int tolerance) {
 class RecognitionReportTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("uwscan_recognition_report_test_" + std::to_string(::getpid()));
+    dir_ = fs::temp_directory_path() /
+           ("uwscan_recognition_report_test_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
     T_S_O_.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     T_S_O_.translation() = Eigen::Vector3d(0.25, -0.1, 0.8);
@@ -52,7 +54,8 @@ class RecognitionReportTest : public ::testing::Test {
     tile.source = "made by the test";
     std::vector<Eigen::Vector3d> model_points;
     for (int i = 0; i < 5; ++i) {
-      for (int j = 0; j < 5; ++j) model_points.emplace_back(0.025 * i - 0.05, 0.025 * j - 0.05, 0.0);
+      for (int j = 0; j < 5; ++j)
+        model_points.emplace_back(0.025 * i - 0.05, 0.025 * j - 0.05, 0.0);
     }
     tile.model = perception::MakeCloud(model_points);
     tile.model.normals.assign(model_points.size(), Eigen::Vector3f(0.0f, 0.0f, -1.0f));
@@ -99,7 +102,8 @@ class RecognitionReportTest : public ::testing::Test {
   std::string ErrorOf(const json& report) {
     try {
       Scene scene;
-      AddFile(Write(report, "bad.json"), mapping::ReconstructionOptions{}, MapReportDrawing{}, scene);
+      AddFile(Write(report, "bad.json"), mapping::ReconstructionOptions{}, MapReportDrawing{},
+              scene);
     } catch (const Error& e) {
       return e.what();
     }
@@ -134,12 +138,14 @@ TEST_F(RecognitionReportTest, SegmentAndModelShareTheObjectsColourAndTheGraspSho
   ASSERT_EQ(scene.labels.size(), 1u);
   EXPECT_EQ(scene.labels[0].text, "tile 0.87");
   for (std::size_t i = 0; i < model_S_.size(); ++i) {
-    EXPECT_LT((scene.clouds[1].Point(i) - model_S_[i]).norm(), 1e-6) << "model point " << i << " not at the pose";
+    EXPECT_LT((scene.clouds[1].Point(i) - model_S_[i]).norm(), 1e-6)
+        << "model point " << i << " not at the pose";
   }
   // The segment's points (after the 81 wall points) carry the object's index; the wall none.
   const std::vector<std::int32_t>& ids = scene.clouds[0].object_ids;
   ASSERT_EQ(ids.size(), 81u + 25u);
-  for (std::size_t i = 0; i < ids.size(); ++i) EXPECT_EQ(ids[i], i < 81 ? -1 : 0) << "scan point " << i;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    EXPECT_EQ(ids[i], i < 81 ? -1 : 0) << "scan point " << i;
 
   RenderOptions options;
   options.width_px = 400;
@@ -164,19 +170,25 @@ TEST_F(RecognitionReportTest, SegmentAndModelShareTheObjectsColourAndTheGraspSho
       under_tile = under_tile || (q && (*q - *px).cwiseAbs().maxCoeff() <= 6);
     }
     if (under_tile) continue;
-    EXPECT_TRUE(Near(image.At(px->x(), px->y()), kNoValue, 2)) << "wall point at " << px->transpose();
+    EXPECT_TRUE(Near(image.At(px->x(), px->y()), kNoValue, 2))
+        << "wall point at " << px->transpose();
     ++wall_seen;
   }
   EXPECT_GT(wall_seen, 60);
-  const Eigen::Vector3d x_axis_middle = T_S_G_ * Eigen::Vector3d(0.5 * scene.frames[0].length_m, 0.0, 0.0);
-  const Eigen::Vector3d y_axis_middle = T_S_G_ * Eigen::Vector3d(0.0, 0.5 * scene.frames[0].length_m, 0.0);
+  const Eigen::Vector3d x_axis_middle =
+      T_S_G_ * Eigen::Vector3d(0.5 * scene.frames[0].length_m, 0.0, 0.0);
+  const Eigen::Vector3d y_axis_middle =
+      T_S_G_ * Eigen::Vector3d(0.0, 0.5 * scene.frames[0].length_m, 0.0);
   for (const Eigen::Vector3d& m : model_S_) {
     const std::optional<Eigen::Vector2i> px = info.PixelOf(m);
     ASSERT_TRUE(px.has_value());
     // The grasp's lines lie over some tile points; those are checked below.
-    const auto on_axis = [&](const Eigen::Vector3d& a) { return (info.PixelOf(a).value() - *px).cwiseAbs().maxCoeff() <= 12; };
+    const auto on_axis = [&](const Eigen::Vector3d& a) {
+      return (info.PixelOf(a).value() - *px).cwiseAbs().maxCoeff() <= 12;
+    };
     if (on_axis(x_axis_middle) || on_axis(y_axis_middle) || on_axis(T_S_G_.translation())) continue;
-    EXPECT_TRUE(Near(image.At(px->x(), px->y()), CategoricalColour(0), 2)) << "tile point at " << px->transpose();
+    EXPECT_TRUE(Near(image.At(px->x(), px->y()), CategoricalColour(0), 2))
+        << "tile point at " << px->transpose();
   }
   const Eigen::Vector2i x_px = info.PixelOf(x_axis_middle).value();
   const Eigen::Vector2i y_px = info.PixelOf(y_axis_middle).value();
@@ -199,7 +211,8 @@ TEST_F(RecognitionReportTest, TheLabelIsDrawn) {
   const RgbImage with = ReadPng(dir_ / "with.png"), without = ReadPng(dir_ / "without.png");
   int changed = 0;
   for (int row = 0; row < with.height_px; ++row) {
-    for (int col = 0; col < with.width_px; ++col) changed += !(with.At(col, row) == without.At(col, row));
+    for (int col = 0; col < with.width_px; ++col)
+      changed += !(with.At(col, row) == without.At(col, row));
   }
   EXPECT_GT(changed, 30) << "the label's text left no mark";
 }

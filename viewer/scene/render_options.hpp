@@ -36,7 +36,7 @@ struct RenderOptions {
   double point_size_px = 2.0;      // > 0
   bool eye_dome_lighting = false;  // vtkEDLShading: shapes of colourless scans read as relief
   CameraPreset camera = CameraPreset::kFit;
-  int width_px = 1280;   // window or picture size, [16, 8192]
+  int width_px = 1280;  // window or picture size, [16, 8192]
   int height_px = 960;
   // At most this many points are handed to VTK; above it every k-th point of every cloud is
   // drawn (the same points every time), so big clouds stay interactive. >= 1.

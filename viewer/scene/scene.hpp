@@ -17,9 +17,9 @@ namespace uwscan::viewer {
 struct CloudLayer {
   std::string name;  // the file it came from, shown when a point is picked
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3f> points;  // metres, relative to origin
-  std::vector<float> error_m;           // empty, or one per point: distance to truth (NaN: none)
-  std::vector<float> intensity;         // empty, or one per point, the file's units
+  std::vector<Eigen::Vector3f> points;   // metres, relative to origin
+  std::vector<float> error_m;            // empty, or one per point: distance to truth (NaN: none)
+  std::vector<float> intensity;          // empty, or one per point, the file's units
   std::vector<std::int32_t> object_ids;  // empty, or one per point (scene object; -1: none)
 
   std::size_t size() const { return points.size(); }
@@ -36,7 +36,7 @@ struct MeshLayer {
 // A path of positions (navigation, truth, a SLAM estimate), drawn as a line.
 struct TrajectoryLayer {
   std::string name;
-  std::vector<double> times_s;              // one per position (may be empty)
+  std::vector<double> times_s;               // one per position (may be empty)
   std::vector<Eigen::Vector3d> positions_W;  // metres
   std::optional<Rgb> colour;                 // default: a categorical colour by its index
 };
@@ -74,8 +74,8 @@ struct Scene {
   std::vector<FrameAxes> frames;
 
   bool empty() const {
-    return clouds.empty() && meshes.empty() && trajectories.empty() && ellipsoids.empty() && labels.empty() &&
-           frames.empty();
+    return clouds.empty() && meshes.empty() && trajectories.empty() && ellipsoids.empty() &&
+           labels.empty() && frames.empty();
   }
   std::size_t num_points() const;
   // A point of the scene near its middle (the first cloud's origin, else the first vertex or

@@ -18,7 +18,8 @@ namespace fs = std::filesystem;
 
 std::string Extension(const fs::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
 
@@ -31,7 +32,8 @@ bool PlyHasFaces(const fs::path& path) {
     std::istringstream words(line);
     std::string element, name;
     long long count = 0;
-    if (words >> element >> name >> count && element == "element" && name == "face") return count > 0;
+    if (words >> element >> name >> count && element == "element" && name == "face")
+      return count > 0;
   }
   return false;
 }
@@ -92,10 +94,13 @@ FileKind KindOfFile(const fs::path& path) {
   if (ext == ".json") {
     if (IsMapReport(path)) return FileKind::kMapReport;
     if (IsRecognitionReport(path)) return FileKind::kRecognitionReport;
-    throw Error(path.string() + ": a JSON file that is neither a map report nor a recognition report (\"kind\": "
-                "\"map_report\" or \"recognition_report\"); bench reports are drawn by `uwscan plot`");
+    throw Error(
+        path.string() +
+        ": a JSON file that is neither a map report nor a recognition report (\"kind\": "
+        "\"map_report\" or \"recognition_report\"); bench reports are drawn by `uwscan plot`");
   }
-  throw Error(path.string() + ": unknown kind of file (clouds .ply .pcd .xyz, meshes .ply .off .stl .obj, "
+  throw Error(path.string() +
+              ": unknown kind of file (clouds .ply .pcd .xyz, meshes .ply .off .stl .obj, "
               "trajectories .txt .tum, dive logs .db, map and recognition reports .json)");
 }
 
@@ -116,7 +121,8 @@ void AddMeshFile(const fs::path& path, Scene& scene) {
   scene.meshes.push_back(std::move(layer));
 }
 
-TrajectoryLayer TrajectoryFromPoses(const std::string& name, const std::vector<StampedPose>& poses) {
+TrajectoryLayer TrajectoryFromPoses(const std::string& name,
+                                    const std::vector<StampedPose>& poses) {
   TrajectoryLayer layer;
   layer.name = name;
   for (const StampedPose& pose : poses) {
@@ -127,10 +133,12 @@ TrajectoryLayer TrajectoryFromPoses(const std::string& name, const std::vector<S
 }
 
 void AddTrajectoryFile(const fs::path& path, Scene& scene) {
-  scene.trajectories.push_back(TrajectoryFromPoses(path.filename().string(), ReadTumTrajectory(path)));
+  scene.trajectories.push_back(
+      TrajectoryFromPoses(path.filename().string(), ReadTumTrajectory(path)));
 }
 
-DiveLogSummary AddDiveLog(const fs::path& path, const mapping::ReconstructionOptions& options, Scene& scene) {
+DiveLogSummary AddDiveLog(const fs::path& path, const mapping::ReconstructionOptions& options,
+                          Scene& scene) {
   const mapping::DiveLogReader log(path);
   const mapping::Reconstruction r = mapping::Reconstruct(log, options);
   if (r.points.empty()) throw Error(path.string() + ": no frame gave a point; nothing to show");
@@ -139,7 +147,8 @@ DiveLogSummary AddDiveLog(const fs::path& path, const mapping::ReconstructionOpt
   summary.frames = r.frames;
   summary.world_frame = r.world_frame;
   summary.has_truth = r.truth.size() == r.points.size();
-  if (const std::optional<mapping::TruthError> e = mapping::CompareToTruth(r)) summary.truth_mean_error_m = e->mean_m;
+  if (const std::optional<mapping::TruthError> e = mapping::CompareToTruth(r))
+    summary.truth_mean_error_m = e->mean_m;
 
   CloudLayer layer;
   layer.name = path.filename().string();
@@ -149,7 +158,8 @@ DiveLogSummary AddDiveLog(const fs::path& path, const mapping::ReconstructionOpt
   if (summary.has_truth) {
     layer.error_m.reserve(r.points.size());
     for (std::size_t i = 0; i < r.points.size(); ++i) {
-      layer.error_m.push_back(static_cast<float>((r.points[i] - r.truth[i]).norm()));  // NaN: no truth
+      layer.error_m.push_back(
+          static_cast<float>((r.points[i] - r.truth[i]).norm()));  // NaN: no truth
     }
   }
   scene.clouds.push_back(std::move(layer));

@@ -44,8 +44,8 @@ struct DiveLogSummary {
 // A dive log's reconstructed cloud (with each point's distance to its true surface point when
 // the log is simulated), the camera path its navigation reports and, when simulated, the true
 // camera path. Throws uwscan::Error naming the log when it cannot be read or gives no point.
-DiveLogSummary AddDiveLog(const std::filesystem::path& path, const mapping::ReconstructionOptions& options,
-                          Scene& scene);
+DiveLogSummary AddDiveLog(const std::filesystem::path& path,
+                          const mapping::ReconstructionOptions& options, Scene& scene);
 
 // Whatever KindOfFile says the file is (map reports with `map_drawing`; dive logs, also those a
 // recognition report names, triangulated with `log_options`).

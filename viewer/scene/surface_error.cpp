@@ -10,9 +10,11 @@
 
 namespace uwscan::viewer {
 
-std::size_t SetSurfaceError(const scanner::sim::RayCaster& truth, double max_distance_m, Scene& scene) {
+std::size_t SetSurfaceError(const scanner::sim::RayCaster& truth, double max_distance_m,
+                            Scene& scene) {
   if (!(max_distance_m > 0.0 && std::isfinite(max_distance_m))) {
-    throw Error("surface error: the search distance must be > 0 m, got " + std::to_string(max_distance_m));
+    throw Error("surface error: the search distance must be > 0 m, got " +
+                std::to_string(max_distance_m));
   }
   std::size_t filled = 0;
   for (CloudLayer& layer : scene.clouds) {

@@ -13,6 +13,7 @@ namespace uwscan::viewer {
 // the nearest surface of `truth`, NaN (no value) where none lies within max_distance_m (> 0).
 // Layers that already carry an error (a dive log's own, point by point) keep it. Returns how many
 // layers were filled. Throws uwscan::Error when max_distance_m is not > 0 or a point is not finite.
-std::size_t SetSurfaceError(const scanner::sim::RayCaster& truth, double max_distance_m, Scene& scene);
+std::size_t SetSurfaceError(const scanner::sim::RayCaster& truth, double max_distance_m,
+                            Scene& scene);
 
 }  // namespace uwscan::viewer

@@ -20,7 +20,8 @@ scanner::sim::RayCaster SphereScene() {
   return scanner::sim::RayCaster({sphere});
 }
 
-CloudLayer Layer(const std::string& name, const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3f>& points) {
+CloudLayer Layer(const std::string& name, const Eigen::Vector3d& origin,
+                 const std::vector<Eigen::Vector3f>& points) {
   CloudLayer layer;
   layer.name = name;
   layer.origin = origin;
@@ -34,9 +35,10 @@ TEST(SurfaceError, IsEachPointsDistanceToTheNearestTrueSurfaceAndNoValueBeyondTh
   // Float offsets from a far origin, as maps are stored: outside, inside, on, and far from the
   // sphere.
   const Eigen::Vector3d origin(1.0, 2.0, 10.0);
-  scene.clouds.push_back(Layer("map.ply", origin,
-                               {Eigen::Vector3f(0.203f, 0.0f, 0.0f), Eigen::Vector3f(0.0f, -0.19f, 0.0f),
-                                Eigen::Vector3f(0.0f, 0.0f, 0.2f), Eigen::Vector3f(0.0f, 0.0f, 1.5f)}));
+  scene.clouds.push_back(
+      Layer("map.ply", origin,
+            {Eigen::Vector3f(0.203f, 0.0f, 0.0f), Eigen::Vector3f(0.0f, -0.19f, 0.0f),
+             Eigen::Vector3f(0.0f, 0.0f, 0.2f), Eigen::Vector3f(0.0f, 0.0f, 1.5f)}));
   // A layer that already carries its own error (a dive log's, point by point) keeps it.
   CloudLayer own = Layer("dive.db", origin, {Eigen::Vector3f(0.5f, 0.0f, 0.0f)});
   own.error_m = {0.123f};
@@ -58,7 +60,8 @@ TEST(SurfaceError, ABadSearchDistanceOrPointIsRefusedByName) {
   const scanner::sim::RayCaster truth = SphereScene();
   Scene scene;
   EXPECT_THROW(SetSurfaceError(truth, 0.0, scene), Error);
-  scene.clouds.push_back(Layer("broken.ply", Eigen::Vector3d::Zero(), {Eigen::Vector3f(NAN, 0.0f, 0.0f)}));
+  scene.clouds.push_back(
+      Layer("broken.ply", Eigen::Vector3d::Zero(), {Eigen::Vector3f(NAN, 0.0f, 0.0f)}));
   try {
     SetSurfaceError(truth, 0.5, scene);
     FAIL() << "expected an error";

@@ -10,7 +10,8 @@ namespace uwscan::viewer {
 
 StampedPose PoseFromTum(std::span<const double> v, const std::string& where) {
   if (v.size() != 8) {
-    throw Error(where + ": expected 8 numbers (t tx ty tz qx qy qz qw), got " + std::to_string(v.size()));
+    throw Error(where + ": expected 8 numbers (t tx ty tz qx qy qz qw), got " +
+                std::to_string(v.size()));
   }
   for (const double x : v) {
     if (!std::isfinite(x)) throw Error(where + ": a number is not finite");
@@ -46,13 +47,15 @@ std::vector<StampedPose> ReadTumTrajectory(const std::filesystem::path& path) {
         values.push_back(std::stod(token, &used));
         if (used != token.size()) throw std::invalid_argument(token);
       } catch (const std::exception&) {
-        throw Error(path.string() + ":" + std::to_string(number) + ": '" + token + "' is not a number");
+        throw Error(path.string() + ":" + std::to_string(number) + ": '" + token +
+                    "' is not a number");
       }
     }
     if (values.empty()) continue;
     poses.push_back(PoseFromTum(values, path.string() + ":" + std::to_string(number)));
   }
-  if (poses.empty()) throw Error(path.string() + ": no pose (expected lines of t tx ty tz qx qy qz qw)");
+  if (poses.empty())
+    throw Error(path.string() + ": no pose (expected lines of t tx ty tz qx qy qz qw)");
   return poses;
 }
 
