@@ -64,22 +64,18 @@ void MemsCalibrationOptions::Check() const {
   if (min_planes_per_pair < 2) throw Error("MEMS calibration: min_planes_per_pair must be >= 2");
 }
 
-MemsCalibrationResult CalibrateMemsProjection(const RefractiveCamera& camera,
-                                              const std::vector<Plane>& planes_C,
-                                              const std::vector<std::vector<DotObservation>>& dots,
-                                              const MemsCalibrationOptions& options) {
-  options.Check();
-  if (planes_C.size() != dots.size()) {
-    throw Error("MEMS calibration: " + std::to_string(planes_C.size()) + " planes but dots for " +
-                std::to_string(dots.size()));
-  }
-  if (planes_C.size() < 2)
-    throw Error("MEMS calibration: needs dots on at least 2 planes, got " +
-                std::to_string(planes_C.size()));
-  // q_kl: each dot's camera ray meets its plane.
+namespace {
+
+// q_kl: where each dot's camera ray meets its plane, by voltage pair, and the depths they span.
+struct DotPoints {
   std::map<VoltsKey, std::vector<Eigen::Vector3d>> points_of;
-  MemsCalibrationResult result;
   double depth_min = 1e300, depth_max = -1e300;
+  int dots = 0;
+};
+
+DotPoints PointsOfDots(const RefractiveCamera& camera, const std::vector<Plane>& planes_C,
+                       const std::vector<std::vector<DotObservation>>& dots) {
+  DotPoints out;
   for (size_t l = 0; l < planes_C.size(); ++l) {
     std::map<VoltsKey, int> seen;
     for (const DotObservation& dot : dots[l]) {
@@ -97,12 +93,34 @@ MemsCalibrationResult CalibrateMemsProjection(const RefractiveCamera& camera,
         throw Error("MEMS calibration: " + dot.image + ": the camera ray of the dot misses plane " +
                     std::to_string(l));
       }
-      points_of[key].push_back(hit.point);
-      depth_min = std::min(depth_min, hit.point.z());
-      depth_max = std::max(depth_max, hit.point.z());
-      ++result.dots;
+      out.points_of[key].push_back(hit.point);
+      out.depth_min = std::min(out.depth_min, hit.point.z());
+      out.depth_max = std::max(out.depth_max, hit.point.z());
+      ++out.dots;
     }
   }
+  return out;
+}
+
+}  // namespace
+
+MemsCalibrationResult CalibrateMemsProjection(const RefractiveCamera& camera,
+                                              const std::vector<Plane>& planes_C,
+                                              const std::vector<std::vector<DotObservation>>& dots,
+                                              const MemsCalibrationOptions& options) {
+  options.Check();
+  if (planes_C.size() != dots.size()) {
+    throw Error("MEMS calibration: " + std::to_string(planes_C.size()) + " planes but dots for " +
+                std::to_string(dots.size()));
+  }
+  if (planes_C.size() < 2)
+    throw Error("MEMS calibration: needs dots on at least 2 planes, got " +
+                std::to_string(planes_C.size()));
+  const DotPoints seen = PointsOfDots(camera, planes_C, dots);
+  const std::map<VoltsKey, std::vector<Eigen::Vector3d>>& points_of = seen.points_of;
+  MemsCalibrationResult result;
+  result.dots = seen.dots;
+  const double depth_min = seen.depth_min, depth_max = seen.depth_max;
   // A line per voltage pair seen on enough planes (seed eq. 18).
   double sum2 = 0.0;
   int fitted = 0;
