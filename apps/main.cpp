@@ -9,6 +9,7 @@
 #include "apps/bench/acquisition_bench_command.hpp"
 #include "apps/bench/bench_commands.hpp"
 #include "apps/bench/calibration_bench_command.hpp"
+#include "apps/bench/change_bench_command.hpp"
 #include "apps/bench/kernels_command.hpp"
 #include "apps/bench/recognition_bench_command.hpp"
 #include "apps/bench/robustness_bench_command.hpp"
@@ -17,6 +18,7 @@
 #include "apps/bench/stripe_commands.hpp"
 #include "apps/bench/thread_bench_command.hpp"
 #include "apps/cli/data_folder.hpp"
+#include "apps/mapping/compare_command.hpp"
 #include "apps/mapping/inspect_command.hpp"
 #include "apps/mapping/log_commands.hpp"
 #include "apps/mapping/map_command.hpp"
@@ -73,6 +75,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddBuildDbCommand(app);
   uwscan::app::AddRecognizeCommand(app);
   uwscan::app::AddMapCommand(app);
+  uwscan::app::AddCompareCommand(app);
   uwscan::app::AddViewCommand(app);
   uwscan::app::AddPlotCommand(app);
   uwscan::app::AddReportCommand(app);
@@ -92,6 +95,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddSimulationBenchCommand(*bench);
   uwscan::app::AddKernelsCommand(*bench);
   uwscan::app::AddSlamBenchCommand(*bench);
+  uwscan::app::AddChangeBenchCommand(*bench);
   uwscan::app::AddRecognitionBenchCommand(*bench);
   uwscan::app::AddViewerBenchCommand(*bench);
   uwscan::app::AddAcquisitionBenchCommand(*bench);

@@ -421,3 +421,71 @@ TEST(CliDive, ForceReplacesOnlyWhatItShouldAndOnlyAfterChecking) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string ReadText(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A short dive mapped, and the scene's design model beside it: what `uwscan compare` takes.
+struct MappedDive {
+  std::filesystem::path log = TempPath("compare.db"), design = TempPath("design.ply"),
+                        map = TempPath("compare_map.ply"), report = TempPath("compare_map.json");
+};
+
+MappedDive MapShortDive() {
+  MappedDive d;
+  const CommandRun simulated =
+      RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " +
+                d.log.string() + " --force --design " + d.design.string());
+  EXPECT_EQ(simulated.exit_code, 0) << simulated.output;
+  const CommandRun mapped =
+      RunUwscan("map " + d.log.string() + " -o " + d.map.string() + " --json " + d.report.string());
+  EXPECT_EQ(mapped.exit_code, 0) << mapped.output;
+  return d;
+}
+
+}  // namespace
+
+// compare end to end: the map report against the scene as built writes the deviations PLY with
+// the fields CloudCompare reads, the report and the table; bad input gets one line and no file.
+TEST(CliDive, CompareWritesDeviationsReportAndTableAndRefusesBadInputWithOneLine) {
+  const MappedDive d = MapShortDive();
+  const std::filesystem::path ply = TempPath("deviations.ply"), json = TempPath("findings.json"),
+                              md = TempPath("findings.md");
+  const CommandRun run =
+      RunUwscan("compare " + d.report.string() + " --reference " + d.design.string() + " -o " +
+                ply.string() + " --json " + json.string() + " --markdown " + md.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(ply, std::ios::binary);
+  std::string header, line;
+  while (std::getline(in, line) && line != "end_header") header += line + "\n";
+  for (const char* field : {"deviation_m", "lod_m", "significant", "inspected", "region"})
+    EXPECT_NE(header.find(std::string(" ") + field + "\n"), std::string::npos) << header;
+  const nlohmann::json report = ReadJson(json);
+  EXPECT_EQ(report["kind"], "change_report");
+  EXPECT_EQ(report["reference"]["kind"], "design");
+  EXPECT_GT(report["surface"]["unchanged_m2"].get<double>(), 1.0);  // the swath, unchanged
+  EXPECT_TRUE(report["alignment"]["registered"].get<bool>());
+  EXPECT_NE(ReadText(md).find("| region | kind |"), std::string::npos);
+
+  // A design model in millimetres read as metres, an empty map: one line each, nothing written.
+  std::filesystem::remove(ply);
+  const CommandRun mm = RunUwscan("compare " + d.report.string() + " --reference " +
+                                  d.design.string() + " --reference-units mm -o " + ply.string());
+  EXPECT_EQ(mm.exit_code, 1) << mm.output;
+  EXPECT_NE(mm.output.find("does not overlap"), std::string::npos) << mm.output;
+  EXPECT_EQ(std::count(mm.output.begin(), mm.output.end(), '\n'), 1) << mm.output;
+  EXPECT_FALSE(std::filesystem::exists(ply));
+  const std::filesystem::path empty = TempPath("empty.xyz");
+  std::ofstream(empty) << "# nothing\n";
+  const CommandRun none = RunUwscan("compare " + empty.string() + " --reference " +
+                                    d.design.string() + " -o " + ply.string());
+  EXPECT_EQ(none.exit_code, 1) << none.output;
+  EXPECT_EQ(std::count(none.output.begin(), none.output.end(), '\n'), 1) << none.output;
+  EXPECT_FALSE(std::filesystem::exists(ply));
+  for (const auto& p : {d.log, d.design, d.map, d.report, json, md, empty})
+    std::filesystem::remove(p);
+}

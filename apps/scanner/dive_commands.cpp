@@ -21,8 +21,10 @@
 #include "scanner/calibration/dataset_simulation.hpp"
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/triangle_mesh.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/scene.hpp"
+#include "scanner/sim/scene_mesh.hpp"
 #include "scanner/sim/simulator.hpp"
 
 namespace uwscan::app {
@@ -31,6 +33,7 @@ namespace {
 struct SimulateArgs {
   std::string scene;
   std::string output;
+  std::string design;
   bool images = false;
   bool force = false;
   int threads = 0;
@@ -72,8 +75,12 @@ void RunSimulateCalibration(const SimulateArgs& a) {
 }
 
 void RunSimulate(const SimulateArgs& a) {
-  if (IsCalibrationScene(ReadText(a.scene))) return RunSimulateCalibration(a);
+  if (IsCalibrationScene(ReadText(a.scene))) {
+    if (!a.design.empty()) throw Error("--design: a calibration scene has no structure to model");
+    return RunSimulateCalibration(a);
+  }
   CheckOutputPath(a.output, "-o", {a.scene});
+  if (!a.design.empty()) CheckOutputPath(a.design, "--design", {a.scene, a.output});
   if (std::filesystem::exists(a.output) && !a.force) {
     throw Error(a.output + ": exists (a dive log is never overwritten; use --force)");
   }
@@ -117,6 +124,12 @@ void RunSimulate(const SimulateArgs& a) {
               static_cast<long long>(summary.peaks),
               static_cast<long long>(summary.navigation_records),
               summary.images_stored ? ", images stored" : "", summary.seconds);
+  if (!a.design.empty()) {
+    const scanner::TriangleMesh design = scanner::sim::SceneMesh(scene);
+    scanner::WriteMeshPly(design, a.design);
+    std::printf("%s: the scene's %zu objects as built, %zu triangles (world frame, metres)\n",
+                a.design.c_str(), scene.objects.size(), design.triangles.size());
+  }
 }
 
 struct ReconstructArgs {
@@ -195,6 +208,9 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_flag("--images", args->images,
                 "store the rendered frames in the log (image effects on)");
   cmd->add_flag("--force", args->force, "replace an existing log at the output path");
+  cmd->add_option("--design", args->design,
+                  "also write the scene's objects as one mesh in the world frame (.ply): the "
+                  "structure as built, a reference for `uwscan compare`");
   cmd->add_option("--threads", args->threads, "frames simulated in parallel (0: all cores)")
       ->check(kNonNegativeNumber);
   cmd->callback([args] { RunSimulate(*args); });

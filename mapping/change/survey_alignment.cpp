@@ -1,0 +1,232 @@
+#include "mapping/change/survey_alignment.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+
+#include "perception/preprocessing/voxel_filter.hpp"
+#include "perception/registration/icp.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+using perception::PointCloud;
+using Key = std::array<int, 3>;
+
+constexpr double kMinGlobalFitness = 0.1;
+
+void CheckStages(const std::vector<double>& stages, const char* name) {
+  if (stages.empty()) throw Error(std::string("SurveyAlignmentOptions: ") + name + " is empty");
+  for (std::size_t i = 0; i < stages.size(); ++i) {
+    if (!(stages[i] > 0.0) || !std::isfinite(stages[i]) || (i > 0 && stages[i] > stages[i - 1]))
+      throw Error(std::string("SurveyAlignmentOptions: ") + name +
+                  " must be finite, > 0 and non-increasing");
+  }
+}
+
+Key KeyOf(const Eigen::Vector3d& p, double tile_m) {
+  return {static_cast<int>(std::floor(p.x() / tile_m)), static_cast<int>(std::floor(p.y() / tile_m)),
+          static_cast<int>(std::floor(p.z() / tile_m))};
+}
+
+// The cloud about its own centroid: ICP's information is then taken about the tile, not about a
+// point metres away where rotations and translations mix.
+PointCloud Recentred(const PointCloud& cloud) {
+  PointCloud out = cloud;
+  const Eigen::Vector3d centroid = perception::Centroid(cloud);
+  const Eigen::Vector3f shift = (centroid - cloud.origin).cast<float>();
+  for (Eigen::Vector3f& p : out.points) p -= shift;
+  out.origin = cloud.origin + shift.cast<double>();
+  return out;
+}
+
+// sigma^2 times the pseudo-inverse of the information: directions without information get none.
+Matrix6d CovarianceOf(const perception::RegistrationResult& r) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(r.information);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  Eigen::Matrix<double, 6, 1> inverse = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int i = 0; i < 6; ++i) {
+    if (eigen.eigenvalues()(i) > 1e-9 * largest) inverse(i) = 1.0 / eigen.eigenvalues()(i);
+  }
+  const double variance = r.inlier_plane_rmse * r.inlier_plane_rmse;
+  return variance * eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+perception::IcpOptions PointToPlane(const std::vector<double>& stages) {
+  perception::IcpOptions icp;
+  icp.method = perception::IcpMethod::kPointToPlane;
+  icp.max_correspondence_distance_m = stages;
+  icp.max_iterations = 30 * static_cast<int>(stages.size());
+  icp.max_iterations_per_stage = 30;
+  icp.stall_iterations = 5;
+  return icp;
+}
+
+// The reference's points within `margin_m` of a cloud's bounding box, about their centroid
+// (empty below 3 points).
+PointCloud ReferenceAround(const PointCloud& reference, const PointCloud& cloud, double margin_m) {
+  Eigen::Vector3d lo = cloud.Point(0), hi = lo;
+  for (std::size_t i = 1; i < cloud.size(); ++i) {
+    lo = lo.cwiseMin(cloud.Point(i));
+    hi = hi.cwiseMax(cloud.Point(i));
+  }
+  lo.array() -= margin_m;
+  hi.array() += margin_m;
+  std::vector<std::size_t> inside;
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    const Eigen::Vector3d q = reference.Point(i);
+    if ((q.array() >= lo.array()).all() && (q.array() <= hi.array()).all()) inside.push_back(i);
+  }
+  return inside.size() < 3 ? PointCloud{} : Recentred(perception::Subset(reference, inside));
+}
+
+// The part of a tile's registration its surface pins firmly: the increment's components along
+// the information's strong directions (eigenvalues above 1 % of the largest). A flat tile pins
+// its height and tilt; what would slide it along the seabed is only the rim of a change, and
+// sliding there would move the change instead of finding it.
+Eigen::Isometry3d FirmPart(const perception::RegistrationResult& r, const Eigen::Vector3d& origin) {
+  const Eigen::Matrix3d R = r.T_target_source.linear();
+  const Eigen::AngleAxisd rotation(R);
+  Eigen::Matrix<double, 6, 1> x;
+  x << rotation.angle() * rotation.axis(), r.T_target_source * origin - origin;
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(r.information);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  Eigen::Matrix<double, 6, 1> firm = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int i = 0; i < 6; ++i) {
+    const Eigen::Matrix<double, 6, 1> u = eigen.eigenvectors().col(i);
+    if (eigen.eigenvalues()(i) > 0.01 * largest) firm += u * u.dot(x);
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const double angle = firm.head<3>().norm();
+  if (angle > 0.0) T.linear() = Eigen::AngleAxisd(angle, firm.head<3>() / angle).toRotationMatrix();
+  T.translation() = firm.tail<3>() + origin - T.linear() * origin;
+  return T;
+}
+
+// The global transform as a prior of the tile's registration: directions its points leave free
+// (a flat seabed's slides) stay where the whole map put them.
+perception::IcpPrior TilePrior(const SurveyAlignmentOptions& options) {
+  perception::IcpPrior prior;
+  Eigen::Matrix<double, 6, 1> sigma;
+  sigma << Eigen::Vector3d::Constant(options.tile_prior_rotation_rad),
+      Eigen::Vector3d::Constant(options.tile_prior_translation_m);
+  prior.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
+  prior.point_sigma_m = options.tile_point_sigma_m;
+  return prior;
+}
+
+SurveyAlignment::Tile AlignTile(const PointCloud& source_W, const PointCloud& reference,
+                                const Key& key, const SurveyAlignment& global,
+                                const SurveyAlignmentOptions& options) {
+  SurveyAlignment::Tile tile;
+  tile.key = Eigen::Vector3i(key[0], key[1], key[2]);
+  tile.T_reference_map = global.T_reference_map;
+  const double reach_m = options.tile_max_correspondence_m.front();
+  const PointCloud target = ReferenceAround(reference, source_W, reach_m);
+  if (static_cast<int>(source_W.size()) < options.min_tile_points || target.size() < 3) return tile;
+  perception::IcpOptions icp = PointToPlane(options.tile_max_correspondence_m);
+  icp.prior = TilePrior(options);
+  const perception::RegistrationResult r =
+      perception::AlignIcp(source_W, target, Eigen::Isometry3d::Identity(), icp);
+  // A tile the reference barely covers, or whose registration wandered beyond the first stage's
+  // reach, keeps the global transform: a wrong local fit would show as a change over the tile.
+  const double moved_m = (r.T_target_source * source_W.origin - source_W.origin).norm();
+  if (r.fitness < 0.5 || !(moved_m < reach_m)) return tile;
+  tile.T_reference_map = FirmPart(r, target.origin) * global.T_reference_map;
+  tile.covariance = CovarianceOf(r);
+  tile.origin_W = target.origin;
+  tile.registered = true;
+  return tile;
+}
+
+SurveyAlignment AlignGlobally(const PointCloud& source, const PointCloud& reference,
+                              const SurveyAlignmentOptions& options) {
+  SurveyAlignment alignment;
+  const Eigen::Isometry3d start = options.T_reference_map.value_or(Eigen::Isometry3d::Identity());
+  alignment.T_reference_map = start;
+  if (options.T_reference_map) return alignment;
+  const perception::RegistrationResult r = perception::AlignIcp(
+      source, reference, start, PointToPlane(options.global_max_correspondence_m));
+  if (r.fitness < kMinGlobalFitness) {
+    throw Error("the map and the reference do not overlap: " +
+                std::to_string(static_cast<int>(100.0 * r.fitness)) +
+                " % of the map's points lie within " +
+                std::to_string(options.global_max_correspondence_m.back()) +
+                " m of the reference after registration (same world frame and units? give "
+                "--transform or --reference-units)");
+  }
+  alignment.T_reference_map = r.T_target_source;
+  alignment.global_fitness = r.fitness;
+  alignment.global_rmse_m = r.inlier_plane_rmse;
+  alignment.registered = true;
+  return alignment;
+}
+
+}  // namespace
+
+void SurveyAlignmentOptions::Check() const {
+  CheckStages(global_max_correspondence_m, "global_max_correspondence_m");
+  CheckStages(tile_max_correspondence_m, "tile_max_correspondence_m");
+  if (!(tile_m >= 0.0) || !std::isfinite(tile_m))
+    throw Error("SurveyAlignmentOptions: tile_m must be finite and >= 0");
+  for (double v : {tile_prior_rotation_rad, tile_prior_translation_m, tile_point_sigma_m}) {
+    if (!(v > 0.0) || !std::isfinite(v))
+      throw Error("SurveyAlignmentOptions: the tile prior's sigmas must be finite and > 0");
+  }
+  if (min_tile_points < 3) throw Error("SurveyAlignmentOptions: min_tile_points must be >= 3");
+  if (!(source_voxel_m > 0.0) || !std::isfinite(source_voxel_m))
+    throw Error("SurveyAlignmentOptions: source_voxel_m must be finite and > 0");
+  if (T_reference_map && !T_reference_map->matrix().allFinite())
+    throw Error("SurveyAlignmentOptions: T_reference_map is not finite");
+}
+
+const SurveyAlignment::Tile* SurveyAlignment::TileOf(const Eigen::Vector3d& p_map) const {
+  if (tiles.empty()) return nullptr;
+  const Key k = KeyOf(p_map, tile_m);
+  const Eigen::Vector3i key(k[0], k[1], k[2]);
+  const auto it = std::lower_bound(tiles.begin(), tiles.end(), key, [](const Tile& t, const Eigen::Vector3i& k) {
+    return std::lexicographical_compare(t.key.data(), t.key.data() + 3, k.data(), k.data() + 3);
+  });
+  return it != tiles.end() && it->key == key ? &*it : nullptr;
+}
+
+Eigen::Isometry3d SurveyAlignment::TransformOf(const Eigen::Vector3d& p_map) const {
+  const Tile* tile = TileOf(p_map);
+  return tile ? tile->T_reference_map : T_reference_map;
+}
+
+double SurveyAlignment::SigmaAlongNormal(const Eigen::Vector3d& p_map,
+                                         const Eigen::Vector3d& q_reference,
+                                         const Eigen::Vector3d& normal_W) const {
+  const Tile* tile = TileOf(p_map);
+  if (!tile || !tile->registered) return 0.0;
+  const Eigen::Vector3d lever = q_reference - tile->origin_W;
+  Eigen::Matrix<double, 1, 6> j;
+  j << lever.cross(normal_W).transpose(), normal_W.transpose();
+  return std::sqrt(std::max(0.0, static_cast<double>(j * tile->covariance * j.transpose())));
+}
+
+SurveyAlignment AlignSurveys(const PointCloud& map, const PointCloud& reference,
+                             const SurveyAlignmentOptions& options) {
+  options.Check();
+  const PointCloud source = perception::VoxelDownsample(map, {.leaf_m = options.source_voxel_m});
+  SurveyAlignment alignment = AlignGlobally(source, reference, options);
+  if (options.tile_m == 0.0) return alignment;
+  alignment.tile_m = options.tile_m;
+  std::map<Key, std::vector<std::size_t>> by_tile;
+  for (std::size_t i = 0; i < source.size(); ++i)
+    by_tile[KeyOf(source.Point(i), options.tile_m)].push_back(i);
+  for (const auto& [key, indices] : by_tile) {
+    const PointCloud tile_W =
+        Recentred(perception::Transformed(perception::Subset(source, indices), alignment.T_reference_map));
+    SurveyAlignment::Tile tile = AlignTile(tile_W, reference, key, alignment, options);
+    if (!tile.registered) ++alignment.tiles_kept_global;
+    alignment.tiles.push_back(tile);
+  }
+  return alignment;
+}
+
+}  // namespace uwscan::mapping
