@@ -27,7 +27,11 @@ nlohmann::json MethodJson(const bench::MethodFigures& m) {
                                   {"detection_rate", d.detection_rate},
                                   {"false_area_share", d.false_area_share}};
   }
+  nlohmann::json changes = nlohmann::json::array();
+  for (const bench::ChangeOutcome& c : m.changes)
+    changes.push_back({{"name", c.name}, {"points", c.points}, {"found", c.found}});
   return {{"by_depth_mm", depths},
+          {"changes", changes},
           {"unchanged_flagged_share", m.unchanged_flagged_share},
           {"unchanged_rms_m", m.unchanged_rms_m},
           {"changed_rms_error_m", m.changed_rms_error_m},
@@ -38,15 +42,17 @@ nlohmann::json MethodJson(const bench::MethodFigures& m) {
 void Print(const bench::ChangeFigures& f) {
   std::printf("maps: %.2f mm RMS to their true surfaces; simulated in %.1f s, mapped in %.1f s\n\n",
               1e3 * f.map_rms_m, f.simulate_seconds, f.map_seconds);
-  std::printf("| method | detected at 2 / 5 / 10 / 20 mm | false area | unchanged flagged | "
-              "unchanged RMS | error on changes | threshold | seconds |\n"
-              "|---|---|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "| method | detected at 2 / 5 / 10 / 20 mm | false area | unchanged flagged | "
+      "unchanged RMS | error on changes | threshold | seconds |\n"
+      "|---|---|---:|---:|---:|---:|---:|---:|\n");
   for (const auto& [name, m] : f.methods) {
     std::string rates;
     double false_share = 0.0;
     for (const auto& [mm, d] : m.by_depth_mm) {
       char rate[32];
-      std::snprintf(rate, sizeof rate, "%s%.0f %%", rates.empty() ? "" : " / ", 100.0 * d.detection_rate);
+      std::snprintf(rate, sizeof rate, "%s%.0f %%", rates.empty() ? "" : " / ",
+                    100.0 * d.detection_rate);
       rates += rate;
       false_share = d.false_area_share;
     }
@@ -56,7 +62,8 @@ void Print(const bench::ChangeFigures& f) {
                 rates.c_str(), 100.0 * false_share, 100.0 * m.unchanged_flagged_share,
                 1e3 * m.unchanged_rms_m, 1e3 * m.changed_rms_error_m, threshold, m.seconds);
   }
-  if (!f.cloudcompare_ran) std::printf("\nCloudCompare not run (not installed, or --no-cloudcompare)\n");
+  if (!f.cloudcompare_ran)
+    std::printf("\nCloudCompare not run (not installed, or --no-cloudcompare)\n");
 }
 
 void RunChangeBench(const ChangeBenchArgs& a) {

@@ -45,29 +45,31 @@ Eigen::Isometry3d TransformOf(const std::vector<double>& v) {
 }
 
 void PrintFindings(const mapping::SurveyComparison& c, const std::string& output) {
-  std::printf("%s: %d core points %.0f mm apart; %.3f m^2 unchanged, %.3f m^2 changed, %.3f m^2 "
-              "not inspected (%.2f s)\n",
-              output.c_str(), c.areas.core_points, 1e3 * c.core_spacing_m, c.areas.unchanged_m2,
-              c.areas.changed_m2, c.areas.not_inspected_m2, c.seconds);
+  std::printf(
+      "%s: %d core points %.0f mm apart; %.3f m^2 unchanged, %.3f m^2 changed, %.3f m^2 "
+      "not inspected (%.2f s)\n",
+      output.c_str(), c.areas.core_points, 1e3 * c.core_spacing_m, c.areas.unchanged_m2,
+      c.areas.changed_m2, c.areas.not_inspected_m2, c.seconds);
   const mapping::SurveyAlignment& a = c.alignment;
   if (a.registered) {
-    std::printf("alignment: registered, fitness %.3f, RMS %.2f mm; %zu tiles of %.2f m, %d kept "
-                "the global transform\n",
-                a.global_fitness, 1e3 * a.global_rmse_m, a.tiles.size(), a.tile_m,
-                a.tiles_kept_global);
+    std::printf(
+        "alignment: registered, fitness %.3f, RMS %.2f mm; %zu tiles of %.2f m, %d kept "
+        "the global transform\n",
+        a.global_fitness, 1e3 * a.global_rmse_m, a.tiles.size(), a.tile_m, a.tiles_kept_global);
   }
   std::printf("%zu significant regions%s\n", c.regions.size(), c.regions.empty() ? "" : ":");
   const std::size_t shown = std::min<std::size_t>(c.regions.size(), 10);
   for (std::size_t i = 0; i < shown; ++i) {
     const mapping::ChangeRegion& r = c.regions[i];
-    std::printf("  %2d %-6s at %.3f %.3f %.3f m: %.0f x %.0f mm, %.1f cm^2, mean %+.1f mm, extreme "
-                "%+.1f mm, %.1fx its level of detection\n",
-                r.id, r.mean_deviation_m > 0.0 ? "gained" : "lost", r.centroid_W.x(),
-                r.centroid_W.y(), r.centroid_W.z(), 1e3 * r.extent_m.x(), 1e3 * r.extent_m.y(),
-                1e4 * r.area_m2, 1e3 * r.mean_deviation_m, 1e3 * r.extreme_deviation_m,
-                r.significance);
+    std::printf(
+        "  %2d %-6s at %.3f %.3f %.3f m: %.0f x %.0f mm, %.1f cm^2, mean %+.1f mm, extreme "
+        "%+.1f mm, %.1fx its level of detection\n",
+        r.id, r.mean_deviation_m > 0.0 ? "gained" : "lost", r.centroid_W.x(), r.centroid_W.y(),
+        r.centroid_W.z(), 1e3 * r.extent_m.x(), 1e3 * r.extent_m.y(), 1e4 * r.area_m2,
+        1e3 * r.mean_deviation_m, 1e3 * r.extreme_deviation_m, r.significance);
   }
-  if (shown < c.regions.size()) std::printf("  ... %zu more in the report\n", c.regions.size() - shown);
+  if (shown < c.regions.size())
+    std::printf("  ... %zu more in the report\n", c.regions.size() - shown);
 }
 
 void RunCompare(const CompareArgs& a) {
@@ -141,7 +143,8 @@ void AddCompareCommand(CLI::App& app) {
                   "detection then carries the map report's pose covariances)")
       ->capture_default_str()
       ->check(kNonNegativeNumber);
-  cmd->add_option("--threads", a->threads, "threads (0: all cores); the output does not depend on it")
+  cmd->add_option("--threads", a->threads,
+                  "threads (0: all cores); the output does not depend on it")
       ->check(kNonNegativeNumber);
   cmd->callback([a] { RunCompare(*a); });
 }

@@ -1,7 +1,7 @@
 #include "bench/change/change_benchmark.hpp"
 
-#include <omp.h>
 #include <fcntl.h>
+#include <omp.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -39,7 +39,7 @@ using mapping::SurfaceStatus;
 using perception::PointCloud;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kSpacing_m = 0.01;      // every method is judged on points this far apart
+constexpr double kSpacing_m = 0.01;  // every method is judged on points this far apart
 constexpr double kSurfaceSearch_m = 0.05;
 
 double SecondsSince(Clock::time_point start) {
@@ -65,8 +65,9 @@ double RmsToScene(const PointCloud& map, const scanner::sim::RayCaster& caster) 
   double sum2 = 0.0;
 #pragma omp parallel for reduction(+ : sum2) schedule(static)
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(map.size()); ++i) {
-    const double d = caster.DistanceToSurface(map.Point(static_cast<std::size_t>(i)), kSurfaceSearch_m)
-                         .value_or(kSurfaceSearch_m);
+    const double d =
+        caster.DistanceToSurface(map.Point(static_cast<std::size_t>(i)), kSurfaceSearch_m)
+            .value_or(kSurfaceSearch_m);
     sum2 += d * d;
   }
   return std::sqrt(sum2 / static_cast<double>(map.size()));
@@ -76,8 +77,9 @@ Epoch SurveyEpoch(const fs::path& scene_path, const fs::path& folder,
                   const ChangeBenchOptions& options, const Progress& progress,
                   ChangeFigures& figures) {
   const std::string text = ReadText(scene_path);
-  Epoch epoch{.scene = scanner::sim::ParseScene(text, scene_path.string(), scene_path.parent_path()),
-              .map = {}};
+  Epoch epoch{
+      .scene = scanner::sim::ParseScene(text, scene_path.string(), scene_path.parent_path()),
+      .map = {}};
   const std::string name = scene_path.stem().string();
   const fs::path log_path = folder / (name + ".db");
   const scanner::sim::Simulator simulator(epoch.scene);
@@ -107,7 +109,7 @@ Epoch SurveyEpoch(const fs::path& scene_path, const fs::path& folder,
 // A change between the scenes: an object in one only (a disc of growth or loss), or moved.
 struct Change {
   std::vector<scanner::sim::SceneObject> footprints;  // the object where it was and where it is
-  double depth_m = 0.0;  // a disc's thickness; 0 for a moved object
+  double depth_m = 0.0;                               // a disc's thickness; 0 for a moved object
   bool growth = false;
   bool disc = false;
 };
@@ -117,7 +119,9 @@ bool SamePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
 }
 
 Change ChangeOf(const scanner::sim::SceneObject& object, bool growth) {
-  Change c{.footprints = {object}, .depth_m = 0.0, .growth = growth,
+  Change c{.footprints = {object},
+           .depth_m = 0.0,
+           .growth = growth,
            .disc = object.shape == scanner::sim::ObjectShape::kCylinder};
   if (c.disc) {
     double lo = 1e300, hi = -1e300;
@@ -130,16 +134,19 @@ Change ChangeOf(const scanner::sim::SceneObject& object, bool growth) {
   return c;
 }
 
-std::vector<Change> ChangesBetween(const scanner::sim::Scene& before, const scanner::sim::Scene& after) {
+std::vector<Change> ChangesBetween(const scanner::sim::Scene& before,
+                                   const scanner::sim::Scene& after) {
   const auto find = [](const scanner::sim::Scene& s, const std::string& name) {
-    const auto it = std::find_if(s.objects.begin(), s.objects.end(),
-                                 [&](const scanner::sim::SceneObject& o) { return o.name == name; });
+    const auto it =
+        std::find_if(s.objects.begin(), s.objects.end(),
+                     [&](const scanner::sim::SceneObject& o) { return o.name == name; });
     return it == s.objects.end() ? nullptr : &*it;
   };
   std::vector<Change> changes;
   for (const scanner::sim::SceneObject& o : after.objects) {
     const scanner::sim::SceneObject* old = find(before, o.name);
-    if (!old) changes.push_back(ChangeOf(o, true));
+    if (!old)
+      changes.push_back(ChangeOf(o, true));
     else if (!SamePose(old->T_W_O, o.T_W_O)) {
       Change moved = ChangeOf(o, true);
       moved.disc = false;
@@ -174,7 +181,8 @@ bool OnChange(const Change& c, const Eigen::Vector3d& p_W) {
 }
 
 // Each point's change (index), -1 where nothing changed.
-std::vector<int> TruthLabels(const std::vector<CoreDeviation>& points, const std::vector<Change>& changes) {
+std::vector<int> TruthLabels(const std::vector<CoreDeviation>& points,
+                             const std::vector<Change>& changes) {
   std::vector<int> label(points.size(), -1);
   for (std::size_t i = 0; i < points.size(); ++i) {
     for (std::size_t k = 0; k < changes.size() && label[i] < 0; ++k)
@@ -215,10 +223,13 @@ MethodFigures Judge(const std::vector<CoreDeviation>& points, const std::vector<
   f.changed_rms_error_m = changed > 0 ? std::sqrt(error2 / changed) : 0.0;
   const double false_share = unchanged > 0 ? in_region / unchanged : 0.0;
   for (std::size_t k = 0; k < changes.size(); ++k) {
-    if (!changes[k].disc) continue;
+    f.changes.push_back({.name = changes[k].footprints.front().name,
+                         .points = on[k],
+                         .found = on[k] > 0 ? static_cast<double>(found[k]) / on[k] : 0.0});
+    if (!changes[k].disc || on[k] == 0) continue;  // never seen: not a detection to judge
     DepthFigures& depth = f.by_depth_mm[static_cast<int>(std::lround(changes[k].depth_m * 1e3))];
     depth.changes += 1;
-    depth.detection_rate += on[k] > 0 && 2 * found[k] >= on[k];
+    depth.detection_rate += 2 * found[k] >= on[k];
     depth.false_area_share = false_share;
   }
   for (auto& [mm, depth] : f.by_depth_mm) depth.detection_rate /= depth.changes;
@@ -231,7 +242,8 @@ double FalseShare(const MethodFigures& f) {
 
 // A plain distance judged at the threshold that gives it uwscan's false area (bisection: the
 // false area falls as the threshold rises): its best single threshold at equal false area.
-MethodFigures JudgeAtEqualFalseArea(std::vector<CoreDeviation> points, const std::vector<int>& label,
+MethodFigures JudgeAtEqualFalseArea(std::vector<CoreDeviation> points,
+                                    const std::vector<int>& label,
                                     const std::vector<Change>& changes, bool signed_distance,
                                     double target_false_share) {
   double lo = 0.0, hi = 0.05;
@@ -240,7 +252,8 @@ MethodFigures JudgeAtEqualFalseArea(std::vector<CoreDeviation> points, const std
     const double threshold = 0.5 * (lo + hi);
     for (CoreDeviation& d : points) {
       if (d.status == SurfaceStatus::kNotInspected) continue;
-      d.status = std::abs(d.deviation_m) > threshold ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
+      d.status =
+          std::abs(d.deviation_m) > threshold ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
     }
     MethodFigures f = Judge(points, label, changes, signed_distance);
     f.threshold_m = threshold;
@@ -259,7 +272,8 @@ std::vector<CoreDeviation> AsPoints(const PointCloud& cloud, const std::vector<d
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     points[i].point_W = cloud.Point(i);
     points[i].deviation_m = distance[i];
-    points[i].status = std::isfinite(distance[i]) ? SurfaceStatus::kUnchanged : SurfaceStatus::kNotInspected;
+    points[i].status =
+        std::isfinite(distance[i]) ? SurfaceStatus::kUnchanged : SurfaceStatus::kNotInspected;
   }
   return points;
 }
@@ -309,9 +323,11 @@ double RunCloudCompare(const std::vector<std::string>& arguments, const fs::path
   const std::string text = ReadText(log);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw Error("bench change: CloudCompare failed (" + log.string() + ")");
-  static const std::regex timing(R"(\[(?:ComputeDistances|computeApproxDistances|DistanceComputationTools)[^\]]*\] Time: ([0-9.]+) s)");
+  static const std::regex timing(
+      R"(\[(?:ComputeDistances|computeApproxDistances|DistanceComputationTools)[^\]]*\] Time: ([0-9.]+) s)");
   double seconds = 0.0;
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), timing); it != std::sregex_iterator(); ++it)
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), timing);
+       it != std::sregex_iterator(); ++it)
     seconds += std::stod((*it)[1]);
   return seconds;
 }
@@ -345,23 +361,26 @@ void CloudCompareMethods(const PointCloud& points, const fs::path& folder, const
   perception::WriteCloud(compared, points);
   perception::WriteCloud(reference, before.map.cloud);
   const double target = FalseShare(figures.methods.at("uwscan"));
-  const std::vector<std::string> common = {"-SILENT", "-AUTO_SAVE", "OFF", "-C_EXPORT_FMT", "ASC",
-                                           "-PREC", "8", "-O", compared.string()};
+  const std::vector<std::string> common = {"-SILENT", "-AUTO_SAVE", "OFF", "-C_EXPORT_FMT",  "ASC",
+                                           "-PREC",   "8",          "-O",  compared.string()};
   std::vector<std::string> c2c = common;
   // Its best local model for a smooth surface: a least-squares plane through the 12 nearest.
-  c2c.insert(c2c.end(), {"-O", reference.string(), "-C2C_DIST", "-MODEL", "LS", "KNN", "12",
-                         "-SAVE_CLOUDS", "FILE", (folder / "c2c.asc").string() + " " + (folder / "c2c_ref.asc").string()});
+  c2c.insert(c2c.end(),
+             {"-O", reference.string(), "-C2C_DIST", "-MODEL", "LS", "KNN", "12", "-SAVE_CLOUDS",
+              "FILE", (folder / "c2c.asc").string() + " " + (folder / "c2c_ref.asc").string()});
   const double c2c_seconds = RunCloudCompare(c2c, folder / "c2c.log");
-  MethodFigures c2c_figures = JudgeAtEqualFalseArea(
-      AsPoints(points, ReadCloudCompareDistances(folder / "c2c.asc", points)), label, changes, false, target);
+  MethodFigures c2c_figures =
+      JudgeAtEqualFalseArea(AsPoints(points, ReadCloudCompareDistances(folder / "c2c.asc", points)),
+                            label, changes, false, target);
   c2c_figures.seconds = c2c_seconds;
   figures.methods["cloudcompare_c2c"] = c2c_figures;
   std::vector<std::string> c2m = common;
   c2m.insert(c2m.end(), {"-O", design_ply.string(), "-C2M_DIST", "-SAVE_CLOUDS", "FILE",
                          (folder / "c2m.asc").string()});
   const double c2m_seconds = RunCloudCompare(c2m, folder / "c2m.log");
-  MethodFigures c2m_figures = JudgeAtEqualFalseArea(
-      AsPoints(points, ReadCloudCompareDistances(folder / "c2m.asc", points)), label, changes, true, target);
+  MethodFigures c2m_figures =
+      JudgeAtEqualFalseArea(AsPoints(points, ReadCloudCompareDistances(folder / "c2m.asc", points)),
+                            label, changes, true, target);
   c2m_figures.seconds = c2m_seconds;
   figures.methods["cloudcompare_c2m"] = c2m_figures;
   figures.cloudcompare_ran = true;
@@ -369,7 +388,8 @@ void CloudCompareMethods(const PointCloud& points, const fs::path& folder, const
 
 // uwscan's comparison of the second survey against a reference, judged.
 MethodFigures UwscanMethod(const Epoch& after, const mapping::Survey& reference,
-                           const mapping::CompareOptions& options, const std::vector<Change>& changes) {
+                           const mapping::CompareOptions& options,
+                           const std::vector<Change>& changes) {
   const mapping::SurveyComparison c = mapping::CompareSurveys(after.map, reference, options);
   MethodFigures f = Judge(c.deviations, TruthLabels(c.deviations, changes), changes, true);
   f.seconds = c.seconds;
@@ -393,9 +413,11 @@ ChangeFigures RunChangeBench(const ChangeBenchOptions& options, const Progress& 
   omp_set_num_threads(options.threads);
   ScratchFolder scratch("bench-change");
   ChangeFigures figures;
-  const Epoch before = SurveyEpoch(options.before_scene, scratch.path(), options, progress, figures);
+  const Epoch before =
+      SurveyEpoch(options.before_scene, scratch.path(), options, progress, figures);
   const Epoch after = SurveyEpoch(options.after_scene, scratch.path(), options, progress, figures);
-  figures.map_rms_m = std::sqrt(0.5 * (before.map_rms_m * before.map_rms_m + after.map_rms_m * after.map_rms_m));
+  figures.map_rms_m =
+      std::sqrt(0.5 * (before.map_rms_m * before.map_rms_m + after.map_rms_m * after.map_rms_m));
   const std::vector<Change> changes = ChangesBetween(before.scene, after.scene);
   if (progress) progress("compare", 0.0);
   mapping::CompareOptions tiles;
@@ -404,7 +426,8 @@ ChangeFigures RunChangeBench(const ChangeBenchOptions& options, const Progress& 
   whole.alignment.tile_m = 0.0;
   figures.methods["uwscan_pose_covariances"] = UwscanMethod(after, before.map, whole, changes);
   const fs::path design_ply = scratch.path() / "design_before.ply";
-  figures.methods["uwscan_design"] = UwscanMethod(after, DesignSurvey(before.scene, design_ply), tiles, changes);
+  figures.methods["uwscan_design"] =
+      UwscanMethod(after, DesignSurvey(before.scene, design_ply), tiles, changes);
 
   const PointCloud points = perception::VoxelDownsample(after.map.cloud, {.leaf_m = kSpacing_m});
   std::vector<CoreDeviation> judged = AsPoints(points, std::vector<double>(points.size(), 0.0));
@@ -412,8 +435,8 @@ ChangeFigures RunChangeBench(const ChangeBenchOptions& options, const Progress& 
   const auto start = Clock::now();
   const std::vector<double> nearest = NearestDistances(points, before.map.cloud);
   const double nearest_seconds = SecondsSince(start);
-  figures.methods["nearest"] = JudgeAtEqualFalseArea(AsPoints(points, nearest), label, changes, false,
-                                                     FalseShare(figures.methods.at("uwscan")));
+  figures.methods["nearest"] = JudgeAtEqualFalseArea(
+      AsPoints(points, nearest), label, changes, false, FalseShare(figures.methods.at("uwscan")));
   figures.methods["nearest"].seconds = nearest_seconds;
   if (options.run_cloudcompare && CloudCompareInstalled()) {
     if (progress) progress("cloudcompare", 0.0);

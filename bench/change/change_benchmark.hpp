@@ -4,6 +4,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bench/progress.hpp"
 
@@ -22,8 +23,8 @@ struct ChangeBenchOptions {
 };
 
 struct DepthFigures {
-  int changes = 0;
-  double detection_rate = 0.0;    // changes of this depth found (half their surface or more)
+  int changes = 0;                // changes of this depth the method has points on
+  double detection_rate = 0.0;    // of those, found (half their points or more)
   double false_area_share = 0.0;  // the method's false area, as for every depth
 };
 
@@ -31,8 +32,15 @@ struct DepthFigures {
 // is detected when at least half of its surface points lie in significant regions of the right
 // sign (unsigned methods: any); false area is the unchanged surface inside significant regions
 // (groups of at least RegionOptions' size).
+struct ChangeOutcome {
+  std::string name;    // the scene object's
+  int points = 0;      // the method's points on it
+  double found = 0.0;  // share of them in significant regions of the right sign
+};
+
 struct MethodFigures {
   std::map<int, DepthFigures> by_depth_mm;
+  std::vector<ChangeOutcome> changes;
   double unchanged_flagged_share = 0.0;  // unchanged points flagged, grouped or not
   double unchanged_rms_m = 0.0;          // RMS of its distance where nothing changed
   double changed_rms_error_m = 0.0;      // RMS of its distance less the true one on the changes

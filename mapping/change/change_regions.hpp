@@ -10,14 +10,14 @@ namespace uwscan::mapping {
 // A connected patch of surface that changed: significant core points of one sign (gained or
 // lost), each within `link_m` of another.
 struct ChangeRegion {
-  int id = 0;                    // from 0, by decreasing area
+  int id = 0;  // from 0, by decreasing area
   std::vector<std::size_t> core_indices;
   Eigen::Vector3d centroid_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d extent_m = Eigen::Vector3d::Zero();  // along its principal axes, largest first
-  double area_m2 = 0.0;          // core points x core spacing squared
+  double area_m2 = 0.0;                                // core points x core spacing squared
   double mean_deviation_m = 0.0;
   double extreme_deviation_m = 0.0;  // the deviation farthest from zero
-  double volume_m3 = 0.0;        // sum of deviation x cell area: > 0 gained, < 0 lost
+  double volume_m3 = 0.0;            // sum of deviation x cell area: > 0 gained, < 0 lost
   // How far beyond its level of detection the region's mean lies: mean |deviation| over mean
   // level of detection (> 1 for every significant region).
   double significance = 0.0;

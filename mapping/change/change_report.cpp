@@ -106,9 +106,8 @@ nlohmann::json ChangeReportJson(const SurveyComparison& c, const Survey& map,
                         {"cylinder_radius_m", d.cylinder_radius_m},
                         {"max_depth_m", d.max_depth_m},
                         {"map_point_sigma_m", d.map_point_sigma_m},
-                        {"reference_point_sigma_m", reference.kind == SurveyKind::kDesign
-                                                        ? 0.0
-                                                        : d.reference_point_sigma_m},
+                        {"reference_point_sigma_m",
+                         reference.kind == SurveyKind::kDesign ? 0.0 : d.reference_point_sigma_m},
                         {"pose_covariances_used", c.pose_covariances_used}};
   report["surface"] = {{"core_points", c.areas.core_points},
                        {"unchanged_m2", c.areas.unchanged_m2},
@@ -135,13 +134,14 @@ std::string ChangeReportMarkdown(const SurveyComparison& c, const Survey& map,
       "| region | kind | centroid (m) | extent (mm) | area (cm^2) | mean (mm) | extreme (mm) | "
       "volume (cm^3) | significance |\n|---:|---|---|---|---:|---:|---:|---:|---:|\n";
   for (const ChangeRegion& r : c.regions) {
-    std::snprintf(line, sizeof line,
-                  "| %d | %s | %.3f %.3f %.3f | %.0f x %.0f x %.0f | %.1f | %+.1f | %+.1f | %+.1f | "
-                  "%.1f |\n",
-                  r.id, r.mean_deviation_m > 0.0 ? "gained" : "lost", r.centroid_W.x(),
-                  r.centroid_W.y(), r.centroid_W.z(), 1e3 * r.extent_m.x(), 1e3 * r.extent_m.y(),
-                  1e3 * r.extent_m.z(), 1e4 * r.area_m2, 1e3 * r.mean_deviation_m,
-                  1e3 * r.extreme_deviation_m, 1e6 * r.volume_m3, r.significance);
+    std::snprintf(
+        line, sizeof line,
+        "| %d | %s | %.3f %.3f %.3f | %.0f x %.0f x %.0f | %.1f | %+.1f | %+.1f | %+.1f | "
+        "%.1f |\n",
+        r.id, r.mean_deviation_m > 0.0 ? "gained" : "lost", r.centroid_W.x(), r.centroid_W.y(),
+        r.centroid_W.z(), 1e3 * r.extent_m.x(), 1e3 * r.extent_m.y(), 1e3 * r.extent_m.z(),
+        1e4 * r.area_m2, 1e3 * r.mean_deviation_m, 1e3 * r.extreme_deviation_m, 1e6 * r.volume_m3,
+        r.significance);
     text += line;
   }
   if (c.regions.empty()) text += "\nNo significant change.\n";

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 
+#include "mapping/change/local_statistics.hpp"
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/normals.hpp"
 #include "scanner/common/error.hpp"
@@ -41,14 +42,18 @@ void RequireComparable(const Survey& map, const Survey& reference,
                        const SurveyAlignmentOptions& options) {
   if (map.cloud.empty()) throw Error(map.name + ": the map has no points");
   if (reference.cloud.empty()) throw Error(reference.name + ": the reference has no points");
-  const Box m = BoundsOf(map.cloud, options.T_reference_map.value_or(Eigen::Isometry3d::Identity()));
+  const Box m =
+      BoundsOf(map.cloud, options.T_reference_map.value_or(Eigen::Isometry3d::Identity()));
   const Box r = BoundsOf(reference.cloud, Eigen::Isometry3d::Identity());
   const double margin_m = options.global_max_correspondence_m.front();
-  const bool meet = ((m.lo.array() - margin_m <= r.hi.array()) && (r.lo.array() - margin_m <= m.hi.array())).all();
+  const bool meet =
+      ((m.lo.array() - margin_m <= r.hi.array()) && (r.lo.array() - margin_m <= m.hi.array()))
+          .all();
   const double ratio = r.Diagonal() / std::max(m.Diagonal(), 1e-9);
   std::string hint;
-  if (ratio > 100.0) hint = " (the reference is " + std::to_string(static_cast<long>(ratio)) +
-                            " times larger: in millimetres? --reference-units mm)";
+  if (ratio > 100.0)
+    hint = " (the reference is " + std::to_string(static_cast<long>(ratio)) +
+           " times larger: in millimetres? --reference-units mm)";
   if (!meet || ratio > 100.0) {
     throw Error(reference.name + ": the reference " + r.ToString() + " does not overlap the map " +
                 m.ToString() + hint);
@@ -65,7 +70,8 @@ perception::NormalOptions NormalsWithin(double radius_m) {
 // dropped).
 PointCloud WithNormals(const PointCloud& cloud, double radius_m) {
   if (cloud.has_normals()) return cloud;
-  const perception::NormalsResult normals = perception::EstimateNormals(cloud, NormalsWithin(radius_m));
+  const perception::NormalsResult normals =
+      perception::EstimateNormals(cloud, NormalsWithin(radius_m));
   return perception::AttachNormals(cloud, normals).cloud;
 }
 
@@ -82,7 +88,8 @@ class NormalOrientation {
     }
     for (const Eigen::Isometry3d& T : reference.poses) viewpoints_.push_back(T.translation());
     if (viewpoints_.empty()) {
-      for (const Eigen::Isometry3d& T : map.poses) viewpoints_.push_back(T_ref_map * T.translation());
+      for (const Eigen::Isometry3d& T : map.poses)
+        viewpoints_.push_back(T_ref_map * T.translation());
     }
   }
 
@@ -117,7 +124,8 @@ std::vector<char> FacingTheSensor(const CorePoints& core, const Survey& referenc
                                   const Survey& map, const Eigen::Isometry3d& T_reference_map) {
   if (reference.kind != SurveyKind::kDesign || map.poses.empty()) return {};
   std::vector<Eigen::Vector3d> viewpoints;
-  for (const Eigen::Isometry3d& T : map.poses) viewpoints.push_back(T_reference_map * T.translation());
+  for (const Eigen::Isometry3d& T : map.poses)
+    viewpoints.push_back(T_reference_map * T.translation());
   std::vector<char> visible(core.points_W.size(), 1);
   for (std::size_t i = 0; i < visible.size(); ++i) {
     const Eigen::Vector3d& p = core.points_W[i];
@@ -137,42 +145,20 @@ PointCloud AlignedMap(const PointCloud& map, const SurveyAlignment& alignment) {
   return perception::MakeCloud(points);
 }
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), middle, v.end());
-  return *middle;
-}
-
-// The placement error left within each tile once it is registered: the map's pose errors that
-// vary inside it (one leg of the dive against another). Measured on the tile's own surface, as
-// M3C2 practice measures registration error on stable ground: the robust spread (1.4826 MAD) of
-// its deviations, less what the level of detection already holds (the median of its variance).
-// Most of a tile being unchanged, a change barely moves the median. Added to the level of
-// detection of the tile's core points, and their status updated.
-void AddTileSpread(std::vector<CoreDeviation>& deviations, const SurveyAlignment& alignment,
-                   const Eigen::Isometry3d& T_map_reference, double z) {
-  std::map<const SurveyAlignment::Tile*, std::vector<std::size_t>> by_tile;
-  for (std::size_t i = 0; i < deviations.size(); ++i) {
-    if (deviations[i].status == SurfaceStatus::kNotInspected) continue;
-    by_tile[alignment.TileOf(T_map_reference * deviations[i].point_W)].push_back(i);
+// The groups AddGroupSpread measures: per registration tile (one for the whole map without
+// tiles), the surfaces facing up (within 30 degrees: seabed, tops) apart from the rest (flanks
+// of pipes, walls, the sides of objects), which the surveys place less reproducibly.
+std::vector<long> SpreadGroups(const SurveyComparison& c,
+                               const Eigen::Isometry3d& T_map_reference) {
+  std::vector<long> group_of(c.deviations.size(), -1);
+  for (std::size_t i = 0; i < c.deviations.size(); ++i) {
+    const CoreDeviation& d = c.deviations[i];
+    const SurveyAlignment::Tile* tile = c.alignment.TileOf(T_map_reference * d.point_W);
+    const long tile_index = tile ? static_cast<long>(tile - c.alignment.tiles.data()) : -1;
+    const bool up = -d.normal_W.z() > std::cos(M_PI / 6);  // NED: up is -z
+    group_of[i] = 2 * (tile_index + 1) + (up ? 0 : 1);
   }
-  for (const auto& [tile, indices] : by_tile) {
-    std::vector<double> values, variances;
-    for (std::size_t i : indices) {
-      values.push_back(deviations[i].deviation_m);
-      variances.push_back((deviations[i].lod_m / z) * (deviations[i].lod_m / z));
-    }
-    const double median = Median(values);
-    for (double& v : values) v = std::abs(v - median);
-    const double spread = 1.4826 * Median(values);
-    const double unexplained = std::max(0.0, spread * spread - Median(variances));
-    for (std::size_t i : indices) {
-      CoreDeviation& d = deviations[i];
-      d.lod_m = z * std::sqrt((d.lod_m / z) * (d.lod_m / z) + unexplained);
-      d.status = std::abs(d.deviation_m) > d.lod_m ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
-    }
-  }
+  return group_of;
 }
 
 SurfaceAreas AreasOf(const std::vector<CoreDeviation>& deviations, double spacing_m) {
@@ -226,16 +212,13 @@ SurveyComparison CompareSurveys(const Survey& map, const Survey& reference,
     RemoveLocalOffsets(result.deviations, deviation.local_offset_radius_m,
                        deviation.max_normal_angle_rad);
   }
-  if (!result.pose_covariances_used) {
-    AddTileSpread(result.deviations, result.alignment, T_map_reference,
-                  TwoSidedQuantile(deviation.confidence));
-  }
+  AddGroupSpread(result.deviations, SpreadGroups(result, T_map_reference),
+                 TwoSidedQuantile(deviation.confidence));
   result.core_spacing_m = deviation.core_spacing_m;
-  result.regions =
-      FindChangeRegions(result.deviations, result.core_spacing_m, options.regions, result.region_of);
+  result.regions = FindChangeRegions(result.deviations, result.core_spacing_m, options.regions,
+                                     result.region_of);
   result.areas = AreasOf(result.deviations, result.core_spacing_m);
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

@@ -69,7 +69,8 @@ Survey Scan(std::uint64_t seed, const Edit& edit = {}, double noise_m = 3e-4) {
 }
 
 Survey Design() {
-  const std::filesystem::path path = std::filesystem::temp_directory_path() / "uwscan_compare_design.ply";
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / "uwscan_compare_design.ply";
   scanner::WriteMeshPly(Structure(), path);
   return ReadSurvey(path);
 }
@@ -172,7 +173,8 @@ TEST(CompareSurveys, BadInputGetsAOneLineErrorNamingWhatIsWrong) {
   empty.name = "empty.ply";
   m = MessageOf([&] { CompareSurveys(empty, Scan(1), {}); });
   EXPECT_NE(m.find("no points"), std::string::npos) << m;
-  const std::filesystem::path faceless = std::filesystem::temp_directory_path() / "uwscan_faceless.ply";
+  const std::filesystem::path faceless =
+      std::filesystem::temp_directory_path() / "uwscan_faceless.ply";
   std::ofstream(faceless) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty "
                              "float y\nproperty float z\nelement face 0\nproperty list uchar int "
                              "vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";

@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
@@ -35,21 +36,21 @@ class CylinderSearch {
   // Each point within radius_m of the line c + t n, |t| <= half_length_m, as its t (metres).
   // Points whose normal (where the cloud has normals) is more than acos(min_cos) off the line's
   // direction, either way, are left out: they lie on another surface that crosses the cylinder.
+  // Each point comes as (u, v, t): across the line in the plane (e1, e2) and along it (n).
   void Projections(const Eigen::Vector3d& c_W, const Eigen::Vector3d& n, double min_cos,
-                   std::vector<double>& t, Scratch& s) const {
-    t.clear();
+                   std::vector<Eigen::Vector3d>& local, Scratch& s) const {
+    local.clear();
     std::vector<std::uint32_t>& seen = s.seen;
-    std::vector<std::uint32_t>& indices = s.indices;
-    std::vector<float>& d2 = s.d2;
     seen.clear();
     const int steps = static_cast<int>(std::ceil(half_length_m_ / radius_m_));
     const Eigen::Vector3d c = c_W - cloud_.origin;
     for (int k = -steps; k <= steps; ++k) {
-      grid_.Query((c + (k * radius_m_) * n).cast<float>(), indices, d2);
-      seen.insert(seen.end(), indices.begin(), indices.end());
+      grid_.Query((c + (k * radius_m_) * n).cast<float>(), s.indices, s.d2);
+      seen.insert(seen.end(), s.indices.begin(), s.indices.end());
     }
     std::sort(seen.begin(), seen.end());
     seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    const Eigen::Vector3d e1 = n.unitOrthogonal(), e2 = n.cross(e1);
     for (std::uint32_t i : seen) {
       const Eigen::Vector3d d = cloud_.points[i].cast<double>() - c;
       const double along = d.dot(n);
@@ -57,7 +58,7 @@ class CylinderSearch {
         continue;
       if (cloud_.has_normals() && std::abs(cloud_.normals[i].cast<double>().dot(n)) < min_cos)
         continue;
-      t.push_back(along);
+      local.emplace_back(d.dot(e1), d.dot(e2), along);
     }
   }
 
@@ -67,33 +68,80 @@ class CylinderSearch {
   RadiusGrid grid_;
 };
 
-// Mean, spread and count of the surface nearest t = 0 among sorted projections: runs of values
-// split where consecutive ones are more than `gap_m` apart.
+// Where a surface crosses the line, from the points of one cloud in the cylinder: the run of
+// points along the line (split where consecutive ones are more than gap_m apart) nearest t = 0,
+// fitted with a height function over the cross-section (a quadric from 12 points, a plane from
+// 4, else their mean) so that a curved or sloping surface sampled unevenly (a pipe seen from one
+// side) is not biased towards its denser side. Its value on the line is the surface's position;
+// its variance follows from the fit's residuals (at least point_sigma_m per point).
 struct SurfaceSample {
-  double mean_m = 0.0, variance_m2 = 0.0;
+  double position_m = 0.0, variance_m2 = 0.0;
   int count = 0;
 };
-SurfaceSample NearestSurface(std::vector<double>& t, double gap_m) {
-  std::sort(t.begin(), t.end());
-  SurfaceSample best;
+
+// The fit with `terms` terms (1 mean, 3 plane, 6 quadric); nullopt when the points do not
+// surround the line well enough for it: the position's variance more than kMaxLeverage times
+// what the same points would give it at the centre of their spread (an extrapolation).
+constexpr double kMaxLeverage = 3.0;
+
+std::optional<SurfaceSample> FitWith(std::span<const Eigen::Vector3d> run, int terms,
+                                     double radius_m, double point_sigma_m) {
+  const int n = static_cast<int>(run.size());
+  if (n < terms) return std::nullopt;
+  Eigen::MatrixXd a(n, terms);
+  Eigen::VectorXd t(n);
+  for (int i = 0; i < n; ++i) {
+    const double u = run[static_cast<std::size_t>(i)].x() / radius_m;
+    const double v = run[static_cast<std::size_t>(i)].y() / radius_m;
+    const double row[6] = {1.0, u, v, u * u, u * v, v * v};
+    for (int k = 0; k < terms; ++k) a(i, k) = row[k];
+    t(i) = run[static_cast<std::size_t>(i)].z();
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(a.transpose() * a);
+  const Eigen::VectorXd x = ldlt.solve(a.transpose() * t);
+  const double leverage = ldlt.solve(Eigen::VectorXd::Unit(terms, 0))(0);
+  if (ldlt.info() != Eigen::Success || !std::isfinite(x(0)) || !(leverage > 0.0) ||
+      leverage * n > kMaxLeverage) {
+    return std::nullopt;
+  }
+  const double rss = (a * x - t).squaredNorm();
+  const double sigma2 =
+      std::max(n > terms ? rss / (n - terms) : 0.0, point_sigma_m * point_sigma_m);
+  return SurfaceSample{.position_m = x(0), .variance_m2 = sigma2 * leverage, .count = n};
+}
+
+SurfaceSample FitSurface(std::span<const Eigen::Vector3d> run, double radius_m,
+                         double point_sigma_m) {
+  for (const int terms : {6, 3}) {
+    if (static_cast<int>(run.size()) < 2 * terms) continue;
+    if (const std::optional<SurfaceSample> fit = FitWith(run, terms, radius_m, point_sigma_m))
+      return *fit;
+  }
+  return *FitWith(run, 1, radius_m, point_sigma_m);
+}
+
+SurfaceSample NearestSurface(std::vector<Eigen::Vector3d>& local, double gap_m, double radius_m,
+                             double point_sigma_m) {
+  std::sort(local.begin(), local.end(),
+            [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.z() < b.z(); });
+  std::size_t best_begin = 0, best_end = 0;
   double best_distance = std::numeric_limits<double>::infinity();
-  for (std::size_t begin = 0; begin < t.size();) {
+  for (std::size_t begin = 0; begin < local.size();) {
     std::size_t end = begin + 1;
-    while (end < t.size() && t[end] - t[end - 1] <= gap_m) ++end;
-    double sum = 0.0;
-    for (std::size_t i = begin; i < end; ++i) sum += t[i];
+    double sum = local[begin].z();
+    while (end < local.size() && local[end].z() - local[end - 1].z() <= gap_m)
+      sum += local[end++].z();
     const double mean = sum / static_cast<double>(end - begin);
     if (std::abs(mean) < best_distance) {
       best_distance = std::abs(mean);
-      double squares = 0.0;
-      for (std::size_t i = begin; i < end; ++i) squares += (t[i] - mean) * (t[i] - mean);
-      best = {.mean_m = mean,
-              .variance_m2 = end - begin > 1 ? squares / static_cast<double>(end - begin - 1) : 0.0,
-              .count = static_cast<int>(end - begin)};
+      best_begin = begin;
+      best_end = end;
     }
     begin = end;
   }
-  return best;
+  if (best_end == best_begin) return {};
+  return FitSurface(std::span(local).subspan(best_begin, best_end - best_begin), radius_m,
+                    point_sigma_m);
 }
 
 // The unit normal of the points around c (their covariance's least eigenvector); zero when they
@@ -176,9 +224,9 @@ CorePoints MakeCorePoints(
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&, const Eigen::Vector3d&)>& orient) {
   options.Check();
   if (reference.empty()) throw Error("the reference has no points");
-  const PointCloud voxels = SpacedOut(
-      perception::VoxelDownsample(reference, {.leaf_m = options.core_spacing_m}),
-      0.5 * options.core_spacing_m);
+  const PointCloud voxels =
+      SpacedOut(perception::VoxelDownsample(reference, {.leaf_m = options.core_spacing_m}),
+                0.5 * options.core_spacing_m);
   const RadiusGrid grid(reference.points, options.normal_radius_m);
   std::vector<Eigen::Vector3d> normals(voxels.size(), Eigen::Vector3d::Zero());
 #pragma omp parallel num_threads(Threads(options.threads))
@@ -216,7 +264,7 @@ std::vector<CoreDeviation> MeasureDeviations(
   const CylinderSearch in_reference(reference, options.cylinder_radius_m, options.max_depth_m);
 #pragma omp parallel num_threads(Threads(options.threads))
   {
-    std::vector<double> t;
+    std::vector<Eigen::Vector3d> local;
     CylinderSearch::Scratch scratch;
 #pragma omp for schedule(dynamic, 256)
     for (std::size_t i = 0; i < out.size(); ++i) {
@@ -224,67 +272,23 @@ std::vector<CoreDeviation> MeasureDeviations(
       d.point_W = core.points_W[i];
       d.normal_W = core.normals_W[i];
       if (!core.visible.empty() && !core.visible[i]) continue;
-      in_reference.Projections(d.point_W, d.normal_W, min_cos, t, scratch);
-      const SurfaceSample r = NearestSurface(t, options.surface_gap_m);
-      in_map.Projections(d.point_W, d.normal_W, min_cos, t, scratch);
-      const SurfaceSample m = NearestSurface(t, options.surface_gap_m);
+      in_reference.Projections(d.point_W, d.normal_W, min_cos, local, scratch);
+      const SurfaceSample r = NearestSurface(
+          local, options.surface_gap_m, options.cylinder_radius_m, options.reference_point_sigma_m);
+      in_map.Projections(d.point_W, d.normal_W, min_cos, local, scratch);
+      const SurfaceSample m = NearestSurface(local, options.surface_gap_m,
+                                             options.cylinder_radius_m, options.map_point_sigma_m);
       d.map_points = m.count;
       d.reference_points = r.count;
       if (m.count < options.min_points || r.count < 1) continue;
-      const double map_var = std::max(m.variance_m2, options.map_point_sigma_m * options.map_point_sigma_m);
-      const double ref_var = std::max(r.variance_m2, options.reference_point_sigma_m *
-                                                          options.reference_point_sigma_m);
       const double placement = placement_sigma(d.point_W, d.normal_W);
-      const double variance = map_var / m.count + ref_var / r.count + placement * placement;
-      d.deviation_m = m.mean_m - r.mean_m;
-      d.lod_m = z * std::sqrt(variance);
-      d.status = std::abs(d.deviation_m) > d.lod_m ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
+      d.deviation_m = m.position_m - r.position_m;
+      d.lod_m = z * std::sqrt(m.variance_m2 + r.variance_m2 + placement * placement);
+      d.status =
+          std::abs(d.deviation_m) > d.lod_m ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
     }
   }
   return out;
-}
-
-}  // namespace uwscan::mapping
-
-namespace uwscan::mapping {
-
-void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
-                        double max_normal_angle_rad) {
-  if (!(radius_m > 0.0)) throw Error("RemoveLocalOffsets: radius_m must be > 0");
-  std::vector<std::size_t> inspected;
-  for (std::size_t i = 0; i < deviations.size(); ++i)
-    if (deviations[i].status != SurfaceStatus::kNotInspected) inspected.push_back(i);
-  if (inspected.empty()) return;
-  const Eigen::Vector3d origin = deviations[inspected.front()].point_W;
-  std::vector<Eigen::Vector3f> points;
-  for (std::size_t i : inspected) points.push_back((deviations[i].point_W - origin).cast<float>());
-  const RadiusGrid grid(points, radius_m);
-  const double min_cos = std::cos(max_normal_angle_rad);
-  constexpr std::size_t kMaxSamples = 256;  // the median of a window from this many, evenly strided
-  std::vector<double> offsets(inspected.size(), 0.0);
-#pragma omp parallel
-  {
-    std::vector<std::uint32_t> neighbours;
-    std::vector<float> d2;
-    std::vector<double> values;
-#pragma omp for schedule(dynamic, 256)
-    for (std::size_t k = 0; k < inspected.size(); ++k) {
-      const CoreDeviation& d = deviations[inspected[k]];
-      grid.Query(points[k], neighbours, d2);
-      std::sort(neighbours.begin(), neighbours.end());
-      const std::size_t stride = std::max<std::size_t>(1, neighbours.size() / kMaxSamples);
-      values.clear();
-      for (std::size_t j = 0; j < neighbours.size(); j += stride) {
-        const CoreDeviation& n = deviations[inspected[neighbours[j]]];
-        if (n.normal_W.dot(d.normal_W) >= min_cos) values.push_back(n.deviation_m);
-      }
-      if (values.empty()) continue;
-      const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-      std::nth_element(values.begin(), middle, values.end());
-      offsets[k] = *middle;
-    }
-  }
-  for (std::size_t k = 0; k < inspected.size(); ++k) deviations[inspected[k]].deviation_m -= offsets[k];
 }
 
 }  // namespace uwscan::mapping

@@ -17,10 +17,10 @@ namespace uwscan::mapping {
 // placements' uncertainties allow at the stated confidence (M3C2-EP, Winiwarter et al. 2021,
 // with the placement's covariance from the caller).
 struct DeviationOptions {
-  double core_spacing_m = 0.01;    // core points: the reference voxelised at this size, > 0
-  double normal_radius_m = 0.025;  // normals from the reference's points within this radius, > 0
+  double core_spacing_m = 0.01;      // core points: the reference voxelised at this size, > 0
+  double normal_radius_m = 0.025;    // normals from the reference's points within this radius, > 0
   double cylinder_radius_m = 0.015;  // points averaged within this distance of the normal line, > 0
-  double max_depth_m = 0.1;  // ... and within this distance of the core point along it, > 0
+  double max_depth_m = 0.1;          // ... and within this distance of the core point along it, > 0
   // Along the normal, points more than this apart belong to different surfaces (the near and
   // far walls of a pipe, a flange behind a pipe); each cloud's surface nearest the core point
   // is taken. Metres, > 0.
@@ -39,7 +39,7 @@ struct DeviationOptions {
   // keep their depth.
   double local_offset_radius_m = 0.2;
   double confidence = 0.95;  // two-sided, of the level of detection, in (0, 1)
-  int threads = 0;           // OpenMP threads, 0 = OpenMP's default; the result does not depend on it
+  int threads = 0;  // OpenMP threads, 0 = OpenMP's default; the result does not depend on it
   void Check() const;
 };
 
@@ -50,8 +50,8 @@ enum class SurfaceStatus : std::uint8_t {
 };
 
 struct CoreDeviation {
-  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();   // on the reference
-  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ(); // the reference's normal, unit
+  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();    // on the reference
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  // the reference's normal, unit
   // Map surface minus reference surface along the normal, metres: > 0 where the map lies in
   // front of the reference (material gained), < 0 behind it (lost). NaN when not inspected.
   double deviation_m = std::numeric_limits<double>::quiet_NaN();
@@ -82,15 +82,6 @@ std::vector<CoreDeviation> MeasureDeviations(
     const perception::PointCloud& map, const perception::PointCloud& reference,
     const CorePoints& core, const DeviationOptions& options,
     const std::function<double(const Eigen::Vector3d&, const Eigen::Vector3d&)>& placement_sigma);
-
-// Takes out, at each inspected core point, the median deviation of the core points within
-// `radius_m` that face the same way (normals within `max_normal_angle_rad`): the slowly varying
-// offsets that the two surveys' placement errors leave after registration (a millimetre or two
-// at the far edges of a swath, where a small tilt of the sensor moves the surface most). A
-// change much smaller than the window (under half its area) keeps its depth; a wider one is
-// taken for an offset and shrinks. The status is not touched. radius_m > 0.
-void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
-                        double max_normal_angle_rad);
 
 // The two-sided standard normal quantile: z with P(|N(0,1)| <= z) = confidence.
 double TwoSidedQuantile(double confidence);

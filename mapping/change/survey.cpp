@@ -69,8 +69,8 @@ Survey ReadMapReport(const fs::path& path, const SurveyReadOptions& options) {
   if (map_path.is_relative()) map_path = path.parent_path() / map_path;
   survey.cloud = perception::ReadCloud(map_path);
   const Field slam_field = root["trajectories"]["slam"];
-  const nlohmann::json& slam =
-      json_fields::Require(json_fields::Require(report, "trajectories", root), "slam", root["trajectories"]);
+  const nlohmann::json& slam = json_fields::Require(
+      json_fields::Require(report, "trajectories", root), "slam", root["trajectories"]);
   const nlohmann::json& covariance = json_fields::Require(report, "pose_covariance", root);
   if (!slam.is_array() || !covariance.is_array() || covariance.size() != slam.size() ||
       slam.empty()) {

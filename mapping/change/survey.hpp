@@ -31,9 +31,10 @@ struct Survey {
 };
 
 struct SurveyReadOptions {
-  double units_to_m = 1.0;          // the file's unit in metres (a CAD model in millimetres: 0.001), > 0
-  double design_spacing_m = 0.004;  // a mesh is sampled with one point per this spacing squared of area, > 0
-  std::uint64_t seed = 1;           // of the surface sampling
+  double units_to_m = 1.0;  // the file's unit in metres (a CAD model in millimetres: 0.001), > 0
+  double design_spacing_m =
+      0.004;               // a mesh is sampled with one point per this spacing squared of area, > 0
+  std::uint64_t seed = 1;  // of the surface sampling
   void Check() const;
 };
 

@@ -28,7 +28,8 @@ void CheckStages(const std::vector<double>& stages, const char* name) {
 }
 
 Key KeyOf(const Eigen::Vector3d& p, double tile_m) {
-  return {static_cast<int>(std::floor(p.x() / tile_m)), static_cast<int>(std::floor(p.y() / tile_m)),
+  return {static_cast<int>(std::floor(p.x() / tile_m)),
+          static_cast<int>(std::floor(p.y() / tile_m)),
           static_cast<int>(std::floor(p.z() / tile_m))};
 }
 
@@ -187,9 +188,10 @@ const SurveyAlignment::Tile* SurveyAlignment::TileOf(const Eigen::Vector3d& p_ma
   if (tiles.empty()) return nullptr;
   const Key k = KeyOf(p_map, tile_m);
   const Eigen::Vector3i key(k[0], k[1], k[2]);
-  const auto it = std::lower_bound(tiles.begin(), tiles.end(), key, [](const Tile& t, const Eigen::Vector3i& k) {
-    return std::lexicographical_compare(t.key.data(), t.key.data() + 3, k.data(), k.data() + 3);
-  });
+  const auto it = std::lower_bound(
+      tiles.begin(), tiles.end(), key, [](const Tile& t, const Eigen::Vector3i& k) {
+        return std::lexicographical_compare(t.key.data(), t.key.data() + 3, k.data(), k.data() + 3);
+      });
   return it != tiles.end() && it->key == key ? &*it : nullptr;
 }
 
@@ -220,8 +222,8 @@ SurveyAlignment AlignSurveys(const PointCloud& map, const PointCloud& reference,
   for (std::size_t i = 0; i < source.size(); ++i)
     by_tile[KeyOf(source.Point(i), options.tile_m)].push_back(i);
   for (const auto& [key, indices] : by_tile) {
-    const PointCloud tile_W =
-        Recentred(perception::Transformed(perception::Subset(source, indices), alignment.T_reference_map));
+    const PointCloud tile_W = Recentred(
+        perception::Transformed(perception::Subset(source, indices), alignment.T_reference_map));
     SurveyAlignment::Tile tile = AlignTile(tile_W, reference, key, alignment, options);
     if (!tile.registered) ++alignment.tiles_kept_global;
     alignment.tiles.push_back(tile);

@@ -27,7 +27,7 @@ struct SurveyAlignmentOptions {
   double tile_prior_rotation_rad = 0.01;
   double tile_prior_translation_m = 0.02;
   double tile_point_sigma_m = 0.001;
-  int min_tile_points = 200;  // a tile with fewer map points keeps the global transform, >= 3
+  int min_tile_points = 200;     // a tile with fewer map points keeps the global transform, >= 3
   double source_voxel_m = 0.01;  // the map is registered voxelised at this size, metres, > 0
   void Check() const;
 };
@@ -35,9 +35,9 @@ struct SurveyAlignmentOptions {
 // Where the map lies on the reference: one transform for the whole, and one per tile.
 struct SurveyAlignment {
   Eigen::Isometry3d T_reference_map = Eigen::Isometry3d::Identity();
-  double global_fitness = 0.0;     // share of the map's points paired at the last stage
-  double global_rmse_m = 0.0;      // point-to-plane RMS of those pairs, metres
-  bool registered = false;         // false: the transform was given
+  double global_fitness = 0.0;  // share of the map's points paired at the last stage
+  double global_rmse_m = 0.0;   // point-to-plane RMS of those pairs, metres
+  bool registered = false;      // false: the transform was given
   struct Tile {
     Eigen::Vector3i key = Eigen::Vector3i::Zero();  // floor(p / tile_m) of its points
     Eigen::Isometry3d T_reference_map = Eigen::Isometry3d::Identity();

@@ -1,0 +1,99 @@
+#include "mapping/change/local_statistics.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include "perception/cloud/cloud_neighbors.hpp"
+#include "scanner/common/error.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+constexpr std::size_t kMaxSamples = 256;
+
+double MedianOf(std::vector<double>& values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// Calls visit(i, neighbours) for each inspected core point i with the indices of its
+// neighbourhood (itself included), in parallel; visit must only write to what belongs to i.
+void ForEachNeighbourhood(const std::vector<CoreDeviation>& deviations, double radius_m,
+                          double max_normal_angle_rad,
+                          const std::function<void(std::size_t, const std::vector<std::size_t>&)>& visit) {
+  if (!(radius_m > 0.0)) throw Error("local statistics: radius_m must be > 0");
+  std::vector<std::size_t> inspected;
+  for (std::size_t i = 0; i < deviations.size(); ++i)
+    if (deviations[i].status != SurfaceStatus::kNotInspected) inspected.push_back(i);
+  if (inspected.empty()) return;
+  const Eigen::Vector3d origin = deviations[inspected.front()].point_W;
+  std::vector<Eigen::Vector3f> points;
+  for (std::size_t i : inspected) points.push_back((deviations[i].point_W - origin).cast<float>());
+  const perception::RadiusGrid grid(points, radius_m);
+  const double min_cos = std::cos(max_normal_angle_rad);
+#pragma omp parallel
+  {
+    std::vector<std::uint32_t> found;
+    std::vector<float> d2;
+    std::vector<std::size_t> neighbours;
+#pragma omp for schedule(dynamic, 256)
+    for (std::size_t k = 0; k < inspected.size(); ++k) {
+      const Eigen::Vector3d& normal = deviations[inspected[k]].normal_W;
+      grid.Query(points[k], found, d2);
+      std::sort(found.begin(), found.end());
+      const std::size_t stride = std::max<std::size_t>(1, found.size() / kMaxSamples);
+      neighbours.clear();
+      for (std::size_t j = 0; j < found.size(); j += stride) {
+        const std::size_t n = inspected[found[j]];
+        if (deviations[n].normal_W.dot(normal) >= min_cos) neighbours.push_back(n);
+      }
+      if (!neighbours.empty()) visit(inspected[k], neighbours);
+    }
+  }
+}
+
+}  // namespace
+
+void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
+                        double max_normal_angle_rad) {
+  std::vector<double> offsets(deviations.size(), 0.0);
+  ForEachNeighbourhood(deviations, radius_m, max_normal_angle_rad,
+                       [&](std::size_t i, const std::vector<std::size_t>& neighbours) {
+                         std::vector<double> values;
+                         for (std::size_t n : neighbours) values.push_back(deviations[n].deviation_m);
+                         offsets[i] = MedianOf(values);
+                       });
+  for (std::size_t i = 0; i < deviations.size(); ++i) deviations[i].deviation_m -= offsets[i];
+}
+
+void AddGroupSpread(std::vector<CoreDeviation>& deviations, const std::vector<long>& group_of,
+                    double z) {
+  std::map<long, std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < deviations.size(); ++i) {
+    if (deviations[i].status != SurfaceStatus::kNotInspected && group_of[i] >= 0)
+      groups[group_of[i]].push_back(i);
+  }
+  for (const auto& [group, members] : groups) {
+    std::vector<double> values, variances;
+    for (std::size_t i : members) {
+      values.push_back(deviations[i].deviation_m);
+      variances.push_back(std::pow(deviations[i].lod_m / z, 2));
+    }
+    const double median = MedianOf(values);
+    for (double& v : values) v = std::abs(v - median);
+    const double spread = 1.4826 * MedianOf(values);
+    const double unexplained = std::max(0.0, spread * spread - MedianOf(variances));
+    for (std::size_t i : members) {
+      CoreDeviation& d = deviations[i];
+      d.lod_m = z * std::sqrt(std::pow(d.lod_m / z, 2) + unexplained);
+      d.status = std::abs(d.deviation_m) > d.lod_m ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
+    }
+  }
+}
+
+}  // namespace uwscan::mapping
