@@ -3,9 +3,11 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <map>
+#include <set>
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
@@ -13,27 +15,37 @@
 namespace uwscan::mapping {
 namespace {
 
-constexpr std::size_t kMaxSamples = 256;
-
 double MedianOf(std::vector<double>& values) {
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
   std::nth_element(values.begin(), middle, values.end());
   return *middle;
 }
 
-// Calls visit(i, neighbours) for each inspected core point i with the indices of its
-// neighbourhood (itself included), in parallel; visit must only write to what belongs to i.
-void ForEachNeighbourhood(const std::vector<CoreDeviation>& deviations, double radius_m,
-                          double max_normal_angle_rad,
-                          const std::function<void(std::size_t, const std::vector<std::size_t>&)>& visit) {
+// Calls visit(i, neighbours) for each inspected core point i with its neighbourhood: the
+// inspected core points within radius_m facing the same way, taken from a sample of them one per
+// cell of a grid (a tenth of the radius), so a wide neighbourhood costs a few hundred points, not
+// thousands. In parallel; visit must only write to what belongs to i.
+void ForEachNeighbourhood(
+    const std::vector<CoreDeviation>& deviations, double radius_m, double max_normal_angle_rad,
+    const std::function<void(std::size_t, const std::vector<std::size_t>&)>& visit) {
   if (!(radius_m > 0.0)) throw Error("local statistics: radius_m must be > 0");
-  std::vector<std::size_t> inspected;
+  std::vector<std::size_t> inspected, sample;
   for (std::size_t i = 0; i < deviations.size(); ++i)
     if (deviations[i].status != SurfaceStatus::kNotInspected) inspected.push_back(i);
   if (inspected.empty()) return;
   const Eigen::Vector3d origin = deviations[inspected.front()].point_W;
+  const double cell_m = 0.1 * radius_m;
+  std::set<std::array<long, 3>> taken;
   std::vector<Eigen::Vector3f> points;
-  for (std::size_t i : inspected) points.push_back((deviations[i].point_W - origin).cast<float>());
+  for (std::size_t i : inspected) {
+    const Eigen::Vector3d p = deviations[i].point_W - origin;
+    const std::array<long, 3> key = {std::lround(std::floor(p.x() / cell_m)),
+                                     std::lround(std::floor(p.y() / cell_m)),
+                                     std::lround(std::floor(p.z() / cell_m))};
+    if (!taken.insert(key).second) continue;
+    sample.push_back(i);
+    points.push_back(p.cast<float>());
+  }
   const perception::RadiusGrid grid(points, radius_m);
   const double min_cos = std::cos(max_normal_angle_rad);
 #pragma omp parallel
@@ -43,14 +55,12 @@ void ForEachNeighbourhood(const std::vector<CoreDeviation>& deviations, double r
     std::vector<std::size_t> neighbours;
 #pragma omp for schedule(dynamic, 256)
     for (std::size_t k = 0; k < inspected.size(); ++k) {
-      const Eigen::Vector3d& normal = deviations[inspected[k]].normal_W;
-      grid.Query(points[k], found, d2);
-      std::sort(found.begin(), found.end());
-      const std::size_t stride = std::max<std::size_t>(1, found.size() / kMaxSamples);
+      const CoreDeviation& d = deviations[inspected[k]];
+      grid.Query((d.point_W - origin).cast<float>(), found, d2);
       neighbours.clear();
-      for (std::size_t j = 0; j < found.size(); j += stride) {
-        const std::size_t n = inspected[found[j]];
-        if (deviations[n].normal_W.dot(normal) >= min_cos) neighbours.push_back(n);
+      for (std::uint32_t j : found) {
+        if (deviations[sample[j]].normal_W.dot(d.normal_W) >= min_cos)
+          neighbours.push_back(sample[j]);
       }
       if (!neighbours.empty()) visit(inspected[k], neighbours);
     }
@@ -65,7 +75,8 @@ void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
   ForEachNeighbourhood(deviations, radius_m, max_normal_angle_rad,
                        [&](std::size_t i, const std::vector<std::size_t>& neighbours) {
                          std::vector<double> values;
-                         for (std::size_t n : neighbours) values.push_back(deviations[n].deviation_m);
+                         for (std::size_t n : neighbours)
+                           values.push_back(deviations[n].deviation_m);
                          offsets[i] = MedianOf(values);
                        });
   for (std::size_t i = 0; i < deviations.size(); ++i) deviations[i].deviation_m -= offsets[i];
@@ -91,7 +102,8 @@ void AddGroupSpread(std::vector<CoreDeviation>& deviations, const std::vector<lo
     for (std::size_t i : members) {
       CoreDeviation& d = deviations[i];
       d.lod_m = z * std::sqrt(std::pow(d.lod_m / z, 2) + unexplained);
-      d.status = std::abs(d.deviation_m) > d.lod_m ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
+      d.status =
+          std::abs(d.deviation_m) > d.lod_m ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
     }
   }
 }

@@ -8,7 +8,7 @@ namespace uwscan::mapping {
 
 // What the deviations around each core point say about it: within a radius, among the
 // inspected core points whose normals lie within an angle of its own (the same surface, not the
-// pipe beside the seabed), evenly strided to at most 256 of them.
+// pipe beside the seabed), one per cell of a grid a tenth of the radius wide.
 
 // Takes out, at each inspected core point, the median deviation of its neighbourhood: the slowly
 // varying offsets the two surveys' placement errors leave after registration (a millimetre or
