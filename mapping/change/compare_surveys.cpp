@@ -9,7 +9,6 @@
 #include "mapping/change/local_statistics.hpp"
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/normals.hpp"
-#include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
@@ -188,13 +187,9 @@ SurveyComparison CompareSurveys(const Survey& map, const Survey& reference,
   options.Check();
   RequireComparable(map, reference, options.alignment);
   SurveyComparison result;
-  // The registration's target: the reference at the map's registration voxel, with normals.
-  const PointCloud target =
-      WithNormals(reference.cloud.has_normals()
-                      ? reference.cloud
-                      : perception::VoxelDownsample(reference.cloud,
-                                                    {.leaf_m = options.alignment.source_voxel_m}),
-                  options.deviation.normal_radius_m);
+  // The reference with normals: the registration's target, and what each cylinder averages
+  // only the same surface's points of.
+  const PointCloud target = WithNormals(reference.cloud, options.deviation.normal_radius_m);
   result.alignment = AlignSurveys(map.cloud, target, options.alignment);
   const PointCloud aligned =
       WithNormals(AlignedMap(map.cloud, result.alignment), options.deviation.normal_radius_m);
@@ -214,7 +209,7 @@ SurveyComparison CompareSurveys(const Survey& map, const Survey& reference,
     const double pose_reference = PoseSigmaAlongNormal(reference, c, n);
     return std::sqrt(align * align + pose_map * pose_map + pose_reference * pose_reference);
   };
-  result.deviations = MeasureDeviations(aligned, reference.cloud, core, deviation, placement_sigma);
+  result.deviations = MeasureDeviations(aligned, target, core, deviation, placement_sigma);
   if (deviation.local_offset_radius_m > 0.0) {
     RemoveLocalOffsets(result.deviations, deviation.local_offset_radius_m,
                        deviation.max_normal_angle_rad);

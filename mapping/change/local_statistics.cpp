@@ -35,13 +35,18 @@ void ForEachNeighbourhood(
   if (inspected.empty()) return;
   const Eigen::Vector3d origin = deviations[inspected.front()].point_W;
   const double cell_m = 0.1 * radius_m;
-  std::set<std::array<long, 3>> taken;
+  std::set<std::array<long, 4>> taken;
   std::vector<Eigen::Vector3f> points;
   for (std::size_t i : inspected) {
     const Eigen::Vector3d p = deviations[i].point_W - origin;
-    const std::array<long, 3> key = {std::lround(std::floor(p.x() / cell_m)),
+    // One per cell and per way of facing (the normal's largest component and its sign): a box's
+    // side and the seabed at its foot share cells, not samples.
+    Eigen::Index axis = 0;
+    deviations[i].normal_W.cwiseAbs().maxCoeff(&axis);
+    const long facing = 2 * axis + (deviations[i].normal_W(axis) > 0.0 ? 1 : 0);
+    const std::array<long, 4> key = {std::lround(std::floor(p.x() / cell_m)),
                                      std::lround(std::floor(p.y() / cell_m)),
-                                     std::lround(std::floor(p.z() / cell_m))};
+                                     std::lround(std::floor(p.z() / cell_m)), facing};
     if (!taken.insert(key).second) continue;
     sample.push_back(i);
     points.push_back(p.cast<float>());
