@@ -63,11 +63,10 @@ std::pair<int, int> ParseSize(const std::string& text) {
   throw Error("--size " + text + ": expected WIDTHxHEIGHT in pixels, e.g. 1280x960");
 }
 
-bool ShowsARecognitionReport(const ViewArgs& a) {
+bool Shows(const ViewArgs& a, viewer::FileKind kind) {
   for (const std::string& file : a.files) {
     if (std::filesystem::path(file).extension() == ".json" &&
-        std::filesystem::is_regular_file(file) &&
-        viewer::KindOfFile(file) == viewer::FileKind::kRecognitionReport) {
+        std::filesystem::is_regular_file(file) && viewer::KindOfFile(file) == kind) {
       return true;
     }
   }
@@ -78,13 +77,16 @@ viewer::RenderOptions RenderOptionsFrom(const ViewArgs& a) {
   viewer::RenderOptions o;
   // A recognition report's scan is in the sensor's frame (y down): by default it is coloured by
   // object (a segment and its model share a colour) and shown upright as the sensor saw it.
-  const bool recognition = ShowsARecognitionReport(a);
-  const std::string colour_name = !a.colour.empty()  ? a.colour
-                                  : recognition      ? "object"
-                                  : !a.scene.empty() ? "error"
-                                                     : "height";
+  // A change report's points by their significant deviation.
+  const bool recognition = Shows(a, viewer::FileKind::kRecognitionReport);
+  const std::string colour_name = !a.colour.empty()                           ? a.colour
+                                  : recognition                               ? "object"
+                                  : Shows(a, viewer::FileKind::kChangeReport) ? "deviation"
+                                  : !a.scene.empty()                          ? "error"
+                                                                              : "height";
   const std::optional<viewer::ColourMode> colour = viewer::ParseColourMode(colour_name);
-  if (!colour) throw Error("--colour " + colour_name + ": use height, error, intensity or object");
+  if (!colour)
+    throw Error("--colour " + colour_name + ": use height, error, intensity, object or deviation");
   o.colour = *colour;
   const std::optional<viewer::CameraPreset> camera = viewer::ParseCameraPreset(a.camera);
   if (!camera) throw Error("--camera " + a.camera + ": use fit, top or side");
@@ -240,14 +242,17 @@ void AddViewCommand(CLI::App& app) {
   auto a = std::make_shared<ViewArgs>();
   CLI::App* cmd = app.add_subcommand(
       "view",
-      std::string("show clouds (.ply .pcd .xyz), meshes (.ply .off .stl .obj), TUM trajectories "
-                  "(.txt .tum), dive logs (.db), map and recognition reports (.json); keys: ") +
+      std::string(
+          "show clouds (.ply .pcd .xyz), meshes (.ply .off .stl .obj), TUM trajectories "
+          "(.txt .tum), dive logs (.db), map, recognition and change reports (.json); keys: ") +
           viewer::kViewKeys);
   cmd->add_option("files", a->files, "files to show (none with --scene: the scene's objects)");
   cmd->add_option(
       "--colour,--color", a->colour,
-      "height, error (simulated dive logs, or clouds given --scene), intensity or object (default: "
-      "object with a recognition report, error with --scene, else height)");
+      "height, error (simulated dive logs, or clouds given --scene), intensity, object or "
+      "deviation "
+      "(change reports; default: object with a recognition report, deviation with a change "
+      "report, error with --scene, else height)");
   cmd->add_option("--range", a->range, "fixed colour range LOW HIGH (metres for height and error)")
       ->expected(2);
   cmd->add_option("--point-size", a->point_size_px, "point size in pixels");

@@ -53,7 +53,55 @@ nlohmann::json RegionJson(const ChangeRegion& r) {
           {"significance", r.significance}};
 }
 
+constexpr const char* kProperties =
+    "property double x\nproperty double y\nproperty double z\nproperty float nx\n"
+    "property float ny\nproperty float nz\nproperty float deviation_m\nproperty float "
+    "lod_m\nproperty uchar significant\nproperty uchar inspected\nproperty int region\n"
+    "end_header\n";
+constexpr std::size_t kRowBytes = 3 * 8 + 5 * 4 + 2 + 4;
+
+template <typename T>
+T Take(const char*& at) {
+  T value;
+  std::memcpy(&value, at, sizeof value);
+  at += sizeof value;
+  return value;
+}
+
 }  // namespace
+
+DeviationsFile ReadDeviationsPly(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot read");
+  std::string line, header;
+  long long count = -1;
+  for (int lines = 0; lines < 20 && std::getline(in, line); ++lines) {
+    if (line.rfind("element vertex ", 0) == 0) count = std::atoll(line.c_str() + 15);
+    if (line.rfind("property", 0) == 0 || line == "end_header") header += line + "\n";
+    if (line == "end_header") break;
+  }
+  if (header != kProperties || count < 0) {
+    throw Error(path.string() +
+                ": not the deviations PLY `uwscan compare -o` writes (its properties differ)");
+  }
+  const std::string rows((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (rows.size() < static_cast<std::size_t>(count) * kRowBytes)
+    throw Error(path.string() + ": cut short (" + std::to_string(count) + " points declared)");
+  DeviationsFile f;
+  const char* at = rows.data();
+  for (long long i = 0; i < count; ++i) {
+    Eigen::Vector3d p;
+    for (int k = 0; k < 3; ++k) p[k] = Take<double>(at);
+    at += 3 * sizeof(float);  // the normal
+    f.points.push_back(p);
+    f.deviation_m.push_back(Take<float>(at));
+    f.lod_m.push_back(Take<float>(at));
+    f.significant.push_back(Take<std::uint8_t>(at));
+    f.inspected.push_back(Take<std::uint8_t>(at));
+    f.region.push_back(Take<std::int32_t>(at));
+  }
+  return f;
+}
 
 void WriteDeviationsPly(const fs::path& path, const SurveyComparison& c) {
   const fs::path temporary = TemporaryBeside(path);
@@ -61,11 +109,8 @@ void WriteDeviationsPly(const fs::path& path, const SurveyComparison& c) {
     std::ofstream out(temporary, std::ios::binary);
     out << "ply\nformat binary_little_endian 1.0\ncomment uwscan compare: deviations along the "
            "reference's normals, metres\nelement vertex "
-        << c.deviations.size()
-        << "\nproperty double x\nproperty double y\nproperty double z\nproperty float nx\n"
-           "property float ny\nproperty float nz\nproperty float deviation_m\nproperty float "
-           "lod_m\nproperty uchar significant\nproperty uchar inspected\nproperty int region\n"
-           "end_header\n";
+        << c.deviations.size() << "\n"
+        << kProperties;
     WriteRows(out, c);
     out.flush();
     if (!out) {

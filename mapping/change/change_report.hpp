@@ -1,8 +1,10 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "mapping/change/compare_surveys.hpp"
 
@@ -16,6 +18,17 @@ namespace uwscan::mapping {
 // (int32, -1 outside any). Atomic (a temporary renamed over the target). Throws uwscan::Error
 // naming the file when it cannot be written.
 void WriteDeviationsPly(const std::filesystem::path& path, const SurveyComparison& comparison);
+
+// What WriteDeviationsPly wrote, read back (the viewer draws it). Throws uwscan::Error naming the
+// file when it is missing, not this layout (another PLY: give the file `compare` wrote), or cut
+// short.
+struct DeviationsFile {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<float> deviation_m, lod_m;  // NaN where not inspected
+  std::vector<std::uint8_t> significant, inspected;
+  std::vector<std::int32_t> region;
+};
+DeviationsFile ReadDeviationsPly(const std::filesystem::path& path);
 
 // The report: surveys, alignment, areas, settings and one entry per region.
 nlohmann::json ChangeReportJson(const SurveyComparison& comparison, const Survey& map,

@@ -272,8 +272,10 @@ class LiveScene {
     drawn_.push_back(std::move(drawn));
     if (IsContinuous(render_.colour) && render_.colour_bar) {
       props_.push_back(
-          internal::ColourBar(range, std::string(ToString(render_.colour)) +
-                                         (render_.colour == ColourMode::kIntensity ? "" : " m")));
+          internal::ColourBar(range,
+                              std::string(ToString(render_.colour)) +
+                                  (render_.colour == ColourMode::kIntensity ? "" : " m"),
+                              render_.colour));
     }
   }
 

@@ -153,6 +153,8 @@ std::string BarTitle(ColourMode mode) {
       return "error m";
     case ColourMode::kIntensity:
       return "intensity";
+    case ColourMode::kDeviation:
+      return "deviation m";
     case ColourMode::kObject:
       break;
   }
@@ -257,12 +259,14 @@ vtkSmartPointer<vtkActor> PointActor(vtkPolyData* points, double point_size_px) 
   return actor;
 }
 
-vtkSmartPointer<vtkScalarBarActor> ColourBar(const ScalarRange& range, const std::string& title) {
+vtkSmartPointer<vtkScalarBarActor> ColourBar(const ScalarRange& range, const std::string& title,
+                                             ColourMode mode) {
   vtkNew<vtkLookupTable> table;
   table->SetNumberOfTableValues(kColourBarEntries);
   table->SetRange(range.lo, range.hi);
   for (int i = 0; i < kColourBarEntries; ++i) {
-    const Rgb c = ContinuousColour(static_cast<double>(i) / (kColourBarEntries - 1));
+    const double t = static_cast<double>(i) / (kColourBarEntries - 1);
+    const Rgb c = mode == ColourMode::kDeviation ? DivergingColour(t) : ContinuousColour(t);
     table->SetTableValue(i, c.r / 255.0, c.g / 255.0, c.b / 255.0, 1.0);
   }
   auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
@@ -339,7 +343,8 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
   for (const Label& label : scene.labels) out.renderer->AddActor2D(LabelActor(label, out.anchor_W));
   if (IsContinuous(options.colour) && out.points_total > 0) {
     out.range = range;
-    if (options.colour_bar) out.renderer->AddViewProp(ColourBar(range, BarTitle(options.colour)));
+    if (options.colour_bar)
+      out.renderer->AddViewProp(ColourBar(range, BarTitle(options.colour), options.colour));
   }
   if (options.eye_dome_lighting) EnableEyeDomeLighting(*out.renderer);
   return out;

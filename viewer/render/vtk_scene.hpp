@@ -61,8 +61,10 @@ vtkSmartPointer<vtkActor> MeshActor(const MeshLayer& layer, const Rgb& colour,
                                     const Eigen::Vector3d& anchor_W);
 // An unlit point actor (vtkPointGaussianMapper drawing plain points): exact colours.
 vtkSmartPointer<vtkActor> PointActor(vtkPolyData* points, double point_size_px);
-// The scalar bar of the continuous colour map over `range`.
-vtkSmartPointer<vtkScalarBarActor> ColourBar(const ScalarRange& range, const std::string& title);
+// The scalar bar of `mode`'s colour map (diverging for deviations, else the continuous one)
+// over `range`.
+vtkSmartPointer<vtkScalarBarActor> ColourBar(const ScalarRange& range, const std::string& title,
+                                             ColourMode mode);
 void EnableEyeDomeLighting(vtkRenderer& renderer);
 
 // Places the camera for a preset around `bounds` (render coordinates), or everything visible.

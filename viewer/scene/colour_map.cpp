@@ -50,6 +50,17 @@ Rgb ContinuousColour(double t) {
   return {Mix(a.r, b.r, f), Mix(a.g, b.g, f), Mix(a.b, b.b, f)};
 }
 
+Rgb DivergingColour(double t) {
+  if (std::isnan(t)) return kNoValue;
+  // Moreland's cool-to-warm ends, a light middle distinct from kNoValue's grey.
+  constexpr Rgb kLow{59, 76, 192}, kMiddle{236, 236, 236}, kHigh{180, 4, 38};
+  const double x = std::clamp(t, 0.0, 1.0);
+  const Rgb& a = x < 0.5 ? kLow : kMiddle;
+  const Rgb& b = x < 0.5 ? kMiddle : kHigh;
+  const double f = x < 0.5 ? 2.0 * x : 2.0 * x - 1.0;
+  return {Mix(a.r, b.r, f), Mix(a.g, b.g, f), Mix(a.b, b.b, f)};
+}
+
 Rgb CategoricalColour(int i) {
   const int n = static_cast<int>(kCategorical.size());
   return kCategorical[static_cast<std::size_t>(((i % n) + n) % n)];

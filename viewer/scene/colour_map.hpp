@@ -14,6 +14,10 @@ struct Rgb {
 // between nine control colours. t in [0, 1]; values outside are clamped, NaN gives kNoValue.
 Rgb ContinuousColour(double t);
 
+// A diverging map for signed values (blue below the middle, light grey at it, red above), t in
+// [0, 1] with 0.5 the middle; values outside are clamped, NaN gives kNoValue.
+Rgb DivergingColour(double t);
+
 // Points whose scalar is missing (NaN: no truth for that point).
 inline constexpr Rgb kNoValue{128, 128, 128};
 

@@ -22,6 +22,12 @@ std::vector<float> PointScalars(const CloudLayer& layer, ColourMode mode, const 
           "scene its scene with --scene)");
     }
     values = &layer.error_m;
+  } else if (mode == ColourMode::kDeviation) {
+    if (layer.deviation_m.size() != layer.size()) {
+      throw Error("colour by deviation: " + layer.name +
+                  " has no deviations (`uwscan compare --json` reports have them)");
+    }
+    values = &layer.deviation_m;
   } else if (mode == ColourMode::kIntensity) {
     if (layer.intensity.size() != layer.size()) {
       throw Error("colour by intensity: " + layer.name + " has no intensity values");
@@ -41,6 +47,7 @@ std::vector<float> PointScalars(const CloudLayer& layer, ColourMode mode, const 
 
 Rgb PointColour(ColourMode mode, float scalar, const ScalarRange& range, int layer_index,
                 std::optional<std::int32_t> object_id) {
+  if (mode == ColourMode::kDeviation) return DivergingColour(range.Normalise(scalar));
   if (IsContinuous(mode)) return ContinuousColour(range.Normalise(scalar));
   if (!object_id) return CategoricalColour(layer_index);
   return *object_id < 0 ? kNoValue : CategoricalColour(*object_id);
@@ -51,7 +58,11 @@ ScalarRange SceneRange(const std::vector<std::vector<float>>& scalars,
   if (options.range) return *options.range;
   std::vector<float> all;
   for (const std::vector<float>& s : scalars) all.insert(all.end(), s.begin(), s.end());
-  return RobustRange(all);
+  const ScalarRange robust = RobustRange(all);
+  if (options.colour != ColourMode::kDeviation) return robust;
+  // Symmetric about zero, so that the map's middle is no change.
+  const double reach = std::max(std::abs(robust.lo), std::abs(robust.hi));
+  return {-reach, reach};
 }
 
 }  // namespace uwscan::viewer

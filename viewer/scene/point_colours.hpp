@@ -34,7 +34,7 @@ Rgb PointColour(ColourMode mode, float scalar, const ScalarRange& range, int lay
                 std::optional<std::int32_t> object_id);
 
 // The range a scene's colours span: `options.range` when set, else RobustRange over every
-// drawn point's scalar.
+// drawn point's scalar (made symmetric about zero for deviations).
 ScalarRange SceneRange(const std::vector<std::vector<float>>& scalars,
                        const RenderOptions& options);
 

@@ -11,6 +11,7 @@ std::optional<ColourMode> ParseColourMode(const std::string& text) {
   if (text == "error") return ColourMode::kError;
   if (text == "intensity") return ColourMode::kIntensity;
   if (text == "object") return ColourMode::kObject;
+  if (text == "deviation") return ColourMode::kDeviation;
   return std::nullopt;
 }
 
@@ -31,6 +32,8 @@ const char* ToString(ColourMode mode) {
       return "intensity";
     case ColourMode::kObject:
       return "object";
+    case ColourMode::kDeviation:
+      return "deviation";
   }
   return "?";
 }

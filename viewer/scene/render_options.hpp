@@ -16,6 +16,9 @@ enum class ColourMode {
   kError,      // distance to the true surface point, metres (dive logs with ground truth)
   kIntensity,  // the cloud's intensity values
   kObject,     // one colour per file, or per scene object when the points know theirs
+  // Signed deviation from a reference, metres (a change report): a diverging map about zero,
+  // grey where the deviation is not significant.
+  kDeviation,
 };
 enum class CameraPreset {
   kFit,   // oblique, from above, the whole scene in view
@@ -23,7 +26,7 @@ enum class CameraPreset {
   kSide,  // looking horizontally
 };
 
-// Parse "height|error|intensity|object" and "fit|top|side"; std::nullopt otherwise.
+// Parse "height|error|intensity|object|deviation" and "fit|top|side"; std::nullopt otherwise.
 std::optional<ColourMode> ParseColourMode(const std::string& text);
 std::optional<CameraPreset> ParseCameraPreset(const std::string& text);
 const char* ToString(ColourMode mode);

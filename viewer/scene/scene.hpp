@@ -17,9 +17,11 @@ namespace uwscan::viewer {
 struct CloudLayer {
   std::string name;  // the file it came from, shown when a point is picked
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3f> points;   // metres, relative to origin
-  std::vector<float> error_m;            // empty, or one per point: distance to truth (NaN: none)
-  std::vector<float> intensity;          // empty, or one per point, the file's units
+  std::vector<Eigen::Vector3f> points;  // metres, relative to origin
+  std::vector<float> error_m;           // empty, or one per point: distance to truth (NaN: none)
+  std::vector<float> intensity;         // empty, or one per point, the file's units
+  // Empty, or one per point: signed deviation from a reference, metres (NaN: not significant).
+  std::vector<float> deviation_m;
   std::vector<std::int32_t> object_ids;  // empty, or one per point (scene object; -1: none)
 
   std::size_t size() const { return points.size(); }

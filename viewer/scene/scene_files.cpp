@@ -9,6 +9,7 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"
+#include "viewer/scene/change_report.hpp"
 #include "viewer/scene/recognition_report.hpp"
 
 namespace uwscan::viewer {
@@ -79,6 +80,8 @@ const char* ToString(FileKind kind) {
       return "map report";
     case FileKind::kRecognitionReport:
       return "recognition report";
+    case FileKind::kChangeReport:
+      return "change report";
   }
   return "?";
 }
@@ -94,10 +97,11 @@ FileKind KindOfFile(const fs::path& path) {
   if (ext == ".json") {
     if (IsMapReport(path)) return FileKind::kMapReport;
     if (IsRecognitionReport(path)) return FileKind::kRecognitionReport;
-    throw Error(
-        path.string() +
-        ": a JSON file that is neither a map report nor a recognition report (\"kind\": "
-        "\"map_report\" or \"recognition_report\"); bench reports are drawn by `uwscan plot`");
+    if (IsChangeReport(path)) return FileKind::kChangeReport;
+    throw Error(path.string() +
+                ": a JSON file that is not a map, recognition or change report (\"kind\": "
+                "\"map_report\", \"recognition_report\" or \"change_report\"); bench reports "
+                "are drawn by `uwscan plot`");
   }
   throw Error(path.string() +
               ": unknown kind of file (clouds .ply .pcd .xyz, meshes .ply .off .stl .obj, "
@@ -191,6 +195,8 @@ void AddFile(const fs::path& path, const mapping::ReconstructionOptions& log_opt
       return AddMapReport(ReadMapReport(path), map_drawing, scene);
     case FileKind::kRecognitionReport:
       return AddRecognitionReport(ReadRecognitionReport(path), log_options, scene);
+    case FileKind::kChangeReport:
+      return AddChangeReport(path, scene);
   }
 }
 

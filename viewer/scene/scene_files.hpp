@@ -13,13 +13,21 @@
 // perception::ReadCloud, meshes through scanner::LoadMesh, dive logs through mapping::Reconstruct.
 namespace uwscan::viewer {
 
-enum class FileKind { kCloud, kMesh, kTrajectory, kDiveLog, kMapReport, kRecognitionReport };
+enum class FileKind {
+  kCloud,
+  kMesh,
+  kTrajectory,
+  kDiveLog,
+  kMapReport,
+  kRecognitionReport,
+  kChangeReport
+};
 const char* ToString(FileKind kind);
 
 // What a file holds, from its extension and, where one extension has two meanings, its first
 // bytes: .pcd .xyz clouds; .ply a mesh when its header declares faces, else a cloud; .off .stl
-// .obj meshes; .txt .tum trajectories; .db .uwlog dive logs (SQLite); .json map and recognition
-// reports (by their "kind"). Throws
+// .obj meshes; .txt .tum trajectories; .db .uwlog dive logs (SQLite); .json map, recognition and
+// change reports (by their "kind"). Throws
 // uwscan::Error naming the file when it is missing or of none of these kinds.
 FileKind KindOfFile(const std::filesystem::path& path);
 
