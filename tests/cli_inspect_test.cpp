@@ -11,6 +11,7 @@
 #include "mapping/log/dive_log.hpp"
 #include "tests/cli_camera_support.hpp"
 #include "tests/cli_run.hpp"
+#include "viewer/plots/png_image.hpp"
 
 namespace {
 
@@ -194,6 +195,49 @@ TEST(CliInspect, TheLiveViewWritesItsLastPicture) {
   EXPECT_EQ(bytes.compare(1, 3, "PNG"), 0);
   EXPECT_GT(bytes.size(), 20000u) << "a picture of the scene, not an empty window";
   EXPECT_GT(ReadJson(json)["frames_mapped"].get<std::int64_t>(), 0);
+}
+
+// --reference colours the live map by its deviation from a design model: against the scene as
+// built the map is grey (within the live threshold); against a design whose seabed lies 1 cm
+// deeper (NED: further from the camera), the seabed in the map is 1 cm in front of it: gained, red.
+TEST(CliInspect, TheLiveViewColoursTheMapByItsDeviationFromAReference) {
+  const std::string scene = SourcePath("data/scenes/default.yaml");
+  std::string deeper = ReadFile(scene);
+  const std::string seabed = "translation_m: [0, 0, 1.3]";
+  ASSERT_NE(deeper.find(seabed), std::string::npos);
+  deeper.replace(deeper.find(seabed), seabed.size(), "translation_m: [0, 0, 1.31]");
+  const std::string scanners = "../scanners/";
+  ASSERT_NE(deeper.find(scanners), std::string::npos);
+  deeper.replace(deeper.find(scanners), scanners.size(), SourcePath("data/scanners/"));
+  const fs::path deeper_scene = TempPath("deeper.yaml");
+  { std::ofstream(deeper_scene) << deeper; }
+  auto camera = StartFakeCamera({"fake-camera", scene}, "reference_camera");
+  int red[2] = {0, 0};
+  const fs::path designs[2] = {TempPath("design.ply"), TempPath("deeper_design.ply")};
+  const std::string scenes[2] = {scene, deeper_scene.string()};
+  for (int k = 0; k < 2; ++k) {
+    const CommandRun design =
+        RunUwscan("simulate " + scenes[k] + " -o " + TempPath("design.db").string() +
+                  " --force --design " + designs[k].string());
+    ASSERT_EQ(design.exit_code, 0) << design.output;
+    const fs::path png = TempPath("reference.png");
+    const CommandRun run =
+        RunCommand(SourcePath("cmake/run_with_display.sh") + " " + UWSCAN_BIN +
+                   " inspect --camera 127.0.0.1 --scene " + scene + " --frames 402 --screenshot " +
+                   png.string() + " --reference " + designs[k].string());
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const uwscan::viewer::RgbImage image = uwscan::viewer::ReadPng(png);
+    for (int row = 0; row < image.height_px; ++row) {
+      for (int column = 0; column < image.width_px * 4 / 5; ++column) {  // the colour bar aside
+        const uwscan::viewer::Rgb c = image.At(column, row);
+        red[k] += c.r > 120 && c.r > c.b + 60 && c.r > c.g + 60;
+      }
+    }
+  }
+  std::printf("red pixels: %d against the scene as built, %d against a seabed 1 cm deeper\n",
+              red[0], red[1]);
+  EXPECT_LT(red[0], 500) << "the scene as built: grey";
+  EXPECT_GT(red[1], 20 * std::max(red[0], 100)) << "a seabed 1 cm deeper: the map's is gained";
 }
 
 }  // namespace

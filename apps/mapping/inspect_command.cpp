@@ -16,6 +16,7 @@
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/stop_signal.hpp"
 #include "apps/scanner/camera_frames.hpp"
+#include "mapping/change/live_deviation.hpp"
 #include "mapping/inspection/live_inspection.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
@@ -44,7 +45,21 @@ struct InspectArgs {
   double voxel_m = 0.005;
   int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
   int threads = 0;
+  std::string reference;  // the live map coloured by its deviation from it
+  std::string reference_units = "m";
+  double live_threshold_m = mapping::LiveDeviationOptions{}.threshold_m;
 };
+
+// The reference the live map is coloured against (--reference), read before the camera opens.
+std::unique_ptr<mapping::LiveDeviation> LoadReference(const InspectArgs& a, bool view) {
+  if (a.reference.empty()) return nullptr;
+  if (!view) throw Error("--reference: colours the live view; give --view or --screenshot");
+  mapping::SurveyReadOptions read;
+  read.units_to_m = a.reference_units == "mm" ? 1e-3 : a.reference_units == "cm" ? 1e-2 : 1.0;
+  mapping::LiveDeviationOptions options;
+  options.threshold_m = a.live_threshold_m;
+  return std::make_unique<mapping::LiveDeviation>(mapping::ReadSurvey(a.reference, read), options);
+}
 
 void PrintStatus(const ReadSummary& r, const mapping::InspectionStatistics& s, double seconds,
                  bool final_line) {
@@ -115,6 +130,7 @@ void RunInspect(const InspectArgs& a) {
   }
   const bool view = a.view || !a.screenshot.empty();
   if (view) viewer::RequireDisplay();  // before the camera, not after the dive
+  const std::unique_ptr<mapping::LiveDeviation> reference = LoadReference(a, view);
   const acq::CameraSettings settings = MakeCameraSettings(a.camera);
   mapping::InspectionOptions options;
   options.log_queue_bytes = static_cast<std::size_t>(a.queue_mb * 1e6);
@@ -135,6 +151,7 @@ void RunInspect(const InspectArgs& a) {
   if (view) {
     viewer::LiveViewOptions live;
     live.offscreen = !a.screenshot.empty();
+    if (reference) live.render.colour = viewer::ColourMode::kDeviation;
     live_view = std::make_unique<viewer::LiveView>(live);
     if (!a.screenshot.empty()) live_view->SetFinalScreenshot(a.screenshot);
   }
@@ -142,11 +159,13 @@ void RunInspect(const InspectArgs& a) {
   // No navigation from a camera alone: the scanner is held fixed, the vehicle at the origin.
   mapping::LiveInspection inspection(context.header, a.log, context.T_V_C,
                                      mapping::NavigationNoise{}, options,
-                                     [&live_view](const mapping::MappedFrame& f) {
+                                     [&live_view, &reference](const mapping::MappedFrame& f) {
                                        if (!live_view) return;
                                        viewer::LiveCloud cloud;
                                        cloud.time_s = f.time_s;
                                        cloud.points_W.assign(f.points_W.begin(), f.points_W.end());
+                                       if (reference)
+                                         cloud.deviation_m = reference->Deviations(cloud.points_W);
                                        live_view->Push(std::move(cloud));
                                      });
   std::printf(
@@ -281,6 +300,18 @@ void AddInspectCommand(CLI::App& app) {
   cmd->add_option("--threads", a->threads, "threads of the mapper's ICP and normals (0: all cores)")
       ->check(kNonNegativeNumber);
   cmd->add_flag("--force", a->force, "replace an existing log at the --log path");
+  cmd->add_option("--reference", a->reference,
+                  "colour the live map by its deviation from this design model, earlier map "
+                  "report or cloud, in the map's frame (with --view or --screenshot; the findings "
+                  "and their significance: `uwscan compare` afterwards)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--reference-units", a->reference_units, "the reference file's unit")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"m", "cm", "mm"}));
+  cmd->add_option("--live-threshold", a->live_threshold_m,
+                  "metres: live deviations smaller than this are drawn as no change")
+      ->capture_default_str()
+      ->check(kNonNegativeNumber);
   cmd->callback([a] { RunInspect(*a); });
 }
 

@@ -59,13 +59,14 @@ CloudLayer Combine(const std::vector<std::shared_ptr<const LiveCloud>>& clouds,
   CloudLayer layer;
   layer.name = "live";
   layer.origin = anchor_W;
-  bool errors = true, intensities = true, ids = true;
+  bool errors = true, intensities = true, ids = true, deviations = true;
   std::size_t n = 0;
   for (const auto& c : clouds) {
     n += c->points_W.size();
     errors = errors && c->error_m.size() == c->points_W.size();
     intensities = intensities && c->intensity.size() == c->points_W.size();
     ids = ids && c->object_ids.size() == c->points_W.size();
+    deviations = deviations && c->deviation_m.size() == c->points_W.size();
   }
   layer.points.reserve(n);
   for (const auto& c : clouds) {
@@ -76,6 +77,9 @@ CloudLayer Combine(const std::vector<std::shared_ptr<const LiveCloud>>& clouds,
       layer.intensity.insert(layer.intensity.end(), c->intensity.begin(), c->intensity.end());
     if (ids)
       layer.object_ids.insert(layer.object_ids.end(), c->object_ids.begin(), c->object_ids.end());
+    if (deviations)
+      layer.deviation_m.insert(layer.deviation_m.end(), c->deviation_m.begin(),
+                               c->deviation_m.end());
   }
   return layer;
 }
@@ -136,6 +140,7 @@ void LiveView::Push(LiveCloud cloud) {
   RequireSize(cloud.error_m, n, "error_m");
   RequireSize(cloud.intensity, n, "intensity");
   RequireSize(cloud.object_ids, n, "object_ids");
+  RequireSize(cloud.deviation_m, n, "deviation_m");
   if (n == 0) return;
   auto shared_cloud = std::make_shared<const LiveCloud>(std::move(cloud));
   const std::lock_guard<std::mutex> lock(impl_->mutex);

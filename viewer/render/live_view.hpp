@@ -31,6 +31,9 @@ struct LiveCloud {
   std::vector<float> error_m;            // empty, or one per point
   std::vector<float> intensity;          // empty, or one per point
   std::vector<std::int32_t> object_ids;  // empty, or one per point
+  // Empty, or one per point: signed deviation from a reference, metres (NaN: within the
+  // threshold, or no reference surface near).
+  std::vector<float> deviation_m;
 };
 
 // A pose on a named track ("navigation", "truth", "slam"): drawn as the track's line.

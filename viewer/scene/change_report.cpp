@@ -28,13 +28,14 @@ CloudLayer DeviationLayer(const fs::path& ply) {
 }
 
 Label RegionLabel(const nlohmann::json& region, const Field& field) {
-  const std::vector<double> c = json_fields::Numbers(json_fields::Require(region, "centroid_m", field), 3,
-                                                     field["centroid_m"]);
+  const std::vector<double> c = json_fields::Numbers(
+      json_fields::Require(region, "centroid_m", field), 3, field["centroid_m"]);
   const double mean_m = json_fields::Numbers(
       nlohmann::json::array({json_fields::Require(region, "mean_deviation_m", field)}), 1,
       field["mean_deviation_m"])[0];
-  const double area_m2 = json_fields::Numbers(
-      nlohmann::json::array({json_fields::Require(region, "area_m2", field)}), 1, field["area_m2"])[0];
+  const double area_m2 =
+      json_fields::Numbers(nlohmann::json::array({json_fields::Require(region, "area_m2", field)}),
+                           1, field["area_m2"])[0];
   char text[96];
   std::snprintf(text, sizeof text, "%d: %+.1f mm, %.0f cm2",
                 json_fields::Require(region, "id", field).get<int>(), 1e3 * mean_m, 1e4 * area_m2);

@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "scanner/common/atomic_file.hpp"
 #include "mapping/change/change_report.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/scene/point_colours.hpp"
 #include "viewer/scene/scene_files.hpp"
@@ -49,15 +49,17 @@ mapping::SurveyComparison ThreePoints() {
 }
 
 TEST(ChangeReport, SignificantDeviationsInDivergingColoursTheRestGreyARegionLabelled) {
-  const fs::path folder = fs::temp_directory_path() / ("uwscan_change_report_" + std::to_string(getpid()));
+  const fs::path folder =
+      fs::temp_directory_path() / ("uwscan_change_report_" + std::to_string(getpid()));
   fs::create_directories(folder);
   const mapping::SurveyComparison c = ThreePoints();
   mapping::Survey map, reference;
   map.name = "after.json";
   reference.name = "before.json";
   mapping::WriteDeviationsPly(folder / "changes.ply", c);
-  WriteTextAtomically(folder / "changes.json",
-                      mapping::ChangeReportJson(c, map, reference, {}, (folder / "changes.ply").string()).dump());
+  WriteTextAtomically(
+      folder / "changes.json",
+      mapping::ChangeReportJson(c, map, reference, {}, (folder / "changes.ply").string()).dump());
   ASSERT_EQ(KindOfFile(folder / "changes.json"), FileKind::kChangeReport);
 
   Scene scene;
@@ -84,10 +86,12 @@ TEST(ChangeReport, SignificantDeviationsInDivergingColoursTheRestGreyARegionLabe
   EXPECT_EQ(PointColour(options.colour, scalars[1], range, 0, std::nullopt), kNoValue);
 
   // A PLY that is not the deviations file, and a report of another kind, are refused by name.
-  std::ofstream(folder / "other.ply") << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
-                                         "property float y\nproperty float z\nend_header\n0 0 0\n";
-  WriteTextAtomically(folder / "other.json",
-                      mapping::ChangeReportJson(c, map, reference, {}, (folder / "other.ply").string()).dump());
+  std::ofstream(folder / "other.ply")
+      << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+         "property float y\nproperty float z\nend_header\n0 0 0\n";
+  WriteTextAtomically(
+      folder / "other.json",
+      mapping::ChangeReportJson(c, map, reference, {}, (folder / "other.ply").string()).dump());
   Scene other;
   try {
     AddChangeReport(folder / "other.json", other);
