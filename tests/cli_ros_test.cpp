@@ -43,11 +43,15 @@ const std::filesystem::path& Folder() {
 std::filesystem::path TempPath(const std::string& name) { return Folder() / name; }
 
 // The short inspection dive (20 s, one lap with drifting navigation), simulated once.
+// The short dive's scene as built (simulate --design), beside it.
+std::filesystem::path ShortDesign() { return TempPath("short_design.ply"); }
+
 const std::filesystem::path& ShortDive() {
   static const std::filesystem::path log = [] {
     const std::filesystem::path path = TempPath("short.db");
-    const CommandRun run = RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") +
-                                     " -o " + path.string());
+    const CommandRun run =
+        RunUwscan("simulate " + SourcePath("data/scenes/inspection_short.yaml") + " -o " +
+                  path.string() + " --design " + ShortDesign().string());
     EXPECT_EQ(run.exit_code, 0) << run.output;
     return path;
   }();
@@ -264,12 +268,13 @@ TEST(CliRos, ImportRefusesUnusableBagsByName) {
 // The node on a played bag maps as `map` does offline on the same dive: the same submaps, the
 // trajectory within a millimetre, the map within the voxel's diagonal; every frame and
 // navigation sample logged; its SLAM path (read back from what it published) beats dead
-// reckoning as map's does.
+// reckoning as map's does. Given the scene as built, its published map carries each point's
+// deviation from it.
 TEST(CliRos, NodeMapsAPlayedBagAsMapDoesOffline) {
   const std::filesystem::path out = TempPath("node");
-  const CommandRun run =
-      RunCommand(SourcePath("tests/ros/replay_dive.sh") + " " + UWSCAN_BIN + " " +
-                 ShortBag().string() + " " + out.string() + " --idle-stop-s 3");
+  const CommandRun run = RunCommand(SourcePath("tests/ros/replay_dive.sh") + " " + UWSCAN_BIN +
+                                    " " + ShortBag().string() + " " + out.string() +
+                                    " --idle-stop-s 3 --reference " + ShortDesign().string());
   std::ifstream log_file(out / "node.log");
   const std::string node_log((std::istreambuf_iterator<char>(log_file)),
                              std::istreambuf_iterator<char>());
@@ -303,6 +308,10 @@ TEST(CliRos, NodeMapsAPlayedBagAsMapDoesOffline) {
   EXPECT_EQ(Dump(published["/uwscan/sweep"]["frame_ids"]),
             Dump(nlohmann::json::array({"uwscan_camera"})));
   EXPECT_EQ(Dump(published["/uwscan/map"]["type"]), Dump("sensor_msgs/PointCloud2"));
+  EXPECT_EQ(Dump(published["/uwscan/map"]["last_fields"]),
+            Dump(nlohmann::json::array({"x", "y", "z", "deviation"})));
+  // Against the scene as built, most of the map is within the live threshold (NaN).
+  EXPECT_LT(published["/uwscan/map"]["last_finite_share"].get<double>(), 0.2);
   EXPECT_EQ(Dump(published["/uwscan/pose"]["type"]),
             Dump("geometry_msgs/PoseWithCovarianceStamped"));
   const nlohmann::json& transforms =

@@ -272,13 +272,22 @@ Covariance6d RosCovariance(const mapping::Matrix6d& c) {
   return out;
 }
 
+// The map in the navigation's axes; with a reference, each point's deviation from it (taken in
+// uwscan's world frame, where the reference is) as the field "deviation".
 CloudMessage MapMessage(const perception::PointCloud& map, const Header& header,
-                        NavigationAxes axes) {
+                        NavigationAxes axes, const mapping::LiveDeviation* reference) {
   CloudMessage c;
   c.header = header;
   c.points.reserve(map.size());
-  for (std::size_t i = 0; i < map.size(); ++i)
-    c.points.push_back(WorldPointInNavigationAxes(map.Point(i), axes).cast<float>());
+  std::vector<Eigen::Vector3d> points_W;
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    points_W.push_back(map.Point(i));
+    c.points.push_back(WorldPointInNavigationAxes(points_W.back(), axes).cast<float>());
+  }
+  if (reference) {
+    c.scalar_name = "deviation";
+    c.scalars = reference->Deviations(points_W);
+  }
   return c;
 }
 
@@ -329,7 +338,8 @@ class Outlet {
     }
     if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
       ros_.Publish(map_id_, MapMessage(m.Map(options_.inspection.map_voxel_m),
-                                       Stamp(slam.back().time_s, options_.frames.map), axes()));
+                                       Stamp(slam.back().time_s, options_.frames.map), axes(),
+                                       options_.reference.get()));
       last_map_ = Clock::now();
       ++maps_;
     }
@@ -341,8 +351,8 @@ class Outlet {
     if (!sweep_points_W_.empty()) PublishSweep();
     if (r.slam.empty()) return;
     PublishTrajectory(r.slam, r.navigation);
-    ros_.Publish(map_id_,
-                 MapMessage(r.map, Stamp(r.slam.back().time_s, options_.frames.map), axes()));
+    ros_.Publish(map_id_, MapMessage(r.map, Stamp(r.slam.back().time_s, options_.frames.map),
+                                     axes(), options_.reference.get()));
     ++maps_;
   }
 

@@ -3,9 +3,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
+#include "mapping/change/live_deviation.hpp"
 #include "mapping/inspection/live_inspection.hpp"
 #include "ros/bridge/ros_connection.hpp"
 #include "ros/conversions/navigation_input.hpp"
@@ -57,6 +59,9 @@ struct InspectionNodeOptions {
   // idle_stop_s after the first (0: never): for replays and tests.
   std::int64_t max_frames = 0;
   double idle_stop_s = 0.0;
+  // When set, the published map carries each point's deviation from this reference (a float
+  // field "deviation", metres, NaN where none; LiveDeviation), for RViz to colour by.
+  std::shared_ptr<const mapping::LiveDeviation> reference;
   void Check() const;  // throws uwscan::Error naming the field
 };
 

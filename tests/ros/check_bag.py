@@ -3,11 +3,13 @@
 and prints one JSON line per topic: type, message count, first and last header stamp, frame ids
 seen, whether header stamps never go back, and for some types what they hold (the last path's
 positions, the last marker array's labels, every pose's position, the last cloud's point
-count and the last pose array's size). Used by tests/cli_ros_test.cpp."""
+count and fields (and the share of finite values of a "deviation" field) and the last pose
+array's size). Used by tests/cli_ros_test.cpp."""
 import json
 import sys
 
 import rosbag
+from sensor_msgs import point_cloud2
 
 
 def main():
@@ -41,6 +43,11 @@ def main():
             entry.setdefault("positions", []).append([p.x, p.y, p.z])
         if message._type == "sensor_msgs/PointCloud2":
             entry["last_points"] = message.width * message.height
+            entry["last_fields"] = [f.name for f in message.fields]
+            if "deviation" in entry["last_fields"]:
+                values = [v[0] for v in point_cloud2.read_points(message, field_names=["deviation"])]
+                finite = [v for v in values if v == v]
+                entry["last_finite_share"] = len(finite) / max(1, len(values))
         if message._type == "geometry_msgs/PoseArray":
             entry["last_poses"] = len(message.poses)
         if topic.endswith("/path") and hasattr(message, "poses"):
