@@ -47,3 +47,13 @@ mkdir -p docs
 "$UWSCAN" bench stripe --json "$work/stripe.json" >/dev/null
 "$UWSCAN" plot "$work/stripe.json" -o docs/stripe_tradeoff.png
 echo "make_docs_pictures: docs/*.png written"
+
+# What the inspection found: two surveys of the change scenes mapped by SLAM, the second against
+# the first; significant deviations in the diverging colours, the largest regions labelled.
+"$UWSCAN" simulate data/scenes/change_before.yaml -o "$work/before.db" >/dev/null
+"$UWSCAN" simulate data/scenes/change_after.yaml -o "$work/after.db" >/dev/null
+"$UWSCAN" map "$work/before.db" -o "$work/before.ply" --json "$work/before.json" >/dev/null
+"$UWSCAN" map "$work/after.db" -o "$work/after.ply" --json "$work/after.json" >/dev/null
+"$UWSCAN" compare "$work/after.json" --reference "$work/before.json" -o "$work/changes.ply" \
+  --json "$work/changes.json" >/dev/null
+"$UWSCAN" view "$work/changes.json" --camera top --screenshot docs/findings.png --size 800x900

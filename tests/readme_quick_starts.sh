@@ -93,10 +93,11 @@ for pid in $(jobs -p); do kill -INT "$pid" 2>/dev/null || true; done; wait || tr
   fi
   adapt "$line" >>"$script"
 done < <(blocks_between "## Quick starts" "## Documentation")
-[ "$count" -ge 5 ] || { echo "quick starts: $count blocks found in README.md, expected 5" >&2; exit 1; }
+[ "$count" -ge 6 ] || { echo "quick starts: $count blocks found in README.md, expected 6" >&2; exit 1; }
 
 # What the blocks were to make, there.
 for f in inspect.db inspect_view.png objects.db recognition.json inspection.db map.ply map.json \
+         as_built.ply before.json after.json changes.ply changes.json changes.md \
          inspection.bag node.db node.ply step1.yaml step2.yaml; do
   [ -s "$f" ] || { echo "quick starts: $f was not written" >&2; exit 1; }
 done
