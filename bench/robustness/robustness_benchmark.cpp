@@ -335,17 +335,21 @@ DiveLogDamage CountDamage(const fs::path& damaged, const OriginalLog& original, 
   const ChildResult result = ReadInChild(
       [&] {
         DiveLogDamage damage;
-        int frames_back = 0, navigation_back = 0, silent = 0;
+        // Rows: frames, their ground truth, navigation samples. A frame handed over without its
+        // truth had its truth row flagged as damaged (DiveLogReader::Check): detected, not
+        // silent (every frame of the original has its truth).
+        int frames_back = 0, truths_back = 0, navigation_back = 0, silent = 0;
         try {
           const mapping::DiveLogReader reader(damaged);
           reader.Check(
               [&](const mapping::FrameRecord& frame, const mapping::GroundTruthRecord* truth) {
                 ++frames_back;
                 const std::size_t i = static_cast<std::size_t>(frame.index);
-                const bool same = i < original.frames.size() &&
-                                  SameFrame(frame, original.frames[i]) &&
-                                  SameTruth(truth, original.truths[i]);
-                if (!same) ++silent;
+                const bool known = i < original.frames.size();
+                if (!known || !SameFrame(frame, original.frames[i])) ++silent;
+                if (truth == nullptr) return;  // its truth row flagged
+                ++truths_back;
+                if (!known || !SameTruth(truth, original.truths[i])) ++silent;
               },
               [&](const mapping::NavigationRecord& nav) {
                 ++navigation_back;
@@ -360,8 +364,9 @@ DiveLogDamage CountDamage(const fs::path& damaged, const OriginalLog& original, 
         } catch (const Error&) {
           // Refused as a whole: nothing handed over.
         }
-        const int rows = static_cast<int>(original.frames.size() + original.navigation.size());
-        const int refused = rows - frames_back - navigation_back;
+        const int rows = static_cast<int>(original.frames.size() + original.truths.size() +
+                                          original.navigation.size());
+        const int refused = rows - frames_back - truths_back - navigation_back;
         damage.damaged_rows = refused + silent;
         damage.detected = refused;
         if (::write(report[1], &damage, sizeof(damage)) != sizeof(damage))

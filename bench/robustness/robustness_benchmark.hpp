@@ -33,8 +33,9 @@ struct ReaderOutcomes {
 };
 
 struct DiveLogDamage {
-  int damaged_rows = 0;  // rows (frames with their truth, navigation samples) whose content changed
-  int detected = 0;      // of those, flagged by the reader instead of handed over
+  int damaged_rows =
+      0;             // rows (frames, their ground truth, navigation samples) whose content changed
+  int detected = 0;  // of those, flagged by the reader instead of handed over
 };
 
 struct RobustnessResult {

@@ -56,7 +56,8 @@ std::vector<float> LiveDeviation::Deviations(std::span<const Eigen::Vector3d> po
   for (std::size_t i = 0; i < points_W.size(); ++i) {
     impl_->index->Query((points_W[i] - r.origin).cast<float>(), 1, nearest, d2);
     if (nearest.empty() || std::sqrt(d2.front()) > o.max_distance_m) continue;
-    const double d = r.normals[nearest.front()].cast<double>().dot(points_W[i] - r.Point(nearest.front()));
+    const double d =
+        r.normals[nearest.front()].cast<double>().dot(points_W[i] - r.Point(nearest.front()));
     if (std::abs(d) >= o.threshold_m) out[i] = static_cast<float>(d);
   }
   return out;
