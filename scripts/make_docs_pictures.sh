@@ -56,4 +56,4 @@ echo "make_docs_pictures: docs/*.png written"
 "$UWSCAN" map "$work/after.db" -o "$work/after.ply" --json "$work/after.json" >/dev/null
 "$UWSCAN" compare "$work/after.json" --reference "$work/before.json" -o "$work/changes.ply" \
   --json "$work/changes.json" >/dev/null
-"$UWSCAN" view "$work/changes.json" --camera top --screenshot docs/findings.png --size 800x900
+"$UWSCAN" view "$work/changes.json" --camera top --range -0.02 0.02 --screenshot docs/findings.png --size 800x900
