@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "mapping/change/change_report.hpp"
 #include "mapping/log/dive_log.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/features/descriptor_database.hpp"
@@ -121,6 +122,8 @@ std::vector<ReaderProbe> MakeProbes() {
        [](const fs::path& path) { return viewer::ReadMapReport(path).trajectories.size(); }},
       {"recognition_report", ".json",
        [](const fs::path& path) { return viewer::ReadRecognitionReport(path).objects.size(); }},
+      {"change_deviations", ".ply",
+       [](const fs::path& path) { return mapping::ReadDeviationsPly(path).points.size(); }},
       {"tum_trajectory", ".tum",
        [](const fs::path& path) { return viewer::ReadTumTrajectory(path).size(); }},
       {"bag", ".bag", ReadBag},

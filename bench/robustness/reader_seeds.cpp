@@ -2,10 +2,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "mapping/change/change_report.hpp"
 #include "mapping/log/dive_log.hpp"
 #include "mapping/log/dive_simulation.hpp"
 #include "perception/cloud/cloud_io.hpp"
@@ -194,6 +196,24 @@ void WriteReportSeeds(const fs::path& folder) {
                 "  {\"id\": \"unknown\", \"segment\": [0, 1], \"centroid_m\": [0, 0, 1.2]}]}\n");
 }
 
+// What `uwscan compare -o` writes, for three core points: one changed (in region 0), one not,
+// one not inspected.
+void WriteDeviationSeeds(const fs::path& folder) {
+  mapping::SurveyComparison c;
+  for (int i = 0; i < 3; ++i) {
+    mapping::CoreDeviation d;
+    d.point_W = Eigen::Vector3d(0.01 * i, 0.0, 10.0);
+    d.deviation_m = i == 2 ? NAN : 0.004 / (i + 1);
+    d.lod_m = i == 2 ? NAN : 0.001;
+    d.status = i == 0   ? mapping::SurfaceStatus::kChanged
+               : i == 1 ? mapping::SurfaceStatus::kUnchanged
+                        : mapping::SurfaceStatus::kNotInspected;
+    c.deviations.push_back(d);
+    c.region_of.push_back(i == 0 ? 0 : -1);
+  }
+  mapping::WriteDeviationsPly(folder / "change_deviations" / "seed_0.ply", c);
+}
+
 void RemoveLog(const fs::path& log) {
   for (const char* suffix : {"", "-wal", "-shm", "-journal"}) fs::remove(log.string() + suffix);
 }
@@ -257,6 +277,7 @@ void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
                              "descriptor_database",
                              "map_report",
                              "recognition_report",
+                             "change_deviations",
                              "tum_trajectory",
                              "bag"}) {
     fs::create_directories(folder / reader);
@@ -267,6 +288,7 @@ void WriteReaderSeeds(const fs::path& data_dir, const fs::path& folder) {
   perception::WriteCloud(folder / "cloud_pcd" / "seed_1.pcd", SeedCloud(false), false);
   WriteText(folder / "cloud_xyz" / "seed_0.xyz",
             "# x y z\n0.1 0.2 1.0\n0.11 0.2 1.01 7\n\n0.12 0.21 1.0\n");
+  WriteDeviationSeeds(folder);
   WriteMeshSeeds(folder);
 
   int n = 0;

@@ -85,7 +85,7 @@ DeviationsFile ReadDeviationsPly(const fs::path& path) {
                 ": not the deviations PLY `uwscan compare -o` writes (its properties differ)");
   }
   const std::string rows((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (rows.size() < static_cast<std::size_t>(count) * kRowBytes)
+  if (rows.size() / kRowBytes < static_cast<std::size_t>(count))  // no overflow for any count
     throw Error(path.string() + ": cut short (" + std::to_string(count) + " points declared)");
   DeviationsFile f;
   const char* at = rows.data();
