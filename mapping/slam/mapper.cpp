@@ -1,14 +1,13 @@
 #include "mapping/slam/mapper.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
 
+#include "mapping/slam/mapper_impl.hpp"
 #include "mapping/slam/navigation_buffer.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
-#include "mapping/slam/overlap_gate.hpp"
 #include "mapping/slam/registration_information.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "perception/registration/icp.hpp"
@@ -19,11 +18,9 @@
 namespace uwscan::mapping {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double Since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using mapper_steps::AppendMoved;
+using mapper_steps::Clock;
+using mapper_steps::Since;
 
 // Frames waiting for navigation beyond this many mean the navigation has stopped.
 constexpr std::size_t kMaxWaitingFrames = 20000;
@@ -31,37 +28,12 @@ constexpr std::size_t kMaxWaitingFrames = 20000;
 constexpr double kStartSigma_m = 0.001;
 constexpr double kStartSigma_rad = 0.001;
 
-// Appends `cloud` (points and normals) moved by T to `out`, whose origin is 0.
-void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isometry3d& T,
-                 perception::PointCloud* out) {
-  const Eigen::Matrix3f R = T.linear().cast<float>();
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    out->points.push_back((T * cloud.Point(i)).cast<float>());
-    if (cloud.has_normals()) out->normals.push_back(R * cloud.normals[i]);
-  }
-}
-
 // Information along world axes [w_W, t_W] holding only heading, x and y: the start fix.
 Matrix6d StartInformation() {
   Matrix6d info = Matrix6d::Zero();
   info(2, 2) = 1.0 / (kStartSigma_rad * kStartSigma_rad);
   info(3, 3) = info(4, 4) = 1.0 / (kStartSigma_m * kStartSigma_m);
   return info;
-}
-
-// Covariance of the position of `to` seen from `from`'s frame, from the [w, v] covariance of
-// T_from_to: the rotation moves it by w x t.
-Eigen::Matrix3d PositionCovariance(const Matrix6d& covariance, const Eigen::Vector3d& t) {
-  Eigen::Matrix<double, 3, 6> J;
-  Eigen::Matrix3d minus_skew;
-  minus_skew << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;
-  J << minus_skew, Eigen::Matrix3d::Identity();
-  return J * covariance * J.transpose();
-}
-
-double LargestStd(const Eigen::Matrix3d& covariance) {
-  return std::sqrt(
-      std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
 }
 
 // The ICP of a registration with the given stages, as MapperOptions sets it.
@@ -121,114 +93,6 @@ void MapperOptions::Check() const {
   RegistrationIcp(*this, icp_distances_m).Check();
   RegistrationIcp(*this, loop_icp_distances_m).Check();
 }
-
-struct Mapper::Impl {
-  MapperOptions options;
-  Eigen::Isometry3d T_V_C;
-  NavigationUncertainty uncertainty;
-  std::unique_ptr<scanner::Triangulator> triangulator;
-  NavigationBuffer navigation;
-  std::deque<FrameRecord> waiting;
-  bool finished = false;
-  Mapper::FramePlacedCallback on_placed;
-  Mapper::FrameLeftOutCallback on_left_out;
-
-  // The submap being filled: points in the navigation's world frame, and its frames. Its frames
-  // are placed with the navigation corrected by the calibration estimated when it opened, about
-  // the navigation's position at its first frame.
-  std::vector<Eigen::Vector3d> points_W;
-  DeadReckoningCalibration placement;
-  Eigen::Vector3d placement_origin_W = Eigen::Vector3d::Zero();
-  std::vector<std::pair<std::int64_t, double>> frames;  // index, time
-  int first_sweep = 0;
-  std::vector<scanner::TriangulatedPoint> triangulated;
-
-  // Submap i has two nodes in the graph: its anchor (the vehicle at its middle frame, which
-  // the navigation measures) and its scan (the pose at which its cloud, bent by the navigation
-  // that placed its frames, fits the scene best, which registration measures); a distortion
-  // edge ties them (SubmapDistortionCovariance). Bending is then a bounded offset per submap,
-  // not a step that accumulates along a chain of registrations.
-  std::vector<Submap> submaps;
-  std::vector<Matrix6d>
-      increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
-  PoseGraph graph;
-  std::vector<LoopClosure> loops;
-  MapperStats stats;
-  int since_solve = 0;
-
-  Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
-      : options(o), T_V_C(mount), uncertainty(noise) {}
-
-  // Places the waiting frames the navigation covers, leaves out those it never will; at the
-  // end of the dive (`finishing`) also those after its last sample.
-  void Drain(bool finishing);
-  void Place(const FrameRecord& frame);
-  void CloseSubmap();
-  void AddToGraph(Submap submap);
-  // A submap registered to the ones before it (AddToGraph), step by step.
-  struct ConsecutiveRegistration {
-    Eigen::Isometry3d anchor_initial = Eigen::Isometry3d::Identity();  // where its nodes start
-    Eigen::Isometry3d scan_initial = Eigen::Isometry3d::Identity();
-    Matrix6d increment_cov = Matrix6d::Zero();     // of the scan's motion since the previous one
-    std::optional<RelativePoseEdge> registration;  // when it was kept
-    Matrix6d slides = Matrix6d::Zero();            // how loosely the scan is tied along free slides
-  };
-  ConsecutiveRegistration RegisterToPrevious(const Submap& submap, int k);
-  perception::PointCloud LocalMap(int k) const;
-  void AddNodesAndEdges(const Submap& submap, int k, const ConsecutiveRegistration& c);
-  void CloseLoopsAndSolve(int k);
-  perception::RegistrationResult Register(const Submap& source,
-                                          const perception::PointCloud& target,
-                                          const Eigen::Isometry3d& T_init,
-                                          const Matrix6d& prior_covariance,
-                                          const std::vector<double>& distances) const;
-  // The registration's own information (its pairs), weak directions removed. It relates the
-  // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
-  // `kept`, when given, receives what the pairs alone pin (KeptDirections).
-  Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
-                                   const Submap& source, KeptDirections* kept = nullptr) const;
-  // How far a submap's effective pose may sit from its anchor's navigation pose.
-  Matrix6d Distortion(const Submap& s, SystematicErrors systematic_errors) const;
-  // The navigation's motion between two submaps' effective poses (in a's frame).
-  // Everything it may be off by: the scale error and misalignment as noise, as the
-  // calibration may still be settling.
-  Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
-  Matrix6d ChainCovariance(int from, int to) const;
-  // Loop closures (TryLoopClosures), step by step.
-  struct LoopCandidate {
-    int j;                // the earlier submap
-    double distance;      // between the two centres, as the graph places them now
-    Matrix6d covariance;  // of T_j_k, predicted along the chain between them
-  };
-  void TryLoopClosures(int k);
-  std::vector<LoopCandidate> LoopCandidates(int k) const;
-  perception::PointCloud LoopTarget(int j,
-                                    int k) const;  // submap j with its neighbours, in j's frame
-  std::vector<double> LoopIcpDistances(const LoopCandidate& c,
-                                       const Eigen::Isometry3d& T_pred) const;
-  LoopClosure JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c, int k,
-                        const Eigen::Isometry3d& T_pred) const;
-  std::string LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
-                            const Matrix6d& information, const Matrix6d& prediction_covariance,
-                            const Eigen::Isometry3d& T_pred, double* chi2) const;
-  void Solve(bool last = false);  // last: the solve at Finish, to the full tolerance
-  static int AnchorNode(int submap) { return 2 * submap; }
-  static int ScanNode(int submap) { return 2 * submap + 1; }
-  Eigen::Isometry3d AnchorPose(int submap) const { return graph.pose(AnchorNode(submap)); }
-  Eigen::Isometry3d ScanPose(int submap) const { return graph.pose(ScanNode(submap)); }
-  SystematicErrors systematic() const {
-    return options.estimate_dead_reckoning_calibration ? SystematicErrors::kEstimated
-                                                       : SystematicErrors::kAsNoise;
-  }
-  // The navigation at t (held at its ends) with its motion since the submap's first frame
-  // corrected by the placement calibration.
-  Eigen::Isometry3d PlacementPose(double time_s) const {
-    Eigen::Isometry3d T_W_V = navigation.T_W_V(navigation.HeldTime(time_s));
-    T_W_V.translation() =
-        placement_origin_W + placement.Correct(T_W_V.translation() - placement_origin_W);
-    return T_W_V;
-  }
-};
 
 void Mapper::Impl::Drain(bool finishing) {
   while (!waiting.empty()) {
@@ -484,123 +348,6 @@ void Mapper::Impl::CloseLoopsAndSolve(int k) {
 // Loop closures for submap k: the earlier submaps whose overlap with it is plausible, nearest
 // first, each registered from the predicted pose and judged (JudgeLoop); an accepted one becomes
 // an edge between the two scans.
-void Mapper::Impl::TryLoopClosures(int k) {
-  if (options.max_loop_candidates == 0 || k % options.loop_every_submaps != 0) return;
-  const Clock::time_point start = Clock::now();
-  for (const LoopCandidate& c : LoopCandidates(k)) {
-    const Eigen::Isometry3d T_pred = ScanPose(c.j).inverse() * ScanPose(k);
-    const perception::RegistrationResult r =
-        Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), T_pred, c.covariance,
-                 LoopIcpDistances(c, T_pred));
-    const LoopClosure loop = JudgeLoop(r, c, k, T_pred);
-    if (loop.accepted) {
-      graph.AddEdge({.from = ScanNode(c.j),
-                     .to = ScanNode(k),
-                     .T_from_to = r.T_target_source,
-                     .information = loop.information,
-                     .robust = true});
-    }
-    loops.push_back(loop);
-  }
-  stats.loop_s += Since(start);
-}
-
-std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) const {
-  const Submap& current = submaps[static_cast<size_t>(k)];
-  const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
-  std::vector<LoopCandidate> candidates;
-  for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
-    const Submap& old = submaps[static_cast<size_t>(j)];
-    const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
-    const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
-    if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
-    // In j's frame: how far k's centre is predicted from j's, and how uncertain that is.
-    const Matrix6d covariance = ChainCovariance(j, k);
-    const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
-    const Eigen::Vector3d gap_m = centre_k_in_j - old.centroid_V;
-    if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <=
-          options.gate_sigmas)) {
-      continue;
-    }
-    candidates.push_back({j, distance, covariance});
-  }
-  std::stable_sort(
-      candidates.begin(), candidates.end(),
-      [](const LoopCandidate& a, const LoopCandidate& b) { return a.distance < b.distance; });
-  if (candidates.size() > static_cast<size_t>(options.max_loop_candidates)) {
-    candidates.resize(static_cast<size_t>(options.max_loop_candidates));
-  }
-  return candidates;
-}
-
-perception::PointCloud Mapper::Impl::LoopTarget(int j, int k) const {
-  perception::PointCloud target;
-  for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
-    AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i),
-                &target);
-  }
-  return target;
-}
-
-std::vector<double> Mapper::Impl::LoopIcpDistances(const LoopCandidate& c,
-                                                   const Eigen::Isometry3d& T_pred) const {
-  // The first stage reaches as far as the prediction may be off: three times the largest
-  // position std of the scan's origin (the gate asked the narrower question, whether the two
-  // centres can meet at all).
-  std::vector<double> distances = options.loop_icp_distances_m;
-  const double reach =
-      options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, T_pred.translation()));
-  if (reach > distances.front()) distances.insert(distances.begin(), reach);
-  return distances;
-}
-
-LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c,
-                                    int k, const Eigen::Isometry3d& T_pred) const {
-  LoopClosure loop;
-  loop.from = c.j;
-  loop.to = k;
-  loop.fitness = r.fitness;
-  loop.T_from_to = r.T_target_source;
-  KeptDirections kept;
-  loop.information = RegistrationInformation(r, submaps[static_cast<size_t>(c.j)],
-                                             submaps[static_cast<size_t>(k)], &kept);
-  loop.constrained_directions = kept.count;
-  loop.reason = LoopRejection(r, kept, loop.information, c.covariance, T_pred, &loop.chi2);
-  loop.accepted = loop.reason.empty();
-  return loop;
-}
-
-// Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
-// others, as for consecutive submaps, are left to the navigation), and the registration must be
-// certain and consistent with the prediction in them. "" when it is.
-std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r,
-                                        const KeptDirections& kept, const Matrix6d& information,
-                                        const Matrix6d& prediction_covariance,
-                                        const Eigen::Isometry3d& T_pred, double* chi2) const {
-  const int constrained = kept.count;
-  const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
-  const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
-  if (r.fitness < options.loop_min_fitness) {
-    return "fitness " + std::to_string(r.fitness) + " below " +
-           std::to_string(options.loop_min_fitness);
-  }
-  if (constrained < options.loop_min_directions) {
-    return "degenerate: the scans pin " + std::to_string(constrained) + " directions, fewer than " +
-           std::to_string(options.loop_min_directions);
-  }
-  if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
-    return "uncertain: registration std " + std::to_string(sigma_m) + " m, " +
-           std::to_string(sigma_rad) + " rad";
-  }
-  const Vector6d innovation = PoseError(r.T_target_source, T_pred);
-  *chi2 = innovation.dot(InformationOfSum(information, prediction_covariance) * innovation);
-  if (!(*chi2 <= Chi2Quantile999(constrained))) {
-    return "inconsistent with the prediction: chi2 " + std::to_string(*chi2) + " in " +
-           std::to_string(constrained) + " directions";
-  }
-  return "";
-}
-
 void Mapper::Impl::Solve(bool last) {
   const Clock::time_point start = Clock::now();
   PoseGraphOptions solve;

@@ -1,0 +1,150 @@
+#pragma once
+
+// Mapper's state and the declarations of its steps, shared by the files that define them
+// (mapper.cpp: frames, submaps, consecutive registration, the graph; mapper_loops.cpp: loop
+// closures). Internal to mapping/slam.
+
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mapping/slam/mapper.hpp"
+#include "mapping/slam/navigation_buffer.hpp"
+#include "mapping/slam/navigation_uncertainty.hpp"
+#include "mapping/slam/registration_information.hpp"
+#include "perception/registration/registration_result.hpp"
+
+namespace uwscan::mapping {
+namespace mapper_steps {
+
+using Clock = std::chrono::steady_clock;
+
+inline double Since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Appends `cloud` (points and normals) moved by T to `out`, whose origin is 0.
+inline void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isometry3d& T,
+                 perception::PointCloud* out) {
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    out->points.push_back((T * cloud.Point(i)).cast<float>());
+    if (cloud.has_normals()) out->normals.push_back(R * cloud.normals[i]);
+  }
+}
+
+}  // namespace mapper_steps
+
+struct Mapper::Impl {
+  MapperOptions options;
+  Eigen::Isometry3d T_V_C;
+  NavigationUncertainty uncertainty;
+  std::unique_ptr<scanner::Triangulator> triangulator;
+  NavigationBuffer navigation;
+  std::deque<FrameRecord> waiting;
+  bool finished = false;
+  Mapper::FramePlacedCallback on_placed;
+  Mapper::FrameLeftOutCallback on_left_out;
+
+  // The submap being filled: points in the navigation's world frame, and its frames. Its frames
+  // are placed with the navigation corrected by the calibration estimated when it opened, about
+  // the navigation's position at its first frame.
+  std::vector<Eigen::Vector3d> points_W;
+  DeadReckoningCalibration placement;
+  Eigen::Vector3d placement_origin_W = Eigen::Vector3d::Zero();
+  std::vector<std::pair<std::int64_t, double>> frames;  // index, time
+  int first_sweep = 0;
+  std::vector<scanner::TriangulatedPoint> triangulated;
+
+  // Submap i has two nodes in the graph: its anchor (the vehicle at its middle frame, which
+  // the navigation measures) and its scan (the pose at which its cloud, bent by the navigation
+  // that placed its frames, fits the scene best, which registration measures); a distortion
+  // edge ties them (SubmapDistortionCovariance). Bending is then a bounded offset per submap,
+  // not a step that accumulates along a chain of registrations.
+  std::vector<Submap> submaps;
+  std::vector<Matrix6d>
+      increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
+  PoseGraph graph;
+  std::vector<LoopClosure> loops;
+  MapperStats stats;
+  int since_solve = 0;
+
+  Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
+      : options(o), T_V_C(mount), uncertainty(noise) {}
+
+  // Places the waiting frames the navigation covers, leaves out those it never will; at the
+  // end of the dive (`finishing`) also those after its last sample.
+  void Drain(bool finishing);
+  void Place(const FrameRecord& frame);
+  void CloseSubmap();
+  void AddToGraph(Submap submap);
+  // A submap registered to the ones before it (AddToGraph), step by step.
+  struct ConsecutiveRegistration {
+    Eigen::Isometry3d anchor_initial = Eigen::Isometry3d::Identity();  // where its nodes start
+    Eigen::Isometry3d scan_initial = Eigen::Isometry3d::Identity();
+    Matrix6d increment_cov = Matrix6d::Zero();     // of the scan's motion since the previous one
+    std::optional<RelativePoseEdge> registration;  // when it was kept
+    Matrix6d slides = Matrix6d::Zero();            // how loosely the scan is tied along free slides
+  };
+  ConsecutiveRegistration RegisterToPrevious(const Submap& submap, int k);
+  perception::PointCloud LocalMap(int k) const;
+  void AddNodesAndEdges(const Submap& submap, int k, const ConsecutiveRegistration& c);
+  void CloseLoopsAndSolve(int k);
+  perception::RegistrationResult Register(const Submap& source,
+                                          const perception::PointCloud& target,
+                                          const Eigen::Isometry3d& T_init,
+                                          const Matrix6d& prior_covariance,
+                                          const std::vector<double>& distances) const;
+  // The registration's own information (its pairs), weak directions removed. It relates the
+  // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
+  // `kept`, when given, receives what the pairs alone pin (KeptDirections).
+  Matrix6d RegistrationInformation(const perception::RegistrationResult& r, const Submap& target,
+                                   const Submap& source, KeptDirections* kept = nullptr) const;
+  // How far a submap's effective pose may sit from its anchor's navigation pose.
+  Matrix6d Distortion(const Submap& s, SystematicErrors systematic_errors) const;
+  // The navigation's motion between two submaps' effective poses (in a's frame).
+  // Everything it may be off by: the scale error and misalignment as noise, as the
+  // calibration may still be settling.
+  Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
+  Matrix6d ChainCovariance(int from, int to) const;
+  // Loop closures (TryLoopClosures), step by step.
+  struct LoopCandidate {
+    int j;                // the earlier submap
+    double distance;      // between the two centres, as the graph places them now
+    Matrix6d covariance;  // of T_j_k, predicted along the chain between them
+  };
+  void TryLoopClosures(int k);
+  std::vector<LoopCandidate> LoopCandidates(int k) const;
+  perception::PointCloud LoopTarget(int j,
+                                    int k) const;  // submap j with its neighbours, in j's frame
+  std::vector<double> LoopIcpDistances(const LoopCandidate& c,
+                                       const Eigen::Isometry3d& T_pred) const;
+  LoopClosure JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c, int k,
+                        const Eigen::Isometry3d& T_pred) const;
+  std::string LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
+                            const Matrix6d& information, const Matrix6d& prediction_covariance,
+                            const Eigen::Isometry3d& T_pred, double* chi2) const;
+  void Solve(bool last = false);  // last: the solve at Finish, to the full tolerance
+  static int AnchorNode(int submap) { return 2 * submap; }
+  static int ScanNode(int submap) { return 2 * submap + 1; }
+  Eigen::Isometry3d AnchorPose(int submap) const { return graph.pose(AnchorNode(submap)); }
+  Eigen::Isometry3d ScanPose(int submap) const { return graph.pose(ScanNode(submap)); }
+  SystematicErrors systematic() const {
+    return options.estimate_dead_reckoning_calibration ? SystematicErrors::kEstimated
+                                                       : SystematicErrors::kAsNoise;
+  }
+  // The navigation at t (held at its ends) with its motion since the submap's first frame
+  // corrected by the placement calibration.
+  Eigen::Isometry3d PlacementPose(double time_s) const {
+    Eigen::Isometry3d T_W_V = navigation.T_W_V(navigation.HeldTime(time_s));
+    T_W_V.translation() =
+        placement_origin_W + placement.Correct(T_W_V.translation() - placement_origin_W);
+    return T_W_V;
+  }
+};
+
+}  // namespace uwscan::mapping

@@ -1,0 +1,151 @@
+// Mapper's loop closures: candidates, their registration and the gates a loop must pass.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "mapping/slam/mapper_impl.hpp"
+#include "mapping/slam/overlap_gate.hpp"
+#include "perception/registration/icp.hpp"
+
+namespace uwscan::mapping {
+namespace {
+
+using mapper_steps::AppendMoved;
+using mapper_steps::Clock;
+using mapper_steps::Since;
+
+// Covariance of the position of `to` seen from `from`'s frame, from the [w, v] covariance of
+// T_from_to: the rotation moves it by w x t.
+Eigen::Matrix3d PositionCovariance(const Matrix6d& covariance, const Eigen::Vector3d& t) {
+  Eigen::Matrix<double, 3, 6> J;
+  Eigen::Matrix3d minus_skew;
+  minus_skew << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;
+  J << minus_skew, Eigen::Matrix3d::Identity();
+  return J * covariance * J.transpose();
+}
+
+double LargestStd(const Eigen::Matrix3d& covariance) {
+  return std::sqrt(
+      std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
+}
+
+}  // namespace
+
+void Mapper::Impl::TryLoopClosures(int k) {
+  if (options.max_loop_candidates == 0 || k % options.loop_every_submaps != 0) return;
+  const Clock::time_point start = Clock::now();
+  for (const LoopCandidate& c : LoopCandidates(k)) {
+    const Eigen::Isometry3d T_pred = ScanPose(c.j).inverse() * ScanPose(k);
+    const perception::RegistrationResult r =
+        Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), T_pred, c.covariance,
+                 LoopIcpDistances(c, T_pred));
+    const LoopClosure loop = JudgeLoop(r, c, k, T_pred);
+    if (loop.accepted) {
+      graph.AddEdge({.from = ScanNode(c.j),
+                     .to = ScanNode(k),
+                     .T_from_to = r.T_target_source,
+                     .information = loop.information,
+                     .robust = true});
+    }
+    loops.push_back(loop);
+  }
+  stats.loop_s += Since(start);
+}
+
+std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) const {
+  const Submap& current = submaps[static_cast<size_t>(k)];
+  const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
+  std::vector<LoopCandidate> candidates;
+  for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
+    const Submap& old = submaps[static_cast<size_t>(j)];
+    const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
+    const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
+    if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
+    // In j's frame: how far k's centre is predicted from j's, and how uncertain that is.
+    const Matrix6d covariance = ChainCovariance(j, k);
+    const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
+    const Eigen::Vector3d gap_m = centre_k_in_j - old.centroid_V;
+    if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <=
+          options.gate_sigmas)) {
+      continue;
+    }
+    candidates.push_back({j, distance, covariance});
+  }
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const LoopCandidate& a, const LoopCandidate& b) { return a.distance < b.distance; });
+  if (candidates.size() > static_cast<size_t>(options.max_loop_candidates)) {
+    candidates.resize(static_cast<size_t>(options.max_loop_candidates));
+  }
+  return candidates;
+}
+
+perception::PointCloud Mapper::Impl::LoopTarget(int j, int k) const {
+  perception::PointCloud target;
+  for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
+    AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i),
+                &target);
+  }
+  return target;
+}
+
+std::vector<double> Mapper::Impl::LoopIcpDistances(const LoopCandidate& c,
+                                                   const Eigen::Isometry3d& T_pred) const {
+  // The first stage reaches as far as the prediction may be off: three times the largest
+  // position std of the scan's origin (the gate asked the narrower question, whether the two
+  // centres can meet at all).
+  std::vector<double> distances = options.loop_icp_distances_m;
+  const double reach =
+      options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, T_pred.translation()));
+  if (reach > distances.front()) distances.insert(distances.begin(), reach);
+  return distances;
+}
+
+LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c,
+                                    int k, const Eigen::Isometry3d& T_pred) const {
+  LoopClosure loop;
+  loop.from = c.j;
+  loop.to = k;
+  loop.fitness = r.fitness;
+  loop.T_from_to = r.T_target_source;
+  KeptDirections kept;
+  loop.information = RegistrationInformation(r, submaps[static_cast<size_t>(c.j)],
+                                             submaps[static_cast<size_t>(k)], &kept);
+  loop.constrained_directions = kept.count;
+  loop.reason = LoopRejection(r, kept, loop.information, c.covariance, T_pred, &loop.chi2);
+  loop.accepted = loop.reason.empty();
+  return loop;
+}
+
+// Along a pipe or over a flat seabed a loop pins only some directions: those are kept (the
+// others, as for consecutive submaps, are left to the navigation), and the registration must be
+// certain and consistent with the prediction in them. "" when it is.
+std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r,
+                                        const KeptDirections& kept, const Matrix6d& information,
+                                        const Matrix6d& prediction_covariance,
+                                        const Eigen::Isometry3d& T_pred, double* chi2) const {
+  const int constrained = kept.count;
+  const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
+  const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
+  if (r.fitness < options.loop_min_fitness) {
+    return "fitness " + std::to_string(r.fitness) + " below " +
+           std::to_string(options.loop_min_fitness);
+  }
+  if (constrained < options.loop_min_directions) {
+    return "degenerate: the scans pin " + std::to_string(constrained) + " directions, fewer than " +
+           std::to_string(options.loop_min_directions);
+  }
+  if (sigma_m > options.loop_max_sigma_m || sigma_rad > options.loop_max_sigma_rad) {
+    return "uncertain: registration std " + std::to_string(sigma_m) + " m, " +
+           std::to_string(sigma_rad) + " rad";
+  }
+  const Vector6d innovation = PoseError(r.T_target_source, T_pred);
+  *chi2 = innovation.dot(InformationOfSum(information, prediction_covariance) * innovation);
+  if (!(*chi2 <= Chi2Quantile999(constrained))) {
+    return "inconsistent with the prediction: chi2 " + std::to_string(*chi2) + " in " +
+           std::to_string(constrained) + " directions";
+  }
+  return "";
+}
+
+}  // namespace uwscan::mapping
