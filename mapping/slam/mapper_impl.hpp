@@ -29,7 +29,7 @@ inline double Since(Clock::time_point start) {
 
 // Appends `cloud` (points and normals) moved by T to `out`, whose origin is 0.
 inline void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isometry3d& T,
-                 perception::PointCloud* out) {
+                        perception::PointCloud* out) {
   const Eigen::Matrix3f R = T.linear().cast<float>();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     out->points.push_back((T * cloud.Point(i)).cast<float>());
