@@ -10,6 +10,7 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
+#include "apps/cli/reference_options.hpp"
 #include "mapping/change/change_report.hpp"
 #include "mapping/change/compare_surveys.hpp"
 #include "scanner/common/atomic_file.hpp"
@@ -29,10 +30,6 @@ struct CompareArgs {
   mapping::CompareOptions options;
   int threads = 0;
 };
-
-double UnitsToMetres(const std::string& units) {
-  return units == "mm" ? 1e-3 : units == "cm" ? 1e-2 : 1.0;
-}
 
 Eigen::Isometry3d TransformOf(const std::vector<double>& v) {
   const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
@@ -119,7 +116,7 @@ void AddCompareCommand(CLI::App& app) {
   cmd->add_option("--markdown", a->markdown, "the regions as a Markdown table");
   cmd->add_option("--reference-units", a->reference_units, "the reference file's unit")
       ->capture_default_str()
-      ->check(CLI::IsMember({"m", "cm", "mm"}));
+      ->check(kReferenceUnits);
   cmd->add_option("--transform", a->transform,
                   "T_reference_map as tx ty tz qx qy qz qw (metres): no global registration")
       ->expected(7);

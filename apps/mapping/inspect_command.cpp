@@ -14,9 +14,9 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
+#include "apps/cli/reference_options.hpp"
 #include "apps/cli/stop_signal.hpp"
 #include "apps/scanner/camera_frames.hpp"
-#include "mapping/change/live_deviation.hpp"
 #include "mapping/inspection/live_inspection.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
@@ -45,20 +45,14 @@ struct InspectArgs {
   double voxel_m = 0.005;
   int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
   int threads = 0;
-  std::string reference;  // the live map coloured by its deviation from it
-  std::string reference_units = "m";
-  double live_threshold_m = mapping::LiveDeviationOptions{}.threshold_m;
+  LiveReferenceArgs reference;  // the live map coloured by its deviation from it
 };
 
 // The reference the live map is coloured against (--reference), read before the camera opens.
 std::unique_ptr<mapping::LiveDeviation> LoadReference(const InspectArgs& a, bool view) {
-  if (a.reference.empty()) return nullptr;
-  if (!view) throw Error("--reference: colours the live view; give --view or --screenshot");
-  mapping::SurveyReadOptions read;
-  read.units_to_m = a.reference_units == "mm" ? 1e-3 : a.reference_units == "cm" ? 1e-2 : 1.0;
-  mapping::LiveDeviationOptions options;
-  options.threshold_m = a.live_threshold_m;
-  return std::make_unique<mapping::LiveDeviation>(mapping::ReadSurvey(a.reference, read), options);
+  if (!a.reference.path.empty() && !view)
+    throw Error("--reference: colours the live view; give --view or --screenshot");
+  return LoadLiveReference(a.reference);
 }
 
 void PrintStatus(const ReadSummary& r, const mapping::InspectionStatistics& s, double seconds,
@@ -300,18 +294,9 @@ void AddInspectCommand(CLI::App& app) {
   cmd->add_option("--threads", a->threads, "threads of the mapper's ICP and normals (0: all cores)")
       ->check(kNonNegativeNumber);
   cmd->add_flag("--force", a->force, "replace an existing log at the --log path");
-  cmd->add_option("--reference", a->reference,
-                  "colour the live map by its deviation from this design model, earlier map "
-                  "report or cloud, in the map's frame (with --view or --screenshot; the findings "
-                  "and their significance: `uwscan compare` afterwards)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--reference-units", a->reference_units, "the reference file's unit")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"m", "cm", "mm"}));
-  cmd->add_option("--live-threshold", a->live_threshold_m,
-                  "metres: live deviations smaller than this are drawn as no change")
-      ->capture_default_str()
-      ->check(kNonNegativeNumber);
+  AddLiveReferenceOptions(*cmd, a->reference,
+                          "the live map coloured by its deviation from it (with --view or "
+                          "--screenshot)");
   cmd->callback([a] { RunInspect(*a); });
 }
 

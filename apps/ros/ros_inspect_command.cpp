@@ -12,11 +12,11 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
+#include "apps/cli/reference_options.hpp"
 #include "apps/cli/stop_signal.hpp"
 #include "apps/ros/ros_arguments.hpp"
 #include "apps/ros/ros_recognize_command.hpp"
 #include "apps/scanner/camera_frames.hpp"
-#include "mapping/change/live_deviation.hpp"
 #include "mapping/slam/trajectory_metrics.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "ros/node/inspection_node.hpp"
@@ -38,9 +38,7 @@ struct RosInspectArgs {
   double idle_stop_s = 0.0;
   double master_wait_s = 10.0;
   bool force = false;
-  std::string reference;  // the published map carries its deviation from it
-  std::string reference_units = "m";
-  double live_threshold_m = mapping::LiveDeviationOptions{}.threshold_m;
+  LiveReferenceArgs reference;             // the published map carries its deviation from it
   std::vector<std::string> ros_arguments;  // name:=value
 };
 
@@ -109,14 +107,7 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
     header.scan_pattern.kind = header.scanner.kind();
     o.header = header;
   }
-  if (!a.reference.empty()) {
-    mapping::SurveyReadOptions read;
-    read.units_to_m = a.reference_units == "mm" ? 1e-3 : a.reference_units == "cm" ? 1e-2 : 1.0;
-    mapping::LiveDeviationOptions live;
-    live.threshold_m = a.live_threshold_m;
-    o.reference = std::make_shared<const mapping::LiveDeviation>(
-        mapping::ReadSurvey(a.reference, read), live);
-  }
+  o.reference = LoadLiveReference(a.reference);
   o.description_wait_s = ros.Param("description_wait_s", o.description_wait_s);
   o.mount_wait_s = ros.Param("mount_wait_s", o.mount_wait_s);
   o.map_period_s = ros.Param("map_period_s", o.map_period_s);
@@ -278,18 +269,9 @@ void AddRosCommands(CLI::App& app) {
   cmd->add_option("--trajectory", a->trajectory,
                   "SLAM trajectory at the submaps' anchors to write at the end (TUM)");
   cmd->add_option("--json", a->json, "figures as JSON at the end");
-  cmd->add_option("--reference", a->reference,
-                  "design model, earlier map report or cloud (uwscan's world frame): the "
-                  "published map carries each point's deviation from it, field \"deviation\" "
-                  "(metres, NaN where none), for RViz to colour by")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--reference-units", a->reference_units, "the reference file's unit")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"m", "cm", "mm"}));
-  cmd->add_option("--live-threshold", a->live_threshold_m,
-                  "metres: deviations smaller than this are published as NaN (no change)")
-      ->capture_default_str()
-      ->check(kNonNegativeNumber);
+  AddLiveReferenceOptions(*cmd, a->reference,
+                          "the published map carries each point's deviation from it, field "
+                          "\"deviation\" (metres), for RViz to colour by");
   cmd->add_option("--frames", a->frames, "stop after this many frames")->check(kPositiveNumber);
   cmd->add_option("--idle-stop-s", a->idle_stop_s,
                   "stop when frames stopped coming this long (replays)")

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <optional>
 
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/json_fields.hpp"
+#include "scanner/common/ply_reader.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::mapping {
@@ -22,17 +22,6 @@ constexpr double kMaxDesignSamples = 50e6;
 std::string Lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
   return s;
-}
-
-// The face count a PLY header declares; nullopt without a face element.
-std::optional<long long> PlyFaceCount(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  for (int i = 0; i < 200 && std::getline(in, line); ++i) {
-    if (line.rfind("end_header", 0) == 0) break;
-    if (line.rfind("element face ", 0) == 0) return std::atoll(line.c_str() + 13);
-  }
-  return std::nullopt;
 }
 
 Eigen::Isometry3d TumPose(const std::vector<double>& row) {
@@ -150,7 +139,7 @@ Survey ReadSurvey(const fs::path& path, const SurveyReadOptions& options) {
   if (extension == ".obj" || extension == ".stl" || extension == ".off")
     return ReadDesign(path, options);
   if (extension == ".ply") {
-    const std::optional<long long> faces = PlyFaceCount(path);
+    const std::optional<long long> faces = scanner::PlyFaceCount(path);
     if (faces && *faces <= 0) {
       throw Error(path.string() +
                   ": a mesh without faces (its face element is empty); give a cloud without a "

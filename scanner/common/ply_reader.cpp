@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <initializer_list>
 #include <limits>
 #include <optional>
@@ -388,6 +389,19 @@ PlyContent ReadPly(const fs::path& path, bool faces) {
   BodyReader reader(body, header.encoding, name, faces);
   for (const Element& element : header.elements) reader.Read(element);
   return reader.Finish();
+}
+
+std::optional<long long> PlyFaceCount(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int lines = 0; lines < 200 && std::getline(in, line); ++lines) {
+    if (line.rfind("end_header", 0) == 0) break;
+    std::istringstream words(line);
+    std::string element, name;
+    long long count = 0;
+    if (words >> element >> name >> count && element == "element" && name == "face") return count;
+  }
+  return std::nullopt;
 }
 
 }  // namespace uwscan::scanner

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 namespace uwscan::scanner {
@@ -27,5 +28,9 @@ struct PlyContent {
 // file is missing, not PLY, has no vertex element with x, y and z, is cut short, or (with
 // `faces`) has a polygon of fewer than 3 vertices or an index out of range.
 PlyContent ReadPly(const std::filesystem::path& path, bool faces);
+
+// The face count a PLY header declares (its "element face N" line), reading the header lines
+// only; std::nullopt when it has no face element (a cloud) or cannot be read. N > 0: a mesh.
+std::optional<long long> PlyFaceCount(const std::filesystem::path& path);
 
 }  // namespace uwscan::scanner

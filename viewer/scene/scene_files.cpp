@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
-#include <sstream>
 
 #include "mapping/log/dive_log.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/ply_reader.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "viewer/scene/change_report.hpp"
 #include "viewer/scene/recognition_report.hpp"
@@ -22,21 +21,6 @@ std::string Extension(const fs::path& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
-}
-
-// A PLY header's "element face N" with N > 0 makes it a mesh. Reads the header lines only.
-bool PlyHasFaces(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  for (int lines = 0; lines < 200 && std::getline(in, line); ++lines) {
-    if (line.rfind("end_header", 0) == 0) break;
-    std::istringstream words(line);
-    std::string element, name;
-    long long count = 0;
-    if (words >> element >> name >> count && element == "element" && name == "face")
-      return count > 0;
-  }
-  return false;
 }
 
 // The camera's path in {W} as the navigation reports it (vehicle pose times the camera mount).
@@ -90,7 +74,8 @@ FileKind KindOfFile(const fs::path& path) {
   if (!fs::is_regular_file(path)) throw Error(path.string() + ": no such file");
   const std::string ext = Extension(path);
   if (ext == ".pcd" || ext == ".xyz") return FileKind::kCloud;
-  if (ext == ".ply") return PlyHasFaces(path) ? FileKind::kMesh : FileKind::kCloud;
+  if (ext == ".ply")
+    return scanner::PlyFaceCount(path).value_or(0) > 0 ? FileKind::kMesh : FileKind::kCloud;
   if (ext == ".off" || ext == ".stl" || ext == ".obj") return FileKind::kMesh;
   if (ext == ".txt" || ext == ".tum") return FileKind::kTrajectory;
   if (ext == ".db" || ext == ".uwlog") return FileKind::kDiveLog;
