@@ -354,35 +354,49 @@ std::vector<double> ReadCloudCompareDistances(const fs::path& asc, const PointCl
   return out;
 }
 
+// One CloudCompare distance from `points` (written to compared.ply) with `arguments` after it,
+// its output read back from NAME.asc and judged at uwscan's false area.
+MethodFigures CloudCompareMethod(const std::string& name, const std::vector<std::string>& arguments,
+                                 bool signed_distance, const PointCloud& points,
+                                 const fs::path& folder, const std::vector<int>& label,
+                                 const std::vector<Change>& changes, double target_false_share) {
+  std::vector<std::string> argv = {"-SILENT",
+                                   "-AUTO_SAVE",
+                                   "OFF",
+                                   "-C_EXPORT_FMT",
+                                   "ASC",
+                                   "-PREC",
+                                   "8",
+                                   "-O",
+                                   (folder / "compared.ply").string()};
+  argv.insert(argv.end(), arguments.begin(), arguments.end());
+  const double seconds = RunCloudCompare(argv, folder / (name + ".log"));
+  MethodFigures f = JudgeAtEqualFalseArea(
+      AsPoints(points, ReadCloudCompareDistances(folder / (name + ".asc"), points)), label, changes,
+      signed_distance, target_false_share);
+  f.seconds = seconds;
+  return f;
+}
+
 void CloudCompareMethods(const PointCloud& points, const fs::path& folder, const Epoch& before,
                          const fs::path& design_ply, const std::vector<int>& label,
                          const std::vector<Change>& changes, ChangeFigures& figures) {
-  const fs::path compared = folder / "compared.ply", reference = folder / "reference.ply";
-  perception::WriteCloud(compared, points);
-  perception::WriteCloud(reference, before.map.cloud);
+  perception::WriteCloud(folder / "compared.ply", points);
+  perception::WriteCloud(folder / "reference.ply", before.map.cloud);
   const double target = FalseShare(figures.methods.at("uwscan"));
-  const std::vector<std::string> common = {"-SILENT", "-AUTO_SAVE", "OFF", "-C_EXPORT_FMT",  "ASC",
-                                           "-PREC",   "8",          "-O",  compared.string()};
-  std::vector<std::string> c2c = common;
-  // Its best local model for a smooth surface: a least-squares plane through the 12 nearest.
-  c2c.insert(c2c.end(),
-             {"-O", reference.string(), "-C2C_DIST", "-MODEL", "LS", "KNN", "12", "-SAVE_CLOUDS",
-              "FILE", (folder / "c2c.asc").string() + " " + (folder / "c2c_ref.asc").string()});
-  const double c2c_seconds = RunCloudCompare(c2c, folder / "c2c.log");
-  MethodFigures c2c_figures =
-      JudgeAtEqualFalseArea(AsPoints(points, ReadCloudCompareDistances(folder / "c2c.asc", points)),
-                            label, changes, false, target);
-  c2c_figures.seconds = c2c_seconds;
-  figures.methods["cloudcompare_c2c"] = c2c_figures;
-  std::vector<std::string> c2m = common;
-  c2m.insert(c2m.end(), {"-O", design_ply.string(), "-C2M_DIST", "-SAVE_CLOUDS", "FILE",
-                         (folder / "c2m.asc").string()});
-  const double c2m_seconds = RunCloudCompare(c2m, folder / "c2m.log");
-  MethodFigures c2m_figures =
-      JudgeAtEqualFalseArea(AsPoints(points, ReadCloudCompareDistances(folder / "c2m.asc", points)),
-                            label, changes, true, target);
-  c2m_figures.seconds = c2m_seconds;
-  figures.methods["cloudcompare_c2m"] = c2m_figures;
+  // Cloud-to-cloud with its best local model for a smooth surface: a least-squares plane through
+  // the 12 nearest. It saves both clouds, so it is given two names.
+  figures.methods["cloudcompare_c2c"] =
+      CloudCompareMethod("c2c",
+                         {"-O", (folder / "reference.ply").string(), "-C2C_DIST", "-MODEL", "LS",
+                          "KNN", "12", "-SAVE_CLOUDS", "FILE",
+                          (folder / "c2c.asc").string() + " " + (folder / "c2c_ref.asc").string()},
+                         false, points, folder, label, changes, target);
+  figures.methods["cloudcompare_c2m"] =
+      CloudCompareMethod("c2m",
+                         {"-O", design_ply.string(), "-C2M_DIST", "-SAVE_CLOUDS", "FILE",
+                          (folder / "c2m.asc").string()},
+                         true, points, folder, label, changes, target);
   figures.cloudcompare_ran = true;
 }
 
