@@ -52,8 +52,6 @@ echo "make_docs_pictures: docs/*.png written"
 # the first; significant deviations in the diverging colours, the largest regions labelled.
 "$UWSCAN" simulate data/scenes/change_before.yaml -o "$work/before.db" >/dev/null
 "$UWSCAN" simulate data/scenes/change_after.yaml -o "$work/after.db" >/dev/null
-"$UWSCAN" map "$work/before.db" -o "$work/before.ply" --json "$work/before.json" >/dev/null
-"$UWSCAN" map "$work/after.db" -o "$work/after.ply" --json "$work/after.json" >/dev/null
-"$UWSCAN" compare "$work/after.json" --reference "$work/before.json" -o "$work/changes.ply" \
+"$UWSCAN" compare "$work/after.db" --reference "$work/before.db" -o "$work/changes.ply" \
   --json "$work/changes.json" >/dev/null
 "$UWSCAN" view "$work/changes.json" --camera top --range -0.02 0.02 --screenshot docs/findings.png --size 800x900

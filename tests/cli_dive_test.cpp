@@ -471,6 +471,18 @@ TEST(CliDive, CompareWritesDeviationsReportAndTableAndRefusesBadInputWithOneLine
   EXPECT_TRUE(report["alignment"]["registered"].get<bool>());
   EXPECT_NE(ReadText(md).find("| region | kind |"), std::string::npos);
 
+  // The dive log itself, mapped by compare as `map` maps it, gives the findings its report gives.
+  const std::filesystem::path from_log = TempPath("findings_from_log.json");
+  const CommandRun logged =
+      RunUwscan("compare " + d.log.string() + " --reference " + d.design.string() + " -o " +
+                TempPath("deviations_from_log.ply").string() + " --json " + from_log.string());
+  ASSERT_EQ(logged.exit_code, 0) << logged.output;
+  const nlohmann::json log_report = ReadJson(from_log);
+  EXPECT_EQ(log_report["map"]["kind"], "map");
+  EXPECT_NEAR(log_report["surface"]["unchanged_m2"].get<double>(),
+              report["surface"]["unchanged_m2"].get<double>(), 1e-9);
+  EXPECT_EQ(log_report["regions"].size(), report["regions"].size());
+
   // A design model in millimetres read as metres, an empty map: one line each, nothing written.
   std::filesystem::remove(ply);
   const CommandRun mm = RunUwscan("compare " + d.report.string() + " --reference " +
@@ -486,6 +498,7 @@ TEST(CliDive, CompareWritesDeviationsReportAndTableAndRefusesBadInputWithOneLine
   EXPECT_EQ(none.exit_code, 1) << none.output;
   EXPECT_EQ(std::count(none.output.begin(), none.output.end(), '\n'), 1) << none.output;
   EXPECT_FALSE(std::filesystem::exists(ply));
-  for (const auto& p : {d.log, d.design, d.map, d.report, json, md, empty})
+  for (const auto& p : {d.log, d.design, d.map, d.report, json, md, empty, from_log,
+                        TempPath("deviations_from_log.ply")})
     std::filesystem::remove(p);
 }

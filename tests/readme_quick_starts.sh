@@ -97,7 +97,7 @@ done < <(blocks_between "## Quick starts" "## Documentation")
 
 # What the blocks were to make, there.
 for f in inspect.db inspect_view.png objects.db recognition.json inspection.db map.ply map.json \
-         as_built.ply before.json after.json changes.ply changes.json changes.md \
+         as_built.ply before.db after.db changes.ply changes.json changes.md \
          inspection.bag node.db node.ply step1.yaml step2.yaml; do
   [ -s "$f" ] || { echo "quick starts: $f was not written" >&2; exit 1; }
 done

@@ -5,7 +5,7 @@
 namespace uwscan::app {
 
 void WriteJsonFile(const std::string& path, const nlohmann::json& value) {
-  WriteTextAtomically(path, value.dump(2) + '\n');
+  WriteFileAtomically(path, value.dump(2) + '\n');
 }
 
 }  // namespace uwscan::app

@@ -7,12 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
+#include "apps/cli/progress_bar.hpp"
 #include "apps/cli/reference_options.hpp"
 #include "mapping/change/change_report.hpp"
 #include "mapping/change/compare_surveys.hpp"
+#include "mapping/log/dive_log.hpp"
+#include "mapping/slam/dive_mapping.hpp"
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 
@@ -69,6 +73,26 @@ void PrintFindings(const mapping::SurveyComparison& c, const std::string& output
     std::printf("  ... %zu more in the report\n", c.regions.size() - shown);
 }
 
+// A dive log is mapped here as `uwscan map` would with its defaults; anything else is read.
+mapping::Survey LoadSurvey(const std::string& path, const mapping::SurveyReadOptions& options,
+                           const char* option, int threads) {
+  if (!mapping::IsSqliteFile(path)) return mapping::ReadSurvey(path, options);
+  if (options.units_to_m != 1.0)
+    throw Error(std::string(option) + " " + path + ": a dive log maps in metres (no units)");
+  const mapping::DiveLogReader log(path);
+  mapping::DiveMappingOptions mapping_options;
+  mapping_options.mapper.threads = threads;
+  mapping_options.table_cache = TableCache();
+  mapping::DiveMapping m;
+  {
+    ProgressBar bar;
+    m = mapping::MapDive(log, mapping_options, [&bar](double f) { bar.Update("map", f); });
+  }
+  std::printf("%s: mapped, %zu points, %d submaps over %.1f s of dive (%.2f s)\n", path.c_str(),
+              m.map.size(), m.submaps, m.dive_duration_s, m.seconds);
+  return mapping::SurveyOfDive(m, path);
+}
+
 void RunCompare(const CompareArgs& a) {
   const std::vector<std::filesystem::path> inputs = {a.map, a.reference};
   CheckCloudOutputPath(a.output, "-o", inputs);
@@ -78,16 +102,17 @@ void RunCompare(const CompareArgs& a) {
   mapping::CompareOptions options = a.options;
   if (!a.transform.empty()) options.alignment.T_reference_map = TransformOf(a.transform);
   options.deviation.threads = a.threads;
-  const mapping::Survey map = mapping::ReadSurvey(a.map);
+  const mapping::Survey map = LoadSurvey(a.map, {}, "map", a.threads);
   mapping::SurveyReadOptions reference_options;
   reference_options.units_to_m = UnitsToMetres(a.reference_units);
-  const mapping::Survey reference = mapping::ReadSurvey(a.reference, reference_options);
+  const mapping::Survey reference =
+      LoadSurvey(a.reference, reference_options, "--reference", a.threads);
   const mapping::SurveyComparison c = mapping::CompareSurveys(map, reference, options);
   mapping::WriteDeviationsPly(a.output, c);
   if (!a.json.empty())
     WriteJsonFile(a.json, mapping::ChangeReportJson(c, map, reference, options, a.output));
   if (!a.markdown.empty())
-    WriteTextAtomically(a.markdown, mapping::ChangeReportMarkdown(c, map, reference));
+    WriteFileAtomically(a.markdown, mapping::ChangeReportMarkdown(c, map, reference));
   PrintFindings(c, a.output);
 }
 
@@ -100,13 +125,13 @@ void AddCompareCommand(CLI::App& app) {
       "what the inspection found: a map against its design model or an earlier survey, signed "
       "deviations along the normals, each with a level of detection, significant regions");
   cmd->add_option("map", a->map,
-                  "the map: `uwscan map --json` report (its poses' covariance used) or a cloud "
-                  "(.ply .pcd .xyz)")
+                  "the map: a dive log (mapped as `uwscan map` does), a `uwscan map --json` "
+                  "report (its poses' covariance used either way) or a cloud (.ply .pcd .xyz)")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--reference", a->reference,
-                  "design model (mesh: .ply with faces, .obj, .stl, .off), earlier map report "
-                  "(.json) or cloud (.ply .pcd .xyz)")
+                  "design model (mesh: .ply with faces, .obj, .stl, .off), earlier dive log or "
+                  "map report (.json), or cloud (.ply .pcd .xyz)")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", a->output,

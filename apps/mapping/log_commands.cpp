@@ -7,7 +7,6 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/output_path.hpp"
 #include "mapping/log/dive_log.hpp"
-#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::app {
@@ -87,34 +86,24 @@ void RunSalvage(const SalvageArgs& a) {
       " (salvaged by uwscan log salvage from " + fs::path(a.log).filename().string() + ")";
 
   // Written under a temporary name and renamed when complete: the output is never a half.
-  const fs::path partial = TemporaryBeside(a.output);
   mapping::DiveLogCheck check;
   bool mount_copied = false;
-  try {
-    {
-      mapping::DiveLogWriter writer(partial, header);
-      check = reader.Check(
-          [&](const mapping::FrameRecord& frame, const mapping::GroundTruthRecord* truth) {
-            writer.AppendFrame(frame, truth);
-          },
-          [&](const mapping::NavigationRecord& sample) { writer.AppendNavigation(sample); });
-      try {
-        if (const auto mount = reader.vehicle_mount()) {
-          writer.SetVehicleMount(*mount);
-          mount_copied = true;
-        }
-      } catch (const Error&) {
-        // Damaged: already in check.damage; the salvaged log goes without it.
+  mapping::WriteDiveLogAtomically(a.output, [&](const fs::path& partial) {
+    mapping::DiveLogWriter writer(partial, header);
+    check = reader.Check(
+        [&](const mapping::FrameRecord& frame, const mapping::GroundTruthRecord* truth) {
+          writer.AppendFrame(frame, truth);
+        },
+        [&](const mapping::NavigationRecord& sample) { writer.AppendNavigation(sample); });
+    try {
+      if (const auto mount = reader.vehicle_mount()) {
+        writer.SetVehicleMount(*mount);
+        mount_copied = true;
       }
+    } catch (const Error&) {
+      // Damaged: already in check.damage; the salvaged log goes without it.
     }
-    ReplaceWithTemporary(partial, a.output);
-  } catch (...) {
-    std::error_code ignored;
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
-      fs::remove(fs::path(partial.string() + suffix), ignored);
-    }
-    throw;
-  }
+  });
   PrintCheck(a.log, check);
   const std::string without_truth = check.frames_with_damaged_truth == 0
                                         ? ""

@@ -174,6 +174,7 @@ nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
       {"navigation_logged", i.log.navigation_written},
       {"sweeps_published", s.sweeps_published},
       {"maps_published", s.maps_published},
+      {"maps_replaced", s.maps_replaced},
       {"submaps", i.submaps},
       {"map_points", s.result.map.size()},
       {"reregistrations", s.reregistrations},

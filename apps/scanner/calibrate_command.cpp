@@ -48,7 +48,7 @@ void RunCalibrate(const CalibrateArgs& a) {
         a.step, dataset, scanner::LoadScanner(initial), initial.string(),
         [&bar, &a](double f) { bar.Update("calibrate " + a.step, f); }, a.options);
   }
-  WriteTextAtomically(a.output, scanner::ScannerToYaml(outcome.scanner));
+  WriteFileAtomically(a.output, scanner::ScannerToYaml(outcome.scanner));
   std::printf("%s: step %s from %s, started from %s, %.2f s\n", a.output.c_str(), a.step.c_str(),
               a.dataset.c_str(), initial.string().c_str(), outcome.record.seconds);
   for (const std::string& line : outcome.summary) std::printf("  %s\n", line.c_str());
@@ -89,7 +89,7 @@ void RunImportIntrinsics(const ImportArgs& a) {
                    {"cy_px", camera.cy_px, 0.0}};
   record.date_utc = scanner::calibration::NowUtc();
   scanner::SetStepRecord(&calibrated, record);
-  WriteTextAtomically(a.output, scanner::ScannerToYaml(calibrated));
+  WriteFileAtomically(a.output, scanner::ScannerToYaml(calibrated));
   std::printf("%s: intrinsics from %s (fx %.3f, fy %.3f, cx %.3f, cy %.3f px; k1 %.6g) into %s\n",
               a.output.c_str(), a.opencv_yaml.c_str(), camera.fx_px, camera.fy_px, camera.cx_px,
               camera.cy_px, camera.k1, a.into.c_str());

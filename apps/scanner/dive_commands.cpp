@@ -19,7 +19,6 @@
 #include "perception/cloud/point_cloud.hpp"
 #include "scanner/calibration/calibration_scene.hpp"
 #include "scanner/calibration/dataset_simulation.hpp"
-#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/lasers/scanner_file.hpp"
@@ -100,23 +99,12 @@ void RunSimulate(const SimulateArgs& a) {
   options.producer = std::string("uwscan simulate ") + UWSCAN_VERSION;
   // The dive is written under a temporary name and replaces the output (an older log under
   // --force) only when complete: killed or failing, the output is the old file or none.
-  const std::filesystem::path partial = TemporaryBeside(a.output);
   mapping::DiveSimulationSummary summary;
-  try {
+  mapping::WriteDiveLogAtomically(a.output, [&](const std::filesystem::path& partial) {
     ProgressBar bar;
     summary = mapping::SimulateDive(simulator, ReadText(a.scene), partial, options,
                                     [&bar](double f) { bar.Update("simulate", f); });
-    // A stray WAL of an earlier log at the output would be replayed into the new one.
-    for (const char* suffix : {"-wal", "-shm", "-journal"})
-      std::filesystem::remove(a.output + suffix);
-    ReplaceWithTemporary(partial, a.output);
-  } catch (...) {
-    std::error_code ignored;
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
-      std::filesystem::remove(partial.string() + suffix, ignored);
-    }
-    throw;
-  }
+  });
   std::printf("%s: %lld frames (%s scanner, %s), %lld peaks, %lld navigation records%s, %.2f s\n",
               a.output.c_str(), static_cast<long long>(summary.frames),
               scanner::ToString(scene.scanner.model.kind()),

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/fnv1a.hpp"
 
@@ -93,15 +94,7 @@ void SaveCachedScan(const std::filesystem::path& folder, const CachedScanKey& ke
   const std::uint64_t sum = Fnv1a64(bytes.data(), bytes.size());
   Append(bytes, &sum, 1);
   const std::filesystem::path file = FileOf(folder, key);
-  const std::filesystem::path partial = file.string() + ".partial-" + std::to_string(::getpid());
-  {
-    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw Error("scan cache " + partial.string() + ": cannot write");
-  }
-  std::filesystem::rename(partial, file, error);
-  if (error)
-    throw Error("scan cache " + file.string() + ": cannot rename into place: " + error.message());
+  WriteFileAtomically(file, bytes);
 }
 
 }  // namespace uwscan::bench

@@ -150,6 +150,20 @@ Survey ReadSurvey(const fs::path& path, const SurveyReadOptions& options) {
   return ReadCloudSurvey(path, options);
 }
 
+Survey SurveyOfDive(const DiveMapping& mapping, const std::string& name) {
+  if (mapping.covariances.size() != mapping.slam.size() || mapping.slam.empty())
+    throw Error(name + ": the dive's mapping has no pose covariances");
+  Survey survey;
+  survey.name = name;
+  survey.kind = SurveyKind::kMap;
+  survey.cloud = mapping.map;
+  for (std::size_t i = 0; i < mapping.slam.size(); ++i) {
+    survey.poses.push_back(mapping.slam[i].T_W_V);
+    survey.pose_covariances.push_back(mapping.covariances[i]);
+  }
+  return survey;
+}
+
 double PoseSigmaAlongNormal(const Survey& survey, const Eigen::Vector3d& p_W,
                             const Eigen::Vector3d& normal_W) {
   if (survey.poses.empty()) return 0.0;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "mapping/slam/dive_mapping.hpp"
 #include "mapping/slam/pose_graph.hpp"
 #include "perception/cloud/point_cloud.hpp"
 
@@ -15,7 +16,7 @@ namespace uwscan::mapping {
 enum class SurveyKind {
   kDesign,  // an as-built or design model (a mesh): exact, sampled on its surface
   kCloud,   // a point cloud from another tool or sensor: its own error unknown
-  kMap      // a uwscan map read through its report: its poses' covariance known
+  kMap      // a uwscan map (its report, or a dive log mapped): its poses' covariance known
 };
 const char* ToString(SurveyKind kind);
 
@@ -47,6 +48,11 @@ struct SurveyReadOptions {
 // report or lacks the covariances, a PLY declares faces but holds none, or a mesh's area would
 // take more than 50 million samples at the spacing asked.
 Survey ReadSurvey(const std::filesystem::path& path, const SurveyReadOptions& options = {});
+
+// A dive log mapped (MapDive) as an epoch, as its map report would give it: its map, its SLAM
+// poses and their covariances. `name` names the log. Throws uwscan::Error when the mapping has
+// no covariances.
+Survey SurveyOfDive(const DiveMapping& mapping, const std::string& name);
 
 // The position uncertainty, along `normal_W`, of a point placed by the survey's pose nearest to
 // it (std, metres): n^T J C J^T n with J = [-[p - t]x, I] for the pose's position t and

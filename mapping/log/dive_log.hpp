@@ -124,6 +124,14 @@ class DiveLogWriter {
   std::unique_ptr<Impl> impl_;
 };
 
+// Writes a whole dive log or none: `write` makes the log at the temporary path it is given
+// (beside `path`, through a DiveLogWriter destroyed before it returns); then SQLite's files of an
+// earlier log at `path` (`-wal`, `-shm`, `-journal`, which SQLite would replay into the new one)
+// are removed and the new log replaces `path`. On any failure the temporary and its SQLite files
+// are removed and the exception passes on: `path` keeps what it held, or stays absent.
+void WriteDiveLogAtomically(const std::filesystem::path& path,
+                            const std::function<void(const std::filesystem::path&)>& write);
+
 // A damaged row that DiveLogReader::Check found.
 struct DiveLogDamage {
   std::string table;      // "frames" (a frame or its ground truth), "navigation", "header", "file"
@@ -153,6 +161,10 @@ enum class DiveLogOpening {
   kDamaged,  // for Check and salvage: a truncated file is read as far as it goes (a file being
              // written may show as truncated to Check while its writer checkpoints)
 };
+
+// Whether the file starts as every SQLite database does: a dive log, or another SQLite file that
+// DiveLogReader refuses by name. False for a missing or unreadable file.
+bool IsSqliteFile(const std::filesystem::path& path);
 
 // Reads a dive log, read-only. Works on a log whose writer is still appending (in this or
 // another process: each call sees what was committed when it starts) and on a log whose writer

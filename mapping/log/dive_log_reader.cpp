@@ -235,6 +235,13 @@ struct DiveLogReader::Impl {
   }
 };
 
+bool IsSqliteFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[16] = {};
+  in.read(magic, sizeof(magic));
+  return in.gcount() == 16 && std::string(magic, 16) == std::string("SQLite format 3", 16);
+}
+
 DiveLogReader::DiveLogReader(const std::filesystem::path& path, DiveLogOpening opening)
     : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;

@@ -14,6 +14,7 @@
 #include "mapping/log/dive_log_format.hpp"
 #include "mapping/log/row_checksums.hpp"
 #include "mapping/log/sqlite_db.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
@@ -467,5 +468,24 @@ void DiveLogWriter::SetVehicleMount(const Eigen::Isometry3d& T_V_C) {
 std::int64_t DiveLogWriter::frame_count() const { return impl_->frame_count; }
 
 const std::filesystem::path& DiveLogWriter::path() const { return impl_->path; }
+
+void WriteDiveLogAtomically(const std::filesystem::path& path,
+                            const std::function<void(const std::filesystem::path&)>& write) {
+  const std::filesystem::path temporary = TemporaryBeside(path);
+  const auto remove_with_sqlite_files = [](const std::filesystem::path& log, bool itself) {
+    std::error_code ignored;
+    for (const char* suffix : {"-wal", "-shm", "-journal"})
+      std::filesystem::remove(log.string() + suffix, ignored);
+    if (itself) std::filesystem::remove(log, ignored);
+  };
+  try {
+    write(temporary);
+    remove_with_sqlite_files(path, false);
+    ReplaceWithTemporary(temporary, path);
+  } catch (...) {
+    remove_with_sqlite_files(temporary, true);
+    throw;
+  }
+}
 
 }  // namespace uwscan::mapping

@@ -81,7 +81,7 @@ void WriteTum(const std::filesystem::path& path, const std::vector<TimedPose>& p
                   t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
     text += line;
   }
-  WriteTextAtomically(path, text);
+  WriteFileAtomically(path, text);
 }
 
 }  // namespace uwscan::mapping

@@ -1,8 +1,12 @@
 #include "perception/cloud/cloud_io.hpp"
 
 #include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_types.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -10,7 +14,9 @@
 #include <random>
 #include <string>
 
+#include "perception/cloud/pcd_reader.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/ply_reader.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -180,6 +186,190 @@ TEST_F(CloudIoTest, FailedWriteLeavesTheExistingFileIntact) {
     ++entries;
   }
   EXPECT_EQ(entries, 2u);  // keep.ply and blocked.pcd
+}
+
+// uwscan's own PLY and PCD readers against files written by PCL's writers (the independent
+// reference), in every encoding, and their refusals of broken files: one error, no output.
+
+class CloudReadersTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("uwscan_cloud_readers_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    std::mt19937_64 rng(4);
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    cloud_.width = 37;
+    cloud_.height = 3;  // organised: rows are read in order
+    for (int i = 0; i < 37 * 3; ++i) {
+      pcl::PointNormal p;
+      p.x = u(rng);
+      p.y = u(rng);
+      p.z = 5.0f + u(rng);
+      const Eigen::Vector3f n = Eigen::Vector3f(u(rng), u(rng), u(rng)).normalized();
+      p.normal_x = n.x();
+      p.normal_y = n.y();
+      p.normal_z = n.z();
+      p.curvature = 0.5f;
+      cloud_.push_back(p);
+    }
+    cloud_.width = 37;
+    cloud_.height = 3;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  void ExpectSamePoints(const std::vector<Eigen::Vector3d>& points,
+                        const std::vector<Eigen::Vector3d>& normals) {
+    ASSERT_EQ(points.size(), cloud_.size());
+    ASSERT_EQ(normals.size(), cloud_.size());
+    for (std::size_t i = 0; i < cloud_.size(); ++i) {
+      // float32 in the file: bit for bit when binary, to the 8 digits PCL prints in ascii.
+      EXPECT_NEAR(points[i].x(), cloud_[i].x, 1e-6) << i;
+      EXPECT_NEAR(points[i].y(), cloud_[i].y, 1e-6) << i;
+      EXPECT_NEAR(points[i].z(), cloud_[i].z, 1e-6) << i;
+      EXPECT_NEAR(normals[i].z(), cloud_[i].normal_z, 1e-6) << i;
+    }
+  }
+
+  fs::path dir_;
+  pcl::PointCloud<pcl::PointNormal> cloud_;
+};
+
+TEST_F(CloudReadersTest, ReadsEveryPcdEncodingPclWrites) {
+  pcl::PCDWriter writer;
+  const fs::path ascii = dir_ / "a.pcd", binary = dir_ / "b.pcd", compressed = dir_ / "c.pcd";
+  ASSERT_EQ(writer.writeASCII(ascii.string(), cloud_, 8), 0);
+  ASSERT_EQ(writer.writeBinary(binary.string(), cloud_), 0);
+  ASSERT_EQ(writer.writeBinaryCompressed(compressed.string(), cloud_), 0);
+  for (const fs::path& path : {ascii, binary, compressed}) {
+    SCOPED_TRACE(path.filename().string());
+    const PcdContent content = ReadPcd(path);
+    ExpectSamePoints(content.points, content.normals);
+  }
+}
+
+TEST_F(CloudReadersTest, ReadsPlyPclWritesAndFacesOfAnyPolygon) {
+  pcl::PLYWriter writer;
+  const fs::path binary = dir_ / "b.ply", ascii = dir_ / "a.ply";
+  ASSERT_EQ(writer.write(binary.string(), cloud_, true, false), 0);
+  ASSERT_EQ(writer.write(ascii.string(), cloud_, false, false), 0);
+  for (const fs::path& path : {binary, ascii}) {
+    SCOPED_TRACE(path.filename().string());
+    const scanner::PlyContent content = scanner::ReadPly(path, false);
+    // PCL's ascii PLY keeps 6 significant digits.
+    const double tolerance = path == ascii ? 1e-5 : 0.0;
+    ASSERT_EQ(content.vertices.size(), cloud_.size());
+    for (std::size_t i = 0; i < cloud_.size(); ++i) {
+      EXPECT_NEAR(content.vertices[i].x(), cloud_[i].x, tolerance + 1e-7);
+      EXPECT_NEAR(content.normals[i].y(), cloud_[i].normal_y, tolerance + 1e-7);
+    }
+  }
+
+  // Big-endian binary with a quad and a triangle, a list of uchar counts and int indices.
+  const fs::path mesh = dir_ / "quad.ply";
+  {
+    std::ofstream out(mesh, std::ios::binary);
+    out << "ply\nformat binary_big_endian 1.0\ncomment made by hand\nelement vertex 4\n"
+           "property double x\nproperty double y\nproperty double z\nelement face 2\n"
+           "property list uchar int vertex_indices\nend_header\n";
+    auto put_be = [&out](auto value) {
+      char bytes[sizeof(value)];
+      std::memcpy(bytes, &value, sizeof(value));
+      for (int b = int(sizeof(value)) - 1; b >= 0; --b) out.put(bytes[b]);
+    };
+    for (double v : {0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.25}) put_be(v);
+    out.put(4);
+    for (std::int32_t i : {0, 1, 2, 3}) put_be(i);
+    out.put(3);
+    for (std::int32_t i : {0, 2, 3}) put_be(i);
+  }
+  const scanner::PlyContent quad = scanner::ReadPly(mesh, true);
+  ASSERT_EQ(quad.vertices.size(), 4u);
+  EXPECT_EQ(quad.vertices[3], Eigen::Vector3d(0.0, 1.0, 0.25));
+  ASSERT_EQ(quad.triangles.size(), 3u);  // the quad fanned into two, then the triangle
+  EXPECT_EQ(quad.triangles[1], Eigen::Vector3i(0, 2, 3));
+}
+
+// Intensities as PCL writes them (PointXYZI, float32 "intensity"), and CloudCompare's
+// "scalar_Intensity" PLY property, reach the cloud point for point; uwscan's writer keeps them.
+TEST_F(CloudReadersTest, ReadsIntensityFromPclPcdAndPlyAndKeepsItOnWrite) {
+  pcl::PointCloud<pcl::PointXYZI> with_intensity;
+  for (std::size_t i = 0; i < cloud_.size(); ++i) {
+    pcl::PointXYZI p;
+    p.x = cloud_[i].x;
+    p.y = cloud_[i].y;
+    p.z = cloud_[i].z;
+    p.intensity = 10.0f + 0.5f * static_cast<float>(i);
+    with_intensity.push_back(p);
+  }
+  const fs::path pcd = dir_ / "i.pcd", ply = dir_ / "i.ply";
+  ASSERT_EQ(pcl::PCDWriter().writeBinaryCompressed(pcd.string(), with_intensity), 0);
+  ASSERT_EQ(pcl::PLYWriter().write(ply.string(), with_intensity, true, false), 0);
+  for (const fs::path& path : {pcd, ply}) {
+    SCOPED_TRACE(path.filename().string());
+    const PointCloud read = ReadCloud(path);
+    ASSERT_TRUE(read.has_intensity());
+    for (std::size_t i = 0; i < with_intensity.size(); ++i) {
+      EXPECT_EQ(read.intensity[i], with_intensity[i].intensity) << i;
+    }
+    const fs::path again = dir_ / ("again" + path.extension().string());
+    WriteCloud(again, read, /*binary=*/false);
+    EXPECT_EQ(ReadCloud(again).intensity, read.intensity);
+  }
+
+  const fs::path cloud_compare = dir_ / "cc.ply";
+  {
+    std::ofstream out(cloud_compare);
+    out << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty "
+           "float z\n"
+           "property float scalar_Intensity\nend_header\n0 0 1 0.25\n1 0 1 nan\n";
+  }
+  const PointCloud cc = ReadCloud(cloud_compare);
+  ASSERT_EQ(cc.intensity.size(), 2u);
+  EXPECT_EQ(cc.intensity[0], 0.25f);
+  EXPECT_TRUE(std::isnan(cc.intensity[1]));  // no value: the point stays, its intensity is NaN
+  const fs::path plain = dir_ / "plain.ply";
+  ASSERT_EQ(pcl::PLYWriter().write(plain.string(), cloud_, true, false), 0);
+  EXPECT_FALSE(ReadCloud(plain).has_intensity());
+}
+
+TEST_F(CloudReadersTest, BrokenFilesGiveOneErrorAndPrintNothing) {
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"empty.pcd", ""},
+      {"noheader.pcd", "1 2 3\n4 5 6\n"},
+      {"huge.pcd",
+       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4000000000\nHEIGHT 1\nDATA binary\n\x01\x02"},
+      {"short.pcd",
+       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nDATA ascii\n1 2 3\n4 "
+       "5\n"},
+      {"mismatch.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n1 2 3\n"},
+      {"noxyz.pcd", "FIELDS a b\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n1 2\n"},
+      {"empty.ply", ""},
+      {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"},
+      {"huge.ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 999999999999\nproperty float x\n"
+       "property float y\nproperty float z\nend_header\n\x01"},
+      {"badtype.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n1\n"},
+      {"cut.ply",
+       "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n1 2 3\n4\n"},
+  };
+  for (const auto& [name, text] : files) {
+    const fs::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << text;
+    testing::internal::CaptureStderr();
+    testing::internal::CaptureStdout();
+    std::string message;
+    try {
+      ReadCloud(path);
+    } catch (const Error& e) {
+      message = e.what();
+    }
+    const std::string printed =
+        testing::internal::GetCapturedStderr() + testing::internal::GetCapturedStdout();
+    EXPECT_NE(message.find(path.string()), std::string::npos) << name << ": '" << message << "'";
+    EXPECT_EQ(message.find('\n'), std::string::npos) << name;
+    EXPECT_EQ(printed, "") << name;
+  }
 }
 
 }  // namespace

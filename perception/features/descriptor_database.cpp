@@ -16,6 +16,7 @@
 #include <set>
 
 #include "perception/features/esf.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/fnv1a.hpp"
 
@@ -115,18 +116,6 @@ std::string InvalidValue(std::span<const float> values) {
     if (values[i] < 0.0f) return "value " + std::to_string(i) + " is negative";
   }
   return {};
-}
-
-void WriteAll(int fd, const std::string& bytes, const std::filesystem::path& tmp) {
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      throw Error(Quoted(tmp) + ": cannot write: " + std::strerror(errno));
-    }
-    written += static_cast<std::size_t>(n);
-  }
 }
 
 }  // namespace
@@ -311,41 +300,7 @@ void DescriptorDatabase::Save(const std::filesystem::path& path) const {
   }
   PutUnsigned(bytes, Fnv1a64(bytes.data(), bytes.size()));
 
-  // A unique temporary name beside the target, so that the rename stays on one file system.
-  static std::atomic<unsigned> counter{0};
-  std::filesystem::path tmp = path;
-  tmp += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    throw Error(Quoted(path) + ": cannot create temporary file '" + tmp.string() +
-                "': " + std::strerror(errno));
-  }
-  try {
-    WriteAll(fd, bytes, tmp);
-    if (::fsync(fd) != 0) throw Error(Quoted(tmp) + ": fsync failed: " + std::strerror(errno));
-  } catch (...) {
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    throw;
-  }
-  if (::close(fd) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    throw Error(Quoted(tmp) + ": close failed: " + std::strerror(err));
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    ::unlink(tmp.c_str());
-    throw Error(Quoted(path) + ": cannot rename '" + tmp.string() + "' over it: " + ec.message());
-  }
-  // Make the rename itself durable; best effort, the file is complete either way.
-  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
-  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
-  }
+  WriteFileAtomically(path, bytes);
 }
 
 DescriptorDatabase DescriptorDatabase::Load(const std::filesystem::path& path,

@@ -186,7 +186,7 @@ void ObjectDatabase::Save(const std::filesystem::path& path) const {
   for (const ObjectModel& o : objects) PutObject(out, o);
   const std::uint64_t checksum = Fnv1a64(out.bytes().data(), out.bytes().size());
   out.Put<std::uint64_t>(checksum);
-  WriteTextAtomically(path, out.bytes());
+  WriteFileAtomically(path, out.bytes());
 }
 
 ObjectDatabase ObjectDatabase::Load(const std::filesystem::path& path) {

@@ -36,13 +36,6 @@ double TimeOrigin(const mapping::DiveLogReader& reader) {
   return created > 0.0 ? created : kUnixTimeFloor_s;
 }
 
-bool IsSqlite(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[16] = {};
-  in.read(magic, sizeof(magic));
-  return in.gcount() == 16 && std::string(magic, 15) == "SQLite format 3";
-}
-
 std::string ReportKind(const std::filesystem::path& path) {
   std::ifstream in(path);
   try {
@@ -67,13 +60,15 @@ std::filesystem::path LogOfReport(const std::filesystem::path& input) {
       report["scan"].is_string()) {
     log = input.parent_path() / report["scan"].get<std::string>();
   }
-  return std::filesystem::is_regular_file(log) && IsSqlite(log) ? log : std::filesystem::path();
+  return std::filesystem::is_regular_file(log) && mapping::IsSqliteFile(log)
+             ? log
+             : std::filesystem::path();
 }
 
 // The origin of the first dive log, else of the log the first report names.
 double TimeOriginOf(const std::vector<std::filesystem::path>& inputs) {
   for (const std::filesystem::path& input : inputs) {
-    if (IsSqlite(input)) return TimeOrigin(mapping::DiveLogReader(input));
+    if (mapping::IsSqliteFile(input)) return TimeOrigin(mapping::DiveLogReader(input));
   }
   for (const std::filesystem::path& input : inputs) {
     if (const std::filesystem::path log = LogOfReport(input); !log.empty())
@@ -139,7 +134,8 @@ void ExportDive(const std::filesystem::path& log, double origin_s, const BagExpo
 
 void ExportInput(const std::filesystem::path& input, const BagExportOptions& o, BagWriter& bag,
                  BagExportSummary& summary) {
-  if (IsSqlite(input)) return ExportDive(input, summary.time_origin_s, o, bag, summary);
+  if (mapping::IsSqliteFile(input))
+    return ExportDive(input, summary.time_origin_s, o, bag, summary);
   const std::string kind = ReportKind(input);
   if (kind == "map_report") {
     const ReportExportSummary r = ExportMapReport(input, summary.time_origin_s, o, bag);

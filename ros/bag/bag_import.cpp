@@ -157,31 +157,21 @@ BagImportSummary ImportBag(const std::filesystem::path& bag, const std::filesyst
   summary.time_origin_s = d.time_origin_s;
   mapping::DiveLogHeader header = d.header;
   header.producer = o.producer;
-  const std::filesystem::path partial = log.string() + ".partial";
-  for (const char* suffix : {"", "-wal", "-shm", "-journal"})
-    std::filesystem::remove(partial.string() + suffix);
-  try {
+  mapping::WriteDiveLogAtomically(log, [&](const std::filesystem::path& partial) {
     std::string camera_frame, vehicle_frame;
-    {
-      mapping::DiveLogWriter writer(partial, header);
-      ReadDive(reader, bag, o, d, writer, summary, camera_frame, vehicle_frame);
-      if (o.navigation.source == NavigationSource::kTf && summary.navigation == 0) {
-        throw Error(bag.string() + ": no " + o.frames.odom + " -> " + o.frames.base_link +
-                    " transform on " + o.topics.tf + " (the navigation)");
-      }
-      const std::optional<Eigen::Isometry3d> T_V_C = d.statics.Find(vehicle_frame, camera_frame);
-      writer.SetVehicleMount(
-          MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()), o.navigation.axes));
-      summary.mount = T_V_C ? o.topics.tf_static + " " + vehicle_frame + " -> " + camera_frame
-                            : "none on " + o.topics.tf_static + " from " + vehicle_frame + " to " +
-                                  camera_frame + ": the camera is taken at the vehicle's origin";
+    mapping::DiveLogWriter writer(partial, header);
+    ReadDive(reader, bag, o, d, writer, summary, camera_frame, vehicle_frame);
+    if (o.navigation.source == NavigationSource::kTf && summary.navigation == 0) {
+      throw Error(bag.string() + ": no " + o.frames.odom + " -> " + o.frames.base_link +
+                  " transform on " + o.topics.tf + " (the navigation)");
     }
-    std::filesystem::rename(partial, log);
-  } catch (...) {
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
-      std::filesystem::remove(partial.string() + suffix);
-    throw;
-  }
+    const std::optional<Eigen::Isometry3d> T_V_C = d.statics.Find(vehicle_frame, camera_frame);
+    writer.SetVehicleMount(
+        MountInUwscanAxes(T_V_C.value_or(Eigen::Isometry3d::Identity()), o.navigation.axes));
+    summary.mount = T_V_C ? o.topics.tf_static + " " + vehicle_frame + " -> " + camera_frame
+                          : "none on " + o.topics.tf_static + " from " + vehicle_frame + " to " +
+                                camera_frame + ": the camera is taken at the vehicle's origin";
+  });
   return summary;
 }
 

@@ -18,6 +18,7 @@
 #include "ros/conversions/dive_description.hpp"
 #include "ros/conversions/frame_image.hpp"
 #include "ros/conversions/static_transforms.hpp"
+#include "ros/node/map_publisher.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::ros {
@@ -272,34 +273,17 @@ Covariance6d RosCovariance(const mapping::Matrix6d& c) {
   return out;
 }
 
-// The map in the navigation's axes; with a reference, each point's deviation from it (taken in
-// uwscan's world frame, where the reference is) as the field "deviation".
-CloudMessage MapMessage(const perception::PointCloud& map, const Header& header,
-                        NavigationAxes axes, const mapping::LiveDeviation* reference) {
-  CloudMessage c;
-  c.header = header;
-  c.points.reserve(map.size());
-  std::vector<Eigen::Vector3d> points_W;
-  for (std::size_t i = 0; i < map.size(); ++i) {
-    points_W.push_back(map.Point(i));
-    c.points.push_back(WorldPointInNavigationAxes(points_W.back(), axes).cast<float>());
-  }
-  if (reference) {
-    c.scalar_name = "deviation";
-    c.scalars = reference->Deviations(points_W);
-  }
-  return c;
-}
-
 // Publishes what the mapper makes: sweeps, paths, pose, TF and map.
 class Outlet {
  public:
   Outlet(RosConnection& ros, const InspectionNodeOptions& o, double time_origin_s,
-         int frames_per_sweep)
+         int frames_per_sweep, Failure& failure)
       : ros_(ros), options_(o), origin_s_(time_origin_s), frames_per_sweep_(frames_per_sweep) {
     const RosTopics& t = o.topics;
     sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
-    map_id_ = ros.Advertise(t.map, RosConnection::Kind::kCloud, true);
+    map_ = std::make_unique<MapPublisher>(
+        ros, ros.Advertise(t.map, RosConnection::Kind::kCloud, true), o.navigation.axes,
+        o.reference, [&failure](std::exception_ptr e) { failure.Set(std::move(e)); });
     slam_path_id_ = ros.Advertise(t.slam_path, RosConnection::Kind::kPath, true);
     navigation_path_id_ = ros.Advertise(t.navigation_path, RosConnection::Kind::kPath, true);
     pose_id_ = ros.Advertise(t.pose, RosConnection::Kind::kPose, true);
@@ -337,11 +321,9 @@ class Outlet {
                           RosCovariance(c->anchors[static_cast<std::size_t>(last)]), axes())});
     }
     if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
-      ros_.Publish(map_id_, MapMessage(m.Map(options_.inspection.map_voxel_m),
-                                       Stamp(slam.back().time_s, options_.frames.map), axes(),
-                                       options_.reference.get()));
+      map_->Submit(m.Map(options_.inspection.map_voxel_m),
+                   Stamp(slam.back().time_s, options_.frames.map));
       last_map_ = Clock::now();
-      ++maps_;
     }
   }
 
@@ -351,13 +333,12 @@ class Outlet {
     if (!sweep_points_W_.empty()) PublishSweep();
     if (r.slam.empty()) return;
     PublishTrajectory(r.slam, r.navigation);
-    ros_.Publish(map_id_, MapMessage(r.map, Stamp(r.slam.back().time_s, options_.frames.map),
-                                     axes(), options_.reference.get()));
-    ++maps_;
+    map_->PublishLast(r.map, Stamp(r.slam.back().time_s, options_.frames.map));
   }
 
   std::int64_t sweeps() const { return sweeps_; }
-  std::int64_t maps() const { return maps_; }
+  std::int64_t maps_published() const { return map_->published(); }
+  std::int64_t maps_replaced() const { return map_->replaced(); }
   // Median and 95th percentile of the sweeps' latencies; call once the mapping thread ended.
   std::pair<double, double> SweepLatency() const {
     if (sweep_latencies_s_.empty()) return {0.0, 0.0};
@@ -417,8 +398,7 @@ class Outlet {
   double origin_s_;
   int frames_per_sweep_;
   int frames_in_sweep_ = 0;
-  int sweep_id_ = 0, map_id_ = 0, slam_path_id_ = 0, navigation_path_id_ = 0, pose_id_ = 0,
-      tf_id_ = 0;
+  int sweep_id_ = 0, slam_path_id_ = 0, navigation_path_id_ = 0, pose_id_ = 0, tf_id_ = 0;
   std::optional<int> sweep_;
   double sweep_time_s_ = 0.0;
   double sweep_received_s_ = 0.0;
@@ -426,7 +406,8 @@ class Outlet {
   Eigen::Isometry3d T_W_C_last_ = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3d> sweep_points_W_;
   std::optional<Clock::time_point> last_map_;
-  std::atomic<std::int64_t> sweeps_{0}, maps_{0};
+  std::atomic<std::int64_t> sweeps_{0};
+  std::unique_ptr<MapPublisher> map_;
 };
 
 // Why the node stops now, "" to go on.
@@ -552,8 +533,8 @@ void StartInspection(Node& node, const InspectionNodeOptions& o, const DiveSetup
   header.producer = o.producer;
   mapping::InspectionOptions options = o.inspection;
   options.fixed_scanner = false;
-  node.outlet = std::make_unique<Outlet>(node.ros, o, setup.time_origin_s,
-                                         setup.header.scan_pattern.frames_per_sweep());
+  node.outlet = std::make_unique<Outlet>(
+      node.ros, o, setup.time_origin_s, setup.header.scan_pattern.frames_per_sweep(), node.failure);
   Outlet* outlet = node.outlet.get();
   node.inspection = std::make_unique<mapping::LiveInspection>(
       header, o.log, setup.T_V_C,
@@ -627,7 +608,8 @@ InspectionNodeSummary RunInspectionNode(
   summary.sweeps_published = node.outlet->sweeps();
   std::tie(summary.sweep_latency_median_s, summary.sweep_latency_p95_s) =
       node.outlet->SweepLatency();
-  summary.maps_published = node.outlet->maps();
+  summary.maps_published = node.outlet->maps_published();
+  summary.maps_replaced = node.outlet->maps_replaced();
   summary.reregistrations = ros.reregistrations();
   summary.described = setup.described;
   summary.mount = setup.mount;

@@ -76,6 +76,8 @@ struct InspectionNodeSummary {
   double sweep_latency_median_s = 0.0;
   double sweep_latency_p95_s = 0.0;
   std::int64_t maps_published = 0;
+  // Maps the publishing thread had not taken before a newer one came (it publishes the newest).
+  std::int64_t maps_replaced = 0;
   int reregistrations = 0;     // times the node registered again with a restarted master
   bool described = false;      // the scanner came from the dive topic
   std::string mount;           // where the camera's mount came from

@@ -1,7 +1,5 @@
 #include "scanner/calibration/calibration_dataset.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -11,6 +9,7 @@
 #include <sstream>
 
 #include "scanner/calibration/calibration_yaml.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
@@ -341,32 +340,6 @@ CalibrationDataset ParseManifest(const YAML::Node& root, const std::string& sour
 
 // --- writing ----------------------------------------------------------------------------------
 
-void WriteAtomically(const fs::path& path, const std::string& text) {
-  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "." + std::string(..).
-  std::string name = ".";
-  name += path.filename().string();
-  name += ".tmp-";
-  name += std::to_string(getpid());
-  const fs::path temporary = path.parent_path() / name;
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(temporary, ignored);
-      throw Error(path.string() + ": cannot write (temporary file " + temporary.string() + ")");
-    }
-  }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw Error(path.string() + ": cannot replace: " + error.message());
-  }
-}
-
 // A path as the manifest holds it: relative to the folder when inside it.
 std::string RelativeToFolder(const fs::path& path, const fs::path& folder) {
   const fs::path relative =
@@ -478,7 +451,7 @@ void WriteCalibrationManifest(const CalibrationDataset& d) {
   }
   out << YAML::EndMap;
   if (!out.good()) throw Error(manifest.string() + ": cannot emit YAML: " + out.GetLastError());
-  WriteAtomically(manifest, std::string(out.c_str()) + "\n");
+  WriteFileAtomically(manifest, std::string(out.c_str()) + "\n");
 }
 
 DatasetTruth LoadDatasetTruth(const fs::path& path) {
@@ -514,7 +487,7 @@ void WriteDatasetTruth(const fs::path& path, const DatasetTruth& truth) {
   }
   out << YAML::EndMap;
   if (!out.good()) throw Error(path.string() + ": cannot emit YAML: " + out.GetLastError());
-  WriteAtomically(path, std::string(out.c_str()) + "\n");
+  WriteFileAtomically(path, std::string(out.c_str()) + "\n");
 }
 
 }  // namespace uwscan::scanner::calibration

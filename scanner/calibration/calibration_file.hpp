@@ -4,7 +4,7 @@
 #include <optional>
 #include <string>
 
-#include "scanner/common/atomic_file.hpp"  // WriteTextAtomically, used with these files
+#include "scanner/common/atomic_file.hpp"  // WriteFileAtomically, used with these files
 #include "scanner/lasers/scanner.hpp"
 
 namespace uwscan::scanner::calibration {

@@ -36,8 +36,8 @@ TEST(CalibrationFile, NowUtcIsIso8601) {
 TEST(CalibrationFile, AtomicWriteKeepsTheOldFileOnFailure) {
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() / "uwscan_calib_atomic.yaml";
-  WriteTextAtomically(path, "first\n");
-  EXPECT_THROW(WriteTextAtomically("/nonexistent/folder/x.yaml", "second\n"), Error);
+  WriteFileAtomically(path, "first\n");
+  EXPECT_THROW(WriteFileAtomically("/nonexistent/folder/x.yaml", "second\n"), Error);
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);

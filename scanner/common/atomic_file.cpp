@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 #include "scanner/common/error.hpp"
 
@@ -55,11 +56,11 @@ void ReplaceWithTemporary(const fs::path& temporary, const fs::path& path) {
   Sync(path.has_parent_path() ? path.parent_path() : fs::path("."), O_RDONLY | O_DIRECTORY);
 }
 
-void WriteTextAtomically(const fs::path& path, const std::string& text) {
+void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
   const fs::path temporary = TemporaryBeside(path);
   std::FILE* file = std::fopen(temporary.c_str(), "wb");
   if (file == nullptr) throw Error(path.string() + ": cannot write (" + std::strerror(errno) + ")");
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
+  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
   const int write_errno = errno;
   const bool closed = std::fclose(file) == 0;
   if (!written || !closed) {

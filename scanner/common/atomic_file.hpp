@@ -1,7 +1,7 @@
 #pragma once
 
 #include <filesystem>
-#include <string>
+#include <string_view>
 
 // Files that are replaced whole or not at all: written under a temporary name beside the target
 // (same file system, so the rename is atomic) and renamed over it when complete. A failure, a
@@ -18,8 +18,8 @@ std::filesystem::path TemporaryBeside(const std::filesystem::path& path);
 void ReplaceWithTemporary(const std::filesystem::path& temporary,
                           const std::filesystem::path& path);
 
-// Writes text to path through TemporaryBeside and ReplaceWithTemporary. Throws uwscan::Error
-// naming the path (and the system's reason: no space left, read-only, ...).
-void WriteTextAtomically(const std::filesystem::path& path, const std::string& text);
+// Writes `bytes` (text or binary) to path through TemporaryBeside and ReplaceWithTemporary.
+// Throws uwscan::Error naming the path (and the system's reason: no space left, read-only, ...).
+void WriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
 }  // namespace uwscan

@@ -13,6 +13,7 @@
 #include <string>
 #include <system_error>
 
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/off_reader.hpp"
 #include "scanner/common/ply_reader.hpp"
@@ -131,26 +132,7 @@ void WriteMeshPly(const TriangleMesh& mesh, const std::filesystem::path& path) {
     data.push_back(3);
     for (int i = 0; i < 3; ++i) PutLittleEndian(&data, static_cast<std::int32_t>(t[i]));
   }
-  // Write beside the target, then rename: a rename within a folder replaces it atomically.
-  const std::filesystem::path temporary = name + ".part";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(name + ": cannot write mesh (cannot create " + temporary.string() + ")");
-    out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      throw Error(name + ": cannot write mesh (write to " + temporary.string() + " failed)");
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw Error(name + ": cannot write mesh: " + error.message());
-  }
+  WriteFileAtomically(path, data);
 }
 
 SurfaceSamples SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed) {

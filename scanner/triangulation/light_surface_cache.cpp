@@ -1,7 +1,5 @@
 #include "scanner/triangulation/light_surface_cache.hpp"
 
-#include <unistd.h>
-
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -10,9 +8,10 @@
 #include <optional>
 #include <string>
 #include <system_error>
-#include <thread>
 #include <vector>
 
+#include "scanner/common/atomic_file.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/common/fnv1a.hpp"
 
 namespace uwscan::scanner {
@@ -175,24 +174,13 @@ std::optional<std::vector<char>> ReadFile(const std::filesystem::path& path) {
 }
 
 // Best effort: a cache that cannot be written is no error, the table is still correct.
-void WriteFileAtomically(const std::filesystem::path& path, const std::vector<char>& data) {
+void WriteCacheFile(const std::filesystem::path& path, const std::vector<char>& data) {
   std::error_code ec;
   std::filesystem::create_directories(path.parent_path(), ec);
-  // Unique per process and thread, so that writers of the same table never share a temp file.
-  const std::filesystem::path temp =
-      path.string() + ".part" + std::to_string(::getpid()) + "_" +
-      std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id()));
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) return;
-    out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    if (!out.flush()) {
-      std::filesystem::remove(temp, ec);
-      return;
-    }
+  try {
+    WriteFileAtomically(path, std::string_view(data.data(), data.size()));
+  } catch (const Error&) {
   }
-  std::filesystem::rename(temp, path, ec);
-  if (ec) std::filesystem::remove(temp, ec);
 }
 
 }  // namespace
@@ -212,7 +200,7 @@ CachedTable LoadOrBuildLightSurfaceTable(const GalvoLaser& laser,
       return {table, true};
   }
   auto table = std::make_shared<const LightSurfaceTable>(laser, options);
-  WriteFileAtomically(path, Serialize(inputs, *table));
+  WriteCacheFile(path, Serialize(inputs, *table));
   return {table, false};
 }
 

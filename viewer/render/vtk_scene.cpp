@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <system_error>
 
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/scene/point_colours.hpp"
 
@@ -423,7 +424,7 @@ void WriteWindowPng(vtkRenderWindow& window, const std::filesystem::path& path) 
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
   grab->Update();
-  const std::filesystem::path temporary = path.string() + ".tmp.png";
+  const std::filesystem::path temporary = TemporaryBeside(path);
   vtkNew<vtkPNGWriter> writer;
   writer->SetFileName(temporary.c_str());
   writer->SetInputConnection(grab->GetOutputPort());
@@ -433,11 +434,7 @@ void WriteWindowPng(vtkRenderWindow& window, const std::filesystem::path& path) 
     std::filesystem::remove(temporary, ec);
     throw Error(path.string() + ": cannot write the PNG (does the folder exist?)");
   }
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    throw Error(path.string() + ": cannot replace: " + ec.message());
-  }
+  ReplaceWithTemporary(temporary, path);
 }
 
 Eigen::Matrix4d NdcFromWorld(vtkRenderer& renderer, const Eigen::Vector3d& anchor_W) {

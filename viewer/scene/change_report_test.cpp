@@ -57,7 +57,7 @@ TEST(ChangeReport, SignificantDeviationsInDivergingColoursTheRestGreyARegionLabe
   map.name = "after.json";
   reference.name = "before.json";
   mapping::WriteDeviationsPly(folder / "changes.ply", c);
-  WriteTextAtomically(
+  WriteFileAtomically(
       folder / "changes.json",
       mapping::ChangeReportJson(c, map, reference, {}, (folder / "changes.ply").string()).dump());
   ASSERT_EQ(KindOfFile(folder / "changes.json"), FileKind::kChangeReport);
@@ -89,7 +89,7 @@ TEST(ChangeReport, SignificantDeviationsInDivergingColoursTheRestGreyARegionLabe
   std::ofstream(folder / "other.ply")
       << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
          "property float y\nproperty float z\nend_header\n0 0 0\n";
-  WriteTextAtomically(
+  WriteFileAtomically(
       folder / "other.json",
       mapping::ChangeReportJson(c, map, reference, {}, (folder / "other.ply").string()).dump());
   Scene other;

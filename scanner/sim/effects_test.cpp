@@ -1,6 +1,8 @@
 // The dives' peak noise (exact peaks perturbed along the detection axis) stands for the
 // detector's error on their stripes: rendered with the accuracy experiments' image stages and
 // detected, each dive's stripes must err by what its scene says.
+#include "scanner/sim/effects.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "scanner/sim/effects.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 

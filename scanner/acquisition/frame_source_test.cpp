@@ -1,8 +1,9 @@
+#include "scanner/acquisition/frame_source.hpp"
+
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "scanner/acquisition/frame_source.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::scanner::acquisition {

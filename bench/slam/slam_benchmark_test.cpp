@@ -1,4 +1,6 @@
 // The SLAM bench's walk scale: the scene's random walks scaled, nothing else changed.
+#include "bench/slam/slam_benchmark.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -6,7 +8,6 @@
 #include <sstream>
 #include <string>
 
-#include "bench/slam/slam_benchmark.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/sim/scene.hpp"
 

@@ -1,3 +1,5 @@
+#include "scanner/triangulation/triangulator_factory.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -7,7 +9,6 @@
 
 #include "scanner/common/error.hpp"
 #include "scanner/lasers/scanner_file.hpp"
-#include "scanner/triangulation/triangulator_factory.hpp"
 
 namespace uwscan::scanner {
 namespace {

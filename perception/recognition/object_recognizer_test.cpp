@@ -1,3 +1,5 @@
+#include "perception/recognition/object_recognizer.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -18,7 +20,6 @@
 #include "perception/recognition/object_database.hpp"
 #include "perception/recognition/object_database_builder.hpp"
 #include "perception/recognition/object_pose_search.hpp"
-#include "perception/recognition/object_recognizer.hpp"
 #include "perception/recognition/object_symmetry.hpp"
 #include "perception/recognition/recognition_test_support.hpp"
 #include "scanner/common/error.hpp"
