@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 extern char** environ;
 
@@ -138,11 +139,12 @@ double Median(std::vector<double> values) {
 }  // namespace
 
 void ThreadLoadOptions::Check() const {
-  if (repeats < 1 || repeats > 100) throw Error("bench threads: repeats must be in [1, 100]");
-  if (!std::filesystem::is_regular_file(uwscan))
-    throw Error("bench threads: no uwscan executable at " + uwscan.string());
-  if (!std::filesystem::is_directory(data_dir))
-    throw Error("bench threads: no data folder at " + data_dir.string());
+  const OptionChecks check("ThreadLoadOptions");
+  check.InRange("repeats", repeats, 1, 100);
+  check.Require(std::filesystem::is_regular_file(uwscan), "uwscan", "the uwscan executable",
+                OptionQuotedText(uwscan.string()) + " (no such file)");
+  check.Require(std::filesystem::is_directory(data_dir), "data_dir", "the data folder",
+                OptionQuotedText(data_dir.string()) + " (no such folder)");
 }
 
 double ThreadLoadResult::Median(const std::string& workload, const std::string& policy, bool loaded,

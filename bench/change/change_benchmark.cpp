@@ -22,6 +22,7 @@
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
@@ -418,8 +419,10 @@ mapping::Survey DesignSurvey(const scanner::sim::Scene& scene, const fs::path& p
 }  // namespace
 
 void ChangeBenchOptions::Check() const {
-  if (before_scene.empty() || after_scene.empty()) throw Error("bench change: two scenes needed");
-  if (threads < 1) throw Error("bench change: threads must be > 0");
+  const OptionChecks check("ChangeBenchOptions");
+  check.Require(!before_scene.empty(), "before_scene", "a scene file", "''");
+  check.Require(!after_scene.empty(), "after_scene", "a scene file", "''");
+  check.GreaterThan("threads", threads, 0);
 }
 
 ChangeFigures RunChangeBench(const ChangeBenchOptions& options, const Progress& progress) {

@@ -19,8 +19,8 @@
 #include "perception/recognition/object_pose_search.hpp"
 #include "perception/recognition/object_recognizer.hpp"
 #include "perception/recognition/pose_check.hpp"
-#include "scanner/common/error.hpp"
 #include "scanner/common/fnv1a.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
@@ -353,9 +353,11 @@ sim::VirtualScan ScanOf(const Scene& scene, int s, const sim::VirtualScanner& sc
 }  // namespace
 
 void RecognitionBenchOptions::Check() const {
-  if (scans < 1 || views < 1 || galvo_stride < 1 || threads < 1) {
-    throw Error("bench recognition: scans, views, stride and threads must be >= 1");
-  }
+  const OptionChecks check("RecognitionBenchOptions");
+  check.AtLeast("scans", scans, 1);
+  check.AtLeast("views", views, 1);
+  check.AtLeast("galvo_stride", galvo_stride, 1);
+  check.AtLeast("threads", threads, 1);
 }
 
 RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& options,

@@ -3,19 +3,22 @@
 #include <functional>
 
 #include "bench/registration/registration_pipelines.hpp"
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::bench {
 
 void RegistrationBenchOptions::Check() const {
-  if (threads < 1) throw Error("bench registration: threads must be >= 1");
-  if (!(max_rotation_error_rad > 0.0) || !(max_translation_fraction > 0.0)) {
-    throw Error("bench registration: success thresholds must be > 0");
-  }
+  const OptionChecks check("RegistrationBenchOptions");
+  check.AtLeast("threads", threads, 1);
+  check.GreaterThan("max_rotation_error_rad", max_rotation_error_rad, 0.0, "rad");
+  check.GreaterThan("max_translation_fraction", max_translation_fraction, 0.0);
   pairs.Check();
-  for (const double f : sweep_voxel_fractions) {
-    if (!(f > 0.0 && f < 1.0))
-      throw Error("bench registration: a swept voxel fraction must be in (0, 1)");
+  for (std::size_t i = 0; i < sweep_voxel_fractions.size(); ++i) {
+    const double f = sweep_voxel_fractions[i];
+    if (!(f > 0.0 && f < 1.0)) {
+      check.Fail("sweep_voxel_fractions[" + std::to_string(i) + "]", "in (0, 1)",
+                 OptionValueText(f));
+    }
   }
 }
 

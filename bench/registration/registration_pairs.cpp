@@ -7,6 +7,7 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::bench {
@@ -142,10 +143,11 @@ void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng,
 }  // namespace
 
 void RegistrationPairOptions::Check() const {
-  if (mesh_samples < 1000) throw Error("registration pairs: mesh_samples must be >= 1000");
-  if (!(mesh_size_m > 0.0)) throw Error("registration pairs: mesh_size_m must be > 0");
-  if (!(noise_sigma_m >= 0.0)) throw Error("registration pairs: noise_sigma_m must be >= 0");
-  if (pairs_per_mesh < 1) throw Error("registration pairs: pairs_per_mesh must be >= 1");
+  const OptionChecks check("RegistrationPairOptions");
+  check.AtLeast("mesh_samples", mesh_samples, 1000);
+  check.GreaterThan("mesh_size_m", mesh_size_m, 0.0, "m");
+  check.AtLeast("noise_sigma_m", noise_sigma_m, 0.0, "m");
+  check.AtLeast("pairs_per_mesh", pairs_per_mesh, 1);
 }
 
 std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,

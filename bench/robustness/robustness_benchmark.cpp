@@ -22,6 +22,7 @@
 #include "mapping/log/dive_log.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/file_bytes.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::bench {
@@ -403,14 +404,14 @@ DiveLogDamage MeasureDiveLogDamage(const fs::path& original_path, const Original
 }  // namespace
 
 void RobustnessOptions::Check() const {
-  if (mutants_per_kind < 1) throw Error("robustness: mutants_per_kind must be >= 1");
-  if (!(timeout_s > 0.0)) throw Error("robustness: timeout_s must be > 0");
-  if (dive_log_trials < 0) throw Error("robustness: dive_log_trials must be >= 0");
-  if (damaged_bytes < 1) throw Error("robustness: damaged_bytes must be >= 1");
-  if (!fs::is_directory(data_dir / "scanners") || !fs::is_directory(data_dir / "scenes")) {
-    throw Error("robustness: data folder '" + data_dir.string() +
-                "' has no scanners/ and scenes/ (use --data)");
-  }
+  const OptionChecks check("RobustnessOptions");
+  check.AtLeast("mutants_per_kind", mutants_per_kind, 1);
+  check.GreaterThan("timeout_s", timeout_s, 0.0, "s");
+  check.AtLeast("dive_log_trials", dive_log_trials, 0);
+  check.AtLeast("damaged_bytes", damaged_bytes, 1);
+  check.Require(fs::is_directory(data_dir / "scanners") && fs::is_directory(data_dir / "scenes"),
+                "data_dir", "a data folder with scanners/ and scenes/ (use --data)",
+                OptionQuotedText(data_dir.string()));
 }
 
 RobustnessResult RunRobustnessBenchmark(const RobustnessOptions& options, const fs::path& scratch,

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "perception/preprocessing/sphere_fit.hpp"
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/parallel_tasks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/imr_objects.hpp"
@@ -397,25 +397,38 @@ class AccuracyRun {
 }  // namespace
 
 void AccuracyBenchOptions::Check() const {
-  if (gauge_positions < 1) throw Error("bench accuracy: gauge_positions must be >= 1");
-  if (!(gauge_near_m > 0.0 && gauge_far_m >= gauge_near_m)) {
-    throw Error("bench accuracy: gauge range must satisfy 0 < near <= far");
+  const OptionChecks check("AccuracyBenchOptions");
+  const auto index = [](const char* field, std::size_t i) {
+    return std::string(field) + "[" + std::to_string(i) + "]";
+  };
+  check.AtLeast("gauge_positions", gauge_positions, 1);
+  check.GreaterThan("gauge_near_m", gauge_near_m, 0.0, "m");
+  check.Require(gauge_far_m >= gauge_near_m, "gauge_far_m",
+                ">= gauge_near_m (" + OptionValueText(gauge_near_m) + " m)", gauge_far_m);
+  for (std::size_t i = 0; i < gauge_lengths_m.size(); ++i) {
+    if (!(gauge_lengths_m[i] > 0.0)) {
+      check.Fail(index("gauge_lengths_m", i), "> 0 m", OptionValueText(gauge_lengths_m[i]));
+    }
   }
-  for (double l : gauge_lengths_m) {
-    if (!(l > 0.0)) throw Error("bench accuracy: gauge lengths must be > 0 m");
+  for (std::size_t i = 0; i < plane_distances_m.size(); ++i) {
+    if (!(plane_distances_m[i] > 0.0)) {
+      check.Fail(index("plane_distances_m", i), "> 0 m", OptionValueText(plane_distances_m[i]));
+    }
   }
-  for (double d : plane_distances_m) {
-    if (!(d > 0.0)) throw Error("bench accuracy: plane distances must be > 0 m");
+  for (std::size_t i = 0; i < sphere_distances_m.size(); ++i) {
+    if (!(sphere_distances_m[i] > sphere_radius_m)) {
+      check.Fail(index("sphere_distances_m", i),
+                 "> sphere_radius_m (" + OptionValueText(sphere_radius_m) + " m)",
+                 OptionValueText(sphere_distances_m[i]));
+    }
   }
-  for (double d : sphere_distances_m) {
-    if (!(d > sphere_radius_m))
-      throw Error("bench accuracy: sphere distances must exceed the radius");
+  for (std::size_t i = 0; i < waypoints_per_line.size(); ++i) {
+    if (waypoints_per_line[i] < 2) {
+      check.Fail(index("waypoints_per_line", i), ">= 2", std::to_string(waypoints_per_line[i]));
+    }
   }
-  for (int m : waypoints_per_line) {
-    if (m < 2) throw Error("bench accuracy: waypoints per line must be >= 2");
-  }
-  if (mems_lines < 1) throw Error("bench accuracy: mems_lines must be >= 1");
-  if (threads < 0) throw Error("bench accuracy: threads must be >= 0");
+  check.AtLeast("mems_lines", mems_lines, 1);
+  check.AtLeast("threads", threads, 0);
 }
 
 GaugeFigures RunGaugeExperiment(const AccuracyBenchOptions& options, bool underwater,

@@ -13,6 +13,7 @@
 #include "scanner/calibration/galvo_laser_calibration.hpp"
 #include "scanner/calibration/parameter_lists.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::bench {
@@ -97,12 +98,11 @@ double FanError(const scanner::Scanner& true_scanner, const scanner::Scanner& es
 }  // namespace
 
 void CalibrationBenchOptions::Check() const {
-  if (gauge_positions < 1) throw Error("bench calibration: gauge_positions must be >= 1");
-  if (threads < 0) throw Error("bench calibration: threads must be >= 0");
-  if (!std::filesystem::is_directory(data_dir / "scenes")) {
-    throw Error("bench calibration: " + (data_dir / "scenes").string() +
-                " is not a folder (give --data)");
-  }
+  const OptionChecks check("CalibrationBenchOptions");
+  check.AtLeast("gauge_positions", gauge_positions, 1);
+  check.AtLeast("threads", threads, 0);
+  check.Require(std::filesystem::is_directory(data_dir / "scenes"), "data_dir",
+                "a data folder with scenes/ (give --data)", OptionQuotedText(data_dir.string()));
 }
 
 CalibrationBenchResult RunCalibrationBenchmark(const CalibrationBenchOptions& options,

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/optics/flat_viewport.hpp"
 #include "scanner/triangulation/light_plane.hpp"
 
@@ -42,20 +43,19 @@ FanPoints TraceFan(const DeformationOptions& o, const scanner::FlatViewport& vie
 }  // namespace
 
 void DeformationOptions::Check() const {
-  auto require = [](bool ok, const char* what) {
-    if (!ok) throw Error(std::string("deformation experiment: ") + what);
-  };
-  require(rays >= 3, "rays must be >= 3");
-  require(aperture_rad > 0.0 && aperture_rad < 2.5, "aperture_rad must be in (0, 2.5)");
-  require(points_per_ray >= 2, "points_per_ray must be >= 2");
-  require(point_spacing_m > 0.0, "point_spacing_m must be > 0");
-  require(projection_distance_m > (points_per_ray - 1) * point_spacing_m,
-          "projection_distance_m must exceed the span of the points");
-  require(incidence_angles >= 1, "incidence_angles must be >= 1");
-  require(max_incidence_rad >= 0.0 && max_incidence_rad < 1.2,
-          "max_incidence_rad must be in [0, 1.2)");
-  require(source_to_viewport_m > 0.0 && thickness_m > 0.0,
-          "source_to_viewport_m and thickness_m must be > 0");
+  const OptionChecks check("DeformationOptions");
+  check.AtLeast("rays", rays, 3);
+  check.InRange("aperture_rad", aperture_rad, 0.0, 2.5, Interval::kOpen, "rad");
+  check.AtLeast("points_per_ray", points_per_ray, 2);
+  check.GreaterThan("point_spacing_m", point_spacing_m, 0.0, "m");
+  const double span_m = (points_per_ray - 1) * point_spacing_m;
+  check.Require(projection_distance_m > span_m, "projection_distance_m",
+                "> the span of the points (" + OptionValueText(span_m) + " m)",
+                projection_distance_m);
+  check.AtLeast("incidence_angles", incidence_angles, 1);
+  check.InRange("max_incidence_rad", max_incidence_rad, 0.0, 1.2, Interval::kOpenHigh, "rad");
+  check.GreaterThan("source_to_viewport_m", source_to_viewport_m, 0.0, "m");
+  check.GreaterThan("thickness_m", thickness_m, 0.0, "m");
   cone.Check();
 }
 

@@ -7,7 +7,7 @@
 #include <memory>
 #include <utility>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 
@@ -99,8 +99,9 @@ std::vector<EffectCost> TimeRows(const Scene& base,
 }  // namespace
 
 void SimulationBenchOptions::Check() const {
-  if (frames < 1) throw Error("bench simulation: --frames must be >= 1");
-  if (repeats < 1) throw Error("bench simulation: repeats must be >= 1");
+  const OptionChecks check("SimulationBenchOptions");
+  check.AtLeast("frames", frames, 1);
+  check.AtLeast("repeats", repeats, 1);
 }
 
 SimulationBenchResult RunSimulationBenchmark(const SimulationBenchOptions& o,

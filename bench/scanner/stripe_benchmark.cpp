@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/stripe/stripe_render.hpp"
 
 namespace uwscan::bench {
@@ -116,14 +117,15 @@ class ColumnMaximumPass {
 }  // namespace
 
 void StripeBenchOptions::Check() const {
-  if (width_px < 16 || height_px < 16) throw Error("bench stripe: image must be at least 16x16");
-  if (height_px > 65535) throw Error("bench stripe: height_px must be <= 65535");
-  if (frames < 1) throw Error("bench stripe: --frames must be >= 1");
-  if (repeats < 1) throw Error("bench stripe: repeats must be >= 1");
-  if (!(min_seconds >= 0.0)) throw Error("bench stripe: min_seconds must be >= 0");
-  if (!(amplitude > 0.0) || !(background >= 0.0) || !(speed_noise_sigma >= 0.0)) {
-    throw Error("bench stripe: need amplitude > 0, background >= 0, speed_noise_sigma >= 0");
-  }
+  const OptionChecks check("StripeBenchOptions");
+  check.AtLeast("width_px", width_px, 16, "px");
+  check.InRange("height_px", height_px, 16, 65535, Interval::kClosed, "px");
+  check.AtLeast("frames", frames, 1);
+  check.AtLeast("repeats", repeats, 1);
+  check.AtLeast("min_seconds", min_seconds, 0.0, "s");
+  check.GreaterThan("amplitude", amplitude, 0.0, "image units");
+  check.AtLeast("background", background, 0.0, "image units");
+  check.AtLeast("speed_noise_sigma", speed_noise_sigma, 0.0);
 }
 
 StripeBenchResult RunStripeBenchmark(const StripeBenchOptions& o, const Progress& progress) {

@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/triangulation/ray_ray_triangulator.hpp"
 #include "scanner/triangulation/surface_triangulators.hpp"
 
@@ -229,16 +229,20 @@ std::vector<TableResolutionRow> SweepResolutions(
 }  // namespace
 
 void TriangulationBenchOptions::Check() const {
-  if (points < 1) throw Error("bench triangulation: --points must be >= 1");
-  if (points_per_frame < 1) throw Error("bench triangulation: points_per_frame must be >= 1");
-  if (!(depth_min_m > 0.0 && depth_max_m > depth_min_m)) {
-    throw Error("bench triangulation: need 0 < depth_min_m < depth_max_m");
-  }
-  if (repeats < 1) throw Error("bench triangulation: repeats must be >= 1");
-  if (camera_grid_px < 1) throw Error("bench triangulation: camera_grid_px must be >= 1");
+  const OptionChecks check("TriangulationBenchOptions");
+  check.AtLeast("points", points, 1);
+  check.AtLeast("points_per_frame", points_per_frame, 1);
+  check.GreaterThan("depth_min_m", depth_min_m, 0.0, "m");
+  check.Require(depth_max_m > depth_min_m, "depth_max_m",
+                "> depth_min_m (" + OptionValueText(depth_min_m) + " m)", depth_max_m);
+  check.AtLeast("repeats", repeats, 1);
+  check.AtLeast("camera_grid_px", camera_grid_px, 1, "px");
   surfaces.Check();
-  for (const int g : sweep_camera_grid_px) {
-    if (g < 1) throw Error("bench triangulation: a camera-ray table spacing must be >= 1 px");
+  for (std::size_t i = 0; i < sweep_camera_grid_px.size(); ++i) {
+    if (sweep_camera_grid_px[i] < 1) {
+      check.Fail("sweep_camera_grid_px[" + std::to_string(i) + "]", ">= 1 px",
+                 std::to_string(sweep_camera_grid_px[i]));
+    }
   }
   for (const int r : sweep_rays_per_fan) {
     scanner::LightSurfaceTableOptions swept = surfaces;

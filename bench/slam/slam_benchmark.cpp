@@ -16,6 +16,7 @@
 #include "mapping/slam/submap.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
@@ -210,13 +211,11 @@ DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t see
 }  // namespace
 
 void SlamBenchOptions::Check() const {
-  if (scenes.empty()) throw Error("bench slam: no scene");
-  if (seeds < 1) throw Error("bench slam: seeds must be > 0");
-  if (threads < 1) throw Error("bench slam: threads must be > 0");
-  if (!(std::isfinite(walk_scale) && walk_scale > 0.0)) {
-    throw Error("bench slam: walk scale must be a finite number > 0, got " +
-                std::to_string(walk_scale));
-  }
+  const OptionChecks check("SlamBenchOptions");
+  check.Require(!scenes.empty(), "scenes", "at least one scene", "none");
+  check.GreaterThan("seeds", seeds, 0);
+  check.GreaterThan("threads", threads, 0);
+  check.Positive("walk_scale", walk_scale);
 }
 
 std::string SceneWithWalkScale(const std::string& yaml_text, double scale,

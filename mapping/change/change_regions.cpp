@@ -6,6 +6,7 @@
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -85,9 +86,9 @@ ChangeRegion Describe(const std::vector<CoreDeviation>& d, std::vector<std::size
 }  // namespace
 
 void RegionOptions::Check() const {
-  if (!(link_m >= 0.0) || !std::isfinite(link_m))
-    throw Error("RegionOptions: link_m must be finite and >= 0");
-  if (min_core_points < 1) throw Error("RegionOptions: min_core_points must be >= 1");
+  const OptionChecks check("RegionOptions");
+  check.NonNegative("link_m", link_m, "m");
+  check.AtLeast("min_core_points", min_core_points, 1);
 }
 
 std::vector<ChangeRegion> FindChangeRegions(const std::vector<CoreDeviation>& deviations,

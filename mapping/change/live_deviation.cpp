@@ -6,6 +6,7 @@
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/normals.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping {
 
@@ -16,12 +17,10 @@ struct LiveDeviation::Impl {
 };
 
 void LiveDeviationOptions::Check() const {
-  if (!(max_distance_m > 0.0) || !std::isfinite(max_distance_m))
-    throw Error("LiveDeviationOptions: max_distance_m must be finite and > 0");
-  if (!(threshold_m >= 0.0) || !std::isfinite(threshold_m))
-    throw Error("LiveDeviationOptions: threshold_m must be finite and >= 0");
-  if (!(normal_radius_m > 0.0) || !std::isfinite(normal_radius_m))
-    throw Error("LiveDeviationOptions: normal_radius_m must be finite and > 0");
+  const OptionChecks check("LiveDeviationOptions");
+  check.Positive("max_distance_m", max_distance_m, "m");
+  check.NonNegative("threshold_m", threshold_m, "m");
+  check.Positive("normal_radius_m", normal_radius_m, "m");
 }
 
 LiveDeviation::LiveDeviation(const Survey& reference, const LiveDeviationOptions& options)

@@ -10,6 +10,7 @@
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -185,26 +186,20 @@ int Threads(int threads) { return threads > 0 ? threads : omp_get_max_threads();
 }  // namespace
 
 void DeviationOptions::Check() const {
-  const auto positive = [](double v, const char* name) {
-    if (!(v > 0.0) || !std::isfinite(v))
-      throw Error(std::string("DeviationOptions: ") + name + " must be finite and > 0");
-  };
-  positive(core_spacing_m, "core_spacing_m");
-  positive(normal_radius_m, "normal_radius_m");
-  positive(cylinder_radius_m, "cylinder_radius_m");
-  positive(max_depth_m, "max_depth_m");
-  positive(surface_gap_m, "surface_gap_m");
-  if (!(local_offset_radius_m >= 0.0) || !std::isfinite(local_offset_radius_m))
-    throw Error("DeviationOptions: local_offset_radius_m must be finite and >= 0");
-  if (min_points < 2) throw Error("DeviationOptions: min_points must be >= 2");
-  if (!(map_point_sigma_m >= 0.0) || !(reference_point_sigma_m >= 0.0) ||
-      !std::isfinite(map_point_sigma_m) || !std::isfinite(reference_point_sigma_m))
-    throw Error("DeviationOptions: the point sigmas must be finite and >= 0");
-  if (!(confidence > 0.0 && confidence < 1.0))
-    throw Error("DeviationOptions: confidence must be in (0, 1)");
-  if (!(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= M_PI / 2))
-    throw Error("DeviationOptions: max_normal_angle_rad must be in [0, pi/2]");
-  if (threads < 0) throw Error("DeviationOptions: threads must be >= 0");
+  const OptionChecks check("DeviationOptions");
+  check.Positive("core_spacing_m", core_spacing_m, "m");
+  check.Positive("normal_radius_m", normal_radius_m, "m");
+  check.Positive("cylinder_radius_m", cylinder_radius_m, "m");
+  check.Positive("max_depth_m", max_depth_m, "m");
+  check.Positive("surface_gap_m", surface_gap_m, "m");
+  check.NonNegative("local_offset_radius_m", local_offset_radius_m, "m");
+  check.AtLeast("min_points", min_points, 2);
+  check.NonNegative("map_point_sigma_m", map_point_sigma_m, "m");
+  check.NonNegative("reference_point_sigma_m", reference_point_sigma_m, "m");
+  check.InRange("confidence", confidence, 0.0, 1.0, Interval::kOpen);
+  check.Require(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= M_PI / 2,
+                "max_normal_angle_rad", "in [0, pi/2] rad", max_normal_angle_rad);
+  check.AtLeast("threads", threads, 0);
 }
 
 double TwoSidedQuantile(double confidence) {

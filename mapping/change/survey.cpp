@@ -8,6 +8,7 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/json_fields.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/ply_reader.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 
@@ -125,10 +126,9 @@ const char* ToString(SurveyKind kind) {
 }
 
 void SurveyReadOptions::Check() const {
-  if (!(units_to_m > 0.0) || !std::isfinite(units_to_m))
-    throw Error("SurveyReadOptions: units_to_m must be finite and > 0");
-  if (!(design_spacing_m > 0.0) || !std::isfinite(design_spacing_m))
-    throw Error("SurveyReadOptions: design_spacing_m must be finite and > 0");
+  const OptionChecks check("SurveyReadOptions");
+  check.Positive("units_to_m", units_to_m);
+  check.Positive("design_spacing_m", design_spacing_m, "m");
 }
 
 Survey ReadSurvey(const fs::path& path, const SurveyReadOptions& options) {

@@ -9,6 +9,7 @@
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -18,12 +19,16 @@ using Key = std::array<int, 3>;
 
 constexpr double kMinGlobalFitness = 0.1;
 
-void CheckStages(const std::vector<double>& stages, const char* name) {
-  if (stages.empty()) throw Error(std::string("SurveyAlignmentOptions: ") + name + " is empty");
+// ICP stages' correspondence distances: at least one, each finite, > 0 and no larger than the
+// one before.
+void CheckStages(const OptionChecks& check, const std::vector<double>& stages, const char* name) {
+  check.Require(!stages.empty(), name, "at least one stage", "none");
   for (std::size_t i = 0; i < stages.size(); ++i) {
-    if (!(stages[i] > 0.0) || !std::isfinite(stages[i]) || (i > 0 && stages[i] > stages[i - 1]))
-      throw Error(std::string("SurveyAlignmentOptions: ") + name +
-                  " must be finite, > 0 and non-increasing");
+    if (!(std::isfinite(stages[i]) && stages[i] > 0.0) || (i > 0 && stages[i] > stages[i - 1])) {
+      check.Fail(std::string(name) + "[" + std::to_string(i) + "]",
+                 "a finite value > 0 m, no larger than the stage before",
+                 OptionValueText(stages[i]));
+    }
   }
 }
 
@@ -169,19 +174,17 @@ SurveyAlignment AlignGlobally(const PointCloud& source, const PointCloud& refere
 }  // namespace
 
 void SurveyAlignmentOptions::Check() const {
-  CheckStages(global_max_correspondence_m, "global_max_correspondence_m");
-  CheckStages(tile_max_correspondence_m, "tile_max_correspondence_m");
-  if (!(tile_m >= 0.0) || !std::isfinite(tile_m))
-    throw Error("SurveyAlignmentOptions: tile_m must be finite and >= 0");
-  for (double v : {tile_prior_rotation_rad, tile_prior_translation_m, tile_point_sigma_m}) {
-    if (!(v > 0.0) || !std::isfinite(v))
-      throw Error("SurveyAlignmentOptions: the tile prior's sigmas must be finite and > 0");
-  }
-  if (min_tile_points < 3) throw Error("SurveyAlignmentOptions: min_tile_points must be >= 3");
-  if (!(source_voxel_m > 0.0) || !std::isfinite(source_voxel_m))
-    throw Error("SurveyAlignmentOptions: source_voxel_m must be finite and > 0");
-  if (T_reference_map && !T_reference_map->matrix().allFinite())
-    throw Error("SurveyAlignmentOptions: T_reference_map is not finite");
+  const OptionChecks check("SurveyAlignmentOptions");
+  CheckStages(check, global_max_correspondence_m, "global_max_correspondence_m");
+  CheckStages(check, tile_max_correspondence_m, "tile_max_correspondence_m");
+  check.NonNegative("tile_m", tile_m, "m");
+  check.Positive("tile_prior_rotation_rad", tile_prior_rotation_rad, "rad");
+  check.Positive("tile_prior_translation_m", tile_prior_translation_m, "m");
+  check.Positive("tile_point_sigma_m", tile_point_sigma_m, "m");
+  check.AtLeast("min_tile_points", min_tile_points, 3);
+  check.Positive("source_voxel_m", source_voxel_m, "m");
+  check.Require(!T_reference_map || T_reference_map->matrix().allFinite(), "T_reference_map",
+                "a finite transform");
 }
 
 const SurveyAlignment::Tile* SurveyAlignment::TileOf(const Eigen::Vector3d& p_map) const {

@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -64,13 +65,11 @@ struct FrameTimes {
 }  // namespace
 
 void InspectionOptions::Check() const {
-  const auto fail = [](const std::string& field, const std::string& expected) {
-    throw Error("InspectionOptions." + field + ": expected " + expected);
-  };
-  if (log_queue_bytes == 0) fail("log_queue_bytes", "> 0 bytes");
-  if (live_queue_frames < 1) fail("live_queue_frames", ">= 1");
-  if (!(map_voxel_m > 0.0)) fail("map_voxel_m", "> 0 m");
-  if (mapper_nice < 0 || mapper_nice > 19) fail("mapper_nice", "in [0, 19]");
+  const OptionChecks check("InspectionOptions");
+  check.GreaterThan("log_queue_bytes", log_queue_bytes, 0, "bytes");
+  check.AtLeast("live_queue_frames", live_queue_frames, 1);
+  check.GreaterThan("map_voxel_m", map_voxel_m, 0.0, "m");
+  check.InRange("mapper_nice", mapper_nice, 0, 19);
   mapper.Check();
 }
 

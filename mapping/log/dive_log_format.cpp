@@ -1,11 +1,10 @@
 #include "mapping/log/dive_log_format.hpp"
 
-#include <cmath>
 #include <string>
 #include <utility>
 
 #include "mapping/log/dive_log.hpp"
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping::dive_log_format {
 
@@ -30,19 +29,13 @@ void SwapBytePairs(std::vector<std::uint8_t>& bytes) {
 namespace uwscan::mapping {
 
 void NavigationNoise::Check() const {
-  const std::pair<const char*, double> fields[] = {
-      {"position_walk_m_per_sqrt_s", position_walk_m_per_sqrt_s},
-      {"heading_walk_rad_per_sqrt_s", heading_walk_rad_per_sqrt_s},
-      {"speed_scale_sigma", speed_scale_sigma},
-      {"heading_bias_sigma_rad", heading_bias_sigma_rad},
-      {"depth_sigma_m", depth_sigma_m},
-      {"roll_pitch_sigma_rad", roll_pitch_sigma_rad}};
-  for (const auto& [field, value] : fields) {
-    if (!(std::isfinite(value) && value >= 0.0)) {
-      throw Error(std::string("navigation noise ") + field + ": " + std::to_string(value) +
-                  ", expected a finite value >= 0");
-    }
-  }
+  const OptionChecks check("NavigationNoise");
+  check.NonNegative("position_walk_m_per_sqrt_s", position_walk_m_per_sqrt_s, "m/sqrt(s)");
+  check.NonNegative("heading_walk_rad_per_sqrt_s", heading_walk_rad_per_sqrt_s, "rad/sqrt(s)");
+  check.NonNegative("speed_scale_sigma", speed_scale_sigma);
+  check.NonNegative("heading_bias_sigma_rad", heading_bias_sigma_rad, "rad");
+  check.NonNegative("depth_sigma_m", depth_sigma_m, "m");
+  check.NonNegative("roll_pitch_sigma_rad", roll_pitch_sigma_rad, "rad");
 }
 
 }  // namespace uwscan::mapping

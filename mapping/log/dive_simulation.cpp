@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "mapping/log/dive_log.hpp"
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::mapping {
@@ -32,10 +32,9 @@ LogImage ToLogImage(const scanner::StripeFrame& frame) {
 }  // namespace
 
 void DiveSimulationOptions::Check() const {
-  if (threads < 0) throw Error("dive simulation: threads must be >= 0");
-  if (!(navigation_rate_hz > 0.0 && navigation_rate_hz <= 1000.0)) {
-    throw Error("dive simulation: navigation_rate_hz must be in (0, 1000] Hz");
-  }
+  const OptionChecks check("DiveSimulationOptions");
+  check.AtLeast("threads", threads, 0);
+  check.InRange("navigation_rate_hz", navigation_rate_hz, 0.0, 1000.0, Interval::kOpenLow, "Hz");
 }
 
 DiveSimulationSummary SimulateDive(const scanner::sim::Simulator& simulator,

@@ -5,6 +5,7 @@
 
 #include "mapping/slam/map_uncertainty.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -17,7 +18,7 @@ constexpr std::size_t kExpectedErrorStride = 8;
 
 void DiveMappingOptions::Check() const {
   mapper.Check();
-  if (!(map_voxel_m > 0.0)) throw Error("DiveMappingOptions.map_voxel_m: expected > 0 m");
+  OptionChecks("DiveMappingOptions").GreaterThan("map_voxel_m", map_voxel_m, 0.0, "m");
 }
 
 NavigationNoise AssumedNavigationNoise() {

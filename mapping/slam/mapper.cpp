@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <deque>
 
 #include "mapping/slam/mapper_impl.hpp"
@@ -12,6 +11,7 @@
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/symmetrized.hpp"
 #include "scanner/triangulation/triangulator_factory.hpp"
 
@@ -54,42 +54,36 @@ perception::IcpOptions RegistrationIcp(const MapperOptions& o,
 }  // namespace
 
 void MapperOptions::Check() const {
-  const auto fail = [](const std::string& field, const std::string& expected) {
-    throw Error("MapperOptions." + field + ": expected " + expected);
-  };
+  const OptionChecks check("MapperOptions");
   clouds.Check();
-  if (sweeps_per_submap < 1) fail("sweeps_per_submap", "> 0");
-  if (local_map_submaps < 1) fail("local_map_submaps", "> 0");
-  if (!(point_sigma_floor_m > 0.0)) fail("point_sigma_floor_m", "> 0 m");
-  if (!(min_fitness >= 0.0 && min_fitness <= 1.0)) fail("min_fitness", "in [0, 1]");
-  if (!(loop_min_fitness >= 0.0 && loop_min_fitness <= 1.0)) fail("loop_min_fitness", "in [0, 1]");
-  if (loop_min_directions < 1 || loop_min_directions > 6) fail("loop_min_directions", "in [1, 6]");
-  if (loop_min_index_gap <= local_map_submaps) fail("loop_min_index_gap", "> local_map_submaps");
-  if (max_loop_candidates < 0) fail("max_loop_candidates", ">= 0");
-  if (loop_every_submaps < 1) fail("loop_every_submaps", "> 0");
-  if (!(gate_sigmas > 0.0)) fail("gate_sigmas", "> 0");
-  if (!(loop_overlap_ratio > 0.0 && loop_overlap_ratio <= 1.0))
-    fail("loop_overlap_ratio", "in (0, 1]");
-  if (!(loop_max_sigma_m > 0.0)) fail("loop_max_sigma_m", "> 0 m");
-  if (!(loop_max_sigma_rad > 0.0)) fail("loop_max_sigma_rad", "> 0 rad");
-  if (solve_every_submaps < 1) fail("solve_every_submaps", "> 0");
-  if (!(running_solve_tolerance > 0.0 && running_solve_tolerance < 1.0))
-    fail("running_solve_tolerance", "in (0, 1)");
-  if (!(weak_direction_ratio >= 0.0 && weak_direction_ratio < 1.0))
-    fail("weak_direction_ratio", "in [0, 1)");
-  if (!(slide_sigma_m >= 0.0)) fail("slide_sigma_m", ">= 0 m");
-  if (!(max_navigation_gap_s > 0.0 && std::isfinite(max_navigation_gap_s)))
-    fail("max_navigation_gap_s", "> 0 s");
-  if (!(navigation_latency_s >= 0.0 && std::isfinite(navigation_latency_s)))
-    fail("navigation_latency_s", ">= 0 s");
-  if (threads < 0) fail("threads", ">= 0");
-  if (icp_max_iterations < 1) fail("icp_max_iterations", "> 0");
-  if (icp_max_iterations_per_stage < 1) fail("icp_max_iterations_per_stage", "> 0");
-  if (!(icp_translation_tolerance_voxels > 0.0)) fail("icp_translation_tolerance_voxels", "> 0");
-  if (!(icp_rotation_tolerance_rad > 0.0)) fail("icp_rotation_tolerance_rad", "> 0 rad");
-  if (!(icp_relative_rmse_tolerance >= 0.0 && icp_relative_rmse_tolerance < 1.0)) {
-    fail("icp_relative_rmse_tolerance", "in [0, 1)");
-  }
+  check.GreaterThan("sweeps_per_submap", sweeps_per_submap, 0);
+  check.GreaterThan("local_map_submaps", local_map_submaps, 0);
+  check.GreaterThan("point_sigma_floor_m", point_sigma_floor_m, 0.0, "m");
+  check.InRange("min_fitness", min_fitness, 0.0, 1.0);
+  check.InRange("loop_min_fitness", loop_min_fitness, 0.0, 1.0);
+  check.InRange("loop_min_directions", loop_min_directions, 1, 6);
+  check.Require(loop_min_index_gap > local_map_submaps, "loop_min_index_gap",
+                "> local_map_submaps (" + std::to_string(local_map_submaps) + ")",
+                loop_min_index_gap);
+  check.AtLeast("max_loop_candidates", max_loop_candidates, 0);
+  check.GreaterThan("loop_every_submaps", loop_every_submaps, 0);
+  check.GreaterThan("gate_sigmas", gate_sigmas, 0.0);
+  check.InRange("loop_overlap_ratio", loop_overlap_ratio, 0.0, 1.0, Interval::kOpenLow);
+  check.GreaterThan("loop_max_sigma_m", loop_max_sigma_m, 0.0, "m");
+  check.GreaterThan("loop_max_sigma_rad", loop_max_sigma_rad, 0.0, "rad");
+  check.GreaterThan("solve_every_submaps", solve_every_submaps, 0);
+  check.InRange("running_solve_tolerance", running_solve_tolerance, 0.0, 1.0, Interval::kOpen);
+  check.InRange("weak_direction_ratio", weak_direction_ratio, 0.0, 1.0, Interval::kOpenHigh);
+  check.AtLeast("slide_sigma_m", slide_sigma_m, 0.0, "m");
+  check.Positive("max_navigation_gap_s", max_navigation_gap_s, "s");
+  check.NonNegative("navigation_latency_s", navigation_latency_s, "s");
+  check.AtLeast("threads", threads, 0);
+  check.GreaterThan("icp_max_iterations", icp_max_iterations, 0);
+  check.GreaterThan("icp_max_iterations_per_stage", icp_max_iterations_per_stage, 0);
+  check.GreaterThan("icp_translation_tolerance_voxels", icp_translation_tolerance_voxels, 0.0);
+  check.GreaterThan("icp_rotation_tolerance_rad", icp_rotation_tolerance_rad, 0.0, "rad");
+  check.InRange("icp_relative_rmse_tolerance", icp_relative_rmse_tolerance, 0.0, 1.0,
+                Interval::kOpenHigh);
   RegistrationIcp(*this, icp_distances_m).Check();
   RegistrationIcp(*this, loop_icp_distances_m).Check();
 }

@@ -13,6 +13,7 @@
 
 #include "mapping/slam/inverse_blocks.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
@@ -146,11 +147,10 @@ void RequireRigid(const Eigen::Isometry3d& T, const std::string& what) {
 }  // namespace
 
 void PoseGraphOptions::Check() const {
-  if (max_iterations < 1) throw Error("PoseGraphOptions.max_iterations: expected > 0");
-  if (threads < 1) throw Error("PoseGraphOptions.threads: expected > 0");
-  if (!(function_tolerance > 0.0 && function_tolerance < 1.0)) {
-    throw Error("PoseGraphOptions.function_tolerance: expected in (0, 1)");
-  }
+  const OptionChecks check("PoseGraphOptions");
+  check.GreaterThan("max_iterations", max_iterations, 0);
+  check.GreaterThan("threads", threads, 0);
+  check.InRange("function_tolerance", function_tolerance, 0.0, 1.0, Interval::kOpen);
 }
 
 Vector6d PoseError(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) {

@@ -9,15 +9,16 @@
 #include "perception/preprocessing/normals.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::mapping {
 
 void SubmapCloudOptions::Check() const {
-  if (!(map_voxel_m > 0.0)) throw Error("SubmapCloudOptions.map_voxel_m: expected > 0 m");
-  if (!(registration_voxel_m > 0.0))
-    throw Error("SubmapCloudOptions.registration_voxel_m: expected > 0 m");
-  if (normal_neighbours < 3) throw Error("SubmapCloudOptions.normal_neighbours: expected >= 3");
-  if (threads < 0) throw Error("SubmapCloudOptions.threads: expected >= 0");
+  const OptionChecks check("SubmapCloudOptions");
+  check.GreaterThan("map_voxel_m", map_voxel_m, 0.0, "m");
+  check.GreaterThan("registration_voxel_m", registration_voxel_m, 0.0, "m");
+  check.AtLeast("normal_neighbours", normal_neighbours, 3);
+  check.AtLeast("threads", threads, 0);
 }
 
 void BuildSubmapClouds(const std::vector<Eigen::Vector3d>& points_V,

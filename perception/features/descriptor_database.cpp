@@ -19,6 +19,7 @@
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/fnv1a.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 
@@ -121,12 +122,9 @@ std::string InvalidValue(std::span<const float> values) {
 }  // namespace
 
 void DescriptorIndexOptions::Check() const {
-  if (trees < 1 || trees > 64) {
-    throw Error("DescriptorIndexOptions.trees: expected 1..64, got " + std::to_string(trees));
-  }
-  if (checks < 1) {
-    throw Error("DescriptorIndexOptions.checks: expected >= 1, got " + std::to_string(checks));
-  }
+  const OptionChecks check("DescriptorIndexOptions");
+  check.InRange("trees", trees, 1, 64);
+  check.AtLeast("checks", checks, 1);
 }
 
 DescriptorDatabase::DescriptorDatabase(int dimension, const DescriptorIndexOptions& options)

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "perception/cloud/pcl_conversion.hpp"
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -371,14 +371,11 @@ EsfDescriptor ToHistogram(const Counts& counts) {
 }  // namespace
 
 void EsfOptions::Check() const {
-  if (samples < 1 || samples > 10'000'000) {
-    throw Error("EsfOptions.samples: expected 1..1e7, got " + std::to_string(samples));
-  }
-  if (grid_size < 16 || grid_size > 256 || grid_size % 2 != 0) {
-    throw Error("EsfOptions.grid_size: expected an even number in 16..256, got " +
-                std::to_string(grid_size));
-  }
-  if (threads < 0) throw Error("EsfOptions.threads: expected >= 0, got " + std::to_string(threads));
+  const OptionChecks check("EsfOptions");
+  check.InRange("samples", samples, 1, 10'000'000);
+  check.Require(grid_size >= 16 && grid_size <= 256 && grid_size % 2 == 0, "grid_size",
+                "an even number in [16, 256]", grid_size);
+  check.AtLeast("threads", threads, 0);
 }
 
 EsfResult ComputeEsf(const PointCloud& cloud, const EsfOptions& options) {

@@ -14,6 +14,7 @@
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/cloud/pcl_conversion.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -146,13 +147,9 @@ bool WeightSpfh(const std::vector<Histogram>& spfh, const std::vector<std::uint3
 }  // namespace
 
 void FpfhOptions::Check() const {
-  if (!(std::isfinite(radius_m) && radius_m > 0.0)) {
-    throw Error("FpfhOptions.radius_m: expected a finite value > 0, got " +
-                std::to_string(radius_m));
-  }
-  if (threads < 0) {
-    throw Error("FpfhOptions.threads: expected >= 0, got " + std::to_string(threads));
-  }
+  const OptionChecks check("FpfhOptions");
+  check.Positive("radius_m", radius_m, "m");
+  check.AtLeast("threads", threads, 0);
 }
 
 FpfhFeatures ComputeFpfh(const PointCloud& cloud_with_normals,

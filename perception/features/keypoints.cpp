@@ -1,17 +1,15 @@
 #include "perception/features/keypoints.hpp"
 
 #include <cmath>
-#include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 
 void CurvatureKeypointOptions::Check() const {
-  if (!(min_curvature >= 0.0 && min_curvature <= 1.0 / 3.0)) {
-    throw Error("CurvatureKeypointOptions.min_curvature: expected a value in [0, 1/3], got " +
-                std::to_string(min_curvature));
-  }
+  OptionChecks("CurvatureKeypointOptions")
+      .Require(min_curvature >= 0.0 && min_curvature <= 1.0 / 3.0, "min_curvature", "in [0, 1/3]",
+               min_curvature);
 }
 
 std::vector<std::size_t> CurvatureKeypoints(std::span<const float> curvatures,

@@ -1,25 +1,20 @@
 #include "perception/preprocessing/clustering.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <string>
 
 #include "perception/cloud/cloud_neighbors.hpp"
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 
 void ClusteringOptions::Check() const {
-  if (!(std::isfinite(tolerance_m) && tolerance_m > 0.0)) {
-    throw Error("ClusteringOptions.tolerance_m: expected a finite value > 0, got " +
-                std::to_string(tolerance_m));
-  }
-  if (min_size < 1) throw Error("ClusteringOptions.min_size: expected >= 1, got 0");
-  if (max_size < min_size) {
-    throw Error("ClusteringOptions.max_size: expected >= min_size (" + std::to_string(min_size) +
-                "), got " + std::to_string(max_size));
-  }
+  const OptionChecks check("ClusteringOptions");
+  check.Positive("tolerance_m", tolerance_m, "m");
+  check.AtLeast("min_size", min_size, 1);
+  check.Require(max_size >= min_size, "max_size", ">= min_size (" + std::to_string(min_size) + ")",
+                max_size);
 }
 
 std::vector<std::vector<std::size_t>> EuclideanClusters(const PointCloud& cloud,

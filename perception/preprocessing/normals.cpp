@@ -11,6 +11,7 @@
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -46,18 +47,11 @@ std::optional<PlaneEstimate> FitNeighbourhood(const std::vector<Eigen::Vector3f>
 }  // namespace
 
 void NormalOptions::Check() const {
-  if (!(std::isfinite(radius_m) && radius_m >= 0.0)) {
-    throw Error("NormalOptions.radius_m: expected a finite value >= 0, got " +
-                std::to_string(radius_m));
-  }
-  if (radius_m == 0.0 && k < 3) {
-    throw Error("NormalOptions.k: expected >= 3 (a plane needs 3 points), got " +
-                std::to_string(k));
-  }
-  if (!viewpoint.allFinite()) throw Error("NormalOptions.viewpoint: expected finite coordinates");
-  if (threads < 0) {
-    throw Error("NormalOptions.threads: expected >= 0, got " + std::to_string(threads));
-  }
+  const OptionChecks check("NormalOptions");
+  check.NonNegative("radius_m", radius_m, "m");
+  if (radius_m == 0.0) check.AtLeast("k", k, 3, "(a plane needs 3 points)");
+  check.Require(viewpoint.allFinite(), "viewpoint", "finite coordinates");
+  check.AtLeast("threads", threads, 0);
 }
 
 NormalsResult EstimateNormals(const PointCloud& cloud, const NormalOptions& options) {

@@ -4,22 +4,17 @@
 
 #include <cmath>
 #include <cstdint>
-#include <string>
 
 #include "perception/cloud/cloud_neighbors.hpp"
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 
 void OutlierFilterOptions::Check() const {
-  if (k < 1) throw Error("OutlierFilterOptions.k: expected >= 1, got " + std::to_string(k));
-  if (!std::isfinite(std_ratio)) {
-    throw Error("OutlierFilterOptions.std_ratio: expected a finite value, got " +
-                std::to_string(std_ratio));
-  }
-  if (threads < 0) {
-    throw Error("OutlierFilterOptions.threads: expected >= 0, got " + std::to_string(threads));
-  }
+  const OptionChecks check("OutlierFilterOptions");
+  check.AtLeast("k", k, 1);
+  check.Finite("std_ratio", std_ratio);
+  check.AtLeast("threads", threads, 0);
 }
 
 OutlierFilterResult RemoveStatisticalOutliers(const PointCloud& cloud,

@@ -7,9 +7,8 @@
 #include <cmath>
 #include <optional>
 #include <random>
-#include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -134,28 +133,13 @@ std::optional<Candidate> FindPlane(const PointCloud& cloud, const std::vector<st
 }  // namespace
 
 void PlaneRemovalOptions::Check() const {
-  if (!(std::isfinite(distance_threshold_m) && distance_threshold_m > 0.0)) {
-    throw Error("PlaneRemovalOptions.distance_threshold_m: expected a finite value > 0, got " +
-                std::to_string(distance_threshold_m));
-  }
-  if (!(min_fraction > 0.0 && min_fraction <= 1.0)) {
-    throw Error("PlaneRemovalOptions.min_fraction: expected a value in (0, 1], got " +
-                std::to_string(min_fraction));
-  }
-  if (max_planes < 0) {
-    throw Error("PlaneRemovalOptions.max_planes: expected >= 0, got " + std::to_string(max_planes));
-  }
-  if (max_iterations < 1) {
-    throw Error("PlaneRemovalOptions.max_iterations: expected >= 1, got " +
-                std::to_string(max_iterations));
-  }
-  if (!(probability > 0.0 && probability < 1.0)) {
-    throw Error("PlaneRemovalOptions.probability: expected a value in (0, 1), got " +
-                std::to_string(probability));
-  }
-  if (threads < 0) {
-    throw Error("PlaneRemovalOptions.threads: expected >= 0, got " + std::to_string(threads));
-  }
+  const OptionChecks check("PlaneRemovalOptions");
+  check.Positive("distance_threshold_m", distance_threshold_m, "m");
+  check.InRange("min_fraction", min_fraction, 0.0, 1.0, Interval::kOpenLow);
+  check.AtLeast("max_planes", max_planes, 0);
+  check.AtLeast("max_iterations", max_iterations, 1);
+  check.InRange("probability", probability, 0.0, 1.0, Interval::kOpen);
+  check.AtLeast("threads", threads, 0);
 }
 
 PlaneRemovalResult RemovePlanes(const PointCloud& cloud, const PlaneRemovalOptions& options) {

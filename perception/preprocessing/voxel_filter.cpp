@@ -8,14 +8,12 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 
 void VoxelFilterOptions::Check() const {
-  if (!(std::isfinite(leaf_m) && leaf_m > 0.0)) {
-    throw Error("VoxelFilterOptions.leaf_m: expected a finite value > 0, got " +
-                std::to_string(leaf_m));
-  }
+  OptionChecks("VoxelFilterOptions").Positive("leaf_m", leaf_m, "m");
 }
 
 PointCloud VoxelDownsample(const PointCloud& cloud, const VoxelFilterOptions& options) {

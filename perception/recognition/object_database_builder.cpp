@@ -11,6 +11,7 @@
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/sim/ray_caster.hpp"
 
 namespace uwscan::perception {
@@ -102,16 +103,24 @@ PointCloud ModelCloud(const std::string& id, const scanner::TriangleMesh& mesh, 
 }  // namespace
 
 void DatabaseBuildOptions::Check() const {
-  if (views < 1) throw Error("build-db: views must be >= 1");
-  if (standoffs_m.empty()) throw Error("build-db: at least one stand-off is needed");
-  for (double d : standoffs_m) {
-    if (!(d > 0.0) || !std::isfinite(d)) throw Error("build-db: stand-offs must be finite and > 0");
+  const OptionChecks check("DatabaseBuildOptions");
+  check.AtLeast("views", views, 1);
+  check.Require(!standoffs_m.empty(), "standoffs_m", "at least one stand-off", "none");
+  for (std::size_t i = 0; i < standoffs_m.size(); ++i) {
+    if (!(std::isfinite(standoffs_m[i]) && standoffs_m[i] > 0.0)) {
+      check.Fail("standoffs_m[" + std::to_string(i) + "]", "a finite value > 0 m",
+                 OptionValueText(standoffs_m[i]));
+    }
   }
-  if (!(parameters.voxel_m > 0.0) || !(parameters.normal_radius_m > parameters.voxel_m) ||
-      !(parameters.feature_radius_m > parameters.normal_radius_m)) {
-    throw Error("build-db: needs 0 < voxel < normal radius < feature radius");
-  }
-  if (threads < 0) throw Error("build-db: threads must be >= 0");
+  check.GreaterThan("parameters.voxel_m", parameters.voxel_m, 0.0, "m");
+  check.Require(parameters.normal_radius_m > parameters.voxel_m, "parameters.normal_radius_m",
+                "> parameters.voxel_m (" + OptionValueText(parameters.voxel_m) + " m)",
+                parameters.normal_radius_m);
+  check.Require(
+      parameters.feature_radius_m > parameters.normal_radius_m, "parameters.feature_radius_m",
+      "> parameters.normal_radius_m (" + OptionValueText(parameters.normal_radius_m) + " m)",
+      parameters.feature_radius_m);
+  check.AtLeast("threads", threads, 0);
 }
 
 EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t seed, int threads) {

@@ -1,7 +1,6 @@
 #include "perception/recognition/object_recognizer.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <deque>
 #include <limits>
 #include <map>
@@ -27,6 +26,7 @@
 #include "perception/registration/coarse_alignment.hpp"
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::perception {
@@ -392,55 +392,35 @@ void JoinSegmentsOneObjectExplains(const PointCloud& remaining, double largest_o
 }  // namespace
 
 void RecognitionOptions::Check() const {
-  auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
-  if (!positive(plane_distance_m)) throw Error("recognition: plane_distance_m must be > 0");
-  if (!(plane_min_fraction > 0.0 && plane_min_fraction <= 1.0)) {
-    throw Error("recognition: plane_min_fraction must be in (0, 1]");
-  }
-  if (!positive(cluster_tolerance_m)) throw Error("recognition: cluster_tolerance_m must be > 0");
-  if (!(attach_distance_m >= 0.0 && std::isfinite(attach_distance_m))) {
-    throw Error("recognition: attach_distance_m must be >= 0");
-  }
-  if (min_segment_points < 10) throw Error("recognition: min_segment_points must be >= 10");
-  if (max_candidates < 1)
-    throw Error("recognition: max_candidates must be >= 1, got " + std::to_string(max_candidates));
-  auto in_range = [](const char* field, int value, int lo, int hi) {
-    if (value < lo || value > hi) {
-      throw Error(std::string("recognition: ") + field + " must be in [" + std::to_string(lo) +
-                  ", " + std::to_string(hi) + "], got " + std::to_string(value));
-    }
-  };
-  in_range("pose_views", pose_views, 0, 64);
-  in_range("unverified_pose_views", unverified_pose_views, 0, 64);
-  in_range("pose_rolls", pose_rolls, 1, 360);
-  in_range("sift_points", sift_points, 10, 100000);
-  in_range("refined_starts", refined_starts, 1, 64);
-  in_range("refine_points", refine_points, 10, 10000000);
-  if (!positive(max_chi_square)) throw Error("recognition: max_chi_square must be > 0");
-  if (!(max_chi_square_ratio >= 1.0)) throw Error("recognition: max_chi_square_ratio must be >= 1");
-  if (!(min_fitness >= 0.0 && min_fitness <= 1.0) || !(max_missing >= 0.0 && max_missing <= 1.0) ||
-      !(min_close >= 0.0 && min_close <= 1.0)) {
-    throw Error("recognition: min_fitness, min_close and max_missing must be in [0, 1]");
-  }
-  if (!(min_part_share >= 0.0 && min_part_share <= 1.0))
-    throw Error("recognition: min_part_share must be in [0, 1]");
-  if (!(weak_score >= 0.0 && weak_score <= 1.0))
-    throw Error("recognition: weak_score must be in [0, 1]");
-  if (max_objects_per_segment < 1) throw Error("recognition: max_objects_per_segment must be >= 1");
-  if (split_candidates < 1) throw Error("recognition: split_candidates must be >= 1");
-  if (!positive(close_distance_m)) throw Error("recognition: close_distance_m must be > 0");
-  if (!positive(free_direction_std_m)) throw Error("recognition: free_direction_std_m must be > 0");
-  if (!positive(residual_patch_m)) throw Error("recognition: residual_patch_m must be > 0");
-  if (!(buried_depth_m >= 0.0 && std::isfinite(buried_depth_m))) {
-    throw Error("recognition: buried_depth_m must be finite and >= 0");
-  }
-  if (!(pose_floor_std_m >= 0.0 && std::isfinite(pose_floor_std_m))) {
-    throw Error("recognition: pose_floor_std_m must be finite and >= 0");
-  }
-  if (!(min_phase_points >= 0.0 && std::isfinite(min_phase_points))) {
-    throw Error("recognition: min_phase_points must be finite and >= 0");
-  }
-  if (threads < 0) throw Error("recognition: threads must be >= 0");
+  const OptionChecks check("RecognitionOptions");
+  check.Positive("plane_distance_m", plane_distance_m, "m");
+  check.InRange("plane_min_fraction", plane_min_fraction, 0.0, 1.0, Interval::kOpenLow);
+  check.Positive("cluster_tolerance_m", cluster_tolerance_m, "m");
+  check.NonNegative("attach_distance_m", attach_distance_m, "m");
+  check.AtLeast("min_segment_points", min_segment_points, 10);
+  check.AtLeast("max_candidates", max_candidates, 1);
+  check.InRange("pose_views", pose_views, 0, 64);
+  check.InRange("unverified_pose_views", unverified_pose_views, 0, 64);
+  check.InRange("pose_rolls", pose_rolls, 1, 360);
+  check.InRange("sift_points", sift_points, 10, 100000);
+  check.InRange("refined_starts", refined_starts, 1, 64);
+  check.InRange("refine_points", refine_points, 10, 10000000);
+  check.Positive("max_chi_square", max_chi_square);
+  check.AtLeast("max_chi_square_ratio", max_chi_square_ratio, 1.0);
+  check.InRange("min_fitness", min_fitness, 0.0, 1.0);
+  check.InRange("min_close", min_close, 0.0, 1.0);
+  check.InRange("max_missing", max_missing, 0.0, 1.0);
+  check.InRange("min_part_share", min_part_share, 0.0, 1.0);
+  check.InRange("weak_score", weak_score, 0.0, 1.0);
+  check.AtLeast("max_objects_per_segment", max_objects_per_segment, 1);
+  check.AtLeast("split_candidates", split_candidates, 1);
+  check.Positive("close_distance_m", close_distance_m, "m");
+  check.Positive("free_direction_std_m", free_direction_std_m, "m");
+  check.Positive("residual_patch_m", residual_patch_m, "m");
+  check.NonNegative("buried_depth_m", buried_depth_m, "m");
+  check.NonNegative("pose_floor_std_m", pose_floor_std_m, "m");
+  check.NonNegative("min_phase_points", min_phase_points);
+  check.AtLeast("threads", threads, 0);
 }
 
 RecognitionResult RecognizeObjects(const PointCloud& scan, const ObjectDatabase& db,

@@ -8,6 +8,7 @@
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -66,12 +67,11 @@ std::vector<Eigen::Isometry3d> SymmetryTransforms(std::span<const SymmetryAxis> 
 }
 
 void SymmetryDetectionOptions::Check() const {
-  if (samples < 1000) throw Error("symmetry detection: samples must be >= 1000");
-  if (test_points < 100) throw Error("symmetry detection: test_points must be >= 100");
-  if (max_order < 2) throw Error("symmetry detection: max_order must be >= 2");
-  if (!(tolerance_fraction >= 0.0)) {
-    throw Error("symmetry detection: tolerance_fraction must be >= 0");
-  }
+  const OptionChecks check("SymmetryDetectionOptions");
+  check.AtLeast("samples", samples, 1000);
+  check.AtLeast("test_points", test_points, 100);
+  check.AtLeast("max_order", max_order, 2);
+  check.AtLeast("tolerance_fraction", tolerance_fraction, 0.0);
 }
 
 std::vector<SymmetryAxis> DetectSymmetries(const scanner::TriangleMesh& mesh,

@@ -14,6 +14,7 @@
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/registration/svd_alignment.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -342,30 +343,16 @@ Hypothesis MostOverlapping(const std::vector<Hypothesis>& candidates, const Poin
 }  // namespace
 
 void CoarseAlignmentOptions::Check() const {
-  const auto fail = [](const std::string& field, const std::string& expected) {
-    throw Error("CoarseAlignmentOptions." + field + ": expected " + expected);
-  };
-  if (k_nearest < 1) fail("k_nearest", ">= 1, got " + std::to_string(k_nearest));
-  if (max_iterations < 1) fail("max_iterations", "> 0, got " + std::to_string(max_iterations));
-  if (!(confidence > 0.0 && confidence <= 1.0)) {
-    fail("confidence", "a value in (0, 1], got " + std::to_string(confidence));
-  }
-  if (!(edge_similarity > 0.0 && edge_similarity < 1.0)) {
-    fail("edge_similarity", "a value in (0, 1), got " + std::to_string(edge_similarity));
-  }
-  if (!(inlier_distance_m > 0.0 && std::isfinite(inlier_distance_m))) {
-    fail("inlier_distance_m", "a finite value > 0 m, got " + std::to_string(inlier_distance_m));
-  }
-  if (!(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0)) {
-    fail("min_inlier_fraction", "a value in [0, 1], got " + std::to_string(min_inlier_fraction));
-  }
-  if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
-  if (verified_hypotheses < 0) {
-    fail("verified_hypotheses", ">= 0, got " + std::to_string(verified_hypotheses));
-  }
-  if (verification_points < 1) {
-    fail("verification_points", "> 0, got " + std::to_string(verification_points));
-  }
+  const OptionChecks check("CoarseAlignmentOptions");
+  check.AtLeast("k_nearest", k_nearest, 1);
+  check.GreaterThan("max_iterations", max_iterations, 0);
+  check.InRange("confidence", confidence, 0.0, 1.0, Interval::kOpenLow);
+  check.InRange("edge_similarity", edge_similarity, 0.0, 1.0, Interval::kOpen);
+  check.Positive("inlier_distance_m", inlier_distance_m, "m");
+  check.InRange("min_inlier_fraction", min_inlier_fraction, 0.0, 1.0);
+  check.AtLeast("threads", threads, 0, "(0 = OpenMP's default)");
+  check.AtLeast("verified_hypotheses", verified_hypotheses, 0);
+  check.GreaterThan("verification_points", verification_points, 0);
 }
 
 std::vector<FeatureCorrespondence> MatchFeatures(const FpfhFeatures& source,

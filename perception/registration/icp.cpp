@@ -19,6 +19,7 @@
 #include "perception/cloud/nearest_grid.hpp"
 #include "perception/registration/svd_alignment.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -461,53 +462,42 @@ RegistrationResult Evaluate(const IcpProblem& problem, const PointCloud& source,
 }  // namespace
 
 void IcpOptions::Check() const {
-  const auto fail = [](const std::string& field, const std::string& expected) {
-    throw Error("IcpOptions." + field + ": expected " + expected);
-  };
-  if (method != IcpMethod::kPointToPoint && method != IcpMethod::kPointToPlane) {
-    fail("method", "kPointToPoint or kPointToPlane");
-  }
-  if (max_iterations < 1) fail("max_iterations", "> 0, got " + std::to_string(max_iterations));
-  if (max_iterations_per_stage < 1) {
-    fail("max_iterations_per_stage", "> 0, got " + std::to_string(max_iterations_per_stage));
-  }
-  if (max_correspondence_distance_m.empty()) {
-    fail("max_correspondence_distance_m", "at least one distance");
-  }
+  const OptionChecks check("IcpOptions");
+  check.Require(method == IcpMethod::kPointToPoint || method == IcpMethod::kPointToPlane, "method",
+                "kPointToPoint or kPointToPlane", static_cast<int>(method));
+  check.GreaterThan("max_iterations", max_iterations, 0);
+  check.GreaterThan("max_iterations_per_stage", max_iterations_per_stage, 0);
+  check.Require(!max_correspondence_distance_m.empty(), "max_correspondence_distance_m",
+                "at least one distance", "none");
   for (std::size_t s = 0; s < max_correspondence_distance_m.size(); ++s) {
     const double d = max_correspondence_distance_m[s];
     const std::string field = "max_correspondence_distance_m[" + std::to_string(s) + "]";
-    if (!(std::isfinite(d) && d > 0.0)) fail(field, "a finite distance > 0 m");
+    check.Positive(field, d, "m");
     if (s > 0 && d > max_correspondence_distance_m[s - 1]) {
-      fail(field, "a distance no larger than the previous stage's");
+      check.Fail(field,
+                 "a distance no larger than the previous stage's (" +
+                     OptionValueText(max_correspondence_distance_m[s - 1]) + " m)",
+                 OptionValueText(d));
     }
   }
-  const auto require_tolerance = [&](const std::string& field, double value) {
-    if (!(std::isfinite(value) && value >= 0.0)) fail(field, "a finite value >= 0");
-  };
-  require_tolerance("rotation_tolerance_rad", rotation_tolerance_rad);
-  require_tolerance("translation_tolerance_m", translation_tolerance_m);
-  require_tolerance("relative_rmse_tolerance", relative_rmse_tolerance);
+  check.NonNegative("rotation_tolerance_rad", rotation_tolerance_rad, "rad");
+  check.NonNegative("translation_tolerance_m", translation_tolerance_m, "m");
   // A relative change of the whole residual is no tolerance (and would make every iteration a
   // stall, stall_iterations counting a residual as lower only by this fraction).
-  if (!(relative_rmse_tolerance < 1.0)) fail("relative_rmse_tolerance", "a value below 1");
-  if (stall_iterations < 0)
-    fail("stall_iterations", ">= 0 (0 = off), got " + std::to_string(stall_iterations));
-  if (threads < 0) fail("threads", ">= 0 (0 = OpenMP's default), got " + std::to_string(threads));
-  if (!(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi)) {
-    fail("max_normal_angle_rad", "an angle in [0, pi] rad");
-  }
+  check.InRange("relative_rmse_tolerance", relative_rmse_tolerance, 0.0, 1.0, Interval::kOpenHigh);
+  check.AtLeast("stall_iterations", stall_iterations, 0, "(0 = off)");
+  check.AtLeast("threads", threads, 0, "(0 = OpenMP's default)");
+  check.Require(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi,
+                "max_normal_angle_rad", "in [0, pi] rad", max_normal_angle_rad);
   if (prior) {
-    if (method != IcpMethod::kPointToPlane) fail("prior", "point-to-plane (method kPointToPlane)");
-    if (!(std::isfinite(prior->point_sigma_m) && prior->point_sigma_m > 0.0)) {
-      fail("prior.point_sigma_m", "a finite value > 0 m");
-    }
+    check.Require(method == IcpMethod::kPointToPlane, "prior",
+                  "point-to-plane (method kPointToPlane)", "point-to-point");
+    check.Positive("prior.point_sigma_m", prior->point_sigma_m, "m");
     const Matrix6d& info = prior->information;
-    if (!info.allFinite() || !info.isApprox(info.transpose(), 1e-9) ||
-        Eigen::SelfAdjointEigenSolver<Matrix6d>(info).eigenvalues().minCoeff() <
-            -1e-9 * info.cwiseAbs().maxCoeff()) {
-      fail("prior.information", "a finite, symmetric, positive semi-definite 6x6 matrix");
-    }
+    check.Require(info.allFinite() && info.isApprox(info.transpose(), 1e-9) &&
+                      Eigen::SelfAdjointEigenSolver<Matrix6d>(info).eigenvalues().minCoeff() >=
+                          -1e-9 * info.cwiseAbs().maxCoeff(),
+                  "prior.information", "a finite, symmetric, positive semi-definite 6x6 matrix");
   }
 }
 

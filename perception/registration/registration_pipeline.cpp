@@ -7,6 +7,7 @@
 #include "perception/preprocessing/normals.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -90,18 +91,13 @@ RegistrationPipelineOptions RegistrationPipelineOptions::ForObjectSize(double si
 }
 
 void RegistrationPipelineOptions::Check() const {
-  const auto positive = [](double v, const char* field) {
-    if (!(v > 0.0) || !std::isfinite(v)) {
-      throw Error(std::string("registration: field '") + field + "' must be finite and > 0");
-    }
-  };
-  positive(voxel_m, "voxel_m");
-  positive(normal_radius_m, "normal_radius_m");
-  positive(feature_radius_m, "feature_radius_m");
-  if (!source_viewpoint.allFinite() || !target_viewpoint.allFinite()) {
-    throw Error("registration: fields 'source_viewpoint' and 'target_viewpoint' must be finite");
-  }
-  if (threads < 0) throw Error("registration: field 'threads' must be >= 0");
+  const OptionChecks check("RegistrationPipelineOptions");
+  check.Positive("voxel_m", voxel_m, "m");
+  check.Positive("normal_radius_m", normal_radius_m, "m");
+  check.Positive("feature_radius_m", feature_radius_m, "m");
+  check.Require(source_viewpoint.allFinite(), "source_viewpoint", "finite coordinates");
+  check.Require(target_viewpoint.allFinite(), "target_viewpoint", "finite coordinates");
+  check.AtLeast("threads", threads, 0);
   coarse.Check();
   icp.Check();
 }

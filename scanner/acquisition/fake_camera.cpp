@@ -18,6 +18,7 @@
 
 #include "scanner/acquisition/fake_camera_wakeup.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 extern const char* const kFakeCameraGenicamXml;
@@ -59,18 +60,16 @@ const char* ToString(FakeCameraMode mode) {
 }
 
 void FakeCameraOptions::Check() const {
-  if (address.empty()) throw Error("fake camera: address is empty");
-  if (serial.empty() || serial.size() > 15)
-    throw Error("fake camera: serial must have 1 to 15 characters");
-  if (!(frame_rate_hz >= 0.0 && frame_rate_hz <= 1000.0)) {
-    throw Error(
-        "fake camera: frame rate must be in (0, 1000] frames/s (Aravis's fake camera's ceiling), "
-        "or 0");
-  }
-  if (!(loss_ratio >= 0.0 && loss_ratio < 1.0))
-    throw Error("fake camera: loss ratio must be in [0, 1)");
-  if (peak_rows < 1 || peak_rows > 64) throw Error("fake camera: peak_rows must be in [1, 64]");
-  if (threads < 0) throw Error("fake camera: threads must be >= 0");
+  const OptionChecks check("FakeCameraOptions");
+  check.Require(!address.empty(), "address", "an address to answer on", "''");
+  check.Require(!serial.empty() && serial.size() <= 15, "serial", "1 to 15 characters",
+                OptionQuotedText(serial));
+  check.InRange(
+      "frame_rate_hz", frame_rate_hz, 0.0, 1000.0, Interval::kClosed,
+      "frames/s (0 = the scan pattern's rate; Aravis's fake camera runs at 1000 at most)");
+  check.InRange("loss_ratio", loss_ratio, 0.0, 1.0, Interval::kOpenHigh);
+  check.InRange("peak_rows", peak_rows, 1, 64);
+  check.AtLeast("threads", threads, 0);
 }
 
 struct FakeCamera::Impl {

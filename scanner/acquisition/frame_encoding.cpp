@@ -7,6 +7,7 @@
 
 #include "scanner/common/error.hpp"
 #include "scanner/common/fnv1a.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::acquisition {
 namespace {
@@ -77,17 +78,10 @@ std::optional<FrameMetadata> DecodeMetadata(std::span<const std::uint8_t> row) {
 }
 
 void ProfileLayout::Check() const {
-  if (lines < 32 || lines > 65535) {
-    throw Error("profile layout: lines " + std::to_string(lines) +
-                ", expected [32, 65535] (the metadata row needs 32 pixels)");
-  }
-  if (line_length_px < 1 || line_length_px > 65536) {
-    throw Error("profile layout: line_length_px " + std::to_string(line_length_px) +
-                ", expected [1, 65536]");
-  }
-  if (peak_rows < 1 || peak_rows > 64) {
-    throw Error("profile layout: peak_rows " + std::to_string(peak_rows) + ", expected [1, 64]");
-  }
+  const OptionChecks check("ProfileLayout");
+  check.InRange("lines", lines, 32, 65535, Interval::kClosed, "(the metadata row needs 32 pixels)");
+  check.InRange("line_length_px", line_length_px, 1, 65536, Interval::kClosed, "px");
+  check.InRange("peak_rows", peak_rows, 1, 64);
 }
 
 int ProfileLayout::fraction_bits() const {
@@ -171,14 +165,12 @@ std::optional<DecodedProfile> DecodeProfile(const ProfileLayout& layout,
 }
 
 void ImageLayout::Check() const {
-  if (width_px < 1 || height_px < 1 || width_px > 65535 || height_px > 65534) {
-    throw Error("image layout: size " + std::to_string(width_px) + "x" + std::to_string(height_px) +
-                " px, expected 1..65535 x 1..65534");
-  }
-  if (row_bytes() < kMetadataBytes) {
-    throw Error("image layout: a row of " + std::to_string(row_bytes()) +
-                " bytes cannot hold the " + std::to_string(kMetadataBytes) + "-byte metadata row");
-  }
+  const OptionChecks check("ImageLayout");
+  check.InRange("width_px", width_px, 1, 65535, Interval::kClosed, "px");
+  check.InRange("height_px", height_px, 1, 65534, Interval::kClosed, "px");
+  check.Require(row_bytes() >= kMetadataBytes, "width_px",
+                "a row of at least " + std::to_string(kMetadataBytes) + " bytes (the metadata row)",
+                std::to_string(row_bytes()) + " bytes");
 }
 
 std::optional<DecodedImage> DecodeImage(const ImageLayout& layout,

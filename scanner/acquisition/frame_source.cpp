@@ -4,7 +4,6 @@
 #include <arv.h>
 
 #include <atomic>
-#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +12,7 @@
 #include <thread>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::acquisition {
 namespace {
@@ -63,40 +63,34 @@ std::optional<ReceivePath> ReceivePathFromString(const std::string& name) {
 }
 
 void CameraSettings::Check() const {
-  if (address.empty()) throw Error("camera settings: address is empty (expected an IPv4 address)");
+  const OptionChecks check("CameraSettings");
   in_addr parsed{};
+  // Aravis takes anything else for a device name and looks for it on every interface.
   if (inet_pton(AF_INET, address.c_str(), &parsed) != 1) {
-    // Aravis takes anything else for a device name and looks for it on every interface.
-    throw Error("camera settings: address '" + address +
-                "' is not an IPv4 address (a.b.c.d): cameras are opened by address, never searched "
-                "for by name");
+    check.Fail("address",
+               "an IPv4 address a.b.c.d (cameras are opened by address, never searched for by "
+               "name)",
+               OptionQuotedText(address));
   }
-  if (roi_x_px < 0 || roi_y_px < 0 || roi_width_px < 0 || roi_height_px < 0 ||
-      (roi_width_px > 0) != (roi_height_px > 0)) {
-    throw Error("camera settings: roi must be non-negative, width and height both set or both 0");
-  }
-  if (!(exposure_us >= 0.0) || !std::isfinite(exposure_us))
-    throw Error("camera settings: exposure_us must be >= 0");
-  if (!std::isfinite(gain)) throw Error("camera settings: gain must be finite");
-  if (!(frame_rate_hz >= 0.0 && frame_rate_hz <= 100000.0)) {
-    throw Error("camera settings: frame_rate_hz must be in [0, 100000] Hz");
-  }
-  if (packet_size_bytes != 0 && (packet_size_bytes < 576 || packet_size_bytes > 65000)) {
-    throw Error("camera settings: packet_size_bytes must be 0 or in [576, 65000]");
-  }
-  if (buffers < 2 || buffers > 100000)
-    throw Error("camera settings: buffers must be in [2, 100000]");
-  if (!(watchdog_s > 0.0 && watchdog_s <= 3600.0))
-    throw Error("camera settings: watchdog_s must be in (0, 3600] s");
-  if (!(frame_retention_s > 0.0 && frame_retention_s <= 60.0)) {
-    throw Error("camera settings: frame_retention_s must be in (0, 60] s");
-  }
-  if (!(control_wait_s >= 0.0 && control_wait_s <= 3600.0)) {
-    throw Error("camera settings: control_wait_s must be in [0, 3600] s");
-  }
-  if (trigger == TriggerMode::kLine && trigger_line.empty()) {
-    throw Error("camera settings: trigger_line is empty (expected e.g. Line0)");
-  }
+  check.AtLeast("roi_x_px", roi_x_px, 0);
+  check.AtLeast("roi_y_px", roi_y_px, 0);
+  check.AtLeast("roi_width_px", roi_width_px, 0);
+  check.AtLeast("roi_height_px", roi_height_px, 0);
+  check.Require((roi_width_px > 0) == (roi_height_px > 0), "roi_height_px",
+                "> 0 with roi_width_px > 0, 0 with roi_width_px 0 (roi_width_px is " +
+                    std::to_string(roi_width_px) + ")",
+                roi_height_px);
+  check.NonNegative("exposure_us", exposure_us, "us");
+  check.Finite("gain", gain);
+  check.InRange("frame_rate_hz", frame_rate_hz, 0.0, 100000.0, Interval::kClosed, "Hz");
+  check.Require(packet_size_bytes == 0 || (packet_size_bytes >= 576 && packet_size_bytes <= 65000),
+                "packet_size_bytes", "0 or in [576, 65000] bytes", packet_size_bytes);
+  check.InRange("buffers", buffers, 2, 100000);
+  check.InRange("watchdog_s", watchdog_s, 0.0, 3600.0, Interval::kOpenLow, "s");
+  check.InRange("frame_retention_s", frame_retention_s, 0.0, 60.0, Interval::kOpenLow, "s");
+  check.InRange("control_wait_s", control_wait_s, 0.0, 3600.0, Interval::kClosed, "s");
+  check.Require(trigger != TriggerMode::kLine || !trigger_line.empty(), "trigger_line",
+                "a line name such as Line0 (trigger is line)", "''");
 }
 
 struct FrameSource::Impl {

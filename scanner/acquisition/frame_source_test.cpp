@@ -27,10 +27,13 @@ TEST(CameraSettings, TheCameraIsGivenByItsIpv4AddressOnly) {
   for (const char* name :
        {"not-an-ip", "camera-1", "127.0.0", "127.0.0.256", "::1", " 127.0.0.1", "Basler-4711"}) {
     const std::string message = CheckMessage(name);
-    EXPECT_NE(message.find("is not an IPv4 address"), std::string::npos) << name << ": " << message;
-    EXPECT_NE(message.find(std::string("'") + name + "'"), std::string::npos) << message;
+    EXPECT_NE(message.find("CameraSettings.address: expected an IPv4 address"), std::string::npos)
+        << name << ": " << message;
+    EXPECT_NE(message.find(std::string("got '") + name + "'"), std::string::npos) << message;
   }
-  EXPECT_NE(CheckMessage("").find("address is empty"), std::string::npos);
+  EXPECT_NE(CheckMessage("").find("CameraSettings.address: expected an IPv4 address"),
+            std::string::npos);
+  EXPECT_NE(CheckMessage("").find("got ''"), std::string::npos);
 }
 
 }  // namespace

@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
+#include <string>
 
 #include "scanner/calibration/calibration_dataset.hpp"
 #include "scanner/calibration/calibration_yaml.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/lasers/galvo_scanner_model.hpp"
 
 namespace uwscan::scanner::calibration {
@@ -217,61 +220,58 @@ void ReadSection(const Context& where, const YAML::Node& node, const fs::path& b
 }  // namespace
 
 void CalibrationScene::Check() const {
-  auto fail = [&](const std::string& field, const std::string& what) {
-    throw Error(scene.source + ": field 'calibration." + field + "': " + what);
+  // Named by the scene file: "calib_laser.yaml: calibration.views: expected >= 3, got 2".
+  const OptionChecks check(scene.source + ": calibration");
+  const auto nested = [&](const std::string& field, const std::function<void()>& nested_check) {
+    try {
+      nested_check();
+    } catch (const Error& e) {
+      throw Error(scene.source + ": calibration." + field + ": " + e.what());
+    }
   };
   const std::vector<std::string>& steps = CalibrationSteps();
   if (std::find(steps.begin(), steps.end(), step) == steps.end()) {
-    fail("step", "unknown step '" + step + "'");
+    std::string names;
+    for (const std::string& s : steps) names += (names.empty() ? "" : ", ") + s;
+    check.Fail("step", "one of " + names, OptionQuotedText(step));
   }
   const bool stripes = step == "laser" || step == "laser_viewport";
   const bool mems_scanner = scene.scanner.model.kind() == ScannerKind::kMems;
-  if ((stripes && mems_scanner) || (step == "mems" && !mems_scanner)) {
-    fail("step",
-         "a " + step + " step cannot be simulated with the scanner " + scene.scanner.file.string());
-  }
-  try {
-    pattern.Check();
-  } catch (const Error& e) {
-    fail("pattern", e.what());
-  }
-  try {
-    BoardOf(pattern, board_size_m);
-  } catch (const Error& e) {
-    fail("board_size_m", e.what());
-  }
-  try {
-    render.Check();
-  } catch (const Error& e) {
-    fail("render", e.what());
-  }
-  if (!(board_reflectance > 0.0 && board_reflectance <= 1.0)) {
-    fail("board_reflectance", "expected in (0, 1]");
-  }
-  if (views < 3) fail("views", "expected >= 3");
-  if (planes < 2) fail("planes", "expected >= 2");
-  if (!(distance_m.x() > 0.0 && distance_m.y() >= distance_m.x())) {
-    fail("distance_m", "expected [min, max] with 0 < min <= max, metres");
-  }
-  if (!(max_tilt_rad >= 0.0 && max_tilt_rad <= 1.3)) fail("max_tilt_rad", "expected in [0, 1.3]");
-  if (!(max_roll_rad >= 0.0 && max_roll_rad <= M_PI)) fail("max_roll_rad", "expected in [0, pi]");
-  if (!(image_scale > 0.0 && image_scale <= 1.0)) fail("image_scale", "expected in (0, 1]");
+  check.Require(!(stripes && mems_scanner) && !(step == "mems" && !mems_scanner), "step",
+                std::string("a step the ") + (mems_scanner ? "MEMS" : "galvanometer") +
+                    " scanner " + scene.scanner.file.string() + " can simulate",
+                OptionQuotedText(step));
+  nested("pattern", [&] { pattern.Check(); });
+  nested("board_size_m", [&] { BoardOf(pattern, board_size_m); });
+  nested("render", [&] { render.Check(); });
+  check.InRange("board_reflectance", board_reflectance, 0.0, 1.0, Interval::kOpenLow);
+  check.AtLeast("views", views, 3);
+  check.AtLeast("planes", planes, 2);
+  check.Require(distance_m.x() > 0.0 && distance_m.y() >= distance_m.x(), "distance_m",
+                "[min, max] with 0 < min <= max, metres",
+                OptionPairText(distance_m.x(), distance_m.y()));
+  check.InRange("max_tilt_rad", max_tilt_rad, 0.0, 1.3, Interval::kClosed, "rad");
+  check.Require(max_roll_rad >= 0.0 && max_roll_rad <= M_PI, "max_roll_rad", "in [0, pi] rad",
+                max_roll_rad);
+  check.InRange("image_scale", image_scale, 0.0, 1.0, Interval::kOpenLow);
   if (stripes) {
     const GalvoLaser& laser = scene.scanner.model.galvo().laser;
     const std::set<int> distinct(mirror_steps.begin(), mirror_steps.end());
-    if (distinct.size() != mirror_steps.size() || distinct.size() < 2) {
-      fail("mirror_steps", "expected at least 2 mirror steps, each once");
-    }
-    if (*distinct.begin() < laser.step_min || *distinct.rbegin() > laser.step_max) {
-      fail("mirror_steps", "outside the laser's range [" + std::to_string(laser.step_min) + ", " +
-                               std::to_string(laser.step_max) + "]");
-    }
+    check.Require(distinct.size() == mirror_steps.size() && distinct.size() >= 2, "mirror_steps",
+                  "at least 2 mirror steps, each once",
+                  std::to_string(mirror_steps.size()) + " steps, " +
+                      std::to_string(distinct.size()) + " distinct");
+    check.Require(*distinct.begin() >= laser.step_min && *distinct.rbegin() <= laser.step_max,
+                  "mirror_steps",
+                  "steps in the laser's range [" + std::to_string(laser.step_min) + ", " +
+                      std::to_string(laser.step_max) + "]",
+                  "steps from " + std::to_string(*distinct.begin()) + " to " +
+                      std::to_string(*distinct.rbegin()));
   }
   if (step == "mems") {
-    if (volts_grid.minCoeff() < 1) fail("volts_grid", "expected [a, b] >= 1");
-    if (!(volts_fraction > 0.0 && volts_fraction <= 1.0)) {
-      fail("volts_fraction", "expected in (0, 1]");
-    }
+    check.Require(volts_grid.minCoeff() >= 1, "volts_grid", "[a, b] >= 1",
+                  OptionPairText(volts_grid.x(), volts_grid.y()));
+    check.InRange("volts_fraction", volts_fraction, 0.0, 1.0, Interval::kOpenLow);
   }
 }
 

@@ -423,7 +423,7 @@ TEST(DatasetSimulation, ScenesChangedInCodeAreCheckedToo) {
   };
   CalibrationScene changed = scene;
   changed.mirror_steps = {-120, 0};
-  EXPECT_NE(error(changed).find("field 'calibration.mirror_steps': outside the laser's range"),
+  EXPECT_NE(error(changed).find("calibration.mirror_steps: expected steps in the laser's range"),
             std::string::npos)
       << error(changed);
   changed = scene;

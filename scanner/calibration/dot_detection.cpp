@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -25,12 +26,10 @@ double Median(const cv::Mat& image) {
 }  // namespace
 
 void DotDetectionOptions::Check() const {
-  if (!(threshold_fraction > 0.0 && threshold_fraction < 1.0)) {
-    throw Error("dot detection: threshold_fraction must be in (0, 1)");
-  }
-  if (min_peak_above_background < 1)
-    throw Error("dot detection: min_peak_above_background must be >= 1");
-  if (max_radius_px < 1) throw Error("dot detection: max_radius_px must be >= 1");
+  const OptionChecks check("DotDetectionOptions");
+  check.InRange("threshold_fraction", threshold_fraction, 0.0, 1.0, Interval::kOpen);
+  check.AtLeast("min_peak_above_background", min_peak_above_background, 1, "image units");
+  check.AtLeast("max_radius_px", max_radius_px, 1, "px");
 }
 
 std::optional<Eigen::Vector2d> DetectDot(const std::filesystem::path& image_path,

@@ -18,6 +18,7 @@
 #include "scanner/calibration/galvo_laser_simplified.hpp"
 #include "scanner/calibration/jet_geometry.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/optics/refraction.hpp"
 #include "scanner/triangulation/light_plane.hpp"
 
@@ -356,10 +357,7 @@ GalvoLaserCalibrationResult Refine(const std::vector<LaserCalibrationPoint>& poi
 }  // namespace
 
 void GalvoLaserCalibrationOptions::Check() const {
-  if (max_iterations <= 0) {
-    throw Error("GalvoLaserCalibrationOptions.max_iterations: expected > 0, got " +
-                std::to_string(max_iterations));
-  }
+  OptionChecks("GalvoLaserCalibrationOptions").GreaterThan("max_iterations", max_iterations, 0);
 }
 
 GalvoLaser SimplifiedGalvoLaser(const std::vector<LaserCalibrationPoint>& points,

@@ -13,6 +13,7 @@
 
 #include "scanner/calibration/pattern_pose.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -253,18 +254,10 @@ std::vector<Eigen::Isometry3d> ViewPoses(std::size_t view_count, const Selection
 }  // namespace
 
 void IntrinsicsOptions::Check() const {
-  if (min_views < 3) {
-    throw Error(
-        "IntrinsicsOptions.min_views: expected >= 3 (Zhang's method needs three views of "
-        "a plane to fix every intrinsic), got " +
-        std::to_string(min_views));
-  }
-  if (!(std::isfinite(reject_view_rms_px) && reject_view_rms_px > 0.0)) {
-    std::ostringstream message;
-    message << "IntrinsicsOptions.reject_view_rms_px: expected a finite value > 0 (pixels), got "
-            << reject_view_rms_px;
-    throw Error(message.str());
-  }
+  const OptionChecks check("IntrinsicsOptions");
+  check.AtLeast("min_views", min_views, 3,
+                "(Zhang's method needs three views of a plane to fix every intrinsic)");
+  check.Positive("reject_view_rms_px", reject_view_rms_px, "px");
 }
 
 IntrinsicsResult CalibrateIntrinsics(const PatternSpec& spec,

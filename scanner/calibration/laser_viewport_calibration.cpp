@@ -11,6 +11,7 @@
 
 #include "scanner/calibration/jet_geometry.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -296,10 +297,7 @@ FitFigures FiguresAtSolution(const std::vector<Observation>& observations, const
 }  // namespace
 
 void LaserViewportCalibrationOptions::Check() const {
-  if (max_iterations <= 0) {
-    throw Error("LaserViewportCalibrationOptions.max_iterations: expected > 0, got " +
-                std::to_string(max_iterations));
-  }
+  OptionChecks("LaserViewportCalibrationOptions").GreaterThan("max_iterations", max_iterations, 0);
 }
 
 LaserViewportCalibrationResult CalibrateLaserViewport(

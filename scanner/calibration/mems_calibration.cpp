@@ -7,6 +7,7 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -57,11 +58,10 @@ Eigen::Isometry3d ProjectionPlane(const std::vector<VoltageLine>& lines, double 
 }  // namespace
 
 void MemsCalibrationOptions::Check() const {
-  if (degree < 1 || degree > 8) throw Error("MEMS calibration: degree must be in [1, 8]");
-  if (!(projection_plane_depth_m >= 0.0)) {
-    throw Error("MEMS calibration: projection_plane_depth_m must be >= 0 m (0 = automatic)");
-  }
-  if (min_planes_per_pair < 2) throw Error("MEMS calibration: min_planes_per_pair must be >= 2");
+  const OptionChecks check("MemsCalibrationOptions");
+  check.InRange("degree", degree, 1, 8);
+  check.AtLeast("projection_plane_depth_m", projection_plane_depth_m, 0.0, "m (0 = automatic)");
+  check.AtLeast("min_planes_per_pair", min_planes_per_pair, 2);
 }
 
 namespace {

@@ -2,22 +2,22 @@
 
 #include <cmath>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::calibration {
 
 void PatternSpec::Check() const {
-  if (columns < 2 || rows < 2) throw Error("pattern: columns and rows must be >= 2");
-  if (!(square_m > 0.0 && square_m < 10.0)) throw Error("pattern: square_m must be in (0, 10) m");
+  const OptionChecks check("PatternSpec");
+  check.AtLeast("columns", columns, 2);
+  check.AtLeast("rows", rows, 2);
+  check.InRange("square_m", square_m, 0.0, 10.0, Interval::kOpen, "m");
   if (type == PatternType::kCharuco) {
-    if (columns < 3 || rows < 3) throw Error("pattern: a ChArUco board needs >= 3 squares a side");
-    if (!(marker_m > 0.0 && marker_m < square_m)) {
-      throw Error("pattern: marker_m must be in (0, square_m)");
-    }
-    if (dictionary.rfind("DICT_", 0) != 0) {
-      throw Error("pattern: dictionary '" + dictionary +
-                  "' is not an OpenCV ArUco dictionary name");
-    }
+    check.AtLeast("columns", columns, 3, "(a ChArUco board needs 3 squares a side)");
+    check.AtLeast("rows", rows, 3, "(a ChArUco board needs 3 squares a side)");
+    check.Require(marker_m > 0.0 && marker_m < square_m, "marker_m",
+                  "in (0, square_m) = (0, " + OptionValueText(square_m) + ") m", marker_m);
+    check.Require(dictionary.rfind("DICT_", 0) == 0, "dictionary",
+                  "an OpenCV ArUco dictionary name (DICT_...)", OptionQuotedText(dictionary));
   }
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::calibration {
 namespace {
@@ -180,26 +181,20 @@ BoardGeometry BoardOf(const PatternSpec& spec, const Eigen::Vector2d& board_size
 }
 
 void TargetRenderOptions::Check() const {
-  if (supersampling < 1 || supersampling > 16) {
-    throw Error("target render: supersampling " + std::to_string(supersampling) +
-                ", expected in [1, 16]");
-  }
-  if (!(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0)) {
-    throw Error("target render: blur_sigma_px must be in [0, 20] px");
-  }
+  const OptionChecks check("TargetRenderOptions");
+  check.InRange("supersampling", supersampling, 1, 16);
+  check.InRange("blur_sigma_px", blur_sigma_px, 0.0, 20.0, Interval::kClosed, "px");
+  check.AtLeast("black_level", black_level, 0.0, "image units");
   const double max_value = MaxPixelValue(format);
-  if (!(black_level >= 0.0 && white_level > black_level && white_level <= max_value)) {
-    throw Error("target render: expected 0 <= black_level < white_level <= " +
-                std::to_string(static_cast<int>(max_value)) + " (image units), got black " +
-                std::to_string(black_level) + ", white " + std::to_string(white_level));
-  }
-  if (!(noise_sigma >= 0.0 && std::isfinite(noise_sigma))) {
-    throw Error("target render: noise_sigma must be >= 0");
-  }
-  if (!(board_size_m.array() >= 0.0).all() || !board_size_m.allFinite() ||
-      (board_size_m.x() > 0.0) != (board_size_m.y() > 0.0)) {
-    throw Error("target render: board_size_m must be both > 0, or both 0 (default board)");
-  }
+  check.Require(white_level > black_level && white_level <= max_value, "white_level",
+                "> black_level (" + OptionValueText(black_level) +
+                    ") and <= " + OptionValueText(max_value) + " image units",
+                white_level);
+  check.NonNegative("noise_sigma", noise_sigma, "image units");
+  check.Require(board_size_m.allFinite() && (board_size_m.array() >= 0.0).all() &&
+                    (board_size_m.x() > 0.0) == (board_size_m.y() > 0.0),
+                "board_size_m", "[x, y] both > 0, or both 0 (the default board), metres",
+                OptionPairText(board_size_m.x(), board_size_m.y()));
 }
 
 TargetRenderer::TargetRenderer(const RefractiveCamera& camera) : camera_(camera), rays_(camera) {}

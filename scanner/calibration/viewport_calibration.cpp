@@ -17,6 +17,7 @@
 
 #include "scanner/calibration/pattern_pose.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/symmetrized.hpp"
 #include "scanner/optics/refractive_camera.hpp"
 
@@ -372,10 +373,7 @@ ViewportCalibrationResult FittedResult(const PinholeCamera& intrinsics, const Fl
 }  // namespace
 
 void ViewportCalibrationOptions::Check() const {
-  if (max_iterations <= 0) {
-    throw Error("ViewportCalibrationOptions.max_iterations: expected > 0, got " +
-                std::to_string(max_iterations));
-  }
+  OptionChecks("ViewportCalibrationOptions").GreaterThan("max_iterations", max_iterations, 0);
 }
 
 ViewportCalibrationResult CalibrateCameraViewport(

@@ -4,15 +4,11 @@
 #include <numbers>
 #include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/optics/refraction.hpp"
 
 namespace uwscan::scanner {
 namespace {
-
-void Require(bool ok, const char* field, const char* expected) {
-  if (!ok) throw Error(std::string("laser: field '") + field + "' must be " + expected);
-}
 
 bool IsRigid(const Eigen::Isometry3d& T) {
   return T.matrix().allFinite() &&
@@ -38,17 +34,17 @@ RayTrace LaserFan::RayInWater(double fan_tan) const {
 }
 
 void GalvoLaser::Check() const {
-  Require(IsRigid(T_C_L), "T_C_L", "a rigid transform");
-  Require(IsRigid(T_C_M), "T_C_M", "a rigid transform");
-  Require(
-      std::isfinite(mirror_step_rad) && mirror_step_rad != 0.0 && std::abs(mirror_step_rad) < 0.1,
-      "mirror_step_rad", "non-zero and below 0.1 rad");
-  Require(std::isfinite(rotation_distance_m) && std::abs(rotation_distance_m) < 0.1,
-          "rotation_distance_m", "finite and below 0.1 m");
-  Require(
-      std::isfinite(aperture_rad) && aperture_rad > 0.0 && aperture_rad < 0.9 * std::numbers::pi,
-      "aperture_rad", "in (0, 0.9 pi)");
-  Require(step_min <= step_max, "step_min", "<= step_max");
+  const OptionChecks check("GalvoLaser");
+  check.Require(IsRigid(T_C_L), "T_C_L", "a rigid transform");
+  check.Require(IsRigid(T_C_M), "T_C_M", "a rigid transform");
+  check.Require(mirror_step_rad != 0.0 && std::abs(mirror_step_rad) < 0.1, "mirror_step_rad",
+                "non-zero and below 0.1 rad in magnitude", mirror_step_rad);
+  check.Require(std::abs(rotation_distance_m) < 0.1, "rotation_distance_m",
+                "below 0.1 m in magnitude", rotation_distance_m);
+  check.Require(aperture_rad > 0.0 && aperture_rad < 0.9 * std::numbers::pi, "aperture_rad",
+                "in (0, 0.9 pi) rad", aperture_rad);
+  check.Require(step_min <= step_max, "step_min", "<= step_max (" + std::to_string(step_max) + ")",
+                step_min);
   viewport.Check();
 }
 

@@ -6,15 +6,11 @@
 #include <numbers>
 #include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/optics/refraction.hpp"
 
 namespace uwscan::scanner {
 namespace {
-
-void Require(bool ok, const char* field, const std::string& expected) {
-  if (!ok) throw Error(std::string("mems laser: field '") + field + "' must be " + expected);
-}
 
 bool IsRigid(const Eigen::Isometry3d& T) {
   return T.matrix().allFinite() &&
@@ -25,33 +21,33 @@ bool IsRigid(const Eigen::Isometry3d& T) {
 }  // namespace
 
 void MemsLaser::Check() const {
-  Require(emitter_origin_C.allFinite(), "emitter_origin_C", "finite (metres)");
-  Require(emitter_direction_C.allFinite() && std::abs(emitter_direction_C.norm() - 1.0) < 1e-9,
-          "emitter_direction_C", "a finite unit vector");
-  Require(IsRigid(T_C_M), "T_C_M", "a rigid transform");
-  Require(IsRigid(T_C_Lens), "T_C_Lens", "a rigid transform");
-  Require(std::isfinite(max_volts) && max_volts > 0.0, "max_volts", "positive (volts)");
+  const OptionChecks check("MemsLaser");
+  check.Require(emitter_origin_C.allFinite(), "emitter_origin_C", "finite coordinates (metres)");
+  check.Require(
+      emitter_direction_C.allFinite() && std::abs(emitter_direction_C.norm() - 1.0) < 1e-9,
+      "emitter_direction_C", "a finite unit vector");
+  check.Require(IsRigid(T_C_M), "T_C_M", "a rigid transform");
+  check.Require(IsRigid(T_C_Lens), "T_C_Lens", "a rigid transform");
+  check.Positive("max_volts", max_volts, "V");
   for (int axis = 0; axis < 2; ++axis) {
+    const std::string index = axis == 0 ? "[0]" : "[1]";
     // 0.35 rad (20 deg) is far beyond any MEMS mirror; it only catches degrees typed as radians.
-    Require(
-        std::isfinite(max_tilt_rad[axis]) && max_tilt_rad[axis] > 0.0 && max_tilt_rad[axis] <= 0.35,
-        "max_tilt_rad", "in (0, 0.35] rad on both axes");
-    Require(std::isfinite(saturation[axis]) && saturation[axis] > 0.0 && saturation[axis] <= 5.0,
-            "saturation", "in (0, 5] on both axes");
+    check.InRange("max_tilt_rad" + index, max_tilt_rad[axis], 0.0, 0.35, Interval::kOpenLow, "rad");
+    check.InRange("saturation" + index, saturation[axis], 0.0, 5.0, Interval::kOpenLow);
   }
-  Require(std::isfinite(lens_gain) && lens_gain >= 1.0 && lens_gain <= 10.0, "lens_gain",
-          "in [1, 10]");
+  check.InRange("lens_gain", lens_gain, 1.0, 10.0);
   viewport.Check();
   // The whole drive range must reach the water: the projection functions are fitted over it.
   for (const double sx : {-1.0, 0.0, 1.0}) {
     for (const double sy : {-1.0, 0.0, 1.0}) {
       const RayTrace trace = RayInWater(max_volts * Eigen::Vector2d(sx, sy));
-      if (!trace.ok()) {
-        throw Error("mems laser: the beam at volts (" + std::to_string(sx * max_volts) + ", " +
-                    std::to_string(sy * max_volts) + ") does not reach the water (" +
-                    ToString(trace.status) + "); check the emitter, T_C_M, T_C_Lens, " +
-                    "lens_gain and the viewport");
-      }
+      if (trace.ok()) continue;
+      check.Fail("max_volts",
+                 "every beam of the drive range to reach the water (check the emitter, T_C_M, "
+                 "T_C_Lens, lens_gain and the viewport)",
+                 "the beam at volts (" + OptionValueText(sx * max_volts) + ", " +
+                     OptionValueText(sy * max_volts) + ") does not reach the water (" +
+                     ToString(trace.status) + ")");
     }
   }
 }

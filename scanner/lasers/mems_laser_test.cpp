@@ -169,22 +169,22 @@ TEST(MemsLaser, WaterRayIsTheLensRayThroughTheViewport) {
 TEST(MemsLaser, CheckNamesTheField) {
   MemsLaser laser = DefaultLaser();
   laser.max_volts = 0.0;
-  EXPECT_NE(CheckError(laser).find("'max_volts'"), std::string::npos);
+  EXPECT_NE(CheckError(laser).find("MemsLaser.max_volts"), std::string::npos);
   laser = DefaultLaser();
   laser.max_tilt_rad = Eigen::Vector2d(5.0, 5.0);  // degrees typed as radians
-  EXPECT_NE(CheckError(laser).find("'max_tilt_rad'"), std::string::npos);
+  EXPECT_NE(CheckError(laser).find("MemsLaser.max_tilt_rad"), std::string::npos);
   laser = DefaultLaser();
   laser.saturation = Eigen::Vector2d(0.5, 0.0);
-  EXPECT_NE(CheckError(laser).find("'saturation'"), std::string::npos);
+  EXPECT_NE(CheckError(laser).find("MemsLaser.saturation"), std::string::npos);
   laser = DefaultLaser();
   laser.lens_gain = 0.5;
-  EXPECT_NE(CheckError(laser).find("'lens_gain'"), std::string::npos);
+  EXPECT_NE(CheckError(laser).find("MemsLaser.lens_gain"), std::string::npos);
   laser = DefaultLaser();
   laser.emitter_direction_C *= 1.01;
-  EXPECT_NE(CheckError(laser).find("'emitter_direction_C'"), std::string::npos);
+  EXPECT_NE(CheckError(laser).find("MemsLaser.emitter_direction_C"), std::string::npos);
   laser = DefaultLaser();
   laser.T_C_Lens.linear() *= 2.0;
-  EXPECT_NE(CheckError(laser).find("'T_C_Lens'"), std::string::npos);
+  EXPECT_NE(CheckError(laser).find("MemsLaser.T_C_Lens"), std::string::npos);
   // Valid fields, but the emitter shines away from the mirror.
   laser = DefaultLaser();
   laser.emitter_direction_C = -laser.emitter_direction_C;

@@ -5,13 +5,10 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 namespace {
-
-void Require(bool ok, const char* field, const char* expected) {
-  if (!ok) throw Error(std::string("scan pattern: field '") + field + "' must be " + expected);
-}
 
 // Position k of `count` equidistant positions across [lo, hi] shrunk about its centre by
 // `fraction`; the centre itself when count == 1.
@@ -29,14 +26,13 @@ constexpr double kDriveRangeSlack = 1e-3;
 }  // namespace
 
 void MemsScanPatternOptions::Check() const {
-  Require(lines >= 1, "lines", ">= 1");
-  Require(waypoints_per_line >= 2, "waypoints_per_line", ">= 2");
-  Require(std::isfinite(fov_fraction_x) && fov_fraction_x > 0.0 && fov_fraction_x <= 1.0,
-          "fov_fraction_x", "in (0, 1]");
-  Require(std::isfinite(fov_fraction_y) && fov_fraction_y > 0.0 && fov_fraction_y <= 1.0,
-          "fov_fraction_y", "in (0, 1]");
-  Require(std::isfinite(plane_extension_m) && plane_extension_m != 0.0, "plane_extension_m",
-          "finite and non-zero (metres)");
+  const OptionChecks check("MemsScanPatternOptions");
+  check.AtLeast("lines", lines, 1);
+  check.AtLeast("waypoints_per_line", waypoints_per_line, 2);
+  check.InRange("fov_fraction_x", fov_fraction_x, 0.0, 1.0, Interval::kOpenLow);
+  check.InRange("fov_fraction_y", fov_fraction_y, 0.0, 1.0, Interval::kOpenLow);
+  check.Require(std::isfinite(plane_extension_m) && plane_extension_m != 0.0, "plane_extension_m",
+                "a finite non-zero value (metres)", plane_extension_m);
 }
 
 std::vector<MemsLine> DesignMemsScanPattern(const ProjectionFunctions& functions,

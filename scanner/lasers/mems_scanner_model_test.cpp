@@ -129,11 +129,11 @@ TEST(MemsScannerModel, ErrorsNameTheLineAndTheField) {
   // Values that parse but fail the section's Check() name the section and the field.
   const std::string bad_gain = ParseError(Edited(text, "  lens_gain: 3.0", "  lens_gain: 0.5"));
   EXPECT_NE(bad_gain.find("section 'mems'"), std::string::npos) << bad_gain;
-  EXPECT_NE(bad_gain.find("'lens_gain'"), std::string::npos) << bad_gain;
+  EXPECT_NE(bad_gain.find("MemsLaser.lens_gain"), std::string::npos) << bad_gain;
   const std::string bad_rate =
       ParseError(Edited(text, "    sample_rate_hz: 70000.0", "    sample_rate_hz: 71000.0"));
   EXPECT_NE(bad_rate.find("section 'mems.dynamics'"), std::string::npos) << bad_rate;
-  EXPECT_NE(bad_rate.find("'sample_rate_hz'"), std::string::npos) << bad_rate;
+  EXPECT_NE(bad_rate.find("MirrorDynamicsOptions.sample_rate_hz"), std::string::npos) << bad_rate;
   // Not YAML at all.
   EXPECT_NE(ParseError("uwscan_format: 1\nmems: [unclosed\n").find(std::string(kSource) + ":"),
             std::string::npos);

@@ -7,13 +7,10 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 namespace {
-
-void Require(bool ok, const char* field, const std::string& expected) {
-  if (!ok) throw Error(std::string("mirror dynamics: field '") + field + "' must be " + expected);
-}
 
 // A continuous-time single-input single-output system x' = A x + B u, y = x[output].
 struct StateSpace {
@@ -75,20 +72,22 @@ StateSpace AxisModel(const MirrorDynamicsOptions& o) {
 }  // namespace
 
 void MirrorDynamicsOptions::Check() const {
-  Require(std::isfinite(resonance_hz) && resonance_hz > 0.0, "resonance_hz", "positive (Hz)");
-  Require(std::isfinite(damping_ratio) && damping_ratio > 0.0 && damping_ratio < 1.0,
-          "damping_ratio", "in (0, 1) (an underdamped mirror)");
-  Require(lpf_order >= 0 && lpf_order <= 8, "lpf_order", "in [0, 8]");
-  Require(lpf_order == 0 || (std::isfinite(lpf_cutoff_hz) && lpf_cutoff_hz > 0.0), "lpf_cutoff_hz",
-          "positive (Hz)");
-  Require(std::isfinite(waypoint_rate_hz) && waypoint_rate_hz > 0.0, "waypoint_rate_hz",
-          "positive (Hz)");
-  Require(std::isfinite(settle_s) && settle_s >= 0.0, "settle_s", "non-negative (seconds)");
-  Require(std::isfinite(sample_rate_hz) && sample_rate_hz >= waypoint_rate_hz, "sample_rate_hz",
-          "at least waypoint_rate_hz");
+  const OptionChecks check("MirrorDynamicsOptions");
+  check.Positive("resonance_hz", resonance_hz, "Hz");
+  check.InRange("damping_ratio", damping_ratio, 0.0, 1.0, Interval::kOpen,
+                "(an underdamped mirror)");
+  check.InRange("lpf_order", lpf_order, 0, 8);
+  if (lpf_order != 0) check.Positive("lpf_cutoff_hz", lpf_cutoff_hz, "Hz");
+  check.Positive("waypoint_rate_hz", waypoint_rate_hz, "Hz");
+  check.NonNegative("settle_s", settle_s, "s");
+  check.Require(std::isfinite(sample_rate_hz) && sample_rate_hz >= waypoint_rate_hz,
+                "sample_rate_hz",
+                "a finite value >= waypoint_rate_hz (" + OptionValueText(waypoint_rate_hz) + " Hz)",
+                sample_rate_hz);
   const double ratio = sample_rate_hz / waypoint_rate_hz;
-  Require(std::abs(ratio - std::round(ratio)) <= 1e-9 * ratio && ratio <= 1e6, "sample_rate_hz",
-          "a whole multiple (up to 1e6) of waypoint_rate_hz");
+  check.Require(std::abs(ratio - std::round(ratio)) <= 1e-9 * ratio && ratio <= 1e6,
+                "sample_rate_hz", "a whole multiple (up to 1e6) of waypoint_rate_hz",
+                sample_rate_hz);
 }
 
 int MirrorDynamicsOptions::SamplesPerWaypoint() const {

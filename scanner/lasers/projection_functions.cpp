@@ -7,6 +7,7 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -51,14 +52,14 @@ Polynomial2d FitOne(int index, std::span<const Eigen::Vector2d> x, const std::ve
 }  // namespace
 
 void ProjectionFunctions::Check() const {
-  if (!IsRigid(T_C_P)) throw Error("projection functions: field 'T_C_P' must be a rigid transform");
+  const OptionChecks check("ProjectionFunctions");
+  check.Require(IsRigid(T_C_P), "T_C_P", "a rigid transform");
   for (int axis = 0; axis < 2; ++axis) {
-    if (!(std::isfinite(volts_min[axis]) && std::isfinite(volts_max[axis]) &&
-          volts_min[axis] < 0.0 && volts_max[axis] > 0.0)) {
-      throw Error(
-          "projection functions: fields 'volts_min', 'volts_max' must be finite and bracket 0 "
-          "volts on both axes");
-    }
+    const std::string index = axis == 0 ? "[0]" : "[1]";
+    check.Require(std::isfinite(volts_min[axis]) && volts_min[axis] < 0.0, "volts_min" + index,
+                  "a finite value < 0 V (the drive range must bracket 0 V)", volts_min[axis]);
+    check.Require(std::isfinite(volts_max[axis]) && volts_max[axis] > 0.0, "volts_max" + index,
+                  "a finite value > 0 V (the drive range must bracket 0 V)", volts_max[axis]);
   }
 }
 

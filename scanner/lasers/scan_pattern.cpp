@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/yaml_fields.hpp"
 
 namespace uwscan::scanner {
@@ -10,23 +11,20 @@ namespace uwscan::scanner {
 const char* ToString(ScannerKind kind) { return kind == ScannerKind::kGalvo ? "galvo" : "mems"; }
 
 void GalvoScan::Check() const {
-  if (step_stride < 1) throw Error("galvo scan: step_stride must be >= 1");
-  if (step_max < step_min) throw Error("galvo scan: step_max must be >= step_min");
-  if (!(frame_rate_hz > 0.0 && frame_rate_hz < 1e6)) {
-    throw Error("galvo scan: frame_rate_hz must be in (0, 1e6) Hz");
-  }
+  const OptionChecks check("GalvoScan");
+  check.AtLeast("step_stride", step_stride, 1);
+  check.Require(step_max >= step_min, "step_max", ">= step_min (" + std::to_string(step_min) + ")",
+                step_max);
+  check.InRange("frame_rate_hz", frame_rate_hz, 0.0, 1e6, Interval::kOpen, "Hz");
 }
 
 void MemsScan::Check() const {
-  if (lines < 1) throw Error("mems scan: lines must be >= 1");
-  if (waypoints_per_line < 2) throw Error("mems scan: waypoints_per_line must be >= 2");
-  if (!(waypoint_rate_hz > 0.0 && waypoint_rate_hz < 1e7)) {
-    throw Error("mems scan: waypoint_rate_hz must be in (0, 1e7) Hz");
-  }
-  if (!(fov_fraction_x > 0.0 && fov_fraction_x <= 1.0 && fov_fraction_y > 0.0 &&
-        fov_fraction_y <= 1.0)) {
-    throw Error("mems scan: fov_fraction must be in (0, 1]");
-  }
+  const OptionChecks check("MemsScan");
+  check.AtLeast("lines", lines, 1);
+  check.AtLeast("waypoints_per_line", waypoints_per_line, 2);
+  check.InRange("waypoint_rate_hz", waypoint_rate_hz, 0.0, 1e7, Interval::kOpen, "Hz");
+  check.InRange("fov_fraction_x", fov_fraction_x, 0.0, 1.0, Interval::kOpenLow);
+  check.InRange("fov_fraction_y", fov_fraction_y, 0.0, 1.0, Interval::kOpenLow);
 }
 
 void ScanPattern::Check() const {

@@ -4,17 +4,12 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/optics/refraction.hpp"
 
 namespace uwscan::scanner {
 namespace {
-
-void Require(bool ok, const char* field, const char* expected) {
-  if (!ok) throw Error(std::string("viewport: field '") + field + "' must be " + expected);
-}
 
 // Intersects a ray with the plane normal . x = offset; kParallel / kBehind as values. An
 // origin on the face to round-off (as the rays returned here start) counts as on it, t = 0.
@@ -65,14 +60,14 @@ Reach RadialReach(double u, const std::array<double, 3>& lengths,
 }  // namespace
 
 void FlatViewport::Check() const {
-  Require(normal.allFinite() && std::abs(normal.norm() - 1.0) < 1e-9, "normal",
-          "a finite unit vector");
-  Require(std::isfinite(distance_m), "distance_m", "finite (metres)");
-  Require(std::isfinite(thickness_m) && thickness_m >= 0.0 && thickness_m < 1.0, "thickness_m",
-          "in [0, 1) metres");
-  Require(std::isfinite(n_air) && n_air >= 1.0 && n_air < 3.0, "n_air", "in [1, 3)");
-  Require(std::isfinite(n_glass) && n_glass >= n_air && n_glass < 3.0, "n_glass", "in [n_air, 3)");
-  Require(std::isfinite(n_water) && n_water >= n_air && n_water < 3.0, "n_water", "in [n_air, 3)");
+  const OptionChecks check("FlatViewport");
+  check.Require(normal.allFinite() && std::abs(normal.norm() - 1.0) < 1e-9, "normal",
+                "a finite unit vector");
+  check.Finite("distance_m", distance_m);
+  check.InRange("thickness_m", thickness_m, 0.0, 1.0, Interval::kOpenHigh, "m");
+  check.InRange("n_air", n_air, 1.0, 3.0, Interval::kOpenHigh);
+  check.Require(n_glass >= n_air && n_glass < 3.0, "n_glass", "in [n_air, 3)", n_glass);
+  check.Require(n_water >= n_air && n_water < 3.0, "n_water", "in [n_air, 3)", n_water);
 }
 
 RayTrace TraceOut(const FlatViewport& v, const Ray& ray_in_air) {

@@ -3,16 +3,11 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cmath>
-#include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 namespace {
-
-void Require(bool ok, const char* field, const char* expected) {
-  if (!ok) throw Error(std::string("camera: field '") + field + "' must be " + expected);
-}
 
 // Jacobian of Distort with respect to (x, y).
 Eigen::Matrix2d DistortJacobian(const PinholeCamera& c, const Eigen::Vector2d& xy) {
@@ -54,15 +49,16 @@ bool OnOriginBranch(const PinholeCamera& c, double u) {
 }  // namespace
 
 void PinholeCamera::Check() const {
-  Require(width_px > 0, "width_px", "> 0");
-  Require(height_px > 0, "height_px", "> 0");
-  Require(std::isfinite(fx_px) && fx_px > 0.0, "fx_px", "finite and > 0");
-  Require(std::isfinite(fy_px) && fy_px > 0.0, "fy_px", "finite and > 0");
-  Require(std::isfinite(cx_px), "cx_px", "finite");
-  Require(std::isfinite(cy_px), "cy_px", "finite");
-  Require(std::isfinite(k1) && std::isfinite(k2) && std::isfinite(p1) && std::isfinite(p2) &&
-              std::isfinite(k3),
-          "distortion", "five finite numbers [k1, k2, p1, p2, k3]");
+  const OptionChecks check("PinholeCamera");
+  check.GreaterThan("width_px", width_px, 0);
+  check.GreaterThan("height_px", height_px, 0);
+  check.Positive("fx_px", fx_px);
+  check.Positive("fy_px", fy_px);
+  check.Finite("cx_px", cx_px);
+  check.Finite("cy_px", cy_px);
+  check.Require(std::isfinite(k1) && std::isfinite(k2) && std::isfinite(p1) && std::isfinite(p2) &&
+                    std::isfinite(k3),
+                "distortion", "five finite numbers [k1, k2, p1, p2, k3]");
 }
 
 Eigen::Vector2d PinholeCamera::Distort(const Eigen::Vector2d& xy) const {

@@ -1,15 +1,15 @@
 #include "scanner/optics/refractive_camera.hpp"
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 
 void RefractiveCamera::Check() const {
   camera.Check();
   viewport.Check();
-  if (!(viewport.distance_m > 0.0)) {
-    throw Error("camera viewport: field 'distance_m' must be > 0 (the camera centre is inside)");
-  }
+  OptionChecks("RefractiveCamera")
+      .GreaterThan("viewport.distance_m", viewport.distance_m, 0.0,
+                   "m (else the camera centre is inside the viewport)");
 }
 
 RayTrace RefractiveCamera::PixelToRayInWater(const Eigen::Vector2d& uv_px) const {

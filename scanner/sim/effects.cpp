@@ -1,68 +1,39 @@
 #include "scanner/sim/effects.hpp"
 
-#include <cmath>
-#include <cstdio>
-#include <string>
 #include <utility>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::sim {
-namespace {
-
-// Throws "simulation effects: <field>: <value>, expected <what>" unless `ok`.
-void Require(bool ok, const char* field, double value, const char* expected) {
-  if (ok) return;
-  char number[32];
-  std::snprintf(number, sizeof(number), "%.9g", value);
-  throw Error(std::string("simulation effects: ") + field + ": " + number + ", expected " +
-              expected);
-}
-
-bool NonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
-bool Positive(double v) { return std::isfinite(v) && v > 0.0; }
-
-}  // namespace
 
 // Values are checked whether or not their stage is on: a scene that switches a stage on later
 // must not discover then that its numbers were never usable.
 void SimulationEffects::Check() const {
-  Require(NonNegative(navigation_drift.position_walk_m_per_sqrt_s),
-          "navigation_drift.position_walk_m_per_sqrt_s",
-          navigation_drift.position_walk_m_per_sqrt_s, ">= 0 m/sqrt(s)");
-  Require(NonNegative(navigation_drift.yaw_walk_rad_per_sqrt_s),
-          "navigation_drift.yaw_walk_rad_per_sqrt_s", navigation_drift.yaw_walk_rad_per_sqrt_s,
-          ">= 0 rad/sqrt(s)");
-  Require(
-      NonNegative(navigation_drift.speed_scale_sigma) && navigation_drift.speed_scale_sigma < 0.5,
-      "navigation_drift.speed_scale_sigma", navigation_drift.speed_scale_sigma, "in [0, 0.5)");
-  Require(NonNegative(navigation_drift.heading_bias_sigma_rad),
-          "navigation_drift.heading_bias_sigma_rad", navigation_drift.heading_bias_sigma_rad,
-          ">= 0 rad");
-  Require(NonNegative(navigation_drift.depth_sigma_m), "navigation_drift.depth_sigma_m",
-          navigation_drift.depth_sigma_m, ">= 0 m");
-  Require(NonNegative(navigation_drift.roll_pitch_sigma_rad),
-          "navigation_drift.roll_pitch_sigma_rad", navigation_drift.roll_pitch_sigma_rad,
-          ">= 0 rad");
-  Require(NonNegative(peak_noise.sigma_px), "peak_noise.sigma_px", peak_noise.sigma_px, ">= 0 px");
-  if (image.format != PixelFormat::kMono8 && image.format != PixelFormat::kMono16) {
-    throw Error("simulation effects: image.format: expected mono8 or mono16");
-  }
+  const OptionChecks check("SimulationEffects");
+  const NavigationDrift& drift = navigation_drift;
+  check.NonNegative("navigation_drift.position_walk_m_per_sqrt_s", drift.position_walk_m_per_sqrt_s,
+                    "m/sqrt(s)");
+  check.NonNegative("navigation_drift.yaw_walk_rad_per_sqrt_s", drift.yaw_walk_rad_per_sqrt_s,
+                    "rad/sqrt(s)");
+  check.InRange("navigation_drift.speed_scale_sigma", drift.speed_scale_sigma, 0.0, 0.5,
+                Interval::kOpenHigh);
+  check.NonNegative("navigation_drift.heading_bias_sigma_rad", drift.heading_bias_sigma_rad, "rad");
+  check.NonNegative("navigation_drift.depth_sigma_m", drift.depth_sigma_m, "m");
+  check.NonNegative("navigation_drift.roll_pitch_sigma_rad", drift.roll_pitch_sigma_rad, "rad");
+  check.NonNegative("peak_noise.sigma_px", peak_noise.sigma_px, "px");
+  check.Require(image.format == PixelFormat::kMono8 || image.format == PixelFormat::kMono16,
+                "image.format", "mono8 or mono16", static_cast<int>(image.format));
   // A peak above the format's maximum is allowed: it simulates a saturated stripe.
-  Require(Positive(image.peak_level), "image.peak_level", image.peak_level, "> 0 image units");
-  Require(Positive(image.blur_sigma_px), "image.blur_sigma_px", image.blur_sigma_px, "> 0 px");
-  Require(Positive(beam.diameter_m), "beam.diameter_m", beam.diameter_m, "> 0 m");
-  Require(NonNegative(beam.divergence_rad) && beam.divergence_rad < 0.1, "beam.divergence_rad",
-          beam.divergence_rad, "in [0, 0.1) rad (full angle)");
-  Require(NonNegative(sensor_noise.read_sigma), "sensor_noise.read_sigma", sensor_noise.read_sigma,
-          ">= 0 image units");
-  Require(Positive(sensor_noise.electrons_per_level), "sensor_noise.electrons_per_level",
-          sensor_noise.electrons_per_level, "> 0");
-  Require(NonNegative(speckle.contrast) && speckle.contrast <= 1.0, "speckle.contrast",
-          speckle.contrast, "in [0, 1]");
-  Require(NonNegative(backscatter.level), "backscatter.level", backscatter.level,
-          ">= 0 image units");
-  Require(NonNegative(ambient.level), "ambient.level", ambient.level, ">= 0 image units");
+  check.Positive("image.peak_level", image.peak_level, "image units");
+  check.Positive("image.blur_sigma_px", image.blur_sigma_px, "px");
+  check.Positive("beam.diameter_m", beam.diameter_m, "m");
+  check.InRange("beam.divergence_rad", beam.divergence_rad, 0.0, 0.1, Interval::kOpenHigh,
+                "rad (full angle)");
+  check.NonNegative("sensor_noise.read_sigma", sensor_noise.read_sigma, "image units");
+  check.Positive("sensor_noise.electrons_per_level", sensor_noise.electrons_per_level);
+  check.InRange("speckle.contrast", speckle.contrast, 0.0, 1.0);
+  check.NonNegative("backscatter.level", backscatter.level, "image units");
+  check.NonNegative("ambient.level", ambient.level, "image units");
 }
 
 SimulationEffects RealisticImageEffects(bool underwater, SimulationEffects base) {

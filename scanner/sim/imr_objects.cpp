@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {
@@ -129,13 +130,12 @@ Eigen::Isometry3d Placed(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
 Eigen::Matrix3d ZToX() { return Eigen::AngleAxisd(0.5 * kPi, Eigen::Vector3d::UnitY()).matrix(); }
 Eigen::Matrix3d ZToY() { return Eigen::AngleAxisd(-0.5 * kPi, Eigen::Vector3d::UnitX()).matrix(); }
 
-void CheckPipeSection(const char* shape, double outer_radius_m, double wall_m) {
-  RequirePositive(shape, "outer_radius_m", outer_radius_m);
-  RequirePositive(shape, "wall_m", wall_m);
-  if (!(wall_m < outer_radius_m)) {
-    throw Error(std::string(shape) + ": wall_m: " + Num(wall_m) +
-                ", expected less than outer_radius_m (" + Num(outer_radius_m) + ")");
-  }
+// The pipe section every shape but the primitives has.
+void CheckPipeSection(const OptionChecks& check, double outer_radius_m, double wall_m) {
+  check.Positive("outer_radius_m", outer_radius_m, "m");
+  check.Positive("wall_m", wall_m, "m");
+  check.Require(wall_m < outer_radius_m, "wall_m",
+                "< outer_radius_m (" + Num(outer_radius_m) + " m)", wall_m);
 }
 
 }  // namespace
@@ -210,8 +210,9 @@ TriangleMesh MakeUvSphere(double radius_m, double chord_error_m) {
 }
 
 void PipeShape::Check() const {
-  CheckPipeSection("pipe", outer_radius_m, wall_m);
-  RequirePositive("pipe", "length_m", length_m);
+  const OptionChecks check("PipeShape");
+  CheckPipeSection(check, outer_radius_m, wall_m);
+  check.Positive("length_m", length_m, "m");
 }
 
 TriangleMesh MakePipe(const PipeShape& shape, double chord_error_m) {
@@ -223,16 +224,15 @@ TriangleMesh MakePipe(const PipeShape& shape, double chord_error_m) {
 }
 
 void ElbowShape::Check() const {
-  CheckPipeSection("elbow", outer_radius_m, wall_m);
-  RequirePositive("elbow", "bend_radius_m", bend_radius_m);
-  if (!(bend_radius_m > outer_radius_m)) {
-    throw Error("elbow: bend_radius_m: " + Num(bend_radius_m) +
-                ", expected more than outer_radius_m (" + Num(outer_radius_m) +
-                ") so that the inside of the bend does not fold over");
-  }
-  if (!(std::isfinite(bend_angle_rad) && bend_angle_rad > 0.0 && bend_angle_rad < 2.0 * kPi)) {
-    throw Error("elbow: bend_angle_rad: " + Num(bend_angle_rad) + ", expected in (0, 2 pi)");
-  }
+  const OptionChecks check("ElbowShape");
+  CheckPipeSection(check, outer_radius_m, wall_m);
+  check.Positive("bend_radius_m", bend_radius_m, "m");
+  check.Require(bend_radius_m > outer_radius_m, "bend_radius_m",
+                "> outer_radius_m (" + Num(outer_radius_m) +
+                    " m) so that the inside of the bend does not fold over",
+                bend_radius_m);
+  check.Require(bend_angle_rad > 0.0 && bend_angle_rad < 2.0 * kPi, "bend_angle_rad",
+                "in (0, 2 pi) rad", bend_angle_rad);
 }
 
 TriangleMesh MakeElbow(const ElbowShape& shape, double chord_error_m) {
@@ -282,16 +282,14 @@ TriangleMesh MakeElbow(const ElbowShape& shape, double chord_error_m) {
 }
 
 void TeeShape::Check() const {
-  CheckPipeSection("tee", outer_radius_m, wall_m);
-  RequirePositive("tee", "run_length_m", run_length_m);
-  if (!(run_length_m > 2.0 * outer_radius_m)) {
-    throw Error("tee: run_length_m: " + Num(run_length_m) +
-                ", expected more than the branch's diameter (" + Num(2.0 * outer_radius_m) + ")");
-  }
-  if (!(std::isfinite(branch_length_m) && branch_length_m > outer_radius_m)) {
-    throw Error("tee: branch_length_m: " + Num(branch_length_m) +
-                ", expected more than outer_radius_m (" + Num(outer_radius_m) + ")");
-  }
+  const OptionChecks check("TeeShape");
+  CheckPipeSection(check, outer_radius_m, wall_m);
+  check.Positive("run_length_m", run_length_m, "m");
+  check.Require(run_length_m > 2.0 * outer_radius_m, "run_length_m",
+                "> the branch's diameter (" + Num(2.0 * outer_radius_m) + " m)", run_length_m);
+  check.Require(std::isfinite(branch_length_m) && branch_length_m > outer_radius_m,
+                "branch_length_m", "> outer_radius_m (" + Num(outer_radius_m) + " m)",
+                branch_length_m);
 }
 
 TriangleMesh MakeTee(const TeeShape& shape, double chord_error_m) {
@@ -305,32 +303,28 @@ TriangleMesh MakeTee(const TeeShape& shape, double chord_error_m) {
 }
 
 void FlangeShape::Check() const {
-  CheckPipeSection("flange", outer_radius_m, wall_m);
-  RequirePositive("flange", "length_m", length_m);
-  RequirePositive("flange", "flange_thickness_m", flange_thickness_m);
-  if (!(flange_thickness_m < length_m)) {
-    throw Error("flange: flange_thickness_m: " + Num(flange_thickness_m) +
-                ", expected less than length_m (" + Num(length_m) + ")");
-  }
-  if (!(std::isfinite(flange_radius_m) && flange_radius_m > outer_radius_m)) {
-    throw Error("flange: flange_radius_m: " + Num(flange_radius_m) +
-                ", expected more than outer_radius_m (" + Num(outer_radius_m) + ")");
-  }
-  if (bolts < 0) throw Error("flange: bolts: " + std::to_string(bolts) + ", expected >= 0");
+  const OptionChecks check("FlangeShape");
+  CheckPipeSection(check, outer_radius_m, wall_m);
+  check.Positive("length_m", length_m, "m");
+  check.Positive("flange_thickness_m", flange_thickness_m, "m");
+  check.Require(flange_thickness_m < length_m, "flange_thickness_m",
+                "< length_m (" + Num(length_m) + " m)", flange_thickness_m);
+  check.Require(std::isfinite(flange_radius_m) && flange_radius_m > outer_radius_m,
+                "flange_radius_m", "> outer_radius_m (" + Num(outer_radius_m) + " m)",
+                flange_radius_m);
+  check.AtLeast("bolts", bolts, 0);
   if (bolts == 0) return;
-  RequirePositive("flange", "bolt_head_radius_m", bolt_head_radius_m);
-  RequirePositive("flange", "bolt_head_height_m", bolt_head_height_m);
+  check.Positive("bolt_head_radius_m", bolt_head_radius_m, "m");
+  check.Positive("bolt_head_height_m", bolt_head_height_m, "m");
   const double circle = 0.5 * (outer_radius_m + flange_radius_m);
-  if (!(bolt_head_radius_m < 0.5 * (flange_radius_m - outer_radius_m))) {
-    throw Error("flange: bolt_head_radius_m: " + Num(bolt_head_radius_m) +
-                ", expected less than half the flange's width beyond the pipe (" +
-                Num(0.5 * (flange_radius_m - outer_radius_m)) + ")");
-  }
-  if (bolts > 1 && !(circle * std::sin(kPi / bolts) > bolt_head_radius_m)) {
-    throw Error("flange: bolts: " + std::to_string(bolts) + " heads of radius " +
-                Num(bolt_head_radius_m) + " m overlap on a bolt circle of radius " + Num(circle) +
-                " m");
-  }
+  const double half_width = 0.5 * (flange_radius_m - outer_radius_m);
+  check.Require(bolt_head_radius_m < half_width, "bolt_head_radius_m",
+                "< half the flange's width beyond the pipe (" + Num(half_width) + " m)",
+                bolt_head_radius_m);
+  check.Require(bolts == 1 || circle * std::sin(kPi / bolts) > bolt_head_radius_m, "bolts",
+                "heads of radius " + Num(bolt_head_radius_m) +
+                    " m that do not overlap on a bolt circle of radius " + Num(circle) + " m",
+                bolts);
 }
 
 TriangleMesh MakeFlange(const FlangeShape& shape, double chord_error_m) {
@@ -355,30 +349,26 @@ TriangleMesh MakeFlange(const FlangeShape& shape, double chord_error_m) {
 }
 
 void ValveShape::Check() const {
-  CheckPipeSection("valve", outer_radius_m, wall_m);
-  RequirePositive("valve", "body_length_m", body_length_m);
-  RequirePositive("valve", "stub_length_m", stub_length_m);
-  RequirePositive("valve", "stem_radius_m", stem_radius_m);
-  if (!(std::isfinite(body_radius_m) && body_radius_m > outer_radius_m / 0.8)) {
-    throw Error("valve: body_radius_m: " + Num(body_radius_m) +
-                ", expected more than 1.25 x outer_radius_m (" + Num(1.25 * outer_radius_m) +
-                ": the body's chamfered ends must cover the pipe)");
-  }
-  if (!(stem_radius_m < 0.5 * body_radius_m)) {
-    throw Error("valve: stem_radius_m: " + Num(stem_radius_m) +
-                ", expected less than half body_radius_m (" + Num(0.5 * body_radius_m) + ")");
-  }
-  if (!(std::isfinite(stem_length_m) && stem_length_m > body_radius_m + 0.02)) {
-    throw Error("valve: stem_length_m: " + Num(stem_length_m) +
-                ", expected more than body_radius_m + 20 mm (" + Num(body_radius_m + 0.02) + ")");
-  }
-  if (!(std::isfinite(handle_radius_m) && handle_radius_m > 3.0 * stem_radius_m)) {
-    throw Error("valve: handle_radius_m: " + Num(handle_radius_m) +
-                ", expected more than 3 x stem_radius_m (" + Num(3.0 * stem_radius_m) + ")");
-  }
-  if (handle != ValveHandle::kWheel && handle != ValveHandle::kLever) {
-    throw Error("valve: handle: expected wheel or lever");
-  }
+  const OptionChecks check("ValveShape");
+  CheckPipeSection(check, outer_radius_m, wall_m);
+  check.Positive("body_length_m", body_length_m, "m");
+  check.Positive("stub_length_m", stub_length_m, "m");
+  check.Positive("stem_radius_m", stem_radius_m, "m");
+  check.Require(std::isfinite(body_radius_m) && body_radius_m > outer_radius_m / 0.8,
+                "body_radius_m",
+                "> 1.25 x outer_radius_m (" + Num(1.25 * outer_radius_m) +
+                    " m: the body's chamfered ends must cover the pipe)",
+                body_radius_m);
+  check.Require(stem_radius_m < 0.5 * body_radius_m, "stem_radius_m",
+                "< half body_radius_m (" + Num(0.5 * body_radius_m) + " m)", stem_radius_m);
+  check.Require(std::isfinite(stem_length_m) && stem_length_m > body_radius_m + 0.02,
+                "stem_length_m", "> body_radius_m + 20 mm (" + Num(body_radius_m + 0.02) + " m)",
+                stem_length_m);
+  check.Require(std::isfinite(handle_radius_m) && handle_radius_m > 3.0 * stem_radius_m,
+                "handle_radius_m", "> 3 x stem_radius_m (" + Num(3.0 * stem_radius_m) + " m)",
+                handle_radius_m);
+  check.Require(handle == ValveHandle::kWheel || handle == ValveHandle::kLever, "handle",
+                "wheel or lever", static_cast<int>(handle));
 }
 
 TriangleMesh MakeValve(const ValveShape& shape, double chord_error_m) {

@@ -208,7 +208,7 @@ TEST(SceneParse, ErrorsNameTheLineAndField) {
   EXPECT_CONTAINS(ParseError(SceneText("objects:\n  - {shape: cone}\n")),
                   "field 'objects[0].shape': got 'cone', expected one of plane, box");
   EXPECT_CONTAINS(ParseError(SceneText("objects:\n  - {shape: pipe, wall_m: 0.06}\n")),
-                  "field 'objects[0]': pipe: wall_m");
+                  "field 'objects[0]': PipeShape.wall_m");
   EXPECT_CONTAINS(ParseError(SceneText("objects:\n  - {shape: sphere, radius_m: -1}\n")),
                   "field 'objects[0].radius_m': got -1, expected > 0");
   EXPECT_CONTAINS(ParseError(SceneText("objects: []\n")), "field 'objects'");
@@ -226,7 +226,7 @@ TEST(SceneParse, ErrorsNameTheLineAndField) {
   EXPECT_CONTAINS(ParseError(SceneText("detector: {method: best}\n" + std::string(kPlaneObject))),
                   "field 'detector.method': got 'best'");
   EXPECT_CONTAINS(ParseError(SceneText("detector: {window_px: 4}\n" + std::string(kPlaneObject))),
-                  "field 'detector': stripe detector: window_px");
+                  "field 'detector': StripeDetectorOptions.window_px");
   EXPECT_CONTAINS(ParseError(SceneText(R"(trajectory:
   poses:
     - {time_s: 1, T_W_V: {translation_m: [0, 0, 0], rotation_xyzw: [0, 0, 0, 1]}}

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner::sim {
 namespace {
@@ -51,20 +51,24 @@ Eigen::Isometry3d Trajectory::T_W_V(double time_s) const {
 }
 
 void Trajectory::Check() const {
-  if (!FinitePose(T_V_C) || !Orthonormal(T_V_C.linear())) {
-    throw Error("trajectory: T_V_C: expected a finite rigid transform");
-  }
-  if (poses.empty()) throw Error("trajectory: poses: expected at least one pose");
+  const OptionChecks check("Trajectory");
+  check.Require(FinitePose(T_V_C) && Orthonormal(T_V_C.linear()), "T_V_C",
+                "a finite rigid transform");
+  check.Require(!poses.empty(), "poses", "at least one pose", "none");
   for (size_t i = 0; i < poses.size(); ++i) {
-    const std::string field = "trajectory: poses[" + std::to_string(i) + "]";
-    if (!std::isfinite(poses[i].time_s)) throw Error(field + ".time_s: expected a finite time");
+    const auto field = [i](const char* member) {
+      return "poses[" + std::to_string(i) + "]." + member;
+    };
+    const double time_s = poses[i].time_s;
+    if (!std::isfinite(time_s))
+      check.Fail(field("time_s"), "a finite time", OptionValueText(time_s));
     if (!FinitePose(poses[i].T_W_V) || !Orthonormal(poses[i].T_W_V.linear())) {
-      throw Error(field + ".T_W_V: expected a finite rigid transform");
+      check.Fail(field("T_W_V"), "a finite rigid transform");
     }
-    if (i > 0 && !(poses[i].time_s > poses[i - 1].time_s)) {
-      throw Error(field + ".time_s: " + std::to_string(poses[i].time_s) +
-                  " s, expected later than the pose before (" +
-                  std::to_string(poses[i - 1].time_s) + " s)");
+    if (i > 0 && !(time_s > poses[i - 1].time_s)) {
+      check.Fail(field("time_s"),
+                 "later than the pose before (" + OptionValueText(poses[i - 1].time_s) + " s)",
+                 OptionValueText(time_s) + " s");
     }
   }
 }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/sim/effective_scanner.hpp"
 #include "scanner/sim/simulator.hpp"
 #include "scanner/triangulation/triangulator_factory.hpp"
@@ -15,12 +16,12 @@ namespace uwscan::scanner::sim {
 void VirtualScannerOptions::Check() const {
   pattern.Check();
   effects.Check();
-  if (!(water.refractive_index >= 1.0) || !std::isfinite(water.refractive_index)) {
-    throw Error("virtual scanner: water.refractive_index must be finite and >= 1");
-  }
-  if (effects.motion || effects.navigation_drift.on) {
-    throw Error("virtual scanner: motion and navigation drift do not apply to a static scan");
-  }
+  const OptionChecks check("VirtualScannerOptions");
+  check.Require(std::isfinite(water.refractive_index) && water.refractive_index >= 1.0,
+                "water.refractive_index", "a finite value >= 1", water.refractive_index);
+  check.Require(!effects.motion, "effects.motion", "off (a static scan has no motion)", "on");
+  check.Require(!effects.navigation_drift.on, "effects.navigation_drift",
+                "off (a static scan has no navigation)", "on");
 }
 
 struct VirtualScanner::Impl {

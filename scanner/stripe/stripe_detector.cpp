@@ -7,6 +7,8 @@
 #include <limits>
 #include <vector>
 
+#include "scanner/common/option_checks.hpp"
+
 namespace uwscan::scanner {
 namespace {
 
@@ -352,32 +354,22 @@ std::optional<StripeMethod> StripeMethodFromString(std::string_view name) {
 std::span<const StripeMethod> AllStripeMethods() { return kAllMethods; }
 
 void StripeDetectorOptions::Check() const {
+  const OptionChecks check("StripeDetectorOptions");
   if (static_cast<int>(method) > static_cast<int>(StripeMethod::kSteger)) {
-    throw Error("stripe detector: method: unknown value " + std::to_string(int(method)));
+    std::string names;
+    for (StripeMethod m : kAllMethods)
+      names += (names.empty() ? "" : ", ") + std::string(ToString(m));
+    check.Fail("method", "one of " + names, std::to_string(static_cast<int>(method)));
   }
-  if (axis != StripeAxis::kColumns && axis != StripeAxis::kRows) {
-    throw Error("stripe detector: axis: expected columns or rows");
-  }
-  if (threshold < 1 || threshold > 65535) {
-    throw Error("stripe detector: threshold: " + std::to_string(threshold) +
-                ", expected 1..65535 image units");
-  }
-  if (window_px < 3 || window_px % 2 == 0 || window_px > 255) {
-    throw Error("stripe detector: window_px: " + std::to_string(window_px) +
-                ", expected an odd width in 3..255 px");
-  }
-  if (!(max_second_peak_ratio > 0.0 && max_second_peak_ratio <= 1.0)) {
-    throw Error("stripe detector: max_second_peak_ratio: " + std::to_string(max_second_peak_ratio) +
-                ", expected in (0, 1] (1 disables multiple-peak rejection)");
-  }
-  if (min_separation_px < 1) {
-    throw Error("stripe detector: min_separation_px: " + std::to_string(min_separation_px) +
-                ", expected >= 1 px");
-  }
-  if (!(steger_sigma_px >= 0.5 && steger_sigma_px <= 10.0)) {
-    throw Error("stripe detector: steger_sigma_px: " + std::to_string(steger_sigma_px) +
-                ", expected in [0.5, 10] px");
-  }
+  check.Require(axis == StripeAxis::kColumns || axis == StripeAxis::kRows, "axis",
+                "columns or rows", static_cast<int>(axis));
+  check.InRange("threshold", threshold, 1, 65535, Interval::kClosed, "image units");
+  check.Require(window_px >= 3 && window_px <= 255 && window_px % 2 != 0, "window_px",
+                "an odd width in [3, 255] px", window_px);
+  check.InRange("max_second_peak_ratio", max_second_peak_ratio, 0.0, 1.0, Interval::kOpenLow,
+                "(1 disables multiple-peak rejection)");
+  check.AtLeast("min_separation_px", min_separation_px, 1, "px");
+  check.InRange("steger_sigma_px", steger_sigma_px, 0.5, 10.0, Interval::kClosed, "px");
 }
 
 StripeDetector::StripeDetector(const StripeDetectorOptions& options)

@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <string>
+
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 namespace {
@@ -18,16 +19,11 @@ double StripeCurve::At(double s) const {
 }
 
 void StripeRenderOptions::Check() const {
-  if (width_px < 1 || height_px < 1) {
-    throw Error("stripe render: width_px x height_px = " + std::to_string(width_px) + "x" +
-                std::to_string(height_px) + ", expected at least 1x1");
-  }
-  if (!std::isfinite(background) || background < 0.0) {
-    throw Error("stripe render: background: expected a finite value >= 0");
-  }
-  if (!std::isfinite(noise_sigma) || noise_sigma < 0.0) {
-    throw Error("stripe render: noise_sigma: expected a finite value >= 0");
-  }
+  const OptionChecks check("StripeRenderOptions");
+  check.AtLeast("width_px", width_px, 1, "px");
+  check.AtLeast("height_px", height_px, 1, "px");
+  check.NonNegative("background", background, "image units");
+  check.NonNegative("noise_sigma", noise_sigma, "image units");
 }
 
 StripeImage StripeFrame::view() const {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/triangulation/light_plane.hpp"
 
 namespace uwscan::scanner {
@@ -350,23 +351,12 @@ void Normalise(ConeParameters& params) {
 }  // namespace
 
 void ConeFitOptions::Check() const {
-  const auto fail = [](const std::string& field, const std::string& expected, double got) {
-    std::ostringstream message;
-    message << "ConeFitOptions." << field << ": expected " << expected << ", got " << got;
-    throw Error(message.str());
-  };
-  if (max_iterations <= 0) {
-    fail("max_iterations", "> 0", max_iterations);
-  }
-  if (!(std::isfinite(function_tolerance) && function_tolerance >= 0.0)) {
-    fail("function_tolerance", "a finite value >= 0", function_tolerance);
-  }
-  if (!(std::isfinite(parameter_tolerance) && parameter_tolerance >= 0.0)) {
-    fail("parameter_tolerance", "a finite value >= 0", parameter_tolerance);
-  }
-  if (!(beta_margin_rad >= 0.0 && beta_margin_rad <= kPi)) {
-    fail("beta_margin_rad", "a value in [0, pi]", beta_margin_rad);
-  }
+  const OptionChecks check("ConeFitOptions");
+  check.GreaterThan("max_iterations", max_iterations, 0);
+  check.NonNegative("function_tolerance", function_tolerance);
+  check.NonNegative("parameter_tolerance", parameter_tolerance);
+  check.Require(beta_margin_rad >= 0.0 && beta_margin_rad <= kPi, "beta_margin_rad",
+                "in [0, pi] rad", beta_margin_rad);
 }
 
 ConeFit FitCone(std::span<const Eigen::Vector3d> points_in_C,

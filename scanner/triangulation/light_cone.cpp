@@ -2,52 +2,37 @@
 
 #include <cmath>
 #include <numbers>
-#include <sstream>
-#include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::scanner {
 namespace {
 
-[[noreturn]] void ThrowField(const std::string& field, const std::string& expected, double got) {
-  std::ostringstream message;
-  message << "EllipticCone." << field << ": expected " << expected << ", got " << got;
-  throw Error(message.str());
-}
-
 // A pose that is not a rotation would turn the cone into a different quadric; catch it here
 // rather than intersect the wrong surface.
-void CheckRigid(const Eigen::Isometry3d& T_C_Q) {
-  if (!T_C_Q.matrix().allFinite()) {
-    throw Error("EllipticCone.T_C_Q: expected finite values");
-  }
+void CheckRigid(const OptionChecks& check, const Eigen::Isometry3d& T_C_Q) {
+  check.Require(T_C_Q.matrix().allFinite(), "T_C_Q", "finite values");
   const Eigen::Matrix3d R = T_C_Q.linear();
   const double orthogonality_error = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
   if (orthogonality_error > 1e-9 || R.determinant() < 0.0) {
-    ThrowField("T_C_Q", "a rotation (|R^T R - I| <= 1e-9, det R = +1)", orthogonality_error);
+    check.Fail("T_C_Q", "a rotation (|R^T R - I| <= 1e-9, det R = +1)",
+               "|R^T R - I| = " + OptionValueText(orthogonality_error) +
+                   ", det R = " + OptionValueText(R.determinant()));
   }
 }
 
 }  // namespace
 
 void EllipticCone::Check() const {
-  CheckRigid(T_C_Q);
-  if (!(std::isfinite(a) && a > 0.0)) {
-    ThrowField("a", "a finite value > 0", a);
-  }
-  if (!std::isfinite(b)) {
-    ThrowField("b", "a finite value", b);
-  }
-  if (!(beta_min_rad >= 0.0 && beta_min_rad <= std::numbers::pi)) {
-    ThrowField("beta_min_rad", "a value in [0, pi]", beta_min_rad);
-  }
-  if (!(beta_max_rad >= beta_min_rad && beta_max_rad <= std::numbers::pi)) {
-    ThrowField("beta_max_rad", "a value in [beta_min_rad, pi]", beta_max_rad);
-  }
-  if (!(std::isfinite(h_min_m) && h_min_m >= 0.0)) {
-    ThrowField("h_min_m", "a finite value >= 0", h_min_m);
-  }
+  const OptionChecks check("EllipticCone");
+  CheckRigid(check, T_C_Q);
+  check.Positive("a", a);
+  check.Finite("b", b);
+  check.Require(beta_min_rad >= 0.0 && beta_min_rad <= std::numbers::pi, "beta_min_rad",
+                "in [0, pi] rad", beta_min_rad);
+  check.Require(beta_max_rad >= beta_min_rad && beta_max_rad <= std::numbers::pi, "beta_max_rad",
+                "in [beta_min_rad, pi] rad", beta_max_rad);
+  check.NonNegative("h_min_m", h_min_m, "m");
 }
 
 Eigen::Vector3d EllipticCone::Point(double h_m, double beta_rad) const {

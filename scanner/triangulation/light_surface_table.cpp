@@ -5,16 +5,19 @@
 #include <utility>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::scanner {
 
 void LightSurfaceTableOptions::Check() const {
-  if (!(depth_min_m > 0.0 && depth_max_m > depth_min_m && std::isfinite(depth_max_m))) {
-    throw Error("light surface table: need 0 < depth_min_m < depth_max_m (metres)");
-  }
-  if (rays_per_fan < 3) throw Error("light surface table: rays_per_fan must be >= 3");
-  if (points_per_ray < 2) throw Error("light surface table: points_per_ray must be >= 2");
+  const OptionChecks check("LightSurfaceTableOptions");
+  check.GreaterThan("depth_min_m", depth_min_m, 0.0, "m");
+  check.Require(std::isfinite(depth_max_m) && depth_max_m > depth_min_m, "depth_max_m",
+                "a finite value > depth_min_m (" + OptionValueText(depth_min_m) + " m)",
+                depth_max_m);
+  check.AtLeast("rays_per_fan", rays_per_fan, 3);
+  check.AtLeast("points_per_ray", points_per_ray, 2);
   cone.Check();
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "scanner/triangulation/cone_batch.hpp"
 
 namespace uwscan::scanner {
@@ -19,9 +20,8 @@ void MarkAll(std::span<TriangulatedPoint> out, HitStatus status) {
 }  // namespace
 
 void TriangulationOptions::Check() const {
-  if (!(min_angle_rad >= 0.0 && min_angle_rad < 1.0)) {
-    throw Error("triangulation: min_angle_rad must be in [0, 1) rad");
-  }
+  OptionChecks("TriangulationOptions")
+      .InRange("min_angle_rad", min_angle_rad, 0.0, 1.0, Interval::kOpenHigh, "rad");
 }
 
 void TriangulatePeaksOnPlane(const CameraRayTable& rays, const Plane& plane, double min_sin2_angle,

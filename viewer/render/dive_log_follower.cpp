@@ -2,7 +2,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -10,6 +9,7 @@
 #include "mapping/log/dive_log.hpp"
 #include "mapping/reconstruction/incremental_reconstruction.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::viewer {
 namespace {
@@ -33,10 +33,10 @@ LiveCloud ToLiveCloud(mapping::ReconstructedFrame& frame) {
 }  // namespace
 
 void FollowOptions::Check() const {
-  if (!(poll_s > 0.0 && poll_s <= 60.0)) throw Error("follow: poll_s must be in (0, 60] s");
-  if (stop_after_frames < 0) throw Error("follow: stop_after_frames must be >= 0");
-  if (!(timeout_s >= 0.0 && std::isfinite(timeout_s)))
-    throw Error("follow: timeout_s must be >= 0");
+  const OptionChecks check("FollowOptions");
+  check.InRange("poll_s", poll_s, 0.0, 60.0, Interval::kOpenLow, "s");
+  check.AtLeast("stop_after_frames", stop_after_frames, 0);
+  check.NonNegative("timeout_s", timeout_s, "s");
 }
 
 struct DiveLogFollower::Impl {

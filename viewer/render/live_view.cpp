@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "viewer/render/display.hpp"
 #include "viewer/render/view_interaction.hpp"
 #include "viewer/render/vtk_scene.hpp"
@@ -88,10 +89,10 @@ CloudLayer Combine(const std::vector<std::shared_ptr<const LiveCloud>>& clouds,
 
 void LiveViewOptions::Check() const {
   render.Check();
-  if (point_budget < 1) throw Error("live view: point_budget must be >= 1");
-  if (!(decay_s >= 0.0 && std::isfinite(decay_s))) throw Error("live view: decay_s must be >= 0");
-  if (!(refresh_s > 0.0 && refresh_s <= 60.0))
-    throw Error("live view: refresh_s must be in (0, 60] s");
+  const OptionChecks check("LiveViewOptions");
+  check.AtLeast("point_budget", point_budget, 1);
+  check.NonNegative("decay_s", decay_s, "s");
+  check.InRange("refresh_s", refresh_s, 0.0, 60.0, Interval::kOpenLow, "s");
 }
 
 struct LiveView::Impl {

@@ -9,7 +9,7 @@
 #include <random>
 #include <string>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "viewer/render/display.hpp"
 #include "viewer/render/vtk_scene.hpp"
 
@@ -95,14 +95,17 @@ ViewerBenchRow Measure(std::size_t n, const ViewerBenchOptions& o) {
 }  // namespace
 
 void ViewerBenchOptions::Check() const {
-  if (point_counts.empty()) throw Error("viewer bench: no point count");
-  for (const std::size_t n : point_counts) {
-    if (n < 1) throw Error("viewer bench: point counts must be >= 1");
+  const OptionChecks check("ViewerBenchOptions");
+  check.Require(!point_counts.empty(), "point_counts", "at least one point count", "none");
+  for (std::size_t i = 0; i < point_counts.size(); ++i) {
+    if (point_counts[i] < 1) {
+      check.Fail("point_counts[" + std::to_string(i) + "]", ">= 1",
+                 std::to_string(point_counts[i]));
+    }
   }
-  if (frames < 1) throw Error("viewer bench: frames must be >= 1");
-  if (width_px < 16 || height_px < 16 || width_px > 8192 || height_px > 8192) {
-    throw Error("viewer bench: width and height must be in [16, 8192]");
-  }
+  check.AtLeast("frames", frames, 1);
+  check.InRange("width_px", width_px, 16, 8192, Interval::kClosed, "px");
+  check.InRange("height_px", height_px, 16, 8192, Interval::kClosed, "px");
 }
 
 std::vector<ViewerBenchRow> RunViewerBenchmark(const ViewerBenchOptions& options,

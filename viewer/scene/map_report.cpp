@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "perception/cloud/cloud_io.hpp"
-#include "scanner/common/error.hpp"
 #include "scanner/common/json_fields.hpp"
+#include "scanner/common/option_checks.hpp"
 #include "viewer/scene/scene_files.hpp"
 
 namespace uwscan::viewer {
@@ -102,9 +102,9 @@ MapReport ReadMapReport(const std::filesystem::path& path) {
 }
 
 void MapReportDrawing::Check() const {
-  if (ellipsoid_every < 1) throw Error("map report drawing: ellipsoid_every must be >= 1");
-  if (!(sigmas > 0.0 && std::isfinite(sigmas)))
-    throw Error("map report drawing: sigmas must be > 0");
+  const OptionChecks check("MapReportDrawing");
+  check.AtLeast("ellipsoid_every", ellipsoid_every, 1);
+  check.Positive("sigmas", sigmas);
 }
 
 void AddMapReport(const MapReport& report, const MapReportDrawing& drawing, Scene& scene) {

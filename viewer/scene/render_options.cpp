@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::viewer {
 
@@ -39,19 +39,16 @@ const char* ToString(ColourMode mode) {
 }
 
 void RenderOptions::Check() const {
-  if (range && !(std::isfinite(range->lo) && std::isfinite(range->hi) && range->hi > range->lo)) {
-    throw Error("render options: range must be two finite numbers, low < high");
+  const OptionChecks check("RenderOptions");
+  if (range) {
+    check.Require(std::isfinite(range->lo) && std::isfinite(range->hi) && range->hi > range->lo,
+                  "range", "two finite numbers, low < high", OptionPairText(range->lo, range->hi));
   }
-  if (!(point_size_px > 0.0 && point_size_px <= 64.0)) {
-    throw Error("render options: point_size_px must be in (0, 64]");
-  }
-  if (width_px < 16 || width_px > 8192 || height_px < 16 || height_px > 8192) {
-    throw Error("render options: width and height must be in [16, 8192] pixels");
-  }
-  if (max_points < 1) throw Error("render options: max_points must be >= 1");
-  if (!(up.allFinite() && up.norm() > 1e-9)) {
-    throw Error("render options: up must be a finite, non-zero vector");
-  }
+  check.InRange("point_size_px", point_size_px, 0.0, 64.0, Interval::kOpenLow, "px");
+  check.InRange("width_px", width_px, 16, 8192, Interval::kClosed, "px");
+  check.InRange("height_px", height_px, 16, 8192, Interval::kClosed, "px");
+  check.AtLeast("max_points", max_points, 1);
+  check.Require(up.allFinite() && up.norm() > 1e-9, "up", "a finite, non-zero vector");
 }
 
 }  // namespace uwscan::viewer
