@@ -20,6 +20,7 @@
 #include "ros/conversions/static_transforms.hpp"
 #include "ros/node/map_publisher.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::ros {
 namespace {
@@ -426,15 +427,13 @@ std::string StopReason(const InspectionNodeOptions& o, RosConnection& ros, const
 }  // namespace
 
 void InspectionNodeOptions::Check() const {
-  const auto fail = [](const std::string& field, const std::string& expected) {
-    throw Error("InspectionNodeOptions." + field + ": expected " + expected);
-  };
-  if (!(description_wait_s > 0.0)) fail("description_wait_s", "> 0 s");
-  if (!(mount_wait_s >= 0.0)) fail("mount_wait_s", ">= 0 s");
-  if (!(map_period_s > 0.0)) fail("map_period_s", "> 0 s");
-  if (frame_queue < 1) fail("frame_queue", ">= 1");
-  if (max_frames < 0) fail("max_frames", ">= 0");
-  if (!(idle_stop_s >= 0.0)) fail("idle_stop_s", ">= 0 s");
+  const OptionChecks check("InspectionNodeOptions");
+  check.GreaterThan("description_wait_s", description_wait_s, 0.0, "s");
+  check.AtLeast("mount_wait_s", mount_wait_s, 0.0, "s");
+  check.GreaterThan("map_period_s", map_period_s, 0.0, "s");
+  check.AtLeast("frame_queue", frame_queue, 1);
+  check.AtLeast("max_frames", static_cast<double>(max_frames), 0);
+  check.AtLeast("idle_stop_s", idle_stop_s, 0.0, "s");
   inspection.Check();
 }
 

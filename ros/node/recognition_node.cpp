@@ -10,6 +10,7 @@
 #include "perception/recognition/object_pose_search.hpp"
 #include "ros/conversions/object_messages.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
 
 namespace uwscan::ros {
 namespace {
@@ -112,13 +113,11 @@ std::string StopReason(const RecognitionNodeOptions& o, RosConnection& ros, cons
 }  // namespace
 
 void RecognitionNodeOptions::Check() const {
-  const auto fail = [](const std::string& field, const std::string& expected) {
-    throw Error("RecognitionNodeOptions." + field + ": expected " + expected);
-  };
-  if (min_points < 1) fail("min_points", ">= 1");
-  if (model_marker_points < 1) fail("model_marker_points", ">= 1");
-  if (max_sweeps < 0) fail("max_sweeps", ">= 0");
-  if (!(idle_stop_s >= 0.0)) fail("idle_stop_s", ">= 0 s");
+  const OptionChecks check("RecognitionNodeOptions");
+  check.AtLeast("min_points", min_points, 1);
+  check.AtLeast("model_marker_points", model_marker_points, 1);
+  check.AtLeast("max_sweeps", max_sweeps, 0);
+  check.AtLeast("idle_stop_s", idle_stop_s, 0.0, "s");
 }
 
 RecognitionNodeSummary RunRecognitionNode(RosConnection& ros, const perception::ObjectDatabase& db,

@@ -217,30 +217,31 @@ std::optional<double> RefineLine(const RefineParams& rp, const Get& at, int n, i
 }
 
 // The one pass over the frame, in row order: each column's maximum over each block of
-// kBlockRows rows and the first row of the block reaching it (found again over the block's rows
-// while they are still in cache: cheaper than reading them back column by column later), then
-// each column's maximum and the first block reaching it, hence arg: the first row of the column
-// with its brightest value.
+// kBlockRows rows and the first row of the block reaching it (a row strictly brighter than the
+// block's maximum so far moves both), then each column's maximum and the first block reaching
+// it, hence arg: the first row of the column with its brightest value.
 template <typename Pixel>
-void ColumnMaxima(const StripeImage& image, ColumnScratch<Pixel>& scratch) {
+[[gnu::always_inline]] inline void ColumnMaxima(const StripeImage& image,
+                                                ColumnScratch<Pixel>& scratch) {
   const int width = image.width_px;
   const int height = image.height_px;
   const int blocks = (height + kBlockRows - 1) / kBlockRows;
   for (int b = 0; b < blocks; ++b) {
     Pixel* __restrict out = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
-    const int v_end = std::min(height, (b + 1) * kBlockRows);
-    const Pixel* __restrict first = image.Row<Pixel>(b * kBlockRows);
-    std::copy(first, first + width, out);
-    for (int v = b * kBlockRows + 1; v < v_end; ++v) {
-      const Pixel* __restrict row = image.Row<Pixel>(v);
-      for (int u = 0; u < width; ++u) out[u] = std::max(out[u], row[u]);
-    }
-    // Rows from last to first, so the first row reaching the maximum is the one kept.
     std::uint8_t* __restrict at = scratch.block_arg.data() + static_cast<std::size_t>(b) * width;
-    for (int v = v_end - 1; v >= b * kBlockRows; --v) {
+    const int v_begin = b * kBlockRows;
+    const int v_end = std::min(height, v_begin + kBlockRows);
+    const Pixel* __restrict first = image.Row<Pixel>(v_begin);
+    std::copy(first, first + width, out);
+    std::fill(at, at + width, std::uint8_t{0});
+    for (int v = v_begin + 1; v < v_end; ++v) {
       const Pixel* __restrict row = image.Row<Pixel>(v);
-      const std::uint8_t k = static_cast<std::uint8_t>(v - b * kBlockRows);
-      for (int u = 0; u < width; ++u) at[u] = row[u] == out[u] ? k : at[u];
+      const std::uint8_t k = static_cast<std::uint8_t>(v - v_begin);
+      for (int u = 0; u < width; ++u) {
+        const bool brighter = row[u] > out[u];
+        out[u] = brighter ? row[u] : out[u];
+        at[u] = brighter ? k : at[u];
+      }
     }
   }
   Pixel* __restrict max = scratch.max.data();
@@ -266,8 +267,9 @@ void ColumnMaxima(const StripeImage& image, ColumnScratch<Pixel>& scratch) {
 // (at least `threshold` and above ratio * max[u]): one vectorisable pass over the block maxima,
 // so that the per-column check below reads only those blocks.
 template <typename Pixel>
-void SecondPeakCandidates(int width, int blocks, int threshold, double ratio,
-                          ColumnScratch<Pixel>& scratch) {
+[[gnu::always_inline]] inline void SecondPeakCandidates(int width, int blocks, int threshold,
+                                                        double ratio,
+                                                        ColumnScratch<Pixel>& scratch) {
   constexpr double kTop = static_cast<double>(std::numeric_limits<Pixel>::max());
   for (int u = 0; u < width; ++u) {
     // Integer values c with c >= threshold and c > ratio * top: c >= floor(ratio * top) + 1.
@@ -277,42 +279,116 @@ void SecondPeakCandidates(int width, int blocks, int threshold, double ratio,
   std::uint16_t* __restrict first = scratch.first_candidate.data();
   std::uint16_t* __restrict last = scratch.last_candidate.data();
   const Pixel* __restrict cut = scratch.cut.data();
-  std::fill(first, first + width, kNoBlock);
-  std::fill(last, last + width, kNoBlock);
-  for (int b = blocks - 1; b >= 0; --b) {  // backwards: the first candidate is written last
+  // One simple select per loop, which the compiler vectorises (the two fused did not): forwards
+  // the last candidate is written last, backwards the first.
+  const auto latest_candidate = [&](std::uint16_t* __restrict out, int b) {
     const Pixel* __restrict block = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
     const std::uint16_t bb = static_cast<std::uint16_t>(b);
-    for (int u = 0; u < width; ++u) {
-      const bool candidate = block[u] >= cut[u];
-      first[u] = candidate ? bb : first[u];
-      last[u] = (candidate & (last[u] == kNoBlock)) ? bb : last[u];
-    }
+    for (int u = 0; u < width; ++u) out[u] = block[u] >= cut[u] ? bb : out[u];
+  };
+  std::fill(first, first + width, kNoBlock);
+  std::fill(last, last + width, kNoBlock);
+  for (int b = 0; b < blocks; ++b) latest_candidate(last, b);
+  for (int b = blocks - 1; b >= 0; --b) latest_candidate(first, b);
+}
+
+// The passes over the whole frame and its block maxima, compiled for AVX2 too and chosen at run
+// time (never -march=native against Debian's PCL, DESIGN.md): integer work, the same result on
+// either path.
+template <typename Pixel>
+[[gnu::always_inline]] inline void ScanColumns(const StripeImage& image, bool reject_multiple,
+                                               int threshold, double ratio,
+                                               ColumnScratch<Pixel>& scratch) {
+  ColumnMaxima<Pixel>(image, scratch);
+  if (reject_multiple) {
+    SecondPeakCandidates(image.width_px, (image.height_px + kBlockRows - 1) / kBlockRows, threshold,
+                         ratio, scratch);
   }
+}
+
+__attribute__((target_clones("avx2", "default"))) void ScanColumns8(
+    const StripeImage& image, bool reject_multiple, int threshold, double ratio,
+    ColumnScratch<std::uint8_t>& scratch) {
+  ScanColumns(image, reject_multiple, threshold, ratio, scratch);
+}
+
+__attribute__((target_clones("avx2", "default"))) void ScanColumns16(
+    const StripeImage& image, bool reject_multiple, int threshold, double ratio,
+    ColumnScratch<std::uint16_t>& scratch) {
+  ScanColumns(image, reject_multiple, threshold, ratio, scratch);
+}
+
+// A row's brightest pixel (the first of equal maxima) and the brightest of its other local
+// maxima (brighter than the pixel before, at least as bright as the one after: a flat top
+// counts once) farther than `separation` from it; 0 when there is none. Branch-free loops the
+// compiler vectorises.
+template <typename Pixel>
+struct RowScan {
+  int u0 = 0;
+  Pixel top = 0;
+  Pixel second = 0;
+};
+
+template <typename Pixel>
+[[gnu::always_inline]] inline Pixel BrightestLocalMaximum(const Pixel* __restrict row, int begin,
+                                                          int end) {
+  Pixel best = 0;
+  for (int u = begin; u < end; ++u) {
+    const bool peak = (row[u] > row[u - 1]) & (row[u] >= row[u + 1]);
+    best = std::max(best, peak ? row[u] : Pixel{0});
+  }
+  return best;
+}
+
+template <typename Pixel>
+[[gnu::always_inline]] inline RowScan<Pixel> ScanRow(const Pixel* __restrict row, int width,
+                                                     int separation, bool second_peak) {
+  RowScan<Pixel> r;
+  for (int u = 0; u < width; ++u) r.top = std::max(r.top, row[u]);
+  while (row[r.u0] != r.top) ++r.u0;
+  if (second_peak) {
+    r.second = std::max(BrightestLocalMaximum(row, 1, std::max(1, r.u0 - separation)),
+                        BrightestLocalMaximum(row, r.u0 + separation + 1, width - 1));
+  }
+  return r;
+}
+
+__attribute__((target_clones("avx2", "default"))) RowScan<std::uint8_t> ScanRow8(
+    const std::uint8_t* row, int width, int separation, bool second_peak) {
+  return ScanRow(row, width, separation, second_peak);
+}
+
+__attribute__((target_clones("avx2", "default"))) RowScan<std::uint16_t> ScanRow16(
+    const std::uint16_t* row, int width, int separation, bool second_peak) {
+  return ScanRow(row, width, separation, second_peak);
 }
 
 // Whether column u holds a second peak that rejects it: an interior local maximum (brighter
 // than the row above, at least as bright as the row below: a flat top counts once) farther than
-// `separation` rows from the brightest pixel arg, at least `threshold` and above ratio * top.
-// Only the candidate blocks are read.
+// `separation` rows from the brightest pixel arg, at least `threshold` and above ratio * top,
+// which for an integer value is at least cut[u] (SecondPeakCandidates). Only the candidate
+// blocks are read, and the rows within `separation` of arg are skipped, not tested.
 template <typename Pixel>
 bool HasSecondPeak(const StripeImage& image, const ColumnScratch<Pixel>& scratch, int u,
-                   int separation, double threshold, double ratio) {
+                   int separation) {
   const int first = scratch.first_candidate[u];
   if (first == kNoBlock) return false;
   const int last = scratch.last_candidate[u];
-  const int height = image.height_px;
-  const double top = scratch.max[u];
-  const int arg = scratch.arg[u];
-  const auto matters = [&](double c) { return c >= threshold && c > ratio * top; };
+  const Pixel cut = scratch.cut[u];
   const Pixel* column = image.Row<Pixel>(0) + u;
   const std::ptrdiff_t step = image.stride_bytes / static_cast<std::ptrdiff_t>(sizeof(Pixel));
-  const int v_end = std::min(height - 1, (last + 1) * kBlockRows);
-  for (int v = std::max(1, first * kBlockRows); v < v_end; ++v) {
-    if (std::abs(v - arg) <= separation) continue;
-    const Pixel c = column[v * step];
-    if (c > column[(v - 1) * step] && c >= column[(v + 1) * step] && matters(c)) return true;
-  }
-  return false;
+  const auto peak_in = [&](int v_begin, int v_end) {  // rows [v_begin, v_end)
+    const Pixel* p = column + v_begin * step;
+    for (int v = v_begin; v < v_end; ++v, p += step) {
+      if (*p > p[-step] && *p >= p[step] && *p >= cut) return true;
+    }
+    return false;
+  };
+  const int v_begin = std::max(1, first * kBlockRows);
+  const int v_end = std::min(image.height_px - 1, (last + 1) * kBlockRows);
+  const int arg = scratch.arg[u];
+  return peak_in(v_begin, std::min(v_end, arg - separation)) ||
+         peak_in(std::max(v_begin, arg + separation + 1), v_end);
 }
 
 }  // namespace
@@ -427,13 +503,15 @@ void StripeDetector::DetectColumns(const StripeImage& image, StripeDetection* re
     scratch = &scratch_->mono16;
   }
   scratch->Resize(width, (height + kBlockRows - 1) / kBlockRows);
-  ColumnMaxima<Pixel>(image, *scratch);
-  const std::uint16_t* arg = scratch->arg.data();
   const bool reject_multiple = options_.max_second_peak_ratio < 1.0;
-  if (reject_multiple) {
-    SecondPeakCandidates(width, (height + kBlockRows - 1) / kBlockRows, options_.threshold,
-                         options_.max_second_peak_ratio, *scratch);
+  if constexpr (sizeof(Pixel) == 1) {
+    ScanColumns8(image, reject_multiple, options_.threshold, options_.max_second_peak_ratio,
+                 *scratch);
+  } else {
+    ScanColumns16(image, reject_multiple, options_.threshold, options_.max_second_peak_ratio,
+                  *scratch);
   }
+  const std::uint16_t* arg = scratch->arg.data();
 
   const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
   const double saturation = MaxPixelValue(image.format);
@@ -444,8 +522,7 @@ void StripeDetector::DetectColumns(const StripeImage& image, StripeDetection* re
       ++result->below_threshold;
       continue;
     }
-    if (reject_multiple && HasSecondPeak(image, *scratch, u, options_.min_separation_px,
-                                         options_.threshold, options_.max_second_peak_ratio)) {
+    if (reject_multiple && HasSecondPeak(image, *scratch, u, options_.min_separation_px)) {
       ++result->multiple_peaks;
       continue;
     }
@@ -470,24 +547,22 @@ void StripeDetector::DetectRows(const StripeImage& image, StripeDetection* resul
   const bool reject_multiple = options_.max_second_peak_ratio < 1.0;
   for (int v = 0; v < image.height_px; ++v) {
     const Pixel* row = image.Row<Pixel>(v);
-    const int u0 = static_cast<int>(std::max_element(row, row + width) - row);
-    const double top = row[u0];
+    RowScan<Pixel> scan;
+    if constexpr (sizeof(Pixel) == 1) {
+      scan = ScanRow8(row, width, options_.min_separation_px, reject_multiple);
+    } else {
+      scan = ScanRow16(row, width, options_.min_separation_px, reject_multiple);
+    }
+    const int u0 = scan.u0;
+    const double top = scan.top;
     if (top < options_.threshold) {
       ++result->below_threshold;
       continue;
     }
-    if (reject_multiple) {
-      Pixel second = 0;
-      for (int u = 1; u + 1 < width; ++u) {
-        if (row[u] > row[u - 1] && row[u] >= row[u + 1] &&
-            std::abs(u - u0) > options_.min_separation_px) {
-          second = std::max(second, row[u]);
-        }
-      }
-      if (second >= options_.threshold && second > options_.max_second_peak_ratio * top) {
-        ++result->multiple_peaks;
-        continue;
-      }
+    if (reject_multiple && scan.second >= options_.threshold &&
+        scan.second > options_.max_second_peak_ratio * top) {
+      ++result->multiple_peaks;
+      continue;
     }
     const auto at = [row](int u) { return static_cast<double>(row[u]); };
     const std::optional<double> offset = RefineLine(rp, at, width, u0, saturation);

@@ -399,6 +399,64 @@ TEST(StripeDetector, FastColumnScanMatchesNaiveReference) {
   }
 }
 
+// The frame with rows and columns swapped: its lines are the original's columns.
+StripeFrame Transposed(const StripeFrame& frame) {
+  StripeFrame t = frame;
+  t.width_px = frame.height_px;
+  t.height_px = frame.width_px;
+  for (int v = 0; v < frame.height_px; ++v) {
+    for (int u = 0; u < frame.width_px; ++u) {
+      const size_t from = static_cast<size_t>(v) * frame.width_px + u;
+      const size_t to = static_cast<size_t>(u) * t.width_px + v;
+      if (frame.format == PixelFormat::kMono8) {
+        t.mono8[to] = frame.mono8[from];
+      } else {
+        t.mono16[to] = frame.mono16[from];
+      }
+    }
+  }
+  return t;
+}
+
+// Detection along rows (DetectRows) of the transposed cluttered frames gives, line for line, the
+// naive reference's answer on the original columns.
+TEST(StripeDetector, FastRowScanMatchesNaiveReference) {
+  for (PixelFormat f : {PixelFormat::kMono8, PixelFormat::kMono16}) {
+    for (std::uint64_t seed : {1u, 2u, 3u}) {
+      const StripeFrame frame = Cluttered(f, seed);
+      const StripeFrame transposed = Transposed(frame);
+      for (StripeMethod m : AllStripeMethods()) {
+        for (double ratio : {0.5, 1.0}) {
+          StripeDetectorOptions o = With(m);
+          o.max_second_peak_ratio = ratio;
+          o.threshold = f == PixelFormat::kMono8 ? 60 : 15000;
+          StripeDetector reference(o);
+          const StripeDetection naive =
+              f == PixelFormat::kMono8 ? NaiveColumns<std::uint8_t>(frame.view(), o, reference)
+                                       : NaiveColumns<std::uint16_t>(frame.view(), o, reference);
+          o.axis = StripeAxis::kRows;
+          StripeDetector detector(o);
+          const StripeDetection rows = detector.Detect(transposed.view());
+          SCOPED_TRACE(std::string(ToString(m)) + " ratio " + std::to_string(ratio));
+          EXPECT_EQ(rows.lines, naive.lines);
+          EXPECT_EQ(rows.below_threshold, naive.below_threshold);
+          EXPECT_EQ(rows.multiple_peaks, naive.multiple_peaks);
+          EXPECT_EQ(rows.unrefined, naive.unrefined);
+          ASSERT_EQ(rows.peaks.size(), naive.peaks.size());
+          for (size_t i = 0; i < rows.peaks.size(); ++i) {
+            EXPECT_EQ(rows.peaks[i].v_px, naive.peaks[i].u_px);
+            EXPECT_EQ(rows.peaks[i].u_px, naive.peaks[i].v_px);
+            EXPECT_EQ(rows.peaks[i].intensity, naive.peaks[i].intensity);
+          }
+          if (ratio < 1.0) {
+            EXPECT_GT(rows.multiple_peaks, 0);
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(StripeDetector, PaddedStrideAndReuseGiveTheSameResult) {
   const StripeFrame frame = Cluttered(PixelFormat::kMono8, 5);
   const int w = frame.width_px, h = frame.height_px, stride = w + 13;
