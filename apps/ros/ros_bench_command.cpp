@@ -218,7 +218,10 @@ InspectFigures DirectInspect(const RosBenchArgs& a, const fs::path& folder) {
   if (exit.exit_code != 0)
     throw Error("bench ros: inspect failed (see " + (folder / "inspect.log").string() + ")");
   const nlohmann::json r = ReadJson(json);
-  return {r["frames_received"], r["lost_frames"], r["frames_per_s"], exit.cpu_s};
+  return {.frames = r["frames_received"],
+          .lost_frames = r["lost_frames"],
+          .frames_per_s = r["frames_per_s"],
+          .cpu_s = exit.cpu_s};
 }
 
 // CPU seconds per frame of `uwscan map` on the dive: the same SLAM offline, without ROS, camera

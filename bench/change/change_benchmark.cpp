@@ -6,12 +6,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <regex>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include "bench/scratch_folder.hpp"
 #include "mapping/change/compare_surveys.hpp"
@@ -107,12 +111,14 @@ Epoch SurveyEpoch(const fs::path& scene_path, const fs::path& folder,
   return epoch;
 }
 
-// A change between the scenes: an object in one only (a disc of growth or loss), or moved.
+// A change between the scenes: an object in one only (a disc of growth or loss), moved, or
+// with part of its surface changed in place (a dent, a bolt head gone).
 struct Change {
   std::vector<scanner::sim::SceneObject> footprints;  // the object where it was and where it is
   double depth_m = 0.0;                               // a disc's thickness; 0 for a moved object
   bool growth = false;
   bool disc = false;
+  std::optional<Eigen::AlignedBox3d> part_O;  // the changed part, in the object's frame
 };
 
 bool SamePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -123,7 +129,8 @@ Change ChangeOf(const scanner::sim::SceneObject& object, bool growth) {
   Change c{.footprints = {object},
            .depth_m = 0.0,
            .growth = growth,
-           .disc = object.shape == scanner::sim::ObjectShape::kCylinder};
+           .disc = object.shape == scanner::sim::ObjectShape::kCylinder,
+           .part_O = std::nullopt};
   if (c.disc) {
     double lo = 1e300, hi = -1e300;
     for (const Eigen::Vector3d& v : object.mesh.vertices) {
@@ -133,6 +140,39 @@ Change ChangeOf(const scanner::sim::SceneObject& object, bool growth) {
     c.depth_m = hi - lo;
   }
   return c;
+}
+
+// The volume a closed mesh encloses (the divergence theorem over its triangles).
+double EnclosedVolume(const scanner::TriangleMesh& mesh) {
+  double six_volume = 0.0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    six_volume += mesh.vertices[static_cast<std::size_t>(t[0])].dot(
+        mesh.vertices[static_cast<std::size_t>(t[1])].cross(
+            mesh.vertices[static_cast<std::size_t>(t[2])]));
+  }
+  return six_volume / 6.0;
+}
+
+// An object at the same pose in both scenes whose surface changed in place: the box around the
+// vertices one mesh has and the other has not (the scenes build the two epochs' meshes alike
+// elsewhere, imr_objects.hpp); std::nullopt when the meshes are the same.
+std::optional<Change> ChangedInPlace(const scanner::sim::SceneObject& before,
+                                     const scanner::sim::SceneObject& after) {
+  const auto key = [](const Eigen::Vector3d& v) { return std::tuple(v.x(), v.y(), v.z()); };
+  std::set<std::tuple<double, double, double>> in_before, in_after;
+  for (const Eigen::Vector3d& v : before.mesh.vertices) in_before.insert(key(v));
+  for (const Eigen::Vector3d& v : after.mesh.vertices) in_after.insert(key(v));
+  Eigen::AlignedBox3d part;
+  for (const Eigen::Vector3d& v : before.mesh.vertices)
+    if (!in_after.count(key(v))) part.extend(v);
+  for (const Eigen::Vector3d& v : after.mesh.vertices)
+    if (!in_before.count(key(v))) part.extend(v);
+  if (part.isEmpty()) return std::nullopt;
+  return Change{.footprints = {after},
+                .depth_m = 0.0,
+                .growth = EnclosedVolume(after.mesh) > EnclosedVolume(before.mesh),
+                .disc = false,
+                .part_O = part};
 }
 
 std::vector<Change> ChangesBetween(const scanner::sim::Scene& before,
@@ -146,9 +186,11 @@ std::vector<Change> ChangesBetween(const scanner::sim::Scene& before,
   std::vector<Change> changes;
   for (const scanner::sim::SceneObject& o : after.objects) {
     const scanner::sim::SceneObject* old = find(before, o.name);
-    if (!old)
+    if (!old) {
       changes.push_back(ChangeOf(o, true));
-    else if (!SamePose(old->T_W_O, o.T_W_O)) {
+    } else if (SamePose(old->T_W_O, o.T_W_O)) {
+      if (std::optional<Change> part = ChangedInPlace(*old, o)) changes.push_back(*part);
+    } else {
       Change moved = ChangeOf(o, true);
       moved.disc = false;
       moved.footprints.push_back(*old);
@@ -160,11 +202,18 @@ std::vector<Change> ChangesBetween(const scanner::sim::Scene& before,
   return changes;
 }
 
-// Whether p lies on the change: within a disc's radius (and near its faces), or within an
-// object's box grown by 2 cm.
+// Whether p lies on the change: within a disc's radius (and near its faces), within a changed
+// part's box grown by 1 cm, or within an object's box grown by 2 cm.
 bool OnChange(const Change& c, const Eigen::Vector3d& p_W) {
   for (const scanner::sim::SceneObject& o : c.footprints) {
     const Eigen::Vector3d p = o.T_W_O.inverse() * p_W;
+    if (c.part_O) {
+      const Eigen::Vector3d margin = Eigen::Vector3d::Constant(0.01);
+      if ((p.array() >= (c.part_O->min() - margin).array()).all() &&
+          (p.array() <= (c.part_O->max() + margin).array()).all())
+        return true;
+      continue;
+    }
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
     for (const Eigen::Vector3d& v : o.mesh.vertices) {
       lo = lo.cwiseMin(v);
@@ -224,9 +273,10 @@ MethodFigures Judge(const std::vector<CoreDeviation>& points, const std::vector<
   f.changed_rms_error_m = changed > 0 ? std::sqrt(error2 / changed) : 0.0;
   const double false_share = unchanged > 0 ? in_region / unchanged : 0.0;
   for (std::size_t k = 0; k < changes.size(); ++k) {
-    f.changes.push_back({.name = changes[k].footprints.front().name,
-                         .points = on[k],
-                         .found = on[k] > 0 ? static_cast<double>(found[k]) / on[k] : 0.0});
+    f.changes.push_back(
+        {.name = changes[k].footprints.front().name + (changes[k].part_O ? " (surface)" : ""),
+         .points = on[k],
+         .found = on[k] > 0 ? static_cast<double>(found[k]) / on[k] : 0.0});
     if (!changes[k].disc || on[k] == 0) continue;  // never seen: not a detection to judge
     DepthFigures& depth = f.by_depth_mm[static_cast<int>(std::lround(changes[k].depth_m * 1e3))];
     depth.changes += 1;

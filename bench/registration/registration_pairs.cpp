@@ -8,6 +8,7 @@
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
+#include "scanner/common/random_draws.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 
 namespace uwscan::bench {
@@ -19,9 +20,9 @@ constexpr const char* kMeshes[] = {"anchor",  "cylinder",     "joint",         "
 Eigen::Isometry3d RandomMotion(std::mt19937_64& rng, double max_translation_m) {
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const Eigen::Vector3d axis = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+  const Eigen::Vector3d axis = DrawVector3LastFirst(gauss, rng).normalized();
   const double angle = unit(rng) * 3.14159265358979323846;
-  Eigen::Vector3d t(gauss(rng), gauss(rng), gauss(rng));
+  Eigen::Vector3d t = DrawVector3LastFirst(gauss, rng);
   t *= unit(rng) * max_translation_m / t.norm();
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
@@ -37,7 +38,7 @@ std::vector<Eigen::Vector3d> PartialView(const scanner::SurfaceSamples& surface,
   std::vector<Eigen::Vector3d> view;
   for (size_t i = 0; i < surface.points.size(); ++i) {
     if (surface.normals[i].dot(viewpoint - surface.points[i]) <= 0.0) continue;
-    view.push_back(surface.points[i] + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+    view.push_back(surface.points[i] + DrawVector3LastFirst(noise, rng));
   }
   return view;
 }
@@ -56,8 +57,7 @@ std::vector<Eigen::Vector3d> Resampled(const std::vector<Eigen::Vector3d>& point
   std::normal_distribution<double> noise(0.0, sigma_m);
   std::vector<Eigen::Vector3d> out;
   for (const Eigen::Vector3d& p : points) {
-    if (unit(rng) < keep)
-      out.push_back(T * (p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
+    if (unit(rng) < keep) out.push_back(T * (p + DrawVector3LastFirst(noise, rng)));
   }
   return out;
 }
@@ -83,7 +83,7 @@ void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOpti
       const double distance = 3.0 * o.mesh_size_m;
       for (int attempt = 0; attempt < 50 && (target.size() < 500 || source.size() < 500);
            ++attempt) {
-        const Eigen::Vector3d a = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        const Eigen::Vector3d a = DrawVector3LastFirst(gauss, rng).normalized();
         const Eigen::Vector3d b = Eigen::AngleAxisd(o.view_separation_rad, a.unitOrthogonal()) * a;
         pair.target_viewpoint = centroid + distance * a;
         pair.source_viewpoint = centroid + distance * b;

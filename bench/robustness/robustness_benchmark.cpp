@@ -23,6 +23,7 @@
 #include "scanner/common/error.hpp"
 #include "scanner/common/file_bytes.hpp"
 #include "scanner/common/option_checks.hpp"
+#include "scanner/common/random_draws.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::bench {
@@ -281,8 +282,9 @@ OriginalLog WriteOriginalLog(const fs::path& path) {
     frame.sweep = i / 100;
     mapping::GroundTruthRecord truth;
     for (int k = 0; k < 150; ++k) {
-      frame.peaks_px.emplace_back(u(rng), u(rng));
-      truth.points_W.emplace_back(u(rng) * 1e-3, u(rng) * 1e-3, 1.0);
+      frame.peaks_px.push_back(DrawVector2LastFirst(u, rng));
+      const Eigen::Vector2d xy = 1e-3 * DrawVector2LastFirst(u, rng);
+      truth.points_W.emplace_back(xy.x(), xy.y(), 1.0);
       truth.object_ids.push_back(k % 3);
     }
     writer.AppendFrame(frame, &truth);

@@ -49,8 +49,8 @@ inline Eigen::Isometry3d TestPose(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
-  T.translation() = Eigen::Vector3d(100.0 * u(rng), -50.0 * u(rng), 1e-3 * u(rng));
+  T.linear() = Eigen::Quaterniond{u(rng), u(rng), u(rng), u(rng)}.normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d{100.0 * u(rng), -50.0 * u(rng), 1e-3 * u(rng)};
   return T;
 }
 
@@ -62,7 +62,7 @@ inline FrameRecord TestFrame(std::int64_t i, int num_peaks) {
   frame.time_s = 0.1 * static_cast<double>(i) + 1.0 / 3.0;
   frame.command = static_cast<int>(i % 201) - 100;
   frame.sweep = static_cast<int>(i / 201);
-  for (int k = 0; k < num_peaks; ++k) frame.peaks_px.emplace_back(u(rng), u(rng));
+  for (int k = 0; k < num_peaks; ++k) frame.peaks_px.push_back({u(rng), u(rng)});
   if (num_peaks >= 2) {
     frame.peaks_px[0] = {-0.0, std::numeric_limits<double>::denorm_min()};
     frame.peaks_px[1] = {std::nextafter(1.0, 2.0), -1.5e300};

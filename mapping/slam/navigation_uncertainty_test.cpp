@@ -53,7 +53,7 @@ std::vector<Vector6d> FittedOffsets(const WalkingSweep& g, double walk_m_per_sqr
     std::vector<Eigen::Vector2d> walk(static_cast<size_t>(g.frames), Eigen::Vector2d::Zero());
     for (int k = 1; k < g.frames; ++k) {
       walk[static_cast<size_t>(k)] =
-          walk[static_cast<size_t>(k - 1)] + step * Eigen::Vector2d(normal(rng), normal(rng));
+          walk[static_cast<size_t>(k - 1)] + step * Eigen::Vector2d{normal(rng), normal(rng)};
     }
     const Eigen::Vector2d anchor = walk[static_cast<size_t>(g.frames / 2)];
     Eigen::Matrix3Xd placed(3, static_cast<Eigen::Index>(truth.size())), actual(3, placed.cols());

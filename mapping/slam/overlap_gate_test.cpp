@@ -50,7 +50,7 @@ TEST(MahalanobisGapToOverlap, MatchesABruteForceSearchOnRandomCases) {
     Eigen::Matrix3d A;
     for (int i = 0; i < 9; ++i) A(i) = 0.03 * normal(rng);
     const Eigen::Matrix3d C = A * A.transpose() + 1e-6 * Eigen::Matrix3d::Identity();
-    const Eigen::Vector3d gap(0.4 * normal(rng), 0.4 * normal(rng), 0.1 * normal(rng));
+    const Eigen::Vector3d gap{0.4 * normal(rng), 0.4 * normal(rng), 0.1 * normal(rng)};
     const double r = 0.1 + 0.05 * std::abs(normal(rng));
     if (gap.norm() <= r) continue;
     const double got = MahalanobisGapToOverlap(gap, r, C), reference = BruteForce(gap, r, C);

@@ -17,6 +17,7 @@
 #include "perception/cloud/pcd_reader.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/ply_reader.hpp"
+#include "scanner/common/random_draws.hpp"
 
 namespace uwscan::perception {
 namespace {
@@ -38,11 +39,11 @@ class CloudIoTest : public ::testing::Test {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<Eigen::Vector3d> points;
     for (int i = 0; i < 500; ++i)
-      points.push_back(offset + Eigen::Vector3d(u(rng), u(rng), u(rng)));
+      points.push_back(offset + Eigen::Vector3d{u(rng), u(rng), u(rng)});
     PointCloud cloud = MakeCloud(points);
     if (normals) {
       for (int i = 0; i < 500; ++i) {
-        cloud.normals.push_back(Eigen::Vector3f(u(rng), u(rng), u(rng)).normalized());
+        cloud.normals.push_back(DrawVector3(u, rng).cast<float>().normalized());
       }
     }
     return cloud;
@@ -205,7 +206,7 @@ class CloudReadersTest : public ::testing::Test {
       p.x = u(rng);
       p.y = u(rng);
       p.z = 5.0f + u(rng);
-      const Eigen::Vector3f n = Eigen::Vector3f(u(rng), u(rng), u(rng)).normalized();
+      const Eigen::Vector3f n = Eigen::Vector3f{u(rng), u(rng), u(rng)}.normalized();
       p.normal_x = n.x();
       p.normal_y = n.y();
       p.normal_z = n.z();

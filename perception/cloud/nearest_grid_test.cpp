@@ -37,7 +37,7 @@ std::vector<Eigen::Vector3f> SurfacePoints(std::mt19937& rng, int count) {
   std::normal_distribution<float> normal(0.0f, 1.0f);
   std::vector<Eigen::Vector3f> points;
   for (int i = 0; i < count; ++i) {
-    Eigen::Vector3f u(normal(rng), normal(rng), normal(rng));
+    Eigen::Vector3f u{normal(rng), normal(rng), normal(rng)};
     points.push_back(Eigen::Vector3f(0.3f, -0.1f, 1.2f) + 0.15f * u.normalized());
   }
   points.emplace_back(0.9f, 0.9f, 0.9f);
@@ -55,9 +55,9 @@ TEST(NearestGrid, FindsWhatBruteForceFindsAtEveryRadiusWithAndWithoutAGate) {
   for (int i = 0; i < 20000; ++i) {
     // Half near the surface (an ICP near convergence), half anywhere around it.
     const Eigen::Vector3f q = i % 2 == 0 ? points[static_cast<std::size_t>(i) % points.size()] +
-                                               Eigen::Vector3f(off(rng), off(rng), off(rng))
+                                               Eigen::Vector3f{off(rng), off(rng), off(rng)}
                                          : Eigen::Vector3f(0.3f, -0.1f, 1.2f) +
-                                               Eigen::Vector3f(box(rng), box(rng), box(rng));
+                                               Eigen::Vector3f{box(rng), box(rng), box(rng)};
     for (float radius : {0.02f, 0.01f, 0.0075f, 0.003f}) {
       const float radius_sq = radius * radius;
       const auto all = [](std::size_t) { return true; };
@@ -117,7 +117,7 @@ TEST(NearestGrid, AWideCloudGetsWiderCellsAndStaysExact) {
   const auto all = [](std::size_t) { return true; };
   std::normal_distribution<float> off(0.0f, 0.001f);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3f q = points[i] + Eigen::Vector3f(off(rng), off(rng), off(rng));
+    const Eigen::Vector3f q = points[i] + Eigen::Vector3f{off(rng), off(rng), off(rng)};
     ASSERT_EQ(grid.Nearest(q, 4e-6f, all), BruteNearest(points, q, 4e-6f, all)) << "point " << i;
   }
 }

@@ -18,7 +18,7 @@ TEST(Diameter, ExactBelowTheCapAndNeverAboveTheTruthBeyondIt) {
   PointCloud box;
   box.origin = Eigen::Vector3d(1e5, -2e5, 30.0);  // far from the origin: offsets stay small
   for (int i = 0; i < 3000; ++i)
-    box.points.emplace_back(0.3f * u(rng), 0.2f * u(rng), 0.1f * u(rng));
+    box.points.push_back({0.3f * u(rng), 0.2f * u(rng), 0.1f * u(rng)});
   box.points.emplace_back(0.0f, 0.0f, 0.0f);
   box.points.emplace_back(0.3f, 0.2f, 0.1f);
   const double truth = std::sqrt(0.09 + 0.04 + 0.01);

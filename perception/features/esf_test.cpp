@@ -55,7 +55,7 @@ std::vector<Eigen::Vector3d> SampleShape(Shape shape, int n, std::uint64_t seed,
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     switch (shape) {
       case Shape::kSphere: {  // radius 0.15 m
-        p = 0.15 * Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+        p = 0.15 * Eigen::Vector3d{g(rng), g(rng), g(rng)}.normalized();
         break;
       }
       case Shape::kBox: {  // 0.4 x 0.25 x 0.1 m, faces chosen by area
@@ -63,7 +63,7 @@ std::vector<Eigen::Vector3d> SampleShape(Shape shape, int n, std::uint64_t seed,
         const Eigen::Vector3d areas(size.y() * size.z(), size.x() * size.z(), size.x() * size.y());
         const double pick = u(rng) * areas.sum();
         const int axis = pick < areas.x() ? 0 : (pick < areas.x() + areas.y() ? 1 : 2);
-        p = Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5).cwiseProduct(size);
+        p = Eigen::Vector3d{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5}.cwiseProduct(size);
         p[axis] = (u(rng) < 0.5 ? -0.5 : 0.5) * size[axis];
         break;
       }
@@ -81,7 +81,7 @@ std::vector<Eigen::Vector3d> SampleShape(Shape shape, int n, std::uint64_t seed,
         break;
       }
       case Shape::kPlanePatch: {  // 0.4 x 0.3 m
-        p = Eigen::Vector3d(0.4 * (u(rng) - 0.5), 0.3 * (u(rng) - 0.5), 0.0);
+        p = Eigen::Vector3d{0.4 * (u(rng) - 0.5), 0.3 * (u(rng) - 0.5), 0.0};
         break;
       }
     }
@@ -224,7 +224,7 @@ TEST(EsfTest, RotationChangesItNoMoreThanPcls) {
     const EsfDescriptor reference = Esf(cloud, 1);
     const double noise = Chi2(reference, Esf(cloud, 2));
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+    T.linear() = Eigen::Quaterniond{g(rng), g(rng), g(rng), g(rng)}.normalized().toRotationMatrix();
     T.translation() = Eigen::Vector3d(1e6, 2e6, -5e5);
     const PointCloud moved = Transformed(cloud, T);
     const double ours = Chi2(reference, Esf(moved, 1));

@@ -33,7 +33,7 @@ PointCloud MakeSurface(const Eigen::Vector3d& offset, std::uint64_t seed) {
                               : face == 2 ? Eigen::Vector3d(0.05, a, 0.03 + b)
                               : face == 3 ? Eigen::Vector3d(a, -0.05, 0.03 + b)
                                           : Eigen::Vector3d(a, 0.05, 0.03 + b);
-    points.push_back(p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+    points.push_back(p + Eigen::Vector3d{noise(rng), noise(rng), noise(rng)});
   }
   for (Eigen::Vector3d& p : points) p += offset;
   const PointCloud cloud = MakeCloud(points);

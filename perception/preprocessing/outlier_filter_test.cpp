@@ -23,7 +23,7 @@ PointCloud PlaneWithOutliers(int outliers, std::vector<std::size_t>* outlier_ind
   }
   for (int o = 0; o < outliers; ++o) {
     outlier_indices->push_back(points.size());
-    points.emplace_back(u(rng), u(rng), 0.2 + 0.3 * u(rng));
+    points.push_back({u(rng), u(rng), 0.2 + 0.3 * u(rng)});
   }
   return MakeCloud(points);
 }

@@ -23,7 +23,7 @@ struct BoxScene {
 BoxScene MakeBoxScene(const Eigen::Vector3d& offset) {
   std::mt19937_64 rng(11);
   std::normal_distribution<double> noise(0.0, 0.001);
-  auto jitter = [&] { return Eigen::Vector3d(noise(rng), noise(rng), noise(rng)); };
+  auto jitter = [&] { return Eigen::Vector3d{noise(rng), noise(rng), noise(rng)}; };
   BoxScene scene;
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < 100; ++i) {

@@ -18,7 +18,7 @@ std::vector<Eigen::Vector3d> CapPoints(const Eigen::Vector3d& centre, double rad
   std::normal_distribution<double> noise(0.0, noise_m);
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3d dir = Eigen::Vector3d(angle(rng), angle(rng), -1.5).normalized();
+    const Eigen::Vector3d dir = Eigen::Vector3d{angle(rng), angle(rng), -1.5}.normalized();
     points.push_back(centre + (radius + (noise_m > 0 ? noise(rng) : 0.0)) * dir);
   }
   return points;

@@ -30,7 +30,7 @@ GridScene MakeGridScene(const Eigen::Vector3d& corner) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         const int count = 1 + (i + j + k) % 3;
         for (int c = 0; c < count; ++c) {
-          const Eigen::Vector3d p = centre + Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+          const Eigen::Vector3d p = centre + Eigen::Vector3d{jitter(rng), jitter(rng), jitter(rng)};
           scene.points.push_back(p);
           sum += p;
         }

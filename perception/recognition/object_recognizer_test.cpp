@@ -375,7 +375,7 @@ TEST(ObjectPoseSearch, TheBoltsPhaseIsFound) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3f> normals;
   for (std::size_t i = 0; i < flange->model.size(); i += 3) {
-    points.push_back(flange->model.Point(i) + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+    points.push_back(flange->model.Point(i) + Eigen::Vector3d{noise(rng), noise(rng), noise(rng)});
     normals.push_back(flange->model.normals[i]);
   }
   PointCloud sample = MakeCloud(points);

@@ -21,8 +21,8 @@ PointCloud LShape() {
   for (int i = 0; i < 400; ++i) {
     const bool long_arm = i % 3 != 0;
     const Eigen::Vector3d p = long_arm
-                                  ? Eigen::Vector3d(0.3 * u(rng), 0.02 * u(rng), 0.01 * u(rng))
-                                  : Eigen::Vector3d(0.02 * u(rng), 0.12 * u(rng), 0.01 * u(rng));
+                                  ? Eigen::Vector3d{0.3 * u(rng), 0.02 * u(rng), 0.01 * u(rng)}
+                                  : Eigen::Vector3d{0.02 * u(rng), 0.12 * u(rng), 0.01 * u(rng)};
     cloud.points.push_back(p.cast<float>());
   }
   return cloud;

@@ -65,7 +65,7 @@ Problem MakeProblem(int true_pairs, int false_pairs, std::uint64_t seed,
   problem.truth = Eigen::Translation3d(target_origin) * KnownMotion();
   std::vector<Eigen::Vector3d> target_points;
   for (int i = 0; i < 1500; ++i)
-    target_points.push_back(target_origin + Eigen::Vector3d(box(rng), box(rng), box(rng)));
+    target_points.push_back(target_origin + Eigen::Vector3d{box(rng), box(rng), box(rng)});
   problem.target = MakeCloud(target_points);
   std::vector<std::size_t> order(target_points.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -80,15 +80,15 @@ Problem MakeProblem(int true_pairs, int false_pairs, std::uint64_t seed,
     const std::size_t target_index = problem.target_features.indices[static_cast<std::size_t>(k)];
     const bool true_pair = k < true_pairs;
     Eigen::Vector3d p = true_pair ? T_source_target * target_points[target_index]
-                                  : Eigen::Vector3d(box(rng), box(rng), box(rng));
+                                  : Eigen::Vector3d{box(rng), box(rng), box(rng)};
     if (position_sigma_m > 0.0)
-      p += position_sigma_m * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+      p += position_sigma_m * Eigen::Vector3d{noise(rng), noise(rng), noise(rng)};
     source_points.push_back(p);
     problem.source_features.descriptors.push_back(
         Perturbed(problem.target_features.descriptors[static_cast<std::size_t>(k)], 0.5f, rng));
   }
   // Unmatched source points around them, so feature indices are not 0..n-1.
-  for (int i = 0; i < 300; ++i) source_points.emplace_back(box(rng), box(rng), box(rng));
+  for (int i = 0; i < 300; ++i) source_points.push_back({box(rng), box(rng), box(rng)});
   std::vector<std::size_t> source_order(source_points.size());
   std::iota(source_order.begin(), source_order.end(), std::size_t{0});
   std::shuffle(source_order.begin(), source_order.end(), rng);

@@ -55,7 +55,7 @@ PointCloud BumpySurface(int n, std::uint64_t seed, double x_min = -0.25, double 
     const double x = ux(rng), y = uy(rng);
     Eigen::Vector2d g;
     Eigen::Vector3d p(x, y, Height(x, y, &g));
-    if (sigma_m > 0.0) p += sigma_m * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    if (sigma_m > 0.0) p += sigma_m * Eigen::Vector3d{noise(rng), noise(rng), noise(rng)};
     cloud.points.push_back(p.cast<float>());
     cloud.normals.push_back(Eigen::Vector3d(-g.x(), -g.y(), 1.0).normalized().cast<float>());
   }
@@ -72,7 +72,7 @@ PointCloud SubsetWithNoise(const PointCloud& target, double x_min, double sigma_
   out.origin = target.origin;
   for (const Eigen::Vector3f& p : target.points) {
     if (p.x() <= x_min) continue;
-    const Eigen::Vector3d n(noise(rng), noise(rng), noise(rng));
+    const Eigen::Vector3d n{noise(rng), noise(rng), noise(rng)};
     out.points.push_back(p + n.cast<float>());
   }
   return out;
@@ -323,7 +323,8 @@ TEST(IcpSinglePlane, InformationShowsTheThreeUnconstrainedDirections) {
   target.origin = Eigen::Vector3d(0.5, 0.2, -0.1);
   for (int i = 0; i < 3000; ++i) {
     // The plane passes 0.4 m from the origin, so the rotation-translation coupling is tested.
-    const Eigen::Vector3d p = 0.4 * normal + uniform(rng) * u + uniform(rng) * w;
+    const double along_u = uniform(rng), along_w = uniform(rng);
+    const Eigen::Vector3d p = 0.4 * normal + along_u * u + along_w * w;
     target.points.push_back(p.cast<float>());
     target.normals.push_back(normal.cast<float>());
   }
@@ -363,7 +364,7 @@ TEST(IcpSinglePlane, APriorDecidesTheDirectionsThePlaneLeavesFree) {
   std::uniform_real_distribution<double> uniform(-0.3, 0.3);
   PointCloud target;
   for (int i = 0; i < 3000; ++i) {
-    target.points.emplace_back(float(uniform(rng)), float(uniform(rng)), 0.4f);
+    target.points.push_back({float(uniform(rng)), float(uniform(rng)), 0.4f});
     target.normals.emplace_back(0.0f, 0.0f, 1.0f);
   }
   PointCloud source = target;

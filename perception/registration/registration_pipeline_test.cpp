@@ -33,7 +33,7 @@ PointCloud RangeView(const scanner::SurfaceSamples& surface, const Eigen::Vector
   std::vector<Eigen::Vector3d> seen;
   for (std::size_t i = 0; i < surface.points.size(); ++i) {
     if (surface.normals[i].dot(viewpoint - surface.points[i]) <= 0.0) continue;
-    seen.push_back(surface.points[i] + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+    seen.push_back(surface.points[i] + Eigen::Vector3d{noise(rng), noise(rng), noise(rng)});
   }
   return MakeCloud(seen);
 }

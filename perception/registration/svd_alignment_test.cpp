@@ -15,13 +15,13 @@ namespace {
 
 Eigen::Vector3d RandomVector(std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  return Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+  return Eigen::Vector3d{normal(rng), normal(rng), normal(rng)};
 }
 
 Eigen::Isometry3d RandomPose(std::mt19937_64& rng, double translation_scale_m) {
   std::normal_distribution<double> normal(0.0, 1.0);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+  T.linear() = Eigen::Quaterniond{normal(rng), normal(rng), normal(rng), normal(rng)}
                    .normalized()
                    .toRotationMatrix();
   T.translation() = translation_scale_m * RandomVector(rng);
@@ -64,7 +64,7 @@ TEST(SvdAlignment, CoplanarPointsAreEnough) {
     const Eigen::Isometry3d plane = RandomPose(rng, 1.0);
     std::vector<Eigen::Vector3d> source;
     for (int i = 0; i < 3 + trial % 10; ++i) {
-      source.push_back(plane * Eigen::Vector3d(uniform(rng), uniform(rng), 0.0));
+      source.push_back(plane * Eigen::Vector3d{uniform(rng), uniform(rng), 0.0});
     }
     const SvdAlignment fit = AlignSvd(source, Moved(truth, source));
     ASSERT_EQ(fit.status, SvdAlignmentStatus::kSuccess) << "trial " << trial;
@@ -118,7 +118,7 @@ TEST(SvdAlignment, ReflectionOfCoplanarPointsIsARotation) {
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   std::vector<Eigen::Vector3d> source, target;
   for (int i = 0; i < 8; ++i) {
-    source.emplace_back(uniform(rng), uniform(rng), 0.0);
+    source.push_back({uniform(rng), uniform(rng), 0.0});
     target.emplace_back(-source.back().x(), source.back().y(), 0.0);
   }
   const SvdAlignment fit = AlignSvd(source, target);

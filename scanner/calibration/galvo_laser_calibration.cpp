@@ -48,14 +48,21 @@ struct StepFan {
 
   template <typename U>
   StepFan<U> Cast() const {
-    return {origin.template cast<U>(), central.template cast<U>(), spread.template cast<U>(),
-            mirror_normal.template cast<U>(), U(mirror_offset)};
+    return {.origin = origin.template cast<U>(),
+            .central = central.template cast<U>(),
+            .spread = spread.template cast<U>(),
+            .mirror_normal = mirror_normal.template cast<U>(),
+            .mirror_offset = U(mirror_offset)};
   }
   StepFan<double> Values() const {
     const auto v = [](const Vec3<T>& x) {
       return Vec3<double>(Value(x[0]), Value(x[1]), Value(x[2]));
     };
-    return {v(origin), v(central), v(spread), v(mirror_normal), Value(mirror_offset)};
+    return {.origin = v(origin),
+            .central = v(central),
+            .spread = v(spread),
+            .mirror_normal = v(mirror_normal),
+            .mirror_offset = Value(mirror_offset)};
   }
 };
 

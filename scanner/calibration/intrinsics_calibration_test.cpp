@@ -49,7 +49,7 @@ std::vector<PatternObservation> MakeViews(const PinholeCamera& camera, const Pat
                          .toRotationMatrix();
     const double depth = 0.725 + 0.275 * unit(rng);
     const std::optional<Eigen::Vector3d> ray = camera.BackProject(
-        Eigen::Vector2d(1023.5 + 0.85 * 1024.0 * unit(rng), 543.5 + 0.85 * 544.0 * unit(rng)));
+        Eigen::Vector2d{1023.5 + 0.85 * 1024.0 * unit(rng), 543.5 + 0.85 * 544.0 * unit(rng)});
     if (!ray) continue;
     T_C_O.translation() = (depth / ray->z()) * *ray - T_C_O.linear() * centre_O;
     PatternObservation observation;
@@ -63,7 +63,7 @@ std::vector<PatternObservation> MakeViews(const PinholeCamera& camera, const Pat
         break;
       }
       observation.corner_ids.push_back(static_cast<int>(id));
-      observation.corners_px.push_back(uv + sigma_px * Eigen::Vector2d(noise(rng), noise(rng)));
+      observation.corners_px.push_back(uv + sigma_px * Eigen::Vector2d{noise(rng), noise(rng)});
     }
     if (!inside) continue;
     observations.push_back(std::move(observation));

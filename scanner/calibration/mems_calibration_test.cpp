@@ -48,7 +48,7 @@ Dataset MakeDataset(const MemsScannerModel& truth, double noise_px, double volts
         if (!px || !truth.camera.camera.InImage(*px)) continue;
         DotObservation dot;
         dot.volts = volts * volts_scale;
-        dot.dot_px = *px + (noise_px > 0 ? Eigen::Vector2d(noise(rng), noise(rng))
+        dot.dot_px = *px + (noise_px > 0 ? Eigen::Vector2d{noise(rng), noise(rng)}
                                          : Eigen::Vector2d::Zero());
         d.dots.back().push_back(dot);
       }

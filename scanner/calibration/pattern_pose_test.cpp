@@ -72,7 +72,7 @@ std::optional<PatternObservation> Observe(const RefractiveCamera& camera, const 
     const std::optional<Eigen::Vector2d> uv = camera.ProjectPointInWater(T_C_O * points_O[id]);
     if (!uv || !camera.camera.InImage(*uv)) return std::nullopt;
     Eigen::Vector2d jitter = Eigen::Vector2d::Zero();
-    if (sigma_px > 0.0) jitter = Eigen::Vector2d(noise(rng), noise(rng));
+    if (sigma_px > 0.0) jitter = Eigen::Vector2d{noise(rng), noise(rng)};
     observation.corner_ids.push_back(static_cast<int>(id));
     observation.corners_px.push_back(*uv + jitter);
   }
@@ -91,7 +91,7 @@ TEST(ProjectThroughViewport, AgreesWithProjectPointInWater) {
   double worst_px = 0.0;
   for (int i = 0; i < 2000; ++i) {
     // Points seen anywhere in the image (corners included), 0.1 to 3 m beyond the port.
-    const Eigen::Vector2d pixel(1023.5 + 1024.0 * unit(rng), 543.5 + 544.0 * unit(rng));
+    const Eigen::Vector2d pixel{1023.5 + 1024.0 * unit(rng), 543.5 + 544.0 * unit(rng)};
     const RayTrace ray = camera.PixelToRayInWater(pixel);
     ASSERT_TRUE(ray.ok());
     const Eigen::Vector3d p = ray.ray.At(1.55 + 1.45 * unit(rng));
@@ -162,10 +162,11 @@ void ExpectExactPose(const RefractiveCamera& camera, const char* label) {
   double worst_rad = 0.0;
   int max_iterations = 0;
   while (tested < 30) {
-    const Eigen::Vector2d centre(1024.0 + 600.0 * unit(rng), 544.0 + 300.0 * unit(rng));
+    const Eigen::Vector2d centre{1024.0 + 600.0 * unit(rng), 544.0 + 300.0 * unit(rng)};
+    const double distance_m = 0.9 + 0.6 * unit(rng);
+    const double tilt_a = 40.0 * kDeg * unit(rng), tilt_b = 40.0 * kDeg * unit(rng);
     const Eigen::Isometry3d truth =
-        PoseSeenAt(camera, spec, centre, 0.9 + 0.6 * unit(rng), 40.0 * kDeg * unit(rng),
-                   40.0 * kDeg * unit(rng), std::numbers::pi * unit(rng));
+        PoseSeenAt(camera, spec, centre, distance_m, tilt_a, tilt_b, std::numbers::pi * unit(rng));
     const std::optional<PatternObservation> observation = Observe(camera, spec, truth, 0.0, rng);
     if (!observation) continue;
     ++tested;

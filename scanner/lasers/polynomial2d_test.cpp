@@ -60,7 +60,7 @@ TEST(Polynomial2d, RecoversAKnownDegree5PolynomialExactly) {
   std::uniform_real_distribution<double> volts(-10.0, 10.0);
   double worst = 0.0;
   for (int k = 0; k < 2000; ++k) {
-    const Eigen::Vector2d v(volts(rng), volts(rng));
+    const Eigen::Vector2d v{volts(rng), volts(rng)};
     worst = std::max(worst, std::abs(f(v) - Known(v)));
   }
   // Values reach ~40 here; exact recovery up to rounding.
@@ -90,7 +90,7 @@ TEST(Polynomial2d, VoltsAndMillivoltsGiveTheSameValues) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-10.0, 10.0);
   for (int k = 0; k < 500; ++k) {
-    const Eigen::Vector2d v(u(rng), u(rng));
+    const Eigen::Vector2d v{u(rng), u(rng)};
     const double a = f_v(v), b = f_mv(1000.0 * v);
     EXPECT_NEAR(a, b, 1e-12 * std::max(1.0, std::abs(a))) << v.transpose();
   }
@@ -121,8 +121,8 @@ TEST(Polynomial2d, UnevenButSpreadDataStayWellConditioned) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> narrow(-0.1, 0.1), wide(-10.0, 10.0);
   std::vector<Eigen::Vector2d> x;
-  for (int k = 0; k < 950; ++k) x.emplace_back(narrow(rng), narrow(rng));
-  for (int k = 0; k < 50; ++k) x.emplace_back(wide(rng), wide(rng));
+  for (int k = 0; k < 950; ++k) x.push_back({narrow(rng), narrow(rng)});
+  for (int k = 0; k < 50; ++k) x.push_back({wide(rng), wide(rng)});
   const Polynomial2d f = Polynomial2d::Fit(x, Values(x), 5);
   for (const Eigen::Vector2d& v : Grid(7, -10.0, 10.0)) EXPECT_NEAR(f(v), Known(v), 1e-9);
 }
@@ -134,7 +134,7 @@ TEST(Polynomial2d, ClusteredInputsFailClearly) {
   std::vector<Eigen::Vector2d> clumps;
   for (const Eigen::Vector2d& c : {Eigen::Vector2d(-5, -5), Eigen::Vector2d(5, -5),
                                    Eigen::Vector2d(-5, 5), Eigen::Vector2d(5, 5)}) {
-    for (int k = 0; k < 50; ++k) clumps.push_back(c + Eigen::Vector2d(jitter(rng), jitter(rng)));
+    for (int k = 0; k < 50; ++k) clumps.push_back(c + Eigen::Vector2d{jitter(rng), jitter(rng)});
   }
   const std::string clumped = FitError(clumps, Values(clumps), 5);
   EXPECT_NE(clumped.find("condition number"), std::string::npos) << clumped;

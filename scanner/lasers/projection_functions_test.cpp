@@ -33,7 +33,7 @@ RayErrors CompareRays(const MemsLaser& laser, const ProjectionFunctions& f, doub
   std::uniform_real_distribution<double> volts(-laser.max_volts, laser.max_volts);
   RayErrors e;
   for (int k = 0; k < count; ++k) {
-    const Eigen::Vector2d v(volts(rng), volts(rng));
+    const Eigen::Vector2d v{volts(rng), volts(rng)};
     const RayTrace truth = laser.RayInWater(v), fitted = f.RayInWater_C(v);
     EXPECT_TRUE(truth.ok() && fitted.ok());
     const double d = (AtDepth(truth.ray, z_m) - AtDepth(fitted.ray, z_m)).norm();
@@ -157,7 +157,7 @@ TEST(ProjectionFunctions, MillivoltCalibrationGivesTheSameRays) {
   std::mt19937_64 rng(23);
   std::uniform_real_distribution<double> u(-10.0, 10.0);
   for (int k = 0; k < 500; ++k) {
-    const Eigen::Vector2d v(u(rng), u(rng));
+    const Eigen::Vector2d v{u(rng), u(rng)};
     const Ray a = f_v.RayInWater_C(v).ray, b = f_mv.RayInWater_C(1000.0 * v).ray;
     EXPECT_LT((a.origin - b.origin).norm(), 1e-12 * a.origin.norm());
     EXPECT_LT((a.direction - b.direction).norm(), 1e-12);

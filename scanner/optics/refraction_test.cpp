@@ -21,7 +21,7 @@ constexpr double kWater = 1.33;
 
 Eigen::Vector3d RandomUnit(std::mt19937& rng) {
   std::normal_distribution<double> gauss;
-  return Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+  return Eigen::Vector3d{gauss(rng), gauss(rng), gauss(rng)}.normalized();
 }
 
 double SinToNormal(const Eigen::Vector3d& d, const Eigen::Vector3d& n) { return d.cross(n).norm(); }

@@ -213,10 +213,57 @@ void PipeShape::Check() const {
   const OptionChecks check("PipeShape");
   CheckPipeSection(check, outer_radius_m, wall_m);
   check.Positive("length_m", length_m, "m");
+  check.NonNegative("dent_radius_m", dent_radius_m, "m");
+  if (dent_radius_m == 0.0) return;
+  check.Require(dent_radius_m < kPi * outer_radius_m, "dent_radius_m",
+                "< pi x outer_radius_m (" + Num(kPi * outer_radius_m) + " m)", dent_radius_m);
+  check.NonNegative("dent_depth_m", dent_depth_m, "m");
+  check.Require(dent_depth_m < wall_m, "dent_depth_m", "< wall_m (" + Num(wall_m) + " m)",
+                dent_depth_m);
+  check.Finite("dent_angle_rad", dent_angle_rad);
+  check.Require(std::abs(dent_position_m) + dent_radius_m < 0.5 * length_m, "dent_position_m",
+                "the dent within the pipe (|position| + radius < " + Num(0.5 * length_m) + " m)",
+                dent_position_m);
 }
+
+namespace {
+
+// How deep the dent is at a point of the outer wall (its angle about z_O and its z).
+double DentDepth(const PipeShape& shape, double angle_rad, double z_m) {
+  const double turn = std::remainder(angle_rad - shape.dent_angle_rad, 2.0 * kPi);
+  const double s = std::hypot(shape.outer_radius_m * turn, z_m - shape.dent_position_m);
+  if (s >= shape.dent_radius_m) return 0.0;
+  return shape.dent_depth_m * 0.5 * (1.0 + std::cos(kPi * s / shape.dent_radius_m));
+}
+
+// The outer wall of a dented pipe: rings and segments at most an eighth of the dent's radius
+// apart (the whole wall, so that an undented epoch has the same vertices), then the wall's
+// vertices pressed in.
+TriangleMesh MakeDentedPipe(const PipeShape& shape, double chord_error_m) {
+  const double ro = shape.outer_radius_m, ri = ro - shape.wall_m, h = 0.5 * shape.length_m;
+  const double step = shape.dent_radius_m / 8.0;
+  const int rings = static_cast<int>(std::ceil(shape.length_m / step));
+  std::vector<Eigen::Vector2d> profile = {{ri, -h}};
+  for (int k = 0; k <= rings; ++k) profile.emplace_back(ro, -h + shape.length_m * k / rings);
+  profile.emplace_back(ri, h);
+  const int around = std::max(CircleSegments(ro, chord_error_m),
+                              static_cast<int>(std::ceil(2.0 * kPi * ro / step / 4.0)) * 4);
+  TriangleMesh mesh;
+  AddRevolution(&mesh, profile, around);
+  for (Eigen::Vector3d& v : mesh.vertices) {
+    const double r = v.head<2>().norm();
+    if (std::abs(r - ro) > 1e-12 * ro) continue;  // the inner wall
+    const double depth = DentDepth(shape, std::atan2(v.y(), v.x()), v.z());
+    v.head<2>() *= (ro - depth) / r;
+  }
+  return mesh;
+}
+
+}  // namespace
 
 TriangleMesh MakePipe(const PipeShape& shape, double chord_error_m) {
   shape.Check();
+  if (shape.dent_radius_m > 0.0) return MakeDentedPipe(shape, chord_error_m);
   const double ro = shape.outer_radius_m, ri = ro - shape.wall_m, h = 0.5 * shape.length_m;
   TriangleMesh mesh;
   AddRevolution(&mesh, {{ri, -h}, {ro, -h}, {ro, h}, {ri, h}}, CircleSegments(ro, chord_error_m));
@@ -325,6 +372,13 @@ void FlangeShape::Check() const {
                 "heads of radius " + Num(bolt_head_radius_m) +
                     " m that do not overlap on a bolt circle of radius " + Num(circle) + " m",
                 bolts);
+  for (std::size_t i = 0; i < missing_bolts.size(); ++i) {
+    const int k = missing_bolts[i];
+    check.Require(k >= 0 && k < bolts, "missing_bolts[" + std::to_string(i) + "]",
+                  "a bolt's index in [0, " + std::to_string(bolts) + ")", k);
+    check.Require(std::count(missing_bolts.begin(), missing_bolts.end(), k) == 1,
+                  "missing_bolts[" + std::to_string(i) + "]", "each bolt once", k);
+  }
 }
 
 TriangleMesh MakeFlange(const FlangeShape& shape, double chord_error_m) {
@@ -339,6 +393,7 @@ TriangleMesh MakeFlange(const FlangeShape& shape, double chord_error_m) {
   const TriangleMesh head = Prism(shape.bolt_head_radius_m, length, 6);
   const double circle = 0.5 * (ro + rf);
   for (int k = 0; k < shape.bolts; ++k) {
+    if (std::count(shape.missing_bolts.begin(), shape.missing_bolts.end(), k) > 0) continue;
     const double angle = 2.0 * kPi * (k + 0.5) / shape.bolts;
     Append(&mesh, head,
            Placed(Eigen::Matrix3d::Identity(),

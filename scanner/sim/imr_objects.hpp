@@ -17,6 +17,7 @@
 // default 0.1 mm gives 72 segments at 0.1 m radius.
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "scanner/common/triangle_mesh.hpp"
 
@@ -43,11 +44,20 @@ TriangleMesh MakeCylinder(double radius_m, double length_m,
 TriangleMesh MakeUvSphere(double radius_m, double chord_error_m = kDefaultChordErrorM);
 
 // Straight pipe along z_O, centred on {O}: outer and inner cylinders and annular ends.
+// Optionally a dent pressed into the outer wall (a change for `uwscan compare` to find): a smooth
+// round hollow, dent_depth_m deep at its centre, falling to nothing at dent_radius_m from it
+// along the surface (depth * (1 + cos(pi s / radius)) / 2 at distance s), centred at
+// dent_angle_rad about z_O from x_O and dent_position_m along z_O. A dent radius with depth 0
+// builds the same vertices undented, so that two epochs' meshes differ only in the dent.
 struct PipeShape {
   double outer_radius_m = 0.05;
   double wall_m = 0.005;  // (0, outer_radius_m)
   double length_m = 0.5;
-  void Check() const;  // throws uwscan::Error naming the field
+  double dent_radius_m = 0.0;    // 0: no dent; else in (0, pi * outer_radius_m), metres
+  double dent_depth_m = 0.0;     // [0, wall_m), metres
+  double dent_angle_rad = 0.0;   // finite
+  double dent_position_m = 0.0;  // the dent within the length: |position| + radius < length / 2
+  void Check() const;            // throws uwscan::Error naming the field
 };
 TriangleMesh MakePipe(const PipeShape& shape, double chord_error_m = kDefaultChordErrorM);
 
@@ -90,6 +100,9 @@ struct FlangeShape {
   int bolts = 8;                      // >= 0
   double bolt_head_radius_m = 0.009;  // across the corners of the hexagon
   double bolt_head_height_m = 0.008;
+  // Bolt heads that are not there (a change for `uwscan compare` to find): indices in
+  // [0, bolts), bolt k sitting at angle 2 pi (k + 1/2) / bolts about z_O from x_O.
+  std::vector<int> missing_bolts;
   void Check() const;
 };
 TriangleMesh MakeFlange(const FlangeShape& shape, double chord_error_m = kDefaultChordErrorM);

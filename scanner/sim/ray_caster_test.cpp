@@ -59,7 +59,7 @@ std::vector<Eigen::Vector3d> Directions(int count, double half_angle, std::uint6
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-std::tan(half_angle), std::tan(half_angle));
   std::vector<Eigen::Vector3d> out;
-  for (int i = 0; i < count; ++i) out.push_back(Eigen::Vector3d(u(rng), u(rng), 1.0).normalized());
+  for (int i = 0; i < count; ++i) out.push_back(Eigen::Vector3d{u(rng), u(rng), 1.0}.normalized());
   return out;
 }
 
@@ -88,7 +88,7 @@ TEST(RayCaster, TiltedPlaneFromAfar) {
   std::mt19937_64 rng(2);
   std::uniform_real_distribution<double> u(-0.45, 0.45);
   for (int i = 0; i < 500; ++i) {
-    const Eigen::Vector3d target = T_W_O * Eigen::Vector3d(u(rng), u(rng), 0.0);
+    const Eigen::Vector3d target = T_W_O * Eigen::Vector3d{u(rng), u(rng), 0.0};
     const std::optional<SurfaceHit> hit = caster.Cast({origin, target - origin});
     ASSERT_TRUE(hit);
     EXPECT_LE(std::abs(n.dot(hit->point_W - p0)), 1e-12);
@@ -110,7 +110,7 @@ TEST(RayCaster, SphereHitsAreExactInDouble) {
                                         Eigen::Vector3d(-2.0, 0.3, 3.5)}) {
     for (int i = 0; i < 300; ++i) {
       // Aim at points within 0.99 r of the centre across the line of sight.
-      Eigen::Vector3d offset(u(rng), u(rng), u(rng));
+      Eigen::Vector3d offset{u(rng), u(rng), u(rng)};
       offset *= 0.99 * r / std::max(1.0, offset.norm());
       const Eigen::Vector3d d = (c + offset - origin).normalized();
       const std::optional<SurfaceHit> hit = caster.Cast({origin, d});
@@ -217,7 +217,7 @@ TEST(RayCaster, DistanceToSurfaceMatchesExactFormulas) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int found = 0;
   for (int i = 0; i < 500; ++i) {
-    const Eigen::Vector3d p(u(rng), u(rng), 1.1 + 0.5 * u(rng));
+    const Eigen::Vector3d p{u(rng), u(rng), 1.1 + 0.5 * u(rng)};
     const double box = BoxDistance(T_W_O.inverse() * p, 0.5 * size);
     const double sphere = std::abs((p - centre).norm() - 0.15);
     const double expected = std::min(box, sphere);
@@ -243,7 +243,7 @@ TEST(RayCaster, CylinderMeshWithinTheChordError) {
   std::uniform_real_distribution<double> x(-0.099, 0.099), z(-0.24, 0.24);
   for (int i = 0; i < 500; ++i) {
     // Rays across the axis (which is z), from 2 m away along y.
-    const Eigen::Vector3d origin(x(rng), -2.0, 1.0 + z(rng));
+    const Eigen::Vector3d origin{x(rng), -2.0, 1.0 + z(rng)};
     const std::optional<SurfaceHit> hit = caster.Cast({origin, Eigen::Vector3d::UnitY()});
     ASSERT_TRUE(hit);
     const double radius = hit->point_W.head<2>().norm();

@@ -44,9 +44,10 @@ void RequireObjectKeys(const Context& where, const YAML::Node& node, ObjectShape
       return yaml::RequireKnownKeys(where, node,
                                     {"name", "shape", "pose", "reflectance", "file", "scale"});
     case ObjectShape::kPipe:
-      return yaml::RequireKnownKeys(where, node,
-                                    {"name", "shape", "pose", "reflectance", "chord_error_m",
-                                     "outer_radius_m", "wall_m", "length_m"});
+      return yaml::RequireKnownKeys(
+          where, node,
+          {"name", "shape", "pose", "reflectance", "chord_error_m", "outer_radius_m", "wall_m",
+           "length_m", "dent_radius_m", "dent_depth_m", "dent_angle_rad", "dent_position_m"});
     case ObjectShape::kElbow:
       return yaml::RequireKnownKeys(
           where, node,
@@ -62,7 +63,7 @@ void RequireObjectKeys(const Context& where, const YAML::Node& node, ObjectShape
           where, node,
           {"name", "shape", "pose", "reflectance", "chord_error_m", "outer_radius_m", "wall_m",
            "length_m", "flange_radius_m", "flange_thickness_m", "bolts", "bolt_head_radius_m",
-           "bolt_head_height_m"});
+           "bolt_head_height_m", "missing_bolts"});
     case ObjectShape::kValve:
       return yaml::RequireKnownKeys(
           where, node,
@@ -118,6 +119,10 @@ TriangleMesh ReadPipe(const ObjectFields& f) {
   s.outer_radius_m = f.Length("outer_radius_m", s.outer_radius_m);
   s.wall_m = f.Length("wall_m", s.wall_m);
   s.length_m = f.Length("length_m", s.length_m);
+  s.dent_radius_m = Number(f.where, f.node, "dent_radius_m", Range::kNonNegative, 0.0);
+  s.dent_depth_m = Number(f.where, f.node, "dent_depth_m", Range::kNonNegative, 0.0);
+  s.dent_angle_rad = yaml::NumberOr(f.where, f.node, "dent_angle_rad", 0.0);
+  s.dent_position_m = yaml::NumberOr(f.where, f.node, "dent_position_m", 0.0);
   return f.Built([&] { return MakePipe(s, f.chord_error_m); });
 }
 
@@ -149,6 +154,17 @@ TriangleMesh ReadFlange(const ObjectFields& f) {
   s.bolts = Integer(f.where, f.node, "bolts", 0, s.bolts);
   s.bolt_head_radius_m = f.Length("bolt_head_radius_m", s.bolt_head_radius_m);
   s.bolt_head_height_m = f.Length("bolt_head_height_m", s.bolt_head_height_m);
+  if (Has(f.node, "missing_bolts")) {
+    const YAML::Node list = f.node["missing_bolts"];
+    if (!list.IsSequence())
+      FailField(f.where, f.node, "missing_bolts", "expected a list of bolt indices");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      int k = 0;
+      if (!list[i].IsScalar() || !YAML::convert<int>::decode(list[i], k))
+        yaml::Fail(Item(yaml::Enter(f.where, "missing_bolts"), i), list[i], "expected an integer");
+      s.missing_bolts.push_back(k);
+    }
+  }
   return f.Built([&] { return MakeFlange(s, f.chord_error_m); });
 }
 

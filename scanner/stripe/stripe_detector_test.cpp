@@ -347,7 +347,8 @@ StripeFrame Cluttered(PixelFormat format, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<int> pick_u(0, o.width_px - 1), pick_v(0, o.height_px - 1);
   for (int k = 0; k < 200; ++k) {
-    const size_t i = static_cast<size_t>(pick_v(rng)) * o.width_px + pick_u(rng);
+    const size_t v = static_cast<size_t>(pick_v(rng));
+    const size_t i = v * o.width_px + pick_u(rng);
     if (format == PixelFormat::kMono8) {
       frame.mono8[i] = static_cast<std::uint8_t>(k % 2 ? 255 : 0);
     } else {

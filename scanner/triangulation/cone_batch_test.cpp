@@ -15,9 +15,9 @@ EllipticCone RandomCone(std::mt19937_64& rng, double b) {
   EllipticCone cone;
   cone.T_C_Q.linear() =
       Eigen::AngleAxisd(3.0 * unit(rng),
-                        Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized())
+                        Eigen::Vector3d{unit(rng), unit(rng), unit(rng)}.normalized())
           .toRotationMatrix();
-  cone.T_C_Q.translation() = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+  cone.T_C_Q.translation() = Eigen::Vector3d{unit(rng), unit(rng), unit(rng)};
   cone.a = 0.2 + std::abs(unit(rng));
   cone.b = b;
   cone.beta_min_rad = 0.3;
@@ -35,14 +35,14 @@ void ExpectBlockMatchesPerRay(const EllipticCone& cone, std::mt19937_64& rng, in
     Ray per_ray[RayBlock::kSize];
     for (size_t lane = 0; lane < RayBlock::kSize; ++lane) {
       Ray ray;
-      ray.origin = 2.0 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+      ray.origin = 2.0 * Eigen::Vector3d{unit(rng), unit(rng), unit(rng)};
       // Aim half of the rays at points of the cone so that hits are common.
       if (lane % 2 == 0) {
-        const Eigen::Vector3d target =
-            cone.Point(0.2 + std::abs(gauss(rng)), 3.2 * std::abs(unit(rng)));
+        const double height = 0.2 + std::abs(gauss(rng));
+        const Eigen::Vector3d target = cone.Point(height, 3.2 * std::abs(unit(rng)));
         ray.direction = (target - ray.origin).normalized();
       } else {
-        ray.direction = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        ray.direction = Eigen::Vector3d{gauss(rng), gauss(rng), gauss(rng)}.normalized();
       }
       if (lane == 5) ray.origin = cone.T_C_Q.translation();  // from the apex
       if (lane == 7) ray.direction *= 3.0;                   // not unit length

@@ -23,10 +23,10 @@ Eigen::Isometry3d RandomPose(std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
   std::uniform_real_distribution<double> shift(-0.3, 0.3);
   const Eigen::Quaterniond q =
-      Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+      Eigen::Quaterniond{normal(rng), normal(rng), normal(rng), normal(rng)}.normalized();
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = q.toRotationMatrix();
-  T.translation() = Eigen::Vector3d(shift(rng), shift(rng), shift(rng));
+  T.translation() = Eigen::Vector3d{shift(rng), shift(rng), shift(rng)};
   return T;
 }
 
@@ -83,7 +83,7 @@ TEST(IntersectRayCone, HitsPointsOnConeFromOutside) {
       // Gradient of (x/a)^2 + (y/b)^2 - z^2: outward from the solid nappe.
       const Eigen::Vector3d n_Q =
           Eigen::Vector3d(p_Q.x() / (a * a), p_Q.y() / (b * b), -p_Q.z()).normalized();
-      Eigen::Vector3d tangent(normal(rng), normal(rng), normal(rng));
+      Eigen::Vector3d tangent{normal(rng), normal(rng), normal(rng)};
       tangent = (tangent - tangent.dot(n_Q) * n_Q).normalized();
       const Eigen::Vector3d w = (n_Q + 0.7 * tangent).normalized();
       const double distance_m = 0.2 + 2.8 * unit(rng);
@@ -131,7 +131,7 @@ TEST_P(NearlyFlatCone, MatchesPlaneIntersection) {
     const Eigen::Vector3d target_Q(a * u * z, 0.0, z);
     const double side = (i % 2 == 0) ? 1.0 : -1.0;
     const Eigen::Vector3d d_Q =
-        Eigen::Vector3d(0.3 * (2.0 * unit(rng) - 1.0), side, 0.3 * (2.0 * unit(rng) - 1.0))
+        Eigen::Vector3d{0.3 * (2.0 * unit(rng) - 1.0), side, 0.3 * (2.0 * unit(rng) - 1.0)}
             .normalized();
     const double distance_m = 0.5 + 1.5 * unit(rng);
     const Ray ray_C = RayFromQ(cone, target_Q - distance_m * d_Q, d_Q);
@@ -215,7 +215,7 @@ TEST(IntersectRayCone, RayThroughApexIsAMissNotNaN) {
   const EllipticCone cone = MakeCone(0.6, 0.2, RandomPose(rng));
   for (int i = 0; i < 1000; ++i) {
     // Includes directions inside the cone (through the apex into the lit nappe).
-    const Eigen::Vector3d v = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Vector3d v = Eigen::Vector3d{normal(rng), normal(rng), normal(rng)}.normalized();
     const RayHit through = Intersect(cone, -0.8 * v, v);
     EXPECT_TRUE(through.status == HitStatus::kOutsideSurface ||
                 through.status == HitStatus::kNoIntersection)
@@ -397,13 +397,14 @@ TEST(IntersectRayCone, RandomRaysAgreeWithLongDoubleReference) {
   int compared = 0;
   for (int c = 0; c < 8; ++c) {
     const double b = (c % 2 == 0 ? 1.0 : -1.0) * (0.05 + 0.5 * unit(rng));
-    const EllipticCone cone = MakeCone(0.3 + unit(rng), b, RandomPose(rng), 0.4, 2.6, 0.1);
+    const double a = 0.3 + unit(rng);
+    const EllipticCone cone = MakeCone(a, b, RandomPose(rng), 0.4, 2.6, 0.1);
     const PreparedCone prepared = PrepareCone(cone);
     for (int i = 0; i < 5000; ++i) {
-      const Eigen::Vector3d o_Q(2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0,
-                                2.5 * unit(rng) - 0.5);
+      const Eigen::Vector3d o_Q{2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0,
+                                2.5 * unit(rng) - 0.5};
       const Eigen::Vector3d d_Q =
-          Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+          Eigen::Vector3d{normal(rng), normal(rng), normal(rng)}.normalized();
       const Reference ref = ReferenceIntersect(cone, o_Q, d_Q);
       if (!ref.usable) {
         continue;

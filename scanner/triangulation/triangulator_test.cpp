@@ -64,7 +64,8 @@ class TriangulationTest : public ::testing::Test {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> angle(-0.45, 0.45), depth(0.5, 1.5);
     for (int i = 0; i < 50 * count && std::ssize(*px) < count; ++i) {
-      const std::optional<Eigen::Vector3d> p = FanPoint(*model_, step, angle(rng), depth(rng));
+      const double fan_angle = angle(rng);
+      const std::optional<Eigen::Vector3d> p = FanPoint(*model_, step, fan_angle, depth(rng));
       if (!p) continue;
       const std::optional<Eigen::Vector2d> uv = model_->camera.ProjectPointInWater(*p);
       if (!uv || !model_->camera.camera.InImage(*uv)) continue;
@@ -288,7 +289,7 @@ TEST_F(TriangulationTest, CameraRayTableMatchesExactRays) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-0.5, 2047.49), v(-0.5, 1087.49);
   for (int i = 0; i < 20000; ++i) {
-    const Eigen::Vector2d px(u(rng), v(rng));
+    const Eigen::Vector2d px{u(rng), v(rng)};
     Ray table;
     ASSERT_TRUE(rays_->Lookup(px.x(), px.y(), &table));
     const RayTrace exact = model_->camera.PixelToRayInWater(px);
