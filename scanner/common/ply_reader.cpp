@@ -132,7 +132,7 @@ Header ParseHeader(const std::string& file, const std::string& name) {
     throw Error(name + ": not a PLY file (it does not start with 'ply')");
   }
   const std::size_t end = file.find("end_header", 0);
-  if (end == std::string::npos || end > kMaxHeaderBytes) {
+  if (end > kMaxHeaderBytes) {  // npos too
     throw Error(name + ": no 'end_header' in the first " + std::to_string(kMaxHeaderBytes) +
                 " bytes");
   }

@@ -14,8 +14,8 @@ YAML::Node Numbers(const double* values, Eigen::Index count) {
 
 template <typename Vector>
 YAML::Node Numbers(const Vector& v) {
-  const Eigen::VectorXd copy = v;
-  return Numbers(copy.data(), copy.size());
+  const Eigen::Ref<const Eigen::VectorXd> values = v;
+  return Numbers(values.data(), values.size());
 }
 
 Eigen::Vector2d Vector2(const Context& where, const YAML::Node& node, const std::string& key) {

@@ -37,7 +37,7 @@ void SimulationEffects::Check() const {
 }
 
 SimulationEffects RealisticImageEffects(bool underwater, SimulationEffects base) {
-  SimulationEffects e = std::move(base);
+  SimulationEffects e = base;
   e.image.on = true;
   e.image.peak_level = 220.0;
   e.beam.on = true;

@@ -253,7 +253,7 @@ std::optional<ConeParameters> QuadricStart(std::span<const Eigen::Vector3d> poin
   const Spread spread = SpreadOf(points_in_C);
   const Quadric quadric = FitQuadric(points_in_C, spread);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(quadric.M);
-  const Eigen::Vector3d lambda = eigen.eigenvalues();
+  const Eigen::Vector3d& lambda = eigen.eigenvalues();
   const std::optional<int> k_axis = ConeAxis(lambda);
   if (!k_axis) return std::nullopt;
   const Eigen::Vector3d apex_C =
