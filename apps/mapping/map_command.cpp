@@ -30,6 +30,7 @@ struct MapArgs {
   double voxel_m = 0.005;
   int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
   double max_navigation_gap_s = mapping::MapperOptions{}.max_navigation_gap_s;
+  bool whole_graph_solves = false;
   int threads = 0;
 };
 
@@ -141,6 +142,7 @@ void RunMap(const MapArgs& a) {
   options.mapper.sweeps_per_submap = a.sweeps_per_submap;
   options.mapper.threads = a.threads;
   options.mapper.max_navigation_gap_s = a.max_navigation_gap_s;
+  options.mapper.windowed_solves = !a.whole_graph_solves;
   options.table_cache = TableCache();
   const mapping::DiveLogReader log(a.log);
   // Refused before anything is mapped or written: a real log has no truth to write.
@@ -182,9 +184,9 @@ void RunMap(const MapArgs& a) {
               100.0 * m.calibration.scale_error, 1000.0 * m.calibration.misalignment_rad);
   std::printf(
       "time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, "
-      "graph %.2f s\n",
+      "graph %.2f s (%d whole solves, %d of the last submaps)\n",
       m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s,
-      m.stats.graph_s);
+      m.stats.graph_s, m.stats.whole_solves, m.stats.window_solves);
   if (m.expected_map_error_m) {
     std::printf("expected map error from the poses' uncertainty: %.2f mm RMS along the normals\n",
                 *m.expected_map_error_m * 1e3);
@@ -238,6 +240,9 @@ void AddMapCommand(CLI::App& app) {
          "(and counted)")
       ->capture_default_str()
       ->check(kPositiveNumber);
+  cmd->add_flag("--whole-graph-solves", args->whole_graph_solves,
+                "solve the whole pose graph at every loop and every few submaps, not only the last "
+                "submaps and the loop's (slower as the dive grows; the map differs little)");
   cmd->add_option("--threads", args->threads,
                   "threads (0: all cores); the output does not depend on it")
       ->check(kNonNegativeNumber);

@@ -10,6 +10,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "mapping/log/dive_simulation.hpp"
 #include "mapping/slam/map_report.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
+#include "mapping/slam/trajectory_metrics.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
@@ -116,6 +118,35 @@ TEST_F(DiveMappingTest, SameBitsForOneAndTwoThreadsAndOnlineOrOffline) {
           << "map point " << i;
     }
   }
+}
+
+// Solves of the last few submaps (and a loop's) during the dive, the whole graph at Finish: the
+// same trajectory as whole-graph solves throughout, to a fraction of its error.
+TEST_F(DiveMappingTest, WindowedSolvesMapAsWholeGraphSolvesDo) {
+  const fs::path log = Simulate(ShortScene(), "drift.db");
+  DiveMappingOptions options;
+  options.mapper.threads = 2;
+  options.table_cache = dir_ / "tables";
+  options.mapper.solve_window_submaps = 4;
+  options.mapper.solve_window_max_submaps = 8;
+  const DiveMapping windowed = MapDive(DiveLogReader(log), options);
+  options.mapper.windowed_solves = false;
+  const DiveMapping whole = MapDive(DiveLogReader(log), options);
+  EXPECT_GT(windowed.stats.window_solves, windowed.stats.whole_solves);
+  EXPECT_EQ(whole.stats.window_solves, 0);
+  ASSERT_EQ(windowed.slam.size(), whole.slam.size());
+  double largest_m = 0.0;
+  for (std::size_t i = 0; i < whole.slam.size(); ++i) {
+    largest_m =
+        std::max(largest_m,
+                 (windowed.slam[i].T_W_V.translation() - whole.slam[i].T_W_V.translation()).norm());
+  }
+  const double ate_whole = AbsoluteTrajectoryError(whole.slam, whole.truth);
+  const double ate_windowed = AbsoluteTrajectoryError(windowed.slam, windowed.truth);
+  std::printf("largest difference %.2f mm; ATE %.2f mm windowed, %.2f mm whole\n", largest_m * 1e3,
+              ate_windowed * 1e3, ate_whole * 1e3);
+  EXPECT_LT(largest_m, 0.5 * ate_whole);
+  EXPECT_LT(ate_windowed, 1.05 * ate_whole);
 }
 
 TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
@@ -433,69 +464,6 @@ TEST_F(DiveMappingTest, VersionOneLogsOpenAndMapWithAnAssumedNoise) {
   const DiveMapping m = Map(path);
   EXPECT_TRUE(m.navigation_noise_assumed);
   EXPECT_GT(m.submaps, 1);
-}
-
-TEST(PoseGraph, ACovarianceIsTheInverseOfItsOnlyPrior) {
-  PoseGraph graph;
-  const Eigen::Isometry3d T = TestPose(3);
-  graph.AddNode(T);
-  Matrix6d information = Matrix6d::Zero();
-  information.diagonal() << 1e4, 4e4, 9e4, 1e2, 4e2,
-      9e2;  // 0.01, 0.005, 0.0033 rad; 0.1, 0.05, 0.033 m
-  information(0, 3) = information(3, 0) = 50.0;
-  graph.AddPrior({0, T, information});
-  graph.Solve({});
-  const std::optional<std::vector<Matrix6d>> covariance = graph.Covariances();
-  ASSERT_TRUE(covariance.has_value());
-  EXPECT_LT(((*covariance)[0] - information.inverse()).norm(), 1e-9 * information.inverse().norm());
-}
-
-// Node 0 at the origin held by a prior, node 1 measured from it by one edge: to first order
-// node 1's [w, v] is A (e_0 + e_edge) with A = [[I, 0], [-[t]x, I]] (a turn of node 0 swings
-// node 1 about it), so its covariance is A (C_0 + C_edge) A^T.
-TEST(PoseGraph, ACovarianceCarriesThePriorAndTheEdgeAlongTheLever) {
-  const Eigen::Vector3d t(2.0, -1.0, 0.5);
-  Eigen::Isometry3d T_0_1 = Eigen::Isometry3d::Identity();
-  T_0_1.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  T_0_1.translation() = t;
-  Matrix6d prior = Matrix6d::Zero(), edge = Matrix6d::Zero();
-  prior.diagonal() << 1e4, 2e4, 3e4, 1e3, 2e3, 5e3;
-  prior(1, 4) = prior(4, 1) = 300.0;
-  edge.diagonal() << 4e4, 1e4, 2e4, 3e3, 1e3, 2e3;
-  edge(0, 5) = edge(5, 0) = -500.0;
-  PoseGraph graph;
-  graph.AddNode(Eigen::Isometry3d::Identity());
-  graph.AddNode(T_0_1);
-  graph.AddPrior({0, Eigen::Isometry3d::Identity(), prior});
-  graph.AddEdge({0, 1, T_0_1, edge, false, 3.0});
-  graph.Solve({});
-  const std::optional<std::vector<Matrix6d>> covariance = graph.Covariances();
-  ASSERT_TRUE(covariance.has_value());
-  Matrix6d A = Matrix6d::Identity();
-  A.block<3, 3>(3, 0) << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;  // -[t]x
-  const Matrix6d expected = A * (prior.inverse() + edge.inverse()) * A.transpose();
-  EXPECT_LT(((*covariance)[0] - prior.inverse()).norm(), 1e-9 * prior.inverse().norm());
-  EXPECT_LT(((*covariance)[1] - expected).norm(), 1e-9 * expected.norm())
-      << (*covariance)[1] << "\n\n"
-      << expected;
-}
-
-TEST(PoseGraph, RecoversAChainFromExactEdgesAndAPrior) {
-  PoseGraph graph;
-  std::vector<Eigen::Isometry3d> truth;
-  for (int i = 0; i < 5; ++i) truth.push_back(TestPose(10 + static_cast<std::uint64_t>(i)));
-  for (int i = 0; i < 5; ++i)
-    graph.AddNode(i == 0 ? truth[0] : TestPose(100 + static_cast<std::uint64_t>(i)));
-  graph.AddPrior({0, truth[0], Matrix6d::Identity() * 1e6});
-  for (int i = 0; i + 1 < 5; ++i) {
-    graph.AddEdge({i, i + 1,
-                   truth[static_cast<size_t>(i)].inverse() * truth[static_cast<size_t>(i) + 1],
-                   Matrix6d::Identity() * 1e4, false, 3.0});
-  }
-  EXPECT_TRUE(graph.Solve({}).converged);
-  for (int i = 0; i < 5; ++i) {
-    EXPECT_LT(PoseError(graph.pose(i), truth[static_cast<size_t>(i)]).norm(), 1e-7) << "node " << i;
-  }
 }
 
 TEST(NavigationUncertainty, OdometryLeavesDepthRollAndPitchToThePriors) {

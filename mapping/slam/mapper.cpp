@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <deque>
 
 #include "mapping/slam/mapper_impl.hpp"
@@ -72,6 +73,9 @@ void MapperOptions::Check() const {
   check.GreaterThan("loop_max_sigma_m", loop_max_sigma_m, 0.0, "m");
   check.GreaterThan("loop_max_sigma_rad", loop_max_sigma_rad, 0.0, "rad");
   check.GreaterThan("solve_every_submaps", solve_every_submaps, 0);
+  check.GreaterThan("solve_window_submaps", solve_window_submaps, 0);
+  check.AtLeast("solve_window_max_submaps", solve_window_max_submaps, solve_window_submaps);
+  check.GreaterThan("full_solve_growth", full_solve_growth, 1.0);
   check.InRange("running_solve_tolerance", running_solve_tolerance, 0.0, 1.0, Interval::kOpen);
   check.InRange("weak_direction_ratio", weak_direction_ratio, 0.0, 1.0, Interval::kOpenHigh);
   check.AtLeast("slide_sigma_m", slide_sigma_m, 0.0, "m");
@@ -224,14 +228,16 @@ Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b) const 
   return Symmetrized(covariance);
 }
 
-Matrix6d Mapper::Impl::ChainCovariance(int from, int to) const {
-  Matrix6d covariance = Matrix6d::Zero();
-  const Eigen::Isometry3d T_from_W = ScanPose(from).inverse();
-  for (int i = from + 1; i <= to; ++i) {
-    const Matrix6d ad = Adjoint(T_from_W * ScanPose(i - 1));
-    covariance += ad * increment_covariance[static_cast<size_t>(i)] * ad.transpose();
+std::vector<Matrix6d> Mapper::Impl::ChainCovariancesTo(int to, int oldest) const {
+  // C(j, to) = increment(j + 1) + Ad(T_j_j+1) C(j + 1, to) Ad(T_j_j+1)^T, C(to, to) = 0.
+  std::vector<Matrix6d> chain(static_cast<size_t>(to - oldest + 1), Matrix6d::Zero());
+  for (int j = to - 1; j >= oldest; --j) {
+    const Matrix6d ad = Adjoint(ScanPose(j).inverse() * ScanPose(j + 1));
+    chain[static_cast<size_t>(j - oldest)] =
+        increment_covariance[static_cast<size_t>(j + 1)] +
+        ad * chain[static_cast<size_t>(j + 1 - oldest)] * ad.transpose();
   }
-  return covariance;
+  return chain;
 }
 
 void Mapper::Impl::AddToGraph(Submap submap) {
@@ -330,23 +336,39 @@ void Mapper::Impl::AddNodesAndEdges(const Submap& submap, int k, const Consecuti
 
 // A solve after an accepted loop, else every solve_every_submaps submaps.
 void Mapper::Impl::CloseLoopsAndSolve(int k) {
-  const auto accepted = [this] {
-    return std::count_if(loops.begin(), loops.end(),
-                         [](const LoopClosure& l) { return l.accepted; });
-  };
-  const std::ptrdiff_t loops_before = accepted();
+  const size_t tried_before = loops.size();
   TryLoopClosures(k);
-  if (accepted() > loops_before || ++since_solve >= options.solve_every_submaps) Solve();
+  std::optional<int> oldest_loop;
+  for (size_t i = tried_before; i < loops.size(); ++i) {
+    if (loops[i].accepted) oldest_loop = std::min(oldest_loop.value_or(k), loops[i].from);
+  }
+  if (oldest_loop || ++since_solve >= options.solve_every_submaps)
+    Solve(FirstFreeSubmap(k, oldest_loop));
 }
 
-// Loop closures for submap k: the earlier submaps whose overlap with it is plausible, nearest
-// first, each registered from the predicted pose and judged (JudgeLoop); an accepted one becomes
-// an edge between the two scans.
-void Mapper::Impl::Solve(bool last) {
+// The first submap a solve after submap k frees (MapperOptions::windowed_solves); 0: the whole
+// graph.
+int Mapper::Impl::FirstFreeSubmap(int k, std::optional<int> oldest_loop) const {
+  const int submap_count = k + 1;
+  if (!options.windowed_solves || submap_count >= next_whole_solve_submaps) return 0;
+  int first = std::max(0, submap_count - options.solve_window_submaps);
+  if (oldest_loop) first = std::min(first, *oldest_loop);
+  return std::max(first, submap_count - options.solve_window_max_submaps);
+}
+
+void Mapper::Impl::Solve(int first_free_submap, bool last) {
   const Clock::time_point start = Clock::now();
   PoseGraphOptions solve;
   if (!last) solve.function_tolerance = options.running_solve_tolerance;
-  graph.Solve(solve);
+  if (first_free_submap == 0) {
+    graph.Solve(solve);
+    ++stats.whole_solves;
+    const double grown = options.full_solve_growth * static_cast<double>(submaps.size());
+    next_whole_solve_submaps = static_cast<int>(std::ceil(grown));
+  } else {
+    graph.SolveWindow(AnchorNode(first_free_submap), solve);
+    ++stats.window_solves;
+  }
   since_solve = 0;
   stats.graph_s += Since(start);
 }
@@ -413,7 +435,7 @@ void Mapper::Finish() {
   m.Drain(true);
   m.CloseSubmap();
   m.finished = true;
-  if (!m.submaps.empty()) m.Solve(/*last=*/true);
+  if (!m.submaps.empty()) m.Solve(/*first_free_submap=*/0, /*last=*/true);
 }
 
 int Mapper::submap_count() const { return static_cast<int>(impl_->submaps.size()); }

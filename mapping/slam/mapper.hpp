@@ -65,7 +65,17 @@ struct MapperOptions {
   double loop_max_sigma_m = 0.01;     // registration std along any kept direction
   double loop_max_sigma_rad = 0.005;  // registration std about any kept axis
                                       // (and chi-square at 99.9 % for the kept directions)
-  int solve_every_submaps = 2;        // whole-graph solve also without a loop closure, > 0
+  int solve_every_submaps = 2;        // a solve also without a loop closure, > 0
+  // What a solve during the dive frees, so that its cost does not grow with the dive: the last
+  // solve_window_submaps submaps (> 0) and, after an accepted loop, every submap back to the
+  // loop's older end, at most solve_window_max_submaps (>= solve_window_submaps) in all; the
+  // submaps before stay where they are. The whole graph is solved once it holds
+  // full_solve_growth (> 1) times the submaps it held at its last whole solve (the solves then
+  // cost a constant per submap on average), and at Finish. false: every solve is whole.
+  bool windowed_solves = true;
+  int solve_window_submaps = 60;
+  int solve_window_max_submaps = 400;
+  double full_solve_growth = 1.5;
   // The solves during the dive stop once an iteration lowers the cost by less than this
   // fraction (they only have to predict the next registrations and loops); the last one, in
   // Finish, goes to PoseGraphOptions' default. In (0, 1).
@@ -122,6 +132,8 @@ struct MapperStats {
   double registration_s = 0.0;
   double loop_s = 0.0;
   double graph_s = 0.0;
+  int whole_solves = 0;   // of the whole graph
+  int window_solves = 0;  // of the last submaps only (MapperOptions::windowed_solves)
 };
 
 // Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until
@@ -131,7 +143,8 @@ struct MapperStats {
 // which is registered (point-to-plane ICP with the navigation increment as start and prior) to the
 // last few submaps, added to the graph with its odometry and registration edges and its depth and
 // roll/pitch priors, and checked for loop closures against older submaps. The graph is
-// re-solved when a loop closes (and every few submaps). Memory: the voxelised submaps and the
+// re-solved when a loop closes (and every few submaps), in a window of the last submaps
+// (MapperOptions::windowed_solves). Memory: the voxelised submaps and the
 // graph, not the frames. Deterministic: the same inputs give the same bits for any thread count.
 class Mapper {
  public:

@@ -72,6 +72,7 @@ struct Mapper::Impl {
   std::vector<LoopClosure> loops;
   MapperStats stats;
   int since_solve = 0;
+  int next_whole_solve_submaps = 0;  // the graph's size at which the next solve is whole
 
   Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
       : options(o), T_V_C(mount), uncertainty(noise) {}
@@ -110,7 +111,10 @@ struct Mapper::Impl {
   // Everything it may be off by: the scale error and misalignment as noise, as the
   // calibration may still be settling.
   Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
-  Matrix6d ChainCovariance(int from, int to) const;
+  // The covariance C(j, to) of the scans' motion T_j_to along the chain of consecutive
+  // increments, sum over i in (j, to] of Ad(T_j_i-1) increment(i) Ad(T_j_i-1)^T, for every j in
+  // [oldest, to] (indexed j - oldest), in one pass from `to` down.
+  std::vector<Matrix6d> ChainCovariancesTo(int to, int oldest) const;
   // Loop closures (TryLoopClosures), step by step.
   struct LoopCandidate {
     int j;                // the earlier submap
@@ -128,7 +132,10 @@ struct Mapper::Impl {
   std::string LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
                             const Matrix6d& information, const Matrix6d& prediction_covariance,
                             const Eigen::Isometry3d& T_pred, double* chi2) const;
-  void Solve(bool last = false);  // last: the solve at Finish, to the full tolerance
+  int FirstFreeSubmap(int k, std::optional<int> oldest_loop) const;
+  // Solves the submaps from first_free_submap on (0: the whole graph); last: the solve at
+  // Finish, to the full tolerance.
+  void Solve(int first_free_submap, bool last = false);
   static int AnchorNode(int submap) { return 2 * submap; }
   static int ScanNode(int submap) { return 2 * submap + 1; }
   Eigen::Isometry3d AnchorPose(int submap) const { return graph.pose(AnchorNode(submap)); }

@@ -31,6 +31,9 @@ double LargestStd(const Eigen::Matrix3d& covariance) {
 
 }  // namespace
 
+// Loop closures for submap k: the earlier submaps whose overlap with it is plausible, nearest
+// first, each registered from the predicted pose and judged (JudgeLoop); an accepted one becomes
+// an edge between the two scans.
 void Mapper::Impl::TryLoopClosures(int k) {
   if (options.max_loop_candidates == 0 || k % options.loop_every_submaps != 0) return;
   const Clock::time_point start = Clock::now();
@@ -55,14 +58,24 @@ void Mapper::Impl::TryLoopClosures(int k) {
 std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) const {
   const Submap& current = submaps[static_cast<size_t>(k)];
   const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
-  std::vector<LoopCandidate> candidates;
+  // The cheap first cut, far beyond any gate here: centres within 2 m of overlapping.
+  std::vector<std::pair<int, double>> near;  // submap, distance
   for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
     const Submap& old = submaps[static_cast<size_t>(j)];
     const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
     const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
-    if (distance - overlap > 2.0) continue;  // cheap first cut, far beyond any gate here
+    if (distance - overlap <= 2.0) near.emplace_back(j, distance);
+  }
+  std::vector<LoopCandidate> candidates;
+  if (near.empty()) return candidates;
+  // The chain's covariance from each near submap back to k, built from k down to the oldest
+  // (ChainCovariancesTo: one step per submap, so a long dive pays once per candidate search).
+  const std::vector<Matrix6d> chain = ChainCovariancesTo(k, near.front().first);
+  for (const auto& [j, distance] : near) {
+    const Submap& old = submaps[static_cast<size_t>(j)];
+    const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
     // In j's frame: how far k's centre is predicted from j's, and how uncertain that is.
-    const Matrix6d covariance = ChainCovariance(j, k);
+    const Matrix6d& covariance = chain[static_cast<size_t>(j - near.front().first)];
     const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
     const Eigen::Vector3d gap_m = centre_k_in_j - old.centroid_V;
     if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <=

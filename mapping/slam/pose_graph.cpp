@@ -7,6 +7,7 @@
 #include <ceres/solver.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -175,6 +176,17 @@ struct PoseGraph::Impl {
   std::unique_ptr<ceres::Problem> problem;
   // The dead reckoning's [scale error, misalignment], a parameter block once estimated.
   std::unique_ptr<std::array<double, 2>> calibration;
+  // Every measurement as the problem holds it (the problem owns its cost and loss), and those of
+  // each node, so that a window's problem can be built from them alone (SolveWindow).
+  struct Measurement {
+    ceres::CostFunction* cost = nullptr;
+    ceres::LossFunction* loss = nullptr;
+    std::vector<double*> blocks;
+    std::vector<int> nodes;
+  };
+  std::vector<Measurement> measurements;
+  std::vector<std::vector<int>> measurements_of_node;
+  ceres::EigenQuaternionManifold quaternion_manifold;  // shared by the windows' problems
 
   Impl() {
     ceres::Problem::Options options;
@@ -189,6 +201,34 @@ struct PoseGraph::Impl {
   }
   double* q(int node) { return rotations[static_cast<size_t>(node)]->data(); }
   double* p(int node) { return positions[static_cast<size_t>(node)]->data(); }
+
+  // Adds a measurement of the given nodes (their rotation and position blocks in that order,
+  // then `extra`, the calibration, when given) to the problem and to the record.
+  void AddMeasurement(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                      const std::vector<int>& nodes, bool with_rotation, bool with_position,
+                      double* extra = nullptr) {
+    Measurement m{cost, loss, {}, nodes};
+    for (const int node : nodes) {
+      if (with_rotation) m.blocks.push_back(q(node));
+      if (with_position) m.blocks.push_back(p(node));
+    }
+    if (extra) m.blocks.push_back(extra);
+    problem->AddResidualBlock(cost, loss, m.blocks);
+    const int index = static_cast<int>(measurements.size());
+    for (const int node : nodes) measurements_of_node[static_cast<size_t>(node)].push_back(index);
+    measurements.push_back(std::move(m));
+  }
+
+  // The measurements that touch a node from first_node on, each once, in the order added.
+  std::vector<int> MeasurementsFrom(int first_node) const {
+    std::vector<int> indices;
+    for (size_t node = static_cast<size_t>(first_node); node < measurements_of_node.size(); ++node)
+      indices.insert(indices.end(), measurements_of_node[node].begin(),
+                     measurements_of_node[node].end());
+    std::sort(indices.begin(), indices.end());
+    indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
+    return indices;
+  }
 
   // The information J^T J at the current estimate, J the whitened residuals' Jacobian (robust
   // losses applied) in the tangent spaces, columns ordered [q_0, p_0, q_1, p_1, ...,
@@ -227,6 +267,7 @@ int PoseGraph::AddNode(const Eigen::Isometry3d& T_W_V) {
   set_pose(node, T_W_V);
   m.problem->AddParameterBlock(m.q(node), 4, new ceres::EigenQuaternionManifold);
   m.problem->AddParameterBlock(m.p(node), 3);
+  m.measurements_of_node.emplace_back();
   return node;
 }
 
@@ -248,14 +289,12 @@ void PoseGraph::AddEdge(const RelativePoseEdge& edge) {
   if (edge.dead_reckoned) {
     auto* cost = new ceres::AutoDiffCostFunction<DeadReckonedCost, 6, 4, 3, 4, 3, 2>(
         new DeadReckonedCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
-    m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to),
-                                m.p(edge.to), m.calibration->data());
+    m.AddMeasurement(cost, loss, {edge.from, edge.to}, true, true, m.calibration->data());
     return;
   }
   auto* cost = new ceres::AutoDiffCostFunction<RelativeCost, 6, 4, 3, 4, 3>(
       new RelativeCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
-  m.problem->AddResidualBlock(cost, loss, m.q(edge.from), m.p(edge.from), m.q(edge.to),
-                              m.p(edge.to));
+  m.AddMeasurement(cost, loss, {edge.from, edge.to}, true, true);
 }
 
 void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma,
@@ -268,9 +307,9 @@ void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma,
   }
   m.calibration = std::make_unique<std::array<double, 2>>(std::array<double, 2>{0.0, 0.0});
   m.problem->AddParameterBlock(m.calibration->data(), 2);
-  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<CalibrationPriorCost, 2, 2>(
-                                  new CalibrationPriorCost{scale_sigma, misalignment_sigma_rad}),
-                              nullptr, m.calibration->data());
+  m.AddMeasurement(new ceres::AutoDiffCostFunction<CalibrationPriorCost, 2, 2>(
+                       new CalibrationPriorCost{scale_sigma, misalignment_sigma_rad}),
+                   nullptr, {}, false, false, m.calibration->data());
 }
 
 bool PoseGraph::estimates_calibration() const { return impl_->calibration != nullptr; }
@@ -286,9 +325,9 @@ void PoseGraph::AddDepth(const DepthPrior& prior) {
   if (!std::isfinite(prior.z_m) || !(prior.sigma_m > 0.0)) {
     throw Error("pose graph: AddDepth: expected a finite depth and sigma_m > 0");
   }
-  m.problem->AddResidualBlock(
+  m.AddMeasurement(
       new ceres::AutoDiffCostFunction<DepthCost, 1, 3>(new DepthCost{prior.z_m, prior.sigma_m}),
-      nullptr, m.p(prior.node));
+      nullptr, {prior.node}, false, true);
 }
 
 void PoseGraph::AddGravity(const GravityPrior& prior) {
@@ -298,9 +337,9 @@ void PoseGraph::AddGravity(const GravityPrior& prior) {
       !(prior.sigma_rad > 0.0)) {
     throw Error("pose graph: AddGravity: expected a unit down vector and sigma_rad > 0");
   }
-  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<GravityCost, 3, 4>(
-                                  new GravityCost{prior.down_in_V, prior.sigma_rad}),
-                              nullptr, m.q(prior.node));
+  m.AddMeasurement(new ceres::AutoDiffCostFunction<GravityCost, 3, 4>(
+                       new GravityCost{prior.down_in_V, prior.sigma_rad}),
+                   nullptr, {prior.node}, true, false);
 }
 
 void PoseGraph::AddPrior(const PosePrior& prior) {
@@ -308,10 +347,10 @@ void PoseGraph::AddPrior(const PosePrior& prior) {
   m.RequireNode(prior.node, "AddPrior");
   RequireRigid(prior.T_W_V, "AddPrior");
   RequireInformation(prior.information, "AddPrior");
-  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 6, 4, 3>(new PriorCost{
-                                  Eigen::Quaterniond(prior.T_W_V.linear()),
-                                  prior.T_W_V.translation(), SqrtPsd(prior.information)}),
-                              nullptr, m.q(prior.node), m.p(prior.node));
+  m.AddMeasurement(new ceres::AutoDiffCostFunction<PriorCost, 6, 4, 3>(
+                       new PriorCost{Eigen::Quaterniond(prior.T_W_V.linear()),
+                                     prior.T_W_V.translation(), SqrtPsd(prior.information)}),
+                   nullptr, {prior.node}, true, true);
 }
 
 int PoseGraph::node_count() const { return static_cast<int>(impl_->rotations.size()); }
@@ -331,9 +370,10 @@ void PoseGraph::set_pose(int node, const Eigen::Isometry3d& T_W_V) {
   Eigen::Map<Eigen::Vector3d>(impl_->p(node)) = T_W_V.translation();
 }
 
-PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
+namespace {
+
+PoseGraphSolve SolveProblem(ceres::Problem* problem, const PoseGraphOptions& options) {
   options.Check();
-  Impl& m = *impl_;
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.max_num_iterations = options.max_iterations;
@@ -342,13 +382,55 @@ PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
   solver.gradient_tolerance = 1e-12;
   solver.parameter_tolerance = 1e-10;
   ceres::Solver::Summary summary;
-  ceres::Solve(solver, m.problem.get(), &summary);
+  ceres::Solve(solver, problem, &summary);
   PoseGraphSolve result;
   result.converged = summary.termination_type == ceres::CONVERGENCE;
   result.iterations = static_cast<int>(summary.iterations.size());
   result.initial_cost = summary.initial_cost;
   result.final_cost = summary.final_cost;
+  result.measurements = problem->NumResidualBlocks();
   return result;
+}
+
+}  // namespace
+
+PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
+  return SolveProblem(impl_->problem.get(), options);
+}
+
+PoseGraphSolve PoseGraph::SolveWindow(int first_free_node, const PoseGraphOptions& options) {
+  options.Check();
+  Impl& m = *impl_;
+  if (first_free_node < 0 || first_free_node >= node_count()) {
+    throw Error("pose graph: SolveWindow: first free node " + std::to_string(first_free_node) +
+                " outside [0, " + std::to_string(node_count()) + ")");
+  }
+  // The window's problem borrows the costs, losses and manifold: the whole graph's problem and
+  // Impl own them.
+  ceres::Problem::Options borrowed;
+  borrowed.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  borrowed.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  borrowed.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem window(borrowed);
+  std::vector<int> nodes;
+  for (const int index : m.MeasurementsFrom(first_free_node)) {
+    const Impl::Measurement& measurement = m.measurements[static_cast<size_t>(index)];
+    window.AddResidualBlock(measurement.cost, measurement.loss, measurement.blocks);
+    nodes.insert(nodes.end(), measurement.nodes.begin(), measurement.nodes.end());
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  for (const int node : nodes) {
+    const bool held = node < first_free_node;
+    for (double* block : {m.q(node), m.p(node)}) {
+      if (!window.HasParameterBlock(block)) continue;
+      if (block == m.q(node)) window.SetManifold(block, &m.quaternion_manifold);
+      if (held) window.SetParameterBlockConstant(block);
+    }
+  }
+  if (m.calibration && window.HasParameterBlock(m.calibration->data()))
+    window.SetParameterBlockConstant(m.calibration->data());
+  return SolveProblem(&window, options);
 }
 
 std::optional<std::vector<Matrix6d>> PoseGraph::Covariances() const {

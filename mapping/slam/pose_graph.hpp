@@ -65,6 +65,7 @@ struct PoseGraphSolve {
   int iterations = 0;
   double initial_cost = 0.0;
   double final_cost = 0.0;
+  int measurements = 0;  // residual blocks in the problem solved (a window's: those it touches)
 };
 
 class PoseGraph {
@@ -95,6 +96,12 @@ class PoseGraph {
 
   // Solves the whole graph from the current estimates.
   PoseGraphSolve Solve(const PoseGraphOptions& options);
+  // Solves only the nodes from first_free_node on, in [0, node_count()): the others and the
+  // dead reckoning's calibration stay where they are, and the solve builds and evaluates only
+  // the measurements that touch a free node, so it costs what the window holds, whatever the
+  // graph's size (a long dive's running solves). SolveWindow(0) differs from Solve only in
+  // holding the calibration.
+  PoseGraphSolve SolveWindow(int first_free_node, const PoseGraphOptions& options);
 
   // Marginal covariance of every node at the current estimate, ordered [rotation (rad),
   // position (m)], both in the world frame: T_W_V = exp([w, 0]) applied to the rotation,
