@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/bench/long_dive_bench_report.hpp"
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
@@ -26,6 +27,9 @@ struct SlamBenchArgs {
   int threads = 2;
   double walk_scale = 1.0;
   bool no_open3d = false;
+  bool long_dives = false;
+  std::vector<double> minutes = {4.0, 15.0, 30.0};
+  bool no_whole_solves = false;
 };
 
 nlohmann::json MapJson(const bench::SurfaceDistance& d) {
@@ -261,8 +265,22 @@ void AddSlamBenchCommand(CLI::App& bench) {
                   "them (default 1)")
       ->check(kPositiveNumber);
   cmd->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
+  cmd->add_flag("--long", a->long_dives,
+                "instead: mapping cost against dive length, on dives of --minutes over a manifold "
+                "field, with windowed and whole-graph solves (time per submap, memory, real time, "
+                "ATE, map RMS)");
+  cmd->add_option("--minutes", a->minutes, "with --long: the dives' lengths (default 4 15 30)")
+      ->check(kPositiveNumber);
+  cmd->add_flag("--no-whole-solves", a->no_whole_solves,
+                "with --long: skip the whole-graph solves beside the windowed ones");
   cmd->add_option("--json", a->json, "write the figures as JSON");
-  cmd->callback([a] { RunSlamBench(*a); });
+  cmd->callback([a] {
+    if (a->long_dives) {
+      RunLongDiveBench(a->minutes, a->threads, !a->no_whole_solves, a->json);
+    } else {
+      RunSlamBench(*a);
+    }
+  });
 }
 
 }  // namespace uwscan::app

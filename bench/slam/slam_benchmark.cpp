@@ -35,32 +35,6 @@ std::string ReadText(const std::filesystem::path& path) {
   return text.str();
 }
 
-SurfaceDistance DistanceToScene(const perception::PointCloud& map,
-                                const scanner::sim::RayCaster& caster, int threads) {
-  std::vector<double> distances(map.size());
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(map.size()); ++i) {
-    const std::optional<double> d =
-        caster.DistanceToSurface(map.Point(static_cast<size_t>(i)), kSurfaceSearch_m);
-    distances[static_cast<size_t>(i)] = d.value_or(kSurfaceSearch_m);
-  }
-  SurfaceDistance out;
-  out.points = distances.size();
-  if (distances.empty()) return out;
-  double sum = 0.0, sum2 = 0.0;
-  for (double d : distances) {
-    sum += d;
-    sum2 += d * d;
-  }
-  out.mean_m = sum / static_cast<double>(distances.size());
-  out.rms_m = std::sqrt(sum2 / static_cast<double>(distances.size()));
-  const std::size_t k = static_cast<std::size_t>(0.95 * static_cast<double>(distances.size() - 1));
-  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(k),
-                   distances.end());
-  out.p95_m = distances[k];
-  return out;
-}
-
 // The dive's frames triangulated as the mapper does and placed with the true camera pose of each:
 // the map no trajectory estimate can beat, voxelised as the maps it is compared with. What
 // separates it from the true surfaces is the sensor's own error (peak noise, refraction at
@@ -209,6 +183,32 @@ DiveFigures BenchDive(const std::filesystem::path& scene_path, std::uint64_t see
 }
 
 }  // namespace
+
+SurfaceDistance DistanceToScene(const perception::PointCloud& map,
+                                const scanner::sim::RayCaster& caster, int threads) {
+  std::vector<double> distances(map.size());
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(map.size()); ++i) {
+    const std::optional<double> d =
+        caster.DistanceToSurface(map.Point(static_cast<size_t>(i)), kSurfaceSearch_m);
+    distances[static_cast<size_t>(i)] = d.value_or(kSurfaceSearch_m);
+  }
+  SurfaceDistance out;
+  out.points = distances.size();
+  if (distances.empty()) return out;
+  double sum = 0.0, sum2 = 0.0;
+  for (double d : distances) {
+    sum += d;
+    sum2 += d * d;
+  }
+  out.mean_m = sum / static_cast<double>(distances.size());
+  out.rms_m = std::sqrt(sum2 / static_cast<double>(distances.size()));
+  const std::size_t k = static_cast<std::size_t>(0.95 * static_cast<double>(distances.size() - 1));
+  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(k),
+                   distances.end());
+  out.p95_m = distances[k];
+  return out;
+}
 
 void SlamBenchOptions::Check() const {
   const OptionChecks check("SlamBenchOptions");

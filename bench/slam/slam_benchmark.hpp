@@ -9,6 +9,10 @@
 #include "bench/progress.hpp"
 #include "mapping/slam/dive_mapping.hpp"
 
+namespace uwscan::scanner::sim {
+class RayCaster;
+}
+
 namespace uwscan::bench {
 
 // Scan-matching SLAM against dead reckoning and against Open3D's multiway registration on the
@@ -35,6 +39,11 @@ struct SurfaceDistance {
   double p95_m = 0.0;
   std::size_t points = 0;
 };
+
+// The distance of each map point to the nearest true surface the caster holds (points further
+// than 0.5 m count at 0.5 m, as outliers), summarised.
+SurfaceDistance DistanceToScene(const perception::PointCloud& map,
+                                const scanner::sim::RayCaster& caster, int threads);
 
 struct TrajectoryFigures {
   double ate_m = 0.0;

@@ -51,28 +51,54 @@ struct FrameSpan {
   double first_s = 0.0, last_s = 0.0;
 };
 
+// Times the mapper's calls and hands the time spent since the last submap closed to each new
+// one (DiveMapping::submap_seconds).
+class SubmapClock {
+ public:
+  SubmapClock(const Mapper& mapper, std::vector<double>* seconds)
+      : mapper_(mapper), seconds_(seconds) {}
+  template <typename Call>
+  void Time(Call&& call) {
+    const auto start = std::chrono::steady_clock::now();
+    call();
+    pending_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    while (static_cast<int>(seconds_->size()) < mapper_.submap_count()) {
+      seconds_->push_back(pending_s_);
+      pending_s_ = 0.0;
+    }
+  }
+
+ private:
+  const Mapper& mapper_;
+  std::vector<double>* seconds_;
+  double pending_s_ = 0.0;
+};
+
 // The log replayed as the vehicle delivered it: each navigation sample before the frames it
 // precedes.
 FrameSpan Replay(const DiveLogReader& log, const std::vector<NavigationRecord>& navigation,
-                 Mapper& mapper, const std::function<void(double)>& progress) {
+                 Mapper& mapper, const std::function<void(double)>& progress,
+                 std::vector<double>* submap_seconds) {
   const double frame_count = static_cast<double>(log.frame_count());
+  SubmapClock clock(mapper, submap_seconds);
   std::size_t next_nav = 0;
   std::int64_t done = 0;
   FrameSpan span;
   log.ForEachFrame(
       [&](const FrameRecord& frame, const GroundTruthRecord*) {
         while (next_nav < navigation.size() && navigation[next_nav].time_s <= frame.time_s) {
-          mapper.AddNavigation(navigation[next_nav++]);
+          clock.Time([&] { mapper.AddNavigation(navigation[next_nav++]); });
         }
-        mapper.AddFrame(frame);
+        clock.Time([&] { mapper.AddFrame(frame); });
         if (done == 0) span.first_s = frame.time_s;
         span.last_s = frame.time_s;
         ++done;
         if (progress) progress(static_cast<double>(done) / frame_count);
       },
       /*with_truth=*/false);
-  while (next_nav < navigation.size()) mapper.AddNavigation(navigation[next_nav++]);
-  mapper.Finish();
+  while (next_nav < navigation.size())
+    clock.Time([&] { mapper.AddNavigation(navigation[next_nav++]); });
+  clock.Time([&] { mapper.Finish(); });
   return span;
 }
 
@@ -136,7 +162,7 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
   Mapper mapper(header.scanner, header.scan_pattern, T_V_C,
                 header.navigation_noise.value_or(AssumedNavigationNoise()), options.mapper,
                 options.table_cache);
-  const FrameSpan span = Replay(log, navigation, mapper, progress);
+  const FrameSpan span = Replay(log, navigation, mapper, progress, &result.submap_seconds);
   RequireMapped(mapper, navigation, span, options.mapper.max_navigation_gap_s, name);
   result.submaps = mapper.submap_count();
   AddTrajectories(log, mapper, T_V_C, options.keep_submaps, result);

@@ -42,6 +42,10 @@ struct DiveMapping {
   // submaps; filled only when DiveMappingOptions::keep_submaps.
   std::vector<perception::PointCloud> submap_clouds;
   MapperStats stats;
+  // The mapper's processing time for each submap, in order: its calls from the previous submap's
+  // close to this one's (frames placed, the submap built, registered, loops tried, the graph
+  // solved); reading the log excluded.
+  std::vector<double> submap_seconds;
   DeadReckoningCalibration calibration;   // the DVL's scale error and misalignment as estimated
   bool navigation_noise_assumed = false;  // the log did not record it (schema 1)
   double dive_duration_s = 0.0;

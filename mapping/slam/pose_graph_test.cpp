@@ -99,7 +99,8 @@ PoseGraph ExactChain(int n, std::vector<Eigen::Isometry3d>* truth) {
 
 void ExpectSameBits(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, int node) {
   for (int k = 0; k < 16; ++k) {
-    EXPECT_EQ(std::bit_cast<std::uint64_t>(a.matrix()(k)), std::bit_cast<std::uint64_t>(b.matrix()(k)))
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(a.matrix()(k)),
+              std::bit_cast<std::uint64_t>(b.matrix()(k)))
         << "node " << node;
   }
 }
@@ -112,7 +113,8 @@ TEST(PoseGraph, AWindowSolveMovesOnlyItsNodesAndFindsThemFromTheHeldOnes) {
   off.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d(1, -2, 1).normalized()).toRotationMatrix();
   off.translation() = Eigen::Vector3d(0.1, -0.1, 0.14);
   for (int i = 1; i < 8; ++i)
-    graph.set_pose(i, truth[static_cast<size_t>(i)] * (i < 5 ? Eigen::Isometry3d::Identity() : off));
+    graph.set_pose(i,
+                   truth[static_cast<size_t>(i)] * (i < 5 ? Eigen::Isometry3d::Identity() : off));
   std::vector<Eigen::Isometry3d> before;
   for (int i = 0; i < 8; ++i) before.push_back(graph.pose(i));
   EXPECT_TRUE(graph.SolveWindow(5, {}).converged);
@@ -160,11 +162,15 @@ TEST(PoseGraph, AWindowSolveHoldsTheDeadReckoningsCalibration) {
   graph.AddNode(far);
   graph.AddPrior({.node = 0, .information = Matrix6d::Identity() * 1e6});
   // The dead reckoning says 10 m, an exact edge 10.2 m: a whole solve puts 2 % into the scale.
-  graph.AddEdge({.from = 0, .to = 1, .T_from_to = far, .information = Matrix6d::Identity() * 1e2,
+  graph.AddEdge({.from = 0,
+                 .to = 1,
+                 .T_from_to = far,
+                 .information = Matrix6d::Identity() * 1e2,
                  .dead_reckoned = true});
   Eigen::Isometry3d measured = far;
   measured.translation().x() = 10.2;
-  graph.AddEdge({.from = 0, .to = 2, .T_from_to = measured, .information = Matrix6d::Identity() * 1e6});
+  graph.AddEdge(
+      {.from = 0, .to = 2, .T_from_to = measured, .information = Matrix6d::Identity() * 1e6});
   graph.AddEdge({.from = 1, .to = 2, .information = Matrix6d::Identity() * 1e6});
   graph.SolveWindow(1, {});
   EXPECT_EQ(graph.calibration().scale_error, 0.0);

@@ -1,0 +1,88 @@
+#include "apps/bench/long_dive_bench_report.hpp"
+
+#include <cstdio>
+
+#include "apps/cli/data_cache.hpp"
+#include "apps/cli/data_folder.hpp"
+#include "apps/cli/json_output.hpp"
+#include "apps/cli/progress_bar.hpp"
+#include "bench/slam/long_dive_benchmark.hpp"
+
+namespace uwscan::app {
+namespace {
+
+nlohmann::json TimesJson(const bench::SubmapTimes& t) {
+  return {{"median", t.median_s}, {"p95", t.p95_s}};
+}
+
+nlohmann::json RunJson(const bench::LongDiveRun& r) {
+  return {{"seconds", r.seconds},
+          {"real_time_factor", r.real_time_factor},
+          {"ate_m", r.ate_m},
+          {"map_rms_m", r.map_rms_m},
+          {"submap_seconds", {{"first_tenth", TimesJson(r.first_tenth)},
+                              {"last_tenth", TimesJson(r.last_tenth)}}},
+          {"peak_rss_bytes", r.peak_rss_bytes},
+          {"rss_bytes_last_tenth", r.rss_bytes_last_tenth},
+          {"loops_accepted", r.loops_accepted},
+          {"whole_solves", r.whole_solves},
+          {"window_solves", r.window_solves},
+          {"series", {{"submap_time_s", r.submap_time_s},
+                      {"submap_seconds", r.submap_seconds},
+                      {"rss_time_s", r.rss_time_s},
+                      {"rss_bytes", r.rss_bytes}}}};
+}
+
+// The layout: today's mapper's figures at the top of each dive, the whole-graph solves'
+// under "full_solve".
+nlohmann::json DiveJson(const bench::LongDiveFigures& f) {
+  nlohmann::json dive = RunJson(f.windowed);
+  dive["name"] = f.name;
+  dive["duration_s"] = f.duration_s;
+  dive["submaps"] = f.submaps;
+  dive["dead_reckoning_ate_m"] = f.dead_reckoning_ate_m;
+  dive["full_solve"] = f.whole ? RunJson(*f.whole) : nlohmann::json(nullptr);
+  return dive;
+}
+
+void PrintRow(const char* method, const bench::LongDiveRun& r) {
+  std::printf("| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f MB | %.0f MB | %.1fx | %.1f mm | %.2f mm "
+              "| %d | %d + %d |\n",
+              method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3,
+              r.last_tenth.median_s * 1e3, r.last_tenth.p95_s * 1e3,
+              static_cast<double>(r.peak_rss_bytes) / 1e6,
+              static_cast<double>(r.rss_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
+              r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves);
+}
+
+}  // namespace
+
+void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whole_solves,
+                      const std::string& json) {
+  bench::LongDiveBenchOptions options;
+  options.minutes = minutes;
+  options.threads = threads;
+  options.whole_solves = whole_solves;
+  options.scenes_folder = DataFolder() / "scenes";
+  options.table_cache = TableCache();
+  std::vector<bench::LongDiveFigures> dives;
+  {
+    ProgressBar bar;
+    dives = bench::RunLongDiveBench(options, bar.Callback());
+  }
+  std::printf(
+      "| dive | solves | time per submap, first tenth: median / p95 | last tenth | peak RSS | RSS, "
+      "last tenth | real time | ATE | map RMS | loops | whole + window solves |\n"
+      "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  nlohmann::json out = {{"bench", "slam_long"}, {"dives", nlohmann::json::array()}};
+  for (const bench::LongDiveFigures& f : dives) {
+    std::printf("| %s (%.0f s, %d submaps, dead reckoning ATE %.1f mm) | | | | | | | | | | |\n",
+                f.name.c_str(), f.duration_s, f.submaps, f.dead_reckoning_ate_m * 1e3);
+    PrintRow("windowed", f.windowed);
+    if (f.whole) PrintRow("whole graph", *f.whole);
+    out["dives"].push_back(DiveJson(f));
+  }
+  if (!json.empty()) WriteJsonFile(json, out);
+}
+
+}  // namespace uwscan::app

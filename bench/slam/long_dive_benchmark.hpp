@@ -1,0 +1,68 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bench/progress.hpp"
+
+namespace uwscan::bench {
+
+// Mapping cost against dive length (issue 52): dives over the manifold field of
+// long_dive_scene.hpp, each simulated once into a log, then mapped with the windowed solves of
+// today's mapper and, beside them, with whole-graph solves throughout (the mapper before
+// windows), in one run.
+struct LongDiveBenchOptions {
+  std::vector<double> minutes = {4.0, 15.0, 30.0};  // dive lengths, each > 0
+  std::filesystem::path scenes_folder;  // the data folder's scenes/ (the scanner file is there)
+  std::uint64_t seed = 41;              // draws the navigation's drift and the peaks' noise
+  int threads = 2;
+  bool whole_solves = true;  // also map each dive with whole-graph solves
+  std::filesystem::path table_cache;
+  void Check() const;
+};
+
+// Median and 95th percentile of the time per submap over a stretch of the dive.
+struct SubmapTimes {
+  double median_s = 0.0;
+  double p95_s = 0.0;
+};
+
+struct LongDiveRun {
+  double duration_s = 0.0;  // of the dive, its first frame to its last
+  int submaps = 0;
+  double seconds = 0.0;  // mapping, reading the log included
+  double real_time_factor = 0.0;
+  double ate_m = 0.0;
+  double map_rms_m = 0.0;  // distance of the map's points to the true surfaces
+  SubmapTimes first_tenth, last_tenth;
+  std::int64_t peak_rss_bytes = 0;       // the process's resident memory while mapping, at most
+  std::int64_t rss_bytes_last_tenth = 0;  // its mean over the last tenth of the dive
+  int loops_accepted = 0;
+  int whole_solves = 0, window_solves = 0;
+  // Over the dive (seconds of dive time): the median time per submap in each of about 60 stretches,
+  // and the resident memory sampled as the frames went by.
+  std::vector<double> submap_time_s, submap_seconds;
+  std::vector<double> rss_time_s;
+  std::vector<std::int64_t> rss_bytes;
+};
+
+struct LongDiveFigures {
+  std::string name;
+  double duration_s = 0.0;
+  int submaps = 0;
+  double dead_reckoning_ate_m = 0.0;
+  LongDiveRun windowed;
+  std::optional<LongDiveRun> whole;
+};
+
+std::vector<LongDiveFigures> RunLongDiveBench(const LongDiveBenchOptions& options,
+                                              const Progress& progress = {});
+
+// The median and the 95th percentile (nearest rank) of `values` from index `first` to `last`
+// (exclusive); zeros when the range is empty.
+SubmapTimes MedianAndP95(const std::vector<double>& values, std::size_t first, std::size_t last);
+
+}  // namespace uwscan::bench
