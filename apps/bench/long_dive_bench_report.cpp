@@ -20,17 +20,18 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"real_time_factor", r.real_time_factor},
           {"ate_m", r.ate_m},
           {"map_rms_m", r.map_rms_m},
-          {"submap_seconds", {{"first_tenth", TimesJson(r.first_tenth)},
-                              {"last_tenth", TimesJson(r.last_tenth)}}},
+          {"submap_seconds",
+           {{"first_tenth", TimesJson(r.first_tenth)}, {"last_tenth", TimesJson(r.last_tenth)}}},
           {"peak_rss_bytes", r.peak_rss_bytes},
           {"rss_bytes_last_tenth", r.rss_bytes_last_tenth},
           {"loops_accepted", r.loops_accepted},
           {"whole_solves", r.whole_solves},
           {"window_solves", r.window_solves},
-          {"series", {{"submap_time_s", r.submap_time_s},
-                      {"submap_seconds", r.submap_seconds},
-                      {"rss_time_s", r.rss_time_s},
-                      {"rss_bytes", r.rss_bytes}}}};
+          {"series",
+           {{"submap_time_s", r.submap_time_s},
+            {"submap_seconds", r.submap_seconds},
+            {"rss_time_s", r.rss_time_s},
+            {"rss_bytes", r.rss_bytes}}}};
 }
 
 // The layout: today's mapper's figures at the top of each dive, the whole-graph solves'
@@ -46,13 +47,13 @@ nlohmann::json DiveJson(const bench::LongDiveFigures& f) {
 }
 
 void PrintRow(const char* method, const bench::LongDiveRun& r) {
-  std::printf("| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f MB | %.0f MB | %.1fx | %.1f mm | %.2f mm "
-              "| %d | %d + %d |\n",
-              method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3,
-              r.last_tenth.median_s * 1e3, r.last_tenth.p95_s * 1e3,
-              static_cast<double>(r.peak_rss_bytes) / 1e6,
-              static_cast<double>(r.rss_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
-              r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves);
+  std::printf(
+      "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f MB | %.0f MB | %.1fx | %.1f mm | %.2f mm "
+      "| %d | %d + %d |\n",
+      method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3, r.last_tenth.median_s * 1e3,
+      r.last_tenth.p95_s * 1e3, static_cast<double>(r.peak_rss_bytes) / 1e6,
+      static_cast<double>(r.rss_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
+      r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves);
 }
 
 }  // namespace

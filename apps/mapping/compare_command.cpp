@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -82,6 +83,7 @@ mapping::Survey LoadSurvey(const std::string& path, const mapping::SurveyReadOpt
   const mapping::DiveLogReader log(path);
   mapping::DiveMappingOptions mapping_options;
   mapping_options.mapper.threads = threads;
+  mapping_options.mapper.spill_folder = std::filesystem::temp_directory_path();
   mapping_options.table_cache = TableCache();
   mapping::DiveMapping m;
   {

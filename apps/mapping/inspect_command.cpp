@@ -132,6 +132,7 @@ void RunInspect(const InspectArgs& a) {
   options.map_voxel_m = a.voxel_m;
   options.mapper.sweeps_per_submap = a.sweeps_per_submap;
   options.mapper.threads = a.threads;
+  options.mapper.spill_folder = std::filesystem::temp_directory_path();
   options.table_cache = TableCache();
   options.Check();
 

@@ -143,6 +143,8 @@ void RunMap(const MapArgs& a) {
   options.mapper.threads = a.threads;
   options.mapper.max_navigation_gap_s = a.max_navigation_gap_s;
   options.mapper.windowed_solves = !a.whole_graph_solves;
+  // Older submaps' clouds wait on disk, so a long dive's memory does not grow with it.
+  options.mapper.spill_folder = std::filesystem::temp_directory_path();
   options.table_cache = TableCache();
   const mapping::DiveLogReader log(a.log);
   // Refused before anything is mapped or written: a real log has no truth to write.

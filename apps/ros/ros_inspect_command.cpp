@@ -116,6 +116,7 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
   o.inspection.map_voxel_m = ros.Param("voxel_m", o.inspection.map_voxel_m);
   o.inspection.mapper.sweeps_per_submap =
       ros.Param("sweeps_per_submap", o.inspection.mapper.sweeps_per_submap);
+  o.inspection.mapper.spill_folder = std::filesystem::temp_directory_path();
   // On the vehicle every frame should reach SLAM (a skipped frame is a hole in the map), so the
   // live queue absorbs the mapper's pauses at submaps and solves: 1024 frames are 3 s at the
   // seed camera's 339 frames/s (and about 8 MB of peaks).

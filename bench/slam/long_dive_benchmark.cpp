@@ -46,13 +46,14 @@ void AddTimeSeries(const mapping::DiveMapping& m, LongDiveRun& run) {
 
 // Maps the log (windowed or whole solves), sampling the resident memory as it goes, and
 // measures the result against the truth.
-LongDiveRun MapLongDive(const std::filesystem::path& log_path, const scanner::sim::RayCaster& caster,
-                        bool windowed, const LongDiveBenchOptions& options,
-                        const std::string& label, const Progress& progress,
-                        double* dead_reckoning_ate_m) {
+LongDiveRun MapLongDive(const std::filesystem::path& log_path,
+                        const scanner::sim::RayCaster& caster, bool windowed,
+                        const LongDiveBenchOptions& options, const std::string& label,
+                        const Progress& progress, double* dead_reckoning_ate_m) {
   mapping::DiveMappingOptions map_options;
   map_options.mapper.threads = options.threads;
   map_options.mapper.windowed_solves = windowed;
+  map_options.mapper.spill_folder = log_path.parent_path();
   map_options.table_cache = options.table_cache;
   omp_set_num_threads(options.threads);
   LongDiveRun run;
@@ -66,7 +67,8 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path, const scanner::si
     run.rss_bytes.push_back(ResidentBytes());
     if (progress) progress(label, fraction);
   });
-  for (const double fraction : rss_fractions) run.rss_time_s.push_back(fraction * m.dive_duration_s);
+  for (const double fraction : rss_fractions)
+    run.rss_time_s.push_back(fraction * m.dive_duration_s);
   run.duration_s = m.dive_duration_s;
   run.submaps = m.submaps;
   const mapping::MapSummary s = mapping::Summarise(m);
@@ -80,9 +82,10 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path, const scanner::si
   run.last_tenth = MedianAndP95(m.submap_seconds, n - tenth, n);
   run.peak_rss_bytes = *std::max_element(run.rss_bytes.begin(), run.rss_bytes.end());
   const std::size_t last = run.rss_bytes.size(), from = last - std::max<std::size_t>(1, last / 10);
-  run.rss_bytes_last_tenth = std::accumulate(run.rss_bytes.begin() + static_cast<std::ptrdiff_t>(from),
-                                             run.rss_bytes.end(), std::int64_t{0}) /
-                             static_cast<std::int64_t>(last - from);
+  run.rss_bytes_last_tenth =
+      std::accumulate(run.rss_bytes.begin() + static_cast<std::ptrdiff_t>(from),
+                      run.rss_bytes.end(), std::int64_t{0}) /
+      static_cast<std::int64_t>(last - from);
   run.loops_accepted = s.loops_accepted;
   run.whole_solves = m.stats.whole_solves;
   run.window_solves = m.stats.window_solves;
@@ -142,8 +145,9 @@ SubmapTimes MedianAndP95(const std::vector<double>& values, std::size_t first, s
                              values.begin() + static_cast<std::ptrdiff_t>(last));
   std::sort(sorted.begin(), sorted.end());
   const auto rank = [&](double q) {
-    return sorted[std::min(sorted.size() - 1,
-                           static_cast<std::size_t>(std::ceil(q * static_cast<double>(sorted.size()))) - 1)];
+    return sorted[std::min(
+        sorted.size() - 1,
+        static_cast<std::size_t>(std::ceil(q * static_cast<double>(sorted.size()))) - 1)];
   };
   return {rank(0.5), rank(0.95)};
 }

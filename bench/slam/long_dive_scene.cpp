@@ -10,17 +10,17 @@
 namespace uwscan::bench {
 namespace {
 
-constexpr double kRowLength_m = 8.0;    // each pipeline runs from x = 0 to here
-constexpr double kRowSpacing_m = 1.5;   // between pipelines, along y
+constexpr double kRowLength_m = 8.0;   // each pipeline runs from x = 0 to here
+constexpr double kRowSpacing_m = 1.5;  // between pipelines, along y
 constexpr int kRows = 3;
 constexpr double kAltitudeDepth_m = 9;  // the vehicle's depth, 1 m above the seabed
 constexpr double kSpeed_mps = 0.25;
-constexpr double kTurn_s = 3.0;         // a quarter turn in place
-constexpr double kLegStart_m = -0.3;    // where a leg along a pipeline starts and ends
+constexpr double kTurn_s = 3.0;       // a quarter turn in place
+constexpr double kLegStart_m = -0.3;  // where a leg along a pipeline starts and ends
 constexpr double kLegEnd_m = 8.0;
 constexpr double kFrameRate_hz = 100.0;
-constexpr int kFramesPerSweep = 51;     // steps -100..100 by 4
-constexpr double kPipeDepth_m = 9.92;   // axis of a pipe of radius 0.08 lying on the seabed
+constexpr int kFramesPerSweep = 51;    // steps -100..100 by 4
+constexpr double kPipeDepth_m = 9.92;  // axis of a pipe of radius 0.08 lying on the seabed
 
 const char* const kAlongX = "[0, 0.7071067812, 0, 0.7071067812]";
 
@@ -65,9 +65,10 @@ void AddComponent(const Component& c, double y, const std::string& name, std::os
 void AddPipe(double from_x, double to_x, double y, const std::string& name,
              std::ostringstream& out) {
   if (to_x - from_x < 0.05) return;
-  out << "  - {name: " << name << ", shape: pipe, outer_radius_m: 0.08, wall_m: 0.008, length_m: "
-      << Number(to_x - from_x) << ", reflectance: 0.5,\n     "
-      << Pose(0.5 * (from_x + to_x), y, kPipeDepth_m, kAlongX) << "}\n";
+  out << "  - {name: " << name
+      << ", shape: pipe, outer_radius_m: 0.08, wall_m: 0.008, length_m: " << Number(to_x - from_x)
+      << ", reflectance: 0.5,\n     " << Pose(0.5 * (from_x + to_x), y, kPipeDepth_m, kAlongX)
+      << "}\n";
 }
 
 // Pipeline r: its components in order along x, pipe between them.
@@ -107,8 +108,8 @@ void AddDebris(std::ostringstream& out) {
       case 0:
         out << "  - {name: " << name << ", shape: box, size_m: [" << Number(0.12 + 0.2 * v) << ", "
             << Number(0.08 + 0.1 * u) << ", " << Number(0.06 + 0.1 * v)
-            << "], reflectance: 0.5,\n     "
-            << Pose(x, y, 10.0 - 0.5 * (0.06 + 0.1 * v), rotation) << "}\n";
+            << "], reflectance: 0.5,\n     " << Pose(x, y, 10.0 - 0.5 * (0.06 + 0.1 * v), rotation)
+            << "}\n";
         break;
       case 1:
         out << "  - {name: " << name << ", shape: cylinder, radius_m: " << Number(0.06 + 0.05 * v)

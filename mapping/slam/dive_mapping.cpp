@@ -122,7 +122,7 @@ void AddTrajectories(const DiveLogReader& log, const Mapper& mapper, const Eigen
     const Submap& s = mapper.submap(i);
     result.slam.push_back({s.anchor_time_s, mapper.pose(i)});
     result.dead_reckoning.push_back({s.anchor_time_s, s.T_W_V_nav});
-    if (keep_submaps) result.submap_clouds.push_back(s.cloud);
+    if (keep_submaps) result.submap_clouds.push_back(mapper.submap_clouds(i)->cloud);
     if (const std::optional<GroundTruthRecord> truth = log.ReadGroundTruth(s.anchor_frame)) {
       result.truth.push_back({s.anchor_time_s, truth->T_W_C * T_C_V});
     }
@@ -136,14 +136,12 @@ void AddExpectedErrors(const Mapper& mapper, DiveMapping& result) {
   if (!covariances) return;
   result.covariances = covariances->anchors;
   result.expected_position_error_m = ExpectedPositionErrorRms(covariances->anchors);
-  std::vector<const perception::PointCloud*> clouds;
-  std::vector<Eigen::Isometry3d> placed;
+  ExpectedSurfaceError error(kExpectedErrorStride);
   for (int i = 0; i < mapper.submap_count(); ++i) {
-    clouds.push_back(&mapper.submap(i).cloud);
-    placed.push_back(mapper.scan_pose(i));
+    error.Add(mapper.submap_clouds(i)->cloud, mapper.scan_pose(i),
+              covariances->scans[static_cast<size_t>(i)], static_cast<std::size_t>(i));
   }
-  result.expected_map_error_m =
-      ExpectedSurfaceErrorRms(clouds, placed, covariances->scans, kExpectedErrorStride);
+  result.expected_map_error_m = error.Rms();
 }
 
 }  // namespace

@@ -149,6 +149,21 @@ TEST_F(DiveMappingTest, WindowedSolvesMapAsWholeGraphSolvesDo) {
   EXPECT_LT(ate_windowed, 1.05 * ate_whole);
 }
 
+// The clouds of all but the last few submaps spilled to disk and read back for loops and the
+// map: the same bits as with every cloud in memory.
+TEST_F(DiveMappingTest, SpilledSubmapsMapToTheSameBits) {
+  const fs::path log = Simulate(ShortScene(), "drift.db");
+  DiveMappingOptions options;
+  options.mapper.threads = 2;
+  options.table_cache = dir_ / "tables";
+  const DiveMapping in_memory = MapDive(DiveLogReader(log), options);
+  options.mapper.spill_folder = dir_;
+  options.mapper.resident_submaps = 4;
+  const DiveMapping spilled = MapDive(DiveLogReader(log), options);
+  EXPECT_GT(spilled.loops.size(), 0u);
+  ExpectSameBits(spilled, in_memory);
+}
+
 TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
   const DiveMapping m = Map(Simulate(ShortScene(), "drift.db"));
   const MapSummary s = Summarise(m);

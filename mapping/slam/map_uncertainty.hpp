@@ -21,6 +21,22 @@ double ExpectedSurfaceErrorRms(const std::vector<const perception::PointCloud*>&
                                const std::vector<Eigen::Isometry3d>& T_W_V,
                                const std::vector<Matrix6d>& covariances, std::size_t stride = 1);
 
+// The same, one submap at a time (a long dive's submaps read back one by one): Add each cloud
+// with its pose and covariance, then Rms().
+class ExpectedSurfaceError {
+ public:
+  explicit ExpectedSurfaceError(std::size_t stride);  // stride > 0
+  // `submap` names the cloud in errors (it needs normals when it has points).
+  void Add(const perception::PointCloud& cloud_V, const Eigen::Isometry3d& T_W_V,
+           const Matrix6d& covariance, std::size_t submap);
+  double Rms() const;
+
+ private:
+  std::size_t stride_;
+  double sum_ = 0.0;
+  std::size_t count_ = 0;
+};
+
 // How far the poses are expected to lie from the true ones from their covariance alone: the
 // square root of the mean over the poses of their position variance (the trace of the position
 // block of each [rotation, position] covariance). With a consistent covariance this is what the

@@ -9,6 +9,7 @@
 #include "mapping/slam/navigation_buffer.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
 #include "mapping/slam/registration_information.hpp"
+#include "perception/preprocessing/voxel_accumulator.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
@@ -76,6 +77,7 @@ void MapperOptions::Check() const {
   check.GreaterThan("solve_window_submaps", solve_window_submaps, 0);
   check.AtLeast("solve_window_max_submaps", solve_window_max_submaps, solve_window_submaps);
   check.GreaterThan("full_solve_growth", full_solve_growth, 1.0);
+  check.GreaterThan("resident_submaps", resident_submaps, local_map_submaps);
   check.InRange("running_solve_tolerance", running_solve_tolerance, 0.0, 1.0, Interval::kOpen);
   check.InRange("weak_direction_ratio", weak_direction_ratio, 0.0, 1.0, Interval::kOpenHigh);
   check.AtLeast("slide_sigma_m", slide_sigma_m, 0.0, "m");
@@ -187,15 +189,16 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source,
   prior.information = Symmetrized(prior.information);
   prior.point_sigma_m = 2.0 * options.point_sigma_floor_m;
   icp.prior = prior;
-  return perception::AlignIcp(source.sparse, target, T_init, icp);
+  return perception::AlignIcp(store.Get(source.index)->sparse, target, T_init, icp);
 }
 
 Matrix6d Mapper::Impl::RegistrationInformation(const perception::RegistrationResult& r,
                                                const Submap& target, const Submap& source,
                                                KeptDirections* kept) const {
   const double sigma = std::max(r.inlier_plane_rmse, options.point_sigma_floor_m);
-  KeptDirections points = WithoutWeakDirections(r.information / (sigma * sigma), source.sparse,
-                                                r.T_target_source, options.weak_direction_ratio);
+  KeptDirections points =
+      WithoutWeakDirections(r.information / (sigma * sigma), store.Get(source.index)->sparse,
+                            r.T_target_source, options.weak_direction_ratio);
   // The pairs' residuals are not independent: what the navigation bent in each submap beyond a
   // rigid offset stays in every pair. Both submaps' bending floors the registration's covariance.
   const Matrix6d floor =
@@ -243,6 +246,9 @@ std::vector<Matrix6d> Mapper::Impl::ChainCovariancesTo(int to, int oldest) const
 void Mapper::Impl::AddToGraph(Submap submap) {
   const int k = static_cast<int>(submaps.size());
   submap.index = k;
+  store.Add({std::move(submap.cloud), std::move(submap.sparse)});
+  submap.cloud = {};
+  submap.sparse = {};
   const ConsecutiveRegistration c = RegisterToPrevious(submap, k);
   AddNodesAndEdges(submap, k, c);
   submaps.push_back(std::move(submap));
@@ -299,7 +305,7 @@ perception::PointCloud Mapper::Impl::LocalMap(int k) const {
   perception::PointCloud local;
   const Eigen::Isometry3d T_prev_W = ScanPose(k - 1).inverse();
   for (int j = std::max(0, k - options.local_map_submaps); j < k; ++j) {
-    AppendMoved(submaps[static_cast<size_t>(j)].cloud, T_prev_W * ScanPose(j), &local);
+    AppendMoved(store.Get(j)->cloud, T_prev_W * ScanPose(j), &local);
   }
   return local;
 }
@@ -469,15 +475,18 @@ std::optional<Mapper::SubmapCovariances> Mapper::Covariances() const {
   return out;
 }
 
+std::shared_ptr<const SubmapClouds> Mapper::submap_clouds(int index) const {
+  if (index < 0 || index >= submap_count())
+    throw Error("mapper: no submap " + std::to_string(index));
+  return impl_->store.Get(index);
+}
+
 perception::PointCloud Mapper::Map(double voxel_m) const {
-  std::vector<const perception::PointCloud*> clouds;
-  std::vector<Eigen::Isometry3d> poses;
-  for (int i = 0; i < submap_count(); ++i) {
-    const Submap& s = impl_->submaps[static_cast<size_t>(i)];
-    clouds.push_back(&s.cloud);
-    poses.push_back(scan_pose(i));
-  }
-  return MergeClouds(clouds, poses, voxel_m);
+  if (submap_count() == 0) return {};
+  // One submap at a time: the memory is the map's voxels, not every submap's points.
+  perception::VoxelAccumulator map(voxel_m, scan_pose(0).translation());
+  for (int i = 0; i < submap_count(); ++i) map.Add(submap_clouds(i)->cloud, scan_pose(i));
+  return map.Cloud();
 }
 
 }  // namespace uwscan::mapping

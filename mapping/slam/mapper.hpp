@@ -13,6 +13,7 @@
 #include "mapping/log/dive_log.hpp"
 #include "mapping/slam/pose_graph.hpp"
 #include "mapping/slam/submap.hpp"
+#include "mapping/slam/submap_store.hpp"
 #include "perception/cloud/point_cloud.hpp"
 #include "scanner/lasers/scan_pattern.hpp"
 #include "scanner/lasers/scanner.hpp"
@@ -103,6 +104,11 @@ struct MapperOptions {
   // waiting for a navigation that stopped.
   double navigation_latency_s = 1.0;
   int threads = 0;  // OpenMP threads of ICP and normals, 0 = default
+  // Memory that does not grow with the dive: the clouds of all but the newest resident_submaps
+  // submaps (> local_map_submaps) go to a spill file in this folder and are read back when a
+  // loop or the map needs them (SubmapStore); empty: every cloud stays in memory.
+  std::filesystem::path spill_folder;
+  int resident_submaps = 64;
   void Check() const;
 };
 
@@ -177,7 +183,10 @@ class Mapper {
   void Finish();
 
   int submap_count() const;
+  // A submap's place, times and shape; its clouds (empty here) come from submap_clouds.
   const Submap& submap(int index) const;
+  // Read back from the spill file when they were spilled (MapperOptions::spill_folder).
+  std::shared_ptr<const SubmapClouds> submap_clouds(int index) const;
   Eigen::Isometry3d pose(int index) const;  // current estimate of T_W_V at the submap's anchor
   // The pose its cloud is placed with: the anchor's, off by the bending of the navigation that
   // placed its frames (SubmapDistortionCovariance in navigation_uncertainty.hpp).
@@ -194,7 +203,8 @@ class Mapper {
   };
   std::optional<SubmapCovariances> Covariances() const;
   // Every submap's cloud placed with the current estimates, voxelised at `voxel_m`, origin at
-  // the first submap's position.
+  // the first submap's position; the clouds are merged one at a time, so the memory it takes is
+  // the map's.
   perception::PointCloud Map(double voxel_m) const;
 
  private:

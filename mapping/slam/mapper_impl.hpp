@@ -16,6 +16,7 @@
 #include "mapping/slam/navigation_buffer.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
 #include "mapping/slam/registration_information.hpp"
+#include "mapping/slam/submap_store.hpp"
 #include "perception/registration/registration_result.hpp"
 
 namespace uwscan::mapping {
@@ -65,7 +66,8 @@ struct Mapper::Impl {
   // that placed its frames, fits the scene best, which registration measures); a distortion
   // edge ties them (SubmapDistortionCovariance). Bending is then a bounded offset per submap,
   // not a step that accumulates along a chain of registrations.
-  std::vector<Submap> submaps;
+  std::vector<Submap> submaps;  // their clouds are in `store`
+  SubmapStore store;
   std::vector<Matrix6d>
       increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
   PoseGraph graph;
@@ -75,7 +77,7 @@ struct Mapper::Impl {
   int next_whole_solve_submaps = 0;  // the graph's size at which the next solve is whole
 
   Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
-      : options(o), T_V_C(mount), uncertainty(noise) {}
+      : options(o), T_V_C(mount), uncertainty(noise), store(o.spill_folder, o.resident_submaps) {}
 
   // Places the waiting frames the navigation covers, leaves out those it never will; at the
   // end of the dive (`finishing`) also those after its last sample.

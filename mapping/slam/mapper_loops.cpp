@@ -96,8 +96,7 @@ std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) con
 perception::PointCloud Mapper::Impl::LoopTarget(int j, int k) const {
   perception::PointCloud target;
   for (int i = std::max(0, j - 1); i <= std::min(j + 1, k - options.loop_min_index_gap); ++i) {
-    AppendMoved(submaps[static_cast<size_t>(i)].cloud, ScanPose(j).inverse() * ScanPose(i),
-                &target);
+    AppendMoved(store.Get(i)->cloud, ScanPose(j).inverse() * ScanPose(i), &target);
   }
   return target;
 }

@@ -7,6 +7,7 @@
 #include <exception>
 
 #include "perception/preprocessing/normals.hpp"
+#include "perception/preprocessing/voxel_accumulator.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
@@ -88,16 +89,10 @@ perception::PointCloud MergeClouds(const std::vector<const perception::PointClou
                                    const std::vector<Eigen::Isometry3d>& T_W_cloud,
                                    double voxel_m) {
   if (clouds.size() != T_W_cloud.size()) throw Error("MergeClouds: one pose per cloud expected");
-  perception::PointCloud all;
-  if (clouds.empty()) return all;
-  all.origin = T_W_cloud.front().translation();
-  for (std::size_t c = 0; c < clouds.size(); ++c) {
-    // Relative to the merged origin in double, then stored in float.
-    const Eigen::Isometry3d T = Eigen::Translation3d(-all.origin) * T_W_cloud[c];
-    for (std::size_t i = 0; i < clouds[c]->size(); ++i)
-      all.points.push_back((T * clouds[c]->Point(i)).cast<float>());
-  }
-  return perception::VoxelDownsample(all, {voxel_m});
+  if (clouds.empty()) return {};
+  perception::VoxelAccumulator merged(voxel_m, T_W_cloud.front().translation());
+  for (std::size_t c = 0; c < clouds.size(); ++c) merged.Add(*clouds[c], T_W_cloud[c]);
+  return merged.Cloud();
 }
 
 }  // namespace uwscan::mapping

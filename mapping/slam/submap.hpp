@@ -21,6 +21,8 @@ struct Submap {
   double end_s = 0.0;
   Eigen::Isometry3d T_W_V_start = Eigen::Isometry3d::Identity();  // navigation at the first frame
   Eigen::Isometry3d T_W_V_end = Eigen::Isometry3d::Identity();    // and at the last
+  // Built by BuildSubmapClouds; a Mapper keeps them in its SubmapStore (Mapper::submap_clouds),
+  // so the Submaps it hands out have them empty.
   perception::PointCloud cloud;   // voxelised at the map voxel, with normals (ICP target)
   perception::PointCloud sparse;  // voxelised at the registration voxel (ICP source)
   Eigen::Vector3d centroid_V = Eigen::Vector3d::Zero();  // of the cloud, in {V_k}

@@ -1,0 +1,86 @@
+#include "perception/preprocessing/voxel_accumulator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "perception/preprocessing/voxel_filter.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/common/random_draws.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+PointCloud RandomCloud(std::uint64_t seed, std::size_t n, const Eigen::Vector3d& origin) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> coordinate(-0.3, 0.3);
+  PointCloud cloud;
+  cloud.origin = origin;
+  for (std::size_t i = 0; i < n; ++i)
+    cloud.points.push_back(DrawVector3(coordinate, rng).cast<float>());
+  return cloud;
+}
+
+Eigen::Isometry3d Pose(double angle_rad, const Eigen::Vector3d& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(angle_rad, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  T.translation() = t;
+  return T;
+}
+
+// The reference: every cloud moved into one float cloud about the origin, then VoxelDownsample.
+TEST(VoxelAccumulator, GivesTheBitsOfVoxelDownsampleOfAllThePointsTogether) {
+  const Eigen::Vector3d origin(512.25, -73.5, 9.0);  // far from zero, as a world frame is
+  std::vector<PointCloud> clouds;
+  std::vector<Eigen::Isometry3d> poses;
+  for (int c = 0; c < 5; ++c) {
+    clouds.push_back(RandomCloud(10 + static_cast<std::uint64_t>(c), 3000, Eigen::Vector3d(0.1 * c, 0, 0)));
+    poses.push_back(Pose(0.3 * c, origin + Eigen::Vector3d(0.05 * c, -0.02 * c, 0.01)));
+  }
+  PointCloud all;
+  all.origin = origin;
+  VoxelAccumulator accumulator(0.02, origin);
+  for (std::size_t c = 0; c < clouds.size(); ++c) {
+    const Eigen::Isometry3d T = Eigen::Translation3d(-origin) * poses[c];
+    for (std::size_t i = 0; i < clouds[c].size(); ++i)
+      all.points.push_back((T * clouds[c].Point(i)).cast<float>());
+    accumulator.Add(clouds[c], poses[c]);
+  }
+  const PointCloud expected = VoxelDownsample(all, {.leaf_m = 0.02});
+  const PointCloud merged = accumulator.Cloud();
+  EXPECT_EQ(merged.origin, expected.origin);
+  ASSERT_EQ(merged.size(), expected.size());
+  EXPECT_EQ(accumulator.voxel_count(), expected.size());
+  for (std::size_t i = 0; i < merged.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(merged.points[i][k]),
+                std::bit_cast<std::uint32_t>(expected.points[i][k]))
+          << "point " << i;
+    }
+  }
+}
+
+TEST(VoxelAccumulator, RevisitsAddNoVoxels) {
+  const PointCloud cloud = RandomCloud(3, 5000, Eigen::Vector3d::Zero());
+  VoxelAccumulator accumulator(0.05, Eigen::Vector3d::Zero());
+  accumulator.Add(cloud, Eigen::Isometry3d::Identity());
+  const std::size_t once = accumulator.voxel_count();
+  for (int pass = 0; pass < 20; ++pass) accumulator.Add(cloud, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(accumulator.voxel_count(), once);
+}
+
+TEST(VoxelAccumulator, RefusesABadLeafAndANonFinitePoint) {
+  EXPECT_THROW(VoxelAccumulator(0.0, Eigen::Vector3d::Zero()), Error);
+  EXPECT_THROW(VoxelAccumulator(NAN, Eigen::Vector3d::Zero()), Error);
+  VoxelAccumulator accumulator(0.01, Eigen::Vector3d::Zero());
+  PointCloud bad;
+  bad.points.push_back(Eigen::Vector3f(0.0f, NAN, 0.0f));
+  EXPECT_THROW(accumulator.Add(bad, Eigen::Isometry3d::Identity()), Error);
+}
+
+}  // namespace
+}  // namespace uwscan::perception
