@@ -15,6 +15,7 @@
 #include "apps/bench/robustness_bench_command.hpp"
 #include "apps/bench/simulation_bench_command.hpp"
 #include "apps/bench/slam_bench_command.hpp"
+#include "apps/bench/soak_bench_command.hpp"
 #include "apps/bench/stripe_commands.hpp"
 #include "apps/bench/thread_bench_command.hpp"
 #include "apps/cli/data_folder.hpp"
@@ -99,6 +100,7 @@ int main(int argc, char** argv) {
   uwscan::app::AddRecognitionBenchCommand(*bench);
   uwscan::app::AddViewerBenchCommand(*bench);
   uwscan::app::AddAcquisitionBenchCommand(*bench);
+  uwscan::app::AddSoakBenchCommand(*bench);
   uwscan::app::AddRosBenchCommand(*bench);
   uwscan::app::AddRobustnessBenchCommand(*bench);
   uwscan::app::AddThreadBenchCommand(*bench);

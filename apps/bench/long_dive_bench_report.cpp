@@ -22,6 +22,7 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"map_rms_m", r.map_rms_m},
           {"submap_seconds",
            {{"first_tenth", TimesJson(r.first_tenth)}, {"last_tenth", TimesJson(r.last_tenth)}}},
+          {"rss_bytes_at_start", r.rss_bytes_at_start},
           {"peak_rss_bytes", r.peak_rss_bytes},
           {"rss_bytes_last_tenth", r.rss_bytes_last_tenth},
           {"loops_accepted", r.loops_accepted},

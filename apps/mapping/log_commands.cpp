@@ -6,6 +6,7 @@
 
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/output_path.hpp"
+#include "apps/cli/progress_bar.hpp"
 #include "mapping/log/dive_log.hpp"
 #include "scanner/common/error.hpp"
 
@@ -66,7 +67,11 @@ void PrintCheck(const std::string& log, const mapping::DiveLogCheck& check) {
 void RunCheck(const CheckArgs& a) {
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.log});
   const mapping::DiveLogReader reader(a.log, mapping::DiveLogOpening::kDamaged);
-  const mapping::DiveLogCheck check = reader.Check({}, {});
+  mapping::DiveLogCheck check;
+  {
+    ProgressBar bar;
+    check = reader.Check({}, {}, [&](double fraction) { bar.Update("check", fraction); });
+  }
   PrintCheck(a.log, check);
   if (!a.json.empty()) WriteJsonFile(a.json, ToJson(check));
   if (!check.ok()) {
@@ -90,11 +95,13 @@ void RunSalvage(const SalvageArgs& a) {
   bool mount_copied = false;
   mapping::WriteDiveLogAtomically(a.output, [&](const fs::path& partial) {
     mapping::DiveLogWriter writer(partial, header);
+    ProgressBar bar;
     check = reader.Check(
         [&](const mapping::FrameRecord& frame, const mapping::GroundTruthRecord* truth) {
           writer.AppendFrame(frame, truth);
         },
-        [&](const mapping::NavigationRecord& sample) { writer.AppendNavigation(sample); });
+        [&](const mapping::NavigationRecord& sample) { writer.AppendNavigation(sample); },
+        [&](double fraction) { bar.Update("salvage", fraction); });
     try {
       if (const auto mount = reader.vehicle_mount()) {
         writer.SetVehicleMount(*mount);

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -25,6 +26,7 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/output_path.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/resident_memory.hpp"
 
 // The bench runs uwscan's own commands as a user would (simulate, bag export, ros inspect,
 // fake-camera, inspect), each a child process whose CPU time and peak memory wait4 reports, beside
@@ -73,13 +75,10 @@ class RssSampler {
   void Run() {
     const auto start = std::chrono::steady_clock::now();
     while (!stop_) {
-      std::ifstream status("/proc/" + std::to_string(pid_) + "/status");
-      std::string line;
-      while (std::getline(status, line)) {
-        if (line.rfind("VmRSS:", 0) != 0) continue;
+      if (const std::optional<std::int64_t> bytes = ResidentBytes(pid_)) {
         const double t =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        samples_.emplace_back(t, std::stoll(line.substr(6)) * 1024);
+        samples_.emplace_back(t, *bytes);
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
     }

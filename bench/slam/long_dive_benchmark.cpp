@@ -1,7 +1,7 @@
 #include "bench/slam/long_dive_benchmark.hpp"
 
+#include <malloc.h>
 #include <omp.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +15,7 @@
 #include "mapping/slam/dive_mapping.hpp"
 #include "mapping/slam/map_report.hpp"
 #include "scanner/common/option_checks.hpp"
+#include "scanner/common/resident_memory.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
@@ -26,12 +27,6 @@ constexpr int kRssSamples = 200;    // over a dive
 constexpr int kTimeStretches = 60;  // the time-per-submap series' points
 
 // The process's resident memory now (bytes), from /proc/self/statm; 0 if it cannot be read.
-std::int64_t ResidentBytes() {
-  std::ifstream statm("/proc/self/statm");
-  std::int64_t size_pages = 0, resident_pages = 0;
-  if (!(statm >> size_pages >> resident_pages)) return 0;
-  return resident_pages * static_cast<std::int64_t>(::sysconf(_SC_PAGESIZE));
-}
 
 // The median time per submap in each of kTimeStretches stretches of the dive, at each stretch's
 // middle submap's time.
@@ -56,7 +51,11 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   map_options.mapper.spill_folder = log_path.parent_path();
   map_options.table_cache = options.table_cache;
   omp_set_num_threads(options.threads);
+  // The runs share this process: what the last one freed goes back to the system first, so each
+  // run's resident memory starts from the process's own floor, not the last run's peak.
+  malloc_trim(0);
   LongDiveRun run;
+  run.rss_bytes_at_start = ResidentBytes().value_or(0);
   const mapping::DiveLogReader log(log_path);
   int next_sample = 0;
   std::vector<double> rss_fractions;
@@ -64,7 +63,7 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
     if (fraction * kRssSamples < next_sample) return;
     ++next_sample;
     rss_fractions.push_back(fraction);
-    run.rss_bytes.push_back(ResidentBytes());
+    run.rss_bytes.push_back(ResidentBytes().value_or(0));
     if (progress) progress(label, fraction);
   });
   for (const double fraction : rss_fractions)

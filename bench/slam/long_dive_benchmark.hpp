@@ -38,7 +38,8 @@ struct LongDiveRun {
   double ate_m = 0.0;
   double map_rms_m = 0.0;  // distance of the map's points to the true surfaces
   SubmapTimes first_tenth, last_tenth;
-  std::int64_t peak_rss_bytes = 0;        // the process's resident memory while mapping, at most
+  std::int64_t rss_bytes_at_start = 0;    // the process's resident memory before mapping
+  std::int64_t peak_rss_bytes = 0;        // and while mapping, at most
   std::int64_t rss_bytes_last_tenth = 0;  // its mean over the last tenth of the dive
   int loops_accepted = 0;
   int whole_solves = 0, window_solves = 0;

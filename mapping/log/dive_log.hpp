@@ -212,10 +212,11 @@ class DiveLogReader {
   // `navigation` for each intact sample in nav_id order; either may be empty. A frame whose
   // ground truth is damaged is intact, handed over without it (nullptr), and its ground truth
   // is a damaged row of table ground_truth. A truncated file (opened as kDamaged) is an
-  // integrity finding naming how much of it is missing. Throws only when the file cannot be
-  // read at all.
+  // integrity finding naming how much of it is missing. `progress` receives the fraction of
+  // frames read. Throws only when the file cannot be read at all.
   DiveLogCheck Check(const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
-                     const std::function<void(const NavigationRecord&)>& navigation) const;
+                     const std::function<void(const NavigationRecord&)>& navigation,
+                     const std::function<void(double)>& progress = {}) const;
 
   const std::filesystem::path& path() const;
 

@@ -454,7 +454,7 @@ std::vector<std::string> QuickCheck(sqlite3* db) {
 // frame is worth keeping without its ground truth: a real dive has none.
 void CheckFrames(const DiveLogReader& log, sqlite3* db, const std::string& name,
                  const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
-                 DiveLogCheck& check) {
+                 const std::function<void(double)>& progress, DiveLogCheck& check) {
   std::vector<std::int64_t> indices;
   const std::string listing =
       ForEachInteger(db, "SELECT frame_index FROM frames ORDER BY frame_index",
@@ -466,7 +466,9 @@ void CheckFrames(const DiveLogReader& log, sqlite3* db, const std::string& name,
   }
   check.frames = static_cast<std::int64_t>(indices.size());
   std::int64_t expected = 0;
-  for (std::int64_t index : indices) {
+  for (std::size_t done = 0; done < indices.size(); ++done) {
+    const std::int64_t index = indices[done];
+    if (progress) progress(static_cast<double>(done) / static_cast<double>(indices.size()));
     for (; expected < index; ++expected) {
       check.damage.push_back(
           {"frames", expected, name + ": " + FrameName(expected) + " is missing"});
@@ -521,7 +523,8 @@ void CheckNavigation(sqlite3_stmt* s, sqlite3* db, const std::string& name, bool
 
 DiveLogCheck DiveLogReader::Check(
     const std::function<void(const FrameRecord&, const GroundTruthRecord*)>& frame,
-    const std::function<void(const NavigationRecord&)>& navigation) const {
+    const std::function<void(const NavigationRecord&)>& navigation,
+    const std::function<void(double)>& progress) const {
   const Impl& r = *impl_;
   DiveLogCheck check;
   check.schema_version = r.header.schema_version;
@@ -535,13 +538,14 @@ DiveLogCheck DiveLogReader::Check(
   } catch (const Error& e) {
     check.damage.push_back({"header", -1, e.what()});
   }
-  CheckFrames(*this, r.db.get(), r.name, frame, check);
+  CheckFrames(*this, r.db.get(), r.name, frame, progress, check);
   const Statement statement = r.Prepare(
       "SELECT nav_id, time_s, T_W_V_tx, T_W_V_ty, T_W_V_tz, T_W_V_qx, T_W_V_qy, T_W_V_qz, "
       "T_W_V_qw, " +
           Checksums("navigation", r.checksummed()) + " FROM navigation ORDER BY nav_id",
       0);
   CheckNavigation(statement.get(), r.db.get(), r.name, r.checksummed(), navigation, check);
+  if (progress) progress(1.0);
   return check;
 }
 

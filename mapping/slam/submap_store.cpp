@@ -60,7 +60,8 @@ std::int64_t CloudBytes(const perception::PointCloud& c) {
 
 SubmapStore::SubmapStore(const std::filesystem::path& spill_folder, int resident)
     : resident_(resident) {
-  if (resident <= 0) throw Error("submap store: resident must be > 0, got " + std::to_string(resident));
+  if (resident <= 0)
+    throw Error("submap store: resident must be > 0, got " + std::to_string(resident));
   if (spill_folder.empty()) return;
   spill_path_ = NewSpillPath(spill_folder);
   std::ofstream create(spill_path_, std::ios::binary | std::ios::trunc);

@@ -71,10 +71,9 @@ TEST_F(SubmapStoreTest, MemoryStaysUnderItsBoundOnALongStream) {
   constexpr int kResident = 16;
   constexpr std::size_t kPoints = 2000;
   const SubmapClouds one = Clouds(0, kPoints);
-  const std::int64_t per_submap =
-      static_cast<std::int64_t>((one.cloud.points.capacity() + one.cloud.normals.capacity() +
-                                 one.sparse.points.capacity()) *
-                                sizeof(Eigen::Vector3f));
+  const std::int64_t per_submap = static_cast<std::int64_t>(
+      (one.cloud.points.capacity() + one.cloud.normals.capacity() + one.sparse.points.capacity()) *
+      sizeof(Eigen::Vector3f));
   const std::int64_t bound = (kResident + SubmapStore::kReadBackCache) * per_submap;
   SubmapStore store(dir_, kResident);
   std::int64_t largest = 0;

@@ -31,7 +31,8 @@ void VoxelAccumulator::Add(const PointCloud& cloud, const Eigen::Isometry3d& T) 
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f p = (T_relative * cloud.Point(i)).cast<float>();
     const Eigen::Vector3d absolute = origin_ + p.cast<double>();
-    if (!absolute.allFinite()) throw Error("VoxelAccumulator: point " + std::to_string(i) + " is not finite");
+    if (!absolute.allFinite())
+      throw Error("VoxelAccumulator: point " + std::to_string(i) + " is not finite");
     Key key;
     for (int a = 0; a < 3; ++a) {
       const double k = std::floor(absolute[a] / leaf_m_);
@@ -52,12 +53,14 @@ PointCloud VoxelAccumulator::Cloud() const {
   std::vector<const std::pair<const Key, Sum>*> sorted;
   sorted.reserve(voxels_.size());
   for (const auto& entry : voxels_) sorted.push_back(&entry);
-  std::sort(sorted.begin(), sorted.end(), [](const auto* a, const auto* b) { return a->first < b->first; });
+  std::sort(sorted.begin(), sorted.end(),
+            [](const auto* a, const auto* b) { return a->first < b->first; });
   PointCloud out;
   out.origin = origin_;
   out.points.reserve(sorted.size());
   for (const auto* entry : sorted)
-    out.points.push_back((entry->second.sum / static_cast<double>(entry->second.count)).cast<float>());
+    out.points.push_back(
+        (entry->second.sum / static_cast<double>(entry->second.count)).cast<float>());
   return out;
 }
 

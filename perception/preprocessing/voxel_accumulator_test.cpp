@@ -27,7 +27,8 @@ PointCloud RandomCloud(std::uint64_t seed, std::size_t n, const Eigen::Vector3d&
 
 Eigen::Isometry3d Pose(double angle_rad, const Eigen::Vector3d& t) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(angle_rad, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  T.linear() =
+      Eigen::AngleAxisd(angle_rad, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   T.translation() = t;
   return T;
 }
@@ -38,7 +39,8 @@ TEST(VoxelAccumulator, GivesTheBitsOfVoxelDownsampleOfAllThePointsTogether) {
   std::vector<PointCloud> clouds;
   std::vector<Eigen::Isometry3d> poses;
   for (int c = 0; c < 5; ++c) {
-    clouds.push_back(RandomCloud(10 + static_cast<std::uint64_t>(c), 3000, Eigen::Vector3d(0.1 * c, 0, 0)));
+    clouds.push_back(
+        RandomCloud(10 + static_cast<std::uint64_t>(c), 3000, Eigen::Vector3d(0.1 * c, 0, 0)));
     poses.push_back(Pose(0.3 * c, origin + Eigen::Vector3d(0.05 * c, -0.02 * c, 0.01)));
   }
   PointCloud all;

@@ -245,6 +245,59 @@ std::vector<PlotSpec> Slam(const json& j, const std::string& file) {
   return {p};
 }
 
+// A series of a long dive's run (bench slam --long): y against the dive's time in minutes.
+PlotSeries DiveSeries(const json& run, const char* x_key, const char* y_key, double y_scale,
+                      const std::string& label, int colour, const std::string& file) {
+  const json& series = run.at("series");
+  const std::vector<double> x = series.at(x_key).get<std::vector<double>>();
+  const std::vector<double> y = series.at(y_key).get<std::vector<double>>();
+  if (x.size() != y.size() || x.empty())
+    throw Error(file + ": series '" + x_key + "' and '" + y_key +
+                "' differ in length or are empty");
+  PlotSeries line{label, {}, {}, SeriesStyle::kLine, CategoricalColour(colour)};
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    line.x.push_back(x[i] / 60.0);
+    line.y.push_back(y[i] * y_scale);
+  }
+  return line;
+}
+
+// Long dives: time per submap and resident memory against dive time, windowed and whole-graph
+// solves, one line each per dive.
+std::vector<PlotSpec> SlamLong(const json& j, const std::string& file) {
+  PlotSpec time{"Mapping: time per submap against dive time",
+                "dive time (min)",
+                "time per submap (ms, median of each stretch)",
+                false,
+                true,
+                {},
+                {},
+                {}};
+  PlotSpec memory{"Mapping: resident memory against dive time",
+                  "dive time (min)",
+                  "resident memory (MB)",
+                  false,
+                  false,
+                  {},
+                  {},
+                  {}};
+  int colour = 0;
+  for (const json& dive : j.at("dives")) {
+    const std::string name = dive.at("name").get<std::string>();
+    std::vector<std::pair<std::string, const json*>> runs = {{name + ", windowed", &dive}};
+    if (const auto whole = dive.find("full_solve"); whole != dive.end() && !whole->is_null())
+      runs.emplace_back(name + ", whole graph", &*whole);
+    for (const auto& [label, run] : runs) {
+      time.series.push_back(
+          DiveSeries(*run, "submap_time_s", "submap_seconds", 1e3, label, colour, file));
+      memory.series.push_back(
+          DiveSeries(*run, "rss_time_s", "rss_bytes", 1e-6, label, colour, file));
+      ++colour;
+    }
+  }
+  return {time, memory};
+}
+
 std::vector<PlotSpec> Accuracy(const json& j, const std::string& file) {
   std::vector<PlotSpec> plots;
   if (const auto w = j.find("waypoints"); w != j.end() && !w->empty()) {
@@ -377,6 +430,7 @@ BenchPlots ReadBenchPlots(const std::filesystem::path& path) {
     if (j.contains("pipelines") && j.contains("confusion"))
       return {"recognition", Recognition(j, file)};
     if (j.contains("pipelines")) return {"registration", Registration(j, file)};
+    if (j.value("bench", std::string()) == "slam_long") return {"slam_long", SlamLong(j, file)};
     if (j.contains("dives")) return {"slam", Slam(j, file)};
     // The calibration bench reports gauges too: its "steps" tell it from the accuracy bench.
     if (j.contains("steps")) return {"calibration", Calibration(j, file)};
@@ -389,7 +443,7 @@ BenchPlots ReadBenchPlots(const std::filesystem::path& path) {
   throw Error(
       file +
       ": not the JSON of a bench this uwscan can plot (triangulation, stripe, registration, "
-      "recognition, slam, accuracy, calibration, deformation, viewer)");
+      "recognition, slam, slam --long, accuracy, calibration, deformation, viewer)");
 }
 
 }  // namespace uwscan::viewer

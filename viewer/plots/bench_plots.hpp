@@ -13,7 +13,8 @@ namespace uwscan::viewer {
 // their Pareto front and the speed limit measured in the same run; registration pipelines as
 // success against time; the MEMS waypoints per line (plane residual, lines/s) and the plane
 // residual against range; calibration steps as time per step; the deformation experiment as
-// fit residual against incidence; the viewer bench as render time against points.
+// fit residual against incidence; the viewer bench as render time against points; long dives
+// as time per submap and memory against dive time.
 struct BenchPlots {
   std::string bench;  // which bench wrote the file
   std::vector<PlotSpec> plots;

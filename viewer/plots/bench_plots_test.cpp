@@ -84,6 +84,24 @@ TEST(BenchPlots, RecognitionAndSlamAreTellApartFromRegistration) {
       Error);
 }
 
+TEST(BenchPlots, LongDivesDrawTimePerSubmapAndMemoryAgainstDiveTime) {
+  const BenchPlots plots = PlotsOf(R"({"bench": "slam_long", "dives": [{"name": "m4",
+    "series": {"submap_time_s": [60, 120], "submap_seconds": [0.02, 0.03],
+               "rss_time_s": [0, 120], "rss_bytes": [1e8, 2e8]},
+    "full_solve": {"series": {"submap_time_s": [60, 120], "submap_seconds": [0.02, 0.05],
+                              "rss_time_s": [0, 120], "rss_bytes": [1e8, 3e8]}}}]})");
+  EXPECT_EQ(plots.bench, "slam_long");
+  ASSERT_EQ(plots.plots.size(), 2u);
+  const PlotSeries& windowed = SeriesNamed(plots.plots[0], "m4, windowed");
+  EXPECT_EQ(windowed.x, (std::vector<double>{1.0, 2.0}));    // minutes
+  EXPECT_EQ(windowed.y, (std::vector<double>{20.0, 30.0}));  // milliseconds
+  EXPECT_EQ(SeriesNamed(plots.plots[1], "m4, whole graph").y, (std::vector<double>{100.0, 300.0}));
+  EXPECT_THROW(PlotsOf(R"({"bench": "slam_long", "dives": [{"name": "m4",
+    "series": {"submap_time_s": [60], "submap_seconds": [],
+               "rss_time_s": [0], "rss_bytes": [1]}}]})"),
+               Error);
+}
+
 TEST(BenchPlots, CalibrationWithGaugesIsNotTakenForTheAccuracyBench) {
   const BenchPlots plots = PlotsOf(R"({"gauges": [], "seconds": 50,
     "steps": {"intrinsics": {"seconds": 3.5}, "laser": {"seconds": 20}}})");

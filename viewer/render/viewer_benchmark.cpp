@@ -10,6 +10,7 @@
 #include <string>
 
 #include "scanner/common/option_checks.hpp"
+#include "scanner/common/resident_memory.hpp"
 #include "viewer/render/display.hpp"
 #include "viewer/render/vtk_scene.hpp"
 
@@ -22,20 +23,8 @@ double Since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Resident memory of this process (VmRSS), megabytes.
-double ResidentMb() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      double kb = 0.0;
-      status >> kb;
-      return kb / 1024.0;
-    }
-    status.ignore(1 << 12, '\n');
-  }
-  return 0.0;
-}
+// Resident memory of this process, megabytes (MiB).
+double ResidentMb() { return static_cast<double>(ResidentBytes().value_or(0)) / (1024.0 * 1024.0); }
 
 // A rough seabed: a square of `n` points 10 m wide, gentle waves plus uniform noise, 5 m deep.
 Scene Seabed(std::size_t n, std::uint64_t seed) {
