@@ -49,10 +49,12 @@ nlohmann::json DiveJson(const bench::LongDiveFigures& f) {
 
 void PrintRow(const char* method, const bench::LongDiveRun& r) {
   std::printf(
-      "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f MB | %.0f MB | %.1fx | %.1f mm | %.2f mm "
+      "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f / %.0f MB | %.0f MB | %.1fx | %.1f mm | %.2f "
+      "mm "
       "| %d | %d + %d |\n",
       method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3, r.last_tenth.median_s * 1e3,
-      r.last_tenth.p95_s * 1e3, static_cast<double>(r.peak_rss_bytes) / 1e6,
+      r.last_tenth.p95_s * 1e3, static_cast<double>(r.rss_bytes_at_start) / 1e6,
+      static_cast<double>(r.peak_rss_bytes) / 1e6,
       static_cast<double>(r.rss_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
       r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves);
 }
@@ -73,8 +75,8 @@ void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whol
     dives = bench::RunLongDiveBench(options, bar.Callback());
   }
   std::printf(
-      "| dive | solves | time per submap, first tenth: median / p95 | last tenth | peak RSS | RSS, "
-      "last tenth | real time | ATE | map RMS | loops | whole + window solves |\n"
+      "| dive | solves | time per submap, first tenth: median / p95 | last tenth | RSS at start / "
+      "peak | RSS, last tenth | real time | ATE | map RMS | loops | whole + window solves |\n"
       "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json out = {{"bench", "slam_long"}, {"dives", nlohmann::json::array()}};
   for (const bench::LongDiveFigures& f : dives) {

@@ -45,9 +45,9 @@ struct SoakArgs {
 };
 
 struct Minute {
-  std::int64_t frames = 0;   // received in the minute
-  std::int64_t lost = 0;     // lost by the camera link in the minute
-  std::int64_t skipped = 0;  // pushed out of the live queue in the minute
+  std::int64_t frames = 0;     // received in the minute
+  std::int64_t lost = 0;       // lost by the camera link in the minute
+  std::int64_t skipped = 0;    // pushed out of the live queue in the minute
   std::int64_t rss_bytes = 0;  // at the minute's end
   double latency_p95_s = 0.0;  // receive to points in the map, frames mapped in the minute
   double latency_max_s = 0.0;
@@ -58,7 +58,6 @@ double UnixSeconds() {
   clock_gettime(CLOCK_REALTIME, &t);
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
-
 
 // The latencies of the frames mapped since the last call, handed over from the mapping thread.
 class LatencyBox {
@@ -87,24 +86,28 @@ void CloseMinute(std::vector<double> latencies, const acq::FrameSourceStatistics
   m.rss_bytes = ResidentBytes().value_or(0);
   if (!latencies.empty()) {
     std::sort(latencies.begin(), latencies.end());
-    m.latency_p95_s = latencies[static_cast<size_t>(
-        std::ceil(0.95 * static_cast<double>(latencies.size())) - 1)];
+    m.latency_p95_s =
+        latencies[static_cast<size_t>(std::ceil(0.95 * static_cast<double>(latencies.size())) - 1)];
     m.latency_max_s = latencies.back();
   }
   *previous_totals = {inspection.frames_received, link.lost_frames, inspection.frames_skipped};
   minutes->push_back(m);
-  std::printf("minute %3zu: %lld frames, %lld lost, %lld skipped, %.0f MB resident, latency p95 "
-              "%.1f ms (max %.1f)\n",
-              minutes->size(), static_cast<long long>(m.frames), static_cast<long long>(m.lost),
-              static_cast<long long>(m.skipped), static_cast<double>(m.rss_bytes) / 1e6,
-              m.latency_p95_s * 1e3, m.latency_max_s * 1e3);
+  std::printf(
+      "minute %3zu: %lld frames, %lld lost, %lld skipped, %.0f MB resident, latency p95 "
+      "%.1f ms (max %.1f)\n",
+      minutes->size(), static_cast<long long>(m.frames), static_cast<long long>(m.lost),
+      static_cast<long long>(m.skipped), static_cast<double>(m.rss_bytes) / 1e6,
+      m.latency_p95_s * 1e3, m.latency_max_s * 1e3);
   std::fflush(stdout);
 }
 
 nlohmann::json MinuteJson(const Minute& m) {
-  return {{"frames", m.frames},         {"frames_lost", m.lost},
-          {"frames_skipped", m.skipped}, {"rss_bytes", m.rss_bytes},
-          {"latency_p95_s", m.latency_p95_s}, {"latency_max_s", m.latency_max_s}};
+  return {{"frames", m.frames},
+          {"frames_lost", m.lost},
+          {"frames_skipped", m.skipped},
+          {"rss_bytes", m.rss_bytes},
+          {"latency_p95_s", m.latency_p95_s},
+          {"latency_max_s", m.latency_max_s}};
 }
 
 void WriteSoakJson(const std::string& path, const SoakArgs& a, const std::vector<Minute>& minutes,
@@ -115,25 +118,27 @@ void WriteSoakJson(const std::string& path, const SoakArgs& a, const std::vector
     lost += m.lost;
     per_minute.push_back(MinuteJson(m));
   }
-  WriteJsonFile(path, {{"minutes", a.minutes},
-                       {"frames_per_s_asked", kSeedCameraFps},
-                       {"frames", s.frames_received},
-                       {"frames_lost", lost},
-                       {"frames_logged", s.frames_logged},
-                       {"frames_mapped", s.frames_mapped},
-                       {"frames_skipped", s.frames_skipped},
-                       {"rss_bytes",
-                        {{"first_minute", minutes.front().rss_bytes},
-                         {"last_minute", minutes.back().rss_bytes}}},
-                       {"latency_p95_s",
-                        {{"first_minute", minutes.front().latency_p95_s},
-                         {"last_minute", minutes.back().latency_p95_s}}},
-                       {"latency_measured", "host receive to points in the live map"},
-                       {"per_minute", per_minute}});
+  WriteJsonFile(
+      path,
+      {{"minutes", a.minutes},
+       {"frames_per_s_asked", kSeedCameraFps},
+       {"frames", s.frames_received},
+       {"frames_lost", lost},
+       {"frames_logged", s.frames_logged},
+       {"frames_mapped", s.frames_mapped},
+       {"frames_skipped", s.frames_skipped},
+       {"rss_bytes",
+        {{"first_minute", minutes.front().rss_bytes}, {"last_minute", minutes.back().rss_bytes}}},
+       {"latency_p95_s",
+        {{"first_minute", minutes.front().latency_p95_s},
+         {"last_minute", minutes.back().latency_p95_s}}},
+       {"latency_measured", "host receive to points in the live map"},
+       {"per_minute", per_minute}});
 }
 
 void RunSoak(SoakArgs a) {
-  if (!(a.minutes >= 1.0 && a.minutes <= 24.0 * 60.0)) throw Error("--minutes must be in [1, 1440]");
+  if (!(a.minutes >= 1.0 && a.minutes <= 24.0 * 60.0))
+    throw Error("--minutes must be in [1, 1440]");
   if (a.scene.empty()) a.scene = (DataFolder() / "scenes" / "default.yaml").string();
   // A private network namespace, as bench acquisition: nothing leaves the machine. Must come
   // before any thread is started.
@@ -159,7 +164,8 @@ void RunSoak(SoakArgs a) {
   LatencyBox latencies;
   mapping::LiveInspection inspection(
       context.header, scratch.path() / "soak.db", context.T_V_C, mapping::NavigationNoise{},
-      options, [&](const mapping::MappedFrame& f) { latencies.Add(UnixSeconds() - f.receive_time_s); });
+      options,
+      [&](const mapping::MappedFrame& f) { latencies.Add(UnixSeconds() - f.receive_time_s); });
   std::printf("bench soak: inspect on the fake camera, profile mode, %.0f frames/s, %.0f minutes\n",
               kSeedCameraFps, a.minutes);
   std::vector<Minute> minutes;
@@ -171,7 +177,8 @@ void RunSoak(SoakArgs a) {
         inspection.Push(ToInspectionFrame(std::move(*record), *frame));
     }
     if (source.ElapsedSeconds() >= 60.0 * static_cast<double>(minutes.size() + 1))
-      CloseMinute(latencies.Take(), source.statistics(), inspection.statistics(), &totals, &minutes);
+      CloseMinute(latencies.Take(), source.statistics(), inspection.statistics(), &totals,
+                  &minutes);
   }
   source.Stop();
   const mapping::InspectionStatistics s = inspection.Finish().statistics;
@@ -192,7 +199,8 @@ void AddSoakBenchCommand(CLI::App& bench) {
       "inspect on the fake camera (profile mode, 339 frames/s, logged and mapped live) for "
       "--minutes: frames lost and skipped, resident memory and latency to the map, minute by "
       "minute");
-  cmd->add_option("--minutes", args->minutes, "minutes to run, in [1, 1440]")->capture_default_str();
+  cmd->add_option("--minutes", args->minutes, "minutes to run, in [1, 1440]")
+      ->capture_default_str();
   cmd->add_option("--scene", args->scene,
                   "scene the fake camera serves (default: scenes/default.yaml in the data folder)")
       ->check(CLI::ExistingFile);

@@ -32,9 +32,17 @@ struct BuildDbArgs {
   int views = 48;
   std::vector<double> standoffs_m = {0.6, 1.0, 1.4};
   double voxel_m = 0.005;
+  std::string units = "m";
   std::uint64_t seed = 1;
   int threads = 0;
 };
+
+double MetresPer(const std::string& units) {
+  if (units == "m") return 1.0;
+  if (units == "cm") return 0.01;
+  if (units == "mm") return 0.001;
+  throw Error("--units " + units + ": expected m, cm or mm");
+}
 
 void RunBuildDb(const BuildDbArgs& a) {
   std::vector<std::filesystem::path> inputs(a.objects.begin(), a.objects.end());
@@ -42,8 +50,9 @@ void RunBuildDb(const BuildDbArgs& a) {
   CheckOutputPath(a.output, "-o", inputs);
   std::vector<perception::ObjectSource> sources;
   for (const std::string& name : a.objects) {
-    sources.push_back(std::filesystem::exists(name) ? perception::MeshObject(name)
-                                                    : perception::CatalogueObject(name));
+    sources.push_back(std::filesystem::exists(name)
+                          ? perception::MeshObject(name, MetresPer(a.units))
+                          : perception::CatalogueObject(name));
   }
   const scanner::Scanner scanner = a.scanner.empty()
                                        ? scanner::DefaultScanner(scanner::ScannerKind::kGalvo)
@@ -162,7 +171,7 @@ void AddBuildDbCommand(CLI::App& app) {
       "scan objects with the virtual scanner and write the database `recognize` searches: "
       "ESF per view, model with FPFH, diameter, symmetries, grasp frames");
   cmd->add_option("objects", a->objects,
-                  "mesh files (PLY/OFF/STL/OBJ, metres; grasps and symmetries from "
+                  "mesh files (PLY/OFF/STL/OBJ in --units; grasps and symmetries from "
                   "MESH.grasps.yaml beside them) or procedural objects: pipe, elbow, tee, flange, "
                   "valve_wheel, valve_lever")
       ->required();
@@ -177,6 +186,10 @@ void AddBuildDbCommand(CLI::App& app) {
   cmd->add_option("--voxel", a->voxel_m, "voxel of views, models and scans, metres")
       ->capture_default_str()
       ->check(kPositiveNumber);
+  cmd->add_option("--units", a->units,
+                  "units of the mesh files' coordinates: m, cm or mm (CAD exports are often in mm)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"m", "cm", "mm"}));
   cmd->add_option("--seed", a->seed, "scan noise and ESF sampling seed")->capture_default_str();
   cmd->add_option("--threads", a->threads, "threads (0: all)")->check(kNonNegativeNumber);
   cmd->callback([a] { RunBuildDb(*a); });

@@ -28,14 +28,18 @@ constexpr int kTimeStretches = 60;  // the time-per-submap series' points
 
 // The process's resident memory now (bytes), from /proc/self/statm; 0 if it cannot be read.
 
-// The median time per submap in each of kTimeStretches stretches of the dive, at each stretch's
-// middle submap's time.
+// The mean time per submap in each of kTimeStretches stretches of the dive (what the stretch
+// cost; a median would flip between the submaps that solve and those that do not), at each
+// stretch's middle submap's time.
 void AddTimeSeries(const mapping::DiveMapping& m, LongDiveRun& run) {
   const std::size_t n = m.submap_seconds.size();
   const std::size_t stretch = std::max<std::size_t>(1, n / kTimeStretches);
   for (std::size_t first = 0; first + stretch <= n; first += stretch) {
+    const auto begin = m.submap_seconds.begin() + static_cast<std::ptrdiff_t>(first);
     run.submap_time_s.push_back(m.slam[first + stretch / 2].time_s - m.slam.front().time_s);
-    run.submap_seconds.push_back(MedianAndP95(m.submap_seconds, first, first + stretch).median_s);
+    run.submap_seconds.push_back(
+        std::accumulate(begin, begin + static_cast<std::ptrdiff_t>(stretch), 0.0) /
+        static_cast<double>(stretch));
   }
 }
 

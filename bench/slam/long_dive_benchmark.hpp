@@ -43,7 +43,7 @@ struct LongDiveRun {
   std::int64_t rss_bytes_last_tenth = 0;  // its mean over the last tenth of the dive
   int loops_accepted = 0;
   int whole_solves = 0, window_solves = 0;
-  // Over the dive (seconds of dive time): the median time per submap in each of about 60 stretches,
+  // Over the dive (seconds of dive time): the mean time per submap in each of about 60 stretches,
   // and the resident memory sampled as the frames went by.
   std::vector<double> submap_time_s, submap_seconds;
   std::vector<double> rss_time_s;

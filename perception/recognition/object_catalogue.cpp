@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -140,11 +142,34 @@ std::filesystem::path GraspSidecarPath(const std::filesystem::path& mesh_path) {
   return sidecar;
 }
 
-ObjectSource MeshObject(const std::filesystem::path& mesh_path) {
+namespace {
+
+// Refuses an object no IMR task handles, with a hint about the units that would make sense of it.
+void RequireObjectSize(double diagonal_m, double units_to_m, const std::string& name) {
+  if (diagonal_m <= kLargestObject_m && diagonal_m >= kSmallestObject_m) return;
+  char size[64];
+  std::snprintf(size, sizeof size, "%.4g m", diagonal_m);
+  const std::string hint = diagonal_m > kLargestObject_m
+                               ? (units_to_m >= 1.0 ? "is it in millimetres? give --units mm"
+                                                    : "check the mesh's units (--units)")
+                               : (units_to_m < 1.0 ? "is it in metres? give --units m"
+                                                   : "check the mesh's units (--units)");
+  throw Error(
+      name + ": the object is " + size +
+      " across (bounding box diagonal), outside the 5 mm to 10 m an object can be: " + hint);
+}
+
+}  // namespace
+
+ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_m) {
+  if (!(units_to_m > 0.0) || !std::isfinite(units_to_m))
+    throw Error(mesh_path.string() + ": units_to_m must be finite and > 0");
   ObjectSource o;
   o.id = mesh_path.stem().string();
   o.source = mesh_path.string();
   o.mesh = scanner::LoadMesh(mesh_path);
+  for (Eigen::Vector3d& v : o.mesh.vertices) v *= units_to_m;
+  RequireObjectSize(o.mesh.BoundingBoxDiagonal(), units_to_m, mesh_path.string());
   const std::filesystem::path sidecar = GraspSidecarPath(mesh_path);
   if (!std::filesystem::exists(sidecar)) return o;
   std::ifstream in(sidecar);

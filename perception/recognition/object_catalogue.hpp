@@ -35,8 +35,14 @@ ObjectSource CatalogueObject(const std::string& name);
 //     - {name: handle, pose: {translation_m: [x, y, z], rotation_xyzw: [qx, qy, qz, qw]}}
 //   symmetries:                  # optional: declared, replacing detection from the mesh
 //     - {point_m: [0, 0, 0], axis: [0, 0, 1], order: 0}   # 0 continuous, N >= 2 N-fold
+// The mesh's coordinates are multiplied by units_to_m (> 0: 0.001 for a mesh in millimetres);
+// the sidecar is in metres. An object that comes out over kLargestObject_m or under
+// kSmallestObject_m across is refused with a hint about units: no IMR object is that size, a mesh
+// in other units is.
 // Throws uwscan::Error naming the file (and line) on anything missing or malformed.
-ObjectSource MeshObject(const std::filesystem::path& mesh_path);
+inline constexpr double kLargestObject_m = 10.0;
+inline constexpr double kSmallestObject_m = 0.005;
+ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_m = 1.0);
 
 // The sidecar's path for a mesh: the mesh path with its extension replaced by ".grasps.yaml".
 std::filesystem::path GraspSidecarPath(const std::filesystem::path& mesh_path);

@@ -51,13 +51,31 @@ std::string LowerExtension(const std::filesystem::path& path) {
   return extension;
 }
 
+// The format a file name says, for messages: "OBJ", "PCD", ...
+std::string FormatName(const std::string& lower_extension) {
+  std::string name =
+      lower_extension.empty() ? std::string("no extension") : lower_extension.substr(1);
+  std::transform(name.begin(), name.end(), name.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return name;
+}
+
+// Point-cloud formats: what a user who scanned an object holds, not a mesh.
+bool IsPointCloudExtension(const std::string& lower_extension) {
+  for (const char* cloud : {".pcd", ".xyz", ".pts", ".las", ".laz", ".e57"}) {
+    if (lower_extension == cloud) return true;
+  }
+  return false;
+}
+
 TriangleMesh LoadAssimpMesh(const std::filesystem::path& path) {
   Assimp::Importer importer;
   const aiScene* scene =
       importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                            aiProcess_DropNormals | aiProcess_FindDegenerates);
   if (scene == nullptr) {
-    throw Error(path.string() + ": cannot read mesh: " + importer.GetErrorString());
+    throw Error(path.string() + ": cannot read a mesh in " + FormatName(LowerExtension(path)) +
+                " format (through Assimp): " + importer.GetErrorString());
   }
   TriangleMesh mesh;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -83,11 +101,19 @@ TriangleMesh LoadAssimpMesh(const std::filesystem::path& path) {
 TriangleMesh LoadMesh(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path)) throw Error(path.string() + ": no such mesh file");
   const std::string extension = LowerExtension(path);
+  if (IsPointCloudExtension(extension)) {
+    throw Error(path.string() + ": " + FormatName(extension) +
+                " holds a point cloud, not a mesh: give a mesh with faces (PLY, OFF, STL or OBJ)");
+  }
   const TriangleMesh mesh = extension == ".ply"   ? LoadPlyMesh(path)
                             : extension == ".off" ? ReadOff(path)
                             : extension == ".stl" ? ReadStl(path)
                                                   : LoadAssimpMesh(path);
-  if (mesh.triangles.empty()) throw Error(path.string() + ": the mesh has no triangles");
+  if (mesh.triangles.empty()) {
+    throw Error(path.string() + ": " + FormatName(extension) + " with " +
+                std::to_string(mesh.vertices.size()) +
+                " vertices and no triangle: a point cloud, not a mesh (give a mesh with faces)");
+  }
   for (const Eigen::Vector3d& v : mesh.vertices) {
     if (!v.allFinite()) throw Error(path.string() + ": the mesh has a non-finite vertex");
   }

@@ -267,7 +267,7 @@ PlotSeries DiveSeries(const json& run, const char* x_key, const char* y_key, dou
 std::vector<PlotSpec> SlamLong(const json& j, const std::string& file) {
   PlotSpec time{"Mapping: time per submap against dive time",
                 "dive time (min)",
-                "time per submap (ms, median of each stretch)",
+                "time per submap (ms, mean of each stretch)",
                 false,
                 true,
                 {},

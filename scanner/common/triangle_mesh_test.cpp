@@ -1,0 +1,86 @@
+// LoadMesh's answers to files that are not meshes: each message names the file, the format it
+// took it for and what is wrong.
+#include "scanner/common/triangle_mesh.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "scanner/common/error.hpp"
+#include "scanner/sim/imr_objects.hpp"
+
+namespace uwscan::scanner {
+namespace {
+
+namespace fs = std::filesystem;
+
+class LoadMeshTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("uwscan_triangle_mesh_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path Write(const std::string& name, const std::string& text) const {
+    const fs::path path = dir_ / name;
+    std::ofstream(path) << text;
+    return path;
+  }
+  // LoadMesh's message, "" when it did not throw.
+  static std::string Refusal(const fs::path& path) {
+    try {
+      LoadMesh(path);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  }
+  fs::path dir_;
+};
+
+void ExpectMentions(const std::string& message, const std::string& part) {
+  EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+}
+
+TEST_F(LoadMeshTest, APcdIsNamedAsAPointCloud) {
+  const fs::path pcd = Write("scan.pcd",
+                             "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
+                             "COUNT 1 1 1\nWIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\n"
+                             "DATA ascii\n0 0 0\n");
+  const std::string message = Refusal(pcd);
+  ExpectMentions(message, pcd.string());
+  ExpectMentions(message, "PCD");
+  ExpectMentions(message, "point cloud, not a mesh");
+  EXPECT_EQ(message.find("Invalid face index"), std::string::npos) << message;  // Assimp took it for OBJ
+}
+
+TEST_F(LoadMeshTest, APlyWithoutFacesIsNamedAsAPointCloud) {
+  const fs::path ply = Write("scan.ply",
+                             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                             "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
+  const std::string message = Refusal(ply);
+  ExpectMentions(message, ply.string());
+  ExpectMentions(message, "PLY with 3 vertices and no triangle");
+}
+
+TEST_F(LoadMeshTest, AnUnreadableObjNamesItsFormat) {
+  const fs::path obj = Write("broken.obj", "v 0 0 0\nf 1 2 7\n");
+  const std::string message = Refusal(obj);
+  ExpectMentions(message, obj.string());
+  ExpectMentions(message, "OBJ");
+}
+
+TEST_F(LoadMeshTest, AMeshWrittenReadsBack) {
+  const TriangleMesh box = sim::MakeBox({0.1, 0.2, 0.3});
+  const fs::path ply = dir_ / "box.ply";
+  WriteMeshPly(box, ply);
+  const TriangleMesh read = LoadMesh(ply);
+  EXPECT_EQ(read.triangles.size(), box.triangles.size());
+  EXPECT_EQ(read.vertices.size(), box.vertices.size());
+}
+
+}  // namespace
+}  // namespace uwscan::scanner
