@@ -18,7 +18,8 @@ namespace fs = std::filesystem;
 class MeshObjectTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("uwscan_object_catalogue_test_" + std::to_string(::getpid()));
+    dir_ =
+        fs::temp_directory_path() / ("uwscan_object_catalogue_test_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }

@@ -54,13 +54,15 @@ TEST_F(LoadMeshTest, APcdIsNamedAsAPointCloud) {
   ExpectMentions(message, pcd.string());
   ExpectMentions(message, "PCD");
   ExpectMentions(message, "point cloud, not a mesh");
-  EXPECT_EQ(message.find("Invalid face index"), std::string::npos) << message;  // Assimp took it for OBJ
+  EXPECT_EQ(message.find("Invalid face index"), std::string::npos)
+      << message;  // Assimp took it for OBJ
 }
 
 TEST_F(LoadMeshTest, APlyWithoutFacesIsNamedAsAPointCloud) {
-  const fs::path ply = Write("scan.ply",
-                             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                             "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
+  const fs::path ply =
+      Write("scan.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
   const std::string message = Refusal(ply);
   ExpectMentions(message, ply.string());
   ExpectMentions(message, "PLY with 3 vertices and no triangle");
