@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "scanner/common/byte_io.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
@@ -19,35 +20,28 @@ std::filesystem::path NewSpillPath(const std::filesystem::path& folder) {
                    std::to_string(counter.fetch_add(1)) + ".bin");
 }
 
-template <typename T>
-void WriteVector(std::ofstream& out, const std::vector<T>& values) {
-  const std::uint64_t n = values.size();
-  out.write(reinterpret_cast<const char*>(&n), sizeof n);
-  out.write(reinterpret_cast<const char*>(values.data()),
-            static_cast<std::streamsize>(n * sizeof(T)));
+// A cloud as uwscan's own binary encoding (scanner/common/byte_io.hpp): origin, then each array
+// with its count.
+void PutCloud(const perception::PointCloud& cloud, ByteWriter* out) {
+  for (int k = 0; k < 3; ++k) out->Put<double>(cloud.origin[k]);
+  for (const std::vector<Eigen::Vector3f>* array : {&cloud.points, &cloud.normals}) {
+    out->Put<std::uint64_t>(array->size());
+    for (const Eigen::Vector3f& v : *array)
+      for (int k = 0; k < 3; ++k) out->Put<float>(v[k]);
+  }
+  out->Put<std::uint64_t>(cloud.intensity.size());
+  for (const float i : cloud.intensity) out->Put<float>(i);
 }
 
-template <typename T>
-void ReadVector(std::ifstream& in, std::vector<T>* values) {
-  std::uint64_t n = 0;
-  in.read(reinterpret_cast<char*>(&n), sizeof n);
-  if (!in || n > (std::uint64_t{1} << 32)) return;
-  values->resize(n);
-  in.read(reinterpret_cast<char*>(values->data()), static_cast<std::streamsize>(n * sizeof(T)));
-}
-
-void WriteCloud(std::ofstream& out, const perception::PointCloud& cloud) {
-  out.write(reinterpret_cast<const char*>(cloud.origin.data()), 3 * sizeof(double));
-  WriteVector(out, cloud.points);
-  WriteVector(out, cloud.normals);
-  WriteVector(out, cloud.intensity);
-}
-
-void ReadCloud(std::ifstream& in, perception::PointCloud* cloud) {
-  in.read(reinterpret_cast<char*>(cloud->origin.data()), 3 * sizeof(double));
-  ReadVector(in, &cloud->points);
-  ReadVector(in, &cloud->normals);
-  ReadVector(in, &cloud->intensity);
+void GetCloud(ByteReader* in, perception::PointCloud* cloud) {
+  for (int k = 0; k < 3; ++k) cloud->origin[k] = in->Get<double>("origin");
+  for (std::vector<Eigen::Vector3f>* array : {&cloud->points, &cloud->normals}) {
+    array->resize(in->GetCount("vector count", 3 * sizeof(float)));
+    for (Eigen::Vector3f& v : *array)
+      for (int k = 0; k < 3; ++k) v[k] = in->Get<float>("vector");
+  }
+  cloud->intensity.resize(in->GetCount("intensity count", sizeof(float)));
+  for (float& i : cloud->intensity) i = in->Get<float>("intensity");
 }
 
 std::int64_t CloudBytes(const perception::PointCloud& c) {
@@ -84,16 +78,19 @@ void SubmapStore::Add(SubmapClouds clouds) {
 
 void SubmapStore::Spill(int index) {
   Slot& slot = slots_[static_cast<size_t>(index)];
+  ByteWriter record;
+  PutCloud(slot.clouds->cloud, &record);
+  PutCloud(slot.clouds->sparse, &record);
   std::ofstream out(spill_path_, std::ios::binary | std::ios::app);
   const std::int64_t offset = static_cast<std::int64_t>(std::filesystem::file_size(spill_path_));
-  WriteCloud(out, slot.clouds->cloud);
-  WriteCloud(out, slot.clouds->sparse);
+  out.write(record.bytes().data(), static_cast<std::streamsize>(record.bytes().size()));
   out.flush();
   if (!out) {
     throw Error("submap store: cannot write submap " + std::to_string(index) + " to " +
                 spill_path_.string() + " (disk full?)");
   }
   slot.offset = offset;
+  slot.bytes = static_cast<std::int64_t>(record.bytes().size());
   slot.clouds.reset();
 }
 
@@ -110,13 +107,16 @@ std::shared_ptr<const SubmapClouds> SubmapStore::Get(int index) const {
   }
   std::ifstream in(spill_path_, std::ios::binary);
   in.seekg(slot.offset);
-  auto clouds = std::make_shared<SubmapClouds>();
-  ReadCloud(in, &clouds->cloud);
-  ReadCloud(in, &clouds->sparse);
+  std::string record(static_cast<size_t>(slot.bytes), '\0');
+  in.read(record.data(), static_cast<std::streamsize>(record.size()));
   if (!in) {
     throw Error("submap store: cannot read submap " + std::to_string(index) + " back from " +
                 spill_path_.string());
   }
+  ByteReader reader(record, 0, record.size(), spill_path_.string());
+  auto clouds = std::make_shared<SubmapClouds>();
+  GetCloud(&reader, &clouds->cloud);
+  GetCloud(&reader, &clouds->sparse);
   read_back_.emplace_front(index, clouds);
   if (read_back_.size() > kReadBackCache) read_back_.pop_back();
   return clouds;

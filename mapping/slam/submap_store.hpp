@@ -45,6 +45,7 @@ class SubmapStore {
   struct Slot {
     std::shared_ptr<const SubmapClouds> clouds;  // null once spilled
     std::int64_t offset = -1;                    // in the spill file once spilled
+    std::int64_t bytes = 0;                      // its record's length there
   };
   void Spill(int index);
 
