@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "perception/cloud/cloud_io.hpp"
 #include "tests/cli_run.hpp"
 
 namespace uwscan::test {
@@ -110,6 +111,36 @@ TEST_F(CliFaults, OutputsThatCannotBeWrittenAreRefusedBeforeAnyWork) {
   }
   EXPECT_FALSE(fs::exists(dir_ / "m.ply"));
   EXPECT_TRUE(fs::is_regular_file(dive));
+}
+
+// A scan read in a unit it is not in is a size no scan has: refused with a hint, in one line.
+TEST_F(CliFaults, AScanInAnotherUnitIsRefusedWithAHintAboutUnits) {
+  const std::string cloud = (dir_ / "cloud.ply").string(), dive = (dir_ / "dive.db").string();
+  const std::string mm = (dir_ / "cloud_mm.xyz").string();
+  {
+    const perception::PointCloud metres = perception::ReadCloud(cloud);
+    std::ofstream out(mm);
+    for (std::size_t i = 0; i < metres.size(); ++i) {
+      const Eigen::Vector3d p = 1000.0 * metres.Point(i);
+      out << p.x() << " " << p.y() << " " << p.z() << "\n";
+    }
+  }
+  struct Case {
+    std::string arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      {"recognize " + mm + " --db " + dive, "is it in millimetres? give --units mm"},
+      {"recognize " + cloud + " --db " + dive + " --units mm", "is it in metres? give --units m"},
+      {"recognize " + cloud + " --db " + dive + " --viewpoint 1 2 3 4",
+       "--viewpoint: expected 7 numbers: tx ty tz qx qy qz qw (or 3: tx ty tz)"},
+      {"recognize " + dive + " --db " + dive + " --units mm", "a dive log is in metres"},
+  };
+  for (const Case& c : cases) {
+    const CommandRun run = RunUwscan(c.arguments);
+    EXPECT_NE(run.exit_code, 0) << c.arguments;
+    EXPECT_NE(run.output.find(c.expected), std::string::npos) << c.arguments << "\n" << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  }
 }
 
 TEST_F(CliFaults, AReadOnlyFolderIsRefusedBeforeAnyWork) {

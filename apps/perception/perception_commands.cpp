@@ -11,6 +11,7 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
+#include "apps/cli/pose_option.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/registration/features_benchmark.hpp"
 #include "bench/registration/registration_benchmark.hpp"
@@ -36,20 +37,6 @@ nlohmann::json ResultJson(const perception::RegistrationResult& r) {
           {"inlier_rmse_m", r.inlier_rmse},
           {"iterations", r.iterations},
           {"converged", r.converged}};
-}
-
-// "tx ty tz qx qy qz qw" (TUM order) -> pose.
-Eigen::Isometry3d ParsePose(const std::vector<double>& v) {
-  if (v.size() != 7) throw Error("--init: expected 7 numbers: tx ty tz qx qy qz qw");
-  for (double x : v) {
-    if (!std::isfinite(x)) throw Error("--init: every number must be finite");
-  }
-  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-  if (std::abs(q.norm() - 1.0) > 1e-6) throw Error("--init: the quaternion must be unit length");
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = q.normalized().toRotationMatrix();
-  T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-  return T;
 }
 
 struct RegisterArgs {
@@ -83,7 +70,7 @@ void RunRegister(const RegisterArgs& a) {
       perception::RegistrationPipelineOptions::ForObjectSize(
           size > 0.0 ? size : 50.0 * a.voxel_m, a.seed, a.threads, a.voxel_set ? a.voxel_m : 0.0);
   std::optional<Eigen::Isometry3d> init;
-  if (!a.init.empty()) init = ParsePose(a.init);
+  if (!a.init.empty()) init = ParsePoseOption(a.init, "--init");
   perception::RegistrationPipelineResult r;
   try {
     r = perception::RegisterClouds(source, target, options, init);

@@ -12,7 +12,9 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
+#include "apps/cli/pose_option.hpp"
 #include "apps/cli/progress_bar.hpp"
+#include "apps/cli/reference_options.hpp"
 #include "apps/perception/recognition_json.hpp"
 #include "mapping/reconstruction/scan_file.hpp"
 #include "perception/cloud/cloud_io.hpp"
@@ -37,13 +39,6 @@ struct BuildDbArgs {
   int threads = 0;
 };
 
-double MetresPer(const std::string& units) {
-  if (units == "m") return 1.0;
-  if (units == "cm") return 0.01;
-  if (units == "mm") return 0.001;
-  throw Error("--units " + units + ": expected m, cm or mm");
-}
-
 void RunBuildDb(const BuildDbArgs& a) {
   std::vector<std::filesystem::path> inputs(a.objects.begin(), a.objects.end());
   inputs.push_back(a.scanner);
@@ -51,7 +46,7 @@ void RunBuildDb(const BuildDbArgs& a) {
   std::vector<perception::ObjectSource> sources;
   for (const std::string& name : a.objects) {
     sources.push_back(std::filesystem::exists(name)
-                          ? perception::MeshObject(name, MetresPer(a.units))
+                          ? perception::MeshObject(name, UnitsToMetres(a.units))
                           : perception::CatalogueObject(name));
   }
   const scanner::Scanner scanner = a.scanner.empty()
@@ -100,6 +95,8 @@ void RunBuildDb(const BuildDbArgs& a) {
 
 struct RecognizeArgs {
   std::string scan, db, json;
+  std::string units = "m";
+  std::vector<double> viewpoint;
   std::uint64_t seed = 1;
   int threads = 0;
   std::optional<int> sweep;
@@ -116,12 +113,15 @@ std::string RelativeToFolderOf(const std::string& path, const std::string& file)
 
 void RunRecognize(const RecognizeArgs& a) {
   if (!a.json.empty()) CheckOutputPath(a.json, "--json", {a.scan, a.db});
-  const perception::ObjectDatabase db = perception::ObjectDatabase::Load(a.db);
   mapping::ReconstructionOptions log_options;
   log_options.table_cache = TableCache();
   log_options.sweep = a.sweep;
-  const mapping::ScanFile file = mapping::ReadScanFile(a.scan, log_options);
+  mapping::ScanFrame frame;
+  frame.metres_per_unit = UnitsToMetres(a.units);
+  if (!a.viewpoint.empty()) frame.T_file_sensor = ParsePoseOption(a.viewpoint, "--viewpoint", true);
+  const mapping::ScanFile file = mapping::ReadScanFile(a.scan, log_options, frame);
   const perception::PointCloud& scan = file.cloud;
+  const perception::ObjectDatabase db = perception::ObjectDatabase::Load(a.db);
   perception::RecognitionOptions options;
   options.seed = a.seed;
   options.threads = a.threads;
@@ -129,6 +129,15 @@ void RunRecognize(const RecognizeArgs& a) {
   if (file.rows_in_file != scan.size()) {
     std::printf("%zu of the file's %zu points dropped: a NaN or infinite coordinate or normal\n",
                 file.rows_in_file - scan.size(), file.rows_in_file);
+  }
+  if (file.viewpoint != mapping::ViewpointSource::kFileOrigin) {
+    const Eigen::Vector3d at = file.T_file_sensor.translation();
+    std::printf(
+        "sensor at (%g, %g, %g) %s in the file's frame (%s); positions below are in the "
+        "sensor's frame, metres (--json: T_file_O in the file's)\n",
+        at.x(), at.y(), at.z(), a.units.c_str(),
+        file.viewpoint == mapping::ViewpointSource::kGiven ? "--viewpoint"
+                                                           : "the file's VIEWPOINT");
   }
   std::printf("%zu points, %zu on planes, %zu segments\n", scan.size(), result.plane_points,
               result.objects.size());
@@ -153,7 +162,7 @@ void RunRecognize(const RecognizeArgs& a) {
     }
   }
   if (!a.json.empty()) {
-    nlohmann::json j = RecognitionJson(result, file.rows, file.rows_in_file);
+    nlohmann::json j = RecognitionJson(result, file);
     if (a.sweep) j["scan_sweep"] = *a.sweep;
     // Relative to the report's folder, so the viewer finds them from anywhere.
     j["scan"] = RelativeToFolderOf(a.scan, a.json);
@@ -209,6 +218,14 @@ void AddRecognizeCommand(CLI::App& app) {
   cmd->add_option("--sweep", a->sweep,
                   "the sweep of a dive log of several to recognise objects in");
   cmd->add_option("--db", a->db, "object database from `uwscan build-db`")->required();
+  cmd->add_option("--units", a->units,
+                  "unit of the cloud file's coordinates: m, cm or mm (many range scans are in mm)")
+      ->capture_default_str()
+      ->check(kReferenceUnits);
+  cmd->add_option("--viewpoint", a->viewpoint,
+                  "the sensor's pose in the cloud file's frame, in its units: tx ty tz qx qy qz "
+                  "qw, or tx ty tz (default: the PCD's VIEWPOINT, else the file's origin)")
+      ->expected(3, 7);
   cmd->add_option("--json", a->json, "write every object, candidate and grasp as JSON");
   cmd->add_option("--seed", a->seed, "RANSAC and ESF seed");
   cmd->add_option("--threads", a->threads, "threads (0: all)")->check(kNonNegativeNumber);

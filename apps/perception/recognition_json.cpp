@@ -20,8 +20,23 @@ nlohmann::json Pose(const Eigen::Isometry3d& T) {
           {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
-nlohmann::json ObjectJson(const perception::RecognizedObject& o,
-                          const std::vector<std::size_t>& rows) {
+// A pose in the scan file's frame and units (the rows of "matrix" and "position" in them).
+nlohmann::json PoseInFile(const Eigen::Isometry3d& T_file_X) {
+  const Eigen::Quaterniond q(T_file_X.linear());
+  return {{"matrix", Matrix(T_file_X.matrix())},
+          {"position", Vector(T_file_X.translation())},
+          {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
+}
+
+// T_S_X (metres) as a pose in the scan file's frame and units.
+Eigen::Isometry3d InFile(const Eigen::Isometry3d& T_S_X, const mapping::ScanFile& scan) {
+  Eigen::Isometry3d T_S_X_units = T_S_X;
+  T_S_X_units.translation() /= scan.metres_per_unit;
+  return scan.T_file_sensor * T_S_X_units;
+}
+
+nlohmann::json ObjectJson(const perception::RecognizedObject& o, const mapping::ScanFile& scan) {
+  const std::vector<std::size_t>& rows = scan.rows;
   std::vector<std::size_t> segment_rows;
   segment_rows.reserve(o.segment.size());
   for (std::size_t i : o.segment) segment_rows.push_back(rows.at(i));
@@ -51,6 +66,7 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o,
   j["chi_square"] = o.chi_square;
   j["margin"] = o.margin;
   j["T_S_O"] = Pose(o.T_S_O);
+  j["T_file_O"] = PoseInFile(InFile(o.T_S_O, scan));
   nlohmann::json covariance = nlohmann::json::array();
   nlohmann::json std_dev = nlohmann::json::array();
   for (int r = 0; r < 6; ++r) {
@@ -94,13 +110,17 @@ nlohmann::json ObjectJson(const perception::RecognizedObject& o,
 }  // namespace
 
 nlohmann::json RecognitionJson(const perception::RecognitionResult& result,
-                               const std::vector<std::size_t>& rows, std::size_t rows_in_file) {
+                               const mapping::ScanFile& scan) {
   nlohmann::json objects = nlohmann::json::array();
   for (const perception::RecognizedObject& o : result.objects)
-    objects.push_back(ObjectJson(o, rows));
+    objects.push_back(ObjectJson(o, scan));
   return {{"uwscan_format", 1},
           {"kind", "recognition_report"},
-          {"scan_points", rows_in_file},
+          {"scan_points", scan.rows_in_file},
+          {"scan_frame",
+           {{"metres_per_unit", scan.metres_per_unit},
+            {"viewpoint", mapping::ToString(scan.viewpoint)},
+            {"T_file_sensor", PoseInFile(scan.T_file_sensor)}}},
           {"objects", objects},
           {"plane_points", result.plane_points},
           {"stage_seconds", result.stage_seconds}};

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "mapping/reconstruction/scan_file.hpp"
 #include "perception/recognition/object_recognizer.hpp"
 
 namespace uwscan::app {
@@ -13,11 +14,14 @@ namespace uwscan::app {
 // ("unknown" when none was verified), its points (rows of the scan file: `rows[i]` is the row of
 // the scan's point i, so points dropped on reading, e.g. NaN, leave no hole), score, chi-square
 // and margin, pose T_S_O (4x4, position, quaternion xyzw), covariance and standard deviations
-// over [w (rad), v (m)] in the object frame, free directions, grasp poses and the candidates.
+// over [w (rad), v (m)] in the object frame, free directions, grasp poses and the candidates;
+// "scan_frame": how the file became the sensor frame S (its unit, where the sensor's pose came
+// from, T_file_sensor in the file's units), and each pose in the file's frame and units too
+// ("T_file_O").
 // The caller adds "scan" and "database" (paths relative to the report's folder) and, for a
 // sweep of a dive log, "scan_sweep", which `uwscan view` reads. Documented in
 // perception/README.md.
 nlohmann::json RecognitionJson(const perception::RecognitionResult& result,
-                               const std::vector<std::size_t>& rows, std::size_t rows_in_file);
+                               const mapping::ScanFile& scan);
 
 }  // namespace uwscan::app

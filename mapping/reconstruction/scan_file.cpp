@@ -1,10 +1,14 @@
 #include "mapping/reconstruction/scan_file.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <string>
 
 #include "mapping/log/dive_log.hpp"
 #include "perception/cloud/cloud_io.hpp"
+#include "perception/recognition/recognition_report.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
@@ -17,21 +21,100 @@ std::string SweepRange(const std::vector<int>& sweeps) {
          std::to_string(sweeps.back());
 }
 
+// The diagonal of the box that holds all but the outer 1 % of the points along each axis: the
+// scan's size, not that of one stray return.
+double RobustExtent(const perception::PointCloud& cloud) {
+  std::vector<float> values(cloud.size());
+  const std::size_t outer = values.size() / 100;
+  Eigen::Vector3d low, high;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = cloud.points[i][axis];
+    std::nth_element(values.begin(), values.begin() + outer, values.end());
+    low[axis] = values[outer];
+    std::nth_element(values.begin(), values.end() - 1 - outer, values.end());
+    high[axis] = values[values.size() - 1 - outer];
+  }
+  return (high - low).norm();
+}
+
+// Refuses a scan no sensor makes, with a hint about the units that would make sense of it. A
+// scan whose points all coincide has no size to judge (it holds no object either).
+void RequireScanSize(const perception::PointCloud& cloud_m, double metres_per_unit,
+                     const std::string& name) {
+  const double extent_m = RobustExtent(cloud_m);
+  if (extent_m == 0.0 || (extent_m >= kSmallestScan_m && extent_m <= kLargestScan_m)) return;
+  char size[64];
+  std::snprintf(size, sizeof size, "%.4g m", extent_m);
+  const bool large = extent_m > kLargestScan_m;
+  const std::string hint = large ? (metres_per_unit >= 1.0 ? "is it in millimetres? give --units mm"
+                                                           : "check the scan's units (--units)")
+                                 : (metres_per_unit < 1.0 ? "is it in metres? give --units m"
+                                                          : "check the scan's units (--units)");
+  throw Error(name + ": the scan is " + size +
+              " across (its points' extent), outside the 5 mm to 100 m a scan can be: " + hint);
+}
+
+// A cloud file's points in metres, in the sensor's frame.
+ScanFile ReadCloudScan(const std::filesystem::path& path, const ScanFrame& frame) {
+  perception::CloudReadStats stats;
+  ScanFile scan;
+  scan.cloud = perception::ReadCloud(path, &stats);
+  scan.rows = std::move(stats.rows);
+  scan.rows_in_file = stats.num_in_file;
+  scan.metres_per_unit = frame.metres_per_unit;
+  if (frame.T_file_sensor) {
+    scan.T_file_sensor = *frame.T_file_sensor;
+    scan.viewpoint = ViewpointSource::kGiven;
+  } else if (stats.T_file_sensor) {
+    scan.T_file_sensor = *stats.T_file_sensor;
+    scan.viewpoint = ViewpointSource::kFileViewpoint;
+  }
+  if (frame.metres_per_unit != 1.0) {
+    const auto scale = static_cast<float>(frame.metres_per_unit);
+    scan.cloud.origin *= frame.metres_per_unit;
+    for (Eigen::Vector3f& p : scan.cloud.points) p *= scale;
+  }
+  RequireScanSize(scan.cloud, frame.metres_per_unit, path.string());
+  if (!scan.T_file_sensor.matrix().isIdentity(0.0)) {
+    Eigen::Isometry3d T_file_sensor_m = scan.T_file_sensor;
+    T_file_sensor_m.translation() *= frame.metres_per_unit;
+    scan.cloud = perception::Transformed(scan.cloud, T_file_sensor_m.inverse());
+  }
+  return scan;
+}
+
 }  // namespace
 
-ScanFile ReadScanFile(const std::filesystem::path& path, ReconstructionOptions options) {
-  ScanFile scan;
+std::string ToString(ViewpointSource source) {
+  switch (source) {
+    case ViewpointSource::kFileOrigin:
+      return "origin";
+    case ViewpointSource::kFileViewpoint:
+      return "file_viewpoint";
+    case ViewpointSource::kGiven:
+      return "given";
+  }
+  return "origin";
+}
+
+ScanFile ReadScanFile(const std::filesystem::path& path, ReconstructionOptions options,
+                      const ScanFrame& frame) {
+  if (!(frame.metres_per_unit > 0.0) || !std::isfinite(frame.metres_per_unit)) {
+    throw Error(path.string() + ": the scan's metres per unit must be finite and > 0");
+  }
   if (path.extension() != ".db") {
     if (options.sweep) {
       throw Error(path.string() + ": a sweep (" + std::to_string(*options.sweep) +
                   ") is chosen from a dive log, this is a cloud file");
     }
-    perception::CloudReadStats stats;
-    scan.cloud = perception::ReadCloud(path, &stats);
-    scan.rows = std::move(stats.rows);
-    scan.rows_in_file = stats.num_in_file;
-    return scan;
+    return ReadCloudScan(path, frame);
   }
+  if (frame.metres_per_unit != 1.0 || frame.T_file_sensor) {
+    throw Error(path.string() +
+                ": a dive log is in metres and in its camera's frame: no unit or "
+                "viewpoint is given for it");
+  }
+  ScanFile scan;
   const DiveLogReader log(path);
   options.use_navigation = true;
   options.relative_to_middle = true;
@@ -55,6 +138,14 @@ ScanFile ReadScanFile(const std::filesystem::path& path, ReconstructionOptions o
   std::iota(scan.rows.begin(), scan.rows.end(), std::size_t{0});
   scan.rows_in_file = r.points.size();
   return scan;
+}
+
+ScanFrame ReportedScanFrame(const perception::RecognitionReport& report) {
+  ScanFrame frame;
+  if (report.scan.extension() == ".db") return frame;
+  frame.metres_per_unit = report.scan_metres_per_unit;
+  frame.T_file_sensor = report.scan_T_file_sensor;
+  return frame;
 }
 
 }  // namespace uwscan::mapping

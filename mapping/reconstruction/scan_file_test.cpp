@@ -2,12 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "mapping/log/dive_log_test_support.hpp"
 #include "mapping/log/dive_simulation.hpp"
+#include "perception/recognition/recognition_test_support.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
 
@@ -48,6 +52,148 @@ TEST_F(ScanFileTest, ACloudFileSaysWhichRowEachFinitePointCameFrom) {
   options.sweep = 0;
   EXPECT_NE(MessageOf([&] { ReadScanFile(path, options); }).find("this is a cloud file"),
             std::string::npos);
+}
+
+// An ascii PCD of `points` scaled by `units_per_metre`, with a VIEWPOINT line when `viewpoint`
+// is given ("tx ty tz qw qx qy qz", PCL's order).
+void WritePcd(const fs::path& path, const std::vector<Eigen::Vector3d>& points,
+              double units_per_metre, const std::string& viewpoint = "") {
+  std::ofstream out(path);
+  out.precision(10);
+  out << "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " << points.size()
+      << "\nHEIGHT 1\n";
+  if (!viewpoint.empty()) out << "VIEWPOINT " << viewpoint << "\n";
+  out << "POINTS " << points.size() << "\nDATA ascii\n";
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d q = units_per_metre * p;
+    out << q.x() << " " << q.y() << " " << q.z() << "\n";
+  }
+}
+
+// A patch 0.4 m wide, 1 m in front of the sensor (+z).
+std::vector<Eigen::Vector3d> Patch() {
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 40; ++i) {
+    for (int k = 0; k < 40; ++k) points.emplace_back(0.01 * i - 0.2, 0.01 * k - 0.2, 1.0);
+  }
+  return points;
+}
+
+TEST_F(ScanFileTest, AScanInMillimetresIsReadInMetresWithItsUnitAndRefusedWithoutIt) {
+  const std::vector<Eigen::Vector3d> truth = Patch();
+  const fs::path mm = dir_ / "patch_mm.pcd", m = dir_ / "patch_m.pcd";
+  WritePcd(mm, truth, 1000.0);
+  WritePcd(m, truth, 1.0);
+  ScanFrame frame;
+  frame.metres_per_unit = 0.001;
+  const ScanFile scan = ReadScanFile(mm, {}, frame);
+  ASSERT_EQ(scan.cloud.size(), truth.size());
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    EXPECT_LT((scan.cloud.Point(i) - truth[i]).norm(), 1e-6) << i;
+  }
+  EXPECT_EQ(scan.metres_per_unit, 0.001);
+  EXPECT_EQ(scan.viewpoint, ViewpointSource::kFileOrigin);
+
+  // Without its unit: 1.4 km across, which no scan is; a scan in metres said to be in mm is
+  // 1.4 mm across.
+  EXPECT_NE(MessageOf([&] { ReadScanFile(mm); }).find("is it in millimetres? give --units mm"),
+            std::string::npos)
+      << MessageOf([&] { ReadScanFile(mm); });
+  EXPECT_NE(MessageOf([&] { ReadScanFile(m, {}, frame); }).find("is it in metres? give --units m"),
+            std::string::npos)
+      << MessageOf([&] { ReadScanFile(m, {}, frame); });
+}
+
+TEST_F(ScanFileTest, APcdViewpointPutsTheScanInTheSensorsFrameUnlessAnotherIsGiven) {
+  // The sensor 2 m above the file's origin looking down (-z), turned 30 degrees about z: a depth
+  // camera's frame that looks along -z, as many range scanners' do.
+  Eigen::Isometry3d T_file_sensor = Eigen::Isometry3d::Identity();
+  T_file_sensor.linear() = (Eigen::AngleAxisd(0.5236, Eigen::Vector3d::UnitZ()) *
+                            Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
+                               .toRotationMatrix();
+  T_file_sensor.translation() = Eigen::Vector3d(0.3, -0.1, 2.0);
+  const std::vector<Eigen::Vector3d> in_sensor = Patch();
+  std::vector<Eigen::Vector3d> in_file;
+  for (const Eigen::Vector3d& p : in_sensor) in_file.push_back(T_file_sensor * p);
+  const Eigen::Quaterniond q(T_file_sensor.linear());
+  std::ostringstream viewpoint;
+  viewpoint.precision(17);
+  viewpoint << 300.0 << " " << -100.0 << " " << 2000.0 << " " << q.w() << " " << q.x() << " "
+            << q.y() << " " << q.z();
+  const fs::path path = dir_ / "depth_camera_mm.pcd";
+  WritePcd(path, in_file, 1000.0, viewpoint.str());
+
+  ScanFrame frame;
+  frame.metres_per_unit = 0.001;
+  const ScanFile scan = ReadScanFile(path, {}, frame);
+  EXPECT_EQ(scan.viewpoint, ViewpointSource::kFileViewpoint);
+  EXPECT_LT((scan.T_file_sensor.translation() - Eigen::Vector3d(300, -100, 2000)).norm(), 1e-9);
+  ASSERT_EQ(scan.cloud.size(), in_sensor.size());
+  for (std::size_t i = 0; i < in_sensor.size(); ++i) {
+    EXPECT_LT((scan.cloud.Point(i) - in_sensor[i]).norm(), 1e-6) << i;
+  }
+
+  // A viewpoint given overrides the file's: the sensor at the file's origin, axes unturned.
+  frame.T_file_sensor = Eigen::Isometry3d::Identity();
+  const ScanFile given = ReadScanFile(path, {}, frame);
+  EXPECT_EQ(given.viewpoint, ViewpointSource::kGiven);
+  for (std::size_t i = 0; i < in_file.size(); ++i) {
+    EXPECT_LT((given.cloud.Point(i) - in_file[i]).norm(), 1e-6) << i;
+  }
+
+  // A malformed VIEWPOINT is named.
+  WritePcd(path, in_file, 1000.0, "0 0 0 0 0 0 0");
+  EXPECT_NE(MessageOf([&] {
+              ReadScanFile(path, {}, frame);
+            }).find("(VIEWPOINT): the orientation quaternion has zero length"),
+            std::string::npos)
+      << MessageOf([&] { ReadScanFile(path, {}, frame); });
+  WritePcd(path, in_file, 1000.0, "0 0 0 1 0 0");
+  EXPECT_NE(MessageOf([&] { ReadScanFile(path); }).find("(VIEWPOINT): expected 7 numbers"),
+            std::string::npos);
+}
+
+// The same scene as recognition's tests scan it, written as another tool would: in millimetres,
+// in a frame the sensor is not at the origin of, the sensor's pose in the PCD's VIEWPOINT. Read
+// with its unit, it is recognised as the scan in metres from the origin is: the same object, the
+// same pose once put back in the sensor's frame.
+TEST_F(ScanFileTest, AScanInMillimetresFromAViewpointIsRecognisedAsInMetresFromTheOrigin) {
+  namespace rt = perception::recognition_test;
+  const rt::Scan scan = rt::ScanOnSeabed(scanner::sim::MakeFlange(scanner::sim::FlangeShape{}),
+                                         Eigen::Vector3d(0.5, -0.4, 0.9), 3);
+  Eigen::Isometry3d T_file_sensor = Eigen::Isometry3d::Identity();
+  T_file_sensor.linear() =
+      Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  T_file_sensor.translation() = Eigen::Vector3d(12.0, -3.0, 40.0);
+  std::vector<Eigen::Vector3d> in_file, in_sensor;
+  for (std::size_t i = 0; i < scan.cloud.size(); ++i) {
+    in_sensor.push_back(scan.cloud.Point(i));
+    in_file.push_back(T_file_sensor * in_sensor.back());
+  }
+  const Eigen::Quaterniond q(T_file_sensor.linear());
+  std::ostringstream viewpoint;
+  viewpoint.precision(17);
+  viewpoint << 12000.0 << " " << -3000.0 << " " << 40000.0 << " " << q.w() << " " << q.x() << " "
+            << q.y() << " " << q.z();
+  const fs::path path = dir_ / "flange_mm.pcd", reference = dir_ / "flange_m.pcd";
+  WritePcd(path, in_file, 1000.0, viewpoint.str());
+  WritePcd(reference, in_sensor, 1.0);
+  ScanFrame frame;
+  frame.metres_per_unit = 0.001;
+  const perception::ObjectDatabase& db = rt::PipeFlangeValveDb();
+  const perception::RecognitionResult moved =
+      perception::RecognizeObjects(ReadScanFile(path, {}, frame).cloud, db);
+  const perception::RecognitionResult original =
+      perception::RecognizeObjects(ReadScanFile(reference).cloud, db);
+  const perception::RecognizedObject* a = rt::Nearest(moved, scan);
+  const perception::RecognizedObject* b = rt::Nearest(original, scan);
+  ASSERT_NE(a, nullptr);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(b->object_id, "flange");
+  EXPECT_EQ(a->object_id, b->object_id);
+  const Eigen::Isometry3d d = a->T_S_O.inverse() * b->T_S_O;
+  EXPECT_LT(d.translation().norm(), 1e-3);
+  EXPECT_LT(Eigen::AngleAxisd(d.linear()).angle(), 0.2 * M_PI / 180.0);
 }
 
 // A sweep taken while the vehicle moves 10 cm: each frame placed with the navigation, the

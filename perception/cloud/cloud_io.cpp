@@ -57,6 +57,7 @@ struct RawCloud {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3d> normals;
   std::vector<double> intensity;
+  std::optional<Eigen::Isometry3d> T_file_sensor;
 };
 
 // One value of a binary point record, as double.
@@ -234,11 +235,13 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
     raw.points = std::move(pcd.points);
     raw.normals = std::move(pcd.normals);
     raw.intensity = std::move(pcd.intensity);
+    raw.T_file_sensor = pcd.T_file_sensor;
   }
 
   CloudReadStats local;
   local.num_in_file = raw.points.size();
   local.has_normals = !raw.normals.empty();
+  local.T_file_sensor = raw.T_file_sensor;
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3f> normals;
   std::vector<float> intensity;

@@ -1,7 +1,9 @@
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "perception/cloud/point_cloud.hpp"
@@ -17,6 +19,9 @@ struct CloudReadStats {
   // The file's row (0-based point or vertex) of each point of the cloud: what an index into the
   // cloud is in the file once points were dropped.
   std::vector<std::size_t> rows;
+  // The sensor's pose in the file's frame, in the file's units, when the file says it (a PCD
+  // VIEWPOINT line).
+  std::optional<Eigen::Isometry3d> T_file_sensor;
 };
 
 // Reads a point cloud from .pcd (uwscan's bounded reader; ascii, binary and binary_compressed),

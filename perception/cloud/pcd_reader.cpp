@@ -5,6 +5,7 @@
 #include <bit>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -38,6 +39,7 @@ struct Field {
 
 struct Header {
   std::vector<Field> fields;
+  std::optional<Eigen::Isometry3d> viewpoint;
   std::uint64_t points = 0;
   std::string data;  // ascii, binary, binary_compressed
   std::size_t body_offset = 0;
@@ -63,6 +65,7 @@ struct HeaderLines {
   std::string types;
   std::optional<std::uint64_t> width, height, points;
   std::string data;
+  std::optional<Eigen::Isometry3d> viewpoint;
 };
 
 // A value of a SIZE or COUNT line: an integer in [1, max].
@@ -81,6 +84,24 @@ char FieldType(const std::string& word, const std::function<Error(const std::str
     throw bad("'" + word.substr(0, 20) + "' is not I, U or F");
   }
   return word[0];
+}
+
+// A VIEWPOINT line's "tx ty tz qw qx qy qz": the sensor's pose in the file's frame.
+Eigen::Isometry3d Viewpoint(const std::vector<std::string>& words,
+                            const std::function<Error(const std::string&)>& bad) {
+  double v[7];
+  if (words.size() != 7) throw bad("expected 7 numbers: tx ty tz qw qx qy qz");
+  for (std::size_t i = 0; i < 7; ++i) {
+    if (!ParseNumber(words[i], v[i]) || !std::isfinite(v[i])) {
+      throw bad("'" + words[i].substr(0, 20) + "' is not a finite number");
+    }
+  }
+  const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+  if (!(q.norm() > 1e-6)) throw bad("the orientation quaternion has zero length");
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return T;
 }
 
 // The values of one header line (`key` and the words after it, at `where`) added to `lines`.
@@ -108,6 +129,8 @@ void ReadHeaderLine(const std::string& key, const std::vector<std::string>& word
       throw bad("expected ascii, binary or binary_compressed");
     }
     lines.data = words[0];
+  } else if (key == "VIEWPOINT") {
+    lines.viewpoint = Viewpoint(words, bad);
   } else {
     throw Error(where + ": unknown key '" + key.substr(0, 40) + "': not a PCD header");
   }
@@ -173,11 +196,12 @@ Header ParseHeader(const std::string& file, const std::string& name) {
     at = end + 1;
     std::string key;
     stream >> key;
-    if (key.empty() || key[0] == '#' || key == "VERSION" || key == "VIEWPOINT") continue;
+    if (key.empty() || key[0] == '#' || key == "VERSION") continue;
     ReadHeaderLine(key, Words(stream), name + ": header line " + std::to_string(number), lines);
   }
   Header header;
   header.data = lines.data;
+  header.viewpoint = lines.viewpoint;
   header.body_offset = std::min(at, file.size());
   header.fields = LayOutFields(lines, name);
   for (const Field& field : header.fields) {
@@ -297,6 +321,7 @@ PcdContent ReadPcd(const fs::path& path) {
   const std::string file = ReadFileBytes(path);
   const Header header = ParseHeader(file, name);
   PcdContent content;
+  content.T_file_sensor = header.viewpoint;
   if (header.data == "ascii") {
     ReadAscii(file, header, name, content);
     return content;

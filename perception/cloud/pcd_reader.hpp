@@ -1,7 +1,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 namespace uwscan::perception {
@@ -12,6 +14,9 @@ struct PcdContent {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3d> normals;  // one per point, or empty
   std::vector<double> intensity;         // one per point when it has an intensity field, or empty
+  // The sensor's pose in the file's frame from a VIEWPOINT line ("tx ty tz qw qx qy qz"), in the
+  // file's units; unset when the header has none.
+  std::optional<Eigen::Isometry3d> T_file_sensor;
 };
 
 // Reads PCD 0.7 (and older headers without VERSION or COUNT) in ascii, binary and

@@ -106,6 +106,18 @@ RecognitionReport ReadRecognitionReport(const std::filesystem::path& path) {
     if (!sweep.is_number_integer()) root["scan_sweep"].Fail("expected a sweep number");
     report.scan_sweep = sweep.get<int>();
   }
+  if (j.contains("scan_frame")) {
+    const json& frame = j["scan_frame"];
+    const Field field = root["scan_frame"];
+    if (!frame.is_object()) field.Fail("expected an object");
+    const json& unit = Require(frame, "metres_per_unit", field);
+    if (!unit.is_number() || !(unit.get<double>() > 0.0) || !std::isfinite(unit.get<double>())) {
+      field["metres_per_unit"].Fail("expected a finite number > 0");
+    }
+    report.scan_metres_per_unit = unit.get<double>();
+    report.scan_T_file_sensor =
+        RigidPose(Require(frame, "T_file_sensor", field), field["T_file_sensor"]);
+  }
   const json& objects = Require(j, "objects", root);
   if (!objects.is_array()) root["objects"].Fail("expected an array");
   for (std::size_t i = 0; i < objects.size(); ++i) {

@@ -30,11 +30,16 @@ struct RecognitionReport {
   std::filesystem::path database;  // resolved against the report's folder
   std::size_t scan_points = 0;     // rows of the scan file, what the segments index
   std::optional<int> scan_sweep;   // the sweep of a dive log recognised
+  // How the scan file was put in the sensor frame: its unit, and the sensor's pose in the file's
+  // frame (translation in the file's units; identity for a dive log or a scan from the origin).
+  double scan_metres_per_unit = 1.0;
+  Eigen::Isometry3d scan_T_file_sensor = Eigen::Isometry3d::Identity();
   std::vector<ReportedObject> objects;
 };
 
 // Reads {"uwscan_format": 1, "kind": "recognition_report", "scan", "database", "scan_points",
-// optionally "scan_sweep", "objects": [{"id", "segment", "centroid_m", and for a recognised
+// optionally "scan_sweep" and "scan_frame": {"metres_per_unit", "T_file_sensor": {"matrix"}},
+// "objects": [{"id", "segment", "centroid_m", and for a recognised
 // object "score", "T_S_O": {"matrix"}, optionally "covariance" (6 rows of 6), "grasps":
 // [{"name", "matrix"}]}]}. Throws uwscan::Error naming the file and the field when the JSON
 // does not parse, the format or kind differs, or a value has the wrong type or count, is not

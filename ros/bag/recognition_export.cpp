@@ -31,7 +31,8 @@ CloudMessage ScanCloud(const perception::RecognitionReport& report, const Header
   // `recognize` triangulates a dive log with the scanner's default method, as here.
   mapping::ReconstructionOptions options;
   options.sweep = report.scan_sweep;
-  const perception::PointCloud scan = mapping::ReadScanFile(report.scan, options).cloud;
+  const perception::PointCloud scan =
+      mapping::ReadScanFile(report.scan, options, mapping::ReportedScanFrame(report)).cloud;
   CloudMessage message;
   message.header = header;
   message.points.reserve(scan.size());

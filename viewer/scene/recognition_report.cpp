@@ -25,7 +25,8 @@ void AddRecognitionReport(const RecognitionReport& report,
   mapping::ReconstructionOptions scan_options = log_options;
   scan_options.method = std::nullopt;
   scan_options.sweep = report.scan_sweep;
-  const mapping::ScanFile file = mapping::ReadScanFile(report.scan, scan_options);
+  const mapping::ScanFile file =
+      mapping::ReadScanFile(report.scan, scan_options, mapping::ReportedScanFrame(report));
   const perception::PointCloud& scan = file.cloud;
   if (file.rows_in_file != report.scan_points) {
     throw Error(report.scan.string() + ": has " + std::to_string(file.rows_in_file) +
