@@ -66,9 +66,11 @@ void RunRegister(const RegisterArgs& a) {
     throw Error(a.target + ": the target cloud has no extent (give --voxel)");
   }
   // Without an extent (one point) the object's size is taken from the voxel.
-  perception::RegistrationPipelineOptions options =
-      perception::RegistrationPipelineOptions::ForObjectSize(
-          size > 0.0 ? size : 50.0 * a.voxel_m, a.seed, a.threads, a.voxel_set ? a.voxel_m : 0.0);
+  const perception::RegistrationPipelineOptions options =
+      a.voxel_set
+          ? perception::RegistrationPipelineOptions::ForObjectSize(
+                size > 0.0 ? size : 50.0 * a.voxel_m, a.seed, a.threads, a.voxel_m)
+          : perception::RegistrationPipelineOptions::ForClouds(source, target, a.seed, a.threads);
   std::optional<Eigen::Isometry3d> init;
   if (!a.init.empty()) init = ParsePoseOption(a.init, "--init");
   perception::RegistrationPipelineResult r;
@@ -253,7 +255,10 @@ void AddRegisterCommand(CLI::App& app) {
   cmd->add_option("target", a->target, "cloud to align onto")->required()->check(CLI::ExistingFile);
   cmd->add_option("--init", a->init, "initial T_target_source: tx ty tz qx qy qz qw (skips RANSAC)")
       ->expected(7);
-  cmd->add_option("--voxel", a->voxel_m, "downsampling leaf in metres (default: target size / 50)")
+  cmd->add_option(
+         "--voxel", a->voxel_m,
+         "downsampling leaf in metres (default: a hundredth of the target's extent, at most its "
+         "bounding box diagonal / 50, at least twice the clouds' point spacing)")
       ->each([a](const std::string&) { a->voxel_set = true; });
   cmd->add_option("--seed", a->seed, "RANSAC seed");
   cmd->add_option("--threads", a->threads, "threads (0: all)");

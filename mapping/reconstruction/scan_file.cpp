@@ -8,6 +8,7 @@
 
 #include "mapping/log/dive_log.hpp"
 #include "perception/cloud/cloud_io.hpp"
+#include "perception/cloud/cloud_scale.hpp"
 #include "perception/recognition/recognition_report.hpp"
 #include "scanner/common/error.hpp"
 
@@ -21,27 +22,11 @@ std::string SweepRange(const std::vector<int>& sweeps) {
          std::to_string(sweeps.back());
 }
 
-// The diagonal of the box that holds all but the outer 1 % of the points along each axis: the
-// scan's size, not that of one stray return.
-double RobustExtent(const perception::PointCloud& cloud) {
-  std::vector<float> values(cloud.size());
-  const std::size_t outer = values.size() / 100;
-  Eigen::Vector3d low, high;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (std::size_t i = 0; i < values.size(); ++i) values[i] = cloud.points[i][axis];
-    std::nth_element(values.begin(), values.begin() + outer, values.end());
-    low[axis] = values[outer];
-    std::nth_element(values.begin(), values.end() - 1 - outer, values.end());
-    high[axis] = values[values.size() - 1 - outer];
-  }
-  return (high - low).norm();
-}
-
 // Refuses a scan no sensor makes, with a hint about the units that would make sense of it. A
 // scan whose points all coincide has no size to judge (it holds no object either).
 void RequireScanSize(const perception::PointCloud& cloud_m, double metres_per_unit,
                      const std::string& name) {
-  const double extent_m = RobustExtent(cloud_m);
+  const double extent_m = perception::RobustDiagonal(cloud_m);
   if (extent_m == 0.0 || (extent_m >= kSmallestScan_m && extent_m <= kLargestScan_m)) return;
   char size[64];
   std::snprintf(size, sizeof size, "%.4g m", extent_m);

@@ -1,8 +1,10 @@
 #include "perception/registration/registration_pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <numeric>
 
+#include "perception/cloud/cloud_scale.hpp"
 #include "perception/features/fpfh.hpp"
 #include "perception/preprocessing/normals.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
@@ -88,6 +90,20 @@ RegistrationPipelineOptions RegistrationPipelineOptions::ForObjectSize(double si
   o.icp.threads = threads;
   o.threads = threads;
   return o;
+}
+
+RegistrationPipelineOptions RegistrationPipelineOptions::ForClouds(const PointCloud& source,
+                                                                   const PointCloud& target,
+                                                                   std::uint64_t seed,
+                                                                   int threads) {
+  RequireValidCloud(source, "registration source");
+  RequireValidCloud(target, "registration target");
+  const double size_m = BoundingBoxDiagonal(target);
+  if (!(size_m > 0.0)) throw Error("registration: the target cloud has no extent (give a voxel)");
+  const double scale_voxel_m = std::min(RobustDiagonal(target) / 100.0, size_m / 50.0);
+  const double spacing_m = std::max(MedianPointSpacing(source), MedianPointSpacing(target));
+  const double voxel_m = std::max(scale_voxel_m, 2.0 * spacing_m);
+  return ForObjectSize(size_m, seed, threads, voxel_m > 0.0 ? voxel_m : size_m / 50.0);
 }
 
 void RegistrationPipelineOptions::Check() const {

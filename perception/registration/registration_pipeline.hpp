@@ -36,6 +36,15 @@ struct RegistrationPipelineOptions {
   // the object's edge by less than 1 % of a voxel or the RMS changes by less than 1e-4 of it.
   static RegistrationPipelineOptions ForObjectSize(double size_m, std::uint64_t seed = 1,
                                                    int threads = 0, double voxel_m = 0.0);
+  // The same for two scans of any size, the voxel chosen from the target's own scale: a
+  // hundredth of its robust extent (RobustDiagonal), but at most the object rule's size / 50 and
+  // at least twice its point spacing (MedianPointSpacing), so a voxel holds a few points. A scene
+  // is registered at the scale of its parts, not of its extent: two real scans cut in two, a
+  // 1.8 m table scene (1.8 mm spacing) and a 12.6 m site (2.6 cm spacing), fail at size / 50
+  // (4 cm and 0.65 m voxels) and register at these (1.8 cm and 13 cm; bench/registration/
+  // RESULTS.md). Throws uwscan::Error when the target has no extent.
+  static RegistrationPipelineOptions ForClouds(const PointCloud& source, const PointCloud& target,
+                                               std::uint64_t seed = 1, int threads = 0);
   void Check() const;
 };
 
