@@ -160,9 +160,9 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json pipelines = nlohmann::json::object();
   for (const auto& [name, s] : r.pipelines) {
-    auto stage = [&](const char* k) {
-      const auto it = s.stage_seconds_per_pair.find(k);
-      return it == s.stage_seconds_per_pair.end() ? 0.0 : it->second;
+    auto stage = [&stages = s.stage_seconds_per_pair](const char* k) {
+      const auto it = stages.find(k);
+      return it == stages.end() ? 0.0 : it->second;
     };
     std::printf("| %s | %d/%d | %d/%d | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n", name.c_str(),
                 s.successes, s.pairs, s.symmetric_successes, s.pairs, s.seconds_per_pair,

@@ -123,8 +123,8 @@ SimulationBenchResult RunSimulationBenchmark(const SimulationBenchOptions& o,
     }
     rows.emplace_back("off_with_parameters", OffWithParameters());
     rows.emplace_back("all", all);
-    for (EffectCost& cost : TimeRows(scene, rows, o, [&](double f) {
-           if (progress) progress(std::string("simulation ") + name, f);
+    for (EffectCost& cost : TimeRows(scene, rows, o, [&, &scene_name = name](double f) {
+           if (progress) progress(std::string("simulation ") + scene_name, f);
          })) {
       cost.scene = name;
       result.rows.push_back(cost);

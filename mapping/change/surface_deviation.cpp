@@ -157,7 +157,7 @@ Eigen::Vector3d PlaneNormal(const PointCloud& cloud, const Eigen::Vector3d& c_W,
     covariance += d * d.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
-  const Eigen::Vector3d l = eigen.eigenvalues();
+  const Eigen::Vector3d& l = eigen.eigenvalues();
   if (!(l(1) > 1e-6 * l(2))) return Eigen::Vector3d::Zero();  // collinear
   return eigen.eigenvectors().col(0).normalized();
 }

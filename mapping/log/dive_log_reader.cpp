@@ -1,5 +1,6 @@
 #include <bit>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <optional>
 #include <set>
@@ -239,7 +240,8 @@ bool IsSqliteFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   char magic[16] = {};
   in.read(magic, sizeof(magic));
-  return in.gcount() == 16 && std::string(magic, 16) == std::string("SQLite format 3", 16);
+  // The header's 16 bytes are the text and its terminating NUL.
+  return in.gcount() == 16 && std::memcmp(magic, "SQLite format 3", 16) == 0;
 }
 
 DiveLogReader::DiveLogReader(const std::filesystem::path& path, DiveLogOpening opening)

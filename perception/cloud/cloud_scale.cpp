@@ -38,7 +38,8 @@ double MedianPointSpacing(const PointCloud& cloud, std::size_t samples) {
     // The nearest is the point itself, then perhaps twins at the same place (scans written
     // twice over, or returns at the sensor's origin): the first point away from it.
     index.Query(cloud.points[i], kNeighbours, indices, squared_m2);
-    const auto away = std::find_if(squared_m2.begin(), squared_m2.end(), [](float d) { return d > 0.0f; });
+    const auto away =
+        std::find_if(squared_m2.begin(), squared_m2.end(), [](float d) { return d > 0.0f; });
     if (away != squared_m2.end()) nearest_m.push_back(std::sqrt(static_cast<double>(*away)));
   }
   if (nearest_m.empty()) return 0.0;

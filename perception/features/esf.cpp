@@ -140,10 +140,10 @@ std::size_t Farthest(const std::vector<Eigen::Vector3f>& points, const Distance&
 // when even ABC is thinner than PCL's area threshold, no triangle of the cloud is thicker.
 std::string FlatReason(const PointCloud& cloud, const std::vector<Eigen::Vector3f>& scaled) {
   const std::size_t a = Farthest(scaled, [](const Eigen::Vector3f& p) { return p.squaredNorm(); });
-  const Eigen::Vector3f pa = scaled[a];
+  const Eigen::Vector3f& pa = scaled[a];
   const std::size_t b =
       Farthest(scaled, [&](const Eigen::Vector3f& p) { return (p - pa).squaredNorm(); });
-  const Eigen::Vector3f pb = scaled[b];
+  const Eigen::Vector3f& pb = scaled[b];
   const Eigen::Vector3f ab = pb - pa;
   const std::size_t c =
       Farthest(scaled, [&](const Eigen::Vector3f& p) { return ab.cross(p - pa).squaredNorm(); });

@@ -120,7 +120,7 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
   // Combinations of the free directions by how much they turn: the right singular vectors of
   // their rotation halves, most turning first.
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(free.topRows<3>(), Eigen::ComputeFullV);
-  const Eigen::VectorXd turning = svd.singularValues();
+  const Eigen::VectorXd& turning = svd.singularValues();
   std::vector<Vector6d> rotations;  // unscaled twists
   std::vector<Eigen::Vector3d> slides;
   for (Eigen::Index j = 0; j < free.cols(); ++j) {
