@@ -28,21 +28,21 @@ sources=(scanner perception mapping viewer ros bench apps)
 # The library, bench and app sources changed since .tidy-base's commit, with the source of each
 # changed header.
 changed_since_base() {
-  local base
-  base=$(tr -d '[:space:]' < .tidy-base)
-  if ! git cat-file -e "$base^{commit}" 2>/dev/null; then
-    echo "check_tidy: .tidy-base's commit $base is not in this clone's history (shallow?): skipped" >&2
-    exit 77
-  fi
+  local base=$1
   git diff --name-only --diff-filter=d "$base" -- "${sources[@]}" |
     sed -n -e 's/\.hpp$/.cpp/p' -e '/\.cpp$/p' | sort -u |
     while read -r f; do [ -f "$f" ] && echo "$f"; done
 }
 
 if [ "${1:-}" = --since-base ]; then
-  mapfile -t files < <(changed_since_base | grep -v '_test\.cpp$' || true)
+  base=$(tr -d '[:space:]' < .tidy-base)
+  if ! git cat-file -e "$base^{commit}" 2>/dev/null; then
+    echo "check_tidy: .tidy-base's commit $base is not in this clone's history (shallow?): skipped" >&2
+    exit 77
+  fi
+  mapfile -t files < <(changed_since_base "$base" | grep -v '_test\.cpp$' || true)
   if [ ${#files[@]} -eq 0 ]; then
-    echo "check_tidy: no source changed since $(tr -d '[:space:]' < .tidy-base)"
+    echo "check_tidy: no source changed since $base"
     exit 0
   fi
 else
