@@ -182,7 +182,7 @@ void AddBuildDbCommand(CLI::App& app) {
   cmd->add_option("objects", a->objects,
                   "mesh files (PLY/OFF/STL/OBJ in --units; grasps and symmetries from "
                   "MESH.grasps.yaml beside them) or procedural objects: pipe, elbow, tee, flange, "
-                  "valve_wheel, valve_lever")
+                  "valve_wheel, valve_lever, panel")
       ->required();
   cmd->add_option("-o,--output", a->output, "object database to write")->required();
   cmd->add_option("--views", a->views, "views per object over the sphere of directions")

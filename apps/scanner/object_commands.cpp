@@ -56,6 +56,7 @@ const std::map<std::string, std::set<std::string>>& ShapeOptions() {
        {"--radius-m", "--wall-m", "--body-radius-m", "--stem-length-m", "--handle",
         "--handle-radius-m", "--chord-error-m"}},
       {"gauge", {"--length-m"}},
+      {"panel", {"--size-m"}},
   };
   return options;
 }
@@ -91,6 +92,17 @@ scanner::TriangleMesh MakeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
                              given("--length-m") ? a.length_m : 0.2, chord);
   }
   if (a.shape == "gauge") return sim::MakeGaugeBlock(given("--length-m") ? a.length_m : 0.05);
+  if (a.shape == "panel") {
+    sim::PanelShape s;
+    if (given("--size-m")) {
+      if (a.size_m.size() != 3)
+        throw Error("--size-m: a panel takes 3 lengths: width height thickness");
+      s.width_m = a.size_m[0];
+      s.height_m = a.size_m[1];
+      s.thickness_m = a.size_m[2];
+    }
+    return sim::MakePanel(s);
+  }
   // Pipe-like shapes: unset options keep the shape's defaults.
   auto set = [&](const char* option, double value, double* field) {
     if (given(option)) *field = value;
@@ -174,7 +186,7 @@ void AddMakeObjectCommand(CLI::App& app) {
   cmd->add_option("--radius-m", a->radius_m, "sphere or cylinder radius; pipe outer radius")
       ->check(kObjectLengthMetres);
   cmd->add_option("--wall-m", a->wall_m, "pipe wall thickness")->check(kObjectLengthMetres);
-  cmd->add_option("--size-m", a->size_m, "plane: X Y; box: X Y Z")
+  cmd->add_option("--size-m", a->size_m, "plane: X Y; box: X Y Z; panel: width height thickness")
       ->expected(2, 3)
       ->check(kObjectLengthMetres);
   cmd->add_option("--bend-radius-m", a->bend_radius_m, "elbow: radius of the centre line's bend")

@@ -106,12 +106,25 @@ ObjectSource Valve(sim::ValveHandle handle) {
   return o;
 }
 
+ObjectSource Panel() {
+  sim::PanelShape shape;
+  ObjectSource o{"panel", "procedural: panel", sim::MakePanel(shape), {}, std::nullopt};
+  // A handle's bar from the front, fingers closing across it.
+  o.grasps.push_back(Grasp("handle",
+                           Eigen::Vector3d(shape.handle_offset_m, 0, shape.handle_depth_m),
+                           Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(1, 0, 0)));
+  // A half turn about the front face's normal swaps the handles.
+  o.symmetries = std::vector<SymmetryAxis>{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 2}};
+  return o;
+}
+
 const std::map<std::string, ObjectSource (*)()>& Catalogue() {
   static const std::map<std::string, ObjectSource (*)()> catalogue = {
       {"pipe", &Pipe},
       {"elbow", &Elbow},
       {"tee", &Tee},
       {"flange", &Flange},
+      {"panel", &Panel},
       {"valve_wheel", [] { return Valve(sim::ValveHandle::kWheel); }},
       {"valve_lever", [] { return Valve(sim::ValveHandle::kLever); }},
   };

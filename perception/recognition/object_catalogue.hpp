@@ -22,7 +22,8 @@ struct ObjectSource {
 
 // The procedural IMR objects uwscan generates itself, with sensible grasp frames: pipe (its
 // body), elbow (mid-bend), tee (the run, clear of the branch), flange (its rim), valve_wheel
-// and valve_lever (the handle), and their symmetries declared by construction. Names in
+// and valve_lever (the handle), panel (an intervention panel: a handle), and their symmetries
+// declared by construction. Names in
 // CatalogueNames().
 std::vector<std::string> CatalogueNames();
 // Throws uwscan::Error listing the known names when `name` is not one.

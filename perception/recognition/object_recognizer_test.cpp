@@ -553,6 +553,60 @@ TEST(ObjectRecognition, APlainPlyFromAnotherSensorIsRecognised) {
   EXPECT_LT((found->T_S_O.translation() - truth.T_S_O.translation()).norm(), 0.005);
 }
 
+// An intervention panel seen face-on is mostly one plane, larger in the scan than the seabed or
+// wall around it: plane removal must not take it for the support. Lying on the seabed and
+// mounted on a wall, it is found and posed (modulo its half turn about the face's normal).
+TEST(ObjectRecognition, APanelLyingOnTheSeabedOrMountedOnAWallIsFoundNotRemovedAsAPlane) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  static const ObjectDatabase db = Build({"panel", "pipe", "flange"}, 2);
+  const ObjectSource panel = CatalogueObject("panel");
+  const sim::PanelShape shape;
+  sim::SceneObject seabed;
+  seabed.name = "seabed";
+  seabed.shape = sim::ObjectShape::kPlane;
+  seabed.mesh = sim::MakeRectangle(4.0, 4.0);
+  // Lying on its back, handles up, turned 20 degrees about the vertical.
+  Eigen::Isometry3d lying = Eigen::Isometry3d::Identity();
+  lying.linear() = Eigen::AngleAxisd(20.0 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  lying.translation() = Eigen::Vector3d(0.0, 0.0, shape.thickness_m);
+  // On a wall (the plane y = 0.3, facing -y), its front facing -y, 0.5 m above the seabed.
+  sim::SceneObject wall = seabed;
+  wall.name = "wall";
+  wall.T_W_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  wall.T_W_O.translation() = Eigen::Vector3d(0.0, 0.3, 1.0);
+  Eigen::Isometry3d mounted = Eigen::Isometry3d::Identity();
+  mounted.linear() = wall.T_W_O.linear();
+  mounted.translation() = Eigen::Vector3d(0.1, 0.3 - shape.thickness_m, 0.5);
+  struct Case {
+    const char* name;
+    std::vector<sim::SceneObject> scene;
+    Eigen::Isometry3d T_W_O;
+    Eigen::Vector3d eye_W;
+  };
+  const std::vector<Case> cases = {
+      {"lying on the seabed", {seabed, Placed(panel.mesh, lying)}, lying, {0.25, -0.35, 0.75}},
+      {"mounted on a wall",
+       {seabed, wall, Placed(panel.mesh, mounted)},
+       mounted,
+       {0.3, -0.5, 0.75}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const Eigen::Isometry3d T_W_C =
+        sim::LookAt(c.eye_W, c.T_W_O.translation(), Eigen::Vector3d::UnitZ());
+    const sim::VirtualScan virtual_scan = Scanner().Scan(c.scene, T_W_C, 7);
+    const Scan scan{MakeCloud(virtual_scan.points_C), T_W_C.inverse() * c.T_W_O};
+    const RecognitionResult r = RecognizeObjects(scan.cloud, db);
+    const RecognizedObject* found = Nearest(r, scan);
+    ASSERT_NE(found, nullptr);
+    EXPECT_EQ(found->object_id, "panel");
+    const SymmetricPoseError e =
+        PoseErrorModuloSymmetry(found->T_S_O, scan.T_S_O, panel.mesh.vertices, *panel.symmetries);
+    EXPECT_LT(e.rotation_rad, 2.0 * kDeg);
+    EXPECT_LT(e.translation_m, 0.005);
+  }
+}
+
 TEST(ObjectDatabaseFile, TruncatedForeignAndNewerFilesGiveOneLineErrors) {
   const std::filesystem::path dir = TestDir();
   const std::filesystem::path good = dir / "uwscan_db_good.db";

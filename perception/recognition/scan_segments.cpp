@@ -34,6 +34,38 @@ double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
   return std::sqrt(12.0 * std::max(variances(1), 0.0));
 }
 
+// Planes removed as supports at most (the seabed and two walls), and planes looked at to find
+// them (an object's face seen broadside is looked at and kept).
+constexpr std::size_t kMaxSupportPlanes = 3;
+constexpr double kFindingShare = 3.0;
+constexpr int kMaxPlaneSearches = 5;
+
+// The inliers of `plane` within distance_m, and in `rest` the other points of `cloud`.
+DetectedPlane WithInliers(const PointCloud& cloud, DetectedPlane plane, double distance_m,
+                          std::vector<std::size_t>& rest) {
+  plane.inliers.clear();
+  rest.clear();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const double d = plane.normal.dot(cloud.Point(i)) + plane.offset_m;
+    (std::abs(d) < distance_m ? plane.inliers : rest).push_back(i);
+  }
+  return plane;
+}
+
+// Whether a plane hides surface behind it from the sensor at the origin: at least a tenth as
+// many points as it holds (and a segment's worth) lie beyond it by more than plane_distance_m.
+bool HidesSurface(const PointCloud& cloud, const DetectedPlane& plane,
+                  const RecognitionOptions& options) {
+  const double sensor_side = plane.offset_m >= 0.0 ? 1.0 : -1.0;  // sign of n . 0 + offset
+  std::size_t behind = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const double distance_m = plane.normal.dot(cloud.Point(i)) + plane.offset_m;
+    if (sensor_side * distance_m < -options.plane_distance_m) ++behind;
+  }
+  return behind >= std::max<std::size_t>(static_cast<std::size_t>(options.min_segment_points),
+                                         plane.inliers.size() / 10);
+}
+
 // Each fragment joins the segment nearest to it when within `distance_m`.
 void AttachFragments(const PointCloud& cloud,
                      const std::vector<std::vector<std::size_t>>& fragments, double distance_m,
@@ -176,29 +208,49 @@ std::vector<Segment> Segments(const PointCloud& cloud, double largest_object_m,
 PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_object_m,
                                        const RecognitionOptions& options) {
   PlaneRemovalOptions planes;
-  planes.distance_threshold_m = options.plane_distance_m;
+  // Planes are found with a third of the inlier distance and then take their inliers within it
+  // all: with the whole distance, RANSAC's best plane may straddle two parallel surfaces a little
+  // more than it apart (a panel's face and the seabed or wall behind it), tilted to catch a strip
+  // of each, where a third of it holds only the whole of one surface.
+  planes.distance_threshold_m = options.plane_distance_m / kFindingShare;
   planes.max_planes = 1;
   planes.seed = options.seed;
   planes.threads = options.threads;
+  std::vector<bool> removed(down.size(), false);
+  std::vector<std::size_t> searched_indices(down.size());  // into down: where planes are sought
+  for (std::size_t i = 0; i < down.size(); ++i) searched_indices[i] = i;
+  PointCloud searched = down;
   PlaneRemovalResult result;
-  result.remaining = down;
-  for (std::size_t i = 0; i < down.size(); ++i) result.remaining_indices.push_back(i);
-  for (int k = 0; k < 3 && !result.remaining.empty(); ++k) {
+  for (int search = 0;
+       search < kMaxPlaneSearches && result.planes.size() < kMaxSupportPlanes && !searched.empty();
+       ++search) {
     // min_fraction is of the cloud handed over; keep it a share of the whole scan.
     planes.min_fraction =
         std::min(1.0, options.plane_min_fraction * static_cast<double>(down.size()) /
-                          static_cast<double>(result.remaining.size()));
-    PlaneRemovalResult step = RemovePlanes(result.remaining, planes);
+                          static_cast<double>(searched.size()));
+    const PlaneRemovalResult step = RemovePlanes(searched, planes);
     if (step.planes.empty()) break;
-    DetectedPlane& plane = step.planes.front();
-    if (k > 0 && NarrowSpan(result.remaining, plane) < largest_object_m) break;
-    for (std::size_t& i : plane.inliers) i = result.remaining_indices[i];
-    std::vector<std::size_t> kept;
-    for (std::size_t i : step.remaining_indices) kept.push_back(result.remaining_indices[i]);
-    result.remaining_indices = std::move(kept);
-    result.remaining = std::move(step.remaining);
+    std::vector<std::size_t> rest;
+    DetectedPlane plane =
+        WithInliers(searched, step.planes.front(), options.plane_distance_m, rest);
+    const bool wide = NarrowSpan(searched, plane) >= largest_object_m;
+    for (std::size_t& i : plane.inliers) i = searched_indices[i];
+    // A plane may be an object's face seen broadside (a panel, a plate): it hides the surface
+    // behind it, where the seabed or a wall hides nothing. Its points stay in the scan; the
+    // search goes on without them.
+    const bool face = !wide && HidesSurface(down, plane, options);
+    if (!face && !wide && !result.planes.empty()) break;
+    searched = Subset(searched, rest);
+    for (std::size_t& i : rest) i = searched_indices[i];
+    searched_indices = std::move(rest);
+    if (face) continue;
+    for (std::size_t i : plane.inliers) removed[i] = true;
     result.planes.push_back(std::move(plane));
   }
+  for (std::size_t i = 0; i < down.size(); ++i) {
+    if (!removed[i]) result.remaining_indices.push_back(i);
+  }
+  result.remaining = Subset(down, result.remaining_indices);
   return result;
 }
 

@@ -23,8 +23,11 @@ struct Segment {
 // The planes objects rest on or stand beside: the dominant plane (the seabed), then others while
 // they are wider than any object of the database both ways (a wall); the search stops at the
 // first narrower one. A flat face of an object, or a slab cut through the tops of lying pipes,
-// holds many points too, but removing it would cut the object in pieces. Uses options'
-// plane_distance_m, plane_min_fraction (of `down`), seed and threads.
+// holds many points too, but removing it would cut the object in pieces. A plane no wider than an
+// object that hides surface behind it (seen from the sensor at the origin) is an object's face
+// seen broadside, a panel on the seabed or on a wall: it is kept, and the supports are sought
+// among the other points. Uses options' plane_distance_m, plane_min_fraction
+// (of `down`), min_segment_points, seed and threads.
 PlaneRemovalResult RemoveSupportPlanes(const PointCloud& down, double largest_object_m,
                                        const RecognitionOptions& options);
 

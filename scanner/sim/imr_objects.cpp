@@ -479,6 +479,43 @@ TriangleMesh MakeValve(const ValveShape& shape, double chord_error_m) {
   return mesh;
 }
 
+void PanelShape::Check() const {
+  const OptionChecks check("PanelShape");
+  check.Positive("width_m", width_m, "m");
+  check.Positive("height_m", height_m, "m");
+  check.Positive("thickness_m", thickness_m, "m");
+  check.Positive("bar_m", bar_m, "m");
+  check.Require(std::isfinite(handle_offset_m) && handle_offset_m >= 0.0 &&
+                    handle_offset_m < 0.5 * (width_m - bar_m),
+                "handle_offset_m", "in [0, (width_m - bar_m) / 2)", handle_offset_m);
+  check.Require(
+      std::isfinite(handle_span_m) && handle_span_m > bar_m && handle_span_m + bar_m < height_m,
+      "handle_span_m", "in (bar_m, height_m - bar_m)", handle_span_m);
+  check.Require(std::isfinite(handle_depth_m) && handle_depth_m > bar_m, "handle_depth_m",
+                "> bar_m (" + Num(bar_m) + " m)", handle_depth_m);
+}
+
+TriangleMesh MakePanel(const PanelShape& shape) {
+  shape.Check();
+  TriangleMesh mesh = MakeBox(Eigen::Vector3d(shape.width_m, shape.height_m, shape.thickness_m));
+  for (Eigen::Vector3d& v : mesh.vertices) v.z() -= 0.5 * shape.thickness_m;
+  // Each post runs 1 mm into the plate and up into the bar, so that no faces coincide.
+  const double post_length = shape.handle_depth_m - 0.5 * shape.bar_m + 0.001;
+  const TriangleMesh post = MakeBox(Eigen::Vector3d(shape.bar_m, shape.bar_m, post_length));
+  const TriangleMesh bar =
+      MakeBox(Eigen::Vector3d(shape.bar_m, shape.handle_span_m + shape.bar_m, shape.bar_m));
+  for (const double x : {-shape.handle_offset_m, shape.handle_offset_m}) {
+    for (const double y : {-0.5 * shape.handle_span_m, 0.5 * shape.handle_span_m}) {
+      Append(&mesh, post,
+             Placed(Eigen::Matrix3d::Identity(), Eigen::Vector3d(x, y, 0.5 * post_length - 0.001)));
+    }
+    Append(&mesh, bar,
+           Placed(Eigen::Matrix3d::Identity(),
+                  Eigen::Vector3d(x, 0.0, shape.handle_depth_m - 0.5 * shape.bar_m)));
+  }
+  return mesh;
+}
+
 TriangleMesh MakeGaugeBlock(double length_m) {
   RequirePositive("gauge", "length_m", length_m);
   return MakeBox(Eigen::Vector3d(kGaugeWidthM, length_m, kGaugeThicknessM));

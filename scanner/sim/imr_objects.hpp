@@ -1,8 +1,9 @@
 #pragma once
 
 // Procedurally generated objects of inspection, maintenance and repair (IMR) work: pipes,
-// elbows, T-junctions, flanges, valves, gauge blocks, and the plain shapes scenes are built
-// from. Every function returns a TriangleMesh in the object's own frame {O}, metres.
+// elbows, T-junctions, flanges, valves, intervention panels, gauge blocks, and the plain shapes
+// scenes are built from. Every function returns a TriangleMesh in the object's own frame {O},
+// metres.
 //
 // Closed shapes are watertight and oriented outward: every edge is shared by exactly two
 // triangles, in opposite directions, and the signed volume is positive. Composite objects
@@ -124,6 +125,22 @@ struct ValveShape {
   void Check() const;
 };
 TriangleMesh MakeValve(const ValveShape& shape, double chord_error_m = kDefaultChordErrorM);
+
+// Intervention panel (as on subsea structures, ISO 13628-8): a plate in the x-y plane of {O},
+// its front face at z = 0 facing +z_O, and two D-handles standing out of the front face, one
+// each side of the centre along x_O, each two posts and a bar along y_O. Thin and flat: seen
+// face-on it is mostly a plane, which recognition must not take for the seabed or a wall.
+struct PanelShape {
+  double width_m = 0.4;           // along x_O
+  double height_m = 0.3;          // along y_O
+  double thickness_m = 0.02;      // behind the front face, along -z_O
+  double handle_offset_m = 0.12;  // each handle's bar at x = +-offset, < width / 2 - bar / 2
+  double handle_span_m = 0.14;    // between the posts' centres, along y_O, < height_m
+  double handle_depth_m = 0.06;   // the bar's top above the front face
+  double bar_m = 0.02;            // the square section of the bars and posts
+  void Check() const;
+};
+TriangleMesh MakePanel(const PanelShape& shape);
 
 // Gauge block of the seed's experiment: length_m along y_O (20, 50 or 100 mm there), 35 mm
 // along x_O, 9 mm along z_O, centred on {O}.
