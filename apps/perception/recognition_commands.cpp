@@ -45,9 +45,13 @@ void RunBuildDb(const BuildDbArgs& a) {
   CheckOutputPath(a.output, "-o", inputs);
   std::vector<perception::ObjectSource> sources;
   for (const std::string& name : a.objects) {
-    sources.push_back(std::filesystem::exists(name)
-                          ? perception::MeshObject(name, UnitsToMetres(a.units))
-                          : perception::CatalogueObject(name));
+    if (!std::filesystem::exists(name)) {
+      sources.push_back(perception::CatalogueObject(name));
+    } else if (perception::IsCloudFile(name)) {
+      sources.push_back(perception::CloudObject(name, UnitsToMetres(a.units)));
+    } else {
+      sources.push_back(perception::MeshObject(name, UnitsToMetres(a.units)));
+    }
   }
   const scanner::Scanner scanner = a.scanner.empty()
                                        ? scanner::DefaultScanner(scanner::ScannerKind::kGalvo)
@@ -179,10 +183,12 @@ void AddBuildDbCommand(CLI::App& app) {
       "build-db",
       "scan objects with the virtual scanner and write the database `recognize` searches: "
       "ESF per view, model with FPFH, diameter, symmetries, grasp frames");
-  cmd->add_option("objects", a->objects,
-                  "mesh files (PLY/OFF/STL/OBJ in --units; grasps and symmetries from "
-                  "MESH.grasps.yaml beside them) or procedural objects: pipe, elbow, tee, flange, "
-                  "valve_wheel, valve_lever, panel")
+  cmd->add_option(
+         "objects", a->objects,
+         "mesh files (PLY/OFF/STL/OBJ in --units; grasps and symmetries from "
+         "MESH.grasps.yaml beside them), scans of objects (PCD/XYZ, PLY without faces: "
+         "a cloud, taught as its points' surface) or procedural objects: pipe, elbow, tee, flange, "
+         "valve_wheel, valve_lever, panel")
       ->required();
   cmd->add_option("-o,--output", a->output, "object database to write")->required();
   cmd->add_option("--views", a->views, "views per object over the sphere of directions")
@@ -196,7 +202,8 @@ void AddBuildDbCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(kPositiveNumber);
   cmd->add_option("--units", a->units,
-                  "units of the mesh files' coordinates: m, cm or mm (CAD exports are often in mm)")
+                  "units of the mesh and cloud files' coordinates: m, cm or mm (CAD exports are "
+                  "often in mm)")
       ->capture_default_str()
       ->check(CLI::IsMember({"m", "cm", "mm"}));
   cmd->add_option("--seed", a->seed, "scan noise and ESF sampling seed")->capture_default_str();

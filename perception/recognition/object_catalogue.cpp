@@ -2,13 +2,18 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <sstream>
 
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/recognition/cloud_surface.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/ply_reader.hpp"
 #include "scanner/common/yaml_fields.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
@@ -172,19 +177,60 @@ void RequireObjectSize(double diagonal_m, double units_to_m, const std::string& 
       " across (bounding box diagonal), outside the 5 mm to 10 m an object can be: " + hint);
 }
 
+void RequireUnits(double units_to_m, const std::filesystem::path& path) {
+  if (!(units_to_m > 0.0) || !std::isfinite(units_to_m))
+    throw Error(path.string() + ": units_to_m must be finite and > 0");
+}
+
+// The grasps, symmetries and id of the sidecar beside `path`, when there is one.
+void ReadSidecar(const std::filesystem::path& path, ObjectSource& o);
+
 }  // namespace
 
+bool IsCloudFile(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".pcd" || extension == ".xyz") return true;
+  return extension == ".ply" && !scanner::PlyFaceCount(path).has_value();
+}
+
 ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_m) {
-  if (!(units_to_m > 0.0) || !std::isfinite(units_to_m))
-    throw Error(mesh_path.string() + ": units_to_m must be finite and > 0");
+  RequireUnits(units_to_m, mesh_path);
   ObjectSource o;
   o.id = mesh_path.stem().string();
   o.source = mesh_path.string();
   o.mesh = scanner::LoadMesh(mesh_path);
   for (Eigen::Vector3d& v : o.mesh.vertices) v *= units_to_m;
   RequireObjectSize(o.mesh.BoundingBoxDiagonal(), units_to_m, mesh_path.string());
-  const std::filesystem::path sidecar = GraspSidecarPath(mesh_path);
-  if (!std::filesystem::exists(sidecar)) return o;
+  ReadSidecar(mesh_path, o);
+  return o;
+}
+
+ObjectSource CloudObject(const std::filesystem::path& cloud_path, double units_to_m) {
+  RequireUnits(units_to_m, cloud_path);
+  PointCloud cloud = ReadCloud(cloud_path);
+  cloud.origin *= units_to_m;
+  for (Eigen::Vector3f& p : cloud.points) p *= static_cast<float>(units_to_m);
+  cloud.normals.clear();
+  RequireObjectSize(BoundingBoxDiagonal(cloud), units_to_m, cloud_path.string());
+  ObjectSource o;
+  o.id = cloud_path.stem().string();
+  o.source = cloud_path.string() + " (a scan: its points as discs)";
+  try {
+    o.mesh = CloudSurface(cloud);
+  } catch (const Error& e) {
+    throw Error(cloud_path.string() + ": " + e.what());
+  }
+  ReadSidecar(cloud_path, o);
+  return o;
+}
+
+namespace {
+
+void ReadSidecar(const std::filesystem::path& path, ObjectSource& o) {
+  const std::filesystem::path sidecar = GraspSidecarPath(path);
+  if (!std::filesystem::exists(sidecar)) return;
   std::ifstream in(sidecar);
   std::ostringstream text;
   text << in.rdbuf();
@@ -223,7 +269,8 @@ ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_
     }
     o.symmetries = axes;
   }
-  return o;
 }
+
+}  // namespace
 
 }  // namespace uwscan::perception

@@ -45,6 +45,15 @@ inline constexpr double kLargestObject_m = 10.0;
 inline constexpr double kSmallestObject_m = 0.005;
 ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_m = 1.0);
 
+// An object taught from a scan of it: a point cloud (.pcd, .xyz, or a .ply without faces) in
+// units_to_m, whose surface is its points as small discs facing out (CloudSurface), with the
+// sidecar, the id and the size check of MeshObject. Throws uwscan::Error naming the file when it
+// cannot be read, holds too few points for a surface, or is a size no object is.
+ObjectSource CloudObject(const std::filesystem::path& cloud_path, double units_to_m = 1.0);
+
+// Whether a file holds a point cloud rather than a mesh: .pcd or .xyz, or a PLY without faces.
+bool IsCloudFile(const std::filesystem::path& path);
+
 // The sidecar's path for a mesh: the mesh path with its extension replaced by ".grasps.yaml".
 std::filesystem::path GraspSidecarPath(const std::filesystem::path& mesh_path);
 

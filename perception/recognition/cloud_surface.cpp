@@ -1,0 +1,120 @@
+#include "perception/recognition/cloud_surface.hpp"
+
+#include <omp.h>
+
+#include <cmath>
+#include <vector>
+
+#include "perception/cloud/cloud_scale.hpp"
+#include "perception/preprocessing/normals.hpp"
+#include "perception/preprocessing/voxel_filter.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/common/option_checks.hpp"
+#include "scanner/sim/ray_caster.hpp"
+#include "scanner/sim/virtual_scanner.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+constexpr std::size_t kMinPoints = 20;
+constexpr int kDiscSides = 6;
+// Lines of sight closer than this to a disc's plane (cosine) are not tried: a neighbour's disc,
+// tilted by the surface's curvature, would block them on either side.
+constexpr double kMinSightCosine = 0.3;
+
+// The points with unit normals (any sign), those without a valid normal dropped.
+struct Oriented {
+  std::vector<Eigen::Vector3d> points, normals;
+};
+
+Oriented PointsWithNormals(const PointCloud& cloud, const CloudSurfaceOptions& options) {
+  VoxelFilterOptions thin;
+  thin.leaf_m = options.thinning_m;
+  const PointCloud thinned = VoxelDownsample(cloud, thin);
+  NormalOptions normal_options;
+  normal_options.k = options.normal_neighbours;
+  normal_options.viewpoint = Centroid(thinned);
+  normal_options.threads = options.threads;
+  const CloudWithNormals with = AttachNormals(thinned, EstimateNormals(thinned, normal_options));
+  Oriented o;
+  for (std::size_t i = 0; i < with.cloud.size(); ++i) {
+    o.points.push_back(with.cloud.Point(i));
+    o.normals.push_back(with.cloud.normals[i].cast<double>().normalized());
+  }
+  return o;
+}
+
+// A disc of `radius_m` about p in the plane normal to n, wound counter-clockwise seen from +n.
+void AddDisc(const Eigen::Vector3d& p, const Eigen::Vector3d& n, double radius_m,
+             scanner::TriangleMesh& mesh) {
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  const int centre = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.push_back(p);
+  for (int k = 0; k < kDiscSides; ++k) {
+    const double a = 2.0 * M_PI * k / kDiscSides;
+    mesh.vertices.push_back(p + radius_m * (std::cos(a) * u + std::sin(a) * v));
+  }
+  for (int k = 0; k < kDiscSides; ++k) {
+    mesh.triangles.emplace_back(centre, centre + 1 + k, centre + 1 + (k + 1) % kDiscSides);
+  }
+}
+
+scanner::TriangleMesh Discs(const Oriented& o, double radius_m) {
+  scanner::TriangleMesh mesh;
+  for (std::size_t i = 0; i < o.points.size(); ++i) AddDisc(o.points[i], o.normals[i], radius_m, mesh);
+  return mesh;
+}
+
+// Flips each normal towards the side of its disc from which more lines of sight leave the
+// object past every disc (triangles are two-sided to the caster, so the first guess's signs
+// do not matter).
+void FaceOutwards(Oriented& o, double radius_m, const CloudSurfaceOptions& options) {
+  scanner::sim::SceneObject surface;
+  surface.shape = scanner::sim::ObjectShape::kMesh;
+  surface.mesh = Discs(o, radius_m);
+  const scanner::sim::RayCaster caster({surface});
+  const std::vector<Eigen::Vector3d> sights = scanner::sim::SphereDirections(options.directions);
+  const double reach = 2.0 * surface.mesh.BoundingBoxDiagonal();
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
+  for (std::size_t i = 0; i < o.points.size(); ++i) {
+    int out_front = 0, out_back = 0;
+    for (const Eigen::Vector3d& d : sights) {
+      const double c = d.dot(o.normals[i]);
+      if (std::abs(c) < kMinSightCosine) continue;
+      if (!caster.Blocked(o.points[i], o.points[i] + reach * d, 0.5 * radius_m)) {
+        ++(c > 0.0 ? out_front : out_back);
+      }
+    }
+    if (out_back > out_front) o.normals[i] = -o.normals[i];
+  }
+}
+
+}  // namespace
+
+void CloudSurfaceOptions::Check() const {
+  const OptionChecks check("CloudSurfaceOptions");
+  check.Positive("thinning_m", thinning_m, "m");
+  check.Positive("disc_radius_spacings", disc_radius_spacings, "");
+  check.AtLeast("normal_neighbours", normal_neighbours, 3);
+  check.AtLeast("directions", directions, 8);
+  check.AtLeast("threads", threads, 0);
+}
+
+scanner::TriangleMesh CloudSurface(const PointCloud& cloud_m, const CloudSurfaceOptions& options) {
+  options.Check();
+  RequireValidCloud(cloud_m, "CloudSurface: the scan", kMinPoints);
+  Oriented o = PointsWithNormals(cloud_m, options);
+  if (o.points.size() < kMinPoints) {
+    throw Error("CloudSurface: only " + std::to_string(o.points.size()) +
+                " points of the scan have a surface normal (at least " +
+                std::to_string(kMinPoints) + ")");
+  }
+  const double spacing_m = MedianPointSpacing(MakeCloud(o.points));
+  const double radius_m = options.disc_radius_spacings * spacing_m;
+  if (!(radius_m > 0.0)) throw Error("CloudSurface: the scan's points all coincide");
+  FaceOutwards(o, radius_m, options);
+  return Discs(o, radius_m);
+}
+
+}  // namespace uwscan::perception

@@ -1,0 +1,94 @@
+#include "perception/recognition/cloud_surface.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/recognition/object_catalogue.hpp"
+#include "perception/recognition/object_symmetry.hpp"
+#include "perception/recognition/recognition_test_support.hpp"
+#include "scanner/common/error.hpp"
+#include "scanner/common/triangle_mesh.hpp"
+#include "scanner/sim/imr_objects.hpp"
+
+namespace uwscan::perception {
+namespace {
+
+using namespace recognition_test;
+
+// What a scan of `mesh` holds: points on its surface with noise of sigma_m, no normals.
+PointCloud ScannedCloud(const scanner::TriangleMesh& mesh, int count, double sigma_m,
+                        std::uint64_t seed) {
+  const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, count, seed);
+  std::mt19937_64 rng(seed + 1);
+  std::normal_distribution<double> noise(0.0, sigma_m);
+  std::vector<Eigen::Vector3d> points;
+  for (const Eigen::Vector3d& p : samples.points) {
+    points.push_back(p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  }
+  return MakeCloud(points);
+}
+
+// Each disc of a surface made from a sphere's scan faces out of it, and lies on it.
+TEST(CloudSurface, TheDiscsOfAClosedObjectFaceOutwardsAndLieOnItsSurface) {
+  const double radius_m = 0.1;
+  const scanner::TriangleMesh surface =
+      CloudSurface(ScannedCloud(scanner::sim::MakeUvSphere(radius_m), 20000, 0.0003, 1));
+  ASSERT_GT(surface.triangles.size(), 1000u);
+  std::size_t outward = 0, discs = 0;
+  for (std::size_t t = 0; t < surface.triangles.size(); t += 6, ++discs) {  // 6 per disc
+    const Eigen::Vector3i& tri = surface.triangles[t];
+    const Eigen::Vector3d& a = surface.vertices[static_cast<std::size_t>(tri[0])];
+    const Eigen::Vector3d n = (surface.vertices[static_cast<std::size_t>(tri[1])] - a)
+                                  .cross(surface.vertices[static_cast<std::size_t>(tri[2])] - a);
+    outward += n.dot(a) > 0.0;
+    EXPECT_NEAR(a.norm(), radius_m, 0.002);
+  }
+  EXPECT_GE(static_cast<double>(outward), 0.99 * static_cast<double>(discs));
+  EXPECT_THROW(CloudSurface(MakeCloud(std::vector<Eigen::Vector3d>(5, Eigen::Vector3d::Ones()))),
+               Error);
+}
+
+// An object taught from a scan of it (a cloud in a PLY without faces, 0.3 mm noise) is
+// recognised, and posed, as the same object taught from its mesh is.
+TEST(CloudSurface, AnObjectTaughtFromAScanIsRecognisedAsFromItsMesh) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  const ObjectSource flange = CatalogueObject("flange");
+  const std::filesystem::path path = TestDir() / "scanned_flange.ply";
+  WriteCloud(path, ScannedCloud(flange.mesh, 60000, 0.0003, 3));
+  ASSERT_TRUE(IsCloudFile(path));
+  std::vector<ObjectSource> sources = {CloudObject(path), CatalogueObject("pipe"),
+                                       CatalogueObject("valve_wheel")};
+  EXPECT_EQ(sources[0].id, "scanned_flange");
+  DatabaseBuildOptions options;
+  options.views = 16;
+  options.threads = 2;
+  const ObjectDatabase db = BuildObjectDatabase(sources, Scanner(), options);
+  int recognised = 0, posed = 0;
+  for (const Eigen::Vector3d& eye : {Eigen::Vector3d(0.35, 0.55, 0.55),
+                                     Eigen::Vector3d(-0.35, 0.6, 0.5),
+                                     Eigen::Vector3d(-0.5, -0.3, 0.7)}) {
+    const Scan scan = ScanOnSeabed(flange.mesh, eye, 11);
+    const RecognitionResult result = RecognizeObjects(scan.cloud, db);
+    const RecognizedObject* found = Nearest(result, scan);
+    ASSERT_NE(found, nullptr);
+    if (found->object_id != "scanned_flange") continue;
+    ++recognised;
+    const SymmetricPoseError e = PoseErrorModuloSymmetry(found->T_S_O, scan.T_S_O,
+                                                         flange.mesh.vertices, *flange.symmetries);
+    posed += e.rotation_rad < 2.0 * kDeg && e.translation_m < 0.005;
+  }
+  EXPECT_EQ(recognised, 3);
+  // From (-0.5, -0.3, 0.7) the bolts' phase comes out 4.1 degrees off about the axis, where the
+  // model taught from the mesh is 0.8 degrees off: the discs blur the bolt heads' edges.
+  EXPECT_GE(posed, 2);
+}
+
+}  // namespace
+}  // namespace uwscan::perception
