@@ -19,9 +19,10 @@ mkdir -p docs
 "$UWSCAN" view "$work/dive.db" --colour error --screenshot docs/demo_error.png --size 1280x800
 "$UWSCAN" view "$work/dive.db" --edl --point-size 3 --camera top --screenshot docs/demo_edl_top.png --size 1280x800
 
-# Recognition on the demo scene: its valve and flange looked up in a database of IMR objects,
-# each recognised model drawn where it was found, with its label and grasp frame.
-"$UWSCAN" build-db valve_wheel flange pipe --views 16 -o "$work/objects.db" >/dev/null
+# Recognition on the demo scene, as the README's quick start runs it: the valve taught from a
+# scan of it, each recognised model drawn where it was found, with its label and grasp frame.
+"$UWSCAN" make-object valve --handle lever --points 50000 -o "$work/valve_scan.ply" >/dev/null
+"$UWSCAN" build-db "$work/valve_scan.ply" flange pipe --views 16 -o "$work/objects.db" >/dev/null
 "$UWSCAN" recognize "$work/dive.db" --db "$work/objects.db" --json "$work/recognition.json" >/dev/null
 "$UWSCAN" view "$work/recognition.json" --screenshot docs/recognition_demo.png --size 1280x800
 

@@ -1,14 +1,20 @@
 #include "apps/scanner/object_commands.hpp"
 
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "apps/cli/number_validators.hpp"
+#include "apps/cli/output_path.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/cloud/point_cloud.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/random_draws.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
@@ -35,6 +41,9 @@ struct MakeObjectArgs {
   double body_radius_m = 0.0;
   double stem_length_m = 0.0;
   double chord_error_m = sim::kDefaultChordErrorM;
+  int points = 0;  // > 0: a cloud of this many surface points instead of the mesh
+  double noise_m = 0.0003;
+  std::uint64_t seed = 1;
 };
 
 // The dimension options each shape reads; any other one given is a mistake worth stopping on
@@ -151,8 +160,28 @@ scanner::TriangleMesh MakeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
   return sim::MakeValve(s, chord);
 }
 
+// `count` points spread over the mesh's surface by area, each moved by Gaussian noise of sigma_m
+// along every axis: what a scanner that saw all of the object would give.
+perception::PointCloud SurfaceScan(const scanner::TriangleMesh& mesh, int count, double sigma_m,
+                                   std::uint64_t seed) {
+  const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, count, seed);
+  std::mt19937_64 rng(seed + 1);
+  std::normal_distribution<double> noise(0.0, sigma_m);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(samples.points.size());
+  for (const Eigen::Vector3d& p : samples.points) points.push_back(p + DrawVector3(noise, rng));
+  return perception::MakeCloud(points);
+}
+
 void RunMakeObject(const MakeObjectArgs& a, const CLI::App& cmd) {
   const scanner::TriangleMesh mesh = MakeMesh(a, cmd);
+  if (a.points > 0) {
+    CheckCloudOutputPath(a.output, "-o", {});
+    perception::WriteCloud(a.output, SurfaceScan(mesh, a.points, a.noise_m, a.seed));
+    std::printf("wrote %s: %d points over a %s's surface, %g m noise\n", a.output.c_str(), a.points,
+                a.shape.c_str(), a.noise_m);
+    return;
+  }
   scanner::WriteMeshPly(mesh, a.output);
   Eigen::Vector3d lo = mesh.vertices.front(), hi = mesh.vertices.front();
   for (const Eigen::Vector3d& v : mesh.vertices) {
@@ -176,10 +205,20 @@ void AddMakeObjectCommand(CLI::App& app) {
   std::vector<std::string> shapes;
   for (const auto& [name, options] : ShapeOptions()) shapes.push_back(name);
   cmd->add_option("shape", a->shape,
-                  "plane, box, sphere, cylinder, pipe, elbow, tee, flange, valve, gauge")
+                  "plane, box, sphere, cylinder, pipe, elbow, tee, flange, valve, gauge, panel")
       ->required()
       ->check(CLI::IsMember(shapes));
-  cmd->add_option("-o,--output", a->output, "PLY file to write")->required();
+  cmd->add_option("-o,--output", a->output, "PLY file to write (.ply or .pcd with --points)")
+      ->required();
+  cmd->add_option("--points", a->points,
+                  "write this many points over the surface instead of the mesh, as a scanner "
+                  "that saw all of the object would (a stand-in for a scan of it: build-db "
+                  "takes it)")
+      ->check(CLI::Range(20, 10000000));
+  cmd->add_option("--noise-m", a->noise_m, "--points: Gaussian noise on each coordinate, metres")
+      ->capture_default_str()
+      ->check(kNonNegativeNumber);
+  cmd->add_option("--seed", a->seed, "--points: sampling and noise seed")->capture_default_str();
   cmd->add_option("--length-m", a->length_m,
                   "cylinder, pipe or flange length along z; tee run length; gauge length along y")
       ->check(kObjectLengthMetres);

@@ -61,7 +61,8 @@ void AddDisc(const Eigen::Vector3d& p, const Eigen::Vector3d& n, double radius_m
 
 scanner::TriangleMesh Discs(const Oriented& o, double radius_m) {
   scanner::TriangleMesh mesh;
-  for (std::size_t i = 0; i < o.points.size(); ++i) AddDisc(o.points[i], o.normals[i], radius_m, mesh);
+  for (std::size_t i = 0; i < o.points.size(); ++i)
+    AddDisc(o.points[i], o.normals[i], radius_m, mesh);
   return mesh;
 }
 

@@ -14,6 +14,7 @@
 #include "perception/recognition/object_symmetry.hpp"
 #include "perception/recognition/recognition_test_support.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/random_draws.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
@@ -30,7 +31,7 @@ PointCloud ScannedCloud(const scanner::TriangleMesh& mesh, int count, double sig
   std::normal_distribution<double> noise(0.0, sigma_m);
   std::vector<Eigen::Vector3d> points;
   for (const Eigen::Vector3d& p : samples.points) {
-    points.push_back(p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+    points.push_back(p + DrawVector3(noise, rng));
   }
   return MakeCloud(points);
 }
@@ -71,17 +72,17 @@ TEST(CloudSurface, AnObjectTaughtFromAScanIsRecognisedAsFromItsMesh) {
   options.threads = 2;
   const ObjectDatabase db = BuildObjectDatabase(sources, Scanner(), options);
   int recognised = 0, posed = 0;
-  for (const Eigen::Vector3d& eye : {Eigen::Vector3d(0.35, 0.55, 0.55),
-                                     Eigen::Vector3d(-0.35, 0.6, 0.5),
-                                     Eigen::Vector3d(-0.5, -0.3, 0.7)}) {
+  for (const Eigen::Vector3d& eye :
+       {Eigen::Vector3d(0.35, 0.55, 0.55), Eigen::Vector3d(-0.35, 0.6, 0.5),
+        Eigen::Vector3d(-0.5, -0.3, 0.7)}) {
     const Scan scan = ScanOnSeabed(flange.mesh, eye, 11);
     const RecognitionResult result = RecognizeObjects(scan.cloud, db);
     const RecognizedObject* found = Nearest(result, scan);
     ASSERT_NE(found, nullptr);
     if (found->object_id != "scanned_flange") continue;
     ++recognised;
-    const SymmetricPoseError e = PoseErrorModuloSymmetry(found->T_S_O, scan.T_S_O,
-                                                         flange.mesh.vertices, *flange.symmetries);
+    const SymmetricPoseError e =
+        PoseErrorModuloSymmetry(found->T_S_O, scan.T_S_O, flange.mesh.vertices, *flange.symmetries);
     posed += e.rotation_rad < 2.0 * kDeg && e.translation_m < 0.005;
   }
   EXPECT_EQ(recognised, 3);
