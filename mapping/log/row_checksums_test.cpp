@@ -1,5 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+
 #include "mapping/log/dive_log.hpp"
 #include "mapping/log/dive_log_test_support.hpp"
 
@@ -161,6 +167,60 @@ TEST_F(DiveLogTest, CheckFindsEveryDamagedRowAndHandsOverEveryIntactOne) {
   EXPECT_NE(check.damage[1].message.find("column T_W_C_qx"), std::string::npos);
   EXPECT_NE(check.damage[2].message.find("frame 9 is missing"), std::string::npos);
   EXPECT_NE(check.damage[3].message.find("column time_s"), std::string::npos);
+}
+
+// Single-bit damage at random anywhere in the file, 300 times over: whatever the reader hands
+// over as intact is exactly what was written (a damaged row is never returned as good), and what
+// it cannot read it refuses with an error, never a crash.
+TEST_F(DiveLogTest, NoFlippedBitAnywhereIsHandedOverAsAnIntactRow) {
+  const fs::path whole = dir_ / "whole.uwlog";
+  {
+    DiveLogWriter writer(whole, TestHeader());
+    for (int i = 0; i < 20; ++i) {
+      const FrameRecord frame = TestFrame(i, 10);
+      const GroundTruthRecord truth = TestTruth(i, frame);
+      writer.AppendFrame(frame, &truth);
+      writer.AppendNavigation({0.1 * i, TestPose(50 + i)});
+    }
+  }
+  std::string bytes;
+  {
+    std::ifstream in(whole, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  ASSERT_GT(bytes.size(), 4096u);
+  std::mt19937_64 rng(7);
+  int damage_found = 0, refused = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string flipped = bytes;
+    const std::size_t at = std::uniform_int_distribution<std::size_t>(0, bytes.size() - 1)(rng);
+    flipped[at] = static_cast<char>(flipped[at] ^ (1 << (rng() % 8)));
+    const fs::path path = dir_ / "flipped.uwlog";
+    {
+      std::ofstream out(path, std::ios::binary | std::ios::trunc);
+      out.write(flipped.data(), static_cast<std::streamsize>(flipped.size()));
+    }
+    SCOPED_TRACE("byte " + std::to_string(at));
+    try {
+      const DiveLogCheck check = DiveLogReader(path).Check(
+          [](const FrameRecord& frame, const GroundTruthRecord* truth) {
+            ExpectSameFrame(TestFrame(frame.index, 10), frame);
+            if (truth != nullptr) ExpectSameTruth(TestTruth(frame.index, frame), *truth);
+          },
+          [](const NavigationRecord& nav) {
+            const long i = std::lround(nav.time_s / 0.1);
+            EXPECT_TRUE(SameBits(nav.time_s, 0.1 * static_cast<double>(i)));
+            ExpectSamePose(TestPose(static_cast<std::uint64_t>(50 + i)), nav.T_W_V);
+          });
+      damage_found += !check.ok();
+    } catch (const Error&) {
+      ++refused;
+    }
+    fs::remove(path);
+  }
+  // A third of the flips land in rows or in SQLite's structure and are found (here 92 by Check,
+  // 14 refused on opening); the rest fall in the pages' free space.
+  EXPECT_GT(damage_found + refused, 50) << damage_found << " found, " << refused << " refused";
 }
 
 }  // namespace
