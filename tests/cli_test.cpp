@@ -207,6 +207,29 @@ TEST(Cli, RegistrationBenchComparesThePipelines) {
   std::filesystem::remove(json);
 }
 
+// The conditions of users' data: objects taught from meshes and from scans on the same scenes,
+// and flat panels, each with its rate, pose success, time and NEES.
+TEST(Cli, RecognitionBenchConditionsReportEachCondition) {
+  const std::filesystem::path json = TempPath("conditions.json");
+  const CommandRun run =
+      RunUwscan("bench recognition --conditions 2 --views 4 --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  for (const char* name : {"mesh_models", "cloud_models", "flat_objects"}) {
+    SCOPED_TRACE(name);
+    const nlohmann::json& c = j.at("conditions").at(name);
+    EXPECT_GE(c.at("objects").get<int>(), 1);
+    for (const char* rate : {"recognition_rate", "pose_success_rate"}) {
+      EXPECT_GE(c.at(rate).get<double>(), 0.0);
+      EXPECT_LE(c.at(rate).get<double>(), 1.0);
+    }
+    EXPECT_GT(c.at("seconds_per_scan").get<double>(), 0.0);
+    EXPECT_TRUE(c.contains("pose_nees_per_dimension_p95"));
+  }
+  EXPECT_NE(run.output.find("| cloud_models |"), std::string::npos) << run.output;
+  std::filesystem::remove(json);
+}
+
 // The confusion matrix has a row for every database object and the foreign meshes and a column
 // for every object and "unknown", zeros included; its diagonal is the recognition rate.
 TEST(Cli, RecognitionBenchWritesAFullConfusionMatrix) {

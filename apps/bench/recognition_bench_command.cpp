@@ -12,6 +12,7 @@
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/recognition/recognition_benchmark.hpp"
+#include "bench/recognition/recognition_conditions.hpp"
 
 namespace uwscan::app {
 namespace {
@@ -110,14 +111,66 @@ void PrintOutcomes(const std::vector<bench::ObjectOutcome>& outcomes) {
   }
 }
 
+// The value below which 95 % of `v` lie (0 for none).
+double Percentile95(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, v.size() * 95 / 100)];
+}
+
 struct Args {
   bench::RecognitionBenchOptions options;
+  int conditions = 0;  // > 0: the conditions of users' data instead, this many scenes each
   bool no_images = false;
   bool details = false;
   std::string json;
 };
 
+// The conditions users' data brings (bench/recognition/recognition_conditions.hpp): a table and,
+// with --json, {"conditions": {name: {recognition_rate, pose_success_rate, seconds_per_scan,
+// pose_nees_per_dimension_mean, pose_nees_per_dimension_p95, objects}}}.
+void RunConditions(const Args& a) {
+  bench::RecognitionConditionsOptions options;
+  options.scans = a.conditions;
+  options.views = a.options.views;
+  options.seed = a.options.seed;
+  options.threads = a.options.threads;
+  options.table_cache = TableCache();
+  ProgressBar bar;
+  const bench::RecognitionConditions r = bench::RunRecognitionConditions(options, bar.Callback());
+  std::printf(
+      "%d scenes per condition, %d views per object, %d threads\n\n| condition | recognised | "
+      "pose 5 mm / 2 deg | s per scan | NEES per pinned direction: mean, p95 |\n"
+      "|---|---:|---:|---:|---:|\n",
+      options.scans, options.views, options.threads);
+  nlohmann::json conditions = nlohmann::json::object();
+  for (const auto& [name, f] : r) {
+    const double seconds = f.scans == 0 ? 0.0 : f.seconds / f.scans;
+    std::printf("| %s | %d/%d (%.1f %%) | %.1f %% | %.3f | %.2f, %.2f (%zu poses) |\n",
+                name.c_str(), f.recognised, f.objects, 100.0 * Ratio(f.recognised, f.objects),
+                100.0 * Ratio(f.pose_success, f.recognised), seconds, Mean(f.nees_per_dimension),
+                Percentile95(f.nees_per_dimension), f.nees_per_dimension.size());
+    conditions[name] = {{"objects", f.objects},
+                        {"recognition_rate", Ratio(f.recognised, f.objects)},
+                        {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
+                        {"seconds_per_scan", seconds},
+                        {"pose_nees_per_dimension_mean", Mean(f.nees_per_dimension)},
+                        {"pose_nees_per_dimension_p95", Percentile95(f.nees_per_dimension)}};
+  }
+  if (!a.json.empty()) {
+    WriteJsonFile(a.json, {{"bench", "recognition_conditions"},
+                           {"scans_per_condition", options.scans},
+                           {"views", options.views},
+                           {"threads", options.threads},
+                           {"conditions", conditions}});
+  }
+}
+
 void Run(Args a) {
+  if (a.conditions > 0) {
+    RunConditions(a);
+    return;
+  }
   a.options.images = !a.no_images;
   a.options.data_cache = DataCache();
   a.options.table_cache = TableCache();
@@ -163,6 +216,7 @@ void Run(Args a) {
     if (!f.pose_nees_per_dimension.empty()) {
       pipelines[name]["pose_nees_per_dimension_mean"] = Mean(f.pose_nees_per_dimension);
       pipelines[name]["pose_nees_per_dimension_median"] = Median(f.pose_nees_per_dimension);
+      pipelines[name]["pose_nees_per_dimension_p95"] = Percentile95(f.pose_nees_per_dimension);
       pipelines[name]["pose_nees_poses"] = f.pose_nees_per_dimension.size();
       for (const auto& [truth, nees] : f.pose_nees_by_class) {
         pipelines[name]["pose_nees_per_dimension_median_by_class"][truth] = Median(nees);
@@ -248,6 +302,11 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
       "sources, so scans made by other simulator code are never read back)");
   cmd->add_flag("--details", a->details,
                 "print every object's answer and the candidates weighed for it");
+  cmd->add_option("--conditions", a->conditions,
+                  "instead: recognition under the conditions users' data brings, this many scenes "
+                  "each: objects taught from scans (clouds) beside the same from meshes, flat "
+                  "panels on the seabed and on a wall")
+      ->check(CLI::Range(1, 100000));
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { Run(*a); });
 }

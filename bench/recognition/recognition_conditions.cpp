@@ -1,0 +1,250 @@
+#include "bench/recognition/recognition_conditions.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <limits>
+
+#include "bench/recognition/pose_nees.hpp"
+#include "bench/scratch_folder.hpp"
+#include "perception/cloud/cloud_io.hpp"
+#include "perception/recognition/object_catalogue.hpp"
+#include "perception/recognition/object_database_builder.hpp"
+#include "perception/recognition/object_recognizer.hpp"
+#include "perception/recognition/object_symmetry.hpp"
+#include "scanner/common/option_checks.hpp"
+#include "scanner/common/random_draws.hpp"
+#include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/imr_objects.hpp"
+#include "scanner/sim/virtual_scanner.hpp"
+
+namespace uwscan::bench {
+namespace {
+
+namespace sim = scanner::sim;
+using perception::ObjectDatabase;
+using perception::ObjectSource;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr const char* kObjects[] = {"elbow", "flange", "pipe", "tee", "valve_lever", "valve_wheel"};
+constexpr int kMinVisiblePoints = 300;  // an object with fewer scan points is not scored
+constexpr int kCloudPoints = 50000;     // a scan of all of an object's sides
+constexpr double kCloudNoise_m = 0.0003;
+
+// One scene: the objects (the scanned object is [1]), the true pose of [1] and the camera.
+struct Scene {
+  std::vector<sim::SceneObject> objects;
+  std::string id;  // the true object's id
+  Eigen::Isometry3d T_W_O = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+};
+
+sim::SceneObject Placed(const std::string& name, const scanner::TriangleMesh& mesh,
+                        const Eigen::Isometry3d& T_W_O) {
+  sim::SceneObject o;
+  o.name = name;
+  o.shape = sim::ObjectShape::kMesh;
+  o.mesh = mesh;
+  o.T_W_O = T_W_O;
+  return o;
+}
+
+sim::SceneObject Seabed() {
+  sim::SceneObject seabed = Placed("seabed", sim::MakeRectangle(4.0, 4.0),
+                                   Eigen::Isometry3d::Identity());
+  seabed.shape = sim::ObjectShape::kPlane;
+  return seabed;
+}
+
+// The camera at `range_m` from `target_W`, seen at `bearing_rad` about z and `elevation_rad`
+// above the horizontal.
+Eigen::Isometry3d CameraAt(const Eigen::Vector3d& target_W, double bearing_rad,
+                           double elevation_rad, double range_m) {
+  const Eigen::Vector3d from(std::cos(elevation_rad) * std::cos(bearing_rad),
+                             std::cos(elevation_rad) * std::sin(bearing_rad),
+                             std::sin(elevation_rad));
+  return sim::LookAt(target_W + range_m * from, target_W, Eigen::Vector3d::UnitZ());
+}
+
+// A catalogue object resting on the seabed, y_O up, at a random yaw, seen from above and aside.
+Scene ObjectScene(const ObjectSource& object, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Eigen::Matrix3d lay;
+  lay << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // x_O -> x, y_O -> z, z_O -> -y
+  Scene scene;
+  scene.id = object.id;
+  scene.T_W_O.linear() =
+      Eigen::AngleAxisd(2.0 * std::numbers::pi * unit(rng), Eigen::Vector3d::UnitZ()) * lay;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& v : object.mesh.vertices)
+    lowest = std::min(lowest, (scene.T_W_O.linear() * v).z());
+  scene.T_W_O.translation() = Eigen::Vector3d(0.0, 0.0, -lowest);
+  scene.objects = {Seabed(), Placed(object.id, object.mesh, scene.T_W_O)};
+  const double bearing = 2.0 * std::numbers::pi * unit(rng);
+  const double elevation = (35.0 + 30.0 * unit(rng)) * kDeg;
+  const double range = 0.6 + 0.5 * unit(rng);
+  scene.T_W_C = CameraAt(scene.T_W_O.translation(), bearing, elevation, range);
+  return scene;
+}
+
+// An intervention panel lying on the seabed, handles up, or (every other scene) mounted on a
+// wall (the plane y = 0.3, facing -y) above the seabed, seen from in front.
+Scene PanelScene(const ObjectSource& panel, int index, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const sim::PanelShape shape;
+  Scene scene;
+  scene.id = panel.id;
+  if (index % 2 == 0) {
+    scene.T_W_O.linear() =
+        Eigen::AngleAxisd(2.0 * std::numbers::pi * unit(rng), Eigen::Vector3d::UnitZ())
+            .toRotationMatrix();
+    scene.T_W_O.translation() = Eigen::Vector3d(0.0, 0.0, shape.thickness_m);
+    scene.objects = {Seabed(), Placed(panel.id, panel.mesh, scene.T_W_O)};
+    scene.T_W_C = CameraAt(scene.T_W_O.translation(), 2.0 * std::numbers::pi * unit(rng),
+                           (40.0 + 25.0 * unit(rng)) * kDeg, 0.6 + 0.5 * unit(rng));
+    return scene;
+  }
+  sim::SceneObject wall = Seabed();
+  wall.name = "wall";
+  wall.T_W_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // normal -y
+  wall.T_W_O.translation() = Eigen::Vector3d(0.0, 0.3, 1.0);
+  scene.T_W_O.linear() =
+      wall.T_W_O.linear() *
+      Eigen::AngleAxisd(2.0 * std::numbers::pi * unit(rng), Eigen::Vector3d::UnitZ());
+  scene.T_W_O.translation() = Eigen::Vector3d(0.0, 0.3 - shape.thickness_m, 0.3 + 0.3 * unit(rng));
+  scene.objects = {Seabed(), Placed(panel.id, panel.mesh, scene.T_W_O), wall};
+  scene.T_W_C = CameraAt(scene.T_W_O.translation(), -0.5 * std::numbers::pi + (unit(rng) - 0.5),
+                         (5.0 + 30.0 * unit(rng)) * kDeg, 0.6 + 0.5 * unit(rng));
+  return scene;
+}
+
+// A scan of all of `mesh`'s sides as a user would bring it: a PLY without faces, read back as
+// build-db reads it.
+ObjectSource ScannedObject(const std::string& id, const scanner::TriangleMesh& mesh,
+                           const std::filesystem::path& folder, std::uint64_t seed) {
+  const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, kCloudPoints, seed);
+  std::mt19937_64 rng(seed + 1);
+  std::normal_distribution<double> noise(0.0, kCloudNoise_m);
+  std::vector<Eigen::Vector3d> points;
+  for (const Eigen::Vector3d& p : samples.points) points.push_back(p + DrawVector3(noise, rng));
+  const std::filesystem::path path = folder / (id + ".ply");
+  perception::WriteCloud(path, perception::MakeCloud(points));
+  return perception::CloudObject(path);
+}
+
+// What the bench scores poses against: the physical object's declared symmetries and its
+// mesh-taught model's points (every 4th), the same for every condition.
+struct Truth {
+  std::vector<perception::SymmetryAxis> symmetries;
+  std::vector<Eigen::Vector3d> points_O;
+  Eigen::Vector3d centre_O;
+};
+
+Truth TruthOf(const ObjectSource& object, const ObjectDatabase& db) {
+  Truth truth;
+  truth.symmetries = object.symmetries.value_or(std::vector<perception::SymmetryAxis>{});
+  for (const perception::ObjectModel& m : db.objects) {
+    if (m.id != object.id) continue;
+    for (std::size_t i = 0; i < m.model.size(); i += 4) truth.points_O.push_back(m.model.Point(i));
+    truth.centre_O = m.model.origin;
+  }
+  return truth;
+}
+
+// Scans `scene`, recognises it and adds the outcome for its object to `figures`.
+void ScoreScene(const Scene& scene, const sim::VirtualScanner& scanner, const ObjectDatabase& db,
+                const Truth& truth, int index, const RecognitionConditionsOptions& options,
+                ConditionFigures& figures) {
+  const sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, options.seed + 31 * index);
+  const int visible = static_cast<int>(std::count(scan.object_index.begin(), scan.object_index.end(), 1));
+  if (visible < kMinVisiblePoints) return;
+  perception::RecognitionOptions recognition;
+  recognition.seed = options.seed;
+  recognition.threads = options.threads;
+  const auto start = std::chrono::steady_clock::now();
+  const perception::RecognitionResult answer =
+      perception::RecognizeObjects(perception::MakeCloud(scan.points_C), db, recognition);
+  figures.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ++figures.scans;
+  ++figures.objects;
+  const perception::RecognizedObject* best = nullptr;
+  int best_count = 0;
+  for (const perception::RecognizedObject& o : answer.objects) {
+    int count = 0;
+    for (std::size_t i : o.segment) count += scan.object_index[i] == 1;
+    if (count > best_count) best_count = count, best = &o;
+  }
+  if (best == nullptr || best->object_id != scene.id) return;
+  ++figures.recognised;
+  const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.T_W_O;
+  const perception::SymmetricPoseError e =
+      perception::PoseErrorModuloSymmetry(best->T_S_O, T_S_O_true, truth.points_O, truth.symmetries);
+  figures.pose_success += e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005;
+  if (e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
+    if (const auto nees = PoseNeesPerPinnedDirection(best->T_S_O, e.T_symmetric, truth.centre_O,
+                                                     best->covariance)) {
+      figures.nees_per_dimension.push_back(*nees);
+    }
+  }
+}
+
+}  // namespace
+
+void RecognitionConditionsOptions::Check() const {
+  const OptionChecks check("RecognitionConditionsOptions");
+  check.AtLeast("scans", scans, 1);
+  check.AtLeast("views", views, 1);
+  check.AtLeast("threads", threads, 1);
+}
+
+RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOptions& options,
+                                               const Progress& progress) {
+  options.Check();
+  const ScratchFolder folder("recognition-conditions");
+  std::vector<ObjectSource> meshes, clouds;
+  for (const char* name : kObjects) {
+    meshes.push_back(perception::CatalogueObject(name));
+    clouds.push_back(ScannedObject(name, meshes.back().mesh, folder.path(), options.seed));
+  }
+  std::vector<ObjectSource> flat = meshes;
+  flat.push_back(perception::CatalogueObject("panel"));
+
+  sim::VirtualScannerOptions scan_options;
+  scan_options.pattern.kind = scanner::ScannerKind::kGalvo;
+  scan_options.pattern.galvo.step_stride = 2;
+  scan_options.table_cache = options.table_cache;
+  const sim::VirtualScanner scanner(scanner::DefaultScanner(scanner::ScannerKind::kGalvo),
+                                    scan_options);
+  perception::DatabaseBuildOptions build;
+  build.views = options.views;
+  build.seed = options.seed;
+  build.threads = options.threads;
+  auto database = [&](const std::vector<ObjectSource>& sources, const char* name) {
+    return perception::BuildObjectDatabase(sources, scanner, build, [&](double f) {
+      if (progress) progress(std::string("database of ") + name, f);
+    });
+  };
+  const ObjectDatabase mesh_db = database(meshes, "meshes");
+  const ObjectDatabase cloud_db = database(clouds, "scans");
+  const ObjectDatabase flat_db = database(flat, "meshes and a panel");
+
+  RecognitionConditions result;
+  std::mt19937_64 rng(options.seed * 104729 + 17);
+  for (int s = 0; s < options.scans; ++s) {
+    const std::size_t k = static_cast<std::size_t>(s) % meshes.size();
+    const Scene scene = ObjectScene(meshes[k], rng);
+    ScoreScene(scene, scanner, mesh_db, TruthOf(meshes[k], mesh_db), s, options,
+               result["mesh_models"]);
+    ScoreScene(scene, scanner, cloud_db, TruthOf(meshes[k], mesh_db), s, options,
+               result["cloud_models"]);
+    const Scene panel = PanelScene(flat.back(), s, rng);
+    ScoreScene(panel, scanner, flat_db, TruthOf(flat.back(), flat_db), s, options,
+               result["flat_objects"]);
+    if (progress) progress("scans", static_cast<double>(s + 1) / options.scans);
+  }
+  return result;
+}
+
+}  // namespace uwscan::bench

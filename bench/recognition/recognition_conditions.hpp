@@ -1,0 +1,47 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bench/progress.hpp"
+
+// Recognition under the conditions users' data brings (issue 50), each its own figures: the
+// catalogue's objects taught from their meshes (the reference) and from scans of them (clouds),
+// and flat objects (intervention panels) lying on the seabed and mounted on a wall, which plane
+// removal must not take for supports.
+namespace uwscan::bench {
+
+struct RecognitionConditionsOptions {
+  int scans = 24;  // scenes per condition, >= 1
+  int views = 16;  // database views per object, >= 1
+  std::uint64_t seed = 1;
+  int threads = 2;
+  std::filesystem::path table_cache;  // cone table kept between runs
+  void Check() const;
+};
+
+struct ConditionFigures {
+  int objects = 0;       // objects scanned with enough points to count
+  int recognised = 0;    // with the right id
+  int pose_success = 0;  // of those, within 5 mm and 2 degrees modulo symmetry
+  double seconds = 0.0;  // recognition time, summed over the scans
+  int scans = 0;
+  // NEES per pinned direction of each posed object within 10 degrees and 5 cm (pose_nees.hpp)
+  std::vector<double> nees_per_dimension;
+};
+
+// "mesh_models", "cloud_models", "flat_objects".
+using RecognitionConditions = std::map<std::string, ConditionFigures>;
+
+// Each condition's scenes: one object on a seabed (z = 0) at a random yaw, or for the flat objects
+// a panel lying on the seabed or on a wall behind it, seen by the galvanometer scanner from
+// 0.6-1.1 m at a random bearing, exact peaks with the simulator's peak noise. The cloud models
+// are 50,000 points over each object's surface with 0.3 mm noise, written as PLY without faces
+// and read back by build-db's reader (perception::CloudObject). Deterministic for a seed.
+RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOptions& options,
+                                               const Progress& progress = {});
+
+}  // namespace uwscan::bench
