@@ -134,7 +134,7 @@ void RunRecognize(const RecognizeArgs& a) {
     std::printf("%zu of the file's %zu points dropped: a NaN or infinite coordinate or normal\n",
                 file.rows_in_file - scan.size(), file.rows_in_file);
   }
-  if (file.viewpoint != mapping::ViewpointSource::kFileOrigin) {
+  if (!file.T_file_sensor.matrix().isIdentity(0.0)) {
     const Eigen::Vector3d at = file.T_file_sensor.translation();
     std::printf(
         "sensor at (%g, %g, %g) %s in the file's frame (%s); positions below are in the "

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
-#include <limits>
 
 #include "bench/recognition/pose_nees.hpp"
 #include "bench/scratch_folder.hpp"
@@ -52,8 +52,8 @@ sim::SceneObject Placed(const std::string& name, const scanner::TriangleMesh& me
 }
 
 sim::SceneObject Seabed() {
-  sim::SceneObject seabed = Placed("seabed", sim::MakeRectangle(4.0, 4.0),
-                                   Eigen::Isometry3d::Identity());
+  sim::SceneObject seabed =
+      Placed("seabed", sim::MakeRectangle(4.0, 4.0), Eigen::Isometry3d::Identity());
   seabed.shape = sim::ObjectShape::kPlane;
   return seabed;
 }
@@ -110,9 +110,8 @@ Scene PanelScene(const ObjectSource& panel, int index, std::mt19937_64& rng) {
   wall.name = "wall";
   wall.T_W_O.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // normal -y
   wall.T_W_O.translation() = Eigen::Vector3d(0.0, 0.3, 1.0);
-  scene.T_W_O.linear() =
-      wall.T_W_O.linear() *
-      Eigen::AngleAxisd(2.0 * std::numbers::pi * unit(rng), Eigen::Vector3d::UnitZ());
+  scene.T_W_O.linear() = wall.T_W_O.linear() * Eigen::AngleAxisd(2.0 * std::numbers::pi * unit(rng),
+                                                                 Eigen::Vector3d::UnitZ());
   scene.T_W_O.translation() = Eigen::Vector3d(0.0, 0.3 - shape.thickness_m, 0.3 + 0.3 * unit(rng));
   scene.objects = {Seabed(), Placed(panel.id, panel.mesh, scene.T_W_O), wall};
   scene.T_W_C = CameraAt(scene.T_W_O.translation(), -0.5 * std::numbers::pi + (unit(rng) - 0.5),
@@ -158,7 +157,8 @@ void ScoreScene(const Scene& scene, const sim::VirtualScanner& scanner, const Ob
                 const Truth& truth, int index, const RecognitionConditionsOptions& options,
                 ConditionFigures& figures) {
   const sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, options.seed + 31 * index);
-  const int visible = static_cast<int>(std::count(scan.object_index.begin(), scan.object_index.end(), 1));
+  const int visible =
+      static_cast<int>(std::count(scan.object_index.begin(), scan.object_index.end(), 1));
   if (visible < kMinVisiblePoints) return;
   perception::RecognitionOptions recognition;
   recognition.seed = options.seed;
@@ -166,7 +166,8 @@ void ScoreScene(const Scene& scene, const sim::VirtualScanner& scanner, const Ob
   const auto start = std::chrono::steady_clock::now();
   const perception::RecognitionResult answer =
       perception::RecognizeObjects(perception::MakeCloud(scan.points_C), db, recognition);
-  figures.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  figures.seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++figures.scans;
   ++figures.objects;
   const perception::RecognizedObject* best = nullptr;
@@ -179,8 +180,8 @@ void ScoreScene(const Scene& scene, const sim::VirtualScanner& scanner, const Ob
   if (best == nullptr || best->object_id != scene.id) return;
   ++figures.recognised;
   const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.T_W_O;
-  const perception::SymmetricPoseError e =
-      perception::PoseErrorModuloSymmetry(best->T_S_O, T_S_O_true, truth.points_O, truth.symmetries);
+  const perception::SymmetricPoseError e = perception::PoseErrorModuloSymmetry(
+      best->T_S_O, T_S_O_true, truth.points_O, truth.symmetries);
   figures.pose_success += e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005;
   if (e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
     if (const auto nees = PoseNeesPerPinnedDirection(best->T_S_O, e.T_symmetric, truth.centre_O,

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "perception/cloud/cloud_scale.hpp"
@@ -51,7 +52,7 @@ void AddDisc(const Eigen::Vector3d& p, const Eigen::Vector3d& n, double radius_m
   const int centre = static_cast<int>(mesh.vertices.size());
   mesh.vertices.push_back(p);
   for (int k = 0; k < kDiscSides; ++k) {
-    const double a = 2.0 * M_PI * k / kDiscSides;
+    const double a = 2.0 * std::numbers::pi * k / kDiscSides;
     mesh.vertices.push_back(p + radius_m * (std::cos(a) * u + std::sin(a) * v));
   }
   for (int k = 0; k < kDiscSides; ++k) {
