@@ -11,7 +11,9 @@
 #                                                  fails on a new finding; exit 77 (skipped) when
 #                                                  that commit is not in this clone's history
 # clang-tidy parses each file whole (about 7 s of CPU per file here, 25-30 min for the tree), so
-# CI checks what changed. After a whole-tree run is clean, put its commit in .tidy-base.
+# CI checks what changed. A changed header brings only the source beside it: other sources that
+# include it, and header-only code, wait for the next whole-tree run. After a whole-tree run is
+# clean, put its commit in .tidy-base.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"

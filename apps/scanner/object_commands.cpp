@@ -166,10 +166,12 @@ perception::PointCloud SurfaceScan(const scanner::TriangleMesh& mesh, int count,
                                    std::uint64_t seed) {
   const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, count, seed);
   std::mt19937_64 rng(seed + 1);
-  std::normal_distribution<double> noise(0.0, sigma_m);
+  std::normal_distribution<double> noise(0.0, sigma_m > 0.0 ? sigma_m : 1.0);
   std::vector<Eigen::Vector3d> points;
   points.reserve(samples.points.size());
-  for (const Eigen::Vector3d& p : samples.points) points.push_back(p + DrawVector3(noise, rng));
+  for (const Eigen::Vector3d& p : samples.points) {
+    points.push_back(sigma_m > 0.0 ? Eigen::Vector3d(p + DrawVector3(noise, rng)) : p);
+  }
   return perception::MakeCloud(points);
 }
 

@@ -50,6 +50,8 @@ ScanFile ReadCloudScan(const std::filesystem::path& path, const ScanFrame& frame
   if (frame.T_file_sensor) {
     scan.T_file_sensor = *frame.T_file_sensor;
     scan.viewpoint = ViewpointSource::kGiven;
+  } else if (!stats.viewpoint_error.empty()) {
+    throw Error(stats.viewpoint_error + " (give the sensor's pose with --viewpoint)");
   } else if (stats.T_file_sensor) {
     scan.T_file_sensor = *stats.T_file_sensor;
     scan.viewpoint = ViewpointSource::kFileViewpoint;
@@ -59,7 +61,7 @@ ScanFile ReadCloudScan(const std::filesystem::path& path, const ScanFrame& frame
     scan.cloud.origin *= frame.metres_per_unit;
     for (Eigen::Vector3f& p : scan.cloud.points) p *= scale;
   }
-  RequireScanSize(scan.cloud, frame.metres_per_unit, path.string());
+  if (frame.check_size) RequireScanSize(scan.cloud, frame.metres_per_unit, path.string());
   if (!scan.T_file_sensor.matrix().isIdentity(0.0)) {
     Eigen::Isometry3d T_file_sensor_m = scan.T_file_sensor;
     T_file_sensor_m.translation() *= frame.metres_per_unit;
@@ -127,6 +129,7 @@ ScanFile ReadScanFile(const std::filesystem::path& path, ReconstructionOptions o
 
 ScanFrame ReportedScanFrame(const perception::RecognitionReport& report) {
   ScanFrame frame;
+  frame.check_size = false;
   if (report.scan.extension() == ".db") return frame;
   frame.metres_per_unit = report.scan_metres_per_unit;
   frame.T_file_sensor = report.scan_T_file_sensor;

@@ -28,6 +28,9 @@ struct ScanFrame {
   // The sensor's pose in the file's frame, translation in the file's units. Unset: the file's
   // own (a PCD VIEWPOINT line), else the sensor at the file's origin.
   std::optional<Eigen::Isometry3d> T_file_sensor;
+  // Refuse a cloud over kLargestScan_m or under kSmallestScan_m across (off when a report's
+  // scan is read again: it was accepted once, as it is).
+  bool check_size = true;
 };
 
 // Where the sensor pose of a scan came from.

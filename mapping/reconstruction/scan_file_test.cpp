@@ -11,6 +11,7 @@
 
 #include "mapping/log/dive_log_test_support.hpp"
 #include "mapping/log/dive_simulation.hpp"
+#include "perception/cloud/cloud_io.hpp"
 #include "perception/recognition/recognition_test_support.hpp"
 #include "scanner/sim/scene.hpp"
 #include "scanner/sim/simulator.hpp"
@@ -141,16 +142,23 @@ TEST_F(ScanFileTest, APcdViewpointPutsTheScanInTheSensorsFrameUnlessAnotherIsGiv
     EXPECT_LT((given.cloud.Point(i) - in_file[i]).norm(), 1e-6) << i;
   }
 
-  // A malformed VIEWPOINT is named.
+  // A malformed VIEWPOINT is named when the file's viewpoint would be used, and does not matter
+  // when one is given (other readers of the cloud never look at it).
   WritePcd(path, in_file, 1000.0, "0 0 0 0 0 0 0");
+  ScanFrame mm;
+  mm.metres_per_unit = 0.001;
   EXPECT_NE(MessageOf([&] {
-              ReadScanFile(path, {}, frame);
+              ReadScanFile(path, {}, mm);
             }).find("(VIEWPOINT): the orientation quaternion has zero length"),
             std::string::npos)
-      << MessageOf([&] { ReadScanFile(path, {}, frame); });
+      << MessageOf([&] { ReadScanFile(path, {}, mm); });
+  EXPECT_EQ(ReadScanFile(path, {}, frame).cloud.size(), in_file.size());
+  EXPECT_EQ(perception::ReadCloud(path).size(), in_file.size());
   WritePcd(path, in_file, 1000.0, "0 0 0 1 0 0");
-  EXPECT_NE(MessageOf([&] { ReadScanFile(path); }).find("(VIEWPOINT): expected 7 numbers"),
+  EXPECT_NE(MessageOf([&] { ReadScanFile(path, {}, mm); }).find("(VIEWPOINT): expected 7 numbers"),
             std::string::npos);
+  WritePcd(path, in_file, 1000.0, "+300 -100 +2000 1 0 0 0");  // a '+' as other tools write it
+  EXPECT_EQ(ReadScanFile(path, {}, mm).viewpoint, ViewpointSource::kFileViewpoint);
 }
 
 // The same scene as recognition's tests scan it, written as another tool would: in millimetres,

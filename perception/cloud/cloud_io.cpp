@@ -58,6 +58,7 @@ struct RawCloud {
   std::vector<Eigen::Vector3d> normals;
   std::vector<double> intensity;
   std::optional<Eigen::Isometry3d> T_file_sensor;
+  std::string viewpoint_error;
 };
 
 // One value of a binary point record, as double.
@@ -236,12 +237,14 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
     raw.normals = std::move(pcd.normals);
     raw.intensity = std::move(pcd.intensity);
     raw.T_file_sensor = pcd.T_file_sensor;
+    raw.viewpoint_error = pcd.viewpoint_error;
   }
 
   CloudReadStats local;
   local.num_in_file = raw.points.size();
   local.has_normals = !raw.normals.empty();
   local.T_file_sensor = raw.T_file_sensor;
+  local.viewpoint_error = raw.viewpoint_error;
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3f> normals;
   std::vector<float> intensity;

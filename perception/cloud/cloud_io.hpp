@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "perception/cloud/point_cloud.hpp"
@@ -22,6 +23,7 @@ struct CloudReadStats {
   // The sensor's pose in the file's frame, in the file's units, when the file says it (a PCD
   // VIEWPOINT line).
   std::optional<Eigen::Isometry3d> T_file_sensor;
+  std::string viewpoint_error;  // why the file's VIEWPOINT cannot be used (empty: none)
 };
 
 // Reads a point cloud from .pcd (uwscan's bounded reader; ascii, binary and binary_compressed),

@@ -40,6 +40,7 @@ struct Field {
 struct Header {
   std::vector<Field> fields;
   std::optional<Eigen::Isometry3d> viewpoint;
+  std::string viewpoint_error;
   std::uint64_t points = 0;
   std::string data;  // ascii, binary, binary_compressed
   std::size_t body_offset = 0;
@@ -66,6 +67,7 @@ struct HeaderLines {
   std::optional<std::uint64_t> width, height, points;
   std::string data;
   std::optional<Eigen::Isometry3d> viewpoint;
+  std::string viewpoint_error;
 };
 
 // A value of a SIZE or COUNT line: an integer in [1, max].
@@ -92,7 +94,8 @@ Eigen::Isometry3d Viewpoint(const std::vector<std::string>& words,
   double v[7];
   if (words.size() != 7) throw bad("expected 7 numbers: tx ty tz qw qx qy qz");
   for (std::size_t i = 0; i < 7; ++i) {
-    if (!ParseNumber(words[i], v[i]) || !std::isfinite(v[i])) {
+    const std::string word = words[i].starts_with('+') ? words[i].substr(1) : words[i];
+    if (!ParseNumber(word, v[i]) || !std::isfinite(v[i])) {
       throw bad("'" + words[i].substr(0, 20) + "' is not a finite number");
     }
   }
@@ -130,7 +133,12 @@ void ReadHeaderLine(const std::string& key, const std::vector<std::string>& word
     }
     lines.data = words[0];
   } else if (key == "VIEWPOINT") {
-    lines.viewpoint = Viewpoint(words, bad);
+    // Kept aside: only a reader that needs the sensor's pose refuses a bad one.
+    try {
+      lines.viewpoint = Viewpoint(words, bad);
+    } catch (const Error& e) {
+      lines.viewpoint_error = e.what();
+    }
   } else {
     throw Error(where + ": unknown key '" + key.substr(0, 40) + "': not a PCD header");
   }
@@ -202,6 +210,7 @@ Header ParseHeader(const std::string& file, const std::string& name) {
   Header header;
   header.data = lines.data;
   header.viewpoint = lines.viewpoint;
+  header.viewpoint_error = lines.viewpoint_error;
   header.body_offset = std::min(at, file.size());
   header.fields = LayOutFields(lines, name);
   for (const Field& field : header.fields) {
@@ -322,6 +331,7 @@ PcdContent ReadPcd(const fs::path& path) {
   const Header header = ParseHeader(file, name);
   PcdContent content;
   content.T_file_sensor = header.viewpoint;
+  content.viewpoint_error = header.viewpoint_error;
   if (header.data == "ascii") {
     ReadAscii(file, header, name, content);
     return content;

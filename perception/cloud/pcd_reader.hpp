@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace uwscan::perception {
@@ -17,6 +18,7 @@ struct PcdContent {
   // The sensor's pose in the file's frame from a VIEWPOINT line ("tx ty tz qw qx qy qz"), in the
   // file's units; unset when the header has none.
   std::optional<Eigen::Isometry3d> T_file_sensor;
+  std::string viewpoint_error;  // why the VIEWPOINT line cannot be used (empty: none)
 };
 
 // Reads PCD 0.7 (and older headers without VERSION or COUNT) in ascii, binary and

@@ -2,10 +2,14 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <optional>
 #include <vector>
 
+#include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/cloud/cloud_scale.hpp"
 #include "perception/preprocessing/normals.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
@@ -19,6 +23,8 @@ namespace {
 
 constexpr std::size_t kMinPoints = 20;
 constexpr int kDiscSides = 6;
+constexpr double kMaxThinningSteps = 500.0;
+constexpr int kAgreeingNeighbours = 8;  // voxels along the bounding box's diagonal, at most
 // Lines of sight closer than this to a disc's plane (cosine) are not tried: a neighbour's disc,
 // tilted by the surface's curvature, would block them on either side.
 constexpr double kMinSightCosine = 0.3;
@@ -30,7 +36,8 @@ struct Oriented {
 
 Oriented PointsWithNormals(const PointCloud& cloud, const CloudSurfaceOptions& options) {
   VoxelFilterOptions thin;
-  thin.leaf_m = options.thinning_m;
+  // A large object keeps at most a few hundred thousand discs.
+  thin.leaf_m = std::max(options.thinning_m, BoundingBoxDiagonal(cloud) / kMaxThinningSteps);
   const PointCloud thinned = VoxelDownsample(cloud, thin);
   NormalOptions normal_options;
   normal_options.k = options.normal_neighbours;
@@ -40,7 +47,9 @@ Oriented PointsWithNormals(const PointCloud& cloud, const CloudSurfaceOptions& o
   Oriented o;
   for (std::size_t i = 0; i < with.cloud.size(); ++i) {
     o.points.push_back(with.cloud.Point(i));
-    o.normals.push_back(with.cloud.normals[i].cast<double>().normalized());
+    // Facing away from the centroid: the guess a disc keeps when its lines of sight leave
+    // equally on both sides (an open sheet).
+    o.normals.push_back(-with.cloud.normals[i].cast<double>().normalized());
   }
   return o;
 }
@@ -60,6 +69,13 @@ void AddDisc(const Eigen::Vector3d& p, const Eigen::Vector3d& n, double radius_m
   }
 }
 
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
 scanner::TriangleMesh Discs(const Oriented& o, double radius_m) {
   scanner::TriangleMesh mesh;
   for (std::size_t i = 0; i < o.points.size(); ++i)
@@ -67,9 +83,12 @@ scanner::TriangleMesh Discs(const Oriented& o, double radius_m) {
   return mesh;
 }
 
-// Flips each normal towards the side of its disc from which more lines of sight leave the
-// object past every disc (triangles are two-sided to the caster, so the first guess's signs
-// do not matter).
+// Flips each normal towards the more open side of its disc: the one where lines of sight run
+// farther before they meet another disc, by the median (those that leave the object count as
+// running `reach`; a few that slip through gaps between discs do not decide).
+// Outside a closed object most leave; in a pipe's bore none leaves either side, but the bore is
+// wide open to one side and the wall's thickness to the other. (Triangles are two-sided to the
+// caster, so the first guess's signs do not matter.)
 void FaceOutwards(Oriented& o, double radius_m, const CloudSurfaceOptions& options) {
   scanner::sim::SceneObject surface;
   surface.shape = scanner::sim::ObjectShape::kMesh;
@@ -80,15 +99,40 @@ void FaceOutwards(Oriented& o, double radius_m, const CloudSurfaceOptions& optio
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
   for (std::size_t i = 0; i < o.points.size(); ++i) {
-    int out_front = 0, out_back = 0;
+    std::vector<double> front, back;
     for (const Eigen::Vector3d& d : sights) {
       const double c = d.dot(o.normals[i]);
       if (std::abs(c) < kMinSightCosine) continue;
-      if (!caster.Blocked(o.points[i], o.points[i] + reach * d, 0.5 * radius_m)) {
-        ++(c > 0.0 ? out_front : out_back);
-      }
+      const std::optional<scanner::sim::SurfaceHit> hit =
+          caster.Cast({o.points[i], d}, 0.5 * radius_m, reach);
+      (c > 0.0 ? front : back).push_back(hit ? hit->distance_m : reach);
     }
-    if (out_back > out_front) o.normals[i] = -o.normals[i];
+    if (Median(back) > Median(front)) o.normals[i] = -o.normals[i];
+  }
+}
+
+// Each disc then turns to agree with most of its nearest neighbours, twice over: a surface is
+// oriented as a whole, and the few lines of sight a single disc casts leave some discs wrong.
+void AgreeWithNeighbours(Oriented& o) {
+  std::vector<Eigen::Vector3f> points;
+  for (const Eigen::Vector3d& p : o.points) points.push_back(p.cast<float>());
+  const KnnIndex index(points);
+  std::vector<std::vector<std::uint32_t>> neighbours(o.points.size());
+  std::vector<float> squared;
+  for (std::size_t i = 0; i < o.points.size(); ++i) {
+    index.Query(points[i], kAgreeingNeighbours + 1, neighbours[i], squared);
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<Eigen::Vector3d> agreed = o.normals;
+    for (std::size_t i = 0; i < o.points.size(); ++i) {
+      int votes = 0;
+      for (std::uint32_t j : neighbours[i]) {
+        if (j == i) continue;
+        votes += o.normals[i].dot(o.normals[j]) >= 0.0 ? 1 : -1;
+      }
+      if (votes < 0) agreed[i] = -o.normals[i];
+    }
+    o.normals = std::move(agreed);
   }
 }
 
@@ -116,6 +160,7 @@ scanner::TriangleMesh CloudSurface(const PointCloud& cloud_m, const CloudSurface
   const double radius_m = options.disc_radius_spacings * spacing_m;
   if (!(radius_m > 0.0)) throw Error("CloudSurface: the scan's points all coincide");
   FaceOutwards(o, radius_m, options);
+  AgreeWithNeighbours(o);
   return Discs(o, radius_m);
 }
 

@@ -192,7 +192,7 @@ bool IsCloudFile(const std::filesystem::path& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (extension == ".pcd" || extension == ".xyz") return true;
-  return extension == ".ply" && !scanner::PlyFaceCount(path).has_value();
+  return extension == ".ply" && scanner::PlyFaceCount(path).value_or(0) <= 0;
 }
 
 ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_m) {

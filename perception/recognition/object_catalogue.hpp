@@ -51,7 +51,8 @@ ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_
 // cannot be read, holds too few points for a surface, or is a size no object is.
 ObjectSource CloudObject(const std::filesystem::path& cloud_path, double units_to_m = 1.0);
 
-// Whether a file holds a point cloud rather than a mesh: .pcd or .xyz, or a PLY without faces.
+// Whether a file holds a point cloud rather than a mesh: .pcd or .xyz, or a PLY without faces
+// (no face element, or "element face 0" as MeshLab writes clouds).
 bool IsCloudFile(const std::filesystem::path& path);
 
 // The sidecar's path for a mesh: the mesh path with its extension replaced by ".grasps.yaml".

@@ -38,6 +38,7 @@ double NarrowSpan(const PointCloud& cloud, const DetectedPlane& plane) {
 // them (an object's face seen broadside is looked at and kept).
 constexpr std::size_t kMaxSupportPlanes = 3;
 constexpr double kFindingShare = 3.0;
+constexpr double kBehindMargin = 1.5;
 constexpr int kMaxPlaneSearches = 5;
 
 // The inliers of `plane` within distance_m, and in `rest` the other points of `cloud`.
@@ -53,14 +54,16 @@ DetectedPlane WithInliers(const PointCloud& cloud, DetectedPlane plane, double d
 }
 
 // Whether a plane hides surface behind it from the sensor at the origin: at least a tenth as
-// many points as it holds (and a segment's worth) lie beyond it by more than plane_distance_m.
+// many points as it holds (and a segment's worth) lie beyond it by more than 1.5 times
+// plane_distance_m (a seabed dipping a little below its fitted plane does not count; a panel's
+// 2 cm does).
 bool HidesSurface(const PointCloud& cloud, const DetectedPlane& plane,
                   const RecognitionOptions& options) {
   const double sensor_side = plane.offset_m >= 0.0 ? 1.0 : -1.0;  // sign of n . 0 + offset
   std::size_t behind = 0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const double distance_m = plane.normal.dot(cloud.Point(i)) + plane.offset_m;
-    if (sensor_side * distance_m < -options.plane_distance_m) ++behind;
+    if (sensor_side * distance_m < -kBehindMargin * options.plane_distance_m) ++behind;
   }
   return behind >= std::max<std::size_t>(static_cast<std::size_t>(options.min_segment_points),
                                          plane.inliers.size() / 10);

@@ -38,7 +38,8 @@ struct RegistrationPipelineOptions {
                                                    int threads = 0, double voxel_m = 0.0);
   // The same for two scans of any size, the voxel chosen from the target's own scale: a
   // hundredth of its robust extent (RobustDiagonal), but at most the object rule's size / 50 and
-  // at least twice its point spacing (MedianPointSpacing), so a voxel holds a few points. A scene
+  // at least twice the sparser cloud's point spacing (MedianPointSpacing), so a voxel holds a few
+  // points (the floor wins over the cap for a cloud sparser than a fiftieth of its size). A scene
   // is registered at the scale of its parts, not of its extent: two real scans cut in two, a
   // 1.8 m table scene (1.8 mm spacing) and a 12.6 m site (2.6 cm spacing), fail at size / 50
   // (4 cm and 0.65 m voxels) and register at these (1.8 cm and 13 cm; bench/registration/

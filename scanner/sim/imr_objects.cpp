@@ -499,9 +499,11 @@ TriangleMesh MakePanel(const PanelShape& shape) {
   shape.Check();
   TriangleMesh mesh = MakeBox(Eigen::Vector3d(shape.width_m, shape.height_m, shape.thickness_m));
   for (Eigen::Vector3d& v : mesh.vertices) v.z() -= 0.5 * shape.thickness_m;
-  // Each post runs 1 mm into the plate and up into the bar, so that no faces coincide.
+  // Each post, a little thinner than the bar, runs 1 mm into the plate and up into the bar, so
+  // that no faces coincide.
   const double post_length = shape.handle_depth_m - 0.5 * shape.bar_m + 0.001;
-  const TriangleMesh post = MakeBox(Eigen::Vector3d(shape.bar_m, shape.bar_m, post_length));
+  const double post_width = 0.9 * shape.bar_m;
+  const TriangleMesh post = MakeBox(Eigen::Vector3d(post_width, post_width, post_length));
   const TriangleMesh bar =
       MakeBox(Eigen::Vector3d(shape.bar_m, shape.handle_span_m + shape.bar_m, shape.bar_m));
   for (const double x : {-shape.handle_offset_m, shape.handle_offset_m}) {
