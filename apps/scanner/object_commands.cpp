@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -14,7 +13,6 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/cloud/point_cloud.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/common/random_draws.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
@@ -160,26 +158,12 @@ scanner::TriangleMesh MakeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
   return sim::MakeValve(s, chord);
 }
 
-// `count` points spread over the mesh's surface by area, each moved by Gaussian noise of sigma_m
-// along every axis: what a scanner that saw all of the object would give.
-perception::PointCloud SurfaceScan(const scanner::TriangleMesh& mesh, int count, double sigma_m,
-                                   std::uint64_t seed) {
-  const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, count, seed);
-  std::mt19937_64 rng(seed + 1);
-  std::normal_distribution<double> noise(0.0, sigma_m > 0.0 ? sigma_m : 1.0);
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(samples.points.size());
-  for (const Eigen::Vector3d& p : samples.points) {
-    points.push_back(sigma_m > 0.0 ? Eigen::Vector3d(p + DrawVector3(noise, rng)) : p);
-  }
-  return perception::MakeCloud(points);
-}
-
 void RunMakeObject(const MakeObjectArgs& a, const CLI::App& cmd) {
   const scanner::TriangleMesh mesh = MakeMesh(a, cmd);
   if (a.points > 0) {
     CheckCloudOutputPath(a.output, "-o", {});
-    perception::WriteCloud(a.output, SurfaceScan(mesh, a.points, a.noise_m, a.seed));
+    perception::WriteCloud(a.output, perception::MakeCloud(scanner::ScannedSurface(
+                                         mesh, a.points, a.noise_m, a.seed)));
     std::printf("wrote %s: %d points over a %s's surface, %g m noise\n", a.output.c_str(), a.points,
                 a.shape.c_str(), a.noise_m);
     return;

@@ -12,10 +12,10 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/recognition/object_catalogue.hpp"
 #include "perception/recognition/object_database_builder.hpp"
+#include "perception/recognition/object_pose_search.hpp"
 #include "perception/recognition/object_recognizer.hpp"
 #include "perception/recognition/object_symmetry.hpp"
 #include "scanner/common/option_checks.hpp"
-#include "scanner/common/random_draws.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/virtual_scanner.hpp"
@@ -123,13 +123,9 @@ Scene PanelScene(const ObjectSource& panel, int index, std::mt19937_64& rng) {
 // build-db reads it.
 ObjectSource ScannedObject(const std::string& id, const scanner::TriangleMesh& mesh,
                            const std::filesystem::path& folder, std::uint64_t seed) {
-  const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, kCloudPoints, seed);
-  std::mt19937_64 rng(seed + 1);
-  std::normal_distribution<double> noise(0.0, kCloudNoise_m);
-  std::vector<Eigen::Vector3d> points;
-  for (const Eigen::Vector3d& p : samples.points) points.push_back(p + DrawVector3(noise, rng));
   const std::filesystem::path path = folder / (id + ".ply");
-  perception::WriteCloud(path, perception::MakeCloud(points));
+  perception::WriteCloud(path, perception::MakeCloud(scanner::ScannedSurface(mesh, kCloudPoints,
+                                                                             kCloudNoise_m, seed)));
   return perception::CloudObject(path);
 }
 
@@ -152,11 +148,18 @@ Truth TruthOf(const ObjectSource& object, const ObjectDatabase& db) {
   return truth;
 }
 
-// Scans `scene`, recognises it and adds the outcome for its object to `figures`.
-void ScoreScene(const Scene& scene, const sim::VirtualScanner& scanner, const ObjectDatabase& db,
-                const Truth& truth, int index, const RecognitionConditionsOptions& options,
-                ConditionFigures& figures) {
-  const sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, options.seed + 31 * index);
+// One database and what recognition derives from it once, for every scan.
+struct Recogniser {
+  const ObjectDatabase& db;
+  perception::RecognitionCache cache;
+  explicit Recogniser(const ObjectDatabase& database) : db(database), cache(database) {}
+};
+
+// Recognises `scan` of `scene` and adds the outcome for its object (index 1) to `figures`, when
+// the scan holds enough of it.
+void ScoreScan(const Scene& scene, const sim::VirtualScan& scan, Recogniser& recogniser,
+               const Truth& truth, const RecognitionConditionsOptions& options,
+               ConditionFigures& figures) {
   const int visible =
       static_cast<int>(std::count(scan.object_index.begin(), scan.object_index.end(), 1));
   if (visible < kMinVisiblePoints) return;
@@ -164,8 +167,8 @@ void ScoreScene(const Scene& scene, const sim::VirtualScanner& scanner, const Ob
   recognition.seed = options.seed;
   recognition.threads = options.threads;
   const auto start = std::chrono::steady_clock::now();
-  const perception::RecognitionResult answer =
-      perception::RecognizeObjects(perception::MakeCloud(scan.points_C), db, recognition);
+  const perception::RecognitionResult answer = perception::RecognizeObjects(
+      perception::MakeCloud(scan.points_C), recogniser.db, recogniser.cache, recognition);
   figures.seconds +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++figures.scans;
@@ -231,18 +234,23 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
   const ObjectDatabase cloud_db = database(clouds, "scans");
   const ObjectDatabase flat_db = database(flat, "meshes and a panel");
 
+  Recogniser from_meshes(mesh_db), from_scans(cloud_db), with_panel(flat_db);
+  std::vector<Truth> truths;
+  for (const ObjectSource& object : meshes) truths.push_back(TruthOf(object, mesh_db));
+  const Truth panel_truth = TruthOf(flat.back(), flat_db);
+
   RecognitionConditions result;
   std::mt19937_64 rng(options.seed * 104729 + 17);
   for (int s = 0; s < options.scans; ++s) {
     const std::size_t k = static_cast<std::size_t>(s) % meshes.size();
+    const std::uint64_t scan_seed = options.seed + 31 * static_cast<std::uint64_t>(s);
     const Scene scene = ObjectScene(meshes[k], rng);
-    ScoreScene(scene, scanner, mesh_db, TruthOf(meshes[k], mesh_db), s, options,
-               result["mesh_models"]);
-    ScoreScene(scene, scanner, cloud_db, TruthOf(meshes[k], mesh_db), s, options,
-               result["cloud_models"]);
+    const sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, scan_seed);
+    ScoreScan(scene, scan, from_meshes, truths[k], options, result["mesh_models"]);
+    ScoreScan(scene, scan, from_scans, truths[k], options, result["cloud_models"]);
     const Scene panel = PanelScene(flat.back(), s, rng);
-    ScoreScene(panel, scanner, flat_db, TruthOf(flat.back(), flat_db), s, options,
-               result["flat_objects"]);
+    ScoreScan(panel, scanner.Scan(panel.objects, panel.T_W_C, scan_seed), with_panel, panel_truth,
+              options, result["flat_objects"]);
     if (progress) progress("scans", static_cast<double>(s + 1) / options.scans);
   }
   return result;

@@ -118,17 +118,21 @@ TEST_F(DiveLogTest, LogsOfEarlierSchemaVersionsStillRead) {
   EXPECT_EQ(check.frames_intact, 4);
 }
 
+// A checksummed log of `frames` test frames (10 peaks each), each with its ground truth and a
+// navigation record at 0.1 s steps.
+void WriteTestDive(const fs::path& path, int frames) {
+  DiveLogWriter writer(path, TestHeader());
+  for (int i = 0; i < frames; ++i) {
+    const FrameRecord frame = TestFrame(i, 10);
+    const GroundTruthRecord truth = TestTruth(i, frame);
+    writer.AppendFrame(frame, &truth);
+    writer.AppendNavigation({0.1 * i, TestPose(50 + i)});
+  }
+}
+
 TEST_F(DiveLogTest, CheckFindsEveryDamagedRowAndHandsOverEveryIntactOne) {
   const fs::path path = dir_ / "dive.uwlog";
-  {
-    DiveLogWriter writer(path, TestHeader());
-    for (int i = 0; i < 12; ++i) {
-      const FrameRecord frame = TestFrame(i, 10);
-      const GroundTruthRecord truth = TestTruth(i, frame);
-      writer.AppendFrame(frame, &truth);
-      writer.AppendNavigation({0.1 * i, TestPose(50 + i)});
-    }
-  }
+  WriteTestDive(path, 12);
   EXPECT_TRUE(DiveLogReader(path).Check({}, {}).ok());
 
   FlipBlobBit(path, "frames", "peaks_px", "frame_index = 3", 20);
@@ -174,15 +178,7 @@ TEST_F(DiveLogTest, CheckFindsEveryDamagedRowAndHandsOverEveryIntactOne) {
 // it cannot read it refuses with an error, never a crash.
 TEST_F(DiveLogTest, NoFlippedBitAnywhereIsHandedOverAsAnIntactRow) {
   const fs::path whole = dir_ / "whole.uwlog";
-  {
-    DiveLogWriter writer(whole, TestHeader());
-    for (int i = 0; i < 20; ++i) {
-      const FrameRecord frame = TestFrame(i, 10);
-      const GroundTruthRecord truth = TestTruth(i, frame);
-      writer.AppendFrame(frame, &truth);
-      writer.AppendNavigation({0.1 * i, TestPose(50 + i)});
-    }
-  }
+  WriteTestDive(whole, 20);
   std::string bytes;
   {
     std::ifstream in(whole, std::ios::binary);

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -15,7 +14,6 @@
 #include "perception/recognition/object_symmetry.hpp"
 #include "perception/recognition/recognition_test_support.hpp"
 #include "scanner/common/error.hpp"
-#include "scanner/common/random_draws.hpp"
 #include "scanner/common/triangle_mesh.hpp"
 #include "scanner/sim/imr_objects.hpp"
 
@@ -27,14 +25,7 @@ using namespace recognition_test;
 // What a scan of `mesh` holds: points on its surface with noise of sigma_m, no normals.
 PointCloud ScannedCloud(const scanner::TriangleMesh& mesh, int count, double sigma_m,
                         std::uint64_t seed) {
-  const scanner::SurfaceSamples samples = scanner::SampleSurface(mesh, count, seed);
-  std::mt19937_64 rng(seed + 1);
-  std::normal_distribution<double> noise(0.0, sigma_m);
-  std::vector<Eigen::Vector3d> points;
-  for (const Eigen::Vector3d& p : samples.points) {
-    points.push_back(p + DrawVector3(noise, rng));
-  }
-  return MakeCloud(points);
+  return MakeCloud(scanner::ScannedSurface(mesh, count, sigma_m, seed));
 }
 
 // Each disc of a surface made from a sphere's scan faces out of it, and lies on it.

@@ -212,7 +212,6 @@ ObjectSource CloudObject(const std::filesystem::path& cloud_path, double units_t
   PointCloud cloud = ReadCloud(cloud_path);
   cloud.origin *= units_to_m;
   for (Eigen::Vector3f& p : cloud.points) p *= static_cast<float>(units_to_m);
-  cloud.normals.clear();
   RequireObjectSize(BoundingBoxDiagonal(cloud), units_to_m, cloud_path.string());
   ObjectSource o;
   o.id = cloud_path.stem().string();

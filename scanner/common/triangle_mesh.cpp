@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -17,6 +18,7 @@
 #include "scanner/common/error.hpp"
 #include "scanner/common/off_reader.hpp"
 #include "scanner/common/ply_reader.hpp"
+#include "scanner/common/random_draws.hpp"
 #include "scanner/common/stl_reader.hpp"
 
 namespace uwscan::scanner {
@@ -195,6 +197,18 @@ SurfaceSamples SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t 
                                              : Eigen::Vector3d::UnitZ());
   }
   return samples;
+}
+
+std::vector<Eigen::Vector3d> ScannedSurface(const TriangleMesh& mesh, int count, double sigma_m,
+                                            std::uint64_t seed) {
+  if (!(sigma_m >= 0.0) || !std::isfinite(sigma_m))
+    throw Error("ScannedSurface: sigma_m must be finite and >= 0");
+  std::vector<Eigen::Vector3d> points = SampleSurface(mesh, count, seed).points;
+  if (sigma_m == 0.0) return points;
+  std::mt19937_64 rng(seed + 1);
+  std::normal_distribution<double> noise(0.0, sigma_m);
+  for (Eigen::Vector3d& p : points) p += DrawVector3(noise, rng);
+  return points;
 }
 
 }  // namespace uwscan::scanner

@@ -34,4 +34,10 @@ struct SurfaceSamples {
 };
 SurfaceSamples SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed);
 
+// What a scan of all of the mesh's sides gives: `count` points over its surface (SampleSurface),
+// each moved by Gaussian noise of sigma_m (>= 0) along every axis, the draws in sequence.
+// Deterministic for a given seed.
+std::vector<Eigen::Vector3d> ScannedSurface(const TriangleMesh& mesh, int count, double sigma_m,
+                                            std::uint64_t seed);
+
 }  // namespace uwscan::scanner
