@@ -25,6 +25,8 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"rss_bytes_at_start", r.rss_bytes_at_start},
           {"peak_rss_bytes", r.peak_rss_bytes},
           {"rss_bytes_last_tenth", r.rss_bytes_last_tenth},
+          {"heap_in_use_bytes_last_tenth", r.heap_in_use_bytes_last_tenth},
+          {"heap_held_bytes_last_tenth", r.heap_held_bytes_last_tenth},
           {"loops_accepted", r.loops_accepted},
           {"whole_solves", r.whole_solves},
           {"window_solves", r.window_solves},
@@ -32,7 +34,9 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
            {{"submap_time_s", r.submap_time_s},
             {"submap_seconds", r.submap_seconds},
             {"rss_time_s", r.rss_time_s},
-            {"rss_bytes", r.rss_bytes}}}};
+            {"rss_bytes", r.rss_bytes},
+            {"heap_in_use_bytes", r.heap_in_use_bytes},
+            {"heap_held_bytes", r.heap_held_bytes}}}};
 }
 
 // The layout: today's mapper's figures at the top of each dive, the whole-graph solves'
@@ -49,13 +53,15 @@ nlohmann::json DiveJson(const bench::LongDiveFigures& f) {
 
 void PrintRow(const char* method, const bench::LongDiveRun& r) {
   std::printf(
-      "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f / %.0f MB | %.0f MB | %.1fx | %.1f mm | %.2f "
-      "mm "
-      "| %d | %d + %d |\n",
+      "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f / %.0f MB | %.0f MB | %.0f / %.0f MB | %.1fx "
+      "| "
+      "%.1f mm | %.2f mm | %d | %d + %d |\n",
       method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3, r.last_tenth.median_s * 1e3,
       r.last_tenth.p95_s * 1e3, static_cast<double>(r.rss_bytes_at_start) / 1e6,
       static_cast<double>(r.peak_rss_bytes) / 1e6,
-      static_cast<double>(r.rss_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
+      static_cast<double>(r.rss_bytes_last_tenth) / 1e6,
+      static_cast<double>(r.heap_in_use_bytes_last_tenth) / 1e6,
+      static_cast<double>(r.heap_held_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
       r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves);
 }
 
@@ -76,11 +82,13 @@ void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whol
   }
   std::printf(
       "| dive | solves | time per submap, first tenth: median / p95 | last tenth | RSS at start / "
-      "peak | RSS, last tenth | real time | ATE | map RMS | loops | whole + window solves |\n"
-      "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "peak | RSS, last tenth | heap in use / held, last tenth | real time | ATE | map RMS | loops "
+      "| "
+      "whole + window solves |\n"
+      "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json out = {{"bench", "slam_long"}, {"dives", nlohmann::json::array()}};
   for (const bench::LongDiveFigures& f : dives) {
-    std::printf("| %s (%.0f s, %d submaps, dead reckoning ATE %.1f mm) | | | | | | | | | | |\n",
+    std::printf("| %s (%.0f s, %d submaps, dead reckoning ATE %.1f mm) | | | | | | | | | | | |\n",
                 f.name.c_str(), f.duration_s, f.submaps, f.dead_reckoning_ate_m * 1e3);
     PrintRow("windowed", f.windowed);
     if (f.whole) PrintRow("whole graph", *f.whole);

@@ -130,9 +130,39 @@ struct RegistrationBenchArgs {
   int pairs_per_mesh = 2;
   int threads = 2;
   std::uint64_t seed = 1;
-  bool no_pcl = false, no_open3d = false, no_real_scans = false;
+  bool no_pcl = false, no_open3d = false, no_real_scans = false, no_hard_pairs = false;
   std::vector<double> sweep_voxel;
 };
+
+// The table by overlap: in each bucket, per pipeline, the share of pairs it got right (an
+// overlapping pair's pose accepted and right modulo symmetry; a pair without overlap refused) and
+// its time per pair.
+nlohmann::json PrintBuckets(const std::vector<bench::OverlapBucket>& buckets) {
+  std::printf(
+      "\nBy overlap (success: ADD-S success with the pose accepted; where the clouds do not "
+      "overlap, "
+      "refusing; wrong accepted: a wrong pose, or any pose where there is none, given as good)\n\n"
+      "| overlap | pipeline | pairs | success | wrong accepted | s/pair |\n"
+      "|---|---|---:|---:|---:|---:|\n");
+  nlohmann::json out = nlohmann::json::array();
+  for (const bench::OverlapBucket& bucket : buckets) {
+    nlohmann::json pipelines = nlohmann::json::object();
+    for (const auto& [name, p] : bucket.pipelines) {
+      std::printf("| %s | %s | %d | %d | %d | %.3f |\n", bucket.name.c_str(), name.c_str(), p.pairs,
+                  p.useful, p.wrong_accepted, p.seconds_per_pair);
+      pipelines[name] = {{"pairs", p.pairs},
+                         {"symmetric_success_rate", p.useful_rate},
+                         {"wrong_accepted", p.wrong_accepted},
+                         {"seconds_per_pair", p.seconds_per_pair}};
+    }
+    out.push_back({{"overlap", bucket.name},
+                   {"min_overlap", bucket.min_overlap},
+                   {"max_overlap", bucket.max_overlap},
+                   {"overlapping", bucket.overlapping},
+                   {"pipelines", pipelines}});
+  }
+  return out;
+}
 
 void RunRegistrationBench(const RegistrationBenchArgs& a) {
   bench::RegistrationBenchOptions o;
@@ -140,6 +170,7 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
   o.pairs.pairs_per_mesh = a.pairs_per_mesh;
   o.pairs.seed = a.seed;
   o.pairs.real_scans = !a.no_real_scans;
+  o.pairs.hard_pairs = !a.no_hard_pairs;
   o.threads = a.threads;
   o.run_pcl = !a.no_pcl;
   o.run_open3d = !a.no_open3d;
@@ -150,31 +181,35 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
     r = bench::RunRegistrationBenchmark(o, bar.Callback());
   }
   std::printf(
-      "Registration on %d pairs (%d threads): success = rotation < 2 deg and translation "
-      "< 1 %% of the object size; ADD-S success = mean distance to the nearest truly placed "
-      "point < 1 %% of the object size (a symmetric object's equivalent poses pass)\n\n",
+      "Registration on %d overlapping pairs (%d threads): success = rotation < 2 deg and "
+      "translation < 1 %% of the object size; ADD-S success = mean distance to the nearest truly "
+      "placed point < 1 %% of the object size (a symmetric object's equivalent poses pass); "
+      "accepted = the pipeline vouched for its pose\n\n",
       r.pipelines.at("uwscan").pairs, a.threads);
   std::printf(
-      "| pipeline | success | ADD-S success | s/pair | downsample | normals | features | coarse | "
-      "icp |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| pipeline | success | ADD-S success | accepted | s/pair | downsample | normals | features "
+      "| "
+      "coarse | icp |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json pipelines = nlohmann::json::object();
   for (const auto& [name, s] : r.pipelines) {
     auto stage = [&stages = s.stage_seconds_per_pair](const char* k) {
       const auto it = stages.find(k);
       return it == stages.end() ? 0.0 : it->second;
     };
-    std::printf("| %s | %d/%d | %d/%d | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n", name.c_str(),
-                s.successes, s.pairs, s.symmetric_successes, s.pairs, s.seconds_per_pair,
-                stage("downsample"), stage("normals"), stage("features"), stage("coarse"),
-                stage("icp"));
+    std::printf("| %s | %d/%d | %d/%d | %d/%d | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n",
+                name.c_str(), s.successes, s.pairs, s.symmetric_successes, s.pairs, s.accepted,
+                s.pairs, s.seconds_per_pair, stage("downsample"), stage("normals"),
+                stage("features"), stage("coarse"), stage("icp"));
     pipelines[name] = {{"success_rate", s.success_rate},
                        {"symmetric_success_rate", s.symmetric_success_rate},
                        {"seconds_per_pair", s.seconds_per_pair},
                        {"pairs", s.pairs},
                        {"successes", s.successes},
+                       {"accepted", s.accepted},
                        {"stage_seconds_per_pair", s.stage_seconds_per_pair}};
   }
+  const nlohmann::json buckets = PrintBuckets(r.buckets);
   nlohmann::json ratios = nlohmann::json::object();
   const double ours = r.pipelines.at("uwscan").seconds_per_pair;
   for (const auto& [name, s] : r.pipelines) {
@@ -191,7 +226,10 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
                         {"symmetric_error_m", p.symmetric_error_m},
                         {"seconds", p.seconds},
                         {"success", p.success},
-                        {"symmetric_success", p.symmetric_success}});
+                        {"symmetric_success", p.symmetric_success},
+                        {"accepted", p.accepted},
+                        {"overlapping", p.overlapping},
+                        {"overlap", p.overlap}});
   }
   nlohmann::json sweep = nlohmann::json::array();
   if (!r.voxel_sweep.empty()) {
@@ -211,6 +249,7 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
   if (!a.json.empty()) {
     WriteJsonFile(a.json, {{"bench", "registration"},
                            {"pipelines", pipelines},
+                           {"buckets", buckets},
                            {"ratios", ratios},
                            {"pairs", outcomes},
                            {"voxel_sweep", sweep}});
@@ -278,6 +317,9 @@ void AddPerceptionBenchCommands(CLI::App& bench) {
   reg->add_flag("--no-pcl", a->no_pcl, "skip PCL's pipeline");
   reg->add_flag("--no-open3d", a->no_open3d, "skip Open3D's pipeline");
   reg->add_flag("--no-real-scans", a->no_real_scans, "only the mesh pairs");
+  reg->add_flag("--no-hard-pairs", a->no_hard_pairs,
+                "only the main pairs: no views further apart, sparser or with outliers, no scans "
+                "cut in two, no pairs without overlap");
   reg->add_option("--sweep-voxel", a->sweep_voxel,
                   "also run uwscan's pipeline at these voxel sizes, fractions of the object size "
                   "(e.g. 0.01 0.02 0.04)");

@@ -27,6 +27,7 @@ double Time(F&& f) {
 FeaturesBenchResult RunFeaturesBenchmark(const FeaturesBenchOptions& o, const Progress& progress) {
   RegistrationPairOptions pair_options = o.pairs;
   pair_options.real_scans = false;  // object views: what recognition describes
+  pair_options.hard_pairs = false;
   const std::vector<RegistrationPair> pairs = MakeRegistrationPairs(o.data_cache, pair_options);
   FeaturesBenchResult r;
   int esf_pairs = 0;

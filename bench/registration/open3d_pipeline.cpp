@@ -85,6 +85,7 @@ PipelineRun RunOpen3dPipeline(const RegistrationPair& pair, const PipelineParame
   Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
   shift.translation() = frame;
   run.T_target_source = shift * Eigen::Isometry3d(fine.transformation_) * shift.inverse();
+  run.accepted = fine.fitness_ >= 0.1;
   // Stage times only, as for uwscan: conversions into the peer's types are not charged.
   for (const auto& [stage, seconds] : run.stage_seconds) run.seconds += seconds;
   return run;

@@ -111,6 +111,7 @@ PipelineRun RunPclPipeline(const RegistrationPair& pair, const PipelineParameter
   Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
   shift.translation() = frame;
   run.T_target_source = shift * Eigen::Isometry3d(fine) * shift.inverse();
+  run.accepted = ransac.hasConverged() && icp.hasConverged();
   // Stage times only, as for uwscan: conversions into the peer's types are not charged.
   for (const auto& [stage, seconds] : run.stage_seconds) run.seconds += seconds;
   return run;

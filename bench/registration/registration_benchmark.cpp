@@ -27,7 +27,7 @@ namespace {
 using Runner = std::function<PipelineRun(const RegistrationPair&, const PipelineParameters&)>;
 
 // One pipeline over every pair; voxel_fraction > 0 sets the leaf to that fraction of each
-// object's size (0: the default, size / 50).
+// object's size (0: the pair's own, RegistrationPair::voxel_m).
 PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
                             const std::vector<RegistrationPair>& pairs,
                             const RegistrationBenchOptions& o, double voxel_fraction,
@@ -36,8 +36,10 @@ PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
   double total_seconds = 0.0;
   for (size_t i = 0; i < pairs.size(); ++i) {
     const RegistrationPair& pair = pairs[i];
-    const PipelineParameters parameters = ParametersFor(
-        pair.object_size_m, o.pairs.seed + i, o.threads, voxel_fraction * pair.object_size_m);
+    const double voxel_m =
+        voxel_fraction > 0.0 ? voxel_fraction * pair.object_size_m : pair.voxel_m;
+    const PipelineParameters parameters =
+        ParametersFor(pair.object_size_m, o.pairs.seed + i, o.threads, voxel_m);
     const PipelineRun run = run_pipeline(pair, parameters);
     const PoseError error =
         ComparePoses(run.T_target_source, pair.T_target_source_true, pair.source.origin);
@@ -53,22 +55,59 @@ PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
     outcome.success =
         error.rotation_rad < o.max_rotation_error_rad && error.translation_m < limit_m;
     outcome.symmetric_success = outcome.symmetric_error_m < limit_m;
+    outcome.accepted = run.accepted;
+    outcome.overlapping = pair.overlapping;
+    outcome.overlap = pair.overlap;
+    outcome.useful = pair.overlapping ? run.accepted && outcome.symmetric_success : !run.accepted;
+    if (outcomes) outcomes->push_back(outcome);
+    if (progress) progress(name + " pipeline", (i + 1.0) / pairs.size());
+    if (!pair.overlapping) continue;
+    ++summary.pairs;
+    summary.accepted += outcome.accepted ? 1 : 0;
     summary.successes += outcome.success ? 1 : 0;
     summary.symmetric_successes += outcome.symmetric_success ? 1 : 0;
     total_seconds += run.seconds;
     for (const auto& [stage, seconds] : run.stage_seconds) {
-      summary.stage_seconds_per_pair[stage] += seconds / pairs.size();
+      summary.stage_seconds_per_pair[stage] += seconds;
     }
-    if (outcomes) outcomes->push_back(outcome);
-    if (progress) progress(name + " pipeline", (i + 1.0) / pairs.size());
   }
-  summary.pairs = static_cast<int>(pairs.size());
-  if (!pairs.empty()) {
-    summary.success_rate = summary.successes / double(pairs.size());
-    summary.symmetric_success_rate = summary.symmetric_successes / double(pairs.size());
-    summary.seconds_per_pair = total_seconds / pairs.size();
+  if (summary.pairs > 0) {
+    summary.success_rate = summary.successes / double(summary.pairs);
+    summary.symmetric_success_rate = summary.symmetric_successes / double(summary.pairs);
+    summary.seconds_per_pair = total_seconds / summary.pairs;
+    for (auto& [stage, seconds] : summary.stage_seconds_per_pair) seconds /= summary.pairs;
   }
   return summary;
+}
+
+// Every outcome into its overlap bucket, per pipeline.
+std::vector<OverlapBucket> ByOverlap(const std::vector<PairOutcome>& outcomes) {
+  std::vector<OverlapBucket> buckets = {{"none", 0.0, 0.0, false, {}},
+                                        {"under 30 %", 0.0, 0.3, true, {}},
+                                        {"30-50 %", 0.3, 0.5, true, {}},
+                                        {"50-70 %", 0.5, 0.7, true, {}},
+                                        {"70 % and over", 0.7, 1.01, true, {}}};
+  for (const PairOutcome& outcome : outcomes) {
+    for (OverlapBucket& bucket : buckets) {
+      const bool inside = bucket.overlapping
+                              ? outcome.overlapping && outcome.overlap >= bucket.min_overlap &&
+                                    outcome.overlap < bucket.max_overlap
+                              : !outcome.overlapping;
+      if (!inside) continue;
+      OverlapBucket::Pipeline& p = bucket.pipelines[outcome.pipeline];
+      ++p.pairs;
+      p.useful += outcome.useful ? 1 : 0;
+      p.wrong_accepted += outcome.accepted && !outcome.useful ? 1 : 0;
+      p.seconds_per_pair += outcome.seconds;
+    }
+  }
+  for (OverlapBucket& bucket : buckets) {
+    for (auto& [name, p] : bucket.pipelines) {
+      p.useful_rate = p.useful / double(p.pairs);
+      p.seconds_per_pair /= p.pairs;
+    }
+  }
+  return buckets;
 }
 
 }  // namespace
@@ -89,6 +128,7 @@ RegistrationBenchResult RunRegistrationBenchmark(const RegistrationBenchOptions&
     result.pipelines[name] =
         RunPipeline(name, run_pipeline, pairs, o, 0.0, &result.outcomes, progress);
   }
+  result.buckets = ByOverlap(result.outcomes);
   for (const double fraction : o.sweep_voxel_fractions) {
     const std::string what = "uwscan at voxel " + std::to_string(fraction) + " x size";
     result.voxel_sweep.push_back(

@@ -36,10 +36,18 @@ struct PairOutcome {
   double seconds = 0.0;
   bool success = false;            // rotation and translation within the thresholds
   bool symmetric_success = false;  // ADD-S within the translation threshold
+  bool accepted = false;           // the pipeline vouched for its pose (PipelineRun::accepted)
+  bool overlapping = true;         // the pair has an answer (RegistrationPair::overlapping)
+  double overlap = 0.0;            // RegistrationPair::overlap
+  // What a user needs: an overlapping pair's pose accepted and right modulo symmetry; a pair
+  // without overlap refused.
+  bool useful = false;
 };
 
+// Over the pairs that overlap (the pose errors mean nothing on the others).
 struct PipelineSummary {
   int pairs = 0;
+  int accepted = 0;
   int successes = 0;
   double success_rate = 0.0;
   int symmetric_successes = 0;  // judged by ADD-S: a symmetric object's equivalent poses pass
@@ -54,8 +62,26 @@ struct VoxelSweepRow {
   PipelineSummary summary;
 };
 
+// The pairs whose overlap lies in [min_overlap, max_overlap), or those without any.
+struct OverlapBucket {
+  std::string name;  // "none", "under 30 %", "30-50 %", "50-70 %", "70 % and over"
+  double min_overlap = 0.0, max_overlap = 0.0;
+  bool overlapping = true;
+  struct Pipeline {
+    int pairs = 0;
+    int useful = 0;  // PairOutcome::useful
+    double useful_rate = 0.0;
+    // Poses accepted that are wrong (modulo symmetry), or accepted where there is no answer:
+    // what a user would act on unwarned.
+    int wrong_accepted = 0;
+    double seconds_per_pair = 0.0;
+  };
+  std::map<std::string, Pipeline> pipelines;
+};
+
 struct RegistrationBenchResult {
   std::map<std::string, PipelineSummary> pipelines;  // "uwscan", "pcl", "open3d"
+  std::vector<OverlapBucket> buckets;                // every pair once, by its overlap
   std::vector<PairOutcome> outcomes;
   std::vector<VoxelSweepRow> voxel_sweep;
 };

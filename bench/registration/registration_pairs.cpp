@@ -6,6 +6,8 @@
 
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/cloud/cloud_neighbors.hpp"
+#include "perception/cloud/cloud_scale.hpp"
+#include "perception/registration/registration_pipeline.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
 #include "scanner/common/random_draws.hpp"
@@ -13,6 +15,9 @@
 
 namespace uwscan::bench {
 namespace {
+
+// Less than this share in common and a pair has no answer (RegistrationPair::overlapping).
+constexpr double kMinOverlap = 0.05;
 
 constexpr const char* kMeshes[] = {"anchor",  "cylinder",     "joint",         "rotor",  "spool",
                                    "turbine", "pinion_small", "fandisk_large", "bunny00"};
@@ -62,52 +67,166 @@ std::vector<Eigen::Vector3d> Resampled(const std::vector<Eigen::Vector3d>& point
   return out;
 }
 
+scanner::TriangleMesh LoadScaledMesh(const std::filesystem::path& cache, const std::string& name,
+                                     double size_m) {
+  scanner::TriangleMesh mesh = scanner::LoadMesh(cache / "meshes" / (name + ".off"));
+  const double scale = size_m / mesh.BoundingBoxDiagonal();
+  for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
+  return mesh;
+}
+
+// Two independent samplings of one mesh's surface, as two scans would give.
+struct TwoSamplings {
+  scanner::SurfaceSamples surface, other;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+};
+
+TwoSamplings SampleTwice(const scanner::TriangleMesh& mesh, int samples, std::mt19937_64& rng) {
+  TwoSamplings s{scanner::SampleSurface(mesh, samples, rng()),
+                 scanner::SampleSurface(mesh, samples, rng())};
+  for (const Eigen::Vector3d& p : s.surface.points) s.centroid += p;
+  s.centroid /= static_cast<double>(s.surface.points.size());
+  return s;
+}
+
+// Two partial views of the object, from viewpoints `separation_rad` apart at three object sizes
+// from its centroid: the target from one sampling, the source from the other. Viewpoints from
+// which an open mesh shows (almost) no front faces are drawn again.
+struct TwoViews {
+  std::vector<Eigen::Vector3d> target, source;
+  Eigen::Vector3d target_viewpoint, source_viewpoint;
+};
+
+// `gauss` (a unit normal) is the caller's, kept across a mesh's pairs: a normal distribution
+// holds a draw back between calls, and the main pairs' views must stay as published.
+TwoViews CutTwoViews(const TwoSamplings& s, const std::string& name, double separation_rad,
+                     const RegistrationPairOptions& o, std::normal_distribution<double>& gauss,
+                     std::mt19937_64& rng) {
+  TwoViews v;
+  const double distance = 3.0 * o.mesh_size_m;
+  for (int attempt = 0; attempt < 50 && (v.target.size() < 500 || v.source.size() < 500);
+       ++attempt) {
+    const Eigen::Vector3d a = DrawVector3LastFirst(gauss, rng).normalized();
+    const Eigen::Vector3d b = Eigen::AngleAxisd(separation_rad, a.unitOrthogonal()) * a;
+    v.target_viewpoint = s.centroid + distance * a;
+    v.source_viewpoint = s.centroid + distance * b;
+    v.target = PartialView(s.surface, v.target_viewpoint, o.noise_sigma_m, rng);
+    v.source = PartialView(s.other, v.source_viewpoint, o.noise_sigma_m, rng);
+  }
+  if (v.target.size() < 500 || v.source.size() < 500) {
+    throw Error("registration pairs: no usable views of mesh '" + name + "'");
+  }
+  return v;
+}
+
+// The pair of the two views with the source moved by a random rigid motion; `surface` is the
+// object's whole surface in the object's frame.
+RegistrationPair MovedPair(const std::string& name, TwoViews views,
+                           const std::vector<Eigen::Vector3d>& surface, double max_translation_m,
+                           std::mt19937_64& rng) {
+  RegistrationPair pair;
+  pair.name = name;
+  const Eigen::Isometry3d T_source_target = RandomMotion(rng, max_translation_m);
+  for (Eigen::Vector3d& p : views.source) p = T_source_target * p;
+  pair.source_viewpoint = T_source_target * views.source_viewpoint;
+  pair.target_viewpoint = views.target_viewpoint;
+  pair.target = perception::MakeCloud(views.target);
+  pair.source = perception::MakeCloud(views.source);
+  std::vector<Eigen::Vector3d> surface_in_source;
+  surface_in_source.reserve(surface.size());
+  for (const Eigen::Vector3d& p : surface) surface_in_source.push_back(T_source_target * p);
+  pair.surface = perception::MakeCloud(surface_in_source);
+  pair.T_target_source_true = T_source_target.inverse();
+  pair.object_size_m = perception::BoundingBoxDiagonal(pair.target);
+  return pair;
+}
+
 void AddMeshPairs(const std::filesystem::path& cache, const RegistrationPairOptions& o,
                   std::mt19937_64& rng, std::vector<RegistrationPair>* pairs) {
   for (const char* name : kMeshes) {
-    scanner::TriangleMesh mesh = scanner::LoadMesh(cache / "meshes" / (std::string(name) + ".off"));
-    const double scale = o.mesh_size_m / mesh.BoundingBoxDiagonal();
-    for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
-    // Each view gets its own sampling of the surface, as two scans would.
-    const scanner::SurfaceSamples surface = scanner::SampleSurface(mesh, o.mesh_samples, rng());
-    const scanner::SurfaceSamples other = scanner::SampleSurface(mesh, o.mesh_samples, rng());
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : surface.points) centroid += p;
-    centroid /= static_cast<double>(surface.points.size());
+    const TwoSamplings s =
+        SampleTwice(LoadScaledMesh(cache, name, o.mesh_size_m), o.mesh_samples, rng);
     std::normal_distribution<double> gauss(0.0, 1.0);
     for (int k = 0; k < o.pairs_per_mesh; ++k) {
-      RegistrationPair pair;
-      pair.name = std::string(name) + "#" + std::to_string(k);
-      // Viewpoints from which an open mesh shows (almost) no front faces are drawn again.
-      std::vector<Eigen::Vector3d> target, source;
-      const double distance = 3.0 * o.mesh_size_m;
-      for (int attempt = 0; attempt < 50 && (target.size() < 500 || source.size() < 500);
-           ++attempt) {
-        const Eigen::Vector3d a = DrawVector3LastFirst(gauss, rng).normalized();
-        const Eigen::Vector3d b = Eigen::AngleAxisd(o.view_separation_rad, a.unitOrthogonal()) * a;
-        pair.target_viewpoint = centroid + distance * a;
-        pair.source_viewpoint = centroid + distance * b;
-        target = PartialView(surface, pair.target_viewpoint, o.noise_sigma_m, rng);
-        source = PartialView(other, pair.source_viewpoint, o.noise_sigma_m, rng);
-      }
-      if (target.size() < 500 || source.size() < 500) {
-        throw Error(std::string("registration pairs: no usable views of mesh '") + name + "'");
-      }
-      const Eigen::Isometry3d T_source_target = RandomMotion(rng, o.mesh_size_m);
-      for (Eigen::Vector3d& p : source) p = T_source_target * p;
-      pair.source_viewpoint = T_source_target * pair.source_viewpoint;
-      pair.target = perception::MakeCloud(target);
-      pair.source = perception::MakeCloud(source);
-      std::vector<Eigen::Vector3d> surface_in_source;
-      surface_in_source.reserve(other.points.size());
-      for (const Eigen::Vector3d& p : other.points)
-        surface_in_source.push_back(T_source_target * p);
-      pair.surface = perception::MakeCloud(surface_in_source);
-      pair.T_target_source_true = T_source_target.inverse();
-      pair.object_size_m = perception::BoundingBoxDiagonal(pair.target);
-      pairs->push_back(std::move(pair));
+      TwoViews views = CutTwoViews(s, name, o.view_separation_rad, o, gauss, rng);
+      pairs->push_back(MovedPair(std::string(name) + "#" + std::to_string(k), std::move(views),
+                                 s.other.points, o.mesh_size_m, rng));
     }
   }
+}
+
+// A random half of the points: a sparser scan of the same surface.
+std::vector<Eigen::Vector3d> Thinned(const std::vector<Eigen::Vector3d>& points,
+                                     std::mt19937_64& rng) {
+  std::bernoulli_distribution keep(0.5);
+  std::vector<Eigen::Vector3d> out;
+  for (const Eigen::Vector3d& p : points) {
+    if (keep(rng)) out.push_back(p);
+  }
+  return out;
+}
+
+// The points with `fraction` of their number added, uniformly within their bounding box
+// (grown by a tenth on each side): spray, fish, a stray reflection.
+std::vector<Eigen::Vector3d> WithOutliers(std::vector<Eigen::Vector3d> points, double fraction,
+                                          std::mt19937_64& rng) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& p : points) box.extend(p);
+  const Eigen::Vector3d margin = 0.1 * box.sizes();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto count = static_cast<std::size_t>(fraction * static_cast<double>(points.size()));
+  for (std::size_t i = 0; i < count; ++i) {
+    const Eigen::Vector3d u = DrawVector3(unit, rng);
+    points.push_back(box.min() - margin + u.cwiseProduct(box.sizes() + 2.0 * margin));
+  }
+  return points;
+}
+
+// Per mesh, views further apart than the main pairs' (less overlap): at 1.2 rad with the source
+// half as dense, at 1.8 rad with outliers in the source.
+void AddHardMeshPairs(const std::filesystem::path& cache, const RegistrationPairOptions& o,
+                      std::mt19937_64& rng, std::vector<RegistrationPair>* pairs) {
+  for (const char* name : kMeshes) {
+    const TwoSamplings s =
+        SampleTwice(LoadScaledMesh(cache, name, o.mesh_size_m), o.mesh_samples, rng);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    TwoViews sparse = CutTwoViews(s, name, 1.2, o, gauss, rng);
+    sparse.source = Thinned(sparse.source, rng);
+    pairs->push_back(MovedPair(std::string(name) + " sparse 1.2 rad", std::move(sparse),
+                               s.other.points, o.mesh_size_m, rng));
+    TwoViews outliers = CutTwoViews(s, name, 1.8, o, gauss, rng);
+    outliers.source = WithOutliers(std::move(outliers.source), o.outlier_fraction, rng);
+    pairs->push_back(MovedPair(std::string(name) + " outliers 1.8 rad", std::move(outliers),
+                               s.other.points, o.mesh_size_m, rng));
+  }
+}
+
+// Views of two different objects: no answer exists.
+void AddUnrelatedPairs(const std::filesystem::path& cache, const RegistrationPairOptions& o,
+                       std::mt19937_64& rng, std::vector<RegistrationPair>* pairs) {
+  const std::pair<const char*, const char*> kUnrelated[] = {{"anchor", "joint"},
+                                                            {"rotor", "turbine"},
+                                                            {"fandisk_large", "bunny00"},
+                                                            {"spool", "pinion_small"}};
+  for (const auto& [target_name, source_name] : kUnrelated) {
+    const TwoSamplings target =
+        SampleTwice(LoadScaledMesh(cache, target_name, o.mesh_size_m), o.mesh_samples, rng);
+    const TwoSamplings source =
+        SampleTwice(LoadScaledMesh(cache, source_name, o.mesh_size_m), o.mesh_samples, rng);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    TwoViews views = CutTwoViews(target, target_name, 0.6, o, gauss, rng);
+    const TwoViews source_views = CutTwoViews(source, source_name, 0.6, o, gauss, rng);
+    views.source = source_views.source;
+    views.source_viewpoint = source_views.source_viewpoint;
+    RegistrationPair pair = MovedPair(std::string(source_name) + " onto " + target_name,
+                                      std::move(views), source.other.points, o.mesh_size_m, rng);
+    pair.overlapping = false;
+    pairs->push_back(std::move(pair));
+  }
+}
+
+double ScanVoxel(const RegistrationPair& pair) {
+  return perception::RegistrationPipelineOptions::ForClouds(pair.source, pair.target).voxel_m;
 }
 
 void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng,
@@ -136,11 +255,94 @@ void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng,
     pair.surface = perception::MakeCloud(surface_in_source);
     pair.T_target_source_true = T_source_target.inverse();
     pair.object_size_m = size;
+    pair.voxel_m = ScanVoxel(pair);
     pairs->push_back(std::move(pair));
   }
 }
 
+// The points whose x lies between the two quantiles of the scan's x.
+std::vector<Eigen::Vector3d> CutAlongX(const std::vector<Eigen::Vector3d>& points, double from,
+                                       double to) {
+  std::vector<double> x(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) x[i] = points[i].x();
+  std::sort(x.begin(), x.end());
+  const auto quantile = [&x](double q) {
+    return x[static_cast<std::size_t>(q * static_cast<double>(x.size() - 1))];
+  };
+  const double low = quantile(from), high = quantile(to);
+  std::vector<Eigen::Vector3d> out;
+  for (const Eigen::Vector3d& p : points) {
+    if (p.x() >= low && p.x() <= high) out.push_back(p);
+  }
+  return out;
+}
+
+// Each real scan cut across x into two parts, the source moved and noisy as in AddScanPairs:
+// overlapping (the first 65 % and the last 65 %: about half of each part shared) and disjoint
+// (the first 45 % and the last 45 %: a tenth of the scan between them, nothing shared).
+void AddScanCuts(const std::filesystem::path& cache, std::mt19937_64& rng,
+                 std::vector<RegistrationPair>* pairs) {
+  struct Scan {
+    const char* file;
+    double keep;
+  };
+  struct Cut {
+    const char* name;
+    double source_to, target_from;
+    bool overlapping;
+  };
+  for (const Scan scan : {Scan{"bun0", 0.7}, Scan{"table_scene_lms400", 0.25}}) {
+    const std::vector<Eigen::Vector3d> points =
+        Absolute(perception::ReadCloud(cache / "scans" / (std::string(scan.file) + ".pcd")));
+    const double size = perception::BoundingBoxDiagonal(perception::MakeCloud(points));
+    for (const Cut cut : {Cut{"cut in two, overlapping", 0.65, 0.35, true},
+                          Cut{"cut in two, disjoint", 0.45, 0.55, false}}) {
+      RegistrationPair pair;
+      pair.name = std::string(scan.file) + " " + cut.name;
+      pair.target =
+          perception::MakeCloud(Resampled(CutAlongX(points, cut.target_from, 1.0), scan.keep, 0.0,
+                                          Eigen::Isometry3d::Identity(), rng));
+      const Eigen::Isometry3d T_source_target = RandomMotion(rng, size);
+      pair.source = perception::MakeCloud(Resampled(CutAlongX(points, 0.0, cut.source_to),
+                                                    scan.keep, 1e-3 * size, T_source_target, rng));
+      pair.source_viewpoint = T_source_target * Eigen::Vector3d::Zero();
+      std::vector<Eigen::Vector3d> surface_in_source;
+      surface_in_source.reserve(points.size());
+      for (const Eigen::Vector3d& p : points) surface_in_source.push_back(T_source_target * p);
+      pair.surface = perception::MakeCloud(surface_in_source);
+      pair.T_target_source_true = T_source_target.inverse();
+      pair.object_size_m = size;
+      pair.voxel_m = ScanVoxel(pair);
+      pair.overlapping = cut.overlapping;
+      pairs->push_back(std::move(pair));
+    }
+  }
+}
+
+// The share of `from`'s points (moved by T) within radius_m of a point of `to`.
+double CoveredShare(const perception::PointCloud& from, const Eigen::Isometry3d& T,
+                    const perception::PointCloud& to, double radius_m) {
+  std::vector<Eigen::Vector3f> to_points(to.size());
+  for (std::size_t i = 0; i < to.size(); ++i)
+    to_points[i] = (to.Point(i) - to.origin).cast<float>();
+  const perception::KnnIndex index(to_points);
+  std::vector<std::uint32_t> nearest;
+  std::vector<float> squared_m2;
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    index.Query((T * from.Point(i) - to.origin).cast<float>(), 1, nearest, squared_m2);
+    if (squared_m2.front() <= radius_m * radius_m) ++covered;
+  }
+  return static_cast<double>(covered) / static_cast<double>(std::max<std::size_t>(1, from.size()));
+}
+
 }  // namespace
+
+double MeasureOverlap(const RegistrationPair& pair, double radius_m) {
+  return std::min(
+      CoveredShare(pair.source, pair.T_target_source_true, pair.target, radius_m),
+      CoveredShare(pair.target, pair.T_target_source_true.inverse(), pair.source, radius_m));
+}
 
 void RegistrationPairOptions::Check() const {
   const OptionChecks check("RegistrationPairOptions");
@@ -148,6 +350,7 @@ void RegistrationPairOptions::Check() const {
   check.GreaterThan("mesh_size_m", mesh_size_m, 0.0, "m");
   check.AtLeast("noise_sigma_m", noise_sigma_m, 0.0, "m");
   check.AtLeast("pairs_per_mesh", pairs_per_mesh, 1);
+  check.InRange("outlier_fraction", outlier_fraction, 0.0, 1.0, Interval::kOpenHigh);
 }
 
 std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,
@@ -157,6 +360,21 @@ std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path&
   std::vector<RegistrationPair> pairs;
   AddMeshPairs(data_cache, options, rng, &pairs);
   if (options.real_scans) AddScanPairs(data_cache, rng, &pairs);
+  if (options.hard_pairs) {
+    AddHardMeshPairs(data_cache, options, rng, &pairs);
+    if (options.real_scans) AddScanCuts(data_cache, rng, &pairs);
+    AddUnrelatedPairs(data_cache, options, rng, &pairs);
+  }
+  for (RegistrationPair& pair : pairs) {
+    // Within 1 % of the object's size (the success test's tolerance), but never less than a few
+    // sampling steps of the sparser cloud, which would make a sparse view look disjoint.
+    const double spacing_m = std::max(perception::MedianPointSpacing(pair.source),
+                                      perception::MedianPointSpacing(pair.target));
+    const double radius_m = std::max(0.01 * pair.object_size_m, 2.5 * spacing_m);
+    if (pair.overlapping) pair.overlap = MeasureOverlap(pair, radius_m);
+    // Views of a flat object's two faces can share nothing: no answer there either.
+    if (pair.overlap < kMinOverlap) pair.overlapping = false;
+  }
   return pairs;
 }
 

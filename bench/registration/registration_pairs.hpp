@@ -19,10 +19,20 @@ struct RegistrationPair {
   Eigen::Vector3d source_viewpoint = Eigen::Vector3d::Zero();  // sensor, in the source's frame
   Eigen::Vector3d target_viewpoint = Eigen::Vector3d::Zero();  // sensor, in the target's frame
   double object_size_m = 0.0;  // bounding-box diagonal of the target, for the success test
+  // The downsampling leaf every pipeline gets: 0 for an object (its size / 50); for a scan, what
+  // `uwscan register` picks for two clouds (RegistrationPipelineOptions::ForClouds).
+  double voxel_m = 0.0;
   // The whole object's surface in the source's frame (a mesh's full sampling; a scan's every
   // point): what a symmetry-aware error measures against, since a pose equivalent by symmetry
   // may move the seen side onto a side the source view never saw.
   perception::PointCloud surface;
+  // Whether the two clouds share any surface. A pair that does not (two unrelated objects, or
+  // two parts of a scan with a gap between them, views of a disc's two faces: less than 5 % in
+  // common) has no answer: a pipeline succeeds on it by refusing.
+  bool overlapping = true;
+  // The share of the smaller side that the other covers once truly placed (MeasureOverlap);
+  // 0 for a pair that does not overlap.
+  double overlap = 0.0;
 };
 
 struct RegistrationPairOptions {
@@ -33,6 +43,11 @@ struct RegistrationPairOptions {
   int pairs_per_mesh = 2;
   std::uint64_t seed = 1;
   bool real_scans = true;  // add pairs built from bun0.pcd and table_scene_lms400.pcd
+  // Add the pairs users find hard (AddHardPairs): views further apart, one of them sparser or
+  // with outliers; the real scans cut into two overlapping parts; and pairs that do not overlap
+  // at all (two unrelated objects, a scan's two ends).
+  bool hard_pairs = true;
+  double outlier_fraction = 0.05;  // of a hard pair's source points added as outliers, [0, 1)
 
   void Check() const;
 };
@@ -40,11 +55,18 @@ struct RegistrationPairOptions {
 // Pairs from the cached real data (scripts/fetch_data.sh): CGAL meshes sampled into two
 // partial views each (independent surface samplings, back faces culled, different
 // viewpoints, so the overlap is partial), and the real scans against randomly resampled,
-// noisy copies of themselves (full overlap: these test real noise and density, not overlap). Every
-// source is moved by a random rigid motion (any rotation, translation up to the object size).
+// noisy copies of themselves (full overlap: these test real noise and density, not overlap);
+// with hard_pairs, the harder pairs after them. Every source is moved by a random rigid motion
+// (any rotation, translation up to the object size). Each pair's overlap is measured within 1 %
+// of its object's size, or 2.5 sampling steps of the sparser cloud if more.
 // Throws uwscan::Error naming the missing file when the cache is incomplete.
 std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,
                                                     const RegistrationPairOptions& options);
+
+// The smaller of the two shares: of the source's points that lie within `radius_m` of a target
+// point once moved by the true pose, and of the target's that lie within it of a moved source
+// point.
+double MeasureOverlap(const RegistrationPair& pair, double radius_m);
 
 // Rotation error (rad) of an estimate against the truth, and its translation error (m) where
 // it matters: the displacement it gives `at_point` (the source's centre) against the truth's.

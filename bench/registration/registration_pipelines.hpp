@@ -27,6 +27,11 @@ PipelineParameters ParametersFor(double object_size_m, std::uint64_t seed, int t
 // What one pipeline produced on one pair, and the time each stage took.
 struct PipelineRun {
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  // Whether the pipeline vouches for its pose. Each by its own rule: uwscan's converged; PCL's
+  // RANSAC and ICP both converged (its RANSAC asks for a tenth of the source in agreement); Open3D
+  // has no such rule, so its result counts once a tenth of the source lies within the ICP
+  // distance (its fitness), as PCL's inlier fraction asks.
+  bool accepted = false;
   std::map<std::string, double> stage_seconds;  // downsample, normals, features, coarse, icp
   double seconds = 0.0;
 };

@@ -31,6 +31,7 @@ PipelineRun RunUwscanPipeline(const RegistrationPair& pair, const PipelineParame
       perception::RegisterClouds(pair.source, pair.target, o);
   PipelineRun run;
   run.T_target_source = result.fine.T_target_source;
+  run.accepted = result.fine.converged;
   run.stage_seconds = result.stage_seconds;
   for (const auto& [stage, seconds] : result.stage_seconds) run.seconds += seconds;
   return run;

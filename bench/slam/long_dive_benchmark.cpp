@@ -45,6 +45,13 @@ void AddTimeSeries(const mapping::DiveMapping& m, LongDiveRun& run) {
 
 // Maps the log (windowed or whole solves), sampling the resident memory as it goes, and
 // measures the result against the truth.
+// The mean of values[from..] (from < size).
+std::int64_t MeanFrom(const std::vector<std::int64_t>& values, std::size_t from) {
+  return std::accumulate(values.begin() + static_cast<std::ptrdiff_t>(from), values.end(),
+                         std::int64_t{0}) /
+         static_cast<std::int64_t>(values.size() - from);
+}
+
 LongDiveRun MapLongDive(const std::filesystem::path& log_path,
                         const scanner::sim::RayCaster& caster, bool windowed,
                         const LongDiveBenchOptions& options, const std::string& label,
@@ -68,6 +75,9 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
     ++next_sample;
     rss_fractions.push_back(fraction);
     run.rss_bytes.push_back(ResidentBytes().value_or(0));
+    const HeapBytes heap = CurrentHeapBytes();
+    run.heap_in_use_bytes.push_back(heap.in_use);
+    run.heap_held_bytes.push_back(heap.held);
     if (progress) progress(label, fraction);
   });
   for (const double fraction : rss_fractions)
@@ -85,10 +95,9 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   run.last_tenth = MedianAndP95(m.submap_seconds, n - tenth, n);
   run.peak_rss_bytes = *std::max_element(run.rss_bytes.begin(), run.rss_bytes.end());
   const std::size_t last = run.rss_bytes.size(), from = last - std::max<std::size_t>(1, last / 10);
-  run.rss_bytes_last_tenth =
-      std::accumulate(run.rss_bytes.begin() + static_cast<std::ptrdiff_t>(from),
-                      run.rss_bytes.end(), std::int64_t{0}) /
-      static_cast<std::int64_t>(last - from);
+  run.rss_bytes_last_tenth = MeanFrom(run.rss_bytes, from);
+  run.heap_in_use_bytes_last_tenth = MeanFrom(run.heap_in_use_bytes, from);
+  run.heap_held_bytes_last_tenth = MeanFrom(run.heap_held_bytes, from);
   run.loops_accepted = s.loops_accepted;
   run.whole_solves = m.stats.whole_solves;
   run.window_solves = m.stats.window_solves;

@@ -38,9 +38,11 @@ struct LongDiveRun {
   double ate_m = 0.0;
   double map_rms_m = 0.0;  // distance of the map's points to the true surfaces
   SubmapTimes first_tenth, last_tenth;
-  std::int64_t rss_bytes_at_start = 0;    // the process's resident memory before mapping
-  std::int64_t peak_rss_bytes = 0;        // and while mapping, at most
-  std::int64_t rss_bytes_last_tenth = 0;  // its mean over the last tenth of the dive
+  std::int64_t rss_bytes_at_start = 0;            // the process's resident memory before mapping
+  std::int64_t peak_rss_bytes = 0;                // and while mapping, at most
+  std::int64_t rss_bytes_last_tenth = 0;          // its mean over the last tenth of the dive
+  std::int64_t heap_in_use_bytes_last_tenth = 0;  // the same for the heap (CurrentHeapBytes)
+  std::int64_t heap_held_bytes_last_tenth = 0;
   int loops_accepted = 0;
   int whole_solves = 0, window_solves = 0;
   // Over the dive (seconds of dive time): the mean time per submap in each of about 60 stretches,
@@ -48,6 +50,10 @@ struct LongDiveRun {
   std::vector<double> submap_time_s, submap_seconds;
   std::vector<double> rss_time_s;
   std::vector<std::int64_t> rss_bytes;
+  // At the same times, the heap the program holds and what the allocator holds for it
+  // (CurrentHeapBytes): whether resident memory grows with what the mapper keeps or with the
+  // allocator's free space.
+  std::vector<std::int64_t> heap_in_use_bytes, heap_held_bytes;
 };
 
 struct LongDiveFigures {

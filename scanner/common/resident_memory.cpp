@@ -1,5 +1,7 @@
 #include "scanner/common/resident_memory.hpp"
 
+#include <malloc.h>
+
 #include <fstream>
 #include <string>
 
@@ -18,6 +20,13 @@ std::optional<std::int64_t> ResidentBytes(int pid) {
     status.ignore(1 << 12, '\n');
   }
   return std::nullopt;
+}
+
+HeapBytes CurrentHeapBytes() {
+  const struct mallinfo2 info = mallinfo2();
+  // Blocks too large for an arena are mapped on their own (hblkhd): held and in use both.
+  return {static_cast<std::int64_t>(info.uordblks + info.hblkhd),
+          static_cast<std::int64_t>(info.arena + info.hblkhd)};
 }
 
 }  // namespace uwscan

@@ -9,4 +9,14 @@ namespace uwscan {
 // when it cannot be read (the process is gone, or no /proc).
 std::optional<std::int64_t> ResidentBytes(int pid = 0);
 
+// This process's heap as glibc's allocator sees it, over all its arenas (mallinfo2): what the
+// program holds, and what the allocator holds from the system for it (held - in use is freed
+// memory it keeps: fragmentation, when it grows). Resident memory that grows with `in_use` is
+// the program's; with `held` alone, the allocator's.
+struct HeapBytes {
+  std::int64_t in_use = 0;
+  std::int64_t held = 0;
+};
+HeapBytes CurrentHeapBytes();
+
 }  // namespace uwscan
