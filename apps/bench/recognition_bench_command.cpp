@@ -213,6 +213,12 @@ void Run(Args a) {
         {"median_grasp_position_error_m", Median(f.grasp_position_errors_m)},
         {"median_grasp_angle_error_deg", Median(f.grasp_angle_errors_rad) * kRadToDeg},
         {"seconds_per_scan", per_scan}};
+    if (!f.scan_seconds.empty()) {
+      pipelines[name]["seconds_per_scan_p95"] = Percentile95(f.scan_seconds);
+      pipelines[name]["seconds_per_scan_max"] =
+          *std::max_element(f.scan_seconds.begin(), f.scan_seconds.end());
+      pipelines[name]["scan_seconds"] = f.scan_seconds;
+    }
     if (!f.pose_nees_per_dimension.empty()) {
       pipelines[name]["pose_nees_per_dimension_mean"] = Mean(f.pose_nees_per_dimension);
       pipelines[name]["pose_nees_per_dimension_median"] = Median(f.pose_nees_per_dimension);
@@ -223,6 +229,11 @@ void Run(Args a) {
       }
     }
     confusion[name] = DenseConfusion(f.confusion, shape);
+  }
+  if (r.pipelines.count("uwscan") && !r.pipelines.at("uwscan").scan_seconds.empty()) {
+    const std::vector<double>& t = r.pipelines.at("uwscan").scan_seconds;
+    std::printf("uwscan time per scan: p95 %.3f s, slowest %.3f s\n", Percentile95(t),
+                *std::max_element(t.begin(), t.end()));
   }
   std::printf("uwscan stages (s per scan):");
   for (const auto& [stage, s] : r.uwscan_stage_seconds)

@@ -441,7 +441,8 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
     start = std::chrono::steady_clock::now();
     const perception::RecognitionResult answer =
         perception::RecognizeObjects(cloud, db, cache, recognition);
-    result.pipelines["uwscan"].seconds += Seconds(start);
+    result.pipelines["uwscan"].scan_seconds.push_back(Seconds(start));
+    result.pipelines["uwscan"].seconds += result.pipelines["uwscan"].scan_seconds.back();
     for (const auto& [stage, seconds] : answer.stage_seconds)
       result.uwscan_stage_seconds[stage] += seconds;
 

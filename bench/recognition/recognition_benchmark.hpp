@@ -52,7 +52,8 @@ struct PipelineFigures {
   int mssd_success = 0;                  // of those: MSSD below 0.1 x diameter
   int grasp_success = 0;                 // of those: grasp within 5 mm and 3 degrees
   int foreign = 0, foreign_unknown = 0;  // foreign meshes, and those called "unknown"
-  double seconds = 0.0;  // recognition of every scan (segmentation included for uwscan)
+  double seconds = 0.0;              // recognition of every scan (segmentation included for uwscan)
+  std::vector<double> scan_seconds;  // uwscan only: each scan's time (its tail, not just the mean)
   std::vector<double> rotation_errors_rad, translation_errors_m, grasp_position_errors_m,
       grasp_angle_errors_rad;
   // uwscan's reported pose covariance against its error (modulo symmetry): the NEES over the
