@@ -315,8 +315,9 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
                 "print every object's answer and the candidates weighed for it");
   cmd->add_option("--conditions", a->conditions,
                   "instead: recognition under the conditions users' data brings, this many scenes "
-                  "each: objects taught from scans (clouds) beside the same from meshes, flat "
-                  "panels on the seabed and on a wall")
+                  "each: objects taught from scans (clouds) beside the same from meshes, the "
+                  "scenes seen by a depth camera (PCD with a VIEWPOINT), flat panels on the "
+                  "seabed and on a wall")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { Run(*a); });

@@ -9,6 +9,7 @@
 
 #include "bench/recognition/pose_nees.hpp"
 #include "bench/scratch_folder.hpp"
+#include "mapping/reconstruction/scan_file.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/recognition/object_catalogue.hpp"
 #include "perception/recognition/object_database_builder.hpp"
@@ -17,6 +18,7 @@
 #include "perception/recognition/object_symmetry.hpp"
 #include "scanner/common/option_checks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/depth_camera.hpp"
 #include "scanner/sim/imr_objects.hpp"
 #include "scanner/sim/virtual_scanner.hpp"
 
@@ -127,6 +129,31 @@ ObjectSource ScannedObject(const std::string& id, const scanner::TriangleMesh& m
   perception::WriteCloud(path, perception::MakeCloud(scanner::ScannedSurface(mesh, kCloudPoints,
                                                                              kCloudNoise_m, seed)));
   return perception::CloudObject(path);
+}
+
+// The scene seen by a depth camera where the laser scanner stood, brought as a user of such a
+// camera would bring it: a PCD in a frame looking along -z with x right and y up (the graphics
+// convention), its VIEWPOINT giving the camera's pose in that frame, read back by the reader
+// `recognize` uses, which moves it into the sensor's frame.
+sim::VirtualScan DepthCameraScan(const Scene& scene, const std::filesystem::path& folder,
+                                 std::uint64_t seed) {
+  const sim::DepthScan depth =
+      sim::ScanWithDepthCamera(scene.objects, scene.T_W_C, sim::DepthCameraOptions{}, seed);
+  sim::VirtualScan scan;
+  if (depth.points_C.empty()) return scan;
+  Eigen::Isometry3d T_file_C = Eigen::Isometry3d::Identity();
+  T_file_C.linear() = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  std::vector<Eigen::Vector3d> points_file;
+  points_file.reserve(depth.points_C.size());
+  for (const Eigen::Vector3d& p_C : depth.points_C) points_file.push_back(T_file_C * p_C);
+  const std::filesystem::path path = folder / "depth_scan.pcd";
+  perception::WriteCloud(path, perception::MakeCloud(points_file), true, T_file_C);
+  const mapping::ScanFile file = mapping::ReadScanFile(path);
+  for (std::size_t i = 0; i < file.cloud.size(); ++i) {
+    scan.points_C.push_back(file.cloud.Point(i));
+    scan.object_index.push_back(depth.object_index[file.rows[i]]);
+  }
+  return scan;
 }
 
 // What the bench scores poses against: the physical object's declared symmetries and its
@@ -248,6 +275,8 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
     const sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, scan_seed);
     ScoreScan(scene, scan, from_meshes, truths[k], options, result["mesh_models"]);
     ScoreScan(scene, scan, from_scans, truths[k], options, result["cloud_models"]);
+    ScoreScan(scene, DepthCameraScan(scene, folder.path(), scan_seed), from_meshes, truths[k],
+              options, result["depth_camera"]);
     const Scene panel = PanelScene(flat.back(), s, rng);
     ScoreScan(panel, scanner.Scan(panel.objects, panel.T_W_C, scan_seed), with_panel, panel_truth,
               options, result["flat_objects"]);

@@ -10,8 +10,9 @@
 
 // Recognition under the conditions users' data brings (issue 50), each its own figures: the
 // catalogue's objects taught from their meshes (the reference) and from scans of them (clouds),
-// and flat objects (intervention panels) lying on the seabed and mounted on a wall, which plane
-// removal must not take for supports.
+// scenes scanned by a depth camera instead of uwscan's scanner, and flat objects (intervention
+// panels) lying on the seabed and mounted on a wall, which plane removal must not take for
+// supports.
 namespace uwscan::bench {
 
 struct RecognitionConditionsOptions {
@@ -33,14 +34,18 @@ struct ConditionFigures {
   std::vector<double> nees_per_dimension;
 };
 
-// "mesh_models", "cloud_models", "flat_objects".
+// "mesh_models", "cloud_models", "depth_camera", "flat_objects".
 using RecognitionConditions = std::map<std::string, ConditionFigures>;
 
 // Each condition's scenes: one object on a seabed (z = 0) at a random yaw, or for the flat objects
 // a panel lying on the seabed or on a wall behind it, seen by the galvanometer scanner from
 // 0.6-1.1 m at a random bearing, exact peaks with the simulator's peak noise. The cloud models
 // are 50,000 points over each object's surface with 0.3 mm noise, written as PLY without faces
-// and read back by build-db's reader (perception::CloudObject). Deterministic for a seed.
+// and read back by build-db's reader (perception::CloudObject). The depth camera condition sees
+// the mesh models' scenes from the same place with another sensor (sim::ScanWithDepthCamera's
+// defaults: 320 x 240 pixels, depth noise 1.4 mm at 1 m growing with its square), the scan
+// handed over as a PCD looking along -z with a VIEWPOINT and read back by the scan reader of
+// `recognize`; the database is still the laser scanner's. Deterministic for a seed.
 RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOptions& options,
                                                const Progress& progress = {});
 

@@ -274,11 +274,22 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   return cloud;
 }
 
-void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool binary) {
+void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool binary,
+                const std::optional<Eigen::Isometry3d>& T_file_sensor) {
   const std::optional<Format> format = FormatOf(path);
   if (!format || *format == Format::kXyz) {
     throw Error("WriteCloud: " + Quoted(path) + ": unsupported extension (expected .ply or .pcd)");
   }
+  if (T_file_sensor && *format != Format::kPcd) {
+    throw Error("WriteCloud: " + Quoted(path) + ": a sensor pose can only be written to a PCD");
+  }
+  const Eigen::Isometry3d T = T_file_sensor.value_or(Eigen::Isometry3d::Identity());
+  if (!T.matrix().allFinite())
+    throw Error("WriteCloud: " + Quoted(path) + ": sensor pose not finite");
+  const Eigen::Vector4f origin(static_cast<float>(T.translation().x()),
+                               static_cast<float>(T.translation().y()),
+                               static_cast<float>(T.translation().z()), 0.0f);
+  const Eigen::Quaternionf orientation(Eigen::Quaterniond(T.linear()).normalized().cast<float>());
   RequireValidCloud(cloud, "WriteCloud " + Quoted(path), 1);
   const pcl::PCLPointCloud2 blob = ToBlob(cloud, *format);
   const bool doubles =
@@ -292,9 +303,8 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
   try {
     if (*format == Format::kPcd) {
       pcl::PCDWriter writer;
-      status = binary ? writer.writeBinary(temporary.string(), blob)
-                      : writer.writeASCII(temporary.string(), blob, Eigen::Vector4f::Zero(),
-                                          Eigen::Quaternionf::Identity(), precision);
+      status = binary ? writer.writeBinary(temporary.string(), blob, origin, orientation)
+                      : writer.writeASCII(temporary.string(), blob, origin, orientation, precision);
     } else {
       status = WritePly(temporary, blob, binary) ? 0 : -1;
     }

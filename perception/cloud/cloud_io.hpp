@@ -44,8 +44,11 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats = 
 // (float32 "intensity"). PCD goes through PCL's
 // PCDWriter; PLY is written by uwscan (PCL 1.13's PLYWriter prints ASCII values to 6 digits).
 // Atomic: the file is written beside the target under a temporary name and renamed over it,
-// so an existing file stays intact and readable when writing fails. Throws uwscan::Error naming
-// the file on an unsupported extension, an empty or non-finite cloud, or an I/O failure.
-void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool binary = true);
+// so an existing file stays intact and readable when writing fails. `T_file_sensor`, the
+// sensor's pose in the file's frame, goes into a PCD's VIEWPOINT line (identity when unset).
+// Throws uwscan::Error naming the file on an unsupported extension, an empty or non-finite cloud,
+// a sensor pose for a PLY (which has no place for it), or an I/O failure.
+void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool binary = true,
+                const std::optional<Eigen::Isometry3d>& T_file_sensor = std::nullopt);
 
 }  // namespace uwscan::perception

@@ -141,6 +141,24 @@ TEST_F(CloudIoTest, NormalsAreMadeUnitAndZeroNormalsDropTheirPoint) {
   EXPECT_LT((cloud.Point(1) - Eigen::Vector3d(7, 8, 9)).norm(), 1e-6);
 }
 
+TEST_F(CloudIoTest, ASensorPoseWrittenToAPcdIsReadBackFromItsViewpoint) {
+  const PointCloud cloud =
+      MakeCloud(std::vector<Eigen::Vector3d>{{0, 0, 1}, {0.1, 0, 1}, {0, 0.1, 1.2}});
+  Eigen::Isometry3d T_file_sensor = Eigen::Isometry3d::Identity();
+  T_file_sensor.linear() = Eigen::AngleAxisd(3.0, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+  T_file_sensor.translation() = Eigen::Vector3d(0.5, -0.25, 2.0);
+  for (const bool binary : {true, false}) {
+    const fs::path path = dir_ / (binary ? "viewpoint.pcd" : "viewpoint_ascii.pcd");
+    WriteCloud(path, cloud, binary, T_file_sensor);
+    CloudReadStats stats;
+    ReadCloud(path, &stats);
+    ASSERT_TRUE(stats.T_file_sensor.has_value()) << stats.viewpoint_error;
+    // PCL writes the VIEWPOINT's numbers with six significant digits.
+    EXPECT_LT((stats.T_file_sensor->matrix() - T_file_sensor.matrix()).norm(), 1e-5) << binary;
+  }
+  EXPECT_THROW(WriteCloud(dir_ / "viewpoint.ply", cloud, true, T_file_sensor), Error);
+}
+
 TEST_F(CloudIoTest, ErrorsNameTheFile) {
   const fs::path missing = dir_ / "missing.ply";
   EXPECT_NE(MessageOf([&] { ReadCloud(missing); }).find(missing.string()), std::string::npos);
