@@ -5,7 +5,8 @@
 # Idempotent: does nothing once the cache holds every file. Prints the cache folder.
 set -euo pipefail
 cache=${UWSCAN_DATA_CACHE:-$HOME/.cache/uwscan}
-meshes=(anchor cylinder joint rotor spool turbine pinion_small fandisk_large bunny00)
+meshes=(anchor cylinder joint rotor spool turbine pinion_small fandisk_large bunny00
+        dragknob part handle mech-holes-shark ALSTOM_TEST4 itemb)
 scans=(bun0 table_scene_lms400)
 
 complete() {

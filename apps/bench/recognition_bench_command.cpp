@@ -136,6 +136,7 @@ void RunConditions(const Args& a) {
   options.seed = a.options.seed;
   options.threads = a.options.threads;
   options.table_cache = TableCache();
+  options.data_cache = DataCache();
   ProgressBar bar;
   const bench::RecognitionConditions r = bench::RunRecognitionConditions(options, bar.Callback());
   std::printf(
@@ -316,8 +317,8 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
   cmd->add_option("--conditions", a->conditions,
                   "instead: recognition under the conditions users' data brings, this many scenes "
                   "each: objects taught from scans (clouds) beside the same from meshes, the "
-                  "scenes seen by a depth camera (PCD with a VIEWPOINT), flat panels on the "
-                  "seabed and on a wall")
+                  "scenes seen by a depth camera (PCD with a VIEWPOINT), six CAD parts in "
+                  "millimetres, flat panels on the seabed and on a wall")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] { Run(*a); });

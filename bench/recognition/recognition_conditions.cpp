@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -16,6 +17,7 @@
 #include "perception/recognition/object_pose_search.hpp"
 #include "perception/recognition/object_recognizer.hpp"
 #include "perception/recognition/object_symmetry.hpp"
+#include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 #include "scanner/sim/depth_camera.hpp"
@@ -31,6 +33,10 @@ using perception::ObjectSource;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr const char* kObjects[] = {"elbow", "flange", "pipe", "tee", "valve_lever", "valve_wheel"};
+// CAD and scanned parts from CGAL's data no other bench or test uses (scripts/fetch_data.sh).
+constexpr const char* kCadMeshes[] = {"dragknob",         "part",         "handle",
+                                      "mech-holes-shark", "ALSTOM_TEST4", "itemb"};
+constexpr double kCadSize_m = 0.3;      // each part's bounding-box diagonal, as built
 constexpr int kMinVisiblePoints = 300;  // an object with fewer scan points is not scored
 constexpr int kCloudPoints = 50000;     // a scan of all of an object's sides
 constexpr double kCloudNoise_m = 0.0003;
@@ -121,6 +127,29 @@ Scene PanelScene(const ObjectSource& panel, int index, std::mt19937_64& rng) {
   return scene;
 }
 
+// A CGAL part as a CAD export brings it: scaled to kCadSize_m across about its box's centre,
+// written in millimetres as OBJ, and read back by build-db's reader given millimetres.
+ObjectSource CadObject(const std::filesystem::path& data_cache, const std::string& name,
+                       const std::filesystem::path& folder) {
+  const scanner::TriangleMesh mesh = scanner::LoadMesh(data_cache / "meshes" / (name + ".off"));
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : mesh.vertices) box.extend(v);
+  const double to_mm = 1000.0 * kCadSize_m / box.diagonal().norm();
+  const std::filesystem::path path = folder / (name + ".obj");
+  {
+    std::ofstream obj(path);
+    obj.precision(9);
+    for (const Eigen::Vector3d& v : mesh.vertices) {
+      const Eigen::Vector3d mm = to_mm * (v - box.center());
+      obj << "v " << mm.x() << ' ' << mm.y() << ' ' << mm.z() << '\n';
+    }
+    for (const Eigen::Vector3i& t : mesh.triangles)
+      obj << "f " << t.x() + 1 << ' ' << t.y() + 1 << ' ' << t.z() + 1 << '\n';
+    if (!obj.flush()) throw Error("recognition conditions: cannot write " + path.string());
+  }
+  return perception::MeshObject(path, 0.001);
+}
+
 // A scan of all of `mesh`'s sides as a user would bring it: a PLY without faces, read back as
 // build-db reads it.
 ObjectSource ScannedObject(const std::string& id, const scanner::TriangleMesh& mesh,
@@ -156,8 +185,9 @@ sim::VirtualScan DepthCameraScan(const Scene& scene, const std::filesystem::path
   return scan;
 }
 
-// What the bench scores poses against: the physical object's declared symmetries and its
-// mesh-taught model's points (every 4th), the same for every condition.
+// What the bench scores poses against: the object's symmetries in its mesh-taught model
+// (declared for the catalogue's, found from the mesh for the CAD parts) and that model's points
+// (every 4th), the same for every condition.
 struct Truth {
   std::vector<perception::SymmetryAxis> symmetries;
   std::vector<Eigen::Vector3d> points_O;
@@ -166,9 +196,9 @@ struct Truth {
 
 Truth TruthOf(const ObjectSource& object, const ObjectDatabase& db) {
   Truth truth;
-  truth.symmetries = object.symmetries.value_or(std::vector<perception::SymmetryAxis>{});
   for (const perception::ObjectModel& m : db.objects) {
     if (m.id != object.id) continue;
+    truth.symmetries = m.symmetries;
     for (std::size_t i = 0; i < m.model.size(); i += 4) truth.points_O.push_back(m.model.Point(i));
     truth.centre_O = m.model.origin;
   }
@@ -241,6 +271,9 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
   }
   std::vector<ObjectSource> flat = meshes;
   flat.push_back(perception::CatalogueObject("panel"));
+  std::vector<ObjectSource> cad;
+  for (const char* name : kCadMeshes)
+    cad.push_back(CadObject(options.data_cache, name, folder.path()));
 
   sim::VirtualScannerOptions scan_options;
   scan_options.pattern.kind = scanner::ScannerKind::kGalvo;
@@ -260,14 +293,17 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
   const ObjectDatabase mesh_db = database(meshes, "meshes");
   const ObjectDatabase cloud_db = database(clouds, "scans");
   const ObjectDatabase flat_db = database(flat, "meshes and a panel");
+  const ObjectDatabase cad_db = database(cad, "CAD parts in millimetres");
 
-  Recogniser from_meshes(mesh_db), from_scans(cloud_db), with_panel(flat_db);
-  std::vector<Truth> truths;
+  Recogniser from_meshes(mesh_db), from_scans(cloud_db), with_panel(flat_db), from_cad(cad_db);
+  std::vector<Truth> truths, cad_truths;
   for (const ObjectSource& object : meshes) truths.push_back(TruthOf(object, mesh_db));
+  for (const ObjectSource& object : cad) cad_truths.push_back(TruthOf(object, cad_db));
   const Truth panel_truth = TruthOf(flat.back(), flat_db);
 
   RecognitionConditions result;
   std::mt19937_64 rng(options.seed * 104729 + 17);
+  std::mt19937_64 cad_rng(options.seed * 104729 + 29);  // the other conditions' scenes unchanged
   for (int s = 0; s < options.scans; ++s) {
     const std::size_t k = static_cast<std::size_t>(s) % meshes.size();
     const std::uint64_t scan_seed = options.seed + 31 * static_cast<std::uint64_t>(s);
@@ -277,6 +313,10 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
     ScoreScan(scene, scan, from_scans, truths[k], options, result["cloud_models"]);
     ScoreScan(scene, DepthCameraScan(scene, folder.path(), scan_seed), from_meshes, truths[k],
               options, result["depth_camera"]);
+    const std::size_t c = static_cast<std::size_t>(s) % cad.size();
+    const Scene cad_scene = ObjectScene(cad[c], cad_rng);
+    ScoreScan(cad_scene, scanner.Scan(cad_scene.objects, cad_scene.T_W_C, scan_seed), from_cad,
+              cad_truths[c], options, result["catalogue_mm"]);
     const Scene panel = PanelScene(flat.back(), s, rng);
     ScoreScan(panel, scanner.Scan(panel.objects, panel.T_W_C, scan_seed), with_panel, panel_truth,
               options, result["flat_objects"]);

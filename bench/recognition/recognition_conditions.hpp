@@ -21,6 +21,7 @@ struct RecognitionConditionsOptions {
   std::uint64_t seed = 1;
   int threads = 2;
   std::filesystem::path table_cache;  // cone table kept between runs
+  std::filesystem::path data_cache;   // scripts/fetch_data.sh's folder: the CAD parts' meshes
   void Check() const;
 };
 
@@ -34,7 +35,7 @@ struct ConditionFigures {
   std::vector<double> nees_per_dimension;
 };
 
-// "mesh_models", "cloud_models", "depth_camera", "flat_objects".
+// "mesh_models", "cloud_models", "depth_camera", "catalogue_mm", "flat_objects".
 using RecognitionConditions = std::map<std::string, ConditionFigures>;
 
 // Each condition's scenes: one object on a seabed (z = 0) at a random yaw, or for the flat objects
@@ -45,7 +46,10 @@ using RecognitionConditions = std::map<std::string, ConditionFigures>;
 // the mesh models' scenes from the same place with another sensor (sim::ScanWithDepthCamera's
 // defaults: 320 x 240 pixels, depth noise 1.4 mm at 1 m growing with its square), the scan
 // handed over as a PCD looking along -z with a VIEWPOINT and read back by the scan reader of
-// `recognize`; the database is still the laser scanner's. Deterministic for a seed.
+// `recognize`; the database is still the laser scanner's. The millimetre catalogue is six CGAL
+// parts no other bench uses, each 0.3 m across, written as OBJ in millimetres and taught by
+// build-db's reader given millimetres, in scenes of their own. Throws uwscan::Error naming a
+// missing mesh when the data cache lacks one. Deterministic for a seed.
 RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOptions& options,
                                                const Progress& progress = {});
 

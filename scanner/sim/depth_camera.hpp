@@ -15,8 +15,8 @@ namespace uwscan::scanner::sim {
 // the first Kinect). Rays go straight: no viewport, no water (a camera in a housing that corrects
 // for it, or in air).
 struct DepthCameraOptions {
-  int width_px = 320;  // pixels across, >= 2
-  int height_px = 240;  // pixels down, >= 2
+  int width_px = 320;                  // pixels across, >= 2
+  int height_px = 240;                 // pixels down, >= 2
   double horizontal_fov_rad = 1.0123;  // 58 degrees, in (0, pi)
   double min_range_m = 0.3;            // nearer depths are not measured, > 0
   double max_range_m = 4.0;            // farther ones neither, > min_range_m
