@@ -15,11 +15,11 @@ endif()
 # the component libraries themselves through one interface target, so that only the viewer
 # links VTK (DESIGN.md, "Known traps").
 find_package(PCL 1.13 REQUIRED COMPONENTS common io kdtree search features filters
-             segmentation sample_consensus registration)
+             segmentation sample_consensus registration recognition)
 add_library(uwscan_pcl INTERFACE)
 target_include_directories(uwscan_pcl SYSTEM INTERFACE ${PCL_INCLUDE_DIRS})
 foreach(component common io io_ply kdtree search octree features filters segmentation
-                  sample_consensus registration)
+                  sample_consensus registration recognition)
   find_library(UWSCAN_PCL_${component} pcl_${component} REQUIRED)
   target_link_libraries(uwscan_pcl INTERFACE ${UWSCAN_PCL_${component}})
 endforeach()

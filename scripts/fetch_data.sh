@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Fetches the real data of ../shared/DATA.md from Debian's archive into a cache outside git:
 #   ${UWSCAN_DATA_CACHE:-$HOME/.cache/uwscan}/meshes/*.off   CGAL's scanned and CAD meshes
-#   ${UWSCAN_DATA_CACHE:-$HOME/.cache/uwscan}/scans/*.pcd    PCL's tutorial scans
+#   ${UWSCAN_DATA_CACHE:-$HOME/.cache/uwscan}/scans/*.pcd    PCL's tutorial scans and models
 # Idempotent: does nothing once the cache holds every file. Prints the cache folder.
 set -euo pipefail
 cache=${UWSCAN_DATA_CACHE:-$HOME/.cache/uwscan}
 meshes=(anchor cylinder joint rotor spool turbine pinion_small fandisk_large bunny00
         dragknob part handle mech-holes-shark ALSTOM_TEST4 itemb)
-scans=(bun0 table_scene_lms400)
+scans=(bun0 table_scene_lms400 milk milk_cartoon_all_small_clorox)
 
 complete() {
   for m in "${meshes[@]}"; do [ -s "$cache/meshes/$m.off" ] || return 1; done
@@ -33,5 +33,8 @@ if ! complete; then
   examples="$work/pcl/usr/share/doc/python3-pcl/examples"
   cp "$examples/official/Surface/bun0.pcd" "$cache/scans/bun0.pcd"
   cp "$examples/pcldata/tutorials/table_scene_lms400.pcd" "$cache/scans/table_scene_lms400.pcd"
+  for s in milk milk_cartoon_all_small_clorox; do
+    cp "$examples/pcldata/tutorials/correspondence_grouping/$s.pcd" "$cache/scans/$s.pcd"
+  done
 fi
 echo "$cache"

@@ -266,6 +266,20 @@ TEST(Cli, RecognitionBenchConditionsReportEachCondition) {
   std::filesystem::remove(json);
 }
 
+// Real data no one here made (PCL's correspondence grouping tutorial: a milk carton's model and a
+// Kinect scene): uwscan finds the carton where PCL's own correspondence grouping puts it.
+TEST(Cli, RecognitionOnARealScanAgreesWithPclsCorrespondenceGrouping) {
+  const std::filesystem::path json = TempPath("real_pair.json");
+  const CommandRun run = RunUwscan("bench recognition --real-pair --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  ASSERT_TRUE(j.at("uwscan").at("found").get<bool>()) << run.output;
+  ASSERT_TRUE(j.at("pcl_correspondence_grouping").at("found").get<bool>()) << run.output;
+  EXPECT_LT(j.at("rotation_difference_deg").get<double>(), 3.0);
+  EXPECT_LT(j.at("translation_difference_m").get<double>(), 0.005);
+  std::filesystem::remove(json);
+}
+
 // The confusion matrix has a row for every database object and the foreign meshes and a column
 // for every object and "unknown", zeros included; its diagonal is the recognition rate.
 TEST(Cli, RecognitionBenchWritesAFullConfusionMatrix) {

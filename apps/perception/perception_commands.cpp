@@ -25,12 +25,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
-nlohmann::json MatrixJson(const Eigen::Matrix4d& m) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
-  return rows;
-}
-
 nlohmann::json ResultJson(const perception::RegistrationResult& r) {
   return {{"T_target_source", MatrixJson(r.T_target_source.matrix())},
           {"fitness", r.fitness},
