@@ -201,9 +201,8 @@ void RunRealPair(const Args& a) {
   out["uwscan"]["database_seconds"] = f.database_seconds;
   if (f.rotation_difference_rad && f.translation_difference_m) {
     std::printf("\nuwscan's pose against PCL's: %.2f deg, %.1f mm at the model's centroid\n",
-                *f.rotation_difference_rad * 180.0 / std::numbers::pi,
-                *f.translation_difference_m * 1e3);
-    out["rotation_difference_deg"] = *f.rotation_difference_rad * 180.0 / std::numbers::pi;
+                *f.rotation_difference_rad * kRadToDeg, *f.translation_difference_m * 1e3);
+    out["rotation_difference_deg"] = *f.rotation_difference_rad * kRadToDeg;
     out["translation_difference_m"] = *f.translation_difference_m;
   }
   if (!a.json.empty()) WriteJsonFile(a.json, out);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -24,7 +25,7 @@ struct RealPairOptions {
 
 struct RealPairPose {
   std::optional<Eigen::Isometry3d> T_scene_model;  // none: the object was not found
-  double seconds = 0.0;  // uwscan: teaching and recognition; PCL: its whole pipeline
+  double seconds = 0.0;  // uwscan: recognition (teaching apart); PCL: its whole pipeline
 };
 
 struct RealPairFigures {

@@ -12,23 +12,14 @@
 #include <cmath>
 #include <vector>
 
+#include "perception/cloud/pcl_conversion.hpp"
+
 namespace uwscan::bench {
 namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 using Normals = pcl::PointCloud<pcl::Normal>;
 using Descriptors = pcl::PointCloud<pcl::SHOT352>;
-
-// The cloud's points in its file's coordinates (these clouds lie within a few metres of their
-// origin, so floats keep them to a tenth of a micrometre).
-Cloud::Ptr ToPcl(const perception::PointCloud& cloud) {
-  auto out = std::make_shared<Cloud>();
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3f p = cloud.Point(i).cast<float>();
-    out->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  }
-  return out;
-}
 
 Normals::Ptr NormalsOf(const Cloud::Ptr& cloud, int threads) {
   pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> estimation(threads);
@@ -81,7 +72,9 @@ pcl::CorrespondencesPtr Match(const Descriptors::Ptr& model, const Descriptors::
 std::optional<Eigen::Isometry3d> PclCorrespondenceGrouping(const perception::PointCloud& model,
                                                            const perception::PointCloud& scene,
                                                            int threads) {
-  const Cloud::Ptr model_cloud = ToPcl(model), scene_cloud = ToPcl(scene);
+  // PCL's clouds hold each cloud's points relative to its own origin (centroid).
+  const Cloud::Ptr model_cloud = perception::ToPclXYZ(model);
+  const Cloud::Ptr scene_cloud = perception::ToPclXYZ(scene);
   const Normals::Ptr model_normals = NormalsOf(model_cloud, threads);
   const Normals::Ptr scene_normals = NormalsOf(scene_cloud, threads);
   const Cloud::Ptr model_keypoints = Keypoints(model_cloud, 0.01);
@@ -113,7 +106,8 @@ std::optional<Eigen::Isometry3d> PclCorrespondenceGrouping(const perception::Poi
   Cloud aligned;
   icp.align(aligned, poses[best]);
   if (!icp.hasConverged()) return std::nullopt;
-  return Eigen::Isometry3d(icp.getFinalTransformation().cast<double>());
+  const Eigen::Isometry3d T_local(icp.getFinalTransformation().cast<double>());
+  return Eigen::Translation3d(scene.origin) * T_local * Eigen::Translation3d(-model.origin);
 }
 
 }  // namespace uwscan::bench

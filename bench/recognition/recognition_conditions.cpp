@@ -185,9 +185,9 @@ sim::VirtualScan DepthCameraScan(const Scene& scene, const std::filesystem::path
   return scan;
 }
 
-// What the bench scores poses against: the object's symmetries in its mesh-taught model
-// (declared for the catalogue's, found from the mesh for the CAD parts) and that model's points
-// (every 4th), the same for every condition.
+// What the bench scores poses against: the physical object's declared symmetries (none for the
+// CAD parts: what the database finds from a mesh is not a truth to score it against) and its
+// mesh-taught model's points (every 4th), the same for every condition.
 struct Truth {
   std::vector<perception::SymmetryAxis> symmetries;
   std::vector<Eigen::Vector3d> points_O;
@@ -196,9 +196,9 @@ struct Truth {
 
 Truth TruthOf(const ObjectSource& object, const ObjectDatabase& db) {
   Truth truth;
+  truth.symmetries = object.symmetries.value_or(std::vector<perception::SymmetryAxis>{});
   for (const perception::ObjectModel& m : db.objects) {
     if (m.id != object.id) continue;
-    truth.symmetries = m.symmetries;
     for (std::size_t i = 0; i < m.model.size(); i += 4) truth.points_O.push_back(m.model.Point(i));
     truth.centre_O = m.model.origin;
   }

@@ -26,6 +26,22 @@ namespace {
 
 using Runner = std::function<PipelineRun(const RegistrationPair&, const PipelineParameters&)>;
 
+// Under this share in common, a pair counts with those that have no answer ("none").
+constexpr double kMinOverlap = 0.05;
+
+bool WithoutOverlap(bool overlapping, double overlap) {
+  return !overlapping || overlap < kMinOverlap;
+}
+
+// What a user needs from a pipeline on the pair: the pose accepted and right modulo symmetry; on
+// a pair built without overlap, a refusal; on one built to overlap that turned out to share
+// almost nothing (a disc's two faces), either a refusal or a pose right modulo symmetry.
+bool Useful(const RegistrationPair& pair, bool accepted, bool symmetric_success) {
+  if (!pair.overlapping) return !accepted;
+  if (pair.overlap < kMinOverlap) return !accepted || symmetric_success;
+  return accepted && symmetric_success;
+}
+
 // One pipeline over every pair; voxel_fraction > 0 sets the leaf to that fraction of each
 // object's size (0: the pair's own, RegistrationPair::voxel_m).
 PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
@@ -58,10 +74,10 @@ PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
     outcome.accepted = run.accepted;
     outcome.overlapping = pair.overlapping;
     outcome.overlap = pair.overlap;
-    outcome.useful = pair.overlapping ? run.accepted && outcome.symmetric_success : !run.accepted;
+    outcome.useful = Useful(pair, run.accepted, outcome.symmetric_success);
     if (outcomes) outcomes->push_back(outcome);
     if (progress) progress(name + " pipeline", (i + 1.0) / pairs.size());
-    if (!pair.overlapping) continue;
+    if (WithoutOverlap(pair.overlapping, pair.overlap)) continue;
     ++summary.pairs;
     summary.accepted += outcome.accepted ? 1 : 0;
     summary.successes += outcome.success ? 1 : 0;
@@ -83,16 +99,16 @@ PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
 // Every outcome into its overlap bucket, per pipeline.
 std::vector<OverlapBucket> ByOverlap(const std::vector<PairOutcome>& outcomes) {
   std::vector<OverlapBucket> buckets = {{"none", 0.0, 0.0, false, {}},
-                                        {"under 30 %", 0.0, 0.3, true, {}},
+                                        {"under 30 %", kMinOverlap, 0.3, true, {}},
                                         {"30-50 %", 0.3, 0.5, true, {}},
                                         {"50-70 %", 0.5, 0.7, true, {}},
                                         {"70 % and over", 0.7, 1.01, true, {}}};
   for (const PairOutcome& outcome : outcomes) {
     for (OverlapBucket& bucket : buckets) {
-      const bool inside = bucket.overlapping
-                              ? outcome.overlapping && outcome.overlap >= bucket.min_overlap &&
-                                    outcome.overlap < bucket.max_overlap
-                              : !outcome.overlapping;
+      const bool none = WithoutOverlap(outcome.overlapping, outcome.overlap);
+      const bool inside = bucket.overlapping ? !none && outcome.overlap >= bucket.min_overlap &&
+                                                   outcome.overlap < bucket.max_overlap
+                                             : none;
       if (!inside) continue;
       OverlapBucket::Pipeline& p = bucket.pipelines[outcome.pipeline];
       ++p.pairs;

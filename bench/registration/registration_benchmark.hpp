@@ -40,11 +40,11 @@ struct PairOutcome {
   bool overlapping = true;         // the pair has an answer (RegistrationPair::overlapping)
   double overlap = 0.0;            // RegistrationPair::overlap
   // What a user needs: an overlapping pair's pose accepted and right modulo symmetry; a pair
-  // without overlap refused.
+  // without overlap refused (registration_benchmark.cpp, Useful).
   bool useful = false;
 };
 
-// Over the pairs that overlap (the pose errors mean nothing on the others).
+// Over the pairs that overlap by 5 % or more (the pose errors mean nothing on the others).
 struct PipelineSummary {
   int pairs = 0;
   int accepted = 0;
@@ -64,7 +64,9 @@ struct VoxelSweepRow {
 
 // The pairs whose overlap lies in [min_overlap, max_overlap), or those without any.
 struct OverlapBucket {
-  std::string name;  // "none", "under 30 %", "30-50 %", "50-70 %", "70 % and over"
+  // "none" (built without overlap, or under 5 % in common), "under 30 %", "30-50 %", "50-70 %",
+  // "70 % and over"
+  std::string name;
   double min_overlap = 0.0, max_overlap = 0.0;
   bool overlapping = true;
   struct Pipeline {

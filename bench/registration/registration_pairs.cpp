@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/cloud/cloud_scale.hpp"
+#include "perception/registration/cloud_fit.hpp"
 #include "perception/registration/registration_pipeline.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
@@ -15,9 +17,6 @@
 
 namespace uwscan::bench {
 namespace {
-
-// Less than this share in common and a pair has no answer (RegistrationPair::overlapping).
-constexpr double kMinOverlap = 0.05;
 
 constexpr const char* kMeshes[] = {"anchor",  "cylinder",     "joint",         "rotor",  "spool",
                                    "turbine", "pinion_small", "fandisk_large", "bunny00"};
@@ -195,9 +194,12 @@ void AddHardMeshPairs(const std::filesystem::path& cache, const RegistrationPair
     pairs->push_back(MovedPair(std::string(name) + " sparse 1.2 rad", std::move(sparse),
                                s.other.points, o.mesh_size_m, rng));
     TwoViews outliers = CutTwoViews(s, name, 1.8, o, gauss, rng);
+    const std::size_t surface_points = outliers.source.size();
     outliers.source = WithOutliers(std::move(outliers.source), o.outlier_fraction, rng);
-    pairs->push_back(MovedPair(std::string(name) + " outliers 1.8 rad", std::move(outliers),
-                               s.other.points, o.mesh_size_m, rng));
+    RegistrationPair pair = MovedPair(std::string(name) + " outliers 1.8 rad", std::move(outliers),
+                                      s.other.points, o.mesh_size_m, rng);
+    pair.source_outliers = pair.source.size() - surface_points;
+    pairs->push_back(std::move(pair));
   }
 }
 
@@ -225,38 +227,48 @@ void AddUnrelatedPairs(const std::filesystem::path& cache, const RegistrationPai
   }
 }
 
-double ScanVoxel(const RegistrationPair& pair) {
-  return perception::RegistrationPipelineOptions::ForClouds(pair.source, pair.target).voxel_m;
+// A pair from a real scan: the target and the source drawn from `target_points` and
+// `source_points` (each point kept with probability `keep`), the source with noise of a
+// thousandth of the scan's size and moved by a random rigid motion; `points` is the whole scan.
+RegistrationPair ScanPair(const std::string& name, const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<Eigen::Vector3d>& target_points,
+                          const std::vector<Eigen::Vector3d>& source_points, double keep,
+                          std::mt19937_64& rng) {
+  const double size = perception::BoundingBoxDiagonal(perception::MakeCloud(points));
+  RegistrationPair pair;
+  pair.name = name;
+  pair.target = perception::MakeCloud(
+      Resampled(target_points, keep, 0.0, Eigen::Isometry3d::Identity(), rng));
+  const Eigen::Isometry3d T_source_target = RandomMotion(rng, size);
+  pair.source =
+      perception::MakeCloud(Resampled(source_points, keep, 1e-3 * size, T_source_target, rng));
+  pair.source_viewpoint = T_source_target * Eigen::Vector3d::Zero();  // the scanner's origin
+  std::vector<Eigen::Vector3d> surface_in_source;                     // every point, no draw
+  surface_in_source.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) surface_in_source.push_back(T_source_target * p);
+  pair.surface = perception::MakeCloud(surface_in_source);
+  pair.T_target_source_true = T_source_target.inverse();
+  pair.object_size_m = size;
+  pair.voxel_m =
+      perception::RegistrationPipelineOptions::ForClouds(pair.source, pair.target).voxel_m;
+  return pair;
+}
+
+struct Scan {
+  const char* file;
+  double keep;  // fraction of the scan's points in each view
+};
+constexpr Scan kScans[] = {{"bun0", 0.7}, {"table_scene_lms400", 0.25}};
+
+std::vector<Eigen::Vector3d> ScanPoints(const std::filesystem::path& cache, const Scan& scan) {
+  return Absolute(perception::ReadCloud(cache / "scans" / (std::string(scan.file) + ".pcd")));
 }
 
 void AddScanPairs(const std::filesystem::path& cache, std::mt19937_64& rng,
                   std::vector<RegistrationPair>* pairs) {
-  struct Scan {
-    const char* file;
-    double keep;  // fraction of the scan's points in each view
-  };
-  for (const Scan scan : {Scan{"bun0", 0.7}, Scan{"table_scene_lms400", 0.25}}) {
-    const std::vector<Eigen::Vector3d> points =
-        Absolute(perception::ReadCloud(cache / "scans" / (std::string(scan.file) + ".pcd")));
-    const perception::PointCloud reference = perception::MakeCloud(points);
-    const double size = perception::BoundingBoxDiagonal(reference);
-    RegistrationPair pair;
-    pair.name = scan.file;
-    pair.target = perception::MakeCloud(
-        Resampled(points, scan.keep, 0.0, Eigen::Isometry3d::Identity(), rng));
-    const Eigen::Isometry3d T_source_target = RandomMotion(rng, size);
-    pair.source =
-        perception::MakeCloud(Resampled(points, scan.keep, 1e-3 * size, T_source_target, rng));
-    pair.source_viewpoint = T_source_target * Eigen::Vector3d::Zero();  // the scanner's origin
-    std::vector<Eigen::Vector3d>
-        surface_in_source;  // every point, no draw: the pairs stay as they were
-    surface_in_source.reserve(points.size());
-    for (const Eigen::Vector3d& p : points) surface_in_source.push_back(T_source_target * p);
-    pair.surface = perception::MakeCloud(surface_in_source);
-    pair.T_target_source_true = T_source_target.inverse();
-    pair.object_size_m = size;
-    pair.voxel_m = ScanVoxel(pair);
-    pairs->push_back(std::move(pair));
+  for (const Scan& scan : kScans) {
+    const std::vector<Eigen::Vector3d> points = ScanPoints(cache, scan);
+    pairs->push_back(ScanPair(scan.file, points, points, points, scan.keep, rng));
   }
 }
 
@@ -282,66 +294,33 @@ std::vector<Eigen::Vector3d> CutAlongX(const std::vector<Eigen::Vector3d>& point
 // (the first 45 % and the last 45 %: a tenth of the scan between them, nothing shared).
 void AddScanCuts(const std::filesystem::path& cache, std::mt19937_64& rng,
                  std::vector<RegistrationPair>* pairs) {
-  struct Scan {
-    const char* file;
-    double keep;
-  };
   struct Cut {
     const char* name;
     double source_to, target_from;
     bool overlapping;
   };
-  for (const Scan scan : {Scan{"bun0", 0.7}, Scan{"table_scene_lms400", 0.25}}) {
-    const std::vector<Eigen::Vector3d> points =
-        Absolute(perception::ReadCloud(cache / "scans" / (std::string(scan.file) + ".pcd")));
-    const double size = perception::BoundingBoxDiagonal(perception::MakeCloud(points));
+  for (const Scan& scan : kScans) {
+    const std::vector<Eigen::Vector3d> points = ScanPoints(cache, scan);
     for (const Cut cut : {Cut{"cut in two, overlapping", 0.65, 0.35, true},
                           Cut{"cut in two, disjoint", 0.45, 0.55, false}}) {
-      RegistrationPair pair;
-      pair.name = std::string(scan.file) + " " + cut.name;
-      pair.target =
-          perception::MakeCloud(Resampled(CutAlongX(points, cut.target_from, 1.0), scan.keep, 0.0,
-                                          Eigen::Isometry3d::Identity(), rng));
-      const Eigen::Isometry3d T_source_target = RandomMotion(rng, size);
-      pair.source = perception::MakeCloud(Resampled(CutAlongX(points, 0.0, cut.source_to),
-                                                    scan.keep, 1e-3 * size, T_source_target, rng));
-      pair.source_viewpoint = T_source_target * Eigen::Vector3d::Zero();
-      std::vector<Eigen::Vector3d> surface_in_source;
-      surface_in_source.reserve(points.size());
-      for (const Eigen::Vector3d& p : points) surface_in_source.push_back(T_source_target * p);
-      pair.surface = perception::MakeCloud(surface_in_source);
-      pair.T_target_source_true = T_source_target.inverse();
-      pair.object_size_m = size;
-      pair.voxel_m = ScanVoxel(pair);
+      RegistrationPair pair = ScanPair(std::string(scan.file) + " " + cut.name, points,
+                                       CutAlongX(points, cut.target_from, 1.0),
+                                       CutAlongX(points, 0.0, cut.source_to), scan.keep, rng);
       pair.overlapping = cut.overlapping;
       pairs->push_back(std::move(pair));
     }
   }
 }
 
-// The share of `from`'s points (moved by T) within radius_m of a point of `to`.
-double CoveredShare(const perception::PointCloud& from, const Eigen::Isometry3d& T,
-                    const perception::PointCloud& to, double radius_m) {
-  std::vector<Eigen::Vector3f> to_points(to.size());
-  for (std::size_t i = 0; i < to.size(); ++i)
-    to_points[i] = (to.Point(i) - to.origin).cast<float>();
-  const perception::KnnIndex index(to_points);
-  std::vector<std::uint32_t> nearest;
-  std::vector<float> squared_m2;
-  std::size_t covered = 0;
-  for (std::size_t i = 0; i < from.size(); ++i) {
-    index.Query((T * from.Point(i) - to.origin).cast<float>(), 1, nearest, squared_m2);
-    if (squared_m2.front() <= radius_m * radius_m) ++covered;
-  }
-  return static_cast<double>(covered) / static_cast<double>(std::max<std::size_t>(1, from.size()));
-}
-
 }  // namespace
 
 double MeasureOverlap(const RegistrationPair& pair, double radius_m) {
-  return std::min(
-      CoveredShare(pair.source, pair.T_target_source_true, pair.target, radius_m),
-      CoveredShare(pair.target, pair.T_target_source_true.inverse(), pair.source, radius_m));
+  std::vector<std::size_t> on_surface(pair.source.size() - pair.source_outliers);
+  std::iota(on_surface.begin(), on_surface.end(), std::size_t{0});
+  const perception::PointCloud source = perception::Subset(pair.source, on_surface);
+  const Eigen::Isometry3d& T = pair.T_target_source_true;
+  return std::min(perception::FitOnTarget(source, pair.target, T, radius_m).fitness,
+                  perception::FitOnTarget(pair.target, source, T.inverse(), radius_m).fitness);
 }
 
 void RegistrationPairOptions::Check() const {
@@ -361,9 +340,13 @@ std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path&
   AddMeshPairs(data_cache, options, rng, &pairs);
   if (options.real_scans) AddScanPairs(data_cache, rng, &pairs);
   if (options.hard_pairs) {
-    AddHardMeshPairs(data_cache, options, rng, &pairs);
-    if (options.real_scans) AddScanCuts(data_cache, rng, &pairs);
-    AddUnrelatedPairs(data_cache, options, rng, &pairs);
+    // Each group draws from its own stream: leaving one out (--no-real-scans) leaves the
+    // others as they are.
+    std::mt19937_64 hard_rng(options.seed * 7919 + 1), cut_rng(options.seed * 7919 + 2),
+        unrelated_rng(options.seed * 7919 + 3);
+    AddHardMeshPairs(data_cache, options, hard_rng, &pairs);
+    if (options.real_scans) AddScanCuts(data_cache, cut_rng, &pairs);
+    AddUnrelatedPairs(data_cache, options, unrelated_rng, &pairs);
   }
   for (RegistrationPair& pair : pairs) {
     // Within 1 % of the object's size (the success test's tolerance), but never less than a few
@@ -372,8 +355,6 @@ std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path&
                                       perception::MedianPointSpacing(pair.target));
     const double radius_m = std::max(0.01 * pair.object_size_m, 2.5 * spacing_m);
     if (pair.overlapping) pair.overlap = MeasureOverlap(pair, radius_m);
-    // Views of a flat object's two faces can share nothing: no answer there either.
-    if (pair.overlap < kMinOverlap) pair.overlapping = false;
   }
   return pairs;
 }

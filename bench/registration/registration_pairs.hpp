@@ -26,13 +26,14 @@ struct RegistrationPair {
   // point): what a symmetry-aware error measures against, since a pose equivalent by symmetry
   // may move the seen side onto a side the source view never saw.
   perception::PointCloud surface;
-  // Whether the two clouds share any surface. A pair that does not (two unrelated objects, or
-  // two parts of a scan with a gap between them, views of a disc's two faces: less than 5 % in
-  // common) has no answer: a pipeline succeeds on it by refusing.
+  // Whether the pair was built to share surface: two unrelated objects, or two parts of a scan
+  // with a gap between them, have no answer, and a pipeline succeeds on them by refusing.
   bool overlapping = true;
-  // The share of the smaller side that the other covers once truly placed (MeasureOverlap);
-  // 0 for a pair that does not overlap.
+  // For a pair built to overlap, the share of the smaller side that the other covers once truly
+  // placed (MeasureOverlap); it can still come out near 0 (views of a disc's two faces).
   double overlap = 0.0;
+  // The source's last points are this many outliers (no surface), left out of the overlap.
+  std::size_t source_outliers = 0;
 };
 
 struct RegistrationPairOptions {
@@ -43,9 +44,9 @@ struct RegistrationPairOptions {
   int pairs_per_mesh = 2;
   std::uint64_t seed = 1;
   bool real_scans = true;  // add pairs built from bun0.pcd and table_scene_lms400.pcd
-  // Add the pairs users find hard (AddHardPairs): views further apart, one of them sparser or
-  // with outliers; the real scans cut into two overlapping parts; and pairs that do not overlap
-  // at all (two unrelated objects, a scan's two ends).
+  // Add the pairs users find hard: views further apart, one of them sparser or with outliers;
+  // the real scans cut into two overlapping parts; and pairs that do not overlap at all (two
+  // unrelated objects, a scan's two ends).
   bool hard_pairs = true;
   double outlier_fraction = 0.05;  // of a hard pair's source points added as outliers, [0, 1)
 
@@ -63,9 +64,9 @@ struct RegistrationPairOptions {
 std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,
                                                     const RegistrationPairOptions& options);
 
-// The smaller of the two shares: of the source's points that lie within `radius_m` of a target
-// point once moved by the true pose, and of the target's that lie within it of a moved source
-// point.
+// The smaller of the two shares: of the source's points (its outliers left out) that lie within
+// `radius_m` of a target point once moved by the true pose, and of the target's that lie within
+// it of a moved source point.
 double MeasureOverlap(const RegistrationPair& pair, double radius_m);
 
 // Rotation error (rad) of an estimate against the truth, and its translation error (m) where

@@ -43,8 +43,6 @@ void AddTimeSeries(const mapping::DiveMapping& m, LongDiveRun& run) {
   }
 }
 
-// Maps the log (windowed or whole solves), sampling the resident memory as it goes, and
-// measures the result against the truth.
 // The mean of values[from..] (from < size).
 std::int64_t MeanFrom(const std::vector<std::int64_t>& values, std::size_t from) {
   return std::accumulate(values.begin() + static_cast<std::ptrdiff_t>(from), values.end(),
@@ -52,6 +50,8 @@ std::int64_t MeanFrom(const std::vector<std::int64_t>& values, std::size_t from)
          static_cast<std::int64_t>(values.size() - from);
 }
 
+// Maps the log (windowed or whole solves), sampling the resident memory as it goes, and
+// measures the result against the truth.
 LongDiveRun MapLongDive(const std::filesystem::path& log_path,
                         const scanner::sim::RayCaster& caster, bool windowed,
                         const LongDiveBenchOptions& options, const std::string& label,

@@ -110,8 +110,9 @@ RawCloud ReadXyz(const fs::path& path) {
       double value = 0.0;
       const std::from_chars_result parsed = std::from_chars(p, end, value);
       if (parsed.ec != std::errc() || parsed.ptr == p) {
-        throw Error("ReadCloud: " + Quoted(path) + " line " + std::to_string(line_number) +
-                    ": expected three numbers x y z, got '" + line.substr(0, 80) + "'");
+        throw Error("ReadCloud: " + Quoted(path) + " (read as XYZ) line " +
+                    std::to_string(line_number) + ": expected three numbers x y z, got '" +
+                    line.substr(0, 80) + "'");
       }
       point[a] = value;
       p = parsed.ptr;

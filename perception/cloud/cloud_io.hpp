@@ -45,7 +45,9 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats = 
 // PCDWriter; PLY is written by uwscan (PCL 1.13's PLYWriter prints ASCII values to 6 digits).
 // Atomic: the file is written beside the target under a temporary name and renamed over it,
 // so an existing file stays intact and readable when writing fails. `T_file_sensor`, the
-// sensor's pose in the file's frame, goes into a PCD's VIEWPOINT line (identity when unset).
+// sensor's pose in the file's frame, goes into a PCD's VIEWPOINT line (identity when unset; PCL
+// writes it with six significant digits, so a pose hundreds of metres from the file's origin
+// keeps only millimetres to centimetres).
 // Throws uwscan::Error naming the file on an unsupported extension, an empty or non-finite cloud,
 // a sensor pose for a PLY (which has no place for it), or an I/O failure.
 void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool binary = true,

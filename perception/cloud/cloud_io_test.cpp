@@ -371,6 +371,7 @@ TEST_F(CloudReadersTest, BrokenFilesGiveOneErrorAndPrintNothing) {
       {"cut.ply",
        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
        "property float z\nend_header\n1 2 3\n4\n"},
+      {"cut.xyz", "1 2 3\n4 5\n"},
   };
   for (const auto& [name, text] : files) {
     const fs::path path = dir_ / name;
@@ -386,6 +387,15 @@ TEST_F(CloudReadersTest, BrokenFilesGiveOneErrorAndPrintNothing) {
     const std::string printed =
         testing::internal::GetCapturedStderr() + testing::internal::GetCapturedStdout();
     EXPECT_NE(message.find(path.string()), std::string::npos) << name << ": '" << message << "'";
+    // ... and the format it was read as, where the reader got that far (an empty file is refused
+    // before any reader sees it).
+    if (!text.empty()) {
+      const std::string extension = path.extension().string();
+      const std::string format = extension == ".pcd"   ? "read as PCD"
+                                 : extension == ".ply" ? "read as PLY"
+                                                       : "read as XYZ";
+      EXPECT_NE(message.find(format), std::string::npos) << name << ": '" << message << "'";
+    }
     EXPECT_EQ(message.find('\n'), std::string::npos) << name;
     EXPECT_EQ(printed, "") << name;
   }

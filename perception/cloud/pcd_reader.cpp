@@ -326,7 +326,7 @@ void ReadAscii(const std::string& file, const Header& header, const std::string&
 }  // namespace
 
 PcdContent ReadPcd(const fs::path& path) {
-  const std::string name = QuotedPath(path);
+  const std::string name = QuotedPath(path) + " (read as PCD)";
   const std::string file = ReadFileBytes(path);
   const Header header = ParseHeader(file, name);
   PcdContent content;

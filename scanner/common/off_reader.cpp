@@ -63,7 +63,7 @@ std::vector<double> Numbers(std::string_view line, std::size_t count) {
 }  // namespace
 
 TriangleMesh ReadOff(const fs::path& path) {
-  const std::string name = QuotedPath(path);
+  const std::string name = QuotedPath(path) + " (read as OFF)";
   const std::string text = ReadFileBytes(path);
   Lines lines(text);
   std::string_view line;

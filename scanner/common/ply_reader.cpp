@@ -382,7 +382,7 @@ class BodyReader {
 }  // namespace
 
 PlyContent ReadPly(const fs::path& path, bool faces) {
-  const std::string name = QuotedPath(path);
+  const std::string name = QuotedPath(path) + " (read as PLY)";
   const std::string file = ReadFileBytes(path);
   const Header header = ParseHeader(file, name);
   const std::string_view body(file.data() + header.body_offset, file.size() - header.body_offset);

@@ -181,7 +181,7 @@ TriangleMesh ReadAscii(const std::string& text, const std::string& name) {
 }  // namespace
 
 TriangleMesh ReadStl(const fs::path& path) {
-  const std::string name = QuotedPath(path);
+  const std::string name = QuotedPath(path) + " (read as STL)";
   const std::string bytes = ReadFileBytes(path);
   return IsBinary(bytes) ? ReadBinary(bytes) : ReadAscii(bytes, name);
 }

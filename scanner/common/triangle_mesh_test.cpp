@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "scanner/common/error.hpp"
 #include "scanner/sim/imr_objects.hpp"
@@ -73,6 +75,24 @@ TEST_F(LoadMeshTest, AnUnreadableObjNamesItsFormat) {
   const std::string message = Refusal(obj);
   ExpectMentions(message, obj.string());
   ExpectMentions(message, "OBJ");
+}
+
+TEST_F(LoadMeshTest, ABrokenPlyOffOrStlNamesTheFormatItWasReadAs) {
+  const std::pair<const char*, const char*> files[] = {
+      {"cut.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n"},
+      {"cut.off", "OFF\n3 1 0\n0 0 0\n"},
+      {"cut.stl", "solid x\nfacet normal 0 0 1\n"},
+  };
+  for (const auto& [name, text] : files) {
+    const fs::path path = Write(name, text);
+    const std::string message = Refusal(path);
+    ExpectMentions(message, path.string());
+    const std::string extension = path.extension().string();
+    std::string format;
+    for (std::size_t i = 1; i < extension.size(); ++i)
+      format += static_cast<char>(std::toupper(extension[i]));
+    ExpectMentions(message, "read as " + format);
+  }
 }
 
 TEST_F(LoadMeshTest, AMeshWrittenReadsBack) {

@@ -11,9 +11,9 @@ namespace uwscan::scanner::sim {
 // Another sensor than uwscan's own: a depth camera (structured light or time of flight) as a
 // pinhole range image. Each pixel's ray meets the first surface; its depth (along the optical
 // axis) is perturbed by Gaussian noise whose standard deviation grows with the depth squared, as
-// measured on such cameras (Khoshelham and Elberink 2012: about 1.4 mm at 1 m, 2.6 cm at 4 m, for
-// the first Kinect). Rays go straight: no viewport, no water (a camera in a housing that corrects
-// for it, or in air).
+// measured on such cameras (Khoshelham and Elberink 2012: about 1.4 mm at 1 m and 2.2 cm at 4 m
+// for the first Kinect). Rays go straight: no viewport, no water (a camera in a housing that
+// corrects for it, or in air).
 struct DepthCameraOptions {
   int width_px = 320;                  // pixels across, >= 2
   int height_px = 240;                 // pixels down, >= 2
