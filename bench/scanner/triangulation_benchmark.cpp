@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <numeric>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "scanner/common/option_checks.hpp"
@@ -90,63 +93,78 @@ std::vector<Frame> MakeFrames(const scanner::GalvoScannerModel& model,
   return frames;
 }
 
-// Runs `triangulate_frame(frame, out)` over every frame `repeats` times; returns the fastest
-// pass's time spent in it only (the fastest pass is the one least disturbed by the shared
-// machine).
-template <typename TriangulateFrame>
-double TimePasses(const std::vector<Frame>& frames, int repeats,
-                  std::vector<std::vector<scanner::TriangulatedPoint>>* results,
-                  const std::string& what, const Progress& progress,
-                  TriangulateFrame&& triangulate_frame) {
-  results->resize(frames.size());
-  for (size_t f = 0; f < frames.size(); ++f) (*results)[f].resize(frames[f].peaks_px.size());
-  double best = std::numeric_limits<double>::infinity();
+using Points = std::vector<std::vector<scanner::TriangulatedPoint>>;
+using FrameKernel = std::function<void(const Frame&, std::vector<scanner::TriangulatedPoint>&)>;
+
+// A kernel to time: its name, what it does to one frame, and where its points go.
+struct TimedKernel {
+  std::string name;
+  FrameKernel triangulate_frame;
+  Points* results = nullptr;
+};
+
+// Runs every kernel over every frame, `repeats` passes, the kernels in turn within each pass so
+// that they meet the same load from the rest of the machine; returns each kernel's fastest pass
+// (the least disturbed by that load: the machines here are shared). A whole pass between two
+// runs of a kernel leaves the caches as cold for one kernel as for the next.
+std::vector<double> TimeInterleaved(const std::vector<Frame>& frames, int repeats,
+                                    const std::vector<TimedKernel>& kernels,
+                                    const Progress& progress) {
+  for (const TimedKernel& kernel : kernels) {
+    kernel.results->resize(frames.size());
+    for (size_t f = 0; f < frames.size(); ++f) {
+      (*kernel.results)[f].resize(frames[f].peaks_px.size());
+    }
+  }
+  std::vector<double> best(kernels.size(), std::numeric_limits<double>::infinity());
   for (int pass = 0; pass < repeats; ++pass) {
-    const Clock::time_point start = Clock::now();
-    for (size_t f = 0; f < frames.size(); ++f) triangulate_frame(frames[f], (*results)[f]);
-    best = std::min(best, SecondsSince(start));
-    if (progress) progress(what, (pass + 1.0) / repeats);
+    for (size_t k = 0; k < kernels.size(); ++k) {
+      const Clock::time_point start = Clock::now();
+      for (size_t f = 0; f < frames.size(); ++f) {
+        kernels[k].triangulate_frame(frames[f], (*kernels[k].results)[f]);
+      }
+      best[k] = std::min(best[k], SecondsSince(start));
+    }
+    if (progress) progress(kernels.front().name, (pass + 1.0) / repeats);
   }
   return best;
 }
 
+TimedKernel MethodKernel(const scanner::Triangulator& method, Points* results) {
+  return {ToString(method.method()),
+          [&method](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
+            method.TriangulateFrame(frame.step, frame.peaks_px, out);
+          },
+          results};
+}
+
 double RunMethod(const scanner::Triangulator& method, const std::vector<Frame>& frames, int repeats,
-                 std::vector<std::vector<scanner::TriangulatedPoint>>* results,
-                 const Progress& progress) {
-  return TimePasses(frames, repeats, results, ToString(method.method()), progress,
-                    [&](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
-                      method.TriangulateFrame(frame.step, frame.peaks_px, out);
-                    });
+                 Points* results, const Progress& progress) {
+  return TimeInterleaved(frames, repeats, {MethodKernel(method, results)}, progress)[0];
 }
 
 // The floor of any table method over the same pixels: each peak's camera ray looked up in the
 // table (prefetched ahead, as the methods do) and one multiply-add per coordinate, o + s d,
 // with a per-frame s standing for the surface. No intersection, no tests.
-double RunLimit(const scanner::CameraRayTable& rays, const std::vector<Frame>& frames, int repeats,
-                std::vector<std::vector<scanner::TriangulatedPoint>>* results,
-                const Progress& progress) {
-  return TimePasses(frames, repeats, results, "limit", progress,
-                    [&](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
-                      const std::vector<Eigen::Vector2d>& px = frame.peaks_px;
-                      const double s = 1.0 + 1e-3 * frame.step;
-                      scanner::Ray ray;
-                      for (size_t i = 0; i < px.size(); ++i) {
-                        if (i + scanner::CameraRayTable::kPrefetchAhead < px.size()) {
-                          rays.Prefetch(px[i + scanner::CameraRayTable::kPrefetchAhead].x(),
-                                        px[i + scanner::CameraRayTable::kPrefetchAhead].y());
-                        }
-                        const bool in = rays.Lookup(px[i].x(), px[i].y(), &ray);
-                        out[i].p_C = ray.origin + s * ray.direction;
-                        out[i].status =
-                            in ? scanner::HitStatus::kHit : scanner::HitStatus::kNoIntersection;
-                      }
-                    });
+TimedKernel LimitKernel(const scanner::CameraRayTable& rays, Points* results) {
+  return {"limit",
+          [&rays](const Frame& frame, std::vector<scanner::TriangulatedPoint>& out) {
+            const std::vector<Eigen::Vector2d>& px = frame.peaks_px;
+            const double s = 1.0 + 1e-3 * frame.step;
+            constexpr size_t kAhead = scanner::CameraRayTable::kPrefetchAhead;
+            scanner::Ray ray;
+            for (size_t i = 0; i < px.size(); ++i) {
+              if (i + kAhead < px.size()) rays.Prefetch(px[i + kAhead].x(), px[i + kAhead].y());
+              const bool in = rays.Lookup(px[i].x(), px[i].y(), &ray);
+              out[i].p_C = ray.origin + s * ray.direction;
+              out[i].status = in ? scanner::HitStatus::kHit : scanner::HitStatus::kNoIntersection;
+            }
+          },
+          results};
 }
 
 // Mean, standard deviation and maximum of |method - reference| over points both produced.
-void CompareTo(const std::vector<std::vector<scanner::TriangulatedPoint>>& result,
-               const std::vector<std::vector<scanner::TriangulatedPoint>>& reference,
-               MethodFigures* figures) {
+void CompareTo(const Points& result, const Points& reference, MethodFigures* figures) {
   double sum = 0.0, sum2 = 0.0, max = 0.0;
   std::int64_t n = 0, triangulated = 0;
   for (size_t f = 0; f < result.size(); ++f) {
@@ -174,10 +192,9 @@ void SetRate(std::int64_t points, MethodFigures* figures) {
 TableResolutionRow MeasureTables(std::shared_ptr<const scanner::CameraRayTable> rays,
                                  std::shared_ptr<const scanner::LightSurfaceTable> surfaces,
                                  const std::vector<Frame>& frames, std::int64_t points,
-                                 const std::vector<std::vector<scanner::TriangulatedPoint>>& exact,
-                                 int repeats) {
+                                 const Points& exact, int repeats) {
   TableResolutionRow row;
-  std::vector<std::vector<scanner::TriangulatedPoint>> approximate;
+  Points approximate;
   const scanner::RayPlaneTriangulator ray_plane(rays, surfaces);
   const scanner::RayConeTriangulator ray_cone(rays, surfaces);
   row.ray_plane.seconds = RunMethod(ray_plane, frames, repeats, &approximate, {});
@@ -194,8 +211,8 @@ std::vector<TableResolutionRow> SweepResolutions(
     const scanner::GalvoScannerModel& model, const TriangulationBenchOptions& o,
     std::shared_ptr<const scanner::CameraRayTable> default_rays,
     std::shared_ptr<const scanner::LightSurfaceTable> default_surfaces,
-    const std::vector<Frame>& frames, std::int64_t points,
-    const std::vector<std::vector<scanner::TriangulatedPoint>>& exact, const Progress& progress) {
+    const std::vector<Frame>& frames, std::int64_t points, const Points& exact,
+    const Progress& progress) {
   std::vector<TableResolutionRow> rows;
   const double total =
       static_cast<double>(o.sweep_camera_grid_px.size() + o.sweep_rays_per_fan.size());
@@ -236,6 +253,7 @@ void TriangulationBenchOptions::Check() const {
   check.Require(depth_max_m > depth_min_m, "depth_max_m",
                 "> depth_min_m (" + OptionValueText(depth_min_m) + " m)", depth_max_m);
   check.AtLeast("repeats", repeats, 1);
+  check.AtLeast("exact_repeats", exact_repeats, 1);
   check.AtLeast("camera_grid_px", camera_grid_px, 1, "px");
   surfaces.Check();
   for (std::size_t i = 0; i < sweep_camera_grid_px.size(); ++i) {
@@ -271,9 +289,9 @@ TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerMo
   const std::vector<Frame> frames = MakeFrames(model, o, progress);
   for (const Frame& f : frames) result.points += std::ssize(f.peaks_px);
 
-  std::vector<std::vector<scanner::TriangulatedPoint>> exact, approximate;
+  Points exact;
   MethodFigures& exact_figures = result.methods[ToString(scanner::TriangulationMethod::kRayRay)];
-  exact_figures.seconds = RunMethod(ray_ray, frames, o.repeats, &exact, progress);
+  exact_figures.seconds = RunMethod(ray_ray, frames, o.exact_repeats, &exact, progress);
   CompareTo(exact, exact, &exact_figures);
   for (size_t f = 0; f < frames.size(); ++f) {
     for (size_t i = 0; i < frames[f].truth_C.size(); ++i) {
@@ -282,16 +300,22 @@ TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerMo
           std::max(result.exact_vs_truth_max_m, (exact[f][i].p_C - frames[f].truth_C[i]).norm());
     }
   }
-  for (const scanner::Triangulator* method :
-       {static_cast<const scanner::Triangulator*>(&ray_plane),
-        static_cast<const scanner::Triangulator*>(&ray_cone)}) {
-    MethodFigures& figures = result.methods[ToString(method->method())];
-    figures.seconds = RunMethod(*method, frames, o.repeats, &approximate, progress);
-    CompareTo(approximate, exact, &figures);
-  }
-  std::vector<std::vector<scanner::TriangulatedPoint>> limit_points;
-  result.limit_seconds = RunLimit(*rays, frames, o.repeats, &limit_points, progress);
+  // The table methods and their limit timed side by side, so that their ratio holds in one load.
+  Points plane_points, cone_points, limit_points;
+  const std::vector<double> seconds =
+      TimeInterleaved(frames, o.repeats,
+                      {LimitKernel(*rays, &limit_points), MethodKernel(ray_plane, &plane_points),
+                       MethodKernel(ray_cone, &cone_points)},
+                      progress);
+  result.limit_seconds = seconds[0];
   result.limit_points_per_s = result.points / result.limit_seconds;
+  const std::vector<std::pair<const scanner::Triangulator*, const Points*>> table_methods = {
+      {&ray_plane, &plane_points}, {&ray_cone, &cone_points}};
+  for (size_t k = 0; k < table_methods.size(); ++k) {
+    MethodFigures& figures = result.methods[ToString(table_methods[k].first->method())];
+    figures.seconds = seconds[k + 1];
+    CompareTo(*table_methods[k].second, exact, &figures);
+  }
   for (auto& [name, figures] : result.methods) {
     SetRate(result.points, &figures);
     figures.fraction_of_limit = figures.points_per_s / result.limit_points_per_s;

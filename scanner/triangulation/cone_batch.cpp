@@ -20,13 +20,15 @@ constexpr double kNoIntersection = static_cast<double>(HitStatus::kNoIntersectio
 
 }  // namespace
 
-// Each loop below runs over the lanes of the block; every lane follows exactly the arithmetic
-// of the per-ray IntersectRayCone, with its early returns turned into masks.
-__attribute__((target_clones("avx2", "default"))) void IntersectRayConeBlock(
-    const PreparedCone& cone, const RayBlock& rays, HitBlock* hits) {
+// The loop runs over the lanes of the block; every lane follows exactly the arithmetic of the
+// per-ray IntersectRayCone, with its early returns turned into masks, then the grazing test.
+__attribute__((target_clones("avx512f", "avx2", "default"))) void IntersectRayConeBlock(
+    const PreparedCone& cone, const RayBlock& rays, double min_sin2_angle, HitBlock* hits) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const Eigen::Matrix3d& S = cone.S_C;
   const double bb = cone.b * cone.b, abs_b = std::abs(cone.b);
+  const bool planar = bb == 0.0;
+  const bool reject_grazing = min_sin2_angle > 0.0;
   const double s00 = S(0, 0), s01 = S(0, 1), s02 = S(0, 2), s10 = S(1, 0), s11 = S(1, 1),
                s12 = S(1, 2), s20 = S(2, 0), s21 = S(2, 1), s22 = S(2, 2);
   const double c0 = cone.s_origin.x(), c1 = cone.s_origin.y(), c2 = cone.s_origin.z();
@@ -83,53 +85,35 @@ __attribute__((target_clones("avx2", "default"))) void IntersectRayConeBlock(
     const bool candidate = !(parallel | no_intersection | through_apex);
     const bool hit_near = candidate & lit_near;
     const bool hit_far = candidate & !lit_near & lit_far;
-    const bool hit = hit_near | hit_far;
-    const double t = Select(hit_near, t_near, Select(hit_far, t_far, 0.0));
-    // Status in the per-ray function's order of tests, as a lane-wise select chain.
-    double status = Select(ahead, kOutsideSurface, kBehind);
-    status = Select(hit, kHit, status);
-    status = Select(no_intersection, kNoIntersection, status);
-    status = Select(parallel, kParallel, status);
-    hits->status[i] = static_cast<double>(status);
-    hits->t[i] = t;
-    hits->x[i] = Select(hit, rays.ox[i] + t * rays.dx[i], 0.0);
-    hits->y[i] = Select(hit, rays.oy[i] + t * rays.dy[i], 0.0);
-    hits->z[i] = Select(hit, rays.oz[i] + t * rays.dz[i], 0.0);
-  }
-}
 
-// In cone coordinates the cone is F(s) = y^2 - b^2 (z^2 - u^2) = 0, so its normal at s is
-// grad F / 2 = (b^2 u, y, -b^2 z); in {C} it is S_C^T times that, and grad F . d_C equals
-// grad F . (S_C d_C). For b = 0 the cone is the plane y = 0 and the normal is (0, 1, 0).
-__attribute__((target_clones("avx2", "default"))) void RejectGrazingHits(const PreparedCone& cone,
-                                                                         const RayBlock& rays,
-                                                                         double min_sin2_angle,
-                                                                         HitBlock* hits) {
-  const Eigen::Matrix3d& S = cone.S_C;
-  const double bb = cone.b * cone.b;
-  const bool planar = bb == 0.0;
-  const double s00 = S(0, 0), s01 = S(0, 1), s02 = S(0, 2), s10 = S(1, 0), s11 = S(1, 1),
-               s12 = S(1, 2), s20 = S(2, 0), s21 = S(2, 1), s22 = S(2, 2);
-  const double c0 = cone.s_origin.x(), c1 = cone.s_origin.y(), c2 = cone.s_origin.z();
-#pragma omp simd
-  for (std::size_t i = 0; i < kN; ++i) {
-    const double u = s00 * hits->x[i] + s01 * hits->y[i] + s02 * hits->z[i] + c0;
-    const double y = s10 * hits->x[i] + s11 * hits->y[i] + s12 * hits->z[i] + c1;
-    const double z = s20 * hits->x[i] + s21 * hits->y[i] + s22 * hits->z[i] + c2;
-    const double gu = Select(planar, 0.0, bb * u);
-    const double gy = Select(planar, 1.0, y);
-    const double gz = Select(planar, 0.0, -bb * z);
-    const double du = s00 * rays.dx[i] + s01 * rays.dy[i] + s02 * rays.dz[i];
-    const double dy = s10 * rays.dx[i] + s11 * rays.dy[i] + s12 * rays.dz[i];
-    const double dz = s20 * rays.dx[i] + s21 * rays.dy[i] + s22 * rays.dz[i];
-    const double along = gu * du + gy * dy + gz * dz;
+    // Grazing: in cone coordinates the cone is F(s) = y^2 - b^2 (z^2 - u^2) = 0, its normal at
+    // the crossing grad F / 2 = (b^2 u, y, -b^2 z) (for b = 0 the plane y = 0, normal (0, 1, 0));
+    // in {C} the normal is S_C^T times that, and grad F . (S_C d_C) is its product with d_C.
+    const double us = Select(hit_near, un, uf), ys = Select(hit_near, yn, yf),
+                 zs = Select(hit_near, zn, zf);
+    const double gu = Select(planar, 0.0, bb * us);
+    const double gy = Select(planar, 1.0, ys);
+    const double gz = Select(planar, 0.0, -bb * zs);
+    const double along = gu * dx + gy * dy + gz * dz;
     const double nx = s00 * gu + s10 * gy + s20 * gz;
     const double ny = s01 * gu + s11 * gy + s21 * gz;
     const double nz = s02 * gu + s12 * gy + s22 * gz;
     const double n2 = nx * nx + ny * ny + nz * nz;
     const double d2 = rays.dx[i] * rays.dx[i] + rays.dy[i] * rays.dy[i] + rays.dz[i] * rays.dz[i];
-    const bool grazing = along * along <= min_sin2_angle * n2 * d2;
-    hits->status[i] = Select((hits->status[i] == kHit) & grazing, kParallel, hits->status[i]);
+    const bool grazing = reject_grazing & (along * along <= min_sin2_angle * n2 * d2);
+
+    const bool hit = (hit_near | hit_far) & !grazing;
+    const double t = Select(hit_near, t_near, Select(hit_far, t_far, 0.0));
+    // Status in the per-ray function's order of tests, as a lane-wise select chain.
+    double status = Select(ahead, kOutsideSurface, kBehind);
+    status = Select(hit_near | hit_far, Select(grazing, kParallel, kHit), status);
+    status = Select(no_intersection, kNoIntersection, status);
+    status = Select(parallel, kParallel, status);
+    hits->status[i] = status;
+    hits->t[i] = Select(hit, t, 0.0);
+    hits->x[i] = Select(hit, rays.ox[i] + t * rays.dx[i], 0.0);
+    hits->y[i] = Select(hit, rays.oy[i] + t * rays.dy[i], 0.0);
+    hits->z[i] = Select(hit, rays.oz[i] + t * rays.dz[i], 0.0);
   }
 }
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <random>
 
 namespace uwscan::scanner {
@@ -53,7 +54,7 @@ void ExpectBlockMatchesPerRay(const EllipticCone& cone, std::mt19937_64& rng, in
       rays.dz[lane] = ray.direction.z();
     }
     HitBlock block;
-    IntersectRayConeBlock(prepared, rays, &block);
+    IntersectRayConeBlock(prepared, rays, 0.0, &block);
     for (size_t lane = 0; lane < RayBlock::kSize; ++lane) {
       const RayHit expected = IntersectRayCone(per_ray[lane], prepared);
       if (lane == 5) {
@@ -88,6 +89,70 @@ TEST(ConeBatchTest, MatchesPerRayOnDegenerateCones) {
   ExpectBlockMatchesPerRay(circular, rng, 200);
   ExpectBlockMatchesPerRay(RandomCone(rng, 1e-9), rng, 200);  // nearly a plane
   ExpectBlockMatchesPerRay(RandomCone(rng, 0.0), rng, 200);   // exactly a plane
+}
+
+// The cone's implicit function in {C}, F(x) = y^2 - b^2 (z^2 - u^2) at s = S_C x + s_origin:
+// differentiated numerically here, so that the grazing test is checked against a normal the
+// block does not compute the same way.
+Eigen::Vector3d NumericalNormal(const PreparedCone& cone, const Eigen::Vector3d& x_C) {
+  const auto f = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3d s = cone.S_C * x + cone.s_origin;
+    return s.y() * s.y() - cone.b * cone.b * (s.z() * s.z() - s.x() * s.x());
+  };
+  constexpr double kStep = 1e-6;
+  Eigen::Vector3d gradient;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d step = kStep * Eigen::Vector3d::Unit(k);
+    gradient[k] = (f(x_C + step) - f(x_C - step)) / (2.0 * kStep);
+  }
+  return gradient;
+}
+
+TEST(ConeBatchTest, HitsWithinTheMinimumAngleOfTheConeAreParallel) {
+  std::mt19937_64 rng(5);
+  const PreparedCone cone = PrepareCone(RandomCone(rng, 0.4));
+  const double min_angle_rad = 0.35;  // about 20 degrees: a good share of the hits
+  const double min_sin2 = std::pow(std::sin(min_angle_rad), 2);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int kept = 0, rejected = 0;
+  for (int k = 0; k < 300; ++k) {
+    RayBlock rays;
+    Ray per_ray[RayBlock::kSize];
+    for (size_t lane = 0; lane < RayBlock::kSize; ++lane) {
+      Ray& ray = per_ray[lane];
+      ray.origin = 2.0 * Eigen::Vector3d{unit(rng), unit(rng), unit(rng)};
+      ray.direction = Eigen::Vector3d{unit(rng), unit(rng), unit(rng)};
+      rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(),
+      rays.oz[lane] = ray.origin.z();
+      rays.dx[lane] = ray.direction.x(), rays.dy[lane] = ray.direction.y();
+      rays.dz[lane] = ray.direction.z();
+    }
+    HitBlock block;
+    IntersectRayConeBlock(cone, rays, min_sin2, &block);
+    for (size_t lane = 0; lane < RayBlock::kSize; ++lane) {
+      const RayHit expected = IntersectRayCone(per_ray[lane], cone);
+      if (!expected.ok()) {
+        EXPECT_EQ(block.Status(lane), expected.status);
+        continue;
+      }
+      const Eigen::Vector3d n = NumericalNormal(cone, expected.point);
+      const Eigen::Vector3d& d = per_ray[lane].direction;
+      const double sin2 = std::pow(n.dot(d), 2) / (n.squaredNorm() * d.squaredNorm());
+      if (std::abs(sin2 - min_sin2) < 1e-6) continue;  // on the boundary: either is right
+      const Eigen::Vector3d point(block.x[lane], block.y[lane], block.z[lane]);
+      if (sin2 < min_sin2) {
+        ++rejected;
+        EXPECT_EQ(block.Status(lane), HitStatus::kParallel) << "block " << k << " lane " << lane;
+        EXPECT_EQ(point, Eigen::Vector3d::Zero());  // a rejected hit carries no point
+      } else {
+        ++kept;
+        ASSERT_EQ(block.Status(lane), HitStatus::kHit) << "block " << k << " lane " << lane;
+        EXPECT_LT((point - expected.point).norm(), 1e-12 * (1.0 + expected.point.norm()));
+      }
+    }
+  }
+  EXPECT_GT(kept, 100);
+  EXPECT_GT(rejected, 100);
 }
 
 }  // namespace

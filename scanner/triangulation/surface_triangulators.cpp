@@ -94,8 +94,8 @@ void RayConeTriangulator::TriangulateFrame(int mirror_step,
   const LightSurfaces* surface = surfaces_->At(mirror_step);
   if (surface == nullptr) return MarkAll(out, HitStatus::kOutsideSurface);
   const PreparedCone cone = PrepareCone(surface->cone);
-  // Blocks of rays through the vectorised intersection; pixels outside the table keep a dummy
-  // ray in their lane and are reported as misses.
+  // Blocks of rays through the vectorised intersection; a pixel outside the table gets a ray of
+  // zero direction in its lane, which meets nothing, and is reported as a miss.
   RayBlock rays;
   HitBlock hits;
   bool in_image[RayBlock::kSize];
@@ -104,23 +104,20 @@ void RayConeTriangulator::TriangulateFrame(int mirror_step,
     const size_t count = std::min(RayBlock::kSize, peaks_px.size() - start);
     for (size_t lane = 0; lane < RayBlock::kSize; ++lane) {
       const size_t i = start + lane;
-      if (i + kPrefetchAhead < peaks_px.size()) {
-        rays_->Prefetch(peaks_px[i + kPrefetchAhead].x(), peaks_px[i + kPrefetchAhead].y());
-      }
+      const size_t ahead = i + kPrefetchAhead;
+      if (ahead < peaks_px.size()) rays_->Prefetch(peaks_px[ahead].x(), peaks_px[ahead].y());
       in_image[lane] = lane < count && rays_->Lookup(peaks_px[i].x(), peaks_px[i].y(), &ray);
-      if (!in_image[lane]) ray = Ray{};
+      if (!in_image[lane]) ray.direction.setZero();
       rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(),
       rays.oz[lane] = ray.origin.z();
       rays.dx[lane] = ray.direction.x(), rays.dy[lane] = ray.direction.y();
       rays.dz[lane] = ray.direction.z();
     }
-    IntersectRayConeBlock(cone, rays, &hits);
-    RejectGrazingHits(cone, rays, min_sin2_angle_, &hits);
+    IntersectRayConeBlock(cone, rays, min_sin2_angle_, &hits);
     for (size_t lane = 0; lane < count; ++lane) {
       TriangulatedPoint& result = out[start + lane];
       result.status = in_image[lane] ? hits.Status(lane) : HitStatus::kNoIntersection;
-      result.p_C = result.ok() ? Eigen::Vector3d(hits.x[lane], hits.y[lane], hits.z[lane])
-                               : Eigen::Vector3d::Zero();  // misses carry no point
+      result.p_C = Eigen::Vector3d(hits.x[lane], hits.y[lane], hits.z[lane]);  // 0 for misses
     }
   }
 }
