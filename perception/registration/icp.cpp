@@ -214,6 +214,31 @@ Vector6d SolveTruncated(const Matrix6d& JtJ, const Vector6d& Jtr) {
   return x;
 }
 
+// The part of a step x = [w, v] (rotation about the pivot, translation) along the directions the
+// pairs determine well: the eigenvectors of J^T J, its rotation scaled by the pairs' RMS lever arm
+// so that both halves are in metres, whose eigenvalue is at least `ratio` of the largest. A pipe's
+// roll about its axis and slide along it are left out: there the pairs pin nothing, and the pose
+// drifts by noise from one iteration to the next.
+Vector6d WellDeterminedPart(const Matrix6d& JtJ, const Vector6d& x, double ratio) {
+  const double translation_trace = JtJ.bottomRightCorner<3, 3>().trace();
+  const double rotation_trace = JtJ.topLeftCorner<3, 3>().trace();
+  if (!(translation_trace > 0.0 && rotation_trace > 0.0)) return x;
+  const double lever_m = std::sqrt(rotation_trace / translation_trace);
+  Vector6d scale;
+  scale << Eigen::Vector3d::Constant(lever_m), Eigen::Vector3d::Ones();
+  const Matrix6d scaled =
+      scale.cwiseInverse().asDiagonal() * JtJ * scale.cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(scaled);
+  const Vector6d x_scaled = scale.cwiseProduct(x);
+  Vector6d strong = Vector6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    if (solver.eigenvalues()(k) < ratio * solver.eigenvalues()(5)) continue;
+    const Vector6d u = solver.eigenvectors().col(k);
+    strong += u.dot(x_scaled) * u;
+  }
+  return strong.cwiseQuotient(scale);
+}
+
 // The step with a prior: minimises |J x + r|^2 / sigma^2 + (e + x)^T L (e + x), where
 // e = [w, v] is the current pose's perturbation from the prior's (offset = current * prior^-1,
 // its rotation vector and translation) and L the prior's information.
@@ -324,10 +349,12 @@ struct IcpScratch {
   std::vector<Eigen::Vector3d> moved, matched;  // point-to-point pairs
 };
 
-// One iteration's increment and the RMS residual of the pairs it was solved from.
+// One iteration's increment and the RMS residual of the pairs it was solved from; `settled` is
+// the part of the increment the convergence test measures (IcpOptions::weak_direction_ratio).
 struct IcpStep {
   Eigen::Isometry3d increment;
   double rmse;
+  Eigen::Isometry3d settled;
 };
 
 // One Gauss-Newton step on the point-to-plane sums; none with fewer than 3 pairs.
@@ -338,7 +365,12 @@ std::optional<IcpStep> PointToPlaneStep(const IcpProblem& problem, const Sums& s
   const std::optional<IcpPrior>& prior = problem.options.prior;
   const Vector6d x = prior ? SolveWithPrior(sums, *prior, T_rel * problem.prior_rel.inverse())
                            : SolveTruncated(sums.JtJ, sums.Jtr);
-  return IcpStep{IncrementAbout(problem.pivot, x.head<3>(), x.tail<3>()), rmse};
+  const Eigen::Isometry3d increment = IncrementAbout(problem.pivot, x.head<3>(), x.tail<3>());
+  const double ratio = problem.options.weak_direction_ratio;
+  if (!(ratio > 0.0) || prior) return IcpStep{increment, rmse, increment};
+  const Vector6d strong = WellDeterminedPart(sums.JtJ, x, ratio);
+  return IcpStep{increment, rmse,
+                 IncrementAbout(problem.pivot, strong.head<3>(), strong.tail<3>())};
 }
 
 // The closed-form step on the pairs found by the last Pass; none with fewer than 3 pairs or
@@ -360,7 +392,8 @@ std::optional<IcpStep> PointToPointStep(const IcpProblem& problem, const Eigen::
   if (step.status != SvdAlignmentStatus::kSuccess) return std::nullopt;
   double squared = 0.0;
   for (std::size_t i = 0; i < moved.size(); ++i) squared += (moved[i] - matched[i]).squaredNorm();
-  return IcpStep{step.T_target_source, std::sqrt(squared / static_cast<double>(moved.size()))};
+  return IcpStep{step.T_target_source, std::sqrt(squared / static_cast<double>(moved.size())),
+                 step.T_target_source};
 }
 
 // Pairs the source moved by T_rel with the target within `radius` and solves for the next
@@ -394,13 +427,13 @@ struct StallWatch {
   }
 };
 
-// Whether a stage has converged: the increment is below both step tolerances, or the residual
-// changed by at most relative_rmse_tolerance of the previous one (NaN: none yet).
+// Whether a stage has converged: the increment (its settled part) is below both step tolerances,
+// or the residual changed by at most relative_rmse_tolerance of the previous one (NaN: none yet).
 bool StageConverged(const IcpProblem& problem, const IcpStep& step, double previous_rmse) {
   const IcpOptions& options = problem.options;
   const Eigen::Vector3d& centroid = problem.target_centroid;
-  const double rotation_step = Eigen::AngleAxisd(step.increment.linear()).angle();
-  const double translation_step = (step.increment * centroid - centroid).norm();
+  const double rotation_step = Eigen::AngleAxisd(step.settled.linear()).angle();
+  const double translation_step = (step.settled * centroid - centroid).norm();
   const bool small_step = rotation_step < options.rotation_tolerance_rad &&
                           translation_step < options.translation_tolerance_m;
   const bool flat_rmse =
@@ -482,6 +515,7 @@ void IcpOptions::Check() const {
   }
   check.NonNegative("rotation_tolerance_rad", rotation_tolerance_rad, "rad");
   check.NonNegative("translation_tolerance_m", translation_tolerance_m, "m");
+  check.InRange("weak_direction_ratio", weak_direction_ratio, 0.0, 1.0, Interval::kOpenHigh);
   // A relative change of the whole residual is no tolerance (and would make every iteration a
   // stall, stall_iterations counting a residual as lower only by this fraction).
   check.InRange("relative_rmse_tolerance", relative_rmse_tolerance, 0.0, 1.0, Interval::kOpenHigh);

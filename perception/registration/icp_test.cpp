@@ -513,6 +513,48 @@ TEST_P(IcpMethods, StallRuleChangesNothingWhereICPConverges) {
   EXPECT_TRUE(on.T_target_source.matrix() == off.T_target_source.matrix());
 }
 
+// A noisy scan of a pipe's top on its model: nothing pins the roll about the axis or the slide
+// along it, so every iteration moves the pose along them by the noise and the step tolerances are
+// never met. Measured along the directions the pairs pin (weak_direction_ratio), ICP converges,
+// with the scan on the outer wall.
+TEST(IcpWeakDirections, APipeConvergesAlongTheDirectionsItsPairsPin) {
+  const double outer = 0.05, inner = 0.045, length = 0.3;
+  const PointCloud model = PipeWalls(outer, inner, length);
+  const PointCloud top = PipeTopScan(outer, length);
+  PointCloud scan = SubsetWithNoise(top, -1.0, 0.0005, 5);  // every point kept, with noise
+  scan.normals = top.normals;
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  start.linear() = Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitX()).matrix();
+  start.translation() = Eigen::Vector3d(0.002, -0.001, 0.003);
+  IcpOptions options = Options(IcpMethod::kPointToPlane);
+  options.max_correspondence_distance_m = {0.01, 0.005};
+  options.max_normal_angle_rad = 60.0 * kDeg;
+  options.rotation_tolerance_rad = 1e-4;
+  options.translation_tolerance_m = 1e-5;
+  options.relative_rmse_tolerance = 1e-7;  // the step tolerances decide, not a flat residual
+  const RegistrationResult every_direction = AlignIcp(scan, model, start, options);
+  EXPECT_FALSE(every_direction.converged);  // the trap
+  options.weak_direction_ratio = 0.01;
+  const RegistrationResult pinned = AlignIcp(scan, model, start, options);
+  EXPECT_TRUE(pinned.converged);
+  EXPECT_LT(pinned.iterations, every_direction.iterations);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    sum += (pinned.T_target_source * scan.Point(i)).head<2>().norm();
+  }
+  EXPECT_NEAR(sum / static_cast<double>(scan.size()), outer, 2e-4);
+  // Where every direction is pinned nothing is left out: the same bits as without.
+  const PointCloud target = BumpySurface(8000, 2);
+  const PointCloud source =
+      Transformed(SubsetWithNoise(target, 0.0, 0.0005, 3), KnownMotion().inverse());
+  IcpOptions bumpy = Options(IcpMethod::kPointToPlane);
+  const RegistrationResult off = AlignIcp(source, target, Eigen::Isometry3d::Identity(), bumpy);
+  bumpy.weak_direction_ratio = 0.01;
+  const RegistrationResult on = AlignIcp(source, target, Eigen::Isometry3d::Identity(), bumpy);
+  EXPECT_TRUE(on.converged);
+  EXPECT_TRUE(on.T_target_source.matrix() == off.T_target_source.matrix());
+}
+
 TEST(IcpBadInput, EmptyOnePointAndNaNCloudsThrow) {
   const PointCloud good = BumpySurface(100, 13);
   PointCloud empty;

@@ -33,7 +33,9 @@ struct RegistrationPipelineOptions {
   // normals 2.5 voxels, FPFH 5 voxels, RANSAC inliers and ICP 1.5 voxels, then 0.75; a coarse
   // result is accepted from 1 % of the keypoints in agreement (features are computed at every
   // point, so most have no counterpart in a partial view). ICP has converged once a step moves
-  // the object's edge by less than 1 % of a voxel or the RMS changes by less than 1e-4 of it.
+  // the object's edge by less than 1 % of a voxel along the directions the pairs pin (a pipe's
+  // roll and slide left out: IcpOptions::weak_direction_ratio 0.01) or the RMS changes by less
+  // than 1e-4 of it.
   static RegistrationPipelineOptions ForObjectSize(double size_m, std::uint64_t seed = 1,
                                                    int threads = 0, double voxel_m = 0.0);
   // The same for two scans of any size, the voxel chosen from the target's own scale: a
