@@ -19,13 +19,13 @@ void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
                         double max_normal_angle_rad);
 
 // Adds to each inspected core point's level of detection the spread of its group's deviations
-// that their own levels do not explain: the robust spread (1.4826 x the median absolute
-// deviation from their median) squared, less the median of their variances (lod / z)^2 when
-// positive. A group is a patch of one kind of surface (a registration tile's seabed, or its
-// structure): how reproducibly the two surveys place that surface there, measured on the surface
-// itself as M3C2 practice measures registration error on stable ground. A change covering a
-// small part of its group barely moves it. group_of[i] < 0: no group (left as it is). The status
-// is updated; z is the level of detection's quantile.
+// that their own levels do not explain: the robust spread (the third quartile of the absolute
+// deviations from their median, over 1.1503, its value for a Gaussian of unit sigma) squared, less
+// the median of their variances (lod / z)^2 when positive. A group is a patch of one kind of
+// surface (a registration tile's seabed, or its structure): how reproducibly the two surveys place
+// that surface there, measured on the surface itself as M3C2 practice measures registration error
+// on stable ground. A change covering less than a quarter of its group barely moves it. group_of[i]
+// < 0: no group (left as it is). The status is updated; z is the level of detection's quantile.
 void AddGroupSpread(std::vector<CoreDeviation>& deviations, const std::vector<long>& group_of,
                     double z);
 
