@@ -105,8 +105,8 @@ struct TimedKernel {
 
 // Runs every kernel over every frame, `repeats` passes, the kernels in turn within each pass so
 // that they meet the same load from the rest of the machine; returns each kernel's fastest pass
-// (the least disturbed by that load: the machines here are shared). A whole pass between two
-// runs of a kernel leaves the caches as cold for one kernel as for the next.
+// (the least disturbed by that load: the machines here are shared). With several kernels, a whole
+// pass of the others between two runs of one leaves the caches as cold for each.
 std::vector<double> TimeInterleaved(const std::vector<Frame>& frames, int repeats,
                                     const std::vector<TimedKernel>& kernels,
                                     const Progress& progress) {
@@ -125,7 +125,9 @@ std::vector<double> TimeInterleaved(const std::vector<Frame>& frames, int repeat
       }
       best[k] = std::min(best[k], SecondsSince(start));
     }
-    if (progress) progress(kernels.front().name, (pass + 1.0) / repeats);
+    if (progress)
+      progress(kernels.size() == 1 ? kernels.front().name : "table methods and limit",
+               (pass + 1.0) / repeats);
   }
   return best;
 }
@@ -228,7 +230,7 @@ std::vector<TableResolutionRow> SweepResolutions(
     auto rays = std::make_shared<const scanner::CameraRayTable>(model.camera, grid_px);
     const double setup_s = SecondsSince(start);
     add("camera_rays", grid_px, setup_s,
-        MeasureTables(rays, default_surfaces, frames, points, exact, o.repeats));
+        MeasureTables(rays, default_surfaces, frames, points, exact, o.sweep_repeats));
   }
   for (const int rays_per_fan : o.sweep_rays_per_fan) {
     scanner::LightSurfaceTableOptions surface_options = o.surfaces;
@@ -238,7 +240,7 @@ std::vector<TableResolutionRow> SweepResolutions(
         std::make_shared<const scanner::LightSurfaceTable>(model.laser, surface_options);
     const double setup_s = SecondsSince(start);
     add("light_surfaces", rays_per_fan, setup_s,
-        MeasureTables(default_rays, surfaces, frames, points, exact, o.repeats));
+        MeasureTables(default_rays, surfaces, frames, points, exact, o.sweep_repeats));
   }
   return rows;
 }
@@ -254,6 +256,7 @@ void TriangulationBenchOptions::Check() const {
                 "> depth_min_m (" + OptionValueText(depth_min_m) + " m)", depth_max_m);
   check.AtLeast("repeats", repeats, 1);
   check.AtLeast("exact_repeats", exact_repeats, 1);
+  check.AtLeast("sweep_repeats", sweep_repeats, 1);
   check.AtLeast("camera_grid_px", camera_grid_px, 1, "px");
   surfaces.Check();
   for (std::size_t i = 0; i < sweep_camera_grid_px.size(); ++i) {

@@ -26,6 +26,7 @@ struct TriangulationBenchOptions {
   // Passes of each table method and of the limit, interleaved; the fastest of each is reported.
   int repeats = 20;
   int exact_repeats = 3;  // passes of exact ray-ray, the reference (about 20x slower)
+  int sweep_repeats = 5;  // passes of each method at each swept table resolution
   int camera_grid_px = 4;
   scanner::LightSurfaceTableOptions surfaces;
   // Table resolutions to sweep, one table at a time (the other at its default), on the same

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -21,16 +22,18 @@ double MedianOf(std::vector<double>& values) {
   return *middle;
 }
 
+// The q-quantile of values (the element of rank floor(q (n - 1)), no interpolation), q in [0, 1];
+// reorders values, which must not be empty.
 double QuantileOf(std::vector<double>& values, double q) {
+  assert(!values.empty());
   const auto at =
       values.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
   std::nth_element(values.begin(), at, values.end());
   return *at;
 }
-#ifndef SQ
-#define SQ 0.8
-#define SZ 1.2816
-#endif
+
+// |z| of a standard Gaussian at its third quartile: P(|z| < 1.1503) = 0.75.
+constexpr double kGaussianThirdQuartileOfAbs = 1.1503;
 
 // Calls visit(i, neighbours) for each inspected core point i with its neighbourhood: the
 // inspected core points within radius_m facing the same way, taken from a sample of them one per
@@ -113,12 +116,10 @@ void AddGroupSpread(std::vector<CoreDeviation>& deviations, const std::vector<lo
     }
     const double median = MedianOf(values);
     for (double& v : values) v = std::abs(v - median);
-    // The third quartile of |deviation - median| over its value for a Gaussian (1.1503 sigma):
-    // the groups' deviations have heavier tails than a Gaussian (placement offsets a millimetre
-    // or two over patches), and their median absolute deviation, blind to the tails, left 7.9 %
-    // of the unchanged surface beyond a 95 % level of detection (bench/change/RESULTS.md). A
-    // change must still cover a quarter of its group to move it.
-    const double spread = QuantileOf(values, 0.75) / 1.1503;
+    // The third quartile of |deviation - median|, not its median: the groups' deviations have
+    // heavier tails than a Gaussian (placement offsets of a millimetre or two over patches), which
+    // a 95 % level of detection must take in. A change covering a quarter of its group moves it.
+    const double spread = QuantileOf(values, 0.75) / kGaussianThirdQuartileOfAbs;
     const double unexplained = std::max(0.0, spread * spread - MedianOf(variances));
     for (std::size_t i : members) {
       CoreDeviation& d = deviations[i];

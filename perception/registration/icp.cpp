@@ -367,7 +367,7 @@ std::optional<IcpStep> PointToPlaneStep(const IcpProblem& problem, const Sums& s
                            : SolveTruncated(sums.JtJ, sums.Jtr);
   const Eigen::Isometry3d increment = IncrementAbout(problem.pivot, x.head<3>(), x.tail<3>());
   const double ratio = problem.options.weak_direction_ratio;
-  if (!(ratio > 0.0) || prior) return IcpStep{increment, rmse, increment};
+  if (!(ratio > 0.0)) return IcpStep{increment, rmse, increment};
   const Vector6d strong = WellDeterminedPart(sums.JtJ, x, ratio);
   return IcpStep{increment, rmse,
                  IncrementAbout(problem.pivot, strong.head<3>(), strong.tail<3>())};
@@ -516,6 +516,10 @@ void IcpOptions::Check() const {
   check.NonNegative("rotation_tolerance_rad", rotation_tolerance_rad, "rad");
   check.NonNegative("translation_tolerance_m", translation_tolerance_m, "m");
   check.InRange("weak_direction_ratio", weak_direction_ratio, 0.0, 1.0, Interval::kOpenHigh);
+  if (weak_direction_ratio > 0.0) {
+    check.Require(method == IcpMethod::kPointToPlane && !prior, "weak_direction_ratio",
+                  "0 unless point-to-plane without a prior", weak_direction_ratio);
+  }
   // A relative change of the whole residual is no tolerance (and would make every iteration a
   // stall, stall_iterations counting a residual as lower only by this fraction).
   check.InRange("relative_rmse_tolerance", relative_rmse_tolerance, 0.0, 1.0, Interval::kOpenHigh);

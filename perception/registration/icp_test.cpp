@@ -543,16 +543,22 @@ TEST(IcpWeakDirections, APipeConvergesAlongTheDirectionsItsPairsPin) {
     sum += (pinned.T_target_source * scan.Point(i)).head<2>().norm();
   }
   EXPECT_NEAR(sum / static_cast<double>(scan.size()), outer, 2e-4);
-  // Where every direction is pinned nothing is left out: the same bits as without.
+  // Where every direction is pinned nothing is left out: the same bits as without, the step
+  // tolerances deciding (a flat residual would end both runs alike whatever the steps).
   const PointCloud target = BumpySurface(8000, 2);
   const PointCloud source =
       Transformed(SubsetWithNoise(target, 0.0, 0.0005, 3), KnownMotion().inverse());
   IcpOptions bumpy = Options(IcpMethod::kPointToPlane);
+  bumpy.relative_rmse_tolerance = 0.0;
   const RegistrationResult off = AlignIcp(source, target, Eigen::Isometry3d::Identity(), bumpy);
   bumpy.weak_direction_ratio = 0.01;
   const RegistrationResult on = AlignIcp(source, target, Eigen::Isometry3d::Identity(), bumpy);
   EXPECT_TRUE(on.converged);
+  EXPECT_EQ(on.iterations, off.iterations);
   EXPECT_TRUE(on.T_target_source.matrix() == off.T_target_source.matrix());
+  // Only where it means something: point-to-plane without a prior.
+  bumpy.method = IcpMethod::kPointToPoint;
+  EXPECT_THROW(bumpy.Check(), Error);
 }
 
 TEST(IcpBadInput, EmptyOnePointAndNaNCloudsThrow) {

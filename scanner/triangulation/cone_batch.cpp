@@ -18,6 +18,36 @@ constexpr double kBehind = static_cast<double>(HitStatus::kBehind);
 constexpr double kOutsideSurface = static_cast<double>(HitStatus::kOutsideSurface);
 constexpr double kNoIntersection = static_cast<double>(HitStatus::kNoIntersection);
 
+// The cone's frame as plain numbers, for the vector lanes: s = S x + c.
+struct ConeFrame {
+  double s00, s01, s02, s10, s11, s12, s20, s21, s22;
+  double c0, c1, c2;
+};
+
+ConeFrame FrameOf(const PreparedCone& cone) {
+  const Eigen::Matrix3d& S = cone.S_C;
+  return {S(0, 0), S(0, 1), S(0, 2), S(1, 0),           S(1, 1),           S(1, 2),
+          S(2, 0), S(2, 1), S(2, 2), cone.s_origin.x(), cone.s_origin.y(), cone.s_origin.z()};
+}
+
+// Whether a crossing at (u, y, z) in cone coordinates, of a ray of direction (du, dy, dz) there
+// and d_C in {C}, meets the cone within the minimum angle: its squared sine to the cone's tangent
+// plane at most min_sin2. In cone coordinates the cone is F(s) = y^2 - b^2 (z^2 - u^2) = 0, its
+// normal grad F / 2 = (b^2 u, y, -b^2 z) (for b = 0 the plane y = 0: (0, 1, 0)); in {C} the normal
+// is S^T times that, and grad F . (S d_C) is its product with d_C.
+inline bool Grazing(const ConeFrame& f, double bb, double u, double y, double z, double du,
+                    double dy, double dz, double d2_C, double min_sin2) {
+  const bool planar = bb == 0.0;
+  const double gu = Select(planar, 0.0, bb * u);
+  const double gy = Select(planar, 1.0, y);
+  const double gz = Select(planar, 0.0, -bb * z);
+  const double along = gu * du + gy * dy + gz * dz;
+  const double nx = f.s00 * gu + f.s10 * gy + f.s20 * gz;
+  const double ny = f.s01 * gu + f.s11 * gy + f.s21 * gz;
+  const double nz = f.s02 * gu + f.s12 * gy + f.s22 * gz;
+  return along * along <= min_sin2 * (nx * nx + ny * ny + nz * nz) * d2_C;
+}
+
 }  // namespace
 
 // The loop runs over the lanes of the block; every lane follows exactly the arithmetic of the
@@ -25,13 +55,8 @@ constexpr double kNoIntersection = static_cast<double>(HitStatus::kNoIntersectio
 __attribute__((target_clones("avx512f", "avx2", "default"))) void IntersectRayConeBlock(
     const PreparedCone& cone, const RayBlock& rays, double min_sin2_angle, HitBlock* hits) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  const Eigen::Matrix3d& S = cone.S_C;
+  const ConeFrame f = FrameOf(cone);
   const double bb = cone.b * cone.b, abs_b = std::abs(cone.b);
-  const bool planar = bb == 0.0;
-  const bool reject_grazing = min_sin2_angle > 0.0;
-  const double s00 = S(0, 0), s01 = S(0, 1), s02 = S(0, 2), s10 = S(1, 0), s11 = S(1, 1),
-               s12 = S(1, 2), s20 = S(2, 0), s21 = S(2, 1), s22 = S(2, 2);
-  const double c0 = cone.s_origin.x(), c1 = cone.s_origin.y(), c2 = cone.s_origin.z();
   const double b = cone.b, h_min = cone.h_min_m, cos_min = cone.cos_beta_min,
                cos_max = cone.cos_beta_max, coefficient_tol = cone.coefficient_tol,
                origin_size = cone.origin_size;
@@ -39,12 +64,12 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void IntersectRayCo
 #pragma omp simd
   for (std::size_t i = 0; i < kN; ++i) {
     // Ray in cone coordinates s = S x + s_origin.
-    const double ox = s00 * rays.ox[i] + s01 * rays.oy[i] + s02 * rays.oz[i] + c0;
-    const double oy = s10 * rays.ox[i] + s11 * rays.oy[i] + s12 * rays.oz[i] + c1;
-    const double oz = s20 * rays.ox[i] + s21 * rays.oy[i] + s22 * rays.oz[i] + c2;
-    const double dx = s00 * rays.dx[i] + s01 * rays.dy[i] + s02 * rays.dz[i];
-    const double dy = s10 * rays.dx[i] + s11 * rays.dy[i] + s12 * rays.dz[i];
-    const double dz = s20 * rays.dx[i] + s21 * rays.dy[i] + s22 * rays.dz[i];
+    const double ox = f.s00 * rays.ox[i] + f.s01 * rays.oy[i] + f.s02 * rays.oz[i] + f.c0;
+    const double oy = f.s10 * rays.ox[i] + f.s11 * rays.oy[i] + f.s12 * rays.oz[i] + f.c1;
+    const double oz = f.s20 * rays.ox[i] + f.s21 * rays.oy[i] + f.s22 * rays.oz[i] + f.c2;
+    const double dx = f.s00 * rays.dx[i] + f.s01 * rays.dy[i] + f.s02 * rays.dz[i];
+    const double dy = f.s10 * rays.dx[i] + f.s11 * rays.dy[i] + f.s12 * rays.dz[i];
+    const double dz = f.s20 * rays.dx[i] + f.s21 * rays.dy[i] + f.s22 * rays.dz[i];
 
     const double g2 = (dz - dx) * (dz + dx);
     const double g1 = oz * dz - ox * dx;
@@ -85,23 +110,9 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void IntersectRayCo
     const bool candidate = !(parallel | no_intersection | through_apex);
     const bool hit_near = candidate & lit_near;
     const bool hit_far = candidate & !lit_near & lit_far;
-
-    // Grazing: in cone coordinates the cone is F(s) = y^2 - b^2 (z^2 - u^2) = 0, its normal at
-    // the crossing grad F / 2 = (b^2 u, y, -b^2 z) (for b = 0 the plane y = 0, normal (0, 1, 0));
-    // in {C} the normal is S_C^T times that, and grad F . (S_C d_C) is its product with d_C.
-    const double us = Select(hit_near, un, uf), ys = Select(hit_near, yn, yf),
-                 zs = Select(hit_near, zn, zf);
-    const double gu = Select(planar, 0.0, bb * us);
-    const double gy = Select(planar, 1.0, ys);
-    const double gz = Select(planar, 0.0, -bb * zs);
-    const double along = gu * dx + gy * dy + gz * dz;
-    const double nx = s00 * gu + s10 * gy + s20 * gz;
-    const double ny = s01 * gu + s11 * gy + s21 * gz;
-    const double nz = s02 * gu + s12 * gy + s22 * gz;
-    const double n2 = nx * nx + ny * ny + nz * nz;
-    const double d2 = rays.dx[i] * rays.dx[i] + rays.dy[i] * rays.dy[i] + rays.dz[i] * rays.dz[i];
-    const bool grazing = reject_grazing & (along * along <= min_sin2_angle * n2 * d2);
-
+    const double d2_C = rays.dx[i] * rays.dx[i] + rays.dy[i] * rays.dy[i] + rays.dz[i] * rays.dz[i];
+    const bool grazing = Grazing(f, bb, Select(hit_near, un, uf), Select(hit_near, yn, yf),
+                                 Select(hit_near, zn, zf), dx, dy, dz, d2_C, min_sin2_angle);
     const bool hit = (hit_near | hit_far) & !grazing;
     const double t = Select(hit_near, t_near, Select(hit_far, t_far, 0.0));
     // Status in the per-ray function's order of tests, as a lane-wise select chain.

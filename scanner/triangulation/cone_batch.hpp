@@ -24,11 +24,11 @@ struct HitBlock {
 
 // IntersectRayCone (light_cone.hpp) for every ray of a block, the same method, tests and
 // statuses, written without branches over structure-of-arrays data so that it runs several
-// rays per vector instruction (AVX2 where the CPU has it, chosen at run time; results do not
-// depend on which: the same IEEE operations in the same order, no fused multiply-add).
+// rays per vector instruction (AVX-512 or AVX2 where the CPU has them, chosen at run time; results
+// do not depend on which: the same IEEE operations in the same order, no fused multiply-add).
 // Then every hit whose ray meets the cone at an angle whose squared sine is at most
 // min_sin2_angle becomes kParallel: the angle between the ray and the cone's tangent plane at
-// the crossing, the test ray-plane makes against its plane (0 rejects nothing).
+// the crossing, the test ray-plane makes against its plane (0 rejects only rays along it).
 // Misses get t = 0 and the point (0, 0, 0); a ray of zero direction is a kParallel miss. Every
 // lane must hold a finite ray (fill unused lanes with any). Agreement with the per-ray function
 // is checked in cone_batch_test.

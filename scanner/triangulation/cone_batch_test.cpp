@@ -91,12 +91,13 @@ TEST(ConeBatchTest, MatchesPerRayOnDegenerateCones) {
   ExpectBlockMatchesPerRay(RandomCone(rng, 0.0), rng, 200);   // exactly a plane
 }
 
-// The cone's implicit function in {C}, F(x) = y^2 - b^2 (z^2 - u^2) at s = S_C x + s_origin:
-// differentiated numerically here, so that the grazing test is checked against a normal the
-// block does not compute the same way.
+// The cone's implicit function in {C}, F(x) = y^2 - b^2 (z^2 - u^2) at s = S_C x + s_origin (for
+// b = 0 the plane F = y): differentiated numerically here, so that the grazing test is checked
+// against a normal the block does not compute the same way.
 Eigen::Vector3d NumericalNormal(const PreparedCone& cone, const Eigen::Vector3d& x_C) {
   const auto f = [&](const Eigen::Vector3d& x) {
     const Eigen::Vector3d s = cone.S_C * x + cone.s_origin;
+    if (cone.b == 0.0) return s.y();
     return s.y() * s.y() - cone.b * cone.b * (s.z() * s.z() - s.x() * s.x());
   };
   constexpr double kStep = 1e-6;
@@ -108,13 +109,13 @@ Eigen::Vector3d NumericalNormal(const PreparedCone& cone, const Eigen::Vector3d&
   return gradient;
 }
 
-TEST(ConeBatchTest, HitsWithinTheMinimumAngleOfTheConeAreParallel) {
-  std::mt19937_64 rng(5);
-  const PreparedCone cone = PrepareCone(RandomCone(rng, 0.4));
-  const double min_angle_rad = 0.35;  // about 20 degrees: a good share of the hits
-  const double min_sin2 = std::pow(std::sin(min_angle_rad), 2);
+// Random rays against `cone` with the grazing test at min_angle_rad; counts the hits kept and
+// rejected, and checks every lane against the per-ray function and the numerical normal. Lane 3
+// of the first block has a zero direction (a pixel outside the table): a kParallel miss.
+void ExpectGrazingHitsParallel(const PreparedCone& cone, std::mt19937_64& rng, int* kept,
+                               int* rejected) {
+  const double min_sin2 = std::pow(std::sin(0.35), 2);  // about 20 degrees
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  int kept = 0, rejected = 0;
   for (int k = 0; k < 300; ++k) {
     RayBlock rays;
     Ray per_ray[RayBlock::kSize];
@@ -122,6 +123,7 @@ TEST(ConeBatchTest, HitsWithinTheMinimumAngleOfTheConeAreParallel) {
       Ray& ray = per_ray[lane];
       ray.origin = 2.0 * Eigen::Vector3d{unit(rng), unit(rng), unit(rng)};
       ray.direction = Eigen::Vector3d{unit(rng), unit(rng), unit(rng)};
+      if (k == 0 && lane == 3) ray.direction.setZero();
       rays.ox[lane] = ray.origin.x(), rays.oy[lane] = ray.origin.y(),
       rays.oz[lane] = ray.origin.z();
       rays.dx[lane] = ray.direction.x(), rays.dy[lane] = ray.direction.y();
@@ -130,6 +132,15 @@ TEST(ConeBatchTest, HitsWithinTheMinimumAngleOfTheConeAreParallel) {
     HitBlock block;
     IntersectRayConeBlock(cone, rays, min_sin2, &block);
     for (size_t lane = 0; lane < RayBlock::kSize; ++lane) {
+      const Eigen::Vector3d point(block.x[lane], block.y[lane], block.z[lane]);
+      if (block.Status(lane) != HitStatus::kHit) {
+        EXPECT_EQ(point, Eigen::Vector3d::Zero());  // a miss carries no point
+        EXPECT_EQ(block.t[lane], 0.0);
+      }
+      if (k == 0 && lane == 3) {
+        EXPECT_EQ(block.Status(lane), HitStatus::kParallel);
+        continue;
+      }
       const RayHit expected = IntersectRayCone(per_ray[lane], cone);
       if (!expected.ok()) {
         EXPECT_EQ(block.Status(lane), expected.status);
@@ -139,20 +150,26 @@ TEST(ConeBatchTest, HitsWithinTheMinimumAngleOfTheConeAreParallel) {
       const Eigen::Vector3d& d = per_ray[lane].direction;
       const double sin2 = std::pow(n.dot(d), 2) / (n.squaredNorm() * d.squaredNorm());
       if (std::abs(sin2 - min_sin2) < 1e-6) continue;  // on the boundary: either is right
-      const Eigen::Vector3d point(block.x[lane], block.y[lane], block.z[lane]);
       if (sin2 < min_sin2) {
-        ++rejected;
+        ++*rejected;
         EXPECT_EQ(block.Status(lane), HitStatus::kParallel) << "block " << k << " lane " << lane;
-        EXPECT_EQ(point, Eigen::Vector3d::Zero());  // a rejected hit carries no point
       } else {
-        ++kept;
+        ++*kept;
         ASSERT_EQ(block.Status(lane), HitStatus::kHit) << "block " << k << " lane " << lane;
         EXPECT_LT((point - expected.point).norm(), 1e-12 * (1.0 + expected.point.norm()));
       }
     }
   }
-  EXPECT_GT(kept, 100);
-  EXPECT_GT(rejected, 100);
+}
+
+TEST(ConeBatchTest, HitsWithinTheMinimumAngleOfTheConeAreParallel) {
+  std::mt19937_64 rng(5);
+  for (double b : {0.4, 0.0}) {  // an elliptic cone, and the plane b = 0 degenerates to
+    int kept = 0, rejected = 0;
+    ExpectGrazingHitsParallel(PrepareCone(RandomCone(rng, b)), rng, &kept, &rejected);
+    EXPECT_GT(kept, 50) << "b = " << b;
+    EXPECT_GT(rejected, 50) << "b = " << b;
+  }
 }
 
 }  // namespace
