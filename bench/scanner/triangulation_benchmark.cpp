@@ -312,13 +312,13 @@ TriangulationBenchResult RunTriangulationBenchmark(const scanner::GalvoScannerMo
                       progress);
   result.limit_seconds = seconds[0];
   result.limit_points_per_s = result.points / result.limit_seconds;
-  const std::vector<std::pair<const scanner::Triangulator*, const Points*>> table_methods = {
-      {&ray_plane, &plane_points}, {&ray_cone, &cone_points}};
-  for (size_t k = 0; k < table_methods.size(); ++k) {
-    MethodFigures& figures = result.methods[ToString(table_methods[k].first->method())];
-    figures.seconds = seconds[k + 1];
-    CompareTo(*table_methods[k].second, exact, &figures);
-  }
+  const auto record = [&](const scanner::Triangulator& method, const Points& points, double s) {
+    MethodFigures& figures = result.methods[ToString(method.method())];
+    figures.seconds = s;
+    CompareTo(points, exact, &figures);
+  };
+  record(ray_plane, plane_points, seconds[1]);
+  record(ray_cone, cone_points, seconds[2]);
   for (auto& [name, figures] : result.methods) {
     SetRate(result.points, &figures);
     figures.fraction_of_limit = figures.points_per_s / result.limit_points_per_s;
