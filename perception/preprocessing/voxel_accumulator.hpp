@@ -1,11 +1,10 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <array>
-#include <cstdint>
-#include <unordered_map>
+#include <vector>
 
 #include "perception/cloud/point_cloud.hpp"
+#include "perception/preprocessing/voxel_index.hpp"
 
 namespace uwscan::perception {
 
@@ -25,17 +24,14 @@ class VoxelAccumulator {
   std::size_t voxel_count() const { return voxels_.size(); }
 
  private:
-  using Key = std::array<std::int64_t, 3>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const;
-  };
   struct Sum {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     std::int64_t count = 0;
   };
   double leaf_m_;
   Eigen::Vector3d origin_;
-  std::unordered_map<Key, Sum, KeyHash> voxels_;
+  VoxelIndex voxels_;
+  std::vector<Sum> sums_;  // by voxel id
 };
 
 }  // namespace uwscan::perception
