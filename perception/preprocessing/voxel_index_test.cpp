@@ -22,8 +22,7 @@ TEST(VoxelIndex, NumbersKeysInTheOrderFirstSeenAndSortsThemLikeStdMap) {
     VoxelKey key;
     for (std::int64_t& k : key) k = near(rng);
     if (i % 1000 == 0) key[i % 3] = (i % 2 ? 1 : -1) * (std::int64_t{1} << 61);
-    const auto [it, added] =
-        reference.emplace(key, static_cast<std::uint32_t>(reference.size()));
+    const auto [it, added] = reference.emplace(key, static_cast<std::uint32_t>(reference.size()));
     ASSERT_EQ(index.Insert(key), it->second) << "draw " << i;
     ASSERT_EQ(index.size(), reference.size());
   }

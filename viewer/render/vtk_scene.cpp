@@ -1,8 +1,10 @@
 #include "viewer/render/vtk_scene.hpp"
 
+#include <vtkActor2D.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkCommand.h>
 #include <vtkEDLShading.h>
 #include <vtkFloatArray.h>
 #include <vtkIdTypeArray.h>
@@ -14,7 +16,9 @@
 #include <vtkPointGaussianMapper.h>
 #include <vtkPoints.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkPolyDataMapper2D.h>
 #include <vtkProperty.h>
+#include <vtkProperty2D.h>
 #include <vtkRenderStepsPass.h>
 #include <vtkSphereSource.h>
 #include <vtkTextActor.h>
@@ -29,6 +33,7 @@
 
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
+#include "viewer/scene/label_layout.hpp"
 #include "viewer/scene/point_colours.hpp"
 
 namespace uwscan::viewer::internal {
@@ -40,6 +45,7 @@ constexpr int kColourBarEntries = 256;
 constexpr double kTrajectoryPointSizePx = 6.0;  // a vehicle that holds still is still seen
 constexpr double kFitMargin = 0.9;              // of the tightest fit
 constexpr int kLabelFontSizePx = 18;
+constexpr double kLeaderLineWidthPx = 1.5;
 
 void SetColour(vtkProperty& property, const Rgb& c) {
   property.SetColor(c.r / 255.0, c.g / 255.0, c.b / 255.0);
@@ -76,13 +82,11 @@ vtkSmartPointer<vtkActor> FrameActor(const FrameAxes& frame, const Eigen::Vector
   return actor;
 }
 
-// Text anchored at a world point but drawn over the 3-D scene, so no surface hides it.
-vtkSmartPointer<vtkTextActor> LabelActor(const Label& label, const Eigen::Vector3d& anchor_W) {
+// Text drawn over the 3-D scene, so no surface hides it; LabelLayout places it.
+vtkSmartPointer<vtkTextActor> LabelActor(const Label& label) {
   auto actor = vtkSmartPointer<vtkTextActor>::New();
   actor->SetInput(label.text.c_str());
-  const Eigen::Vector3d p = label.position_W - anchor_W;
-  actor->GetPositionCoordinate()->SetCoordinateSystemToWorld();
-  actor->GetPositionCoordinate()->SetValue(p.x(), p.y(), p.z());
+  actor->GetPositionCoordinate()->SetCoordinateSystemToDisplay();
   vtkTextProperty* text = actor->GetTextProperty();
   text->SetFontSize(kLabelFontSizePx);
   text->BoldOn();
@@ -91,8 +95,76 @@ vtkSmartPointer<vtkTextActor> LabelActor(const Label& label, const Eigen::Vector
   text->SetBackgroundColor(0.05, 0.05, 0.05);
   text->SetBackgroundOpacity(0.8);
   text->SetJustificationToCentered();
+  text->SetVerticalJustificationToCentered();
   return actor;
 }
+
+// Before every render, where the camera then looks from: each label placed near the point it
+// names where it hides no label before it (LayOutLabels), and a line from that point to a label
+// moved off it.
+class LabelLayout : public vtkCommand {
+ public:
+  static LabelLayout* New() { return new LabelLayout; }
+
+  void Add(const Label& label, const Eigen::Vector3d& anchor_W, vtkRenderer& renderer) {
+    anchors_render_.push_back(label.position_W - anchor_W);
+    actors_.push_back(LabelActor(label));
+    renderer.AddActor2D(actors_.back());
+    auto line = vtkSmartPointer<vtkActor2D>::New();
+    line->SetMapper(vtkNew<vtkPolyDataMapper2D>());
+    line->GetProperty()->SetColor(label.colour.r / 255.0, label.colour.g / 255.0,
+                                  label.colour.b / 255.0);
+    line->GetProperty()->SetLineWidth(kLeaderLineWidthPx);
+    renderer.AddActor2D(line);
+    leaders_.push_back(line);
+  }
+
+  void Execute(vtkObject* caller, unsigned long /*event*/, void* /*data*/) override {
+    auto* renderer = static_cast<vtkRenderer*>(caller);
+    std::vector<LabelBox> boxes;
+    for (std::size_t i = 0; i < actors_.size(); ++i) {
+      const Eigen::Vector3d& p = anchors_render_[i];
+      renderer->SetWorldPoint(p.x(), p.y(), p.z(), 1.0);
+      renderer->WorldToDisplay();
+      const double* d = renderer->GetDisplayPoint();
+      double bbox[4];  // x min, x max, y min, y max
+      actors_[i]->GetBoundingBox(renderer, bbox);
+      boxes.push_back(
+          {Eigen::Vector2d(d[0], d[1]), Eigen::Vector2d(bbox[1] - bbox[0], bbox[3] - bbox[2])});
+    }
+    const int* size = renderer->GetSize();
+    const std::vector<Eigen::Vector2d> centres =
+        LayOutLabels(boxes, Eigen::Vector2d(size[0], size[1]));
+    for (std::size_t i = 0; i < actors_.size(); ++i) {
+      actors_[i]->GetPositionCoordinate()->SetValue(centres[i].x(), centres[i].y());
+      SetLeader(*leaders_[i], boxes[i], centres[i]);
+    }
+  }
+
+ private:
+  // The line from the label's anchor to the nearest edge of its box; none when the box covers
+  // its anchor.
+  static void SetLeader(vtkActor2D& leader, const LabelBox& box, const Eigen::Vector2d& centre) {
+    const Eigen::Vector2d half = 0.5 * box.size_px;
+    const Eigen::Vector2d nearest = box.anchor_px.cwiseMax(centre - half).cwiseMin(centre + half);
+    vtkNew<vtkPolyData> line;
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkCellArray> cells;
+    if ((nearest - box.anchor_px).norm() > 1.0) {
+      points->InsertNextPoint(box.anchor_px.x(), box.anchor_px.y(), 0.0);
+      points->InsertNextPoint(nearest.x(), nearest.y(), 0.0);
+      const vtkIdType ends[2] = {0, 1};
+      cells->InsertNextCell(2, ends);
+    }
+    line->SetPoints(points);
+    line->SetLines(cells);
+    static_cast<vtkPolyDataMapper2D*>(leader.GetMapper())->SetInputData(line);
+  }
+
+  std::vector<Eigen::Vector3d> anchors_render_;
+  std::vector<vtkSmartPointer<vtkTextActor>> actors_;
+  std::vector<vtkSmartPointer<vtkActor2D>> leaders_;
+};
 
 vtkSmartPointer<vtkPoints> FloatPoints(std::size_t n) {
   auto points = vtkSmartPointer<vtkPoints>::New();
@@ -341,7 +413,11 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
     if (!(frame.length_m > 0.0)) throw Error("frame " + frame.name + ": axis length must be > 0");
     out.renderer->AddActor(FrameActor(frame, out.anchor_W));
   }
-  for (const Label& label : scene.labels) out.renderer->AddActor2D(LabelActor(label, out.anchor_W));
+  if (!scene.labels.empty()) {
+    vtkNew<LabelLayout> layout;
+    for (const Label& label : scene.labels) layout->Add(label, out.anchor_W, *out.renderer);
+    out.renderer->AddObserver(vtkCommand::StartEvent, layout);
+  }
   if (IsContinuous(options.colour) && out.points_total > 0) {
     out.range = range;
     if (options.colour_bar)
