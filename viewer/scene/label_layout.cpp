@@ -39,7 +39,8 @@ std::vector<Eigen::Vector2d> Spots(const LabelBox& label, int max_rings) {
     for (int k = 0; k < 16; ++k) {
       const int turn = (k % 2 == 0 ? 1 : -1) * ((k + 1) / 2);
       const double angle = 0.5 * std::numbers::pi + turn * (2.0 * std::numbers::pi / 16.0);
-      spots.push_back(label.anchor_px + r * step * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
+      spots.push_back(label.anchor_px +
+                      r * step * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
     }
   }
   return spots;
