@@ -36,7 +36,8 @@ void VoxelAccumulator::Add(const PointCloud& cloud, const Eigen::Isometry3d& T) 
       key[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(k);
     }
     const std::uint32_t id = voxels_.Insert(key);
-    if (id == sums_.size()) sums_.emplace_back();
+    // resize, not emplace_back: a failed allocation leaves no id without its sum.
+    if (id >= sums_.size()) sums_.resize(id + std::size_t{1});
     Sum& voxel = sums_[id];
     voxel.sum += p.cast<double>();
     ++voxel.count;

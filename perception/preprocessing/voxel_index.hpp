@@ -16,7 +16,7 @@ using VoxelKey = std::array<std::int64_t, 3>;
 class VoxelIndex {
  public:
   // The number of `key`; a key seen for the first time gets size() (before the call). Throws
-  // uwscan::Error past 2^32 - 1 keys.
+  // uwscan::Error beyond 2^32 - 2 keys.
   std::uint32_t Insert(const VoxelKey& key);
   std::size_t size() const { return keys_.size(); }
   const VoxelKey& key(std::uint32_t id) const { return keys_[id]; }

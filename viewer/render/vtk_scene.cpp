@@ -100,48 +100,69 @@ vtkSmartPointer<vtkTextActor> LabelActor(const Label& label) {
 }
 
 // Before every render, where the camera then looks from: each label placed near the point it
-// names where it hides no label before it (LayOutLabels), and a line from that point to a label
-// moved off it.
+// names where it hides no other label and no named point (LayOutLabels), and a line from that
+// point to the label. A label whose point is behind the camera or outside the picture is hidden.
+// The renderer fills its window, so its display and viewport coordinates are the same.
 class LabelLayout : public vtkCommand {
  public:
   static LabelLayout* New() { return new LabelLayout; }
 
-  void Add(const Label& label, const Eigen::Vector3d& anchor_W, vtkRenderer& renderer) {
-    anchors_render_.push_back(label.position_W - anchor_W);
-    actors_.push_back(LabelActor(label));
-    renderer.AddActor2D(actors_.back());
+  void Add(const Label& label) {
+    points_W_.push_back(label.position_W);
+    texts_.push_back(LabelActor(label));
     auto line = vtkSmartPointer<vtkActor2D>::New();
     line->SetMapper(vtkNew<vtkPolyDataMapper2D>());
     line->GetProperty()->SetColor(label.colour.r / 255.0, label.colour.g / 255.0,
                                   label.colour.b / 255.0);
     line->GetProperty()->SetLineWidth(kLeaderLineWidthPx);
-    renderer.AddActor2D(line);
     leaders_.push_back(line);
+  }
+
+  // The lines first, so that every label is drawn over them; then lays out before each render.
+  void AttachTo(vtkRenderer& renderer, const Eigen::Vector3d& anchor_W) {
+    anchor_W_ = anchor_W;
+    for (vtkActor2D* line : leaders_) renderer.AddActor2D(line);
+    for (vtkTextActor* text : texts_) renderer.AddActor2D(text);
+    renderer.AddObserver(vtkCommand::StartEvent, this);
   }
 
   void Execute(vtkObject* caller, unsigned long /*event*/, void* /*data*/) override {
     auto* renderer = static_cast<vtkRenderer*>(caller);
-    std::vector<LabelBox> boxes;
-    for (std::size_t i = 0; i < actors_.size(); ++i) {
-      const Eigen::Vector3d& p = anchors_render_[i];
-      renderer->SetWorldPoint(p.x(), p.y(), p.z(), 1.0);
-      renderer->WorldToDisplay();
-      const double* d = renderer->GetDisplayPoint();
-      double bbox[4];  // x min, x max, y min, y max
-      actors_[i]->GetBoundingBox(renderer, bbox);
-      boxes.push_back(
-          {Eigen::Vector2d(d[0], d[1]), Eigen::Vector2d(bbox[1] - bbox[0], bbox[3] - bbox[2])});
-    }
     const int* size = renderer->GetSize();
-    const std::vector<Eigen::Vector2d> centres =
-        LayOutLabels(boxes, Eigen::Vector2d(size[0], size[1]));
-    for (std::size_t i = 0; i < actors_.size(); ++i) {
-      actors_[i]->GetPositionCoordinate()->SetValue(centres[i].x(), centres[i].y());
-      SetLeader(*leaders_[i], boxes[i], centres[i]);
+    const Eigen::Vector2d picture(size[0], size[1]);
+    const Eigen::Matrix4d ndc_from_world = NdcFromWorld(*renderer, anchor_W_);
+    std::vector<std::size_t> shown;
+    std::vector<LabelBox> boxes;
+    for (std::size_t i = 0; i < texts_.size(); ++i) {
+      const std::optional<Eigen::Vector2d> at = PixelOf(ndc_from_world, points_W_[i], picture);
+      texts_[i]->SetVisibility(at.has_value());
+      leaders_[i]->SetVisibility(at.has_value());
+      if (!at) continue;
+      double bbox[4] = {0.0, 0.0, 0.0, 0.0};  // x min, x max, y min, y max
+      texts_[i]->GetBoundingBox(renderer, bbox);
+      shown.push_back(i);
+      boxes.push_back({*at, Eigen::Vector2d(bbox[1] - bbox[0], bbox[3] - bbox[2])});
+    }
+    const std::vector<Eigen::Vector2d> centres = LayOutLabels(boxes, picture);
+    for (std::size_t k = 0; k < shown.size(); ++k) {
+      texts_[shown[k]]->GetPositionCoordinate()->SetValue(centres[k].x(), centres[k].y());
+      SetLeader(*leaders_[shown[k]], boxes[k], centres[k]);
     }
   }
 
  private:
+  // Where a world point falls on the picture (pixels, from its bottom left corner); std::nullopt
+  // behind the camera or outside the picture.
+  static std::optional<Eigen::Vector2d> PixelOf(const Eigen::Matrix4d& ndc_from_world,
+                                                const Eigen::Vector3d& p_W,
+                                                const Eigen::Vector2d& picture) {
+    const Eigen::Vector4d clip = ndc_from_world * p_W.homogeneous();
+    if (!(clip.w() > 0.0)) return std::nullopt;
+    const Eigen::Vector2d ndc = clip.head<2>() / clip.w();
+    if (!(ndc.cwiseAbs().maxCoeff() <= 1.0)) return std::nullopt;
+    return (0.5 * (ndc.array() + 1.0) * picture.array()).matrix();
+  }
+
   // The line from the label's anchor to the nearest edge of its box; none when the box covers
   // its anchor.
   static void SetLeader(vtkActor2D& leader, const LabelBox& box, const Eigen::Vector2d& centre) {
@@ -161,8 +182,9 @@ class LabelLayout : public vtkCommand {
     static_cast<vtkPolyDataMapper2D*>(leader.GetMapper())->SetInputData(line);
   }
 
-  std::vector<Eigen::Vector3d> anchors_render_;
-  std::vector<vtkSmartPointer<vtkTextActor>> actors_;
+  Eigen::Vector3d anchor_W_ = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> points_W_;
+  std::vector<vtkSmartPointer<vtkTextActor>> texts_;
   std::vector<vtkSmartPointer<vtkActor2D>> leaders_;
 };
 
@@ -415,8 +437,8 @@ VtkScene BuildVtkScene(const Scene& scene, const RenderOptions& options) {
   }
   if (!scene.labels.empty()) {
     vtkNew<LabelLayout> layout;
-    for (const Label& label : scene.labels) layout->Add(label, out.anchor_W, *out.renderer);
-    out.renderer->AddObserver(vtkCommand::StartEvent, layout);
+    for (const Label& label : scene.labels) layout->Add(label);
+    layout->AttachTo(*out.renderer, out.anchor_W);
   }
   if (IsContinuous(options.colour) && out.points_total > 0) {
     out.range = range;

@@ -24,14 +24,20 @@ bool Overlap(const Box& a, const Box& b) {
          a.low.y() < b.high.y() + kGapPx && b.low.y() < a.high.y() + kGapPx;
 }
 
+// Whether the box hides the point (with the gap around it).
+bool Covers(const Box& box, const Eigen::Vector2d& p) {
+  return p.x() > box.low.x() - kGapPx && p.x() < box.high.x() + kGapPx &&
+         p.y() > box.low.y() - kGapPx && p.y() < box.high.y() + kGapPx;
+}
+
 bool Inside(const Box& box, const Eigen::Vector2d& picture) {
   return box.low.x() >= 0.0 && box.low.y() >= 0.0 && box.high.x() <= picture.x() &&
          box.high.y() <= picture.y();
 }
 
 // The spots tried for a label, nearest first: on ring r (r = 1..max_rings) sixteen directions at
-// r box heights from its anchor, straight up first, then alternately either side of it. Never
-// the anchor itself: the label would hide what it names.
+// r steps of a box height (and the gap) from its anchor, straight up first, then alternately
+// either side of it.
 std::vector<Eigen::Vector2d> Spots(const LabelBox& label, int max_rings) {
   std::vector<Eigen::Vector2d> spots;
   const double step = std::max(label.size_px.y(), 1.0) + kGapPx;
@@ -53,19 +59,23 @@ std::vector<Eigen::Vector2d> LayOutLabels(const std::vector<LabelBox>& labels,
   std::vector<Eigen::Vector2d> centres;
   std::vector<Box> placed;
   for (const LabelBox& label : labels) {
-    const std::vector<Eigen::Vector2d> spots = Spots(label, max_rings);
-    Eigen::Vector2d chosen = spots.front();
-    for (const Eigen::Vector2d& spot : spots) {
+    const std::vector<Eigen::Vector2d> spots = Spots(label, std::max(1, max_rings));
+    const auto fits = [&](const Eigen::Vector2d& spot, bool clear_of_anchors) {
       const Box box = BoxAt(spot, label.size_px);
-      const bool free = std::none_of(placed.begin(), placed.end(),
-                                     [&](const Box& other) { return Overlap(box, other); });
-      if (free && Inside(box, picture_px)) {
-        chosen = spot;
-        break;
-      }
-    }
-    centres.push_back(chosen);
-    placed.push_back(BoxAt(chosen, label.size_px));
+      const auto covers = [&](const LabelBox& other) { return Covers(box, other.anchor_px); };
+      return Inside(box, picture_px) &&
+             std::none_of(placed.begin(), placed.end(),
+                          [&](const Box& other) { return Overlap(box, other); }) &&
+             (!clear_of_anchors || std::none_of(labels.begin(), labels.end(), covers));
+    };
+    // Clear of every label's anchor if it can be, else at least of the other labels.
+    auto chosen =
+        std::find_if(spots.begin(), spots.end(), [&](const auto& p) { return fits(p, true); });
+    if (chosen == spots.end())
+      chosen =
+          std::find_if(spots.begin(), spots.end(), [&](const auto& p) { return fits(p, false); });
+    centres.push_back(chosen != spots.end() ? *chosen : spots.front());
+    placed.push_back(BoxAt(centres.back(), label.size_px));
   }
   return centres;
 }

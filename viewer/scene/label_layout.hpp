@@ -13,11 +13,11 @@ struct LabelBox {
 };
 
 // The centre of each label's box, in the labels' order: each goes to the first spot near its
-// anchor (rings of sixteen spots, a box height apart, up to max_rings out; straight above the
-// anchor first; never on it, so that the label does not hide what it names) where its box
-// overlaps none placed before it and lies inside the picture; a label with no such spot goes
-// straight above its anchor. Earlier labels (the more important) get the nearer spots. max_rings
-// >= 1. The same input gives the same places.
+// anchor (rings of sixteen spots, a box height and 2 px apart, up to max_rings out, at least 1;
+// straight above the anchor first) where its box lies inside the picture, overlaps no box placed
+// before it and hides no label's anchor (so that no label hides what it or another names); failing
+// that, the first such spot that may hide an anchor; failing that, straight above its anchor.
+// Earlier labels (the more important) get the nearer spots. The same input gives the same places.
 std::vector<Eigen::Vector2d> LayOutLabels(const std::vector<LabelBox>& labels,
                                           const Eigen::Vector2d& picture_px, int max_rings = 6);
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 namespace uwscan::viewer {
@@ -37,6 +38,43 @@ TEST(LabelLayout, CrowdedLabelsEachFindAFreeSpotNearTheirAnchor) {
     }
   }
   EXPECT_EQ(LayOutLabels(labels, picture), centres);
+}
+
+bool Hides(const Eigen::Vector2d& centre, const Eigen::Vector2d& size, const Eigen::Vector2d& p) {
+  return std::abs(p.x() - centre.x()) < 0.5 * size.x() &&
+         std::abs(p.y() - centre.y()) < 0.5 * size.y();
+}
+
+// Wide labels whose anchors lie side by side on one row, as regions along a pipe do: no label may
+// sit on any named point, its own or another's, nor on another label.
+TEST(LabelLayout, WideLabelsInARowHideNoAnchor) {
+  std::vector<LabelBox> labels;
+  for (int i = 0; i < 6; ++i)
+    labels.push_back({Eigen::Vector2d(250.0 + 40.0 * i, 400.0), Eigen::Vector2d(180.0, 22.0)});
+  const std::vector<Eigen::Vector2d> centres = LayOutLabels(labels, Eigen::Vector2d(800, 800));
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    for (std::size_t j = 0; j < labels.size(); ++j) {
+      EXPECT_FALSE(Hides(centres[i], labels[i].size_px, labels[j].anchor_px))
+          << "label " << i << " hides anchor " << j;
+      if (j < i) {
+        EXPECT_FALSE(Overlap(centres[i], centres[j], labels[i].size_px, labels[j].size_px))
+            << "labels " << j << " and " << i;
+      }
+    }
+  }
+}
+
+// No spot fits a picture smaller than the label, nor rings asked as 0: the label goes straight
+// above its anchor, the same every time.
+TEST(LabelLayout, WithNoFreeSpotALabelGoesStraightAboveItsAnchor) {
+  const LabelBox label{Eigen::Vector2d(20.0, 20.0), Eigen::Vector2d(100.0, 20.0)};
+  for (const int rings : {0, 1, 6}) {
+    const std::vector<Eigen::Vector2d> centres =
+        LayOutLabels({label}, Eigen::Vector2d(40.0, 40.0), rings);
+    ASSERT_EQ(centres.size(), 1u);
+    EXPECT_NEAR(centres[0].x(), 20.0, 1e-9) << rings << " rings";
+    EXPECT_NEAR(centres[0].y(), 20.0 + 22.0, 1e-9) << rings << " rings";
+  }
 }
 
 // A label alone goes straight above what it names, its box clear of the anchor.
