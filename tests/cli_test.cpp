@@ -253,8 +253,8 @@ TEST(Cli, RecognitionBenchConditionsReportEachCondition) {
       RunUwscan("bench recognition --conditions 2 --views 4 --json " + json.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(json);
-  for (const char* name :
-       {"mesh_models", "cloud_models", "depth_camera", "catalogue_mm", "flat_objects"}) {
+  for (const char* name : {"mesh_models", "cloud_models", "depth_camera", "catalogue_mm",
+                           "catalogue_mm_clouds", "flat_objects"}) {
     SCOPED_TRACE(name);
     const nlohmann::json& c = j.at("conditions").at(name);
     EXPECT_GE(c.at("objects").get<int>(), 1);

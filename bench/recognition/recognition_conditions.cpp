@@ -151,14 +151,17 @@ ObjectSource CadObject(const std::filesystem::path& data_cache, const std::strin
   return perception::MeshObject(path, 0.001);
 }
 
-// A scan of all of `mesh`'s sides as a user would bring it: a PLY without faces, read back as
-// build-db reads it.
+// A scan of all of `mesh`'s sides (in metres) as a user would bring it: a PLY without faces in
+// units of units_to_m metres, read back as build-db reads it given those units.
 ObjectSource ScannedObject(const std::string& id, const scanner::TriangleMesh& mesh,
-                           const std::filesystem::path& folder, std::uint64_t seed) {
+                           const std::filesystem::path& folder, std::uint64_t seed,
+                           double units_to_m = 1.0) {
   const std::filesystem::path path = folder / (id + ".ply");
-  perception::WriteCloud(path, perception::MakeCloud(scanner::ScannedSurface(mesh, kCloudPoints,
-                                                                             kCloudNoise_m, seed)));
-  return perception::CloudObject(path);
+  std::vector<Eigen::Vector3d> points =
+      scanner::ScannedSurface(mesh, kCloudPoints, kCloudNoise_m, seed);
+  for (Eigen::Vector3d& p : points) p /= units_to_m;
+  perception::WriteCloud(path, perception::MakeCloud(points));
+  return perception::CloudObject(path, units_to_m);
 }
 
 // The scene seen by a depth camera where the laser scanner stood, brought as a user of such a
@@ -286,9 +289,11 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
   }
   std::vector<ObjectSource> flat = meshes;
   flat.push_back(perception::CatalogueObject("panel"));
-  std::vector<ObjectSource> cad;
-  for (const char* name : kCadMeshes)
+  std::vector<ObjectSource> cad, cad_scans;
+  for (const char* name : kCadMeshes) {
     cad.push_back(CadObject(options.data_cache, name, folder.path()));
+    cad_scans.push_back(ScannedObject(name, cad.back().mesh, folder.path(), options.seed, 0.001));
+  }
 
   sim::VirtualScannerOptions scan_options;
   scan_options.pattern.kind = scanner::ScannerKind::kGalvo;
@@ -309,8 +314,10 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
   const ObjectDatabase cloud_db = database(clouds, "scans");
   const ObjectDatabase flat_db = database(flat, "meshes and a panel");
   const ObjectDatabase cad_db = database(cad, "CAD parts in millimetres");
+  const ObjectDatabase cad_scan_db = database(cad_scans, "scans of the CAD parts in millimetres");
 
-  Recogniser from_meshes(mesh_db), from_scans(cloud_db), with_panel(flat_db), from_cad(cad_db);
+  Recogniser from_meshes(mesh_db), from_scans(cloud_db), with_panel(flat_db), from_cad(cad_db),
+      from_cad_scans(cad_scan_db);
   std::vector<Truth> truths, cad_truths;
   for (const ObjectSource& object : meshes) truths.push_back(TruthOf(object, mesh_db));
   for (const ObjectSource& object : cad) cad_truths.push_back(TruthOf(object, cad_db));
@@ -330,8 +337,10 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
               options, result["depth_camera"]);
     const std::size_t c = static_cast<std::size_t>(s) % cad.size();
     const Scene cad_scene = ObjectScene(cad[c], cad_rng);
-    ScoreScan(cad_scene, scanner.Scan(cad_scene.objects, cad_scene.T_W_C, scan_seed), from_cad,
-              cad_truths[c], options, result["catalogue_mm"]);
+    const sim::VirtualScan cad_scan = scanner.Scan(cad_scene.objects, cad_scene.T_W_C, scan_seed);
+    ScoreScan(cad_scene, cad_scan, from_cad, cad_truths[c], options, result["catalogue_mm"]);
+    ScoreScan(cad_scene, cad_scan, from_cad_scans, cad_truths[c], options,
+              result["catalogue_mm_clouds"]);
     const Scene panel = PanelScene(flat.back(), s, rng);
     ScoreScan(panel, scanner.Scan(panel.objects, panel.T_W_C, scan_seed), with_panel, panel_truth,
               options, result["flat_objects"]);

@@ -35,7 +35,8 @@ struct ConditionFigures {
   std::vector<double> nees_per_dimension;
 };
 
-// "mesh_models", "cloud_models", "depth_camera", "catalogue_mm", "flat_objects".
+// "mesh_models", "cloud_models", "depth_camera", "catalogue_mm", "catalogue_mm_clouds",
+// "flat_objects".
 using RecognitionConditions = std::map<std::string, ConditionFigures>;
 
 // Each condition's scenes: one object on a seabed (z = 0) at a random yaw, or for the flat objects
@@ -48,7 +49,9 @@ using RecognitionConditions = std::map<std::string, ConditionFigures>;
 // handed over as a PCD looking along -z with a VIEWPOINT and read back by the scan reader of
 // `recognize`; the database is still the laser scanner's. The millimetre catalogue is six CGAL
 // parts no other bench uses, each 0.3 m across, written as OBJ in millimetres and taught by
-// build-db's reader given millimetres, in scenes of their own. Throws uwscan::Error naming a
+// build-db's reader given millimetres, in scenes of their own; the same parts are also taught from
+// scans of them (clouds as above, written in millimetres and read given millimetres), on the same
+// scenes and scored against the same truths. Throws uwscan::Error naming a
 // missing mesh when the data cache lacks one. Deterministic for a seed.
 RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOptions& options,
                                                const Progress& progress = {});
