@@ -4,18 +4,18 @@
 
 #include "scanner/common/error.hpp"
 #include "viewer/render/display.hpp"
+#include "viewer/render/projection.hpp"
 #include "viewer/render/vtk_scene.hpp"
 
 namespace uwscan::viewer {
 
 std::optional<Eigen::Vector2i> PictureInfo::PixelOf(const Eigen::Vector3d& p_W) const {
-  const Eigen::Vector4d clip = ndc_from_world * p_W.homogeneous();
-  if (!(clip.w() > 0.0)) return std::nullopt;
-  const Eigen::Vector3d ndc = clip.head<3>() / clip.w();
-  // NDC x, y in [-1, 1] cover the picture; rows count from the top.
-  const int column = static_cast<int>(std::floor((ndc.x() + 1.0) * 0.5 * width_px));
-  const int row = static_cast<int>(std::floor((1.0 - ndc.y()) * 0.5 * height_px));
-  if (column < 0 || column >= width_px || row < 0 || row >= height_px) return std::nullopt;
+  const std::optional<Eigen::Vector2d> ndc = NdcOf(ndc_from_world, p_W);
+  if (!ndc) return std::nullopt;
+  // Rows count from the top; NDC 1 is the far edge of the last pixel, outside it.
+  const int column = static_cast<int>(std::floor((ndc->x() + 1.0) * 0.5 * width_px));
+  const int row = static_cast<int>(std::floor((1.0 - ndc->y()) * 0.5 * height_px));
+  if (column >= width_px || row >= height_px) return std::nullopt;
   return Eigen::Vector2i(column, row);
 }
 

@@ -33,6 +33,7 @@
 
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
+#include "viewer/render/projection.hpp"
 #include "viewer/scene/label_layout.hpp"
 #include "viewer/scene/point_colours.hpp"
 
@@ -151,16 +152,14 @@ class LabelLayout : public vtkCommand {
   }
 
  private:
-  // Where a world point falls on the picture (pixels, from its bottom left corner); std::nullopt
-  // behind the camera or outside the picture.
+  // Where a world point falls on the picture (sub-pixel, from its bottom left corner, as the
+  // renderer's display coordinates count); std::nullopt behind the camera or outside the picture.
   static std::optional<Eigen::Vector2d> PixelOf(const Eigen::Matrix4d& ndc_from_world,
                                                 const Eigen::Vector3d& p_W,
                                                 const Eigen::Vector2d& picture) {
-    const Eigen::Vector4d clip = ndc_from_world * p_W.homogeneous();
-    if (!(clip.w() > 0.0)) return std::nullopt;
-    const Eigen::Vector2d ndc = clip.head<2>() / clip.w();
-    if (!(ndc.cwiseAbs().maxCoeff() <= 1.0)) return std::nullopt;
-    return (0.5 * (ndc.array() + 1.0) * picture.array()).matrix();
+    const std::optional<Eigen::Vector2d> ndc = NdcOf(ndc_from_world, p_W);
+    if (!ndc) return std::nullopt;
+    return (0.5 * (ndc->array() + 1.0) * picture.array()).matrix();
   }
 
   // The line from the label's anchor to the nearest edge of its box; none when the box covers
