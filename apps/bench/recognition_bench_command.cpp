@@ -363,7 +363,8 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
                   "instead: recognition under the conditions users' data brings, this many scenes "
                   "each: objects taught from scans (clouds) beside the same from meshes, the "
                   "scenes seen by a depth camera (PCD with a VIEWPOINT), six CAD parts in "
-                  "millimetres, flat panels on the seabed and on a wall")
+                  "millimetres taught from their meshes and from scans of them, flat panels on "
+                  "the seabed and on a wall")
       ->check(CLI::Range(1, 100000));
   cmd->add_flag("--real-pair", a->real_pair,
                 "instead: PCL's correspondence grouping tutorial pair (a milk carton's model and a "
