@@ -16,6 +16,11 @@ function(uwscan_add_library name)
   target_include_directories(uwscan_${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(uwscan_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   uwscan_set_warnings(uwscan_${name})
+  if(UWSCAN_BUILD_TESTS)
+    # Every function it compiles for several CPUs is dispatched at run time (the script says why).
+    add_test(NAME dispatch.${name} COMMAND ${PROJECT_SOURCE_DIR}/scripts/check_dispatch.sh
+                                           $<TARGET_FILE:uwscan_${name}> ${ARG_SOURCES})
+  endif()
 endfunction()
 
 # uwscan_add_test(NAME SOURCES ... DEPS ...): one GoogleTest executable registered with CTest.

@@ -48,11 +48,12 @@ inline bool Grazing(const ConeFrame& f, double bb, double u, double y, double z,
   return along * along <= min_sin2 * (nx * nx + ny * ny + nz * nz) * d2_C;
 }
 
-}  // namespace
-
 // The loop runs over the lanes of the block; every lane follows exactly the arithmetic of the
 // per-ray IntersectRayCone, with its early returns turned into masks, then the grazing test.
-__attribute__((target_clones("avx512f", "avx2", "default"))) void IntersectRayConeBlock(
+// The clones belong to this internal function, not to the one the header declares: clang 14
+// compiles a target_clones definition that has an earlier plain declaration into its first
+// clone alone, without dispatch (an AVX-512 function that stops other CPUs with SIGILL).
+__attribute__((target_clones("avx512f", "avx2", "default"))) void IntersectLanes(
     const PreparedCone& cone, const RayBlock& rays, double min_sin2_angle, HitBlock* hits) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const ConeFrame f = FrameOf(cone);
@@ -126,6 +127,13 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void IntersectRayCo
     hits->y[i] = Select(hit, rays.oy[i] + t * rays.dy[i], 0.0);
     hits->z[i] = Select(hit, rays.oz[i] + t * rays.dz[i], 0.0);
   }
+}
+
+}  // namespace
+
+void IntersectRayConeBlock(const PreparedCone& cone, const RayBlock& rays, double min_sin2_angle,
+                           HitBlock* hits) {
+  IntersectLanes(cone, rays, min_sin2_angle, hits);
 }
 
 }  // namespace uwscan::scanner
