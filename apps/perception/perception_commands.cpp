@@ -160,33 +160,32 @@ nlohmann::json PrintBuckets(const std::vector<bench::OverlapBucket>& buckets) {
   return out;
 }
 
-void RunRegistrationBench(const RegistrationBenchArgs& a) {
+bench::RegistrationBenchOptions RegistrationBenchOptionsOf(const RegistrationBenchArgs& a) {
   bench::RegistrationBenchOptions o;
   o.data_cache = DataCache();
   o.pairs.pairs_per_mesh = a.pairs_per_mesh;
   o.pairs.seed = a.seed;
   o.pairs.real_scans = !a.no_real_scans;
   o.pairs.hard_pairs = !a.no_hard_pairs;
+  o.pairs.table_cache = TableCache();
   o.threads = a.threads;
   o.run_pcl = !a.no_pcl;
   o.run_open3d = !a.no_open3d;
   o.sweep_voxel_fractions = a.sweep_voxel;
-  bench::RegistrationBenchResult r;
-  {
-    ProgressBar bar;
-    r = bench::RunRegistrationBenchmark(o, bar.Callback());
-  }
+  return o;
+}
+
+// The table per pipeline over the overlapping pairs, with its time per stage.
+nlohmann::json PrintPipelines(const bench::RegistrationBenchResult& r, int threads) {
   std::printf(
       "Registration on %d overlapping pairs (%d threads): success = rotation < 2 deg and "
       "translation < 1 %% of the object size; ADD-S success = mean distance to the nearest truly "
       "placed point < 1 %% of the object size (a symmetric object's equivalent poses pass); "
       "accepted = the pipeline vouched for its pose\n\n",
-      r.pipelines.at("uwscan").pairs, a.threads);
+      r.pipelines.at("uwscan").pairs, threads);
   std::printf(
       "| pipeline | success | ADD-S success | accepted | s/pair | downsample | normals | features "
-      "| "
-      "coarse | icp |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| coarse | icp |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json pipelines = nlohmann::json::object();
   for (const auto& [name, s] : r.pipelines) {
     auto stage = [&stages = s.stage_seconds_per_pair](const char* k) {
@@ -205,7 +204,11 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
                        {"accepted", s.accepted},
                        {"stage_seconds_per_pair", s.stage_seconds_per_pair}};
   }
-  const nlohmann::json buckets = PrintBuckets(r.buckets);
+  return pipelines;
+}
+
+// Each peer's time per pair over uwscan's.
+nlohmann::json PrintTimeRatios(const bench::RegistrationBenchResult& r) {
   nlohmann::json ratios = nlohmann::json::object();
   const double ours = r.pipelines.at("uwscan").seconds_per_pair;
   for (const auto& [name, s] : r.pipelines) {
@@ -213,27 +216,35 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
     ratios[name + "_over_uwscan_time"] = s.seconds_per_pair / ours;
     std::printf("%s / uwscan time: %.2fx\n", name.c_str(), s.seconds_per_pair / ours);
   }
-  nlohmann::json outcomes = nlohmann::json::array();
-  for (const bench::PairOutcome& p : r.outcomes) {
-    outcomes.push_back({{"pair", p.pair},
-                        {"pipeline", p.pipeline},
-                        {"rotation_error_deg", p.rotation_error_rad * kRadToDeg},
-                        {"translation_error_m", p.translation_error_m},
-                        {"symmetric_error_m", p.symmetric_error_m},
-                        {"seconds", p.seconds},
-                        {"success", p.success},
-                        {"symmetric_success", p.symmetric_success},
-                        {"accepted", p.accepted},
-                        {"overlapping", p.overlapping},
-                        {"overlap", p.overlap}});
+  return ratios;
+}
+
+nlohmann::json OutcomesJson(const std::vector<bench::PairOutcome>& outcomes) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const bench::PairOutcome& p : outcomes) {
+    out.push_back({{"pair", p.pair},
+                   {"pipeline", p.pipeline},
+                   {"rotation_error_deg", p.rotation_error_rad * kRadToDeg},
+                   {"translation_error_m", p.translation_error_m},
+                   {"symmetric_error_m", p.symmetric_error_m},
+                   {"seconds", p.seconds},
+                   {"success", p.success},
+                   {"symmetric_success", p.symmetric_success},
+                   {"accepted", p.accepted},
+                   {"overlapping", p.overlapping},
+                   {"overlap", p.overlap}});
   }
+  return out;
+}
+
+nlohmann::json PrintVoxelSweep(const std::vector<bench::VoxelSweepRow>& rows) {
   nlohmann::json sweep = nlohmann::json::array();
-  if (!r.voxel_sweep.empty()) {
+  if (!rows.empty()) {
     std::printf(
         "\nuwscan's pipeline by voxel size (radii and distances scale with it)\n\n"
         "| voxel / object size | success | ADD-S success | s/pair |\n|---:|---:|---:|---:|\n");
   }
-  for (const bench::VoxelSweepRow& row : r.voxel_sweep) {
+  for (const bench::VoxelSweepRow& row : rows) {
     const bench::PipelineSummary& s = row.summary;
     std::printf("| %.4f | %d/%d | %d/%d | %.3f |\n", row.voxel_fraction, s.successes, s.pairs,
                 s.symmetric_successes, s.pairs, s.seconds_per_pair);
@@ -242,12 +253,25 @@ void RunRegistrationBench(const RegistrationBenchArgs& a) {
                      {"symmetric_success_rate", s.symmetric_success_rate},
                      {"seconds_per_pair", s.seconds_per_pair}});
   }
+  return sweep;
+}
+
+void RunRegistrationBench(const RegistrationBenchArgs& a) {
+  bench::RegistrationBenchResult r;
+  {
+    ProgressBar bar;
+    r = bench::RunRegistrationBenchmark(RegistrationBenchOptionsOf(a), bar.Callback());
+  }
+  const nlohmann::json pipelines = PrintPipelines(r, a.threads);
+  const nlohmann::json buckets = PrintBuckets(r.buckets);
+  const nlohmann::json ratios = PrintTimeRatios(r);
+  const nlohmann::json sweep = PrintVoxelSweep(r.voxel_sweep);
   if (!a.json.empty()) {
     WriteJsonFile(a.json, {{"bench", "registration"},
                            {"pipelines", pipelines},
                            {"buckets", buckets},
                            {"ratios", ratios},
-                           {"pairs", outcomes},
+                           {"pairs", OutcomesJson(r.outcomes)},
                            {"voxel_sweep", sweep}});
   }
 }
@@ -315,7 +339,7 @@ void AddPerceptionBenchCommands(CLI::App& bench) {
   reg->add_flag("--no-real-scans", a->no_real_scans, "only the mesh pairs");
   reg->add_flag("--no-hard-pairs", a->no_hard_pairs,
                 "only the main pairs: no views further apart, sparser or with outliers, no scans "
-                "cut in two, no pairs without overlap");
+                "cut in two, no pairs without overlap, no sweeps of the virtual scanner");
   reg->add_option("--sweep-voxel", a->sweep_voxel,
                   "also run uwscan's pipeline at these voxel sizes, fractions of the object size "
                   "(e.g. 0.01 0.02 0.04)");

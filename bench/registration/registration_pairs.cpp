@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <random>
 
@@ -14,6 +15,8 @@
 #include "scanner/common/option_checks.hpp"
 #include "scanner/common/random_draws.hpp"
 #include "scanner/common/triangle_mesh.hpp"
+#include "scanner/lasers/scanner_file.hpp"
+#include "scanner/sim/virtual_scanner.hpp"
 
 namespace uwscan::bench {
 namespace {
@@ -227,6 +230,105 @@ void AddUnrelatedPairs(const std::filesystem::path& cache, const RegistrationPai
   }
 }
 
+// The camera at `standoff_m` from `centre` along `direction`, looking at it.
+Eigen::Isometry3d ViewFrom(const Eigen::Vector3d& centre, const Eigen::Vector3d& direction,
+                           double standoff_m) {
+  const Eigen::Vector3d up =
+      std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  return scanner::sim::LookAt(centre + standoff_m * direction, centre, up);
+}
+
+// One sweep's points in the camera frame, appended with the stray ones (a peak from no lit
+// surface: noise) last; returns how many are stray.
+std::size_t SweepPoints(const scanner::sim::VirtualScan& scan, std::vector<Eigen::Vector3d>* out) {
+  std::vector<Eigen::Vector3d> stray;
+  for (std::size_t i = 0; i < scan.points_C.size(); ++i) {
+    (scan.truth_C[i].allFinite() ? *out : stray).push_back(scan.points_C[i]);
+  }
+  out->insert(out->end(), stray.begin(), stray.end());
+  return stray.size();
+}
+
+// Two sweeps of the virtual scanner, each in its own camera frame.
+struct TwoSweeps {
+  scanner::sim::VirtualScan target, source;
+  Eigen::Isometry3d T_W_target, T_W_source;
+  double separation_rad = 0.0;
+};
+
+// Views drawn `separation` apart (0.5-1.4 rad) at stand-offs of 0.7-1.3 m each, drawn again while
+// either sweep sees fewer than 500 points of the object.
+TwoSweeps SweepTwice(const scanner::sim::VirtualScanner& scanner,
+                     const scanner::sim::SceneObject& object, std::mt19937_64& rng) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : object.mesh.vertices) box.extend(v);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> standoff_m(0.7, 1.3), separation_rad(0.5, 1.4);
+  TwoSweeps s;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    const Eigen::Vector3d a = DrawVector3LastFirst(gauss, rng).normalized();
+    s.separation_rad = separation_rad(rng);
+    const Eigen::Vector3d b = Eigen::AngleAxisd(s.separation_rad, a.unitOrthogonal()) * a;
+    s.T_W_target = ViewFrom(box.center(), a, standoff_m(rng));
+    s.T_W_source = ViewFrom(box.center(), b, standoff_m(rng));
+    s.target = scanner.Scan({object}, s.T_W_target, rng());
+    s.source = scanner.Scan({object}, s.T_W_source, rng());
+    if (s.target.points_C.size() >= 500 && s.source.points_C.size() >= 500) return s;
+  }
+  throw Error("registration pairs: the virtual scanner sees too little of mesh '" + object.name +
+              "'");
+}
+
+// The two sweeps as a pair, the source moved by a random rigid motion on top of its camera
+// frame; `surface` (object frame = world) is the whole object's.
+RegistrationPair SweepPair(const std::string& name, const TwoSweeps& s,
+                           const std::vector<Eigen::Vector3d>& surface, double max_translation_m,
+                           std::mt19937_64& rng) {
+  RegistrationPair pair;
+  pair.name = name;
+  std::vector<Eigen::Vector3d> target, source;
+  SweepPoints(s.target, &target);
+  pair.source_outliers = SweepPoints(s.source, &source);
+  const Eigen::Isometry3d T_moved_C = RandomMotion(rng, max_translation_m);
+  for (Eigen::Vector3d& p : source) p = T_moved_C * p;
+  const Eigen::Isometry3d T_moved_W = T_moved_C * s.T_W_source.inverse();
+  std::vector<Eigen::Vector3d> surface_in_source;
+  surface_in_source.reserve(surface.size());
+  for (const Eigen::Vector3d& p : surface) surface_in_source.push_back(T_moved_W * p);
+  pair.target = perception::MakeCloud(target);
+  pair.source = perception::MakeCloud(source);
+  pair.surface = perception::MakeCloud(surface_in_source);
+  pair.source_viewpoint = T_moved_C.translation();  // the camera's centre
+  pair.target_viewpoint = Eigen::Vector3d::Zero();
+  pair.T_target_source_true = s.T_W_target.inverse() * T_moved_W.inverse();
+  pair.object_size_m = perception::BoundingBoxDiagonal(pair.target);
+  return pair;
+}
+
+// Per mesh, two sweeps of the virtual scanner (the default galvanometer scanner under water:
+// refraction at both viewports, occlusion, 0.1 px of peak noise): a real sweep's density, which
+// falls with range and incidence, its noise along the camera's rays and its stray points.
+void AddSweepPairs(const std::filesystem::path& cache, const RegistrationPairOptions& o,
+                   std::mt19937_64& rng, std::vector<RegistrationPair>* pairs) {
+  scanner::sim::VirtualScannerOptions scan_options;
+  scan_options.pattern.kind = scanner::ScannerKind::kGalvo;
+  scan_options.table_cache = o.table_cache;
+  const scanner::sim::VirtualScanner scanner(scanner::DefaultScanner(scanner::ScannerKind::kGalvo),
+                                             scan_options);
+  for (const char* name : kMeshes) {
+    scanner::sim::SceneObject object;
+    object.name = name;
+    object.shape = scanner::sim::ObjectShape::kMesh;
+    object.mesh = LoadScaledMesh(cache, name, o.mesh_size_m);
+    const TwoSweeps sweeps = SweepTwice(scanner, object, rng);
+    const std::vector<Eigen::Vector3d> surface =
+        scanner::SampleSurface(object.mesh, o.mesh_samples, rng()).points;
+    char label[64];
+    std::snprintf(label, sizeof label, " sweeps %.1f rad", sweeps.separation_rad);
+    pairs->push_back(SweepPair(name + std::string(label), sweeps, surface, o.mesh_size_m, rng));
+  }
+}
+
 // A pair from a real scan: the target and the source drawn from `target_points` and
 // `source_points` (each point kept with probability `keep`), the source with noise of a
 // thousandth of the scan's size and moved by a random rigid motion; `points` is the whole scan.
@@ -343,10 +445,11 @@ std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path&
     // Each group draws from its own stream: leaving one out (--no-real-scans) leaves the
     // others as they are.
     std::mt19937_64 hard_rng(options.seed * 7919 + 1), cut_rng(options.seed * 7919 + 2),
-        unrelated_rng(options.seed * 7919 + 3);
+        unrelated_rng(options.seed * 7919 + 3), sweep_rng(options.seed * 7919 + 4);
     AddHardMeshPairs(data_cache, options, hard_rng, &pairs);
     if (options.real_scans) AddScanCuts(data_cache, cut_rng, &pairs);
     AddUnrelatedPairs(data_cache, options, unrelated_rng, &pairs);
+    if (options.scanner_sweeps) AddSweepPairs(data_cache, options, sweep_rng, &pairs);
   }
   for (RegistrationPair& pair : pairs) {
     // Within 1 % of the object's size (the success test's tolerance), but never less than a few
