@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A small clang-tidy set over the project's C++ (use after move, dangling handles, redundant
-# expressions, needless copies and moves; in the libraries also no function body over 80 lines,
-# issue 51's rule: split it into named steps), with a build's compile_commands.json:
+# expressions, needless copies and moves; no function body over 80 lines, issue 51's rule: split
+# it into named steps), with a build's compile_commands.json:
 #   scripts/check_tidy.sh [--build DIR] [PATH...]   PATHs: files or folders (default: every
 #                                                  library, bench and app source); exit 1 on any
 #                                                  finding
@@ -56,22 +56,11 @@ else
 fi
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
-# The libraries' sources also get the length rule; the app's and benches' command functions
-# (option tables, report printing) are not held to it. Each file is parsed once.
-library=() others=()
-for f in "${files[@]}"; do
-  case "$f" in scanner/* | perception/* | mapping/* | viewer/* | ros/*) library+=("$f") ;; *) others+=("$f") ;; esac
-done
 # -config takes the place of .clang-tidy, whose header filter is then passed on its own.
 length='{CheckOptions: [{key: readability-function-size.LineThreshold, value: 80}]}'
 headers=$(sed -n "s/^HeaderFilterRegex: '\(.*\)'$/\1/p" .clang-tidy)
-if [ ${#library[@]} -gt 0 ]; then
-  run-clang-tidy-14 -p "$build" -j "$(nproc)" -quiet -checks="$checks,readability-function-size" \
-    -config="$length" -header-filter="$headers" "${library[@]}" >>"$log" 2>&1 || true
-fi
-if [ ${#others[@]} -gt 0 ]; then
-  run-clang-tidy-14 -p "$build" -j "$(nproc)" -quiet -checks="$checks" "${others[@]}" >>"$log" 2>&1 || true
-fi
+run-clang-tidy-14 -p "$build" -j "$(nproc)" -quiet -checks="$checks,readability-function-size" \
+  -config="$length" -header-filter="$headers" "${files[@]}" >>"$log" 2>&1 || true
 if grep -q 'warning:\|error:' "$log"; then
   grep -A3 'warning:\|error:' "$log" >&2
   echo "check_tidy: findings in ${#files[@]} files" >&2

@@ -39,13 +39,7 @@ nlohmann::json PeakJson(const bench::PeakErrorFigures& f) {
           {"peaks", f.peaks}};
 }
 
-void RunAccuracy(const AccuracyArgs& a) {
-  if (!a.json_path.empty()) {
-    const std::filesystem::path parent = std::filesystem::path(a.json_path).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-      throw Error("--json " + a.json_path + ": folder '" + parent.string() + "' does not exist");
-    }
-  }
+bench::AccuracyBenchOptions AccuracyOptionsOf(const AccuracyArgs& a) {
   bench::AccuracyBenchOptions o;
   const std::filesystem::path data = DataFolderOr(a.data_dir);
   o.galvo_scanner = data / "scanners" / "galvo_default.yaml";
@@ -59,11 +53,10 @@ void RunAccuracy(const AccuracyArgs& a) {
     o.waypoints_per_line = {5, 50};
     o.mems_lines = 20;
   }
-  bench::AccuracyBenchResult r;
-  {
-    ProgressBar bar;
-    r = bench::RunAccuracyBenchmark(o, bar.Callback());
-  }
+  return o;
+}
+
+void PrintGauges(const bench::AccuracyBenchOptions& o, const bench::AccuracyBenchResult& r) {
   std::printf(
       "Seed 000 gauges (galvanometer scanner, %d positions %.2f-%.2f m, lengths 20/50/100 mm):\n\n",
       o.gauge_positions, o.gauge_near_m, o.gauge_far_m);
@@ -80,7 +73,10 @@ void RunAccuracy(const AccuracyArgs& a) {
   gauge_row("air", r.gauges_air, r.gauges_air_exact, "0.44 / 0.35");
   gauge_row("water", r.gauges_water, r.gauges_water_exact, "0.98 / 0.72");
   std::printf("\n");
+}
 
+nlohmann::json PrintPlane(const bench::AccuracyBenchOptions& o,
+                          const bench::AccuracyBenchResult& r) {
   nlohmann::json plane = nlohmann::json::array();
   std::printf("Seed 001 plane (MEMS scanner, %d lines x 50 waypoints, under water):\n\n",
               o.mems_lines);
@@ -90,6 +86,11 @@ void RunAccuracy(const AccuracyArgs& a) {
                 static_cast<long long>(row.points));
     plane.push_back({{"distance_m", row.distance_m}, {"rms_m", row.rms_m}, {"points", row.points}});
   }
+  return plane;
+}
+
+nlohmann::json PrintSphere(const bench::AccuracyBenchOptions& o,
+                           const bench::AccuracyBenchResult& r) {
   nlohmann::json sphere = nlohmann::json::array();
   std::printf("\nSeed 001 sphere (radius %.0f mm):\n\n", o.sphere_radius_m * 1e3);
   std::printf("| distance m | radius err mm | fit rms mm | points |\n|---:|---:|---:|---:|\n");
@@ -101,6 +102,11 @@ void RunAccuracy(const AccuracyArgs& a) {
                       {"rms_m", row.rms_m},
                       {"points", row.points}});
   }
+  return sphere;
+}
+
+nlohmann::json PrintWaypoints(const bench::AccuracyBenchOptions& o,
+                              const bench::AccuracyBenchResult& r) {
   nlohmann::json waypoints = nlohmann::json::array();
   std::printf(
       "\nSeed 001 waypoints per line (plane at %.2f m; seed: ~70 lines/s, 140 k points/s at "
@@ -118,6 +124,10 @@ void RunAccuracy(const AccuracyArgs& a) {
                          {"lines_per_s", row.lines_per_s},
                          {"points_per_s", row.points_per_s}});
   }
+  return waypoints;
+}
+
+void PrintPeakErrors(const bench::AccuracyBenchResult& r) {
   std::printf(
       "\nThe detector on the rendered stripes (detected peak minus the exact crossing of its image "
       "line):\n\n");
@@ -130,22 +140,40 @@ void RunAccuracy(const AccuracyArgs& a) {
   };
   peak_row("galvanometer, gauges in water", r.peak_errors_gauges_water);
   peak_row("MEMS, plane", r.peak_errors_plane);
-  std::printf("\n%.1f s. The accuracy-versus-time plot (PNG) is left to the viewer issue.\n",
-              r.seconds);
+}
+
+void RunAccuracy(const AccuracyArgs& a) {
   if (!a.json_path.empty()) {
-    WriteJsonFile(a.json_path, {{"gauges",
-                                 {{"air", GaugeJson(r.gauges_air)},
-                                  {"water", GaugeJson(r.gauges_water)},
-                                  {"air_exact_peaks", GaugeJson(r.gauges_air_exact)},
-                                  {"water_exact_peaks", GaugeJson(r.gauges_water_exact)}}},
-                                {"plane", plane},
-                                {"sphere", sphere},
-                                {"waypoints", waypoints},
-                                {"peak_errors",
-                                 {{"gauges_water", PeakJson(r.peak_errors_gauges_water)},
-                                  {"plane", PeakJson(r.peak_errors_plane)}}},
-                                {"seconds", r.seconds}});
+    const std::filesystem::path parent = std::filesystem::path(a.json_path).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+      throw Error("--json " + a.json_path + ": folder '" + parent.string() + "' does not exist");
+    }
   }
+  const bench::AccuracyBenchOptions o = AccuracyOptionsOf(a);
+  bench::AccuracyBenchResult r;
+  {
+    ProgressBar bar;
+    r = bench::RunAccuracyBenchmark(o, bar.Callback());
+  }
+  PrintGauges(o, r);
+  const nlohmann::json plane = PrintPlane(o, r);
+  const nlohmann::json sphere = PrintSphere(o, r);
+  const nlohmann::json waypoints = PrintWaypoints(o, r);
+  PrintPeakErrors(r);
+  std::printf("\n%.1f s (`uwscan plot` draws the --json's accuracy against time).\n", r.seconds);
+  if (a.json_path.empty()) return;
+  WriteJsonFile(a.json_path, {{"gauges",
+                               {{"air", GaugeJson(r.gauges_air)},
+                                {"water", GaugeJson(r.gauges_water)},
+                                {"air_exact_peaks", GaugeJson(r.gauges_air_exact)},
+                                {"water_exact_peaks", GaugeJson(r.gauges_water_exact)}}},
+                              {"plane", plane},
+                              {"sphere", sphere},
+                              {"waypoints", waypoints},
+                              {"peak_errors",
+                               {{"gauges_water", PeakJson(r.peak_errors_gauges_water)},
+                                {"plane", PeakJson(r.peak_errors_plane)}}},
+                              {"seconds", r.seconds}});
 }
 
 }  // namespace

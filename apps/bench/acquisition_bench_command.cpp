@@ -67,6 +67,78 @@ std::uint64_t RealTimeNs() {
          static_cast<std::uint64_t>(t.tv_nsec);
 }
 
+// The first and last frame received (not their pixels: copying those would cost time here).
+struct FrameMark {
+  std::int64_t frame_number = 0;
+  std::uint64_t camera_ns = 0, host_ns = 0;
+  std::int64_t session = 0;
+};
+
+// What a stream's loop saw: frames received, the first and last, and the latency from capture to
+// decoded peaks of each frame with peaks.
+struct StreamRead {
+  std::int64_t received = 0;
+  std::optional<FrameMark> first;
+  FrameMark last;
+  std::vector<double> latencies_s;
+};
+
+// Reads the started `source` for `seconds`, decoding every frame and handing it to `inspection`
+// when there is one.
+StreamRead ReadStream(acq::FrameSource& source, CameraFrameDecoder& decoder,
+                      mapping::LiveInspection* inspection, double seconds) {
+  StreamRead read;
+  while (source.ElapsedSeconds() < seconds) {
+    std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
+    if (!frame) continue;
+    ++read.received;
+    read.last = {frame->frame_number, frame->camera_timestamp_ns, frame->host_timestamp_ns,
+                 frame->session};
+    if (!read.first) read.first = read.last;
+    std::optional<mapping::FrameRecord> record = decoder.Decode(*frame);
+    if (!record) continue;
+    if (!record->peaks_px.empty()) {
+      read.latencies_s.push_back(
+          (static_cast<double>(RealTimeNs()) - static_cast<double>(frame->camera_timestamp_ns)) *
+          1e-9);
+    }
+    if (inspection) inspection->Push(ToInspectionFrame(std::move(*record), *frame));
+  }
+  return read;
+}
+
+// The rates a stream reached: by the camera's clock, by the host's and over the wall time.
+StreamFigures RatesOf(StreamRead& read, const acq::FrameSourceStatistics& s, double elapsed_s,
+                      double seconds) {
+  const FrameMark& last = read.last;
+  if (read.received < 2 || last.host_ns <= read.first->host_ns ||
+      last.camera_ns <= read.first->camera_ns) {
+    throw Error("bench acquisition: fewer than 2 frames received in " + std::to_string(seconds) +
+                " s");
+  }
+  if (last.session != read.first->session) {
+    throw Error(
+        "bench acquisition: the camera was reopened during the run (it went silent); run again");
+  }
+  StreamFigures f;
+  f.camera_frames_per_s = static_cast<double>(last.frame_number - read.first->frame_number) /
+                          (static_cast<double>(last.camera_ns - read.first->camera_ns) * 1e-9);
+  f.frames_per_s = static_cast<double>(read.received - 1) /
+                   (static_cast<double>(last.host_ns - read.first->host_ns) * 1e-9);
+  f.frames = s.frames;
+  f.frames_per_s_wall = s.frames / elapsed_s;
+  f.mb_per_s = s.frames > 0 ? static_cast<double>(s.bytes) / static_cast<double>(s.frames) *
+                                  f.frames_per_s * 1e-6
+                            : 0.0;
+  f.lost_frames = s.lost_frames;
+  std::vector<double>& latencies = read.latencies_s;
+  if (!latencies.empty()) {
+    std::nth_element(latencies.begin(), latencies.begin() + latencies.size() / 2, latencies.end());
+    f.latency_to_peaks_s = latencies[latencies.size() / 2];
+  }
+  return f;
+}
+
 // Streams `seconds` from the fake camera on 127.0.0.1 and decodes (profile) or detects (image)
 // every frame, as `acquire` does, without the disk; with `map`, also maps them live as
 // `inspect` does (no log), for the latency from capture to points in the map.
@@ -92,60 +164,12 @@ StreamFigures Stream(const scanner::sim::Simulator& simulator, const std::string
     inspection = std::make_unique<mapping::LiveInspection>(
         context.header, "", context.T_V_C, mapping::NavigationNoise{}, inspection_options);
   }
-  std::vector<double> latencies;
-  // The first and last frame received (not their pixels: copying those would cost time here).
-  struct FrameMark {
-    std::int64_t frame_number = 0;
-    std::uint64_t camera_ns = 0, host_ns = 0;
-    std::int64_t session = 0;
-  };
-  std::optional<FrameMark> first;
-  FrameMark last;
-  std::int64_t received = 0;
   source.Start();
-  while (source.ElapsedSeconds() < seconds) {
-    std::optional<acq::AcquiredFrame> frame = source.Next(std::chrono::milliseconds(100));
-    if (!frame) continue;
-    ++received;
-    last = {frame->frame_number, frame->camera_timestamp_ns, frame->host_timestamp_ns,
-            frame->session};
-    if (!first) first = last;
-    std::optional<mapping::FrameRecord> record = decoder.Decode(*frame);
-    if (!record) continue;
-    if (!record->peaks_px.empty()) {
-      latencies.push_back(
-          (static_cast<double>(RealTimeNs()) - static_cast<double>(frame->camera_timestamp_ns)) *
-          1e-9);
-    }
-    if (inspection) inspection->Push(ToInspectionFrame(std::move(*record), *frame));
-  }
+  StreamRead read = ReadStream(source, decoder, inspection.get(), seconds);
   const double elapsed = source.ElapsedSeconds();
   source.Stop();
-  const acq::FrameSourceStatistics s = source.statistics();
-  StreamFigures f;
+  StreamFigures f = RatesOf(read, source.statistics(), elapsed, seconds);
   f.requested_fps = camera.frame_rate_hz();
-  if (received < 2 || last.host_ns <= first->host_ns || last.camera_ns <= first->camera_ns) {
-    throw Error("bench acquisition: fewer than 2 frames received in " + std::to_string(seconds) +
-                " s");
-  }
-  if (last.session != first->session) {
-    throw Error(
-        "bench acquisition: the camera was reopened during the run (it went silent); run again");
-  }
-  f.camera_frames_per_s = static_cast<double>(last.frame_number - first->frame_number) /
-                          (static_cast<double>(last.camera_ns - first->camera_ns) * 1e-9);
-  f.frames_per_s = static_cast<double>(received - 1) /
-                   (static_cast<double>(last.host_ns - first->host_ns) * 1e-9);
-  f.frames = s.frames;
-  f.frames_per_s_wall = s.frames / elapsed;
-  f.mb_per_s = s.frames > 0 ? static_cast<double>(s.bytes) / static_cast<double>(s.frames) *
-                                  f.frames_per_s * 1e-6
-                            : 0.0;
-  f.lost_frames = s.lost_frames;
-  if (!latencies.empty()) {
-    std::nth_element(latencies.begin(), latencies.begin() + latencies.size() / 2, latencies.end());
-    f.latency_to_peaks_s = latencies[latencies.size() / 2];
-  }
   if (inspection) {
     const mapping::InspectionStatistics m = inspection->Finish().statistics;
     if (m.capture_to_map.frames > 0) f.latency_to_map_s = m.capture_to_map.median_s;

@@ -208,6 +208,106 @@ void RunRealPair(const Args& a) {
   if (!a.json.empty()) WriteJsonFile(a.json, out);
 }
 
+nlohmann::json PipelineJson(const bench::PipelineFigures& f, double per_scan) {
+  nlohmann::json out = {
+      {"recognition_rate", Ratio(f.recognised, f.objects)},
+      {"recognition_or_reported_ambiguity_rate", Ratio(f.recognised_or_reported, f.objects)},
+      {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
+      {"pose_or_reported_ambiguity_rate", Ratio(f.pose_or_reported, f.recognised)},
+      {"mssd_success_rate", Ratio(f.mssd_success, f.recognised)},
+      {"grasp_success_rate", Ratio(f.grasp_success, f.recognised)},
+      {"foreign_unknown_rate", Ratio(f.foreign_unknown, f.foreign)},
+      {"objects", f.objects},
+      {"median_rotation_error_deg", Median(f.rotation_errors_rad) * kRadToDeg},
+      {"median_translation_error_m", Median(f.translation_errors_m)},
+      {"median_grasp_position_error_m", Median(f.grasp_position_errors_m)},
+      {"median_grasp_angle_error_deg", Median(f.grasp_angle_errors_rad) * kRadToDeg},
+      {"seconds_per_scan", per_scan}};
+  if (!f.scan_seconds.empty()) {
+    out["seconds_per_scan_p95"] = Percentile95(f.scan_seconds);
+    out["seconds_per_scan_max"] = *std::max_element(f.scan_seconds.begin(), f.scan_seconds.end());
+    out["scan_seconds"] = f.scan_seconds;
+  }
+  if (!f.pose_nees_per_dimension.empty()) {
+    out["pose_nees_per_dimension_mean"] = Mean(f.pose_nees_per_dimension);
+    out["pose_nees_per_dimension_median"] = Median(f.pose_nees_per_dimension);
+    out["pose_nees_per_dimension_p95"] = Percentile95(f.pose_nees_per_dimension);
+    out["pose_nees_poses"] = f.pose_nees_per_dimension.size();
+    for (const auto& [truth, nees] : f.pose_nees_by_class) {
+      out["pose_nees_per_dimension_median_by_class"][truth] = Median(nees);
+    }
+  }
+  return out;
+}
+
+// The table of every pipeline; returns its figures as JSON.
+nlohmann::json PrintPipelines(const bench::RecognitionBenchResult& r) {
+  std::printf(
+      "| pipeline | recognised | ... or among the objects reported to fit as well | pose 5 mm / 2 "
+      "deg | ... or its ambiguity reported | MSSD < 0.1 d | "
+      "grasp 5 mm / 3 deg | foreign -> unknown | median rot / trans err | s per scan |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  nlohmann::json pipelines = nlohmann::json::object();
+  for (const auto& [name, f] : r.pipelines) {
+    const double per_scan = f.seconds / r.scans;
+    std::printf(
+        "| %s | %d/%d (%.1f %%) | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %d/%d | %.2f "
+        "deg / %.1f mm | %.3f |\n",
+        name.c_str(), f.recognised, f.objects, 100.0 * Ratio(f.recognised, f.objects),
+        100.0 * Ratio(f.recognised_or_reported, f.objects),
+        100.0 * Ratio(f.pose_success, f.recognised),
+        100.0 * Ratio(f.pose_or_reported, f.recognised),
+        100.0 * Ratio(f.mssd_success, f.recognised), 100.0 * Ratio(f.grasp_success, f.recognised),
+        f.foreign_unknown, f.foreign, Median(f.rotation_errors_rad) * kRadToDeg,
+        Median(f.translation_errors_m) * 1e3, per_scan);
+    pipelines[name] = PipelineJson(f, per_scan);
+  }
+  return pipelines;
+}
+
+// uwscan's own figures: its time per scan and stages, its covariance's NEES, its confusion.
+void PrintUwscanDetails(const bench::RecognitionBenchResult& r, const ConfusionShape& shape) {
+  const bench::PipelineFigures& f = r.pipelines.at("uwscan");
+  if (!f.scan_seconds.empty()) {
+    std::printf("uwscan time per scan: p95 %.3f s, slowest %.3f s\n", Percentile95(f.scan_seconds),
+                *std::max_element(f.scan_seconds.begin(), f.scan_seconds.end()));
+  }
+  std::printf("uwscan stages (s per scan):");
+  for (const auto& [stage, s] : r.uwscan_stage_seconds)
+    std::printf(" %s %.3f", stage.c_str(), s / r.scans);
+  std::printf("\n");
+  if (!f.pose_nees_per_dimension.empty()) {
+    const std::vector<double>& nees = f.pose_nees_per_dimension;
+    std::printf(
+        "uwscan pose covariance: NEES per pinned direction mean %.2f, median %.2f over %zu poses "
+        "within "
+        "10 deg and 5 cm (1 when consistent)\n",
+        Mean(nees), Median(nees), nees.size());
+    std::printf("  median by class:");
+    for (const auto& [truth, by_class] : f.pose_nees_by_class) {
+      std::printf(" %s %.1f (%zu)", truth.c_str(), Median(by_class), by_class.size());
+    }
+    std::printf("\n");
+  }
+  std::printf("uwscan confusion (rows: the true object, columns: uwscan's answer):\n");
+  PrintConfusion(f.confusion, shape);
+}
+
+// Why catalogue objects were not recognised (ObjectOutcome::why_wrong), counted and printed.
+std::map<std::string, int> PrintWhyWrong(const bench::RecognitionBenchResult& r) {
+  std::map<std::string, int> why_wrong;
+  for (const bench::ObjectOutcome& o : r.outcomes) {
+    if (!o.why_wrong.empty()) ++why_wrong[o.why_wrong];
+  }
+  std::printf(
+      "uwscan wrong answers, the true object checked at its true pose on the segment answered "
+      "for it:");
+  for (const auto& [why, n] : why_wrong) std::printf(" %s %d", why.c_str(), n);
+  if (why_wrong.empty()) std::printf(" none");
+  std::printf("\n");
+  return why_wrong;
+}
+
 void Run(Args a) {
   if (a.real_pair) {
     RunRealPair(a);
@@ -225,110 +325,28 @@ void Run(Args a) {
   std::printf("%d scans (%s), database %.1f s, simulation %.1f s\n", r.scans,
               a.options.images ? "rendered and detected frames" : "exact peaks + 0.1 px noise",
               r.database_seconds, r.simulation_seconds);
-  std::printf(
-      "| pipeline | recognised | ... or among the objects reported to fit as well | pose 5 mm / 2 "
-      "deg | ... or its ambiguity reported | MSSD < 0.1 d | "
-      "grasp 5 mm / 3 deg | foreign -> unknown | median rot / trans err | s per scan |\n"
-      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  nlohmann::json pipelines = nlohmann::json::object();
-  nlohmann::json confusion = nlohmann::json::object();
+  const nlohmann::json pipelines = PrintPipelines(r);
   const ConfusionShape shape = ShapeOf(r.object_ids);
-  for (const auto& [name, f] : r.pipelines) {
-    const double per_scan = f.seconds / r.scans;
-    std::printf(
-        "| %s | %d/%d (%.1f %%) | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %d/%d | %.2f "
-        "deg / %.1f mm | %.3f |\n",
-        name.c_str(), f.recognised, f.objects, 100.0 * Ratio(f.recognised, f.objects),
-        100.0 * Ratio(f.recognised_or_reported, f.objects),
-        100.0 * Ratio(f.pose_success, f.recognised),
-        100.0 * Ratio(f.pose_or_reported, f.recognised),
-        100.0 * Ratio(f.mssd_success, f.recognised), 100.0 * Ratio(f.grasp_success, f.recognised),
-        f.foreign_unknown, f.foreign, Median(f.rotation_errors_rad) * kRadToDeg,
-        Median(f.translation_errors_m) * 1e3, per_scan);
-    pipelines[name] = {
-        {"recognition_rate", Ratio(f.recognised, f.objects)},
-        {"recognition_or_reported_ambiguity_rate", Ratio(f.recognised_or_reported, f.objects)},
-        {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
-        {"pose_or_reported_ambiguity_rate", Ratio(f.pose_or_reported, f.recognised)},
-        {"mssd_success_rate", Ratio(f.mssd_success, f.recognised)},
-        {"grasp_success_rate", Ratio(f.grasp_success, f.recognised)},
-        {"foreign_unknown_rate", Ratio(f.foreign_unknown, f.foreign)},
-        {"objects", f.objects},
-        {"median_rotation_error_deg", Median(f.rotation_errors_rad) * kRadToDeg},
-        {"median_translation_error_m", Median(f.translation_errors_m)},
-        {"median_grasp_position_error_m", Median(f.grasp_position_errors_m)},
-        {"median_grasp_angle_error_deg", Median(f.grasp_angle_errors_rad) * kRadToDeg},
-        {"seconds_per_scan", per_scan}};
-    if (!f.scan_seconds.empty()) {
-      pipelines[name]["seconds_per_scan_p95"] = Percentile95(f.scan_seconds);
-      pipelines[name]["seconds_per_scan_max"] =
-          *std::max_element(f.scan_seconds.begin(), f.scan_seconds.end());
-      pipelines[name]["scan_seconds"] = f.scan_seconds;
-    }
-    if (!f.pose_nees_per_dimension.empty()) {
-      pipelines[name]["pose_nees_per_dimension_mean"] = Mean(f.pose_nees_per_dimension);
-      pipelines[name]["pose_nees_per_dimension_median"] = Median(f.pose_nees_per_dimension);
-      pipelines[name]["pose_nees_per_dimension_p95"] = Percentile95(f.pose_nees_per_dimension);
-      pipelines[name]["pose_nees_poses"] = f.pose_nees_per_dimension.size();
-      for (const auto& [truth, nees] : f.pose_nees_by_class) {
-        pipelines[name]["pose_nees_per_dimension_median_by_class"][truth] = Median(nees);
-      }
-    }
-    confusion[name] = DenseConfusion(f.confusion, shape);
-  }
-  if (r.pipelines.count("uwscan") && !r.pipelines.at("uwscan").scan_seconds.empty()) {
-    const std::vector<double>& t = r.pipelines.at("uwscan").scan_seconds;
-    std::printf("uwscan time per scan: p95 %.3f s, slowest %.3f s\n", Percentile95(t),
-                *std::max_element(t.begin(), t.end()));
-  }
-  std::printf("uwscan stages (s per scan):");
-  for (const auto& [stage, s] : r.uwscan_stage_seconds)
-    std::printf(" %s %.3f", stage.c_str(), s / r.scans);
-  std::printf("\n");
-  if (r.pipelines.count("uwscan") && !r.pipelines.at("uwscan").pose_nees_per_dimension.empty()) {
-    const std::vector<double>& nees = r.pipelines.at("uwscan").pose_nees_per_dimension;
-    std::printf(
-        "uwscan pose covariance: NEES per pinned direction mean %.2f, median %.2f over %zu poses "
-        "within "
-        "10 deg and 5 cm (1 when consistent)\n",
-        Mean(nees), Median(nees), nees.size());
-    std::printf("  median by class:");
-    for (const auto& [truth, by_class] : r.pipelines.at("uwscan").pose_nees_by_class) {
-      std::printf(" %s %.1f (%zu)", truth.c_str(), Median(by_class), by_class.size());
-    }
-    std::printf("\n");
-  }
-  if (r.pipelines.count("uwscan")) {
-    std::printf("uwscan confusion (rows: the true object, columns: uwscan's answer):\n");
-    PrintConfusion(r.pipelines.at("uwscan").confusion, shape);
-  }
-  // Why catalogue objects were not recognised (ObjectOutcome::why_wrong).
+  nlohmann::json confusion = nlohmann::json::object();
+  for (const auto& [name, f] : r.pipelines) confusion[name] = DenseConfusion(f.confusion, shape);
   std::map<std::string, int> why_wrong;
-  for (const bench::ObjectOutcome& o : r.outcomes) {
-    if (!o.why_wrong.empty()) ++why_wrong[o.why_wrong];
-  }
   if (r.pipelines.count("uwscan")) {
-    std::printf(
-        "uwscan wrong answers, the true object checked at its true pose on the segment answered "
-        "for it:");
-    for (const auto& [why, n] : why_wrong) std::printf(" %s %d", why.c_str(), n);
-    if (why_wrong.empty()) std::printf(" none");
-    std::printf("\n");
+    PrintUwscanDetails(r, shape);
+    why_wrong = PrintWhyWrong(r);
   }
   if (a.details) PrintOutcomes(r.outcomes);
-  if (!a.json.empty()) {
-    nlohmann::json stages(r.uwscan_stage_seconds);
-    for (auto& [stage, s] : stages.items()) s = s.get<double>() / r.scans;
-    WriteJsonFile(a.json, {{"scans", r.scans},
-                           {"images", a.options.images},
-                           {"threads", a.options.threads},
-                           {"database_seconds", r.database_seconds},
-                           {"ppf_training_seconds", r.ppf_training_seconds},
-                           {"pipelines", pipelines},
-                           {"confusion", confusion},
-                           {"uwscan_wrong_answers", why_wrong},
-                           {"uwscan_stage_seconds_per_scan", stages}});
-  }
+  if (a.json.empty()) return;
+  nlohmann::json stages(r.uwscan_stage_seconds);
+  for (auto& [stage, s] : stages.items()) s = s.get<double>() / r.scans;
+  WriteJsonFile(a.json, {{"scans", r.scans},
+                         {"images", a.options.images},
+                         {"threads", a.options.threads},
+                         {"database_seconds", r.database_seconds},
+                         {"ppf_training_seconds", r.ppf_training_seconds},
+                         {"pipelines", pipelines},
+                         {"confusion", confusion},
+                         {"uwscan_wrong_answers", why_wrong},
+                         {"uwscan_stage_seconds_per_scan", stages}});
 }
 
 }  // namespace

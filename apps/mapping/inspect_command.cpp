@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -106,7 +107,8 @@ void WriteReport(const InspectArgs& a, const ReadSummary& r,
                          {"stopped_by_signal", r.stop_signal != 0}});
 }
 
-void RunInspect(const InspectArgs& a) {
+// Every argument checked before the camera is opened.
+void CheckInspectArgs(const InspectArgs& a) {
   if (a.frames > 0 && a.seconds > 0.0) throw Error("--frames and --seconds: give one of them");
   if (!a.log.empty()) CheckNewLogPath(a.log, a.force, "--log");
   for (const auto& [path, option] :
@@ -122,10 +124,9 @@ void RunInspect(const InspectArgs& a) {
   if (!a.screenshot.empty() && a.frames <= 0 && a.seconds <= 0.0) {
     throw Error("--screenshot: say when to take the picture with --frames N (or --seconds S)");
   }
-  const bool view = a.view || !a.screenshot.empty();
-  if (view) viewer::RequireDisplay();  // before the camera, not after the dive
-  const std::unique_ptr<mapping::LiveDeviation> reference = LoadReference(a, view);
-  const acq::CameraSettings settings = MakeCameraSettings(a.camera);
+}
+
+mapping::InspectionOptions InspectionOptionsOf(const InspectArgs& a) {
   mapping::InspectionOptions options;
   options.log_queue_bytes = static_cast<std::size_t>(a.queue_mb * 1e6);
   options.live_queue_frames = a.live_queue;
@@ -135,80 +136,38 @@ void RunInspect(const InspectArgs& a) {
   options.mapper.spill_folder = std::filesystem::temp_directory_path();
   options.table_cache = TableCache();
   options.Check();
+  return options;
+}
 
-  InstallStopHandlers();
-  acq::FrameSource source(settings);
-  const acq::PayloadDescription& payload = source.payload();
-  const AcquisitionContext context = MakeContext(a.camera, payload, "inspect");
-  CameraFrameDecoder decoder(payload, context, a.images);
+std::unique_ptr<viewer::LiveView> MakeLiveView(const InspectArgs& a, bool deviations) {
+  viewer::LiveViewOptions live;
+  live.offscreen = !a.screenshot.empty();
+  if (deviations) live.render.colour = viewer::ColourMode::kDeviation;
+  auto live_view = std::make_unique<viewer::LiveView>(live);
+  if (!a.screenshot.empty()) live_view->SetFinalScreenshot(a.screenshot);
+  return live_view;
+}
 
-  std::unique_ptr<viewer::LiveView> live_view;
-  if (view) {
-    viewer::LiveViewOptions live;
-    live.offscreen = !a.screenshot.empty();
-    if (reference) live.render.colour = viewer::ColourMode::kDeviation;
-    live_view = std::make_unique<viewer::LiveView>(live);
-    if (!a.screenshot.empty()) live_view->SetFinalScreenshot(a.screenshot);
+// Runs `read` on its own thread while the view owns this one (VTK's GUI thread), or on this one
+// without a view; returns what the reader failed with, else what the view failed with.
+std::exception_ptr ReadBesideView(viewer::LiveView* view, const std::string& title,
+                                  const std::function<std::exception_ptr()>& read) {
+  if (view == nullptr) return read();
+  std::exception_ptr read_failure, view_failure;
+  std::thread reader([&] { read_failure = read(); });
+  try {
+    view->Run(title);
+  } catch (...) {
+    view_failure = std::current_exception();
   }
-  if (!a.log.empty()) RemoveLog(a.log);
-  // No navigation from a camera alone: the scanner is held fixed, the vehicle at the origin.
-  mapping::LiveInspection inspection(context.header, a.log, context.T_V_C,
-                                     mapping::NavigationNoise{}, options,
-                                     [&live_view, &reference](const mapping::MappedFrame& f) {
-                                       if (!live_view) return;
-                                       viewer::LiveCloud cloud;
-                                       cloud.time_s = f.time_s;
-                                       cloud.points_W.assign(f.points_W.begin(), f.points_W.end());
-                                       if (reference)
-                                         cloud.deviation_m = reference->Deviations(cloud.points_W);
-                                       live_view->Push(std::move(cloud));
-                                     });
-  std::printf(
-      "inspect: camera %s (%s %s), %s mode, %dx%d payload; scanner fixed (no navigation), map in "
-      "the "
-      "vehicle frame; %s\n",
-      a.camera.camera.c_str(), payload.vendor.c_str(), payload.model.c_str(),
-      payload.profile ? "profile" : "image", payload.payload_width_px, payload.payload_height_px,
-      a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
-  std::fflush(stdout);
+  RequestStop();  // the window was closed (or the reader ended)
+  reader.join();
+  return read_failure ? read_failure : view_failure;
+}
 
-  // The camera is read on its own thread when the view owns this one (VTK's GUI thread).
-  ReadSummary read;
-  mapping::InspectionResult result;
-  std::exception_ptr failure;
-  auto acquire = [&] {
-    try {
-      read = ReadFrames(
-          source, decoder, ReadLimits{a.frames, a.seconds}, "inspect",
-          [&inspection](mapping::FrameRecord&& record, const acq::AcquiredFrame& frame) {
-            inspection.Push(ToInspectionFrame(std::move(record), frame));
-          },
-          [&inspection](const ReadSummary& r, double now) {
-            PrintStatus(r, inspection.statistics(), now, false);
-          });
-      result = inspection.Finish();
-    } catch (...) {
-      failure = std::current_exception();
-    }
-    if (live_view) live_view->RequestStop();
-  };
-  if (live_view) {
-    std::thread reader(acquire);
-    try {
-      live_view->Run("uwscan inspect " + a.camera.camera);
-    } catch (...) {
-      if (!failure) failure = std::current_exception();
-    }
-    RequestStop();  // the window was closed (or the reader ended)
-    reader.join();
-  } else {
-    acquire();
-  }
-  if (failure) std::rethrow_exception(failure);
-
+void PrintInspectSummary(const InspectArgs& a, const ReadSummary& read,
+                         const mapping::InspectionResult& result) {
   const mapping::InspectionStatistics& s = result.statistics;
-  PrintStatus(read, s, read.seconds, true);
-  if (!a.map.empty()) perception::WriteCloud(a.map, result.map, !a.ascii);
   std::printf(
       "inspect: %lld frames received in %.2f s (%.1f frames/s), %lld lost, %lld undecodable; "
       "logged %lld; "
@@ -238,6 +197,72 @@ void RunInspect(const InspectArgs& a) {
               read.stop_signal != 0
                   ? (read.stop_signal == SIGINT ? "; stopped by SIGINT" : "; stopped by SIGTERM")
                   : "");
+}
+
+void RunInspect(const InspectArgs& a) {
+  CheckInspectArgs(a);
+  const bool view = a.view || !a.screenshot.empty();
+  if (view) viewer::RequireDisplay();  // before the camera, not after the dive
+  const std::unique_ptr<mapping::LiveDeviation> reference = LoadReference(a, view);
+  const acq::CameraSettings settings = MakeCameraSettings(a.camera);
+  const mapping::InspectionOptions options = InspectionOptionsOf(a);
+
+  InstallStopHandlers();
+  acq::FrameSource source(settings);
+  const acq::PayloadDescription& payload = source.payload();
+  const AcquisitionContext context = MakeContext(a.camera, payload, "inspect");
+  CameraFrameDecoder decoder(payload, context, a.images);
+  const std::unique_ptr<viewer::LiveView> live_view =
+      view ? MakeLiveView(a, reference != nullptr) : nullptr;
+  if (!a.log.empty()) RemoveLog(a.log);
+  // No navigation from a camera alone: the scanner is held fixed, the vehicle at the origin.
+  mapping::LiveInspection inspection(context.header, a.log, context.T_V_C,
+                                     mapping::NavigationNoise{}, options,
+                                     [&live_view, &reference](const mapping::MappedFrame& f) {
+                                       if (!live_view) return;
+                                       viewer::LiveCloud cloud;
+                                       cloud.time_s = f.time_s;
+                                       cloud.points_W.assign(f.points_W.begin(), f.points_W.end());
+                                       if (reference)
+                                         cloud.deviation_m = reference->Deviations(cloud.points_W);
+                                       live_view->Push(std::move(cloud));
+                                     });
+  std::printf(
+      "inspect: camera %s (%s %s), %s mode, %dx%d payload; scanner fixed (no navigation), map in "
+      "the "
+      "vehicle frame; %s\n",
+      a.camera.camera.c_str(), payload.vendor.c_str(), payload.model.c_str(),
+      payload.profile ? "profile" : "image", payload.payload_width_px, payload.payload_height_px,
+      a.log.empty() ? "no log" : ("logging to " + a.log).c_str());
+  std::fflush(stdout);
+
+  ReadSummary read;
+  mapping::InspectionResult result;
+  auto acquire = [&]() -> std::exception_ptr {
+    std::exception_ptr failure;
+    try {
+      read = ReadFrames(
+          source, decoder, ReadLimits{a.frames, a.seconds}, "inspect",
+          [&inspection](mapping::FrameRecord&& record, const acq::AcquiredFrame& frame) {
+            inspection.Push(ToInspectionFrame(std::move(record), frame));
+          },
+          [&inspection](const ReadSummary& r, double now) {
+            PrintStatus(r, inspection.statistics(), now, false);
+          });
+      result = inspection.Finish();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    if (live_view) live_view->RequestStop();
+    return failure;
+  };
+  if (const std::exception_ptr failure =
+          ReadBesideView(live_view.get(), "uwscan inspect " + a.camera.camera, acquire)) {
+    std::rethrow_exception(failure);
+  }
+  PrintStatus(read, result.statistics, read.seconds, true);
+  if (!a.map.empty()) perception::WriteCloud(a.map, result.map, !a.ascii);
+  PrintInspectSummary(a, read, result);
   if (!a.screenshot.empty()) std::printf("%s: written\n", a.screenshot.c_str());
   if (!a.json.empty()) WriteReport(a, read, result);
 }

@@ -127,7 +127,7 @@ void RequireOutput(const std::string& path, const char* option, const std::strin
   CheckOutputPath(path, option, {log});
 }
 
-void RunMap(const MapArgs& a) {
+void CheckMapOutputs(const MapArgs& a) {
   for (const auto& [path, option] : {std::pair{a.output, "-o"},
                                      {a.trajectory, "--trajectory"},
                                      {a.dead_reckoning, "--dead-reckoning"},
@@ -136,7 +136,9 @@ void RunMap(const MapArgs& a) {
     RequireOutput(path, option, a.log);
   }
   CheckCloudOutputPath(a.output, "-o", {a.log});
-  if (a.threads > 0) omp_set_num_threads(a.threads);
+}
+
+mapping::DiveMappingOptions DiveMappingOptionsOf(const MapArgs& a) {
   mapping::DiveMappingOptions options;
   options.map_voxel_m = a.voxel_m;
   options.mapper.sweeps_per_submap = a.sweeps_per_submap;
@@ -146,17 +148,10 @@ void RunMap(const MapArgs& a) {
   // Older submaps' clouds wait on disk, so a long dive's memory does not grow with it.
   options.mapper.spill_folder = std::filesystem::temp_directory_path();
   options.table_cache = TableCache();
-  const mapping::DiveLogReader log(a.log);
-  // Refused before anything is mapped or written: a real log has no truth to write.
-  if (!a.truth.empty() && log.frame_count() > 0 && !log.ReadGroundTruth(0)) {
-    throw Error("--truth " + a.truth + ": the log " + a.log +
-                " holds no ground truth (not simulated)");
-  }
-  mapping::DiveMapping m;
-  {
-    ProgressBar bar;
-    m = mapping::MapDive(log, options, [&bar](double f) { bar.Update("map", f); });
-  }
+  return options;
+}
+
+void WriteMapOutputs(const MapArgs& a, const mapping::DiveMapping& m) {
   perception::WriteCloud(a.output, m.map);
   if (!a.trajectory.empty()) mapping::WriteTum(a.trajectory, m.slam);
   if (!a.dead_reckoning.empty()) mapping::WriteTum(a.dead_reckoning, m.dead_reckoning);
@@ -165,7 +160,11 @@ void RunMap(const MapArgs& a) {
       throw Error("--truth " + a.truth + ": the log holds no ground truth (not simulated)");
     mapping::WriteTum(a.truth, m.truth);
   }
-  const mapping::MapSummary s = mapping::Summarise(m);
+}
+
+// What the dive's mapping did and cost: frames left out, registrations and loops, the dead
+// reckoning's calibration and the stage times.
+void PrintMapWork(const MapArgs& a, const mapping::DiveMapping& m, const mapping::MapSummary& s) {
   std::printf(
       "%s: %zu points, %d submaps over %.1f s of dive, mapped in %.2f s (%.0fx real time)\n",
       a.output.c_str(), m.map.size(), m.submaps, m.dive_duration_s, m.seconds, s.real_time_factor);
@@ -189,6 +188,11 @@ void RunMap(const MapArgs& a) {
       "graph %.2f s (%d whole solves, %d of the last submaps)\n",
       m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s,
       m.stats.graph_s, m.stats.whole_solves, m.stats.window_solves);
+}
+
+// What the map is worth: the errors its poses' uncertainty predicts and, for a simulated dive,
+// the errors against the truth.
+void PrintMapAccuracy(const mapping::DiveMapping& m, const mapping::MapSummary& s) {
   if (m.expected_map_error_m) {
     std::printf("expected map error from the poses' uncertainty: %.2f mm RMS along the normals\n",
                 *m.expected_map_error_m * 1e3);
@@ -208,6 +212,26 @@ void RunMap(const MapArgs& a) {
     if (s.nees_mean) std::printf(", NEES %.2f (6 for a consistent covariance)", *s.nees_mean);
     std::printf("\n");
   }
+}
+
+void RunMap(const MapArgs& a) {
+  CheckMapOutputs(a);
+  if (a.threads > 0) omp_set_num_threads(a.threads);
+  const mapping::DiveLogReader log(a.log);
+  // Refused before anything is mapped or written: a real log has no truth to write.
+  if (!a.truth.empty() && log.frame_count() > 0 && !log.ReadGroundTruth(0)) {
+    throw Error("--truth " + a.truth + ": the log " + a.log +
+                " holds no ground truth (not simulated)");
+  }
+  mapping::DiveMapping m;
+  {
+    ProgressBar bar;
+    m = mapping::MapDive(log, DiveMappingOptionsOf(a), [&bar](double f) { bar.Update("map", f); });
+  }
+  WriteMapOutputs(a, m);
+  const mapping::MapSummary s = mapping::Summarise(m);
+  PrintMapWork(a, m, s);
+  PrintMapAccuracy(m, s);
   if (!a.json.empty()) WriteJsonFile(a.json, MapReportJson(m, a.log, a.output));
 }
 

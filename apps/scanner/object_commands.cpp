@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -74,14 +75,10 @@ const std::vector<std::string> kDimensionOptions = {
     "--flange-thickness-m", "--bolts",          "--handle",          "--handle-radius-m",
     "--body-radius-m",      "--stem-length-m",  "--chord-error-m"};
 
-scanner::TriangleMesh MakeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
+// The solids without a bore: plane, box, sphere, cylinder, gauge block, panel; nullopt for
+// another shape.
+std::optional<scanner::TriangleMesh> MakeSolidMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
   auto given = [&](const char* option) { return cmd.count(option) > 0; };
-  const std::set<std::string>& allowed = ShapeOptions().at(a.shape);
-  for (const std::string& option : kDimensionOptions) {
-    if (cmd.count(option) > 0 && allowed.count(option) == 0) {
-      throw Error(option + ": does not apply to a " + a.shape);
-    }
-  }
   const double chord = a.chord_error_m;
   if (a.shape == "plane" || a.shape == "box") {
     const size_t n = a.shape == "plane" ? 2 : 3;
@@ -110,7 +107,13 @@ scanner::TriangleMesh MakeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
     }
     return sim::MakePanel(s);
   }
-  // Pipe-like shapes: unset options keep the shape's defaults.
+  return std::nullopt;
+}
+
+// The pipe-like shapes: pipe, elbow, tee, flange, valve. Unset options keep the shape's defaults.
+scanner::TriangleMesh MakePipeLikeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
+  auto given = [&](const char* option) { return cmd.count(option) > 0; };
+  const double chord = a.chord_error_m;
   auto set = [&](const char* option, double value, double* field) {
     if (given(option)) *field = value;
   };
@@ -156,6 +159,17 @@ scanner::TriangleMesh MakeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
   if (given("--handle"))
     s.handle = a.handle == "lever" ? sim::ValveHandle::kLever : sim::ValveHandle::kWheel;
   return sim::MakeValve(s, chord);
+}
+
+scanner::TriangleMesh MakeMesh(const MakeObjectArgs& a, const CLI::App& cmd) {
+  const std::set<std::string>& allowed = ShapeOptions().at(a.shape);
+  for (const std::string& option : kDimensionOptions) {
+    if (cmd.count(option) > 0 && allowed.count(option) == 0) {
+      throw Error(option + ": does not apply to a " + a.shape);
+    }
+  }
+  if (std::optional<scanner::TriangleMesh> solid = MakeSolidMesh(a, cmd)) return *std::move(solid);
+  return MakePipeLikeMesh(a, cmd);
 }
 
 void RunMakeObject(const MakeObjectArgs& a, const CLI::App& cmd) {

@@ -354,6 +354,176 @@ sim::VirtualScan ScanOf(const Scene& scene, int s, const sim::VirtualScanner& sc
   return scan;
 }
 
+// The foreign meshes, scaled to 0.25 m across: objects the database does not hold.
+std::vector<scanner::TriangleMesh> ForeignMeshes(const std::filesystem::path& data_cache) {
+  std::vector<scanner::TriangleMesh> foreign;
+  for (const char* name : kForeignMeshes) {
+    scanner::TriangleMesh mesh =
+        scanner::LoadMesh(data_cache / "meshes" / (std::string(name) + ".off"));
+    const double scale = 0.25 / mesh.BoundingBoxDiagonal();
+    for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
+    foreign.push_back(std::move(mesh));
+  }
+  return foreign;
+}
+
+// The scenes' scanner: the database's, with rendered and detected frames when asked, in water
+// that attenuates.
+sim::VirtualScannerOptions SceneScanOptions(sim::VirtualScannerOptions scan, bool images) {
+  if (images) {
+    sim::SimulationEffects& e = scan.effects;
+    e.peak_noise.on = false;
+    e.image.on = e.beam.on = e.sensor_noise.on = e.speckle.on = e.backscatter.on = e.ambient.on =
+        true;
+    e.attenuation = true;
+  }
+  sim::Water water;
+  water.attenuation_per_m = 0.2;
+  scan.water = water;
+  return scan;
+}
+
+// What every scan of a run is recognised and scored with, and where the figures go.
+struct BenchRun {
+  const RecognitionBenchOptions& options;
+  const ObjectDatabase& db;
+  perception::RecognitionCache& cache;
+  const perception::RecognitionOptions& recognition;
+  const std::optional<PclEsfPeer>& pcl_peer;
+  const std::optional<PpfPeer>& ppf_peer;
+  RecognitionBenchResult& result;
+};
+
+// The segment of `answer` holding most of object `o`'s scan points: its index (-1 for none) and
+// that count.
+std::pair<int, int> BestSegment(const sim::VirtualScan& scan,
+                                const perception::RecognitionResult& answer, std::size_t o) {
+  int best_segment = -1, best_count = 0;
+  for (std::size_t k = 0; k < answer.objects.size(); ++k) {
+    int count = 0;
+    for (std::size_t i : answer.objects[k].segment)
+      count += scan.object_index[i] == static_cast<int>(o);
+    if (count > best_count) best_count = count, best_segment = static_cast<int>(k);
+  }
+  return {best_segment, best_count};
+}
+
+// An object no segment holds: every pipeline answered "unknown" for it.
+void ScoreUnseen(BenchRun& run, int s, const std::string& truth, int visible,
+                 const Eigen::Isometry3d& T_S_O_true) {
+  ObjectOutcome outcome;
+  outcome.scan = s;
+  outcome.truth = truth;
+  outcome.answer = "unknown";
+  outcome.points = visible;
+  if (truth != "foreign") outcome.why_wrong = "no segment";
+  run.result.outcomes.push_back(std::move(outcome));
+  Score(truth, "unknown", std::nullopt, T_S_O_true, run.db, run.result.pipelines["uwscan"]);
+  if (!run.options.run_peers) return;
+  Score(truth, "unknown", std::nullopt, T_S_O_true, run.db, run.result.pipelines["pcl_esf"]);
+  if (run.ppf_peer)
+    Score(truth, "unknown", std::nullopt, T_S_O_true, run.db, run.result.pipelines["opencv_ppf"]);
+}
+
+// uwscan's answer for an object (`ours`, the segment holding `best_count` of its `visible`
+// points), before scoring.
+ObjectOutcome OutcomeOf(int s, const std::string& truth, int visible, int best_count,
+                        const perception::RecognizedObject& ours,
+                        const Eigen::Isometry3d& T_S_O_true, const ObjectDatabase& db) {
+  ObjectOutcome outcome;
+  outcome.scan = s;
+  outcome.truth = truth;
+  outcome.answer = ours.object_id;
+  outcome.points = visible;
+  outcome.points_in_segment = best_count;
+  outcome.segment_points = static_cast<int>(ours.segment.size());
+  outcome.candidates = ours.candidates;
+  outcome.equivalent_poses = static_cast<int>(ours.equivalent_poses_S.size());
+  for (const auto& [id, T] : ours.equivalent_objects_S) outcome.equivalent_objects.push_back(id);
+  for (const perception::RecognitionCandidate& c : ours.candidates) {
+    outcome.candidate_errors.push_back(CandidateError(c, truth, T_S_O_true, db));
+  }
+  for (const perception::FreeDirection& f : ours.free_directions) {
+    if (f.kind != perception::FreeKind::kUnconstrained) continue;
+    ++(f.motion == perception::FreeMotion::kTranslation ? outcome.free_slides : outcome.free_turns);
+  }
+  return outcome;
+}
+
+// The peers on the segment uwscan answered for, voxelised as the database's views are.
+void ScorePeers(BenchRun& run, const PointCloud& cloud, const std::vector<std::size_t>& segment_ids,
+                const std::string& truth, const Eigen::Isometry3d& T_S_O_true) {
+  const PointCloud segment =
+      perception::VoxelDownsample(perception::Subset(cloud, segment_ids),
+                                  perception::VoxelFilterOptions{run.db.parameters.voxel_m});
+  auto start = std::chrono::steady_clock::now();
+  const PeerAnswer pcl = run.pcl_peer->Recognize(segment);
+  run.result.pipelines["pcl_esf"].seconds += Seconds(start);
+  Score(truth, pcl.id, pcl.T_S_O, T_S_O_true, run.db, run.result.pipelines["pcl_esf"]);
+  if (!run.ppf_peer) return;
+  start = std::chrono::steady_clock::now();
+  perception::NormalOptions normals;
+  normals.radius_m = run.db.parameters.normal_radius_m;
+  normals.threads = run.options.threads;
+  const perception::CloudWithNormals with_normals =
+      perception::AttachNormals(segment, perception::EstimateNormals(segment, normals));
+  const PeerAnswer ppf = run.ppf_peer->Recognize(with_normals.cloud);
+  run.result.pipelines["opencv_ppf"].seconds += Seconds(start);
+  Score(truth, ppf.id, ppf.T_S_O, T_S_O_true, run.db, run.result.pipelines["opencv_ppf"]);
+}
+
+// Object `o` of scan `s`: uwscan's answer for the segment holding most of it, scored, why it was
+// wrong when it was, and the peers' answers on that segment.
+void ScoreObject(BenchRun& run, int s, const Scene& scene, const sim::VirtualScan& scan,
+                 const PointCloud& cloud, const perception::RecognitionResult& answer,
+                 std::size_t o) {
+  int visible = 0;
+  for (std::int32_t id : scan.object_index) visible += id == static_cast<int>(o);
+  if (visible < kMinVisiblePoints) return;
+  const auto [best_segment, best_count] = BestSegment(scan, answer, o);
+  const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
+  const std::string& truth = scene.classes[o];
+  if (best_segment < 0) {
+    ScoreUnseen(run, s, truth, visible, T_S_O_true);
+    return;
+  }
+  const perception::RecognizedObject& ours = answer.objects[static_cast<std::size_t>(best_segment)];
+  ObjectOutcome outcome = OutcomeOf(s, truth, visible, best_count, ours, T_S_O_true, run.db);
+  if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, run.db,
+                           run.result.pipelines["uwscan"], &ours)) {
+    outcome.rotation_error_rad = e->rotation_rad;
+    outcome.translation_error_m = e->translation_m;
+  }
+  if (ours.object_id != truth && truth != "foreign") {
+    const perception::RecognitionCandidate checked = perception::CheckObjectPose(
+        cloud, ours.segment, run.db, run.cache, truth, T_S_O_true, run.recognition);
+    outcome.why_wrong = WhyWrong(checked, ours, run.recognition.score_tie);
+    outcome.truth_check = checked;
+  }
+  run.result.outcomes.push_back(std::move(outcome));
+  if (run.options.run_peers) ScorePeers(run, cloud, ours.segment, truth, T_S_O_true);
+}
+
+// Scan `s`: simulated (or read from the scan cache), recognised by uwscan, each object scored.
+void RunScan(BenchRun& run, int s, const Scene& scene, const sim::VirtualScanner& scanner) {
+  ++run.result.scans;
+  auto start = std::chrono::steady_clock::now();
+  const sim::VirtualScan scan = ScanOf(scene, s, scanner, run.options);
+  run.result.simulation_seconds += Seconds(start);
+  if (scan.points_C.empty()) return;
+  const PointCloud cloud = perception::MakeCloud(scan.points_C);
+  start = std::chrono::steady_clock::now();
+  const perception::RecognitionResult answer =
+      perception::RecognizeObjects(cloud, run.db, run.cache, run.recognition);
+  PipelineFigures& uwscan = run.result.pipelines["uwscan"];
+  uwscan.scan_seconds.push_back(Seconds(start));
+  uwscan.seconds += uwscan.scan_seconds.back();
+  for (const auto& [stage, seconds] : answer.stage_seconds)
+    run.result.uwscan_stage_seconds[stage] += seconds;
+  for (std::size_t o = 1; o < scene.objects.size(); ++o)
+    ScoreObject(run, s, scene, scan, cloud, answer, o);
+}
+
 }  // namespace
 
 void RecognitionBenchOptions::Check() const {
@@ -370,14 +540,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   RecognitionBenchResult result;
   std::vector<perception::ObjectSource> catalogue;
   for (const char* name : kBenchObjects) catalogue.push_back(perception::CatalogueObject(name));
-  std::vector<scanner::TriangleMesh> foreign;
-  for (const char* name : kForeignMeshes) {
-    scanner::TriangleMesh mesh =
-        scanner::LoadMesh(options.data_cache / "meshes" / (std::string(name) + ".off"));
-    const double scale = 0.25 / mesh.BoundingBoxDiagonal();
-    for (Eigen::Vector3d& v : mesh.vertices) v *= scale;
-    foreign.push_back(std::move(mesh));
-  }
+  const std::vector<scanner::TriangleMesh> foreign = ForeignMeshes(options.data_cache);
 
   sim::VirtualScannerOptions db_scan;
   db_scan.pattern.kind = scanner::ScannerKind::kGalvo;
@@ -397,18 +560,7 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   result.database_seconds = Seconds(start);
   for (const perception::ObjectModel& o : db.objects) result.object_ids.push_back(o.id);
 
-  sim::VirtualScannerOptions scene_scan = db_scan;
-  if (options.images) {
-    sim::SimulationEffects& e = scene_scan.effects;
-    e.peak_noise.on = false;
-    e.image.on = e.beam.on = e.sensor_noise.on = e.speckle.on = e.backscatter.on = e.ambient.on =
-        true;
-    e.attenuation = true;
-  }
-  sim::Water water;
-  water.attenuation_per_m = 0.2;
-  scene_scan.water = water;
-  const sim::VirtualScanner scene_scanner(galvo, scene_scan);
+  const sim::VirtualScanner scene_scanner(galvo, SceneScanOptions(db_scan, options.images));
 
   std::optional<PclEsfPeer> pcl_peer;
   std::optional<PpfPeer> ppf_peer;
@@ -426,123 +578,11 @@ RecognitionBenchResult RunRecognitionBench(const RecognitionBenchOptions& option
   perception::RecognitionOptions recognition;
   recognition.seed = options.seed;
   recognition.threads = options.threads;
+  BenchRun run{options, db, cache, recognition, pcl_peer, ppf_peer, result};
   for (int s = 0; s < options.scans; ++s) {
-    if (!options.only.empty() &&
-        std::find(options.only.begin(), options.only.end(), s) == options.only.end())
-      continue;
-    ++result.scans;
-    const Scene scene = MakeScene(s, catalogue, foreign, options.seed);
-    start = std::chrono::steady_clock::now();
-    const sim::VirtualScan scan = ScanOf(scene, s, scene_scanner, options);
-    result.simulation_seconds += Seconds(start);
-    if (scan.points_C.empty()) continue;
-    const PointCloud cloud = perception::MakeCloud(scan.points_C);
-
-    start = std::chrono::steady_clock::now();
-    const perception::RecognitionResult answer =
-        perception::RecognizeObjects(cloud, db, cache, recognition);
-    result.pipelines["uwscan"].scan_seconds.push_back(Seconds(start));
-    result.pipelines["uwscan"].seconds += result.pipelines["uwscan"].scan_seconds.back();
-    for (const auto& [stage, seconds] : answer.stage_seconds)
-      result.uwscan_stage_seconds[stage] += seconds;
-
-    // Each object of the scene with enough points, and the segment holding most of them.
-    for (std::size_t o = 1; o < scene.objects.size(); ++o) {
-      int visible = 0;
-      for (std::int32_t id : scan.object_index) visible += id == static_cast<int>(o);
-      if (visible < kMinVisiblePoints) continue;
-      int best_segment = -1, best_count = 0;
-      for (std::size_t k = 0; k < answer.objects.size(); ++k) {
-        int count = 0;
-        for (std::size_t i : answer.objects[k].segment)
-          count += scan.object_index[i] == static_cast<int>(o);
-        if (count > best_count) best_count = count, best_segment = static_cast<int>(k);
-      }
-      const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.objects[o].T_W_O;
-      const std::string& truth = scene.classes[o];
-      if (best_segment < 0) {
-        result.outcomes.push_back({s,
-                                   truth,
-                                   "unknown",
-                                   visible,
-                                   0,
-                                   0,
-                                   -1.0,
-                                   -1.0,
-                                   {},
-                                   0,
-                                   {},
-                                   0,
-                                   0,
-                                   {},
-                                   truth == "foreign" ? "" : "no segment",
-                                   std::nullopt});
-        Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["uwscan"]);
-        if (options.run_peers) {
-          Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["pcl_esf"]);
-          if (ppf_peer)
-            Score(truth, "unknown", std::nullopt, T_S_O_true, db, result.pipelines["opencv_ppf"]);
-        }
-        continue;
-      }
-      const perception::RecognizedObject& ours =
-          answer.objects[static_cast<std::size_t>(best_segment)];
-      ObjectOutcome outcome{s,
-                            truth,
-                            ours.object_id,
-                            visible,
-                            best_count,
-                            static_cast<int>(ours.segment.size()),
-                            -1.0,
-                            -1.0,
-                            ours.candidates,
-                            static_cast<int>(ours.equivalent_poses_S.size()),
-                            {},
-                            0,
-                            0,
-                            {},
-                            "",
-                            std::nullopt};
-      for (const auto& [id, T] : ours.equivalent_objects_S)
-        outcome.equivalent_objects.push_back(id);
-      for (const perception::RecognitionCandidate& c : ours.candidates) {
-        outcome.candidate_errors.push_back(CandidateError(c, truth, T_S_O_true, db));
-      }
-      for (const perception::FreeDirection& f : ours.free_directions) {
-        if (f.kind != perception::FreeKind::kUnconstrained) continue;
-        ++(f.motion == perception::FreeMotion::kTranslation ? outcome.free_slides
-                                                            : outcome.free_turns);
-      }
-      if (const auto e = Score(truth, ours.object_id, ours.T_S_O, T_S_O_true, db,
-                               result.pipelines["uwscan"], &ours)) {
-        outcome.rotation_error_rad = e->rotation_rad;
-        outcome.translation_error_m = e->translation_m;
-      }
-      if (ours.object_id != truth && truth != "foreign") {
-        const perception::RecognitionCandidate checked = perception::CheckObjectPose(
-            cloud, ours.segment, db, cache, truth, T_S_O_true, recognition);
-        outcome.why_wrong = WhyWrong(checked, ours, recognition.score_tie);
-        outcome.truth_check = checked;
-      }
-      result.outcomes.push_back(std::move(outcome));
-      if (!options.run_peers) continue;
-      const PointCloud segment =
-          perception::VoxelDownsample(perception::Subset(cloud, ours.segment),
-                                      perception::VoxelFilterOptions{db.parameters.voxel_m});
-      start = std::chrono::steady_clock::now();
-      const PeerAnswer pcl = pcl_peer->Recognize(segment);
-      result.pipelines["pcl_esf"].seconds += Seconds(start);
-      Score(truth, pcl.id, pcl.T_S_O, T_S_O_true, db, result.pipelines["pcl_esf"]);
-      if (!ppf_peer) continue;
-      start = std::chrono::steady_clock::now();
-      perception::NormalOptions normals;
-      normals.radius_m = db.parameters.normal_radius_m;
-      normals.threads = options.threads;
-      const perception::CloudWithNormals with_normals =
-          perception::AttachNormals(segment, perception::EstimateNormals(segment, normals));
-      const PeerAnswer ppf = ppf_peer->Recognize(with_normals.cloud);
-      result.pipelines["opencv_ppf"].seconds += Seconds(start);
-      Score(truth, ppf.id, ppf.T_S_O, T_S_O_true, db, result.pipelines["opencv_ppf"]);
+    if (options.only.empty() ||
+        std::find(options.only.begin(), options.only.end(), s) != options.only.end()) {
+      RunScan(run, s, MakeScene(s, catalogue, foreign, options.seed), scene_scanner);
     }
     if (progress) progress("scans", static_cast<double>(s + 1) / options.scans);
   }
