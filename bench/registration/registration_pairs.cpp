@@ -257,7 +257,7 @@ struct TwoSweeps {
 };
 
 // Views drawn `separation` apart (0.5-1.4 rad) at stand-offs of 0.7-1.3 m each, drawn again while
-// either sweep sees fewer than 500 points of the object.
+// either sweep holds fewer than 500 points.
 TwoSweeps SweepTwice(const scanner::sim::VirtualScanner& scanner,
                      const scanner::sim::SceneObject& object, std::mt19937_64& rng) {
   Eigen::AlignedBox3d box;
