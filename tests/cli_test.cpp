@@ -211,6 +211,10 @@ TEST(Cli, RegistrationBenchComparesThePipelines) {
       ++overlapping[pipeline];
     }
     if (pipeline != "uwscan") continue;
+    // A refusal names its stage; an accepted pose has none.
+    const std::string refused_by = p.at("refused_by");
+    EXPECT_TRUE(refused_by.empty() || refused_by == "coarse" || refused_by == "icp") << name;
+    EXPECT_EQ(refused_by.empty(), p.at("accepted").get<bool>()) << name;
     if (name.ends_with("#0")) main_successes += p.at("success").get<bool>() ? 1 : 0;
     if (name.find(" sweeps ") != std::string::npos) {
       // Two sweeps of one object share some of it; a pose uwscan vouches for is right.

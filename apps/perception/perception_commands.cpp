@@ -231,6 +231,7 @@ nlohmann::json OutcomesJson(const std::vector<bench::PairOutcome>& outcomes) {
                    {"success", p.success},
                    {"symmetric_success", p.symmetric_success},
                    {"accepted", p.accepted},
+                   {"refused_by", p.refused_by},
                    {"overlapping", p.overlapping},
                    {"overlap", p.overlap}});
   }

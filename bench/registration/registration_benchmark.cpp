@@ -72,6 +72,7 @@ PipelineSummary RunPipeline(const std::string& name, const Runner& run_pipeline,
         error.rotation_rad < o.max_rotation_error_rad && error.translation_m < limit_m;
     outcome.symmetric_success = outcome.symmetric_error_m < limit_m;
     outcome.accepted = run.accepted;
+    outcome.refused_by = run.refused_by;
     outcome.overlapping = pair.overlapping;
     outcome.overlap = pair.overlap;
     outcome.useful = Useful(pair, run.accepted, outcome.symmetric_success);

@@ -37,6 +37,7 @@ struct PairOutcome {
   bool success = false;            // rotation and translation within the thresholds
   bool symmetric_success = false;  // ADD-S within the translation threshold
   bool accepted = false;           // the pipeline vouched for its pose (PipelineRun::accepted)
+  std::string refused_by;          // PipelineRun::refused_by
   bool overlapping = true;         // the pair has an answer (RegistrationPair::overlapping)
   double overlap = 0.0;            // RegistrationPair::overlap
   // What a user needs: an overlapping pair's pose accepted and right modulo symmetry; a pair

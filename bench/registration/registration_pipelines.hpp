@@ -32,6 +32,9 @@ struct PipelineRun {
   // has no such rule, so its result counts once a tenth of the source lies within the ICP
   // distance (its fitness), as PCL's inlier fraction asks.
   bool accepted = false;
+  // uwscan only, when it refused: the stage that did, "coarse" (no hypothesis with enough of the
+  // source in agreement) or "icp" (ICP did not converge); empty otherwise.
+  std::string refused_by;
   std::map<std::string, double> stage_seconds;  // downsample, normals, features, coarse, icp
   double seconds = 0.0;
 };

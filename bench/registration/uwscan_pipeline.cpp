@@ -32,6 +32,7 @@ PipelineRun RunUwscanPipeline(const RegistrationPair& pair, const PipelineParame
   PipelineRun run;
   run.T_target_source = result.fine.T_target_source;
   run.accepted = result.fine.converged;
+  if (!run.accepted) run.refused_by = result.coarse.converged ? "icp" : "coarse";
   run.stage_seconds = result.stage_seconds;
   for (const auto& [stage, seconds] : result.stage_seconds) run.seconds += seconds;
   return run;
