@@ -160,7 +160,7 @@ void RunAccuracy(const AccuracyArgs& a) {
   const nlohmann::json sphere = PrintSphere(o, r);
   const nlohmann::json waypoints = PrintWaypoints(o, r);
   PrintPeakErrors(r);
-  std::printf("\n%.1f s (`uwscan plot` draws the --json's accuracy against time).\n", r.seconds);
+  std::printf("\n%.1f s (`uwscan plot` draws the --json's charts).\n", r.seconds);
   if (a.json_path.empty()) return;
   WriteJsonFile(a.json_path, {{"gauges",
                                {{"air", GaugeJson(r.gauges_air)},

@@ -238,17 +238,6 @@ Eigen::Isometry3d ViewFrom(const Eigen::Vector3d& centre, const Eigen::Vector3d&
   return scanner::sim::LookAt(centre + standoff_m * direction, centre, up);
 }
 
-// One sweep's points in the camera frame, appended with the stray ones (a peak from no lit
-// surface: noise) last; returns how many are stray.
-std::size_t SweepPoints(const scanner::sim::VirtualScan& scan, std::vector<Eigen::Vector3d>* out) {
-  std::vector<Eigen::Vector3d> stray;
-  for (std::size_t i = 0; i < scan.points_C.size(); ++i) {
-    (scan.truth_C[i].allFinite() ? *out : stray).push_back(scan.points_C[i]);
-  }
-  out->insert(out->end(), stray.begin(), stray.end());
-  return stray.size();
-}
-
 // Two sweeps of the virtual scanner, each in its own camera frame.
 struct TwoSweeps {
   scanner::sim::VirtualScan target, source;
@@ -286,16 +275,14 @@ RegistrationPair SweepPair(const std::string& name, const TwoSweeps& s,
                            std::mt19937_64& rng) {
   RegistrationPair pair;
   pair.name = name;
-  std::vector<Eigen::Vector3d> target, source;
-  SweepPoints(s.target, &target);
-  pair.source_outliers = SweepPoints(s.source, &source);
   const Eigen::Isometry3d T_moved_C = RandomMotion(rng, max_translation_m);
+  std::vector<Eigen::Vector3d> source = s.source.points_C;
   for (Eigen::Vector3d& p : source) p = T_moved_C * p;
   const Eigen::Isometry3d T_moved_W = T_moved_C * s.T_W_source.inverse();
   std::vector<Eigen::Vector3d> surface_in_source;
   surface_in_source.reserve(surface.size());
   for (const Eigen::Vector3d& p : surface) surface_in_source.push_back(T_moved_W * p);
-  pair.target = perception::MakeCloud(target);
+  pair.target = perception::MakeCloud(s.target.points_C);
   pair.source = perception::MakeCloud(source);
   pair.surface = perception::MakeCloud(surface_in_source);
   pair.source_viewpoint = T_moved_C.translation();  // the camera's centre
@@ -306,8 +293,9 @@ RegistrationPair SweepPair(const std::string& name, const TwoSweeps& s,
 }
 
 // Per mesh, two sweeps of the virtual scanner (the default galvanometer scanner under water:
-// refraction at both viewports, occlusion, 0.1 px of peak noise): a real sweep's density, which
-// falls with range and incidence, its noise along the camera's rays and its stray points.
+// refraction at both viewports, occlusion, 0.1 px of noise on the exact peaks, no rendered
+// frames): a real sweep's density, along its lines and falling with range and incidence, and its
+// noise along the camera's rays.
 void AddSweepPairs(const std::filesystem::path& cache, const RegistrationPairOptions& o,
                    std::mt19937_64& rng, std::vector<RegistrationPair>* pairs) {
   scanner::sim::VirtualScannerOptions scan_options;

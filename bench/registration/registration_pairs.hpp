@@ -50,7 +50,7 @@ struct RegistrationPairOptions {
   bool hard_pairs = true;
   double outlier_fraction = 0.05;  // of a hard pair's source points added as outliers, [0, 1)
   // With hard_pairs: per mesh, two sweeps of the virtual scanner 0.5-1.4 rad apart at 0.7-1.3 m
-  // (the scanner's own density, noise and stray points).
+  // (the scanner's own density and noise), each in its camera's frame.
   bool scanner_sweeps = true;
   std::filesystem::path table_cache;  // folder keeping the scanner's cone table (optional)
 
@@ -62,7 +62,8 @@ struct RegistrationPairOptions {
 // viewpoints, so the overlap is partial), and the real scans against randomly resampled,
 // noisy copies of themselves (full overlap: these test real noise and density, not overlap);
 // with hard_pairs, the harder pairs after them, and with scanner_sweeps the virtual scanner's.
-// Every source is moved by a random rigid motion (any rotation, translation up to the object size).
+// Every source is moved by a random rigid motion (any rotation, translation up to the object size;
+// a sweep's source, in its camera's frame, turns about the camera, a metre from the object).
 // Each pair's overlap is measured within 1 % of its object's size, or 2.5 sampling steps of the
 // sparser cloud if more. Throws uwscan::Error naming the missing file when the cache is incomplete.
 std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path& data_cache,
