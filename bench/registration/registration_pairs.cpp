@@ -230,14 +230,6 @@ void AddUnrelatedPairs(const std::filesystem::path& cache, const RegistrationPai
   }
 }
 
-// The camera at `standoff_m` from `centre` along `direction`, looking at it.
-Eigen::Isometry3d ViewFrom(const Eigen::Vector3d& centre, const Eigen::Vector3d& direction,
-                           double standoff_m) {
-  const Eigen::Vector3d up =
-      std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
-  return scanner::sim::LookAt(centre + standoff_m * direction, centre, up);
-}
-
 // Two sweeps of the virtual scanner, each in its own camera frame.
 struct TwoSweeps {
   scanner::sim::VirtualScan target, source;
@@ -258,8 +250,8 @@ TwoSweeps SweepTwice(const scanner::sim::VirtualScanner& scanner,
     const Eigen::Vector3d a = DrawVector3LastFirst(gauss, rng).normalized();
     s.separation_rad = separation_rad(rng);
     const Eigen::Vector3d b = Eigen::AngleAxisd(s.separation_rad, a.unitOrthogonal()) * a;
-    s.T_W_target = ViewFrom(box.center(), a, standoff_m(rng));
-    s.T_W_source = ViewFrom(box.center(), b, standoff_m(rng));
+    s.T_W_target = scanner::sim::ViewFrom(box.center(), a, standoff_m(rng));
+    s.T_W_source = scanner::sim::ViewFrom(box.center(), b, standoff_m(rng));
     s.target = scanner.Scan({object}, s.T_W_target, rng());
     s.source = scanner.Scan({object}, s.T_W_source, rng());
     if (s.target.points_C.size() >= 500 && s.source.points_C.size() >= 500) return s;

@@ -132,11 +132,8 @@ EsfResult VoxelisedEsf(const PointCloud& cloud, double voxel_m, std::uint64_t se
 
 Eigen::Isometry3d ViewPose(int index, int count, const Eigen::Vector3d& centre_O,
                            double standoff_m) {
-  const Eigen::Vector3d direction =
-      scanner::sim::SphereDirections(count)[static_cast<std::size_t>(index)];
-  const Eigen::Vector3d up =
-      std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
-  return scanner::sim::LookAt(centre_O + standoff_m * direction, centre_O, up);
+  return scanner::sim::ViewFrom(
+      centre_O, scanner::sim::SphereDirections(count)[static_cast<std::size_t>(index)], standoff_m);
 }
 
 ObjectDatabase BuildObjectDatabase(std::span<const ObjectSource> objects,

@@ -103,6 +103,13 @@ Eigen::Isometry3d LookAt(const Eigen::Vector3d& eye_W, const Eigen::Vector3d& ta
   return T_W_C;
 }
 
+Eigen::Isometry3d ViewFrom(const Eigen::Vector3d& centre_W, const Eigen::Vector3d& direction,
+                           double standoff_m) {
+  const Eigen::Vector3d up =
+      std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  return LookAt(centre_W + standoff_m * direction, centre_W, up);
+}
+
 std::vector<Eigen::Vector3d> SphereDirections(int count) {
   if (count < 1) throw Error("SphereDirections: count must be >= 1");
   const double golden_angle = std::numbers::pi * (3.0 - std::sqrt(5.0));

@@ -71,6 +71,11 @@ class VirtualScanner {
 Eigen::Isometry3d LookAt(const Eigen::Vector3d& eye_W, const Eigen::Vector3d& target_W,
                          const Eigen::Vector3d& up_W);
 
+// The camera at `standoff_m` from centre_W along the unit `direction`, looking at centre_W; up is
+// +z unless the direction is within about 25 degrees of it (then +x).
+Eigen::Isometry3d ViewFrom(const Eigen::Vector3d& centre_W, const Eigen::Vector3d& direction,
+                           double standoff_m);
+
 // `count` unit directions spread evenly over the sphere (a Fibonacci lattice), the first
 // nearest +z. Throws uwscan::Error when count < 1.
 std::vector<Eigen::Vector3d> SphereDirections(int count);
