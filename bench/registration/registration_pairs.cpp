@@ -429,7 +429,7 @@ std::vector<RegistrationPair> MakeRegistrationPairs(const std::filesystem::path&
     AddHardMeshPairs(data_cache, options, hard_rng, &pairs);
     if (options.real_scans) AddScanCuts(data_cache, cut_rng, &pairs);
     AddUnrelatedPairs(data_cache, options, unrelated_rng, &pairs);
-    if (options.scanner_sweeps) AddSweepPairs(data_cache, options, sweep_rng, &pairs);
+    AddSweepPairs(data_cache, options, sweep_rng, &pairs);
   }
   for (RegistrationPair& pair : pairs) {
     // Within 1 % of the object's size (the success test's tolerance), but never less than a few

@@ -46,13 +46,11 @@ struct RegistrationPairOptions {
   bool real_scans = true;  // add pairs built from bun0.pcd and table_scene_lms400.pcd
   // Add the pairs users find hard: views further apart, one of them sparser or with outliers;
   // the real scans cut into two overlapping parts; and pairs that do not overlap at all (two
-  // unrelated objects, a scan's two ends).
+  // unrelated objects, a scan's two ends); and per mesh two sweeps of the virtual scanner 0.5-1.4
+  // rad apart at 0.7-1.3 m (the scanner's own density and noise), each in its camera's frame.
   bool hard_pairs = true;
-  double outlier_fraction = 0.05;  // of a hard pair's source points added as outliers, [0, 1)
-  // With hard_pairs: per mesh, two sweeps of the virtual scanner 0.5-1.4 rad apart at 0.7-1.3 m
-  // (the scanner's own density and noise), each in its camera's frame.
-  bool scanner_sweeps = true;
-  std::filesystem::path table_cache;  // folder keeping the scanner's cone table (optional)
+  double outlier_fraction = 0.05;     // of a hard pair's source points added as outliers, [0, 1)
+  std::filesystem::path table_cache;  // folder keeping the sweeps' cone table (optional)
 
   void Check() const;
 };
@@ -61,7 +59,7 @@ struct RegistrationPairOptions {
 // partial views each (independent surface samplings, back faces culled, different
 // viewpoints, so the overlap is partial), and the real scans against randomly resampled,
 // noisy copies of themselves (full overlap: these test real noise and density, not overlap);
-// with hard_pairs, the harder pairs after them, and with scanner_sweeps the virtual scanner's.
+// with hard_pairs, the harder pairs after them.
 // Every source is moved by a random rigid motion (any rotation, translation up to the object size;
 // a sweep's source, in its camera's frame, turns about the camera, a metre from the object).
 // Each pair's overlap is measured within 1 % of its object's size, or 2.5 sampling steps of the

@@ -20,8 +20,8 @@ TEST(ViewFrom, TheCameraLooksAtTheCentreFromTheStandOff) {
     EXPECT_LT((R.col(2) + direction).norm(), 1e-12);  // z forward, towards the centre
     EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
     EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
-    const Eigen::Vector3d up = std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
-                                                             : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d up =
+        std::abs(direction.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
     EXPECT_NEAR(R.col(0).dot(up), 0.0, 1e-12);
     EXPECT_LT(R.col(1).dot(up), 0.0);  // image y (down) leans away from up
   }
