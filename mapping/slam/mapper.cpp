@@ -49,6 +49,7 @@ perception::IcpOptions RegistrationIcp(const MapperOptions& o,
   icp.translation_tolerance_m = o.icp_translation_tolerance_voxels * o.clouds.map_voxel_m;
   icp.rotation_tolerance_rad = o.icp_rotation_tolerance_rad;
   icp.relative_rmse_tolerance = o.icp_relative_rmse_tolerance;
+  icp.early_stage_tolerance_scale = o.icp_early_stage_tolerance_scale;
   icp.threads = o.threads;
   return icp;
 }
@@ -90,6 +91,7 @@ void MapperOptions::Check() const {
   check.GreaterThan("icp_rotation_tolerance_rad", icp_rotation_tolerance_rad, 0.0, "rad");
   check.InRange("icp_relative_rmse_tolerance", icp_relative_rmse_tolerance, 0.0, 1.0,
                 Interval::kOpenHigh);
+  check.AtLeast("icp_early_stage_tolerance_scale", icp_early_stage_tolerance_scale, 1.0);
   RegistrationIcp(*this, icp_distances_m).Check();
   RegistrationIcp(*this, loop_icp_distances_m).Check();
 }

@@ -39,6 +39,9 @@ struct MapperOptions {
   double icp_translation_tolerance_voxels = 0.05;
   double icp_rotation_tolerance_rad = 2e-5;
   double icp_relative_rmse_tolerance = 1e-4;
+  // The stages before the last stop at this many times those tolerances (IcpOptions::
+  // early_stage_tolerance_scale), >= 1.
+  double icp_early_stage_tolerance_scale = 10.0;
   double point_sigma_floor_m = 0.0003;  // a point-to-plane residual is never trusted beyond this
   // A registration edge is kept only above this fitness, and only if it agrees with the
   // navigation's motion in the directions it pins (chi-square at 99.9 % for their number).

@@ -1,9 +1,5 @@
 #include "perception/registration/icp.hpp"
 
-#include <flann/algorithms/dist.h>
-#include <flann/algorithms/kdtree_single_index.h>
-#include <flann/util/matrix.h>
-#include <flann/util/result_set.h>
 #include <omp.h>
 
 #include <Eigen/Eigenvalues>
@@ -18,6 +14,7 @@
 
 #include "perception/cloud/nearest_grid.hpp"
 #include "perception/registration/svd_alignment.hpp"
+#include "perception/registration/target_tree.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
 
@@ -29,83 +26,8 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 constexpr std::ptrdiff_t kBlockSize = 256;  // points per partial sum
 constexpr double kEigenvalueFloor = 1e-10;  // relative: smaller eigenvalues of J^T J dropped
-constexpr int kNoMatch = -1;
 
 int ThreadCount(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
-
-// The nearest point within a radius: a FLANN result set of capacity 1 that starts with the
-// radius as its worst distance, so the tree prunes everything beyond it.
-// With a normal gate, only points whose normal is within the gate's angle of the query's count.
-class NearestWithin : public flann::ResultSet<float> {
- public:
-  void Reset(float radius_sq) {
-    worst_ = radius_sq;
-    index_ = kNoMatch;
-  }
-  // Candidates must have normals[index] . normal >= min_cos; normals == nullptr: no gate.
-  void Gate(const std::vector<Eigen::Vector3f>* normals, const Eigen::Vector3f& normal,
-            float min_cos) {
-    normals_ = normals;
-    normal_ = normal;
-    min_cos_ = min_cos;
-  }
-  bool full() const override { return true; }
-  // Whether target point `index` passes the gate.
-  bool Accepts(std::size_t index) const {
-    return normals_ == nullptr || (*normals_)[index].dot(normal_) >= min_cos_;
-  }
-  void addPoint(float dist, size_t index) override {
-    if (dist < worst_ && Accepts(index)) {
-      worst_ = dist;
-      index_ = static_cast<int>(index);
-    }
-  }
-  float worstDist() const override { return worst_; }
-  int index() const { return index_; }
-
- private:
-  float worst_ = 0.0f;
-  int index_ = kNoMatch;
-  const std::vector<Eigen::Vector3f>* normals_ = nullptr;
-  Eigen::Vector3f normal_ = Eigen::Vector3f::Zero();
-  float min_cos_ = -1.0f;
-};
-
-// Exact nearest-neighbour search on the target points (relative to the target origin): FLANN's
-// kd-tree, and for radii up to grid_radius_m (when > 0) a NearestGrid of cells of grid_cell_m (0: a
-// quarter of the radius).
-class TargetTree {
- public:
-  TargetTree(const PointCloud& target, double grid_radius_m, double grid_cell_m)
-      : index_(flann::Matrix<float>(const_cast<float*>(target.points.front().data()), target.size(),
-                                    3),
-               flann::KDTreeSingleIndexParams(10)) {
-    index_.buildIndex();
-    if (grid_radius_m > 0.0) {
-      grid_.emplace(target.points, grid_cell_m > 0.0 ? grid_cell_m : 0.25 * grid_radius_m,
-                    grid_radius_m);
-      grid_radius_sq_ = static_cast<float>(grid_radius_m * grid_radius_m);
-    }
-  }
-  // Index of the nearest target point within `radius` of p, or kNoMatch. Thread-safe.
-  int Nearest(const Eigen::Vector3d& p, float radius_sq, NearestWithin& result) const {
-    const Eigen::Vector3f query = p.cast<float>();
-    result.Reset(radius_sq);
-    if (grid_ && radius_sq <= grid_radius_sq_) {
-      return static_cast<int>(
-          grid_->Nearest(query, radius_sq, [&](std::uint32_t j) { return result.Accepts(j); }));
-    }
-    index_.findNeighbors(result, query.data(), exact_);
-    return result.index();
-  }
-  const NearestGrid* grid() const { return grid_ ? &*grid_ : nullptr; }
-
- private:
-  flann::KDTreeSingleIndex<flann::L2_3D<float>> index_;
-  flann::SearchParams exact_{-1, 0.0f};  // unlimited checks, eps = 0: exact
-  std::optional<NearestGrid> grid_;
-  float grid_radius_sq_ = 0.0f;
-};
 
 // -[p]x, so that w x p = MinusSkew(p) w.
 Eigen::Matrix3d MinusSkew(const Eigen::Vector3d& p) {
@@ -428,24 +350,28 @@ struct StallWatch {
 };
 
 // Whether a stage has converged: the increment (its settled part) is below both step tolerances,
-// or the residual changed by at most relative_rmse_tolerance of the previous one (NaN: none yet).
-bool StageConverged(const IcpProblem& problem, const IcpStep& step, double previous_rmse) {
+// or the residual changed by at most relative_rmse_tolerance of the previous one (NaN: none yet);
+// the tolerances times `scale`.
+bool StageConverged(const IcpProblem& problem, const IcpStep& step, double previous_rmse,
+                    double scale) {
   const IcpOptions& options = problem.options;
   const Eigen::Vector3d& centroid = problem.target_centroid;
   const double rotation_step = Eigen::AngleAxisd(step.settled.linear()).angle();
   const double translation_step = (step.settled * centroid - centroid).norm();
-  const bool small_step = rotation_step < options.rotation_tolerance_rad &&
-                          translation_step < options.translation_tolerance_m;
+  const bool small_step = rotation_step < scale * options.rotation_tolerance_rad &&
+                          translation_step < scale * options.translation_tolerance_m;
   const bool flat_rmse =
-      std::isfinite(previous_rmse) &&
-      std::abs(previous_rmse - step.rmse) <= options.relative_rmse_tolerance * previous_rmse;
+      std::isfinite(previous_rmse) && std::abs(previous_rmse - step.rmse) <=
+                                          scale * options.relative_rmse_tolerance * previous_rmse;
   return small_step || flat_rmse;
 }
 
 // Iterates with the pairs within `radius` until the stage converges (returns true), stalls,
 // reaches an iteration cap or stops.
-bool RunStage(const IcpProblem& problem, double radius, IcpState& state, IcpScratch& scratch) {
+bool RunStage(const IcpProblem& problem, double radius, bool last_stage, IcpState& state,
+              IcpScratch& scratch) {
   const IcpOptions& options = problem.options;
+  const double scale = last_stage ? 1.0 : options.early_stage_tolerance_scale;
   double previous_rmse = std::numeric_limits<double>::quiet_NaN();
   StallWatch stall{.T_lowest = state.T_rel};
   for (int k = 0; k < options.max_iterations_per_stage; ++k) {
@@ -464,7 +390,7 @@ bool RunStage(const IcpProblem& problem, double radius, IcpState& state, IcpScra
     }
     state.T_rel = step->increment * state.T_rel;
     ++state.iterations;
-    if (StageConverged(problem, *step, previous_rmse)) return true;
+    if (StageConverged(problem, *step, previous_rmse, scale)) return true;
     previous_rmse = step->rmse;
   }
   return false;
@@ -523,6 +449,7 @@ void IcpOptions::Check() const {
   // A relative change of the whole residual is no tolerance (and would make every iteration a
   // stall, stall_iterations counting a residual as lower only by this fraction).
   check.InRange("relative_rmse_tolerance", relative_rmse_tolerance, 0.0, 1.0, Interval::kOpenHigh);
+  check.AtLeast("early_stage_tolerance_scale", early_stage_tolerance_scale, 1.0);
   check.AtLeast("stall_iterations", stall_iterations, 0, "(0 = off)");
   check.AtLeast("threads", threads, 0, "(0 = OpenMP's default)");
   check.Require(max_normal_angle_rad >= 0.0 && max_normal_angle_rad <= std::numbers::pi,
@@ -540,12 +467,12 @@ void IcpOptions::Check() const {
 }
 
 struct IcpTarget::Tree {
-  Tree(const PointCloud& cloud, double grid_radius_m, double grid_cell_m)
-      : tree(cloud, grid_radius_m, grid_cell_m) {}
+  Tree(const PointCloud& cloud, double grid_radius_m, double grid_cell_m, int threads)
+      : tree(cloud, grid_radius_m, grid_cell_m, threads) {}
   TargetTree tree;
 };
 
-IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m, double grid_cell_m)
+IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m, double grid_cell_m, int threads)
     : cloud_(cloud) {
   RequireValidCloud(cloud, "AlignIcp: target", 3);
   if (!(grid_radius_m >= 0.0 && std::isfinite(grid_radius_m))) {
@@ -556,7 +483,7 @@ IcpTarget::IcpTarget(const PointCloud& cloud, double grid_radius_m, double grid_
     throw Error("IcpTarget: grid_cell_m must be in [0, grid_radius_m], got " +
                 std::to_string(grid_cell_m));
   }
-  tree_ = std::make_unique<Tree>(cloud, grid_radius_m, grid_cell_m);
+  tree_ = std::make_unique<Tree>(cloud, grid_radius_m, grid_cell_m, threads);
   centroid_rel_.setZero();
   for (const Eigen::Vector3f& q : cloud.points) centroid_rel_ += q.cast<double>();
   centroid_rel_ /= static_cast<double>(cloud.size());
@@ -571,7 +498,8 @@ RegistrationResult AlignIcp(const PointCloud& source, const PointCloud& target,
                             const IcpOptions& options) {
   options.Check();
   RequireValidCloud(source, "AlignIcp: source", 3);
-  return AlignIcp(source, IcpTarget(target), T_target_source_init, options);
+  return AlignIcp(source, IcpTarget(target, 0.0, 0.0, options.threads), T_target_source_init,
+                  options);
 }
 
 RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
@@ -609,8 +537,8 @@ RegistrationResult AlignIcp(const PointCloud& source, const IcpTarget& prepared,
   bool converged = false;  // the last stage's
   const std::size_t stages = options.max_correspondence_distance_m.size();
   for (std::size_t stage = 0; stage < stages && !state.stopped; ++stage) {
-    const bool stage_converged =
-        RunStage(problem, options.max_correspondence_distance_m[stage], state, scratch);
+    const bool stage_converged = RunStage(problem, options.max_correspondence_distance_m[stage],
+                                          stage + 1 == stages, state, scratch);
     if (stage + 1 == stages) converged = stage_converged && !state.stopped;
   }
   RegistrationResult result = Evaluate(problem, source, state.T_rel, scratch);

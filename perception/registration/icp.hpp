@@ -43,6 +43,9 @@ struct IcpOptions {
   double rotation_tolerance_rad = 1e-6;   // radians
   double translation_tolerance_m = 1e-6;  // metres
   double relative_rmse_tolerance = 1e-6;  // dimensionless
+  // Stages before the last converge at this many times the three tolerances above: each only
+  // has to bring the pose within the next stage's reach, and the last settles it. >= 1.
+  double early_stage_tolerance_scale = 1.0;
   // When > 0, a stage also ends (not converged) once its RMS residual has not gone below its
   // lowest so far by relative_rmse_tolerance for this many iterations, and the pose goes back to
   // where the residual was lowest. Changing pairs can make ICP cycle between poses (a pipe
@@ -119,9 +122,11 @@ class IcpTarget {
   // grid_radius_m > 0: searches within up to that radius use a grid (NearestGrid) of cells of
   // grid_cell_m (0: a quarter of the radius), faster than the tree when the target's points are
   // about a cell apart; the same pairs either way (of equally near points the grid takes the
-  // lowest index). grid_cell_m in [0, grid_radius_m].
-  explicit IcpTarget(const PointCloud& cloud, double grid_radius_m = 0.0, double grid_cell_m = 0.0);
-  IcpTarget(const PointCloud&&, double = 0.0, double = 0.0) = delete;
+  // lowest index). grid_cell_m in [0, grid_radius_m]. threads (0: all) build the search trees;
+  // the trees and every answer are the same for any count.
+  explicit IcpTarget(const PointCloud& cloud, double grid_radius_m = 0.0, double grid_cell_m = 0.0,
+                     int threads = 0);
+  IcpTarget(const PointCloud&&, double = 0.0, double = 0.0, int = 0) = delete;
   ~IcpTarget();
   IcpTarget(const IcpTarget&) = delete;
   IcpTarget& operator=(const IcpTarget&) = delete;

@@ -596,6 +596,30 @@ TEST(IcpBadInput, EmptyOnePointAndNaNCloudsThrow) {
   EXPECT_THROW(AlignIcp(good, good, mirror), Error);
 }
 
+// Early stages stopped at ten times the tolerances leave the last stage to settle the pose: it
+// ends where the fully converged schedule does (within the last stage's tolerances, a few
+// times over), in fewer iterations.
+TEST(IcpEarlyStages, LooserEarlyStagesEndAtTheSamePoseInFewerIterations) {
+  const PointCloud target = BumpySurface(8000, 2, -0.25, 0.0005);
+  const Eigen::Isometry3d truth = KnownMotion();
+  const PointCloud source = Transformed(BumpySurface(4000, 3, 0.0, 0.0005), truth.inverse());
+  IcpOptions options = Options(IcpMethod::kPointToPlane);
+  options.max_correspondence_distance_m = {0.04, 0.02, 0.01};
+  options.rotation_tolerance_rad = 2e-5;
+  options.translation_tolerance_m = 2.5e-4;
+  options.relative_rmse_tolerance = 1e-4;
+  const RegistrationResult tight = AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
+  options.early_stage_tolerance_scale = 10.0;
+  const RegistrationResult loose = AlignIcp(source, target, Eigen::Isometry3d::Identity(), options);
+  ASSERT_TRUE(tight.converged);
+  ASSERT_TRUE(loose.converged);
+  EXPECT_LT(loose.iterations, tight.iterations);
+  EXPECT_LT(RotationErrorRad(loose.T_target_source, tight.T_target_source), 1e-4);
+  EXPECT_LT(TranslationErrorM(loose.T_target_source, tight.T_target_source), 1e-3);
+  EXPECT_LT(RotationErrorRad(loose.T_target_source, truth), 0.1 * kDeg);
+  EXPECT_LT(TranslationErrorM(loose.T_target_source, truth), 1e-3);
+}
+
 TEST(IcpOptions, CheckNamesTheField) {
   const auto field_of = [](const IcpOptions& options) -> std::string {
     try {
@@ -633,6 +657,9 @@ TEST(IcpOptions, CheckNamesTheField) {
   EXPECT_NE(field_of(options).find("relative_rmse_tolerance"), std::string::npos);
   options.relative_rmse_tolerance = 1.0;
   EXPECT_NE(field_of(options).find("relative_rmse_tolerance"), std::string::npos);
+  options = {};
+  options.early_stage_tolerance_scale = 0.5;
+  EXPECT_NE(field_of(options).find("early_stage_tolerance_scale"), std::string::npos);
   options = {};
   options.threads = -2;
   EXPECT_NE(field_of(options).find("threads"), std::string::npos);
