@@ -1,10 +1,8 @@
 #include "mapping/slam/dive_mapping.hpp"
 
 #include <chrono>
-#include <optional>
 #include <string>
 
-#include "mapping/log/frame_read_ahead.hpp"
 #include "mapping/slam/map_uncertainty.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
@@ -77,7 +75,7 @@ class SubmapClock {
 };
 
 // The log replayed as the vehicle delivered it: each navigation sample before the frames it
-// precedes. The frames are read ahead on a thread of their own.
+// precedes.
 FrameSpan Replay(const DiveLogReader& log, const std::vector<NavigationRecord>& navigation,
                  Mapper& mapper, const std::function<void(double)>& progress,
                  std::vector<double>* submap_seconds) {
@@ -86,17 +84,18 @@ FrameSpan Replay(const DiveLogReader& log, const std::vector<NavigationRecord>& 
   std::size_t next_nav = 0;
   std::int64_t done = 0;
   FrameSpan span;
-  FrameReadAhead frames(log);
-  while (const std::optional<FrameRecord> frame = frames.Next()) {
-    while (next_nav < navigation.size() && navigation[next_nav].time_s <= frame->time_s) {
-      clock.Time([&] { mapper.AddNavigation(navigation[next_nav++]); });
-    }
-    clock.Time([&] { mapper.AddFrame(*frame); });
-    if (done == 0) span.first_s = frame->time_s;
-    span.last_s = frame->time_s;
-    ++done;
-    if (progress) progress(static_cast<double>(done) / frame_count);
-  }
+  log.ForEachFrame(
+      [&](const FrameRecord& frame, const GroundTruthRecord*) {
+        while (next_nav < navigation.size() && navigation[next_nav].time_s <= frame.time_s) {
+          clock.Time([&] { mapper.AddNavigation(navigation[next_nav++]); });
+        }
+        clock.Time([&] { mapper.AddFrame(frame); });
+        if (done == 0) span.first_s = frame.time_s;
+        span.last_s = frame.time_s;
+        ++done;
+        if (progress) progress(static_cast<double>(done) / frame_count);
+      },
+      /*with_truth=*/false);
   while (next_nav < navigation.size())
     clock.Time([&] { mapper.AddNavigation(navigation[next_nav++]); });
   clock.Time([&] { mapper.Finish(); });
