@@ -1,7 +1,8 @@
 #pragma once
 
 // The exact nearest-target-point search that ICP pairs with: FLANN kd-trees over the two halves of
-// the target, built side by side. Included by icp.cpp only (it brings FLANN's headers).
+// the target, built side by side. Included by icp.cpp and its test only (it brings FLANN's
+// headers).
 
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
@@ -104,8 +105,9 @@ class TargetTree {
     explicit Half(std::vector<std::uint32_t> ids, const PointCloud& target);
     void Search(const Eigen::Vector3f& query, NearestWithin& result) const {
       result.SearchIn(ids.data());
-      index.findNeighbors(result, query.data(), flann::SearchParams(-1, 0.0f));  // exact
+      index.findNeighbors(result, query.data(), exact);
     }
+    flann::SearchParams exact{-1, 0.0f};  // unlimited checks, eps = 0: exact
     std::vector<std::uint32_t> ids;
     std::vector<Eigen::Vector3f> points;
     flann::KDTreeSingleIndex<flann::L2_3D<float>> index;
