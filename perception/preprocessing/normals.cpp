@@ -7,9 +7,11 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "perception/cloud/cloud_neighbors.hpp"
+#include "perception/preprocessing/knn_grid.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
 
@@ -26,7 +28,7 @@ struct PlaneEstimate {
 // PCA of the neighbourhood; offsets are taken about the query point before averaging.
 std::optional<PlaneEstimate> FitNeighbourhood(const std::vector<Eigen::Vector3f>& points,
                                               const Eigen::Vector3f& query,
-                                              const std::vector<std::uint32_t>& neighbours) {
+                                              std::span<const std::uint32_t> neighbours) {
   if (neighbours.size() < 3) return std::nullopt;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d sum_sq = Eigen::Matrix3d::Zero();
@@ -49,6 +51,7 @@ std::optional<PlaneEstimate> FitNeighbourhood(const std::vector<Eigen::Vector3f>
 void NormalOptions::Check() const {
   const OptionChecks check("NormalOptions");
   check.NonNegative("radius_m", radius_m, "m");
+  check.NonNegative("knn_cell_m", knn_cell_m, "m");
   if (radius_m == 0.0) check.AtLeast("k", k, 3, "(a plane needs 3 points)");
   check.Require(viewpoint.allFinite(), "viewpoint", "finite coordinates");
   check.AtLeast("threads", threads, 0);
@@ -64,35 +67,42 @@ NormalsResult EstimateNormals(const PointCloud& cloud, const NormalOptions& opti
   result.curvatures.assign(n, nan);
   if (n == 0) return result;
 
-  std::optional<RadiusGrid> grid;
-  std::optional<KnnIndex> knn;
-  if (options.radius_m > 0.0) {
-    grid.emplace(cloud.points, options.radius_m);
-  } else {
-    knn.emplace(cloud.points);
-  }
   // The viewpoint relative to the cloud's origin, in double.
   const Eigen::Vector3d viewpoint = options.viewpoint - cloud.origin;
+  auto fit = [&](std::size_t i, std::span<const std::uint32_t> neighbours) {
+    const std::optional<PlaneEstimate> plane =
+        FitNeighbourhood(cloud.points, cloud.points[i], neighbours);
+    if (!plane) return;
+    Eigen::Vector3d normal = plane->normal;
+    if (normal.dot(viewpoint - cloud.points[i].cast<double>()) < 0.0) normal = -normal;
+    result.normals[i] = normal.cast<float>();
+    result.curvatures[i] = static_cast<float>(plane->curvature);
+  };
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  if (options.radius_m == 0.0 && options.knn_cell_m > 0.0) {
+    KnnGrid(cloud.points, options.knn_cell_m).ForEachPoint(options.k, threads, fit);
+  } else {
+    std::optional<RadiusGrid> grid;
+    std::optional<KnnIndex> knn;
+    if (options.radius_m > 0.0) {
+      grid.emplace(cloud.points, options.radius_m);
+    } else {
+      knn.emplace(cloud.points);
+    }
 #pragma omp parallel num_threads(threads)
-  {
-    std::vector<std::uint32_t> neighbours;
-    std::vector<float> d2;
+    {
+      std::vector<std::uint32_t> neighbours;
+      std::vector<float> d2;
 #pragma omp for schedule(dynamic, 256)
-    for (std::ptrdiff_t signed_i = 0; signed_i < static_cast<std::ptrdiff_t>(n); ++signed_i) {
-      const std::size_t i = static_cast<std::size_t>(signed_i);
-      if (grid) {
-        grid->Query(cloud.points[i], neighbours, d2);
-      } else {
-        knn->Query(cloud.points[i], options.k, neighbours, d2);
+      for (std::ptrdiff_t signed_i = 0; signed_i < static_cast<std::ptrdiff_t>(n); ++signed_i) {
+        const std::size_t i = static_cast<std::size_t>(signed_i);
+        if (grid) {
+          grid->Query(cloud.points[i], neighbours, d2);
+        } else {
+          knn->Query(cloud.points[i], options.k, neighbours, d2);
+        }
+        fit(i, neighbours);
       }
-      const std::optional<PlaneEstimate> plane =
-          FitNeighbourhood(cloud.points, cloud.points[i], neighbours);
-      if (!plane) continue;
-      Eigen::Vector3d normal = plane->normal;
-      if (normal.dot(viewpoint - cloud.points[i].cast<double>()) < 0.0) normal = -normal;
-      result.normals[i] = normal.cast<float>();
-      result.curvatures[i] = static_cast<float>(plane->curvature);
     }
   }
   for (const Eigen::Vector3f& normal : result.normals) {

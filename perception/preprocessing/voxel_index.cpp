@@ -49,6 +49,16 @@ std::uint32_t VoxelIndex::Insert(const VoxelKey& key) {
   }
 }
 
+std::int64_t VoxelIndex::Find(const VoxelKey& key) const {
+  if (slots_.empty()) return -1;
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t s = Hash(key) & mask;; s = (s + 1) & mask) {
+    const std::uint32_t slot = slots_[s];
+    if (slot == 0) return -1;
+    if (SameKey(keys_[slot - 1], key)) return slot - 1;
+  }
+}
+
 void VoxelIndex::Grow() {
   slots_.assign(std::max<std::size_t>(64, 2 * slots_.size()), 0);
   const std::size_t mask = slots_.size() - 1;

@@ -12,8 +12,8 @@ namespace uwscan::perception {
 namespace {
 
 // Keys drawn with many repeats, negative and far-out coordinates among them, against a
-// std::map numbering them in the order first seen.
-TEST(VoxelIndex, NumbersKeysInTheOrderFirstSeenAndSortsThemLikeStdMap) {
+// std::map numbering them in the order first seen; keys looked up, present or not.
+TEST(VoxelIndex, NumbersKeysInTheOrderFirstSeenFindsThemAndSortsThemLikeStdMap) {
   std::mt19937_64 rng(7);
   std::uniform_int_distribution<std::int64_t> near(-40, 40);
   std::map<VoxelKey, std::uint32_t> reference;
@@ -25,6 +25,12 @@ TEST(VoxelIndex, NumbersKeysInTheOrderFirstSeenAndSortsThemLikeStdMap) {
     const auto [it, added] = reference.emplace(key, static_cast<std::uint32_t>(reference.size()));
     ASSERT_EQ(index.Insert(key), it->second) << "draw " << i;
     ASSERT_EQ(index.size(), reference.size());
+  }
+  for (int i = 0; i < 20000; ++i) {
+    VoxelKey key;
+    for (std::int64_t& k : key) k = near(rng) * 2;  // many never inserted
+    const auto it = reference.find(key);
+    ASSERT_EQ(index.Find(key), it == reference.end() ? -1 : std::int64_t{it->second});
   }
   const std::vector<std::uint32_t> by_key = index.IdsByKey();
   ASSERT_EQ(by_key.size(), reference.size());
@@ -39,6 +45,7 @@ TEST(VoxelIndex, NumbersKeysInTheOrderFirstSeenAndSortsThemLikeStdMap) {
 TEST(VoxelIndex, EmptyHasNoIds) {
   const VoxelIndex index;
   EXPECT_EQ(index.size(), 0u);
+  EXPECT_EQ(index.Find({0, 0, 0}), -1);
   EXPECT_TRUE(index.IdsByKey().empty());
 }
 
