@@ -32,7 +32,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace uwscan::test;
 
-fs::path TempPath(const std::string& name) { return TempPathOf("uwscan_cli_acq_", name); }
+fs::path TempPath(const std::string& name) { return ScratchPath(name); }
 std::unique_ptr<Background> StartFakeCamera(const std::vector<std::string>& args,
                                             const std::string& name) {
   return StartFakeCameraLogged(args, TempPath(name + ".log"));

@@ -16,9 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <mutex>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -34,23 +32,6 @@ namespace uwscan::test {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// A file of this test process in the temporary folder (`prefix` names the test program).
-// The pid in the name keeps test programs that run side by side apart. A file an earlier
-// process with the same pid left behind (killed before it cleaned up) would be taken for this
-// one's, so it is removed the first time this process asks for the name.
-inline fs::path TempPathOf(const std::string& prefix, const std::string& name) {
-  const fs::path path =
-      fs::temp_directory_path() / (prefix + std::to_string(getpid()) + "_" + name);
-  static std::mutex mutex;
-  static std::set<fs::path> fresh;
-  const std::lock_guard<std::mutex> lock(mutex);
-  if (fresh.insert(path).second) {
-    std::error_code ignored;
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
-      fs::remove_all(path.string() + suffix, ignored);
-  }
-  return path;
-}
 inline std::string SourcePath(const std::string& relative) {
   return std::string(UWSCAN_SOURCE_DIR) + "/" + relative;
 }

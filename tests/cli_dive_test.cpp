@@ -24,10 +24,7 @@ namespace {
 using uwscan::test::CommandRun;
 using uwscan::test::RunUwscan;
 
-std::filesystem::path TempPath(const std::string& name) {
-  return std::filesystem::temp_directory_path() /
-         ("uwscan_cli_dive_test_" + std::to_string(getpid()) + "_" + name);
-}
+std::filesystem::path TempPath(const std::string& name) { return uwscan::test::ScratchPath(name); }
 
 nlohmann::json ReadJson(const std::filesystem::path& path) {
   std::ifstream in(path);

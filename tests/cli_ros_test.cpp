@@ -29,18 +29,7 @@ std::string SourcePath(const std::string& relative) {
   return std::string(UWSCAN_SOURCE_DIR) + "/" + relative;
 }
 
-// A folder of this test process's own, removed at exit.
-const std::filesystem::path& Folder() {
-  static const struct Scratch {
-    std::filesystem::path path = std::filesystem::temp_directory_path() /
-                                 ("uwscan_cli_ros_test_" + std::to_string(::getpid()));
-    Scratch() { std::filesystem::create_directories(path); }
-    ~Scratch() { std::filesystem::remove_all(path); }
-  } scratch;
-  return scratch.path;
-}
-
-std::filesystem::path TempPath(const std::string& name) { return Folder() / name; }
+std::filesystem::path TempPath(const std::string& name) { return uwscan::test::ScratchPath(name); }
 
 // The short inspection dive (20 s, one lap with drifting navigation), simulated once.
 // The short dive's scene as built (simulate --design), beside it.

@@ -22,10 +22,7 @@ using uwscan::test::CommandRun;
 using uwscan::test::RunCommand;
 using uwscan::test::RunUwscan;
 
-fs::path TempPath(const std::string& name) {
-  return fs::temp_directory_path() /
-         ("uwscan_cli_view_test_" + std::to_string(getpid()) + "_" + name);
-}
+fs::path TempPath(const std::string& name) { return uwscan::test::ScratchPath(name); }
 
 std::string SourcePath(const std::string& relative) {
   return std::string(UWSCAN_SOURCE_DIR) + "/" + relative;

@@ -1,6 +1,7 @@
 #include "mapping/change/compare_surveys.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -68,11 +69,23 @@ Survey Scan(std::uint64_t seed, const Edit& edit = {}, double noise_m = 3e-4) {
   return survey;
 }
 
+// A file of this process's own in the temporary folder (tests run side by side), removed when
+// the test is done with it.
+struct TempFile {
+  std::filesystem::path path;
+  explicit TempFile(const std::string& name)
+      : path(std::filesystem::temp_directory_path() /
+             ("uwscan_" + std::to_string(::getpid()) + "_" + name)) {}
+  ~TempFile() {
+    std::error_code ignored;
+    std::filesystem::remove(path, ignored);
+  }
+};
+
 Survey Design() {
-  const std::filesystem::path path =
-      std::filesystem::temp_directory_path() / "uwscan_compare_design.ply";
-  scanner::WriteMeshPly(Structure(), path);
-  return ReadSurvey(path);
+  const TempFile file("compare_design.ply");
+  scanner::WriteMeshPly(Structure(), file.path);
+  return ReadSurvey(file.path);
 }
 
 double ChangedShare(const SurveyComparison& c) {
@@ -173,8 +186,8 @@ TEST(CompareSurveys, BadInputGetsAOneLineErrorNamingWhatIsWrong) {
   empty.name = "empty.ply";
   m = MessageOf([&] { CompareSurveys(empty, Scan(1), {}); });
   EXPECT_NE(m.find("no points"), std::string::npos) << m;
-  const std::filesystem::path faceless =
-      std::filesystem::temp_directory_path() / "uwscan_faceless.ply";
+  const TempFile file("faceless.ply");
+  const std::filesystem::path& faceless = file.path;
   std::ofstream(faceless) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty "
                              "float y\nproperty float z\nelement face 0\nproperty list uchar int "
                              "vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
