@@ -16,13 +16,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The JSON through a file of this process's own, removed also when reading it throws.
 BenchPlots PlotsOf(const std::string& json) {
-  const fs::path path = fs::temp_directory_path() /
-                        ("uwscan_bench_plots_test_" + std::to_string(::getpid()) + ".json");
-  std::ofstream(path) << json;
-  BenchPlots plots = ReadBenchPlots(path);
-  fs::remove(path);
-  return plots;
+  const struct File {
+    fs::path path = fs::temp_directory_path() /
+                    ("uwscan_bench_plots_test_" + std::to_string(::getpid()) + ".json");
+    ~File() {
+      std::error_code ignored;
+      fs::remove(path, ignored);
+    }
+  } file;
+  std::ofstream(file.path) << json;
+  return ReadBenchPlots(file.path);
 }
 
 const PlotSeries& SeriesNamed(const PlotSpec& plot, const std::string& prefix) {

@@ -142,8 +142,10 @@ TEST(DiveLogFollower, PicksUpFramesAppendedAfterItStarted) {
       drawn += !(image.At(col, row) == options.render.background);
   }
   EXPECT_GT(drawn, 2000);
-  fs::remove(source);
-  fs::remove(growing);
+  for (const char* suffix : {"", "-wal", "-shm"}) {  // SQLite's side files too
+    fs::remove(source.string() + suffix);
+    fs::remove(growing.string() + suffix);
+  }
   fs::remove(png);
   fs::remove_all(reconstruction.table_cache);
 }
