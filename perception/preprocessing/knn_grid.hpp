@@ -20,7 +20,7 @@ namespace uwscan::perception {
 // nearest in the cloud when the k-th is nearer than the block's nearest face; the points where
 // it is not (a sparse or isolated part, a cloud's rim) are searched on FLANN's kd-tree, built only
 // when there are such points. Fastest when a cell is about as wide as the k-th neighbour's
-// distance (a surface voxelised at v, k = 15: about 2.5 v).
+// distance (a surface voxelised at v, k = 15: about 3 v).
 // Distances are FLANN's squared L2 (FlannSquaredDistance), so the neighbours are those KnnIndex
 // finds, nearest first; of equally near points the lower index comes first (on the kd-tree,
 // which of several points tied at the k-th distance is taken is FLANN's choice).

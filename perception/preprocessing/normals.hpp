@@ -12,7 +12,7 @@ struct NormalOptions {
   int k = 20;           // neighbours (the point itself included) when radius_m == 0; >= 3
   double radius_m = 0;  // metres; > 0 uses every point within this radius instead of k nearest
   // Metres; > 0 searches the k nearest cell by cell on a grid of this cell (KnnGrid), fastest at
-  // about the k-th neighbour's distance (a cloud voxelised at v, k = 15: 2.5 v); 0 on FLANN's
+  // about the k-th neighbour's distance (a cloud voxelised at v, k = 15: 3 v); 0 on FLANN's
   // kd-tree. The same neighbours either way, but for which of points tied in distance is taken.
   double knn_cell_m = 0;
   // Normals are flipped to face this point, metres, absolute in the cloud's frame (the scanner's
