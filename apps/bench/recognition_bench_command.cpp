@@ -128,9 +128,36 @@ struct Args {
   std::string json;
 };
 
+nlohmann::json ConditionPosesJson(const std::vector<bench::ConditionPose>& poses) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const bench::ConditionPose& p : poses) {
+    out.push_back({{"scene", p.scene},
+                   {"object", p.object},
+                   {"rotation_error_rad", p.rotation_rad},
+                   {"translation_error_m", p.translation_m},
+                   {"nees_per_dimension", p.nees_per_dimension}});
+  }
+  return out;
+}
+
+// Every pose of every condition whose NEES was computed: where a mean's tail comes from.
+void PrintConditionPoses(const bench::RecognitionConditions& r) {
+  std::printf(
+      "\n| condition | scene | object | error (deg, mm) | NEES per pinned direction |\n"
+      "|---|---:|---|---:|---:|\n");
+  for (const auto& [name, f] : r) {
+    for (const bench::ConditionPose& p : f.poses) {
+      std::printf("| %s | %d | %s | %.2f, %.2f | %.2f |\n", name.c_str(), p.scene, p.object.c_str(),
+                  p.rotation_rad * 180.0 / std::numbers::pi, p.translation_m * 1e3,
+                  p.nees_per_dimension);
+    }
+  }
+}
+
 // The conditions users' data brings (bench/recognition/recognition_conditions.hpp): a table and,
 // with --json, {"conditions": {name: {recognition_rate, pose_success_rate, seconds_per_scan,
-// pose_nees_per_dimension_mean, pose_nees_per_dimension_p95, objects}}}.
+// pose_nees_per_dimension_mean, pose_nees_per_dimension_p95, objects, poses: [{scene, object,
+// rotation_error_rad, translation_error_m, nees_per_dimension}]}}}; --details prints the poses.
 void RunConditions(const Args& a) {
   bench::RecognitionConditionsOptions options;
   options.scans = a.conditions;
@@ -158,8 +185,10 @@ void RunConditions(const Args& a) {
                         {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
                         {"seconds_per_scan", seconds},
                         {"pose_nees_per_dimension_mean", Mean(f.nees_per_dimension)},
-                        {"pose_nees_per_dimension_p95", Percentile95(f.nees_per_dimension)}};
+                        {"pose_nees_per_dimension_p95", Percentile95(f.nees_per_dimension)},
+                        {"poses", ConditionPosesJson(f.poses)}};
   }
+  if (a.details) PrintConditionPoses(r);
   if (!a.json.empty()) {
     WriteJsonFile(a.json, {{"bench", "recognition_conditions"},
                            {"scans_per_condition", options.scans},
@@ -376,7 +405,8 @@ void AddRecognitionBenchCommand(CLI::App& bench) {
       "versions of the recogniser; a scan is named by a hash of its scene and of the simulator's "
       "sources, so scans made by other simulator code are never read back)");
   cmd->add_flag("--details", a->details,
-                "print every object's answer and the candidates weighed for it");
+                "print every object's answer and the candidates weighed for it (with --conditions: "
+                "every pose's error and NEES)");
   cmd->add_option("--conditions", a->conditions,
                   "instead: recognition under the conditions users' data brings, this many scenes "
                   "each: objects taught from scans (clouds) beside the same from meshes, the "

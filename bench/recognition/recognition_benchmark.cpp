@@ -297,8 +297,9 @@ std::optional<perception::SymmetricPoseError> Score(
       posed || PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, reported);
   if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
   if (reported != nullptr && e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
-    if (const auto nees = PoseNeesPerPinnedDirection(*T_S_O, e.T_symmetric, model.model.origin,
-                                                     reported->covariance)) {
+    if (const auto nees =
+            PoseNeesPerPinnedDirection(*T_S_O, e.T_symmetric, model.model.origin,
+                                       reported->covariance, reported->free_directions)) {
       figures.pose_nees_per_dimension.push_back(*nees);
       figures.pose_nees_by_class[truth].push_back(*nees);
     }

@@ -232,9 +232,9 @@ struct Recogniser {
 
 // Recognises `scan` of `scene` and adds the outcome for its object (index 1) to `figures`, when
 // the scan holds enough of it.
-void ScoreScan(const Scene& scene, const sim::VirtualScan& scan, Recogniser& recogniser,
-               const Truth& truth, const RecognitionConditionsOptions& options,
-               ConditionFigures& figures) {
+void ScoreScan(int scene_index, const Scene& scene, const sim::VirtualScan& scan,
+               Recogniser& recogniser, const Truth& truth,
+               const RecognitionConditionsOptions& options, ConditionFigures& figures) {
   const int visible =
       static_cast<int>(std::count(scan.object_index.begin(), scan.object_index.end(), 1));
   if (visible < kMinVisiblePoints) return;
@@ -263,8 +263,9 @@ void ScoreScan(const Scene& scene, const sim::VirtualScan& scan, Recogniser& rec
   figures.pose_success += PoseRight(best->T_S_O, T_S_O_true, e, truth);
   if (e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
     if (const auto nees = PoseNeesPerPinnedDirection(best->T_S_O, e.T_symmetric, truth.centre_O,
-                                                     best->covariance)) {
+                                                     best->covariance, best->free_directions)) {
       figures.nees_per_dimension.push_back(*nees);
+      figures.poses.push_back({scene_index, scene.id, e.rotation_rad, e.translation_m, *nees});
     }
   }
 }
@@ -331,19 +332,19 @@ RecognitionConditions RunRecognitionConditions(const RecognitionConditionsOption
     const std::uint64_t scan_seed = options.seed + 31 * static_cast<std::uint64_t>(s);
     const Scene scene = ObjectScene(meshes[k], rng);
     const sim::VirtualScan scan = scanner.Scan(scene.objects, scene.T_W_C, scan_seed);
-    ScoreScan(scene, scan, from_meshes, truths[k], options, result["mesh_models"]);
-    ScoreScan(scene, scan, from_scans, truths[k], options, result["cloud_models"]);
-    ScoreScan(scene, DepthCameraScan(scene, folder.path(), scan_seed), from_meshes, truths[k],
+    ScoreScan(s, scene, scan, from_meshes, truths[k], options, result["mesh_models"]);
+    ScoreScan(s, scene, scan, from_scans, truths[k], options, result["cloud_models"]);
+    ScoreScan(s, scene, DepthCameraScan(scene, folder.path(), scan_seed), from_meshes, truths[k],
               options, result["depth_camera"]);
     const std::size_t c = static_cast<std::size_t>(s) % cad.size();
     const Scene cad_scene = ObjectScene(cad[c], cad_rng);
     const sim::VirtualScan cad_scan = scanner.Scan(cad_scene.objects, cad_scene.T_W_C, scan_seed);
-    ScoreScan(cad_scene, cad_scan, from_cad, cad_truths[c], options, result["catalogue_mm"]);
-    ScoreScan(cad_scene, cad_scan, from_cad_scans, cad_truths[c], options,
+    ScoreScan(s, cad_scene, cad_scan, from_cad, cad_truths[c], options, result["catalogue_mm"]);
+    ScoreScan(s, cad_scene, cad_scan, from_cad_scans, cad_truths[c], options,
               result["catalogue_mm_clouds"]);
     const Scene panel = PanelScene(flat.back(), s, rng);
-    ScoreScan(panel, scanner.Scan(panel.objects, panel.T_W_C, scan_seed), with_panel, panel_truth,
-              options, result["flat_objects"]);
+    ScoreScan(s, panel, scanner.Scan(panel.objects, panel.T_W_C, scan_seed), with_panel,
+              panel_truth, options, result["flat_objects"]);
     if (progress) progress("scans", static_cast<double>(s + 1) / options.scans);
   }
   return result;

@@ -25,6 +25,15 @@ struct RecognitionConditionsOptions {
   void Check() const;
 };
 
+// One posed object whose NEES was computed: which scene, how far off, and its NEES.
+struct ConditionPose {
+  int scene = 0;
+  std::string object;
+  double rotation_rad = 0.0;   // modulo the truth's symmetries
+  double translation_m = 0.0;  // the same
+  double nees_per_dimension = 0.0;
+};
+
 struct ConditionFigures {
   int objects = 0;       // objects scanned with enough points to count
   int recognised = 0;    // with the right id
@@ -33,6 +42,7 @@ struct ConditionFigures {
   int scans = 0;
   // NEES per pinned direction of each posed object within 10 degrees and 5 cm (pose_nees.hpp)
   std::vector<double> nees_per_dimension;
+  std::vector<ConditionPose> poses;  // the same poses, one record each, in scene order
 };
 
 // "mesh_models", "cloud_models", "depth_camera", "catalogue_mm", "catalogue_mm_clouds",

@@ -9,6 +9,7 @@
 #include "perception/recognition/object_database_builder.hpp"
 #include "perception/recognition/object_symmetry.hpp"
 #include "perception/recognition/residual_patches.hpp"
+#include "perception/recognition/restart_spread.hpp"
 
 namespace uwscan::perception::recognition {
 namespace {
@@ -82,6 +83,12 @@ void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted,
       AnalysePoseConstraints(posed.fine.information, spread, model.model.origin,
                              std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m,
                              ctx.options.free_direction_std_m, ctx.options.pose_floor_std_m);
+  if (ctx.options.pose_restart_voxels > 0.0) {
+    c.covariance += RestartSpread(
+        fitted, ctx.cache.Model(posed.object).target, posed.fine.T_target_source,
+        FineIcpLastStage(model.diameter_m, ctx.db.parameters, 1), c.covariance, model.model.origin,
+        radius_m, ctx.options.pose_restart_voxels * ctx.db.parameters.voxel_m, ctx.options.threads);
+  }
   AddUnpinnedPhases(posed, fitted, model, ctx, c);
   const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;
   for (FreeDirection f : c.free_O) {

@@ -31,7 +31,8 @@ std::vector<std::pair<std::string, Eigen::Isometry3d>> EquivalentObjects(
 
 // `object` filled from the chosen candidate: identity, pose, margin to `other_chi_square`, the
 // model's symmetries and the directions and phases the fit on `fitted` leaves free (scan frame),
-// the covariance over the rest, and the grasps.
+// the covariance over the rest, and the grasps. `fitted` is the cloud posed.fine was fitted on,
+// with its normals (the covariance's restarts run that fit again).
 void Accept(const PosedObject& posed, const PointCloud& fitted, const ObjectModel& model,
             double other_chi_square, const ScanContext& ctx, RecognizedObject& object);
 

@@ -222,10 +222,10 @@ SegmentOutcome SplitOffPart(const SegmentInView& seg, const ScanContext& ctx) {
       VoxelisedEsf(part_cloud, ctx.db.parameters.voxel_m, options.seed, options.threads);
   const std::vector<double> part_chi_square = PartChiSquares(part_esf, ctx.db, part->posed);
   // On the part's points with their normals (the fine ICP's normal gate needs them).
-  PlaceAlongFreeDirections(Subset(seg.described.cloud, part->points),
-                           SceneAroundOf(part_cloud, ctx), ctx, part->posed);
+  const PointCloud part_described = Subset(seg.described.cloud, part->points);
+  PlaceAlongFreeDirections(part_described, SceneAroundOf(part_cloud, ctx), ctx, part->posed);
   out.object.candidates.push_back(part->posed.candidate);
-  Accept(part->posed, part_cloud, ctx.db.objects[part->posed.object],
+  Accept(part->posed, part_described, ctx.db.objects[part->posed.object],
          part_esf.ok ? NearestOther(part->posed.object, part_chi_square) : 0.0, ctx, out.object);
   out.object.centroid_S = Centroid(part_cloud);
   std::vector<std::size_t> rest;
@@ -419,6 +419,7 @@ void RecognitionOptions::Check() const {
   check.Positive("residual_patch_m", residual_patch_m, "m");
   check.NonNegative("buried_depth_m", buried_depth_m, "m");
   check.NonNegative("pose_floor_std_m", pose_floor_std_m, "m");
+  check.NonNegative("pose_restart_voxels", pose_restart_voxels, "voxels");
   check.NonNegative("min_phase_points", min_phase_points);
   check.AtLeast("threads", threads, 0);
 }

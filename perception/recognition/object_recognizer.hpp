@@ -114,6 +114,14 @@ struct RecognitionOptions {
   // the recognition bench's 116 poses within 10 degrees and 5 cm (8.8 over 66 on another 60
   // scans, seed 2); with 0.1 mm, 0.89 (0.97 on those, which were not used to choose it).
   double pose_floor_std_m = 0.0001;
+  // The fine ICP restarted from the answer moved this many database voxels each way along every
+  // direction it pins (a rotation's at the object's radius), where it comes to rest added to the
+  // pose covariance (RestartSpread); 0 = not restarted. It shows where the fit is flatter than
+  // its information says: a pipe whose slide only an end's few points pin, a model taught from a
+  // scan whose symmetric halves differ. One voxel is the scale the fine ICP pairs points at (its
+  // stages reach 4, 2 and 1.5 voxels); on issue 50's conditions bench, 0.4 voxel (2 mm) left two
+  // poses 36 mm off at NEES 105 and 107, one voxel at 7 and 11.
+  double pose_restart_voxels = 1.0;
   std::uint64_t seed = 1;
   int threads = 0;     // OpenMP threads, 0 = OpenMP's default; the answer does not depend on it
   void Check() const;  // throws uwscan::Error naming the field
