@@ -12,6 +12,7 @@
 #include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -272,6 +273,14 @@ TEST(Cli, RecognitionBenchConditionsReportEachCondition) {
     }
     EXPECT_GT(c.at("seconds_per_scan").get<double>(), 0.0);
     EXPECT_TRUE(c.contains("pose_nees_per_dimension_p95"));
+    // Each pose behind the NEES, with its scene and error.
+    for (const nlohmann::json& pose : c.at("poses")) {
+      EXPECT_GE(pose.at("scene").get<int>(), 0);
+      EXPECT_LT(pose.at("scene").get<int>(), 2);
+      EXPECT_GE(pose.at("nees_per_dimension").get<double>(), 0.0);
+      EXPECT_LT(pose.at("rotation_error_rad").get<double>(), 10.0 * std::numbers::pi / 180.0);
+      EXPECT_LT(pose.at("translation_error_m").get<double>(), 0.05);
+    }
   }
   EXPECT_NE(run.output.find("| cloud_models |"), std::string::npos) << run.output;
   std::filesystem::remove(json);
