@@ -119,8 +119,7 @@ struct RecognitionOptions {
   // pose covariance (RestartSpread); 0 = not restarted. It shows where the fit is flatter than
   // its information says: a pipe whose slide only an end's few points pin, a model taught from a
   // scan whose symmetric halves differ. One voxel is the scale the fine ICP pairs points at (its
-  // stages reach 4, 2 and 1.5 voxels); on issue 50's conditions bench, 0.4 voxel (2 mm) left two
-  // poses 36 mm off at NEES 105 and 107, one voxel at 7 and 11.
+  // stages reach 4, 2 and 1.5 voxels; bench/recognition/RESULTS.md has the steps tried).
   double pose_restart_voxels = 1.0;
   std::uint64_t seed = 1;
   int threads = 0;     // OpenMP threads, 0 = OpenMP's default; the answer does not depend on it

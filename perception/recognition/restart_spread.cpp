@@ -1,10 +1,10 @@
 #include "perception/recognition/restart_spread.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <array>
 #include <cmath>
 #include <vector>
 
+#include "perception/registration/rigid_increment.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/parallel_tasks.hpp"
 #include "scanner/common/symmetrized.hpp"
@@ -15,20 +15,7 @@ namespace {
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
-// The motion x -> x + w x (x - c) + v, applied exactly: a turn by |w| about the axis through c,
-// then the slide v.
-Eigen::Isometry3d Motion(const Vector6d& twist, const Eigen::Vector3d& centre) {
-  const Eigen::Vector3d w = twist.head<3>();
-  const double angle = w.norm();
-  const Eigen::Matrix3d R = angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
-                                        : Eigen::Matrix3d::Identity();
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = R;
-  T.translation() = centre - R * centre + twist.tail<3>();
-  return T;
-}
-
-// The twist of a motion, as Motion takes it.
+// The twist of a motion, as IncrementAbout takes it.
 Vector6d TwistOf(const Eigen::Isometry3d& motion, const Eigen::Vector3d& centre) {
   const Eigen::AngleAxisd turn(motion.linear());
   Vector6d twist;
@@ -74,7 +61,9 @@ Matrix6d RestartSpread(const PointCloud& source, const IcpTarget& target,
     const std::size_t task = static_cast<std::size_t>(k);
     Vector6d start = Vector6d::Zero();
     if (task < 2 * pinned.size()) start = (task % 2 == 0 ? step_m : -step_m) * pinned[task / 2];
-    const Eigen::Isometry3d T_start = Motion(D * start, centre_O) * T_target_source;
+    const Vector6d twist = D * start;
+    const Eigen::Isometry3d T_start =
+        IncrementAbout(centre_O, twist.head<3>(), twist.tail<3>()) * T_target_source;
     const RegistrationResult r = AlignIcp(source, target, T_start, one);
     rest[task] = D_inverse * TwistOf(r.T_target_source * T_target_source.inverse(), centre_O);
   });

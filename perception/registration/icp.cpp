@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "perception/cloud/nearest_grid.hpp"
+#include "perception/registration/rigid_increment.hpp"
 #include "perception/registration/svd_alignment.hpp"
 #include "perception/registration/target_tree.hpp"
 #include "scanner/common/error.hpp"
@@ -181,16 +182,6 @@ Vector6d SolveWithPrior(const Sums& sums, const IcpPrior& prior, const Eigen::Is
     x -= (u.dot(g) / values(k)) * u;
   }
   return x;
-}
-
-// Rotation by w (rad) about `pivot`, then translation by v.
-Eigen::Isometry3d IncrementAbout(const Eigen::Vector3d& pivot, const Eigen::Vector3d& w,
-                                 const Eigen::Vector3d& v) {
-  Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
-  const double angle = w.norm();
-  if (angle > 0.0) increment.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-  increment.translation() = pivot + v - increment.linear() * pivot;
-  return increment;
 }
 
 void RequireRigid(const Eigen::Isometry3d& T) {
