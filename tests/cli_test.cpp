@@ -267,19 +267,35 @@ TEST(Cli, RecognitionBenchConditionsReportEachCondition) {
     SCOPED_TRACE(name);
     const nlohmann::json& c = j.at("conditions").at(name);
     EXPECT_GE(c.at("objects").get<int>(), 1);
-    for (const char* rate : {"recognition_rate", "pose_success_rate"}) {
+    for (const char* rate : {"recognition_rate", "pose_success_rate", "pose_strict_rate",
+                             "pose_or_ambiguity_reported_rate"}) {
       EXPECT_GE(c.at(rate).get<double>(), 0.0);
       EXPECT_LE(c.at(rate).get<double>(), 1.0);
     }
+    EXPECT_GE(c.at("pose_or_ambiguity_reported_rate").get<double>(),
+              c.at("pose_strict_rate").get<double>());
     EXPECT_GT(c.at("seconds_per_scan").get<double>(), 0.0);
     EXPECT_TRUE(c.contains("pose_nees_per_dimension_p95"));
-    // Each pose behind the NEES, with its scene and error.
+    // Each recognised object's pose, with its scene, error, verdicts and NEES (within 10 degrees
+    // and 5 cm only).
     for (const nlohmann::json& pose : c.at("poses")) {
       EXPECT_GE(pose.at("scene").get<int>(), 0);
       EXPECT_LT(pose.at("scene").get<int>(), 2);
-      EXPECT_GE(pose.at("nees_per_dimension").get<double>(), 0.0);
-      EXPECT_LT(pose.at("rotation_error_rad").get<double>(), 10.0 * std::numbers::pi / 180.0);
-      EXPECT_LT(pose.at("translation_error_m").get<double>(), 0.05);
+      const double rotation = pose.at("rotation_error_rad").get<double>();
+      const double translation = pose.at("translation_error_m").get<double>();
+      EXPECT_EQ(pose.at("strict").get<bool>(),
+                rotation <= 2.0 * std::numbers::pi / 180.0 && translation <= 0.005);
+      if (pose.at("strict").get<bool>()) {
+        EXPECT_TRUE(pose.at("right_or_reported").get<bool>());
+      }
+      EXPECT_GE(pose.at("equivalent_poses").get<int>(), 0);
+      const nlohmann::json& nees = pose.at("nees_per_dimension");
+      if (rotation >= 10.0 * std::numbers::pi / 180.0 || translation >= 0.05) {
+        EXPECT_TRUE(nees.is_null());
+      }
+      if (!nees.is_null()) {
+        EXPECT_GE(nees.get<double>(), 0.0);
+      }
     }
   }
   EXPECT_NE(run.output.find("| cloud_models |"), std::string::npos) << run.output;

@@ -131,33 +131,49 @@ struct Args {
 nlohmann::json ConditionPosesJson(const std::vector<bench::ConditionPose>& poses) {
   nlohmann::json out = nlohmann::json::array();
   for (const bench::ConditionPose& p : poses) {
-    out.push_back({{"scene", p.scene},
-                   {"object", p.object},
-                   {"rotation_error_rad", p.rotation_rad},
-                   {"translation_error_m", p.translation_m},
-                   {"nees_per_dimension", p.nees_per_dimension}});
+    out.push_back(
+        {{"scene", p.scene},
+         {"object", p.object},
+         {"rotation_error_rad", p.rotation_rad},
+         {"translation_error_m", p.translation_m},
+         {"right", p.right},
+         {"strict", p.strict},
+         {"right_or_reported", p.right_or_reported},
+         {"equivalent_poses", p.equivalent_poses},
+         {"nees_per_dimension",
+          p.nees_per_dimension ? nlohmann::json(*p.nees_per_dimension) : nlohmann::json(nullptr)}});
   }
   return out;
 }
 
-// Every pose of every condition whose NEES was computed: where a mean's tail comes from.
+// Every recognised object's pose in every condition: which are wrong, which report why, and
+// where a NEES mean's tail comes from.
 void PrintConditionPoses(const bench::RecognitionConditions& r) {
   std::printf(
-      "\n| condition | scene | object | error (deg, mm) | NEES per pinned direction |\n"
-      "|---|---:|---|---:|---:|\n");
+      "\n| condition | scene | object | error (deg, mm) | right | strict | or reported | "
+      "equivalents | NEES per pinned direction |\n"
+      "|---|---:|---|---:|---|---|---|---:|---:|\n");
+  auto yes = [](bool b) { return b ? "yes" : "no"; };
   for (const auto& [name, f] : r) {
     for (const bench::ConditionPose& p : f.poses) {
-      std::printf("| %s | %d | %s | %.2f, %.2f | %.2f |\n", name.c_str(), p.scene, p.object.c_str(),
-                  p.rotation_rad * 180.0 / std::numbers::pi, p.translation_m * 1e3,
-                  p.nees_per_dimension);
+      std::printf("| %s | %d | %s | %.2f, %.2f | %s | %s | %s | %d | ", name.c_str(), p.scene,
+                  p.object.c_str(), p.rotation_rad * 180.0 / std::numbers::pi,
+                  p.translation_m * 1e3, yes(p.right), yes(p.strict), yes(p.right_or_reported),
+                  p.equivalent_poses);
+      if (p.nees_per_dimension)
+        std::printf("%.2f |\n", *p.nees_per_dimension);
+      else
+        std::printf("- |\n");
     }
   }
 }
 
 // The conditions users' data brings (bench/recognition/recognition_conditions.hpp): a table and,
-// with --json, {"conditions": {name: {recognition_rate, pose_success_rate, seconds_per_scan,
-// pose_nees_per_dimension_mean, pose_nees_per_dimension_p95, objects, poses: [{scene, object,
-// rotation_error_rad, translation_error_m, nees_per_dimension}]}}}; --details prints the poses.
+// with --json, {"conditions": {name: {recognition_rate, pose_success_rate, pose_strict_rate,
+// pose_or_ambiguity_reported_rate, seconds_per_scan, pose_nees_per_dimension_mean,
+// pose_nees_per_dimension_p95, objects, poses: [{scene, object, rotation_error_rad,
+// translation_error_m, right, strict, right_or_reported, equivalent_poses, nees_per_dimension
+// (null outside 10 degrees / 5 cm)}]}}}; --details prints the poses.
 void RunConditions(const Args& a) {
   bench::RecognitionConditionsOptions options;
   options.scans = a.conditions;
@@ -170,23 +186,29 @@ void RunConditions(const Args& a) {
   const bench::RecognitionConditions r = bench::RunRecognitionConditions(options, bar.Callback());
   std::printf(
       "%d scenes per condition, %d views per object, %d threads\n\n| condition | recognised | "
-      "pose 5 mm / 2 deg | s per scan | NEES per pinned direction: mean, p95 |\n"
-      "|---|---:|---:|---:|---:|\n",
+      "pose 5 mm / 2 deg | strict | ... or its ambiguity reported | s per scan | NEES per pinned "
+      "direction: mean, p95 |\n|---|---:|---:|---:|---:|---:|---:|\n",
       options.scans, options.views, options.threads);
   nlohmann::json conditions = nlohmann::json::object();
   for (const auto& [name, f] : r) {
     const double seconds = f.scans == 0 ? 0.0 : f.seconds / f.scans;
-    std::printf("| %s | %d/%d (%.1f %%) | %.1f %% | %.3f | %.2f, %.2f (%zu poses) |\n",
-                name.c_str(), f.recognised, f.objects, 100.0 * Ratio(f.recognised, f.objects),
-                100.0 * Ratio(f.pose_success, f.recognised), seconds, Mean(f.nees_per_dimension),
-                Percentile95(f.nees_per_dimension), f.nees_per_dimension.size());
-    conditions[name] = {{"objects", f.objects},
-                        {"recognition_rate", Ratio(f.recognised, f.objects)},
-                        {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
-                        {"seconds_per_scan", seconds},
-                        {"pose_nees_per_dimension_mean", Mean(f.nees_per_dimension)},
-                        {"pose_nees_per_dimension_p95", Percentile95(f.nees_per_dimension)},
-                        {"poses", ConditionPosesJson(f.poses)}};
+    std::printf(
+        "| %s | %d/%d (%.1f %%) | %.1f %% | %.1f %% | %.1f %% | %.3f | %.2f, %.2f (%zu "
+        "poses) |\n",
+        name.c_str(), f.recognised, f.objects, 100.0 * Ratio(f.recognised, f.objects),
+        100.0 * Ratio(f.pose_success, f.recognised), 100.0 * Ratio(f.pose_strict, f.recognised),
+        100.0 * Ratio(f.pose_or_reported, f.recognised), seconds, Mean(f.nees_per_dimension),
+        Percentile95(f.nees_per_dimension), f.nees_per_dimension.size());
+    conditions[name] = {
+        {"objects", f.objects},
+        {"recognition_rate", Ratio(f.recognised, f.objects)},
+        {"pose_success_rate", Ratio(f.pose_success, f.recognised)},
+        {"pose_strict_rate", Ratio(f.pose_strict, f.recognised)},
+        {"pose_or_ambiguity_reported_rate", Ratio(f.pose_or_reported, f.recognised)},
+        {"seconds_per_scan", seconds},
+        {"pose_nees_per_dimension_mean", Mean(f.nees_per_dimension)},
+        {"pose_nees_per_dimension_p95", Percentile95(f.nees_per_dimension)},
+        {"poses", ConditionPosesJson(f.poses)}};
   }
   if (a.details) PrintConditionPoses(r);
   if (!a.json.empty()) {

@@ -13,6 +13,7 @@
 #include "bench/recognition/pose_nees.hpp"
 #include "bench/recognition/recognition_peers.hpp"
 #include "bench/recognition/recognition_scan_cache.hpp"
+#include "bench/recognition/reported_ambiguity.hpp"
 #include "perception/preprocessing/normals.hpp"
 #include "perception/preprocessing/voxel_filter.hpp"
 #include "perception/recognition/object_database_builder.hpp"
@@ -170,58 +171,6 @@ std::vector<PeerObject> PeerObjects(const ObjectDatabase& db,
   return peers;
 }
 
-// The offset left once the translation along the answer's reported free slides is taken out.
-Eigen::Vector3d OffsetAcrossFreeSlides(Eigen::Vector3d offset,
-                                       const perception::RecognizedObject& reported) {
-  for (const perception::FreeDirection& f : reported.free_directions) {
-    if (f.kind == perception::FreeKind::kUnconstrained &&
-        f.motion == perception::FreeMotion::kTranslation)
-      offset -= offset.dot(f.axis_S) * f.axis_S;
-  }
-  return offset;
-}
-
-// Whether a pose is within 5 mm and 2 degrees of the truth (modulo symmetry) but for a slide
-// along the answer's reported free slides.
-bool PosedButForFreeSlides(const perception::SymmetricPoseError& e, const Eigen::Isometry3d& T_S_O,
-                           const perception::RecognizedObject& reported) {
-  return e.rotation_rad <= 2.0 * kDeg &&
-         OffsetAcrossFreeSlides(T_S_O.translation() - e.T_symmetric.translation(), reported)
-                 .norm() <= 0.005;
-}
-
-// Whether a pose off the truth is right but for what its answer reports it cannot tell: one of
-// the equivalent poses is within 5 mm and 2 degrees (modulo symmetry), or the pose is once the
-// translation along its reported free slides is left out and it is turned about one of its
-// reported free rotation axes (searched by the degree over a full turn).
-bool PosedButForWhatIsReported(const perception::SymmetricPoseError& e,
-                               const Eigen::Isometry3d& T_S_O, const Eigen::Isometry3d& T_S_O_true,
-                               const std::vector<Eigen::Vector3d>& points, const ObjectModel& model,
-                               const perception::RecognizedObject* reported) {
-  if (reported == nullptr) return false;
-  for (const Eigen::Isometry3d& T : reported->equivalent_poses_S) {
-    const perception::SymmetricPoseError other =
-        perception::PoseErrorModuloSymmetry(T, T_S_O_true, points, model.symmetries);
-    if (other.rotation_rad <= 2.0 * kDeg && other.translation_m <= 0.005) return true;
-  }
-  if (PosedButForFreeSlides(e, T_S_O, *reported)) return true;
-  for (const perception::FreeDirection& f : reported->free_directions) {
-    if (f.kind != perception::FreeKind::kUnconstrained ||
-        f.motion != perception::FreeMotion::kRotation)
-      continue;
-    for (int degrees = -180; degrees < 180; ++degrees) {
-      const Eigen::Isometry3d turn = Eigen::Translation3d(f.point_S) *
-                                     Eigen::AngleAxisd(degrees * kDeg, f.axis_S) *
-                                     Eigen::Translation3d(-f.point_S);
-      const Eigen::Isometry3d turned = turn * T_S_O;
-      const perception::SymmetricPoseError t =
-          perception::PoseErrorModuloSymmetry(turned, T_S_O_true, points, model.symmetries);
-      if (PosedButForFreeSlides(t, turned, *reported)) return true;
-    }
-  }
-  return false;
-}
-
 // The database's model named `id`, or none (a foreign mesh).
 const ObjectModel* ModelNamed(const ObjectDatabase& db, const std::string& id) {
   const auto model = std::find_if(db.objects.begin(), db.objects.end(),
@@ -294,7 +243,8 @@ std::optional<perception::SymmetricPoseError> Score(
   const bool posed = e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005;
   figures.pose_success += posed;
   figures.pose_or_reported +=
-      posed || PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, reported);
+      posed || (reported != nullptr &&
+                PosedButForWhatIsReported(e, *T_S_O, T_S_O_true, points, model, *reported));
   if (e.mssd_m < 0.1 * model.diameter_m) ++figures.mssd_success;
   if (reported != nullptr && e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
     if (const auto nees =

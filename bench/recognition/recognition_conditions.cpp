@@ -9,6 +9,7 @@
 #include <random>
 
 #include "bench/recognition/pose_nees.hpp"
+#include "bench/recognition/reported_ambiguity.hpp"
 #include "bench/registration/registration_pairs.hpp"
 #include "bench/scratch_folder.hpp"
 #include "mapping/reconstruction/scan_file.hpp"
@@ -223,6 +224,14 @@ Truth TruthOf(const ObjectSource& object, const ObjectDatabase& db) {
   return truth;
 }
 
+// The database's model of `id` (every scene's object is in its condition's database).
+const perception::ObjectModel& ModelNamed(const ObjectDatabase& db, const std::string& id) {
+  const auto model = std::find_if(db.objects.begin(), db.objects.end(),
+                                  [&](const perception::ObjectModel& o) { return o.id == id; });
+  if (model == db.objects.end()) throw Error("recognition conditions: no model of " + id);
+  return *model;
+}
+
 // One database and what recognition derives from it once, for every scan.
 struct Recogniser {
   const ObjectDatabase& db;
@@ -260,14 +269,29 @@ void ScoreScan(int scene_index, const Scene& scene, const sim::VirtualScan& scan
   const Eigen::Isometry3d T_S_O_true = scene.T_W_C.inverse() * scene.T_W_O;
   const perception::SymmetricPoseError e = perception::PoseErrorModuloSymmetry(
       best->T_S_O, T_S_O_true, truth.points_O, truth.symmetries);
-  figures.pose_success += PoseRight(best->T_S_O, T_S_O_true, e, truth);
+  ConditionPose pose;
+  pose.scene = scene_index;
+  pose.object = scene.id;
+  pose.rotation_rad = e.rotation_rad;
+  pose.translation_m = e.translation_m;
+  pose.right = PoseRight(best->T_S_O, T_S_O_true, e, truth);
+  pose.strict = e.rotation_rad <= 2.0 * kDeg && e.translation_m <= 0.005;
+  const perception::ObjectModel& model = ModelNamed(recogniser.db, scene.id);
+  pose.right_or_reported =
+      pose.strict ||
+      PosedButForWhatIsReported(perception::PoseErrorModuloSymmetry(
+                                    best->T_S_O, T_S_O_true, truth.points_O, model.symmetries),
+                                best->T_S_O, T_S_O_true, truth.points_O, model, *best);
+  pose.equivalent_poses = static_cast<int>(best->equivalent_poses_S.size());
   if (e.rotation_rad < 10.0 * kDeg && e.translation_m < 0.05) {
-    if (const auto nees = PoseNeesPerPinnedDirection(best->T_S_O, e.T_symmetric, truth.centre_O,
-                                                     best->covariance, best->free_directions)) {
-      figures.nees_per_dimension.push_back(*nees);
-      figures.poses.push_back({scene_index, scene.id, e.rotation_rad, e.translation_m, *nees});
-    }
+    pose.nees_per_dimension = PoseNeesPerPinnedDirection(best->T_S_O, e.T_symmetric, truth.centre_O,
+                                                         best->covariance, best->free_directions);
+    if (pose.nees_per_dimension) figures.nees_per_dimension.push_back(*pose.nees_per_dimension);
   }
+  figures.pose_success += pose.right;
+  figures.pose_strict += pose.strict;
+  figures.pose_or_reported += pose.right_or_reported;
+  figures.poses.push_back(pose);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,24 +26,35 @@ struct RecognitionConditionsOptions {
   void Check() const;
 };
 
-// One posed object whose NEES was computed: which scene, how far off, and its NEES.
+// One recognised object: which scene, how far off, whether right, and its NEES.
 struct ConditionPose {
   int scene = 0;
   std::string object;
-  double rotation_rad = 0.0;   // modulo the truth's symmetries
-  double translation_m = 0.0;  // the same
-  double nees_per_dimension = 0.0;
+  double rotation_rad = 0.0;                 // modulo the truth's symmetries
+  double translation_m = 0.0;                // the same
+  bool right = false;                        // counted in ConditionFigures::pose_success
+  bool strict = false;                       // counted in ConditionFigures::pose_strict
+  bool right_or_reported = false;            // counted in ConditionFigures::pose_or_reported
+  int equivalent_poses = 0;                  // other poses the answer reported as fitting as well
+  std::optional<double> nees_per_dimension;  // when within 10 degrees and 5 cm (below)
 };
 
 struct ConditionFigures {
   int objects = 0;       // objects scanned with enough points to count
   int recognised = 0;    // with the right id
-  int pose_success = 0;  // of those, within 5 mm and 2 degrees modulo symmetry
+  int pose_success = 0;  // of those, within 5 mm and 2 degrees modulo symmetry (PoseRight)
+  // Of the recognised, within 5 mm and 2 degrees modulo only the symmetries the object truly has
+  // (declared; none for the CAD parts, which pose_success judges by ADD-S instead)...
+  int pose_strict = 0;
+  // ...or off that but only by what the answer reports it cannot tell: a symmetry its model
+  // carries (the database's, found for the CAD parts), an equivalent pose, a free slide or turn
+  // (reported_ambiguity.hpp). pose_success - pose_or_reported is ambiguity left unreported.
+  int pose_or_reported = 0;
   double seconds = 0.0;  // recognition time, summed over the scans
   int scans = 0;
   // NEES per pinned direction of each posed object within 10 degrees and 5 cm (pose_nees.hpp)
   std::vector<double> nees_per_dimension;
-  std::vector<ConditionPose> poses;  // the same poses, one record each, in scene order
+  std::vector<ConditionPose> poses;  // every recognised object, one record each, in scene order
 };
 
 // "mesh_models", "cloud_models", "depth_camera", "catalogue_mm", "catalogue_mm_clouds",

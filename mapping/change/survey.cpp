@@ -7,6 +7,7 @@
 
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/common/json_fields.hpp"
 #include "scanner/common/option_checks.hpp"
 #include "scanner/common/ply_reader.hpp"
@@ -133,7 +134,7 @@ void SurveyReadOptions::Check() const {
 
 Survey ReadSurvey(const fs::path& path, const SurveyReadOptions& options) {
   options.Check();
-  if (!fs::is_regular_file(path)) throw Error(path.string() + ": no such file");
+  RequireRegularFile(path, path.string());
   const std::string extension = Lower(path.extension().string());
   if (extension == ".json") return ReadMapReport(path, options);
   if (extension == ".obj" || extension == ".stl" || extension == ".off")

@@ -11,6 +11,7 @@
 #include "mapping/log/dive_log_format.hpp"
 #include "mapping/log/sqlite_db.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
 // The reading half of dive_log.hpp.
@@ -237,6 +238,7 @@ struct DiveLogReader::Impl {
 };
 
 bool IsSqliteFile(const std::filesystem::path& path) {
+  if (!IsRegularFile(path)) return false;  // a pipe with no writer would block the read
   std::ifstream in(path, std::ios::binary);
   char magic[16] = {};
   in.read(magic, sizeof(magic));

@@ -20,6 +20,7 @@
 #include "perception/cloud/pcd_reader.hpp"
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/common/ply_reader.hpp"
 
 namespace uwscan::perception {
@@ -49,6 +50,21 @@ std::optional<Format> FormatOf(const fs::path& path) {
   if (ext == ".ply") return Format::kPly;
   if (ext == ".xyz") return Format::kXyz;
   return std::nullopt;
+}
+
+std::string FormatName(Format format) {
+  return format == Format::kPcd ? "PCD" : format == Format::kPly ? "PLY" : "XYZ";
+}
+
+// Why a file with an extension ReadCloud does not take is not read: a mesh format named as such.
+std::string NotACloudFormat(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  if (ext == ".OBJ" || ext == ".OFF" || ext == ".STL")
+    return "an " + ext.substr(1) + " file is a mesh, not a point cloud";
+  if (ext.empty()) return "no extension to tell its format by";
+  return "unknown extension " + ext.substr(1);
 }
 
 // Absolute points (and normals and intensities, when the file has them) as read, before any
@@ -90,36 +106,61 @@ double FieldValue(const std::uint8_t* point, const pcl::PCLPointField& field) {
   }
 }
 
+// The numbers on one line of an XYZ file, separated by spaces, tabs or commas; throws naming the
+// line when a word is not a number.
+std::vector<double> XyzNumbers(const std::string& line, std::size_t line_number,
+                               const fs::path& path) {
+  std::vector<double> numbers;
+  const char* p = line.data();
+  const char* end = p + line.size();
+  auto skip_separators = [&] {
+    while (p < end && (std::isspace(static_cast<unsigned char>(*p)) || *p == ',')) ++p;
+  };
+  for (skip_separators(); p < end; skip_separators()) {
+    if (*p == '+') ++p;  // from_chars takes no leading '+'
+    double value = 0.0;
+    const std::from_chars_result parsed = std::from_chars(p, end, value);
+    const bool separated = parsed.ptr == end ||
+                           std::isspace(static_cast<unsigned char>(*parsed.ptr)) ||
+                           *parsed.ptr == ',';
+    if (parsed.ec != std::errc() || parsed.ptr == p || !separated) {
+      throw Error("ReadCloud: " + Quoted(path) + " (read as XYZ) line " +
+                  std::to_string(line_number) +
+                  ": expected numbers x y z (and as many more as "
+                  "the first point's line has), got '" +
+                  line.substr(0, 80) + "'");
+    }
+    numbers.push_back(value);
+    p = parsed.ptr;
+  }
+  return numbers;
+}
+
+// An XYZ file: a point per line, x y z first, then as many further columns (colour, normal,
+// intensity) as the first point's line has, which every line must have; blank lines and lines
+// starting with '#' are skipped.
 RawCloud ReadXyz(const fs::path& path) {
   std::ifstream in(path);
-  if (!in) throw Error("ReadCloud: cannot open " + Quoted(path));
+  if (!in) throw Error("ReadCloud: cannot open " + Quoted(path) + " (read as XYZ)");
   RawCloud raw;
   std::string line;
+  std::size_t columns = 0, first_line = 0;
   for (std::size_t line_number = 1; std::getline(in, line); ++line_number) {
-    const char* p = line.data();
-    const char* end = p + line.size();
-    auto skip_separators = [&] {
-      while (p < end && (std::isspace(static_cast<unsigned char>(*p)) || *p == ',')) ++p;
-    };
-    skip_separators();
-    if (p == end || *p == '#') continue;
-    Eigen::Vector3d point;
-    for (int a = 0; a < 3; ++a) {
-      skip_separators();
-      if (p < end && *p == '+') ++p;  // from_chars takes no leading '+'
-      double value = 0.0;
-      const std::from_chars_result parsed = std::from_chars(p, end, value);
-      if (parsed.ec != std::errc() || parsed.ptr == p) {
-        throw Error("ReadCloud: " + Quoted(path) + " (read as XYZ) line " +
-                    std::to_string(line_number) + ": expected three numbers x y z, got '" +
-                    line.substr(0, 80) + "'");
-      }
-      point[a] = value;
-      p = parsed.ptr;
+    const std::size_t start = line.find_first_not_of(" \t\r,");
+    if (start == std::string::npos || line[start] == '#') continue;
+    const std::vector<double> numbers = XyzNumbers(line, line_number, path);
+    if (columns == 0) columns = numbers.size(), first_line = line_number;
+    if (numbers.size() < 3 || numbers.size() != columns) {
+      throw Error("ReadCloud: " + Quoted(path) + " (read as XYZ) line " +
+                  std::to_string(line_number) + ": " + std::to_string(numbers.size()) +
+                  " columns where " +
+                  (numbers.size() < 3
+                       ? std::string("x y z need 3")
+                       : "line " + std::to_string(first_line) + " has " + std::to_string(columns)));
     }
-    raw.points.push_back(point);
+    raw.points.emplace_back(numbers[0], numbers[1], numbers[2]);
   }
-  if (in.bad()) throw Error("ReadCloud: error while reading " + Quoted(path));
+  if (in.bad()) throw Error("ReadCloud: error while reading " + Quoted(path) + " (read as XYZ)");
   return raw;
 }
 
@@ -215,13 +256,10 @@ bool WritePly(const fs::path& path, const pcl::PCLPointCloud2& blob, bool binary
 PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   const std::optional<Format> format = FormatOf(path);
   if (!format) {
-    throw Error("ReadCloud: " + Quoted(path) + ": unknown extension (expected .pcd, .ply or .xyz)");
+    throw Error("ReadCloud: " + Quoted(path) + ": " + NotACloudFormat(path) +
+                " (expected a point cloud: .pcd, .ply or .xyz)");
   }
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error("ReadCloud: " + Quoted(path) + ": no such file");
-  if (!fs::is_regular_file(path, ec)) {
-    throw Error("ReadCloud: " + Quoted(path) + ": not a regular file");
-  }
+  RequireRegularFile(path, "ReadCloud: " + Quoted(path));
 
   RawCloud raw;
   if (*format == Format::kXyz) {
@@ -264,9 +302,12 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   }
   local.num_dropped_non_finite = raw.points.size() - points.size();
   if (points.empty()) {
-    throw Error("ReadCloud: " + Quoted(path) + " holds no finite point (" +
+    const std::string as = " (read as " + FormatName(*format) + ")";
+    if (local.num_in_file == 0) throw Error("ReadCloud: " + Quoted(path) + as + ": no point in it");
+    throw Error("ReadCloud: " + Quoted(path) + as + " holds no finite point (" +
                 std::to_string(local.num_in_file) + " in the file, " +
-                std::to_string(local.num_dropped_non_finite) + " dropped as NaN or infinite)");
+                std::to_string(local.num_dropped_non_finite) +
+                " dropped as NaN or infinite, or with a normal that is not a direction)");
   }
   PointCloud cloud = MakeCloud(points);
   cloud.normals = std::move(normals);

@@ -4,6 +4,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -106,7 +107,8 @@ TEST_F(CloudIoTest, HugeCoordinatesKeepTheirPrecision) {
 
 TEST_F(CloudIoTest, ReadsXyzAndDropsNonFinitePoints) {
   const fs::path path = dir_ / "points.xyz";
-  std::ofstream(path) << "# x y z\n1 2 3\n\n4.5, 5.5, 6.5 200 100 50\nnan 1 1\n+7 -8 9e0\n";
+  std::ofstream(path) << "# x y z r g b\n1 2 3 0 0 0\n\n4.5, 5.5, 6.5 200 100 50\nnan 1 1 0 0 0\n"
+                         "+7 -8 9e0 1 1 1\n";
   CloudReadStats stats;
   const PointCloud cloud = ReadCloud(path, &stats);
   ASSERT_EQ(cloud.size(), 3u);
@@ -174,15 +176,63 @@ TEST_F(CloudIoTest, ErrorsNameTheFile) {
   }
   const fs::path empty = dir_ / "empty.xyz";
   std::ofstream(empty) << "# nothing\n";
-  EXPECT_NE(MessageOf([&] { ReadCloud(empty); }).find("no finite point"), std::string::npos);
+  EXPECT_NE(MessageOf([&] { ReadCloud(empty); }).find("(read as XYZ): no point"),
+            std::string::npos);
+  // A line with other columns than the first point's is damage (a line cut short), not a point.
+  const fs::path ragged = dir_ / "ragged.xyz";
+  std::ofstream(ragged) << "1 2 3 200 100 50\n4 5 6 200 100 50\n7 8 9 200\n";
+  const std::string ragged_message = MessageOf([&] { ReadCloud(ragged); });
+  EXPECT_NE(ragged_message.find("(read as XYZ) line 3: 4 columns where line 1 has 6"),
+            std::string::npos)
+      << ragged_message;
+  const fs::path word = dir_ / "word.xyz";
+  std::ofstream(word) << "1 2 3\n4 5 6 abc\n";
+  EXPECT_NE(MessageOf([&] { ReadCloud(word); }).find("line 2"), std::string::npos);
+  // A mesh given where a cloud is read is named as one.
+  const fs::path mesh = dir_ / "part.obj";
+  std::ofstream(mesh) << "v 0 0 0\n";
+  EXPECT_NE(MessageOf([&] { ReadCloud(mesh); }).find("an OBJ file is a mesh, not a point cloud"),
+            std::string::npos);
   const fs::path all_nan = dir_ / "nan.xyz";
   std::ofstream(all_nan) << "nan 0 0\n0 inf 0\n";
-  EXPECT_NE(MessageOf([&] { ReadCloud(all_nan); }).find("2 dropped"), std::string::npos);
+  const std::string nan_message = MessageOf([&] { ReadCloud(all_nan); });
+  EXPECT_NE(nan_message.find("(read as XYZ) holds no finite point"), std::string::npos);
+  EXPECT_NE(nan_message.find("2 dropped"), std::string::npos);
   const fs::path text = dir_ / "out.xyz";
   EXPECT_NE(MessageOf([&] {
               WriteCloud(text, RandomCloud(Eigen::Vector3d::Zero(), false));
             }).find(text.string()),
             std::string::npos);
+}
+
+// A cloud's file damaged where the cloud does not look (its faces) or in a word of its text is
+// refused with what is wrong, not read as if whole.
+TEST_F(CloudIoTest, DamageIsNamedWhereverItIs) {
+  const fs::path faces = dir_ / "faces.ply";
+  std::ofstream(faces) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                          "property float y\nproperty float z\nelement face 1\n"
+                          "property list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 999\n";
+  const std::string face_message = MessageOf([&] { ReadCloud(faces); });
+  EXPECT_NE(face_message.find("(read as PLY): element face row 0: names vertex 999 of 3"),
+            std::string::npos)
+      << face_message;
+  const fs::path word = dir_ / "word.ply";
+  std::ofstream(word) << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header\n0 0 0\n1 abc 0\n";
+  const std::string word_message = MessageOf([&] { ReadCloud(word); });
+  EXPECT_NE(word_message.find("element vertex row 1: y: 'abc' is not a number"), std::string::npos)
+      << word_message;
+  std::ofstream(word) << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header\n0 0 0\n1 2      \n";
+  EXPECT_NE(MessageOf([&] { ReadCloud(word); }).find("z: the file ends"), std::string::npos);
+  const fs::path no_data = dir_ / "no_data.pcd";
+  std::ofstream(no_data) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                            "WIDTH 1\nHEIGHT 1\nPOINTS 1\n1 2 3\n";
+  EXPECT_NE(MessageOf([&] { ReadCloud(no_data); }).find("no DATA line"), std::string::npos);
+  const fs::path fifo = dir_ / "pipe.pcd";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(MessageOf([&] { ReadCloud(fifo); }).find("not a regular file"), std::string::npos);
 }
 
 TEST_F(CloudIoTest, FailedWriteLeavesTheExistingFileIntact) {

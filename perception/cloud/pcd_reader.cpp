@@ -139,6 +139,11 @@ void ReadHeaderLine(const std::string& key, const std::vector<std::string>& word
     } catch (const Error& e) {
       lines.viewpoint_error = e.what();
     }
+  } else if (!key.empty() && (std::isdigit(static_cast<unsigned char>(key[0])) || key[0] == '-' ||
+                              key[0] == '+' || key[0] == '.')) {
+    throw Error(where +
+                ": a number where a header key belongs: the points start with no DATA "
+                "line before them");
   } else {
     throw Error(where + ": unknown key '" + key.substr(0, 40) + "': not a PCD header");
   }

@@ -79,15 +79,20 @@ void AddPoseConstraints(const PosedObject& posed, const PointCloud& fitted,
   const Eigen::Matrix<double, 6, 6> spread = ResidualPatchSpread(
       fitted, posed.fine.T_target_source, model.model, ctx.cache.Model(posed.object).nearest(),
       pair_distance_m, model.model.origin, ctx.options.residual_patch_m);
+  const Eigen::Matrix<double, 6, 6>& information = posed.fine.information;
+  const double sigma_m = std::max(posed.fine.inlier_plane_rmse, 1e-5);
   PoseConstraints c =
-      AnalysePoseConstraints(posed.fine.information, spread, model.model.origin,
-                             std::max(posed.fine.inlier_plane_rmse, 1e-5), radius_m,
+      AnalysePoseConstraints(information, spread, model.model.origin, sigma_m, radius_m,
                              ctx.options.free_direction_std_m, ctx.options.pose_floor_std_m);
   if (ctx.options.pose_restart_voxels > 0.0) {
-    c.covariance += RestartSpread(
+    // Where the fit comes to rest decides what it pins, as its information does.
+    const Eigen::Matrix<double, 6, 6> rest = RestartSpread(
         fitted, ctx.cache.Model(posed.object).target, posed.fine.T_target_source,
         FineIcpLastStage(model.diameter_m, ctx.db.parameters, 1), c.covariance, model.model.origin,
         radius_m, ctx.options.pose_restart_voxels * ctx.db.parameters.voxel_m, ctx.options.threads);
+    c = AnalysePoseConstraints(information, spread, model.model.origin, sigma_m, radius_m,
+                               ctx.options.free_direction_std_m, ctx.options.pose_floor_std_m,
+                               rest);
   }
   AddUnpinnedPhases(posed, fitted, model, ctx, c);
   const Eigen::Isometry3d& T_S_O = posed.candidate.T_S_O;

@@ -79,14 +79,39 @@ std::pair<Vector6d, Vector6d> PureRotations(const Vector6d& a, const Vector6d& b
   return {x1[0] * a + x1[1] * b, x2[0] * a + x2[1] * b};
 }
 
+void AppendColumn(Eigen::Matrix<double, 6, Eigen::Dynamic>& columns, const Vector6d& u) {
+  columns.conservativeResize(Eigen::NoChange, columns.cols() + 1);
+  columns.col(columns.cols() - 1) = u;
+}
+
+// Moves the directions whose variance in `covariance` (scaled, over the pinned directions)
+// exceeds tolerance_m^2 to `free`, and takes them out of the covariance: its own eigenvectors,
+// not the information's, so that one flat direction (a slide the restarts show) is freed as
+// itself rather than leaking into every direction it has a share of.
+void FreeWhatTheFitDoesNotHold(double tolerance_m, Matrix6d& covariance,
+                               Eigen::Matrix<double, 6, Eigen::Dynamic>& free) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(Symmetrized(covariance));
+  Matrix6d held = Matrix6d::Identity();  // projector onto what stays pinned
+  for (int k = 0; k < 6; ++k) {
+    if (eigen.eigenvalues()[k] <= tolerance_m * tolerance_m) continue;
+    const Vector6d u = eigen.eigenvectors().col(k);
+    AppendColumn(free, u);
+    held -= u * u.transpose();
+  }
+  covariance = held * covariance * held;
+}
+
 }  // namespace
 
 PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix6d& patch_spread,
                                        const Eigen::Vector3d& centre_O, double sigma_m,
-                                       double radius_m, double tolerance_m, double floor_std_m) {
+                                       double radius_m, double tolerance_m, double floor_std_m,
+                                       const Matrix6d& rest_spread) {
   Check(information, patch_spread, centre_O, sigma_m, radius_m, tolerance_m);
   if (!(floor_std_m >= 0.0 && std::isfinite(floor_std_m)))
     throw Error("free directions: floor_std_m must be >= 0");
+  if (!rest_spread.allFinite() || !rest_spread.isApprox(rest_spread.transpose(), 1e-9))
+    throw Error("free directions: the rest spread must be a finite, symmetric 6x6 matrix");
   // Rotations scaled by the radius: both halves in metres, so one tolerance judges both.
   Matrix6d D = Matrix6d::Identity();
   D.topLeftCorner<3, 3>() *= 1.0 / radius_m;
@@ -107,14 +132,16 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
       inverse += u * u.transpose() / lambda;
       pinned += u * u.transpose();
     } else {
-      free.conservativeResize(Eigen::NoChange, free.cols() + 1);
-      free.col(free.cols() - 1) = u;
+      AppendColumn(free, u);
     }
   }
-  out.covariance = D *
-                   (sigma_m * sigma_m * inverse + inverse * spread * inverse +
-                    floor_std_m * floor_std_m * pinned) *
-                   D;
+  Matrix6d covariance = sigma_m * sigma_m * inverse + inverse * spread * inverse +
+                        floor_std_m * floor_std_m * pinned;  // scaled
+  if (!rest_spread.isZero(0.0)) {
+    covariance += pinned * D.inverse() * Symmetrized(rest_spread) * D.inverse() * pinned;
+    FreeWhatTheFitDoesNotHold(tolerance_m, covariance, free);
+  }
+  out.covariance = D * covariance * D;
   if (free.cols() == 0) return out;
 
   // Combinations of the free directions by how much they turn: the right singular vectors of

@@ -52,12 +52,17 @@ struct PoseConstraints {
 // tube's tangent) rather than an arbitrary mixture of them.
 // floor_std_m adds a variance of floor_std_m^2 along every pinned direction (a rotation's at
 // radius_m): the error of the model and of the segment's sampling, which no residual shows.
+// rest_spread, a covariance over [w (rad), v (m)] like the result's, is where the fit itself comes
+// to rest when restarted off the answer (RestartSpread): it adds to the variance along each
+// direction, so that one the fit does not bring back from the tolerance's distance is free, not
+// pinned by an information the fit's flatness belies (a pipe taught from a noisy scan, whose
+// normals tilt a little along its run).
 // Throws uwscan::Error when a matrix is not finite and symmetric, a scalar is not positive or the
 // floor is negative.
-PoseConstraints AnalysePoseConstraints(const Eigen::Matrix<double, 6, 6>& information,
-                                       const Eigen::Matrix<double, 6, 6>& patch_spread,
-                                       const Eigen::Vector3d& centre_O, double sigma_m,
-                                       double radius_m, double tolerance_m,
-                                       double floor_std_m = 0.0);
+PoseConstraints AnalysePoseConstraints(
+    const Eigen::Matrix<double, 6, 6>& information, const Eigen::Matrix<double, 6, 6>& patch_spread,
+    const Eigen::Vector3d& centre_O, double sigma_m, double radius_m, double tolerance_m,
+    double floor_std_m = 0.0,
+    const Eigen::Matrix<double, 6, 6>& rest_spread = Eigen::Matrix<double, 6, 6>::Zero());
 
 }  // namespace uwscan::perception

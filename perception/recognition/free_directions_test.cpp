@@ -255,6 +255,49 @@ TEST(FreeDirections, TheToleranceIsAStandardDeviationInMetres) {
   EXPECT_EQ(Of(loose, FreeMotion::kRotation).size(), 1u);
 }
 
+// Where restarts of the fit come to rest (RestartSpread) adds to the covariance, and a direction
+// they leave further off than the tolerance is freed as itself: a slide along x stays a slide
+// along x though every eigenvector of the information has a share of it.
+TEST(FreeDirections, ADirectionTheFitDoesNotHoldIsFreedAsItself) {
+  const double sigma = 1e-3, tolerance = 2e-3, radius = 0.2;
+  const Eigen::Vector3d centre(0.1, 0.0, -0.3);
+  // An information that pins every direction to about 0.3 mm, its eigenvectors mixing them all.
+  Matrix6d any;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) any(i, j) = std::sin(7.0 * i + 3.0 * j + 1.0);
+  }
+  const Matrix6d mix = Eigen::HouseholderQR<Matrix6d>(any).householderQ();
+  Vector6d lambda;
+  lambda << 11.0, 12.0, 13.0, 14.0, 15.0, 16.0;
+  Matrix6d D = Matrix6d::Identity();  // the analysis' scaling: rotations in metres at the radius
+  D.topLeftCorner<3, 3>() *= 1.0 / radius;
+  const Matrix6d information =
+      D.inverse() * (1e6 * mix * lambda.asDiagonal() * mix.transpose()) * D.inverse();
+  const PoseConstraints held =
+      AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance);
+  ASSERT_TRUE(held.free_O.empty());
+
+  Matrix6d small = Matrix6d::Zero();
+  small(3, 3) = 1e-3 * 1e-3;  // restarts resting 1 mm off along x: still held
+  const PoseConstraints loosened =
+      AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance, 0.0, small);
+  EXPECT_TRUE(loosened.free_O.empty());
+  EXPECT_LT((loosened.covariance - held.covariance - small).norm(), 1e-12);
+
+  Matrix6d flat = Matrix6d::Zero();
+  flat(3, 3) = 6e-3 * 6e-3;  // 6 mm: the fit does not hold x
+  const PoseConstraints freed =
+      AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance, 0.0, flat);
+  ASSERT_EQ(freed.free_O.size(), 1u);
+  EXPECT_EQ(freed.free_O[0].motion, FreeMotion::kTranslation);
+  EXPECT_NEAR(std::abs(freed.free_O[0].axis_S.x()), 1.0, 1e-9);
+  EXPECT_LT((freed.covariance * Vector6d::Unit(3)).norm(), 1e-15);
+  // Along the rest, what the information says: the covariance restricted to them.
+  Matrix6d across = Matrix6d::Identity() - Vector6d::Unit(3) * Vector6d::Unit(3).transpose();
+  EXPECT_LT((freed.covariance - across * held.covariance * across).norm(),
+            1e-9 * held.covariance.norm());
+}
+
 TEST(FreeDirections, BadInputIsRefused) {
   Matrix6d information = Matrix6d::Identity();
   const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -269,6 +312,9 @@ TEST(FreeDirections, BadInputIsRefused) {
   spread(2, 3) = 1.0;  // not symmetric
   EXPECT_THROW(AnalysePoseConstraints(Matrix6d::Identity(), spread, centre, 1e-3, 0.1, 1e-3),
                Error);
+  EXPECT_THROW(
+      AnalysePoseConstraints(Matrix6d::Identity(), kNoSpread, centre, 1e-3, 0.1, 1e-3, 0.0, spread),
+      Error);
 }
 
 }  // namespace

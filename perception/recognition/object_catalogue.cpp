@@ -13,6 +13,7 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "perception/recognition/cloud_surface.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/common/ply_reader.hpp"
 #include "scanner/common/yaml_fields.hpp"
 #include "scanner/sim/imr_objects.hpp"
@@ -149,6 +150,9 @@ ObjectSource CatalogueObject(const std::string& name) {
   if (it == Catalogue().end()) {
     std::string known;
     for (const std::string& n : CatalogueNames()) known += (known.empty() ? "" : ", ") + n;
+    const std::filesystem::path path(name);
+    if (path.has_extension() || path.has_parent_path())  // meant as a file
+      throw Error("'" + name + "': no such file (nor a procedural object: " + known + ")");
     throw Error("'" + name + "' is neither a mesh file nor a procedural object (" + known + ")");
   }
   return it->second();
@@ -192,7 +196,8 @@ bool IsCloudFile(const std::filesystem::path& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (extension == ".pcd" || extension == ".xyz") return true;
-  return extension == ".ply" && scanner::PlyFaceCount(path).value_or(0) <= 0;
+  // Not opened unless a regular file: a pipe with no writer would block (LoadMesh says why not).
+  return extension == ".ply" && IsRegularFile(path) && scanner::PlyFaceCount(path).value_or(0) <= 0;
 }
 
 ObjectSource MeshObject(const std::filesystem::path& mesh_path, double units_to_m) {

@@ -2,6 +2,7 @@
 #include "perception/recognition/object_catalogue.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -59,6 +60,30 @@ TEST_F(MeshObjectTest, AMeshInMillimetresTakenForMetresIsRefusedWithTheUnitsHint
   // A mesh in metres said to be in millimetres is 0.37 mm across.
   EXPECT_NE(Refusal(Box("box_m.ply", 1.0), 0.001).find("--units m"), std::string::npos);
   EXPECT_THROW(MeshObject(Box("box.ply", 1.0), 0.0), Error);
+}
+
+// A name meant as a file that is not there is said to be missing, not taken for an unknown
+// procedural object; a pipe is never opened (it would block for ever with no writer).
+TEST_F(MeshObjectTest, WhatIsNotAFileIsNamedForWhatItIs) {
+  const std::string missing = (dir_ / "valve.ply").string();
+  const std::string message = [&] {
+    try {
+      CatalogueObject(missing);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }();
+  EXPECT_NE(message.find(missing + "': no such file"), std::string::npos) << message;
+  EXPECT_NE(message.find("elbow"), std::string::npos) << message;  // the procedural ones listed
+
+  const fs::path fifo = dir_ / "scan.ply";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_FALSE(IsCloudFile(fifo));
+  EXPECT_NE(Refusal(fifo, 1.0).find("not a regular file"), std::string::npos);
+  const fs::path folder = dir_ / "folder.ply";
+  fs::create_directories(folder);
+  EXPECT_NE(Refusal(folder, 1.0).find("a directory, not a file"), std::string::npos);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/byte_io.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/common/fnv1a.hpp"
 
 namespace uwscan::perception {
@@ -191,6 +192,7 @@ void ObjectDatabase::Save(const std::filesystem::path& path) const {
 
 ObjectDatabase ObjectDatabase::Load(const std::filesystem::path& path) {
   const std::string name = "object database '" + path.string() + "'";
+  RequireRegularFile(path, name);
   std::ifstream file(path, std::ios::binary);
   if (!file) throw Error(name + ": cannot be opened (missing or unreadable)");
   std::ostringstream buffer;

@@ -637,6 +637,10 @@ TEST(ObjectDatabaseFile, TruncatedForeignAndNewerFilesGiveOneLineErrors) {
   for (const std::string& m : {truncated, foreign, version}) {
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
   }
+  const std::filesystem::path folder = dir / "uwscan_db_folder.db";
+  std::filesystem::create_directories(folder);
+  EXPECT_NE(message(folder).find("a directory, not a file"), std::string::npos);
+  std::filesystem::remove(folder);
   EXPECT_NO_THROW(ObjectDatabase::Load(good));
 }
 

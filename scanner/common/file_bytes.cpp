@@ -16,9 +16,23 @@ std::string QuotedPath(const std::filesystem::path& path) {
   return quoted;
 }
 
-std::string ReadFileBytes(const std::filesystem::path& path) {
+void RequireRegularFile(const std::filesystem::path& path, const std::string& name) {
+  const std::string named = name.empty() ? QuotedPath(path) : name;
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(QuotedPath(path) + ": no such file");
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::is_regular_file(status)) return;
+  if (!std::filesystem::exists(status)) throw Error(named + ": no such file");
+  if (std::filesystem::is_directory(status)) throw Error(named + ": a directory, not a file");
+  throw Error(named + ": not a regular file (a pipe, device or socket)");
+}
+
+bool IsRegularFile(const std::filesystem::path& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+std::string ReadFileBytes(const std::filesystem::path& path) {
+  RequireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   if (!in && !in.eof()) throw Error(QuotedPath(path) + ": cannot be read");

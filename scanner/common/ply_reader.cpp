@@ -80,6 +80,18 @@ class BodyCursor {
   // The fewest bytes one more value can take: a list longer than the rest of the body is damage.
   std::size_t BytesLeft() const { return body_.size() - at_; }
 
+  // Why Read failed here: the body ends, or (ascii) the word there is not a number.
+  std::string WhyNoValue() const {
+    std::size_t begin = at_;
+    while (begin < body_.size() && std::isspace(static_cast<unsigned char>(body_[begin]))) ++begin;
+    if (encoding_ != Encoding::kAscii || begin == body_.size()) return "the file ends";
+    std::size_t end = begin;
+    while (end < body_.size() && end - begin < 40 &&
+           !std::isspace(static_cast<unsigned char>(body_[end])))
+      ++end;
+    return "'" + std::string(body_.substr(begin, end - begin)) + "' is not a number";
+  }
+
  private:
   static double Decode(ScalarType type, const std::uint8_t* bytes) {
     auto as = [bytes]<typename T>(T) {
@@ -246,15 +258,22 @@ VertexColumns VertexColumnsOf(const Element& element) {
 // Reads a PLY body element by element, keeping the vertices and, when asked, the faces.
 class BodyReader {
  public:
-  BodyReader(std::string_view body, Encoding encoding, const std::string& name, bool faces)
-      : cursor_(body, encoding), encoding_(encoding), name_(name), faces_(faces) {}
+  BodyReader(std::string_view body, Encoding encoding, const std::string& name, bool faces,
+             std::uint64_t vertex_count)
+      : cursor_(body, encoding),
+        encoding_(encoding),
+        name_(name),
+        faces_(faces),
+        vertex_count_(vertex_count) {}
 
   // Reads every row of `element`: the vertex element's points (with their normals and
-  // intensities when it has them), a face element's polygons; other elements are read past.
+  // intensities when it has them), a face element's polygons (their indices checked against the
+  // header's vertex count even when the faces are not kept: a face past the vertices is damage
+  // either way); other elements are read past.
   void Read(const Element& element) {
     RequireRowsFit(element);
     const bool is_vertex = element.name == "vertex";
-    const bool is_face = faces_ && element.name == "face";
+    const bool is_face = element.name == "face";
     const VertexColumns columns = VertexColumnsOf(element);
     if (is_vertex) StartVertices(element, columns);
     std::vector<double> row(element.properties.size());
@@ -311,20 +330,21 @@ class BodyReader {
       const Property& property = element.properties[p];
       if (!property.list_count) {
         if (!cursor_.Read(property.type, row[p])) {
-          throw RowError(element, r, "the file ends or a value is not a number");
+          throw RowError(element, r, property.name + ": " + cursor_.WhyNoValue());
         }
         continue;
       }
-      const bool keep =
+      const bool indices =
           is_face && (property.name == "vertex_indices" || property.name == "vertex_index");
-      std::vector<int> polygon = ReadList(element, r, property, keep);
-      if (keep) polygons_.push_back(std::move(polygon));
+      std::vector<int> polygon = ReadList(element, r, property, indices);
+      if (indices && faces_) polygons_.push_back(std::move(polygon));
     }
   }
 
-  // The items of a list property; as vertex indices when `keep`, else read past (none).
+  // The items of a list property; as vertex indices, each checked against the header's vertex
+  // count, when `indices`, else read past (none).
   std::vector<int> ReadList(const Element& element, std::uint64_t r, const Property& property,
-                            bool keep) {
+                            bool indices) {
     double length = 0.0;
     if (!cursor_.Read(*property.list_count, length) || length < 0.0 ||
         length != std::floor(length) || length > double(cursor_.BytesLeft())) {
@@ -336,10 +356,15 @@ class BodyReader {
       if (!cursor_.Read(property.type, item)) {
         throw RowError(element, r, "list '" + property.name + "' is cut short");
       }
-      if (!keep) continue;
+      if (!indices) continue;
       if (!(item >= 0.0 && item < 2147483647.0) || item != std::floor(item)) {
         throw RowError(element, r,
                        "vertex index " + std::to_string(item) + " is not a valid index");
+      }
+      if (item >= double(vertex_count_)) {
+        throw RowError(element, r,
+                       "names vertex " + std::to_string(std::int64_t(item)) + " of " +
+                           std::to_string(vertex_count_));
       }
       polygon.push_back(int(item));
     }
@@ -374,6 +399,7 @@ class BodyReader {
   Encoding encoding_;
   const std::string& name_;
   bool faces_;
+  std::uint64_t vertex_count_;  // the header's
   PlyContent content_;
   bool vertices_seen_ = false;
   std::vector<std::vector<int>> polygons_;
@@ -386,7 +412,10 @@ PlyContent ReadPly(const fs::path& path, bool faces) {
   const std::string file = ReadFileBytes(path);
   const Header header = ParseHeader(file, name);
   const std::string_view body(file.data() + header.body_offset, file.size() - header.body_offset);
-  BodyReader reader(body, header.encoding, name, faces);
+  std::uint64_t vertex_count = 0;
+  for (const Element& element : header.elements)
+    vertex_count += element.name == "vertex" ? element.count : 0;
+  BodyReader reader(body, header.encoding, name, faces, vertex_count);
   for (const Element& element : header.elements) reader.Read(element);
   return reader.Finish();
 }

@@ -1,5 +1,6 @@
 #include "scanner/common/stl_reader.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
@@ -68,6 +69,28 @@ std::uint32_t BinaryCount(const std::string& bytes) {
   for (int i = 3; i >= 0; --i)
     count = (count << 8) | static_cast<unsigned char>(bytes[80 + std::size_t(i)]);
   return count;
+}
+
+// Whether the first bytes are text, as an ASCII STL is: binary floats hold NULs and control
+// bytes, even behind a header that starts with "solid".
+bool LooksLikeText(const std::string& bytes) {
+  const std::size_t n = std::min<std::size_t>(bytes.size(), 4096);
+  return std::all_of(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u >= 0x20 || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v';
+  });
+}
+
+// What is wrong with a binary STL's size: the count its header claims against the bytes there.
+std::string BinarySizeMismatch(const std::string& bytes) {
+  if (bytes.size() < kBinaryHeaderBytes) {
+    return "only " + std::to_string(bytes.size()) + " bytes, fewer than the 84 of a header";
+  }
+  const std::uint32_t count = BinaryCount(bytes);
+  return "its header claims " + std::to_string(count) + " triangles (84 + 50 x " +
+         std::to_string(count) + " = " +
+         std::to_string(kBinaryHeaderBytes + kBinaryTriangleBytes * std::size_t{count}) +
+         " bytes) and the file has " + std::to_string(bytes.size());
 }
 
 bool IsBinary(const std::string& bytes) {
@@ -183,7 +206,9 @@ TriangleMesh ReadAscii(const std::string& text, const std::string& name) {
 TriangleMesh ReadStl(const fs::path& path) {
   const std::string name = QuotedPath(path) + " (read as STL)";
   const std::string bytes = ReadFileBytes(path);
-  return IsBinary(bytes) ? ReadBinary(bytes) : ReadAscii(bytes, name);
+  if (IsBinary(bytes)) return ReadBinary(bytes);
+  if (LooksLikeText(bytes)) return ReadAscii(bytes, name);
+  throw Error(name + ": binary (not text), but " + BinarySizeMismatch(bytes));
 }
 
 }  // namespace uwscan::scanner

@@ -16,6 +16,7 @@
 
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/file_bytes.hpp"
 #include "scanner/common/off_reader.hpp"
 #include "scanner/common/ply_reader.hpp"
 #include "scanner/common/random_draws.hpp"
@@ -70,6 +71,18 @@ bool IsPointCloudExtension(const std::string& lower_extension) {
   return false;
 }
 
+// Mesh formats Assimp reads beside the four read here, by extension: Assimp would otherwise
+// guess a format from the contents and name the file by an extension that says nothing.
+constexpr const char* kAssimpFormats = "3DS, DAE, FBX, GLB, GLTF, LWO, X";
+
+bool IsMeshExtension(const std::string& lower_extension) {
+  for (const char* mesh :
+       {".ply", ".off", ".stl", ".obj", ".3ds", ".dae", ".fbx", ".glb", ".gltf", ".lwo", ".x"}) {
+    if (lower_extension == mesh) return true;
+  }
+  return false;
+}
+
 TriangleMesh LoadAssimpMesh(const std::filesystem::path& path) {
   Assimp::Importer importer;
   const aiScene* scene =
@@ -101,16 +114,30 @@ TriangleMesh LoadAssimpMesh(const std::filesystem::path& path) {
 }  // namespace
 
 TriangleMesh LoadMesh(const std::filesystem::path& path) {
-  if (!std::filesystem::is_regular_file(path)) throw Error(path.string() + ": no such mesh file");
+  RequireRegularFile(path, path.string());
   const std::string extension = LowerExtension(path);
   if (IsPointCloudExtension(extension)) {
+    const bool read_here = extension == ".pcd" || extension == ".xyz";
     throw Error(path.string() + ": " + FormatName(extension) +
-                " holds a point cloud, not a mesh: give a mesh with faces (PLY, OFF, STL or OBJ)");
+                (read_here ? " holds a point cloud, not a mesh: give a mesh with faces (PLY, OFF, "
+                             "STL or OBJ)"
+                           : " holds a point cloud, in a format uwscan does not read: convert it "
+                             "to PLY, PCD or XYZ"));
+  }
+  if (!IsMeshExtension(extension)) {
+    throw Error(path.string() + ": " +
+                (extension.empty() ? std::string("no extension") : "extension " + extension) +
+                " names no mesh format read here (PLY, OFF, STL, OBJ, or those Assimp reads: " +
+                kAssimpFormats + ")");
   }
   const TriangleMesh mesh = extension == ".ply"   ? LoadPlyMesh(path)
                             : extension == ".off" ? ReadOff(path)
                             : extension == ".stl" ? ReadStl(path)
                                                   : LoadAssimpMesh(path);
+  if (mesh.vertices.empty()) {
+    throw Error(path.string() + ": " + FormatName(extension) +
+                " with no vertex: not a mesh in that format, or an empty one");
+  }
   if (mesh.triangles.empty()) {
     throw Error(path.string() + ": " + FormatName(extension) + " with " +
                 std::to_string(mesh.vertices.size()) +

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -93,6 +94,30 @@ TEST_F(LoadMeshTest, ABrokenPlyOffOrStlNamesTheFormatItWasReadAs) {
       format += static_cast<char>(std::toupper(extension[i]));
     ExpectMentions(message, "read as " + format);
   }
+}
+
+// What is not a mesh file at all is named for what it is: missing, a directory, an extension
+// that names no mesh format, a file with no vertex, a binary STL cut short behind a header that
+// starts like an ASCII one.
+TEST_F(LoadMeshTest, WhatIsNoMeshFileIsNamedForWhatItIs) {
+  ExpectMentions(Refusal(dir_ / "missing.obj"), "no such file");
+  fs::create_directories(dir_ / "folder.ply");
+  ExpectMentions(Refusal(dir_ / "folder.ply"), "a directory, not a file");
+  const std::string text = Refusal(Write("notes.txt", "ply\n"));
+  ExpectMentions(text, "extension .txt names no mesh format");
+  ExpectMentions(Refusal(Write("scan.las", "LASF")), "convert it to PLY, PCD or XYZ");
+  ExpectMentions(Refusal(Write("garbage.obj", "this is no mesh\n")),
+                 "OBJ with no vertex: not a mesh in that format");
+  std::string stl = "solid exported by a tool that writes binary";
+  stl.resize(80, ' ');
+  const std::uint32_t claimed = 10;
+  stl.append(reinterpret_cast<const char*>(&claimed), 4);  // little-endian here
+  stl.append(50 * 3, '\0');                                // 3 of the 10 triangles
+  const fs::path cut = Write("cut_binary.stl", stl);
+  const std::string message = Refusal(cut);
+  ExpectMentions(message, "(read as STL): binary (not text)");
+  ExpectMentions(message, "claims 10 triangles");
+  ExpectMentions(message, "the file has 234");
 }
 
 TEST_F(LoadMeshTest, AMeshWrittenReadsBack) {
