@@ -106,29 +106,29 @@ double FieldValue(const std::uint8_t* point, const pcl::PCLPointField& field) {
   }
 }
 
-// The numbers on one line of an XYZ file, separated by spaces, tabs or commas; throws naming the
-// line when a word is not a number.
+bool IsXyzSeparator(char c) { return std::isspace(static_cast<unsigned char>(c)) || c == ','; }
+
+// The numbers on one line of an XYZ file, separated by white space or commas, up to a '#' that
+// starts a comment; throws naming the line when a word is not a number.
 std::vector<double> XyzNumbers(const std::string& line, std::size_t line_number,
                                const fs::path& path) {
   std::vector<double> numbers;
   const char* p = line.data();
-  const char* end = p + line.size();
+  const char* end = p + std::min(line.size(), line.find('#'));
   auto skip_separators = [&] {
-    while (p < end && (std::isspace(static_cast<unsigned char>(*p)) || *p == ',')) ++p;
+    while (p < end && IsXyzSeparator(*p)) ++p;
   };
   for (skip_separators(); p < end; skip_separators()) {
     if (*p == '+') ++p;  // from_chars takes no leading '+'
     double value = 0.0;
     const std::from_chars_result parsed = std::from_chars(p, end, value);
-    const bool separated = parsed.ptr == end ||
-                           std::isspace(static_cast<unsigned char>(*parsed.ptr)) ||
-                           *parsed.ptr == ',';
+    const bool separated = parsed.ptr == end || IsXyzSeparator(*parsed.ptr);
     if (parsed.ec != std::errc() || parsed.ptr == p || !separated) {
-      throw Error("ReadCloud: " + Quoted(path) + " (read as XYZ) line " +
-                  std::to_string(line_number) +
-                  ": expected numbers x y z (and as many more as "
-                  "the first point's line has), got '" +
-                  line.substr(0, 80) + "'");
+      throw Error(
+          "ReadCloud: " + Quoted(path) + " (read as XYZ) line " + std::to_string(line_number) +
+          ": expected numbers x y z (and as many more as "
+          "the first point's line has), got '" +
+          line.substr(0, std::min<std::size_t>(80, line.find_last_not_of("\r\n") + 1)) + "'");
     }
     numbers.push_back(value);
     p = parsed.ptr;
@@ -137,8 +137,8 @@ std::vector<double> XyzNumbers(const std::string& line, std::size_t line_number,
 }
 
 // An XYZ file: a point per line, x y z first, then as many further columns (colour, normal,
-// intensity) as the first point's line has, which every line must have; blank lines and lines
-// starting with '#' are skipped.
+// intensity) as the first point's line has, which every line must have (a line with others is
+// damage, as a line cut short); '#' starts a comment; lines without numbers are skipped.
 RawCloud ReadXyz(const fs::path& path) {
   std::ifstream in(path);
   if (!in) throw Error("ReadCloud: cannot open " + Quoted(path) + " (read as XYZ)");
@@ -146,9 +146,8 @@ RawCloud ReadXyz(const fs::path& path) {
   std::string line;
   std::size_t columns = 0, first_line = 0;
   for (std::size_t line_number = 1; std::getline(in, line); ++line_number) {
-    const std::size_t start = line.find_first_not_of(" \t\r,");
-    if (start == std::string::npos || line[start] == '#') continue;
     const std::vector<double> numbers = XyzNumbers(line, line_number, path);
+    if (numbers.empty()) continue;  // blank, or only a comment
     if (columns == 0) columns = numbers.size(), first_line = line_number;
     if (numbers.size() < 3 || numbers.size() != columns) {
       throw Error("ReadCloud: " + Quoted(path) + " (read as XYZ) line " +

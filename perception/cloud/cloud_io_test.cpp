@@ -107,8 +107,8 @@ TEST_F(CloudIoTest, HugeCoordinatesKeepTheirPrecision) {
 
 TEST_F(CloudIoTest, ReadsXyzAndDropsNonFinitePoints) {
   const fs::path path = dir_ / "points.xyz";
-  std::ofstream(path) << "# x y z r g b\n1 2 3 0 0 0\n\n4.5, 5.5, 6.5 200 100 50\nnan 1 1 0 0 0\n"
-                         "+7 -8 9e0 1 1 1\n";
+  std::ofstream(path) << "# x y z r g b\n1 2 3 0 0 0 # the first\n\n4.5, 5.5, 6.5 200 100 50\r\n"
+                         "nan 1 1 0 0 0\n+7 -8 9e0 1 1 1\n";
   CloudReadStats stats;
   const PointCloud cloud = ReadCloud(path, &stats);
   ASSERT_EQ(cloud.size(), 3u);

@@ -84,17 +84,21 @@ void AppendColumn(Eigen::Matrix<double, 6, Eigen::Dynamic>& columns, const Vecto
   columns.col(columns.cols() - 1) = u;
 }
 
-// Moves the directions whose variance in `covariance` (scaled, over the pinned directions)
-// exceeds tolerance_m^2 to `free`, and takes them out of the covariance: its own eigenvectors,
-// not the information's, so that one flat direction (a slide the restarts show) is freed as
-// itself rather than leaking into every direction it has a share of.
-void FreeWhatTheFitDoesNotHold(double tolerance_m, Matrix6d& covariance,
+// Moves the directions whose variance in `covariance` (scaled, over the pinned directions, the
+// restarts' `rest` included) exceeds tolerance_m^2 to `free`, and takes them out of the
+// covariance: its own eigenvectors, not the information's, so that one flat direction (a slide
+// the restarts show) is freed as itself rather than leaking into every direction it has a share
+// of. Only where the restarts alone spread over half the tolerance: what is freed here is what
+// they show, never what the information's cross terms add up to (with restarts that all come
+// back, the free directions are the information's).
+void FreeWhatTheFitDoesNotHold(double tolerance_m, const Matrix6d& rest, Matrix6d& covariance,
                                Eigen::Matrix<double, 6, Eigen::Dynamic>& free) {
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(Symmetrized(covariance));
+  const double tolerance2 = tolerance_m * tolerance_m;
   Matrix6d held = Matrix6d::Identity();  // projector onto what stays pinned
   for (int k = 0; k < 6; ++k) {
-    if (eigen.eigenvalues()[k] <= tolerance_m * tolerance_m) continue;
     const Vector6d u = eigen.eigenvectors().col(k);
+    if (eigen.eigenvalues()[k] <= tolerance2 || u.dot(rest * u) <= 0.25 * tolerance2) continue;
     AppendColumn(free, u);
     held -= u * u.transpose();
   }
@@ -138,8 +142,9 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
   Matrix6d covariance = sigma_m * sigma_m * inverse + inverse * spread * inverse +
                         floor_std_m * floor_std_m * pinned;  // scaled
   if (!rest_spread.isZero(0.0)) {
-    covariance += pinned * D.inverse() * Symmetrized(rest_spread) * D.inverse() * pinned;
-    FreeWhatTheFitDoesNotHold(tolerance_m, covariance, free);
+    const Matrix6d rest = pinned * D.inverse() * Symmetrized(rest_spread) * D.inverse() * pinned;
+    covariance += rest;
+    FreeWhatTheFitDoesNotHold(tolerance_m, rest, covariance, free);
   }
   out.covariance = D * covariance * D;
   if (free.cols() == 0) return out;

@@ -53,10 +53,10 @@ struct PoseConstraints {
 // floor_std_m adds a variance of floor_std_m^2 along every pinned direction (a rotation's at
 // radius_m): the error of the model and of the segment's sampling, which no residual shows.
 // rest_spread, a covariance over [w (rad), v (m)] like the result's, is where the fit itself comes
-// to rest when restarted off the answer (RestartSpread): it adds to the variance along each
-// direction, so that one the fit does not bring back from the tolerance's distance is free, not
-// pinned by an information the fit's flatness belies (a pipe taught from a noisy scan, whose
-// normals tilt a little along its run).
+// to rest when restarted off the answer (RestartSpread): it adds to the covariance over the pinned
+// directions, and a direction of that sum (its own eigenvector) over the tolerance along which the
+// restarts alone spread over half the tolerance is free, not pinned by an information the fit's
+// flatness belies (a pipe taught from a noisy scan, whose normals tilt a little along its run).
 // Throws uwscan::Error when a matrix is not finite and symmetric, a scalar is not positive or the
 // floor is negative.
 PoseConstraints AnalysePoseConstraints(

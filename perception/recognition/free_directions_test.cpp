@@ -261,7 +261,7 @@ TEST(FreeDirections, TheToleranceIsAStandardDeviationInMetres) {
 TEST(FreeDirections, ADirectionTheFitDoesNotHoldIsFreedAsItself) {
   const double sigma = 1e-3, tolerance = 2e-3, radius = 0.2;
   const Eigen::Vector3d centre(0.1, 0.0, -0.3);
-  // An information that pins every direction to about 0.3 mm, its eigenvectors mixing them all.
+  // An information that pins every direction to about 0.3 um, its eigenvectors mixing them all.
   Matrix6d any;
   for (int i = 0; i < 6; ++i) {
     for (int j = 0; j < 6; ++j) any(i, j) = std::sin(7.0 * i + 3.0 * j + 1.0);
@@ -282,7 +282,7 @@ TEST(FreeDirections, ADirectionTheFitDoesNotHoldIsFreedAsItself) {
   const PoseConstraints loosened =
       AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance, 0.0, small);
   EXPECT_TRUE(loosened.free_O.empty());
-  EXPECT_LT((loosened.covariance - held.covariance - small).norm(), 1e-12);
+  EXPECT_LT((loosened.covariance - held.covariance - small).norm(), 1e-9 * small.norm());
 
   Matrix6d flat = Matrix6d::Zero();
   flat(3, 3) = 6e-3 * 6e-3;  // 6 mm: the fit does not hold x
@@ -296,6 +296,43 @@ TEST(FreeDirections, ADirectionTheFitDoesNotHoldIsFreedAsItself) {
   Matrix6d across = Matrix6d::Identity() - Vector6d::Unit(3) * Vector6d::Unit(3).transpose();
   EXPECT_LT((freed.covariance - across * held.covariance * across).norm(),
             1e-9 * held.covariance.norm());
+
+  // A turn is judged at the radius: 1 mm there is held, 6 mm frees the turn about x, through the
+  // centre.
+  Matrix6d turn = Matrix6d::Zero();
+  turn(0, 0) = (1e-3 / radius) * (1e-3 / radius);
+  const PoseConstraints turned =
+      AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance, 0.0, turn);
+  EXPECT_TRUE(turned.free_O.empty());
+  EXPECT_LT((turned.covariance - held.covariance - turn).norm(), 1e-9 * turn.norm());
+  turn(0, 0) = (6e-3 / radius) * (6e-3 / radius);
+  const PoseConstraints free_turn =
+      AnalysePoseConstraints(information, kNoSpread, centre, sigma, radius, tolerance, 0.0, turn);
+  ASSERT_EQ(free_turn.free_O.size(), 1u);
+  EXPECT_EQ(free_turn.free_O[0].motion, FreeMotion::kRotation);
+  EXPECT_NEAR(std::abs(free_turn.free_O[0].axis_S.x()), 1.0, 1e-9);
+  EXPECT_LT((free_turn.free_O[0].point_S - centre).norm(), 1e-9);
+}
+
+// What the restarts free is what they show: two directions the information pins, each to 0.95
+// of the tolerance, whose residual patches push them together (their sum's variance is over the
+// tolerance) stay pinned when the restarts all come back, as with no restarts at all.
+TEST(FreeDirections, RestartsThatComeBackFreeNothing) {
+  const double sigma = 1e-3, tolerance = 2e-3, radius = 0.5;
+  const double each = 0.45 * tolerance * tolerance;
+  const double lambda = sigma * sigma / each;  // sigma^2 / lambda = 0.45 tolerance^2...
+  Matrix6d information = Matrix6d::Identity() * 1e12;
+  information(4, 4) = information(5, 5) = lambda;  // ...along the slides in y and z
+  Matrix6d spread = Matrix6d::Zero();
+  // u^T S u / lambda^2 = 0.45 tolerance^2 more along each, pushing y and z together.
+  spread.bottomRightCorner<2, 2>().setConstant(each * lambda * lambda);
+  const Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  ASSERT_TRUE(
+      AnalysePoseConstraints(information, spread, centre, sigma, radius, tolerance).free_O.empty());
+  const Matrix6d tiny = 1e-20 * Matrix6d::Identity();
+  EXPECT_TRUE(
+      AnalysePoseConstraints(information, spread, centre, sigma, radius, tolerance, 0.0, tiny)
+          .free_O.empty());
 }
 
 TEST(FreeDirections, BadInputIsRefused) {

@@ -235,6 +235,7 @@ namespace {
 void ReadSidecar(const std::filesystem::path& path, ObjectSource& o) {
   const std::filesystem::path sidecar = GraspSidecarPath(path);
   if (!std::filesystem::exists(sidecar)) return;
+  RequireRegularFile(sidecar, sidecar.string());
   std::ifstream in(sidecar);
   std::ostringstream text;
   text << in.rdbuf();

@@ -194,7 +194,7 @@ ObjectDatabase ObjectDatabase::Load(const std::filesystem::path& path) {
   const std::string name = "object database '" + path.string() + "'";
   RequireRegularFile(path, name);
   std::ifstream file(path, std::ios::binary);
-  if (!file) throw Error(name + ": cannot be opened (missing or unreadable)");
+  if (!file) throw Error(name + ": cannot be opened (unreadable)");
   std::ostringstream buffer;
   buffer << file.rdbuf();
   const std::string bytes = buffer.str();

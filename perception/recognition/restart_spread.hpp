@@ -19,7 +19,7 @@ namespace uwscan::perception {
 // short arc, a panel's face) the fit is far flatter than that curvature says, and ICP from the
 // truth comes to rest at the answer or anywhere between. A direction the fit pins as its
 // information says brings every restart back (d near 0, nothing added); a flat one leaves them
-// where they start, and adds up to step_m^2.
+// where they start (or beyond, free to slide on), and adds step_m^2 or more.
 // `source` and `target` are the fit's (T_target_source the answer, `icp` its options); each
 // restart runs on one thread, `threads` of them at once; the result does not depend on it.
 // Throws uwscan::Error when a scalar is not positive or the covariance is not finite.

@@ -21,6 +21,9 @@ void RequireRegularFile(const std::filesystem::path& path, const std::string& na
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
   if (std::filesystem::is_regular_file(status)) return;
+  if (ec && ec != std::errc::no_such_file_or_directory) {
+    throw Error(named + ": cannot be examined (" + ec.message() + ")");
+  }
   if (!std::filesystem::exists(status)) throw Error(named + ": no such file");
   if (std::filesystem::is_directory(status)) throw Error(named + ": a directory, not a file");
   throw Error(named + ": not a regular file (a pipe, device or socket)");

@@ -72,9 +72,12 @@ std::uint32_t BinaryCount(const std::string& bytes) {
 }
 
 // Whether the first bytes are text, as an ASCII STL is: binary floats hold NULs and control
-// bytes, even behind a header that starts with "solid".
+// bytes, even behind a header that starts with "solid". NULs and DOS end-of-file marks (0x1a)
+// padding the end of a text file do not count.
 bool LooksLikeText(const std::string& bytes) {
-  const std::size_t n = std::min<std::size_t>(bytes.size(), 4096);
+  const std::size_t padded = bytes.find_last_not_of(std::string("\0\x1a", 2));
+  const std::size_t text = padded == std::string::npos ? 0 : padded + 1;
+  const std::size_t n = std::min<std::size_t>(text, 4096);
   return std::all_of(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n), [](char c) {
     const auto u = static_cast<unsigned char>(c);
     return u >= 0x20 || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v';

@@ -71,16 +71,14 @@ bool IsPointCloudExtension(const std::string& lower_extension) {
   return false;
 }
 
-// Mesh formats Assimp reads beside the four read here, by extension: Assimp would otherwise
-// guess a format from the contents and name the file by an extension that says nothing.
-constexpr const char* kAssimpFormats = "3DS, DAE, FBX, GLB, GLTF, LWO, X";
-
+// Whether a mesh format is read by that extension: PLY, OFF and STL by uwscan's readers, the
+// others (OBJ among them) by Assimp if it knows the extension. A file with any other extension is
+// refused before Assimp, which would guess a format from its contents and name the file by an
+// extension that says nothing.
 bool IsMeshExtension(const std::string& lower_extension) {
-  for (const char* mesh :
-       {".ply", ".off", ".stl", ".obj", ".3ds", ".dae", ".fbx", ".glb", ".gltf", ".lwo", ".x"}) {
-    if (lower_extension == mesh) return true;
-  }
-  return false;
+  if (lower_extension == ".ply" || lower_extension == ".off" || lower_extension == ".stl")
+    return true;
+  return !lower_extension.empty() && Assimp::Importer().IsExtensionSupported(lower_extension);
 }
 
 TriangleMesh LoadAssimpMesh(const std::filesystem::path& path) {
@@ -127,8 +125,8 @@ TriangleMesh LoadMesh(const std::filesystem::path& path) {
   if (!IsMeshExtension(extension)) {
     throw Error(path.string() + ": " +
                 (extension.empty() ? std::string("no extension") : "extension " + extension) +
-                " names no mesh format read here (PLY, OFF, STL, OBJ, or those Assimp reads: " +
-                kAssimpFormats + ")");
+                " names no mesh format read here (PLY, OFF, STL, OBJ, or another Assimp reads by "
+                "its extension: DAE, FBX, 3DS, GLTF and more)");
   }
   const TriangleMesh mesh = extension == ".ply"   ? LoadPlyMesh(path)
                             : extension == ".off" ? ReadOff(path)
