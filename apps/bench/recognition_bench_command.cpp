@@ -173,7 +173,8 @@ void PrintConditionPoses(const bench::RecognitionConditions& r) {
 // pose_or_ambiguity_reported_rate, seconds_per_scan, pose_nees_per_dimension_mean,
 // pose_nees_per_dimension_p95, objects, poses: [{scene, object, rotation_error_rad,
 // translation_error_m, right, strict, right_or_reported, equivalent_poses, nees_per_dimension
-// (null outside 10 degrees / 5 cm)}]}}}; --details prints the poses.
+// (null outside 10 degrees / 5 cm, or where the covariance pins nothing)}]}}}; --details prints
+// the poses.
 void RunConditions(const Args& a) {
   bench::RecognitionConditionsOptions options;
   options.scans = a.conditions;

@@ -30,13 +30,14 @@ struct RecognitionConditionsOptions {
 struct ConditionPose {
   int scene = 0;
   std::string object;
-  double rotation_rad = 0.0;                 // modulo the truth's symmetries
-  double translation_m = 0.0;                // the same
-  bool right = false;                        // counted in ConditionFigures::pose_success
-  bool strict = false;                       // counted in ConditionFigures::pose_strict
-  bool right_or_reported = false;            // counted in ConditionFigures::pose_or_reported
-  int equivalent_poses = 0;                  // other poses the answer reported as fitting as well
-  std::optional<double> nees_per_dimension;  // when within 10 degrees and 5 cm (below)
+  double rotation_rad = 0.0;       // modulo the truth's symmetries
+  double translation_m = 0.0;      // the same
+  bool right = false;              // counted in ConditionFigures::pose_success
+  bool strict = false;             // counted in ConditionFigures::pose_strict
+  bool right_or_reported = false;  // counted in ConditionFigures::pose_or_reported
+  int equivalent_poses = 0;        // other poses the answer reported as fitting as well
+  // Within 10 degrees and 5 cm, when the covariance pins a direction (below); none otherwise.
+  std::optional<double> nees_per_dimension;
 };
 
 struct ConditionFigures {
@@ -48,7 +49,8 @@ struct ConditionFigures {
   int pose_strict = 0;
   // ...or off that but only by what the answer reports it cannot tell: a symmetry its model
   // carries (the database's, found for the CAD parts), an equivalent pose, a free slide or turn
-  // (reported_ambiguity.hpp). pose_success - pose_or_reported is ambiguity left unreported.
+  // (reported_ambiguity.hpp). recognised - pose_or_reported: poses wrong in what the answer
+  // claims to know.
   int pose_or_reported = 0;
   double seconds = 0.0;  // recognition time, summed over the scans
   int scans = 0;
