@@ -34,14 +34,6 @@ constexpr double kMaxFloat32Coordinate_m = 10.0;
 
 enum class Format { kPcd, kPly, kXyz };
 
-std::string Quoted(const fs::path& path) {
-  // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + std::string.
-  std::string quoted(1, '\'');
-  quoted.append(path.string());
-  quoted.push_back('\'');
-  return quoted;
-}
-
 std::optional<Format> FormatOf(const fs::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -108,11 +100,12 @@ double FieldValue(const std::uint8_t* point, const pcl::PCLPointField& field) {
 
 bool IsXyzSeparator(char c) { return std::isspace(static_cast<unsigned char>(c)) || c == ','; }
 
-// The numbers on one line of an XYZ file, separated by white space or commas, up to a '#' that
-// starts a comment; throws naming the line when a word is not a number.
-std::vector<double> XyzNumbers(const std::string& line, std::size_t line_number,
-                               const fs::path& path) {
-  std::vector<double> numbers;
+// The numbers on one line of an XYZ file into `numbers` (its buffer kept from line to line),
+// separated by white space or commas, up to a '#' that starts a comment; throws naming the line
+// when a word is not a number.
+void XyzNumbers(const std::string& line, std::size_t line_number, const fs::path& path,
+                std::vector<double>& numbers) {
+  numbers.clear();
   const char* p = line.data();
   const char* end = p + std::min(line.size(), line.find('#'));
   auto skip_separators = [&] {
@@ -125,7 +118,7 @@ std::vector<double> XyzNumbers(const std::string& line, std::size_t line_number,
     const bool separated = parsed.ptr == end || IsXyzSeparator(*parsed.ptr);
     if (parsed.ec != std::errc() || parsed.ptr == p || !separated) {
       throw Error(
-          "ReadCloud: " + Quoted(path) + " (read as XYZ) line " + std::to_string(line_number) +
+          "ReadCloud: " + QuotedPath(path) + " (read as XYZ) line " + std::to_string(line_number) +
           ": expected numbers x y z (and as many more as "
           "the first point's line has), got '" +
           line.substr(0, std::min<std::size_t>(80, line.find_last_not_of("\r\n") + 1)) + "'");
@@ -133,7 +126,6 @@ std::vector<double> XyzNumbers(const std::string& line, std::size_t line_number,
     numbers.push_back(value);
     p = parsed.ptr;
   }
-  return numbers;
 }
 
 // An XYZ file: a point per line, x y z first, then as many further columns (colour, normal,
@@ -141,16 +133,17 @@ std::vector<double> XyzNumbers(const std::string& line, std::size_t line_number,
 // damage, as a line cut short); '#' starts a comment; lines without numbers are skipped.
 RawCloud ReadXyz(const fs::path& path) {
   std::ifstream in(path);
-  if (!in) throw Error("ReadCloud: cannot open " + Quoted(path) + " (read as XYZ)");
+  if (!in) throw Error("ReadCloud: cannot open " + QuotedPath(path) + " (read as XYZ)");
   RawCloud raw;
   std::string line;
   std::size_t columns = 0, first_line = 0;
+  std::vector<double> numbers;
   for (std::size_t line_number = 1; std::getline(in, line); ++line_number) {
-    const std::vector<double> numbers = XyzNumbers(line, line_number, path);
+    XyzNumbers(line, line_number, path, numbers);
     if (numbers.empty()) continue;  // blank, or only a comment
     if (columns == 0) columns = numbers.size(), first_line = line_number;
     if (numbers.size() < 3 || numbers.size() != columns) {
-      throw Error("ReadCloud: " + Quoted(path) + " (read as XYZ) line " +
+      throw Error("ReadCloud: " + QuotedPath(path) + " (read as XYZ) line " +
                   std::to_string(line_number) + ": " + std::to_string(numbers.size()) +
                   " columns where " +
                   (numbers.size() < 3
@@ -159,7 +152,8 @@ RawCloud ReadXyz(const fs::path& path) {
     }
     raw.points.emplace_back(numbers[0], numbers[1], numbers[2]);
   }
-  if (in.bad()) throw Error("ReadCloud: error while reading " + Quoted(path) + " (read as XYZ)");
+  if (in.bad())
+    throw Error("ReadCloud: error while reading " + QuotedPath(path) + " (read as XYZ)");
   return raw;
 }
 
@@ -255,10 +249,10 @@ bool WritePly(const fs::path& path, const pcl::PCLPointCloud2& blob, bool binary
 PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   const std::optional<Format> format = FormatOf(path);
   if (!format) {
-    throw Error("ReadCloud: " + Quoted(path) + ": " + NotACloudFormat(path) +
+    throw Error("ReadCloud: " + QuotedPath(path) + ": " + NotACloudFormat(path) +
                 " (expected a point cloud: .pcd, .ply or .xyz)");
   }
-  RequireRegularFile(path, "ReadCloud: " + Quoted(path));
+  RequireRegularFile(path, "ReadCloud: " + QuotedPath(path));
 
   RawCloud raw;
   if (*format == Format::kXyz) {
@@ -302,8 +296,9 @@ PointCloud ReadCloud(const std::filesystem::path& path, CloudReadStats* stats) {
   local.num_dropped_non_finite = raw.points.size() - points.size();
   if (points.empty()) {
     const std::string as = " (read as " + FormatName(*format) + ")";
-    if (local.num_in_file == 0) throw Error("ReadCloud: " + Quoted(path) + as + ": no point in it");
-    throw Error("ReadCloud: " + Quoted(path) + as + " holds no finite point (" +
+    if (local.num_in_file == 0)
+      throw Error("ReadCloud: " + QuotedPath(path) + as + ": no point in it");
+    throw Error("ReadCloud: " + QuotedPath(path) + as + " holds no finite point (" +
                 std::to_string(local.num_in_file) + " in the file, " +
                 std::to_string(local.num_dropped_non_finite) +
                 " dropped as NaN or infinite, or with a normal that is not a direction)");
@@ -319,19 +314,20 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
                 const std::optional<Eigen::Isometry3d>& T_file_sensor) {
   const std::optional<Format> format = FormatOf(path);
   if (!format || *format == Format::kXyz) {
-    throw Error("WriteCloud: " + Quoted(path) + ": unsupported extension (expected .ply or .pcd)");
+    throw Error("WriteCloud: " + QuotedPath(path) +
+                ": unsupported extension (expected .ply or .pcd)");
   }
   if (T_file_sensor && *format != Format::kPcd) {
-    throw Error("WriteCloud: " + Quoted(path) + ": a sensor pose can only be written to a PCD");
+    throw Error("WriteCloud: " + QuotedPath(path) + ": a sensor pose can only be written to a PCD");
   }
   const Eigen::Isometry3d T = T_file_sensor.value_or(Eigen::Isometry3d::Identity());
   if (!T.matrix().allFinite())
-    throw Error("WriteCloud: " + Quoted(path) + ": sensor pose not finite");
+    throw Error("WriteCloud: " + QuotedPath(path) + ": sensor pose not finite");
   const Eigen::Vector4f origin(static_cast<float>(T.translation().x()),
                                static_cast<float>(T.translation().y()),
                                static_cast<float>(T.translation().z()), 0.0f);
   const Eigen::Quaternionf orientation(Eigen::Quaterniond(T.linear()).normalized().cast<float>());
-  RequireValidCloud(cloud, "WriteCloud " + Quoted(path), 1);
+  RequireValidCloud(cloud, "WriteCloud " + QuotedPath(path), 1);
   const pcl::PCLPointCloud2 blob = ToBlob(cloud, *format);
   const bool doubles =
       !blob.fields.empty() && blob.fields.front().datatype == pcl::PCLPointField::FLOAT64;
@@ -357,7 +353,7 @@ void WriteCloud(const std::filesystem::path& path, const PointCloud& cloud, bool
     if (reason.empty() && errno != 0) reason = std::string(" (") + std::strerror(errno) + ")";
     std::error_code ignored;
     fs::remove(temporary, ignored);
-    throw Error("WriteCloud: cannot write " + Quoted(path) + reason);
+    throw Error("WriteCloud: cannot write " + QuotedPath(path) + reason);
   }
   ReplaceWithTemporary(temporary, path);  // flushed to disk, then renamed over the old file
 }

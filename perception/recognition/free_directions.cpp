@@ -141,11 +141,9 @@ PoseConstraints AnalysePoseConstraints(const Matrix6d& information, const Matrix
   }
   Matrix6d covariance = sigma_m * sigma_m * inverse + inverse * spread * inverse +
                         floor_std_m * floor_std_m * pinned;  // scaled
-  if (!rest_spread.isZero(0.0)) {
-    const Matrix6d rest = pinned * D.inverse() * Symmetrized(rest_spread) * D.inverse() * pinned;
-    covariance += rest;
-    FreeWhatTheFitDoesNotHold(tolerance_m, rest, covariance, free);
-  }
+  const Matrix6d rest = pinned * D.inverse() * Symmetrized(rest_spread) * D.inverse() * pinned;
+  covariance += rest;
+  FreeWhatTheFitDoesNotHold(tolerance_m, rest, covariance, free);
   out.covariance = D * covariance * D;
   if (free.cols() == 0) return out;
 
