@@ -30,6 +30,7 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"loops_accepted", r.loops_accepted},
           {"whole_solves", r.whole_solves},
           {"window_solves", r.window_solves},
+          {"loop_window_solves", r.loop_window_solves},
           {"series",
            {{"submap_time_s", r.submap_time_s},
             {"submap_seconds", r.submap_seconds},
@@ -55,14 +56,14 @@ void PrintRow(const char* method, const bench::LongDiveRun& r) {
   std::printf(
       "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f / %.0f MB | %.0f MB | %.0f / %.0f MB | %.1fx "
       "| "
-      "%.1f mm | %.2f mm | %d | %d + %d |\n",
+      "%.1f mm | %.2f mm | %d | %d + %d (%d back to a loop) |\n",
       method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3, r.last_tenth.median_s * 1e3,
       r.last_tenth.p95_s * 1e3, static_cast<double>(r.rss_bytes_at_start) / 1e6,
       static_cast<double>(r.peak_rss_bytes) / 1e6,
       static_cast<double>(r.rss_bytes_last_tenth) / 1e6,
       static_cast<double>(r.heap_in_use_bytes_last_tenth) / 1e6,
       static_cast<double>(r.heap_held_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
-      r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves);
+      r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves, r.loop_window_solves);
 }
 
 }  // namespace

@@ -101,6 +101,7 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   run.loops_accepted = s.loops_accepted;
   run.whole_solves = m.stats.whole_solves;
   run.window_solves = m.stats.window_solves;
+  run.loop_window_solves = m.stats.loop_window_solves;
   AddTimeSeries(m, run);
   return run;
 }

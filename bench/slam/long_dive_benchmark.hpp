@@ -45,6 +45,7 @@ struct LongDiveRun {
   std::int64_t heap_held_bytes_last_tenth = 0;
   int loops_accepted = 0;
   int whole_solves = 0, window_solves = 0;
+  int loop_window_solves = 0;  // window solves freed back to a correcting loop's older end
   // Over the dive (seconds of dive time): the mean time per submap in each of about 60 stretches,
   // and the resident memory sampled as the frames went by.
   std::vector<double> submap_time_s, submap_seconds;

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -248,20 +249,25 @@ TEST_F(DiveMappingTest, AlongASinglePipeTheMapFollowsTheNavigation) {
             AbsoluteTrajectoryError(m.dead_reckoning, m.truth) + 0.005);
 }
 
-TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {
-  // The pipe dive, out 3 m instead of 8 and back: coming back over the pipe closes loops that
-  // see it without its ends. They are kept in the five directions they pin and bring the
-  // sideways drift of the dead reckoning back onto the pipe; along it they claim nothing.
+// The pipe dive, out 3 m instead of 8 and back: coming back over the pipe closes loops that see
+// it without its ends.
+scanner::sim::Scene OutAndBackOverAPipe() {
   scanner::sim::Scene scene = scanner::sim::LoadScene(fs::path(UWSCAN_SOURCE_DIR_FOR_TESTS) /
                                                       "data/scenes/inspection_pipe.yaml");
   std::vector<scanner::sim::TrajectoryPose>& poses = scene.trajectory.poses;
-  ASSERT_EQ(poses.size(), 5u);  // out, turning (two), back
+  EXPECT_EQ(poses.size(), 5u);  // out, turning (two), back
   const double shift_s = 20.0;  // 8 m at 0.25 m/s is 32 s; 3 m is 12 s
   for (std::size_t i = 1; i < poses.size(); ++i)
     poses[i].time_s -= i == 4 ? 2.0 * shift_s : shift_s;
   for (std::size_t i = 1; i < 4; ++i) poses[i].T_W_V.translation().x() = 3.0;
   scene.scanner.sweeps = static_cast<int>(poses.back().time_s / 70.0 * scene.scanner.sweeps);
-  const DiveMapping m = Map(Simulate(scene, "pipe_loop.db"));
+  return scene;
+}
+
+TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {
+  // The loops are kept in the five directions they pin and bring the sideways drift of the dead
+  // reckoning back onto the pipe; along it they claim nothing.
+  const DiveMapping m = Map(Simulate(OutAndBackOverAPipe(), "pipe_loop.db"));
   ASSERT_EQ(m.truth.size(), m.slam.size());
   int accepted = 0;
   for (const LoopClosure& loop : m.loops) {
@@ -497,6 +503,46 @@ TEST(NavigationUncertainty, OdometryLeavesDepthRollAndPitchToThePriors) {
   Vector6d yaw = Vector6d::Zero();
   yaw(2) = 1.0;
   EXPECT_GT(yaw.dot(info * yaw), 1e5);
+}
+
+// A loop frees the submaps back to its older end only when the graph misses it by more than
+// loop_window_chi2_per_direction: with 0 every loop does, with infinity none, and the map is
+// the same to a fraction of its error either way.
+TEST_F(DiveMappingTest, OnlyLoopsThatCorrectTheGraphFreeItBackToTheirOlderEnd) {
+  const fs::path log = Simulate(OutAndBackOverAPipe(), "pipe_loop.db");
+  DiveMappingOptions options;
+  options.mapper.threads = 2;
+  options.table_cache = dir_ / "tables";
+  options.mapper.solve_window_submaps = 6;
+  auto map_with = [&](double chi2_per_direction) {
+    options.mapper.loop_window_chi2_per_direction = chi2_per_direction;
+    return MapDive(DiveLogReader(log), options);
+  };
+  const DiveMapping every = map_with(0.0), some = map_with(0.5),
+                    none = map_with(std::numeric_limits<double>::infinity());
+  // How far a loop pulls the graph in its own information is at least its chi-square against
+  // the prediction, whose information (that of the sum with the prediction's covariance) is the
+  // smaller.
+  int correcting = 0, accepted = 0;
+  for (const LoopClosure& loop : some.loops) {
+    EXPECT_GE(loop.correction_chi2, loop.chi2 * (1.0 - 1e-6) - 1e-9)
+        << loop.from << " -> " << loop.to;
+    accepted += loop.accepted ? 1 : 0;
+    correcting += loop.accepted && loop.correction_chi2 > 0.5 * loop.constrained_directions;
+  }
+  std::printf("loops accepted %d, correcting %d; solves back to a loop %d / %d / %d\n", accepted,
+              correcting, every.stats.loop_window_solves, some.stats.loop_window_solves,
+              none.stats.loop_window_solves);
+  EXPECT_EQ(none.stats.loop_window_solves, 0);
+  EXPECT_GT(some.stats.loop_window_solves, 0);
+  EXPECT_LE(some.stats.loop_window_solves, correcting);
+  EXPECT_LT(correcting, accepted);
+  const double ate_every = AbsoluteTrajectoryError(every.slam, every.truth);
+  const double ate_some = AbsoluteTrajectoryError(some.slam, some.truth);
+  const double ate_none = AbsoluteTrajectoryError(none.slam, none.truth);
+  std::printf("ATE %.2f / %.2f / %.2f mm\n", ate_every * 1e3, ate_some * 1e3, ate_none * 1e3);
+  EXPECT_LT(std::abs(ate_some - ate_every), 0.05 * ate_every);
+  EXPECT_LT(std::abs(ate_none - ate_every), 0.05 * ate_every);
 }
 
 }  // namespace

@@ -77,6 +77,7 @@ void MapperOptions::Check() const {
   check.GreaterThan("solve_every_submaps", solve_every_submaps, 0);
   check.GreaterThan("solve_window_submaps", solve_window_submaps, 0);
   check.AtLeast("solve_window_max_submaps", solve_window_max_submaps, solve_window_submaps);
+  check.AtLeast("loop_window_chi2_per_direction", loop_window_chi2_per_direction, 0.0);
   check.GreaterThan("full_solve_growth", full_solve_growth, 1.0);
   check.GreaterThan("resident_submaps", resident_submaps, local_map_submaps);
   check.InRange("running_solve_tolerance", running_solve_tolerance, 0.0, 1.0, Interval::kOpen);
@@ -347,11 +348,19 @@ void Mapper::Impl::CloseLoopsAndSolve(int k) {
   const size_t tried_before = loops.size();
   TryLoopClosures(k);
   std::optional<int> oldest_loop;
+  bool accepted = false;
   for (size_t i = tried_before; i < loops.size(); ++i) {
-    if (loops[i].accepted) oldest_loop = std::min(oldest_loop.value_or(k), loops[i].from);
+    const LoopClosure& loop = loops[i];
+    accepted = accepted || loop.accepted;
+    const double corrects =
+        options.loop_window_chi2_per_direction * static_cast<double>(loop.constrained_directions);
+    if (loop.accepted && loop.correction_chi2 > corrects)
+      oldest_loop = std::min(oldest_loop.value_or(k), loop.from);
   }
-  if (oldest_loop || ++since_solve >= options.solve_every_submaps)
-    Solve(FirstFreeSubmap(k, oldest_loop));
+  if (!accepted && ++since_solve < options.solve_every_submaps) return;
+  const int first = FirstFreeSubmap(k, oldest_loop);
+  if (first > 0 && first < FirstFreeSubmap(k, std::nullopt)) ++stats.loop_window_solves;
+  Solve(first);
 }
 
 // The first submap a solve after submap k frees (MapperOptions::windowed_solves); 0: the whole

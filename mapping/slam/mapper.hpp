@@ -71,14 +71,19 @@ struct MapperOptions {
                                       // (and chi-square at 99.9 % for the kept directions)
   int solve_every_submaps = 2;        // a solve also without a loop closure, > 0
   // What a solve during the dive frees, so that its cost does not grow with the dive: the last
-  // solve_window_submaps submaps (> 0) and, after an accepted loop, every submap back to the
-  // loop's older end, at most solve_window_max_submaps (>= solve_window_submaps) in all; the
-  // submaps before stay where they are. The whole graph is solved once it holds
-  // full_solve_growth (> 1) times the submaps it held at its last whole solve (the solves then
-  // cost a constant per submap on average), and at Finish. false: every solve is whole.
+  // solve_window_submaps submaps (> 0) and, after an accepted loop that corrects the graph (its
+  // correction_chi2 over loop_window_chi2_per_direction times the directions it pins; >= 0,
+  // infinity: no loop does), every submap back to the loop's older end, at most
+  // solve_window_max_submaps (>= solve_window_submaps) in all; the submaps before stay where
+  // they are. A loop the graph already meets within a fraction of the loop's own noise (a
+  // chi-square of 1 per direction is that noise) would move the older submaps by less: it ties
+  // the newest ones to them. The whole graph is solved once it holds full_solve_growth (> 1)
+  // times the submaps it held at its last whole solve (the solves then cost a constant per
+  // submap on average), and at Finish. false: every solve is whole.
   bool windowed_solves = true;
   int solve_window_submaps = 60;
   int solve_window_max_submaps = 400;
+  double loop_window_chi2_per_direction = 0.5;
   double full_solve_growth = 1.5;
   // The solves during the dive stop once an iteration lowers the cost by less than this
   // fraction (they only have to predict the next registrations and loops); the last one, in
@@ -121,7 +126,10 @@ struct LoopClosure {
   bool accepted = false;
   std::string reason;  // why it was rejected ("" when accepted)
   double fitness = 0.0;
-  double chi2 = 0.0;               // of the registration against the prediction
+  double chi2 = 0.0;  // of the registration against the prediction
+  // Of the registration against the graph's estimate in the loop's own information alone: how
+  // far the loop pulls the graph, in its own noise (MapperOptions' windowed solves).
+  double correction_chi2 = 0.0;
   int constrained_directions = 0;  // directions the registration pins (the rest are left free)
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
   // What it measures ([w, v] in `from`'s frame, pose_graph.hpp): zero along the directions it
@@ -141,8 +149,9 @@ struct MapperStats {
   double registration_s = 0.0;
   double loop_s = 0.0;
   double graph_s = 0.0;
-  int whole_solves = 0;   // of the whole graph
-  int window_solves = 0;  // of the last submaps only (MapperOptions::windowed_solves)
+  int whole_solves = 0;        // of the whole graph
+  int window_solves = 0;       // of the last submaps only (MapperOptions::windowed_solves)
+  int loop_window_solves = 0;  // of those, freed back to a correcting loop's older end
 };
 
 // Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until

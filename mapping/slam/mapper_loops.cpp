@@ -126,6 +126,8 @@ LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, con
   loop.constrained_directions = kept.count;
   loop.reason = LoopRejection(r, kept, loop.information, c.covariance, T_pred, &loop.chi2);
   loop.accepted = loop.reason.empty();
+  const Vector6d correction = PoseError(r.T_target_source, T_pred);
+  loop.correction_chi2 = correction.dot(loop.information * correction);
   return loop;
 }
 
