@@ -85,7 +85,7 @@ void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whol
       "| dive | solves | time per submap, first tenth: median / p95 | last tenth | RSS at start / "
       "peak | RSS, last tenth | heap in use / held, last tenth | real time | ATE | map RMS | loops "
       "| "
-      "whole + window solves |\n"
+      "whole + window solves (back to a loop) |\n"
       "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json out = {{"bench", "slam_long"}, {"dives", nlohmann::json::array()}};
   for (const bench::LongDiveFigures& f : dives) {

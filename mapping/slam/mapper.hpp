@@ -128,7 +128,8 @@ struct LoopClosure {
   double fitness = 0.0;
   double chi2 = 0.0;  // of the registration against the prediction
   // Of the registration against the graph's estimate in the loop's own information alone: how
-  // far the loop pulls the graph, in its own noise (MapperOptions' windowed solves).
+  // far the graph misses the loop, in the loop's own noise (1 per direction it pins). Set for
+  // every loop tried; used for accepted ones (MapperOptions' windowed solves).
   double correction_chi2 = 0.0;
   int constrained_directions = 0;  // directions the registration pins (the rest are left free)
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
