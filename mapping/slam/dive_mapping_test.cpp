@@ -43,11 +43,14 @@ class DiveMappingTest : public DiveLogTest {
     SimulateDive(simulator, "", path, options);
     return path;
   }
-  DiveMapping Map(const fs::path& path, int threads = 2) {
+  DiveMappingOptions Options(int threads = 2) const {
     DiveMappingOptions options;
     options.mapper.threads = threads;
     options.table_cache = dir_ / "tables";
-    return MapDive(DiveLogReader(path), options);
+    return options;
+  }
+  DiveMapping Map(const fs::path& path, int threads = 2) {
+    return MapDive(DiveLogReader(path), Options(threads));
   }
 };
 
@@ -125,9 +128,7 @@ TEST_F(DiveMappingTest, SameBitsForOneAndTwoThreadsAndOnlineOrOffline) {
 // same trajectory as whole-graph solves throughout, to a fraction of its error.
 TEST_F(DiveMappingTest, WindowedSolvesMapAsWholeGraphSolvesDo) {
   const fs::path log = Simulate(ShortScene(), "drift.db");
-  DiveMappingOptions options;
-  options.mapper.threads = 2;
-  options.table_cache = dir_ / "tables";
+  DiveMappingOptions options = Options();
   options.mapper.solve_window_submaps = 4;
   options.mapper.solve_window_max_submaps = 8;
   const DiveMapping windowed = MapDive(DiveLogReader(log), options);
@@ -154,9 +155,7 @@ TEST_F(DiveMappingTest, WindowedSolvesMapAsWholeGraphSolvesDo) {
 // map: the same bits as with every cloud in memory.
 TEST_F(DiveMappingTest, SpilledSubmapsMapToTheSameBits) {
   const fs::path log = Simulate(ShortScene(), "drift.db");
-  DiveMappingOptions options;
-  options.mapper.threads = 2;
-  options.table_cache = dir_ / "tables";
+  DiveMappingOptions options = Options();
   const DiveMapping in_memory = MapDive(DiveLogReader(log), options);
   options.mapper.spill_folder = dir_;
   options.mapper.resident_submaps = 4;
@@ -513,9 +512,7 @@ TEST(NavigationUncertainty, OdometryLeavesDepthRollAndPitchToThePriors) {
 // the same to a fraction of its error either way.
 TEST_F(DiveMappingTest, OnlyLoopsThatCorrectTheGraphFreeItBackToTheirOlderEnd) {
   const fs::path log = Simulate(OutAndBackOverAPipe(), "pipe_loop.db");
-  DiveMappingOptions options;
-  options.mapper.threads = 2;
-  options.table_cache = dir_ / "tables";
+  DiveMappingOptions options = Options();
   options.mapper.solve_window_submaps = 6;
   auto map_with = [&](double chi2_per_direction) {
     options.mapper.loop_window_chi2_per_direction = chi2_per_direction;

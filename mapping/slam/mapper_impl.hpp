@@ -133,7 +133,7 @@ struct Mapper::Impl {
                         const Eigen::Isometry3d& T_pred) const;
   std::string LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
                             const Matrix6d& information, const Matrix6d& prediction_covariance,
-                            const Eigen::Isometry3d& T_pred, double* chi2) const;
+                            const Vector6d& miss, double* chi2) const;
   int FirstFreeSubmap(int k, std::optional<int> oldest_loop) const;
   // Solves the submaps from first_free_submap on (0: the whole graph); last: the solve at
   // Finish, to the full tolerance.

@@ -124,10 +124,11 @@ LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, con
   loop.information = RegistrationInformation(r, submaps[static_cast<size_t>(c.j)],
                                              submaps[static_cast<size_t>(k)], &kept);
   loop.constrained_directions = kept.count;
-  loop.reason = LoopRejection(r, kept, loop.information, c.covariance, T_pred, &loop.chi2);
+  // Where the registration puts k against where the graph does.
+  const Vector6d miss = PoseError(r.T_target_source, T_pred);
+  loop.reason = LoopRejection(r, kept, loop.information, c.covariance, miss, &loop.chi2);
   loop.accepted = loop.reason.empty();
-  const Vector6d correction = PoseError(r.T_target_source, T_pred);
-  loop.correction_chi2 = correction.dot(loop.information * correction);
+  loop.correction_chi2 = miss.dot(loop.information * miss);
   return loop;
 }
 
@@ -136,8 +137,8 @@ LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, con
 // certain and consistent with the prediction in them. "" when it is.
 std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r,
                                         const KeptDirections& kept, const Matrix6d& information,
-                                        const Matrix6d& prediction_covariance,
-                                        const Eigen::Isometry3d& T_pred, double* chi2) const {
+                                        const Matrix6d& prediction_covariance, const Vector6d& miss,
+                                        double* chi2) const {
   const int constrained = kept.count;
   const double sigma_m = LargestStd(kept.covariance.bottomRightCorner<3, 3>());
   const double sigma_rad = LargestStd(kept.covariance.topLeftCorner<3, 3>());
@@ -153,8 +154,7 @@ std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r,
     return "uncertain: registration std " + std::to_string(sigma_m) + " m, " +
            std::to_string(sigma_rad) + " rad";
   }
-  const Vector6d innovation = PoseError(r.T_target_source, T_pred);
-  *chi2 = innovation.dot(InformationOfSum(information, prediction_covariance) * innovation);
+  *chi2 = miss.dot(InformationOfSum(information, prediction_covariance) * miss);
   if (!(*chi2 <= Chi2Quantile999(constrained))) {
     return "inconsistent with the prediction: chi2 " + std::to_string(*chi2) + " in " +
            std::to_string(constrained) + " directions";
