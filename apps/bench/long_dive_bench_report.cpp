@@ -15,6 +15,14 @@ nlohmann::json TimesJson(const bench::SubmapTimes& t) {
   return {{"median", t.median_s}, {"p95", t.p95_s}};
 }
 
+nlohmann::json StagesJson(const mapping::MapperStageSeconds& s) {
+  return {{"triangulation", s.triangulation_s},
+          {"submap", s.submap_s},
+          {"registration", s.registration_s},
+          {"loop", s.loop_s},
+          {"graph", s.graph_s}};
+}
+
 nlohmann::json RunJson(const bench::LongDiveRun& r) {
   return {{"seconds", r.seconds},
           {"real_time_factor", r.real_time_factor},
@@ -22,6 +30,9 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"map_rms_m", r.map_rms_m},
           {"submap_seconds",
            {{"first_tenth", TimesJson(r.first_tenth)}, {"last_tenth", TimesJson(r.last_tenth)}}},
+          {"stage_seconds_mean",
+           {{"first_tenth", StagesJson(r.first_tenth_stages)},
+            {"last_tenth", StagesJson(r.last_tenth_stages)}}},
           {"rss_bytes_at_start", r.rss_bytes_at_start},
           {"peak_rss_bytes", r.peak_rss_bytes},
           {"rss_bytes_last_tenth", r.rss_bytes_last_tenth},
@@ -66,6 +77,16 @@ void PrintRow(const char* method, const bench::LongDiveRun& r) {
       r.map_rms_m * 1e3, r.loops_accepted, r.whole_solves, r.window_solves, r.loop_window_solves);
 }
 
+void PrintStages(const std::string& name, const bench::LongDiveRun& r) {
+  const mapping::MapperStageSeconds &a = r.first_tenth_stages, &b = r.last_tenth_stages;
+  std::printf(
+      "%s: triangulation %.1f -> %.1f, submap %.1f -> %.1f, registration %.1f -> %.1f, loops "
+      "%.1f -> %.1f, graph %.1f -> %.1f\n",
+      name.c_str(), a.triangulation_s * 1e3, b.triangulation_s * 1e3, a.submap_s * 1e3,
+      b.submap_s * 1e3, a.registration_s * 1e3, b.registration_s * 1e3, a.loop_s * 1e3,
+      b.loop_s * 1e3, a.graph_s * 1e3, b.graph_s * 1e3);
+}
+
 }  // namespace
 
 void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whole_solves,
@@ -95,6 +116,8 @@ void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whol
     if (f.whole) PrintRow("whole graph", *f.whole);
     out["dives"].push_back(DiveJson(f));
   }
+  std::printf("\nmean ms per submap by stage, first tenth -> last tenth (windowed):\n");
+  for (const bench::LongDiveFigures& f : dives) PrintStages(f.name, f.windowed);
   if (!json.empty()) WriteJsonFile(json, out);
 }
 

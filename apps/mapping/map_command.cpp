@@ -186,8 +186,10 @@ void PrintMapWork(const MapArgs& a, const mapping::DiveMapping& m, const mapping
   std::printf(
       "time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, "
       "graph %.2f s (%d whole solves, %d of the last submaps, %d of them back to a loop)\n",
-      m.stats.triangulation_s, m.stats.submap_s, m.stats.registration_s, m.stats.loop_s,
-      m.stats.graph_s, m.stats.whole_solves, m.stats.window_solves, m.stats.loop_window_solves);
+      m.stats.stage_seconds.triangulation_s, m.stats.stage_seconds.submap_s,
+      m.stats.stage_seconds.registration_s, m.stats.stage_seconds.loop_s,
+      m.stats.stage_seconds.graph_s, m.stats.whole_solves, m.stats.window_solves,
+      m.stats.loop_window_solves);
 }
 
 // What the map is worth: the errors its poses' uncertainty predicts and, for a simulated dive,

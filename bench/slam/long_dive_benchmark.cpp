@@ -50,6 +50,22 @@ std::int64_t MeanFrom(const std::vector<std::int64_t>& values, std::size_t from)
          static_cast<std::int64_t>(values.size() - from);
 }
 
+// The mean of each stage's time per submap over stages[first..last) (first < last).
+mapping::MapperStageSeconds MeanStages(const std::vector<mapping::MapperStageSeconds>& stages,
+                                       std::size_t first, std::size_t last) {
+  mapping::MapperStageSeconds mean;
+  for (std::size_t i = first; i < last; ++i) {
+    mean.triangulation_s += stages[i].triangulation_s;
+    mean.submap_s += stages[i].submap_s;
+    mean.registration_s += stages[i].registration_s;
+    mean.loop_s += stages[i].loop_s;
+    mean.graph_s += stages[i].graph_s;
+  }
+  const double n = static_cast<double>(last - first);
+  return {mean.triangulation_s / n, mean.submap_s / n, mean.registration_s / n, mean.loop_s / n,
+          mean.graph_s / n};
+}
+
 // Maps the log (windowed or whole solves), sampling the resident memory as it goes, and
 // measures the result against the truth.
 LongDiveRun MapLongDive(const std::filesystem::path& log_path,
@@ -93,6 +109,8 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   const std::size_t n = m.submap_seconds.size(), tenth = std::max<std::size_t>(1, n / 10);
   run.first_tenth = MedianAndP95(m.submap_seconds, 0, tenth);
   run.last_tenth = MedianAndP95(m.submap_seconds, n - tenth, n);
+  run.first_tenth_stages = MeanStages(m.submap_stage_seconds, 0, tenth);
+  run.last_tenth_stages = MeanStages(m.submap_stage_seconds, n - tenth, n);
   run.peak_rss_bytes = *std::max_element(run.rss_bytes.begin(), run.rss_bytes.end());
   const std::size_t last = run.rss_bytes.size(), from = last - std::max<std::size_t>(1, last / 10);
   run.rss_bytes_last_tenth = MeanFrom(run.rss_bytes, from);

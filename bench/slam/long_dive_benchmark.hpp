@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bench/progress.hpp"
+#include "mapping/slam/mapper.hpp"
 
 namespace uwscan::bench {
 
@@ -38,6 +39,8 @@ struct LongDiveRun {
   double ate_m = 0.0;
   double map_rms_m = 0.0;  // distance of the map's points to the true surfaces
   SubmapTimes first_tenth, last_tenth;
+  // The mean time per submap by stage over the same stretches: where the growth is.
+  mapping::MapperStageSeconds first_tenth_stages, last_tenth_stages;
   std::int64_t rss_bytes_at_start = 0;            // the process's resident memory before mapping
   std::int64_t peak_rss_bytes = 0;                // and while mapping, at most
   std::int64_t rss_bytes_last_tenth = 0;          // its mean over the last tenth of the dive

@@ -52,35 +52,45 @@ struct FrameSpan {
 };
 
 // Times the mapper's calls and hands the time spent since the last submap closed to each new
-// one (DiveMapping::submap_seconds).
+// one (DiveMapping::submap_seconds), in all and by stage.
 class SubmapClock {
  public:
-  SubmapClock(const Mapper& mapper, std::vector<double>* seconds)
-      : mapper_(mapper), seconds_(seconds) {}
+  SubmapClock(const Mapper& mapper, DiveMapping* result) : mapper_(mapper), result_(result) {}
   template <typename Call>
   void Time(Call&& call) {
     const auto start = std::chrono::steady_clock::now();
     call();
     pending_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    while (static_cast<int>(seconds_->size()) < mapper_.submap_count()) {
-      seconds_->push_back(pending_s_);
+    while (static_cast<int>(result_->submap_seconds.size()) < mapper_.submap_count()) {
+      result_->submap_seconds.push_back(pending_s_);
+      result_->submap_stage_seconds.push_back(StagesSinceLastSubmap());
       pending_s_ = 0.0;
     }
   }
 
  private:
+  MapperStageSeconds StagesSinceLastSubmap() {
+    const MapperStageSeconds now = mapper_.stats().stage_seconds;
+    const MapperStageSeconds since{now.triangulation_s - last_.triangulation_s,
+                                   now.submap_s - last_.submap_s,
+                                   now.registration_s - last_.registration_s,
+                                   now.loop_s - last_.loop_s, now.graph_s - last_.graph_s};
+    last_ = now;
+    return since;
+  }
+
   const Mapper& mapper_;
-  std::vector<double>* seconds_;
+  DiveMapping* result_;
   double pending_s_ = 0.0;
+  MapperStageSeconds last_;
 };
 
 // The log replayed as the vehicle delivered it: each navigation sample before the frames it
 // precedes.
 FrameSpan Replay(const DiveLogReader& log, const std::vector<NavigationRecord>& navigation,
-                 Mapper& mapper, const std::function<void(double)>& progress,
-                 std::vector<double>* submap_seconds) {
+                 Mapper& mapper, const std::function<void(double)>& progress, DiveMapping* result) {
   const double frame_count = static_cast<double>(log.frame_count());
-  SubmapClock clock(mapper, submap_seconds);
+  SubmapClock clock(mapper, result);
   std::size_t next_nav = 0;
   std::int64_t done = 0;
   FrameSpan span;
@@ -160,7 +170,7 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
   Mapper mapper(header.scanner, header.scan_pattern, T_V_C,
                 header.navigation_noise.value_or(AssumedNavigationNoise()), options.mapper,
                 options.table_cache);
-  const FrameSpan span = Replay(log, navigation, mapper, progress, &result.submap_seconds);
+  const FrameSpan span = Replay(log, navigation, mapper, progress, &result);
   RequireMapped(mapper, navigation, span, options.mapper.max_navigation_gap_s, name);
   result.submaps = mapper.submap_count();
   AddTrajectories(log, mapper, T_V_C, options.keep_submaps, result);

@@ -46,6 +46,8 @@ struct DiveMapping {
   // close to this one's (frames placed, the submap built, registered, loops tried, the graph
   // solved); reading the log excluded.
   std::vector<double> submap_seconds;
+  // The same time by the mapper's stages (MapperStats' clocks), per submap in the same order.
+  std::vector<MapperStageSeconds> submap_stage_seconds;
   DeadReckoningCalibration calibration;   // the DVL's scale error and misalignment as estimated
   bool navigation_noise_assumed = false;  // the log did not record it (schema 1)
   double dive_duration_s = 0.0;

@@ -139,7 +139,7 @@ void Mapper::Impl::Place(const FrameRecord& frame) {
   }
   frames.emplace_back(frame.index, frame.time_s);
   ++stats.frames;
-  stats.triangulation_s += Since(start);
+  stats.stage_seconds.triangulation_s += Since(start);
   if (on_placed) {
     on_placed(frame, T_W_C, std::span<const Eigen::Vector3d>(points_W).subspan(first_point));
   }
@@ -174,7 +174,7 @@ void Mapper::Impl::CloseSubmap() {
   points_W.clear();
   frames.clear();
   navigation.DropBefore(last_time);
-  stats.submap_s += Since(start);
+  stats.stage_seconds.submap_s += Since(start);
   // A submap that saw nothing (open water) adds no node: odometry bridges it.
   if (submap.cloud.empty() || submap.sparse.size() < 10) return;
   AddToGraph(std::move(submap));
@@ -279,7 +279,7 @@ Mapper::Impl::ConsecutiveRegistration Mapper::Impl::RegisterToPrevious(const Sub
   const Clock::time_point start = Clock::now();
   const perception::RegistrationResult r =
       Register(submap, LocalMap(k), T_predicted, c.increment_cov, options.icp_distances_m);
-  stats.registration_s += Since(start);
+  stats.stage_seconds.registration_s += Since(start);
   KeptDirections kept;
   const Matrix6d information = RegistrationInformation(r, previous, submap, &kept);
   const Vector6d innovation = PoseError(r.T_target_source, T_predicted);
@@ -387,7 +387,7 @@ void Mapper::Impl::Solve(int first_free_submap, bool last) {
     ++stats.window_solves;
   }
   since_solve = 0;
-  stats.graph_s += Since(start);
+  stats.stage_seconds.graph_s += Since(start);
 }
 
 Mapper::Mapper(const scanner::Scanner& scanner, const scanner::ScanPattern& pattern,

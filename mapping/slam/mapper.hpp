@@ -138,6 +138,16 @@ struct LoopClosure {
   Matrix6d information = Matrix6d::Zero();
 };
 
+// Processing time by stage (seconds): frames triangulated and placed, submaps voxelised with
+// normals, registered to the last ones, loops tried, the graph solved.
+struct MapperStageSeconds {
+  double triangulation_s = 0.0;
+  double submap_s = 0.0;
+  double registration_s = 0.0;
+  double loop_s = 0.0;
+  double graph_s = 0.0;
+};
+
 struct MapperStats {
   std::int64_t frames = 0;                     // placed
   std::int64_t frames_without_navigation = 0;  // left out: no navigation around their time
@@ -145,14 +155,10 @@ struct MapperStats {
   int registrations = 0;               // consecutive submaps registered (fitness above the floor)
   int registrations_failed = 0;        // left to odometry alone: fitness below the floor
   int registrations_inconsistent = 0;  // left to odometry alone: too far from the navigation
-  double triangulation_s = 0.0;
-  double submap_s = 0.0;  // voxels and normals
-  double registration_s = 0.0;
-  double loop_s = 0.0;
-  double graph_s = 0.0;
-  int whole_solves = 0;        // of the whole graph
-  int window_solves = 0;       // of the last submaps only (MapperOptions::windowed_solves)
-  int loop_window_solves = 0;  // of those, freed back to a correcting loop's older end
+  MapperStageSeconds stage_seconds;    // summed over the dive so far
+  int whole_solves = 0;                // of the whole graph
+  int window_solves = 0;               // of the last submaps only (MapperOptions::windowed_solves)
+  int loop_window_solves = 0;          // of those, freed back to a correcting loop's older end
 };
 
 // Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until

@@ -52,7 +52,7 @@ void Mapper::Impl::TryLoopClosures(int k) {
     }
     loops.push_back(loop);
   }
-  stats.loop_s += Since(start);
+  stats.stage_seconds.loop_s += Since(start);
 }
 
 std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) const {

@@ -13,70 +13,13 @@
 #include <string>
 
 #include "mapping/slam/inverse_blocks.hpp"
+#include "mapping/slam/relative_pose_cost.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
 #include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 namespace {
-
-// The left-perturbation error of a predicted relative pose against a measured one, for Jets.
-template <typename T>
-Eigen::Matrix<T, 6, 1> LeftError(const Eigen::Quaternion<T>& q_hat,
-                                 const Eigen::Matrix<T, 3, 1>& t_hat,
-                                 const Eigen::Quaterniond& q_meas,
-                                 const Eigen::Matrix<T, 3, 1>& t_meas) {
-  Eigen::Quaternion<T> q_delta = q_hat * q_meas.conjugate().cast<T>();
-  // q and -q are the same rotation: take the one with w >= 0, so the error is the short way.
-  if (q_delta.w() < T(0)) q_delta.coeffs() = -q_delta.coeffs();
-  const Eigen::Matrix<T, 3, 1> t_delta = t_hat - q_delta * t_meas;
-  Eigen::Matrix<T, 6, 1> e;
-  e << T(2) * q_delta.vec(), t_delta;
-  return e;
-}
-
-// Residual sqrt(L) e of a relative pose measurement between two nodes.
-struct RelativeCost {
-  Eigen::Quaterniond q_meas;
-  Eigen::Vector3d t_meas;
-  Matrix6d sqrt_information;
-
-  template <typename T>
-  bool operator()(const T* q_a_raw, const T* p_a_raw, const T* q_b_raw, const T* p_b_raw,
-                  T* residual_raw) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_a_raw), q_b(q_b_raw);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_a_raw), p_b(p_b_raw);
-    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
-    const Eigen::Matrix<T, 6, 1> e =
-        LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_meas.cast<T>());
-    Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
-    residual = sqrt_information.cast<T>() * e;
-    return true;
-  }
-};
-
-// A dead-reckoned motion: as RelativeCost, its measured translation corrected by the
-// calibration c = [scale error, misalignment] first.
-struct DeadReckonedCost {
-  Eigen::Quaterniond q_meas;
-  Eigen::Vector3d t_meas;
-  Matrix6d sqrt_information;
-
-  template <typename T>
-  bool operator()(const T* q_a_raw, const T* p_a_raw, const T* q_b_raw, const T* p_b_raw,
-                  const T* c, T* residual_raw) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_a_raw), q_b(q_b_raw);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_a_raw), p_b(p_b_raw);
-    const Eigen::Matrix<T, 3, 1> t_true =
-        DeadReckoningCalibration::Correct<T>(t_meas.cast<T>(), c[0], c[1]);
-    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
-    const Eigen::Matrix<T, 6, 1> e =
-        LeftError<T>(q_a_inverse * q_b, q_a_inverse * (p_b - p_a), q_meas, t_true);
-    Eigen::Map<Eigen::Matrix<T, 6, 1>> residual(residual_raw);
-    residual = sqrt_information.cast<T>() * e;
-    return true;
-  }
-};
 
 // The calibration's zero-mean prior.
 struct CalibrationPriorCost {
@@ -285,15 +228,15 @@ void PoseGraph::AddEdge(const RelativePoseEdge& edge) {
   }
   // The problem owns each loss (one per edge: Ceres deletes them one by one).
   ceres::LossFunction* loss = edge.robust ? new ceres::HuberLoss(edge.huber_scale) : nullptr;
-  const Eigen::Quaterniond q_meas(edge.T_from_to.linear());
+  const RelativePoseMeasurement measurement{Eigen::Quaterniond(edge.T_from_to.linear()),
+                                            edge.T_from_to.translation(),
+                                            SqrtPsd(edge.information)};
   if (edge.dead_reckoned) {
-    auto* cost = new ceres::AutoDiffCostFunction<DeadReckonedCost, 6, 4, 3, 4, 3, 2>(
-        new DeadReckonedCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
+    auto* cost = new DeadReckonedPoseCost(measurement);
     m.AddMeasurement(cost, loss, {edge.from, edge.to}, true, true, m.calibration->data());
     return;
   }
-  auto* cost = new ceres::AutoDiffCostFunction<RelativeCost, 6, 4, 3, 4, 3>(
-      new RelativeCost{q_meas, edge.T_from_to.translation(), SqrtPsd(edge.information)});
+  auto* cost = new RelativePoseCost(measurement);
   m.AddMeasurement(cost, loss, {edge.from, edge.to}, true, true);
 }
 
