@@ -86,8 +86,8 @@ void WriteEdge(const RelativePoseMeasurement& m, const EdgeError& error,
 
 bool RelativePoseCost::Evaluate(double const* const* parameters, double* residuals,
                                 double** jacobians) const {
-  WriteEdge(measurement_, ErrorOf(parameters, measurement_.q_meas, measurement_.t_meas),
-            parameters, residuals, jacobians);
+  WriteEdge(measurement_, ErrorOf(parameters, measurement_.q_meas, measurement_.t_meas), parameters,
+            residuals, jacobians);
   return true;
 }
 

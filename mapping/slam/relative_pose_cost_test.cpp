@@ -66,7 +66,9 @@ struct Blocks {
   std::array<double, 4> q_a, q_b;
   std::array<double, 3> p_a, p_b;
   std::array<double, 2> calibration;
-  std::vector<double*> pointers() { return {q_a.data(), p_a.data(), q_b.data(), p_b.data(), calibration.data()}; }
+  std::vector<double*> pointers() {
+    return {q_a.data(), p_a.data(), q_b.data(), p_b.data(), calibration.data()};
+  }
 };
 
 // Evaluates `cost` with every Jacobian; the quaternions' ones times the manifold's Plus Jacobian
@@ -89,9 +91,9 @@ Evaluation Evaluate(const ceres::CostFunction& cost, Blocks& blocks) {
   EXPECT_TRUE(cost.Evaluate(parameters.data(), out.residual.data(), jacobians.data()));
   const ceres::EigenQuaternionManifold manifold;
   for (std::size_t i = 0; i < sizes.size(); ++i) {
-    const Eigen::MatrixXd ambient = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic,
-                                                                   Eigen::Dynamic, Eigen::RowMajor>>(
-        jacobians[i], 6, sizes[i]);
+    const Eigen::MatrixXd ambient =
+        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            jacobians[i], 6, sizes[i]);
     if (sizes[i] != 4) {
       out.jacobians.push_back(ambient);
       continue;
@@ -130,9 +132,9 @@ TEST(RelativePoseCost, MatchesAutomaticDifferentiationAlongTheManifoldOnEitherSi
     const Eigen::Matrix<double, 6, 6> root = Eigen::Matrix<double, 6, 6>::Random();
     const RelativePoseMeasurement m{RandomRotation(random), RandomVector(random, 2.0),
                                     root * root.transpose() * 10.0};
-    const Eigen::Quaterniond q_d =
-        Eigen::Map<Eigen::Quaterniond>(blocks.q_a.data()).conjugate() *
-        Eigen::Map<Eigen::Quaterniond>(blocks.q_b.data()) * m.q_meas.conjugate();
+    const Eigen::Quaterniond q_d = Eigen::Map<Eigen::Quaterniond>(blocks.q_a.data()).conjugate() *
+                                   Eigen::Map<Eigen::Quaterniond>(blocks.q_b.data()) *
+                                   m.q_meas.conjugate();
     flipped += q_d.w() < 0.0 ? 1 : 0;
     ExpectSame(Evaluate(RelativePoseCost(m), blocks),
                Evaluate(ceres::AutoDiffCostFunction<ReferenceRelative, 6, 4, 3, 4, 3>(
