@@ -184,10 +184,8 @@ perception::RegistrationResult Mapper::Impl::Register(const Submap& source,
                                                       const perception::PointCloud& target,
                                                       const Eigen::Isometry3d& T_init,
                                                       const Matrix6d& prior_covariance,
-                                                      const std::vector<double>& distances,
-                                                      double weak_direction_ratio) const {
+                                                      const std::vector<double>& distances) const {
   perception::IcpOptions icp = RegistrationIcp(options, distances);
-  icp.weak_direction_ratio = weak_direction_ratio;
   perception::IcpPrior prior;
   prior.T_target_source = T_init;
   prior.information = prior_covariance.inverse();

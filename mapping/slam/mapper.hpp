@@ -94,8 +94,7 @@ struct MapperOptions {
   // both are treated as noise of each motion.
   bool estimate_dead_reckoning_calibration = true;
   // Registration directions whose normalised information is below this fraction of the
-  // strongest are left to the navigation (Conditioning in mapper.cpp); a loop closure's ICP
-  // converges along the others alone (IcpOptions::weak_direction_ratio). In [0, 1).
+  // strongest are left to the navigation (Conditioning in mapper.cpp).
   double weak_direction_ratio = 0.02;
   // A scan whose registration leaves a slide free (a pipe without its ends in view) is tied to
   // its anchor along that slide only this loosely (metres): its place there is not measured,

@@ -97,14 +97,11 @@ struct Mapper::Impl {
   perception::PointCloud LocalMap(int k) const;
   void AddNodesAndEdges(const Submap& submap, int k, const ConsecutiveRegistration& c);
   void CloseLoopsAndSolve(int k);
-  // Point-to-plane ICP of a submap onto `target` from T_init, the prediction as its prior, with
-  // the given stages; weak_direction_ratio as IcpOptions' (0: settle in every direction).
   perception::RegistrationResult Register(const Submap& source,
                                           const perception::PointCloud& target,
                                           const Eigen::Isometry3d& T_init,
                                           const Matrix6d& prior_covariance,
-                                          const std::vector<double>& distances,
-                                          double weak_direction_ratio = 0.0) const;
+                                          const std::vector<double>& distances) const;
   // The registration's own information (its pairs), weak directions removed. It relates the
   // submaps' effective poses, the graph's nodes (SubmapDistortionCovariance).
   // `kept`, when given, receives what the pairs alone pin (KeptDirections).

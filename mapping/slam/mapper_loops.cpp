@@ -39,13 +39,9 @@ void Mapper::Impl::TryLoopClosures(int k) {
   const Clock::time_point start = Clock::now();
   for (const LoopCandidate& c : LoopCandidates(k)) {
     const Eigen::Isometry3d T_pred = ScanPose(c.j).inverse() * ScanPose(k);
-    // A loop's edge keeps only the directions its pairs pin (JudgeLoop), so its ICP has
-    // converged once those settle: along a pipe the rest slides on by noise for up to a hundred
-    // iterations. A consecutive registration settles in every direction: along a free slide its
-    // answer still places the scan (slide_sigma_m).
     const perception::RegistrationResult r =
         Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), T_pred, c.covariance,
-                 LoopIcpDistances(c, T_pred), options.weak_direction_ratio);
+                 LoopIcpDistances(c, T_pred));
     const LoopClosure loop = JudgeLoop(r, c, k, T_pred);
     if (loop.accepted) {
       graph.AddEdge({.from = ScanNode(c.j),

@@ -434,8 +434,8 @@ void IcpOptions::Check() const {
   check.NonNegative("translation_tolerance_m", translation_tolerance_m, "m");
   check.InRange("weak_direction_ratio", weak_direction_ratio, 0.0, 1.0, Interval::kOpenHigh);
   if (weak_direction_ratio > 0.0) {
-    check.Require(method == IcpMethod::kPointToPlane, "weak_direction_ratio",
-                  "0 unless point-to-plane", weak_direction_ratio);
+    check.Require(method == IcpMethod::kPointToPlane && !prior, "weak_direction_ratio",
+                  "0 unless point-to-plane without a prior", weak_direction_ratio);
   }
   // A relative change of the whole residual is no tolerance (and would make every iteration a
   // stall, stall_iterations counting a residual as lower only by this fraction).

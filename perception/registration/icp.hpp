@@ -52,13 +52,11 @@ struct IcpOptions {
   // rolling about its axis, a wrong object's pose hopping between two fits) until its cap; this
   // ends that. 0 = off, >= 0.
   int stall_iterations = 0;
-  // Point-to-plane only (else 0): when > 0, the step tolerances are tested only on the part of
-  // each step along directions the pairs determine well (eigenvalues of the pairs' J^T J, a
-  // prior's information left out, rotations scaled by the pairs' lever arm, at least this
-  // fraction of the largest). A pipe then converges although it keeps rolling about and sliding
-  // along its axis, where nothing pins it or only a prior holds it against pairs that change
-  // from one iteration to the next (the result's information says which directions are free).
-  // In [0, 1); 0 = every direction.
+  // Point-to-plane without a prior only (else 0): when > 0, the step tolerances are tested only
+  // on the part of each step along directions the pairs determine well (eigenvalues of J^T J,
+  // rotations scaled by the pairs' lever arm, at least this fraction of the largest). A pipe then
+  // converges although it keeps rolling about and sliding along its axis, where nothing pins it
+  // (the result's information says which directions are free). In [0, 1); 0 = every direction.
   double weak_direction_ratio = 0.0;
   int threads = 0;  // OpenMP threads for the nearest-neighbour search, 0 = OpenMP's default, >= 0
   // When > 0, a source point pairs only with target points whose normal is within this angle of
