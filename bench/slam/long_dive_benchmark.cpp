@@ -53,17 +53,9 @@ std::int64_t MeanFrom(const std::vector<std::int64_t>& values, std::size_t from)
 // The mean of each stage's time per submap over stages[first..last) (first < last).
 mapping::MapperStageSeconds MeanStages(const std::vector<mapping::MapperStageSeconds>& stages,
                                        std::size_t first, std::size_t last) {
-  mapping::MapperStageSeconds mean;
-  for (std::size_t i = first; i < last; ++i) {
-    mean.triangulation_s += stages[i].triangulation_s;
-    mean.submap_s += stages[i].submap_s;
-    mean.registration_s += stages[i].registration_s;
-    mean.loop_s += stages[i].loop_s;
-    mean.graph_s += stages[i].graph_s;
-  }
-  const double n = static_cast<double>(last - first);
-  return {mean.triangulation_s / n, mean.submap_s / n, mean.registration_s / n, mean.loop_s / n,
-          mean.graph_s / n};
+  mapping::MapperStageSeconds sum;
+  for (std::size_t i = first; i < last; ++i) sum += stages[i];
+  return sum * (1.0 / static_cast<double>(last - first));
 }
 
 // Maps the log (windowed or whole solves), sampling the resident memory as it goes, and

@@ -71,10 +71,7 @@ class SubmapClock {
  private:
   MapperStageSeconds StagesSinceLastSubmap() {
     const MapperStageSeconds now = mapper_.stats().stage_seconds;
-    const MapperStageSeconds since{now.triangulation_s - last_.triangulation_s,
-                                   now.submap_s - last_.submap_s,
-                                   now.registration_s - last_.registration_s,
-                                   now.loop_s - last_.loop_s, now.graph_s - last_.graph_s};
+    const MapperStageSeconds since = now - last_;
     last_ = now;
     return since;
   }

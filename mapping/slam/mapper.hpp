@@ -146,6 +146,25 @@ struct MapperStageSeconds {
   double registration_s = 0.0;
   double loop_s = 0.0;
   double graph_s = 0.0;
+
+  // Stage by stage: `a - b`, the time between two readings of the summed clocks; `+=` and
+  // `*` to sum and average them.
+  friend MapperStageSeconds operator-(const MapperStageSeconds& a, const MapperStageSeconds& b) {
+    return {a.triangulation_s - b.triangulation_s, a.submap_s - b.submap_s,
+            a.registration_s - b.registration_s, a.loop_s - b.loop_s, a.graph_s - b.graph_s};
+  }
+  friend MapperStageSeconds operator*(const MapperStageSeconds& a, double factor) {
+    return {a.triangulation_s * factor, a.submap_s * factor, a.registration_s * factor,
+            a.loop_s * factor, a.graph_s * factor};
+  }
+  MapperStageSeconds& operator+=(const MapperStageSeconds& b) {
+    triangulation_s += b.triangulation_s;
+    submap_s += b.submap_s;
+    registration_s += b.registration_s;
+    loop_s += b.loop_s;
+    graph_s += b.graph_s;
+    return *this;
+  }
 };
 
 struct MapperStats {

@@ -5,14 +5,13 @@
 #include <Eigen/Geometry>
 
 #include "mapping/slam/dead_reckoning_calibration.hpp"
+#include "mapping/slam/pose_graph.hpp"
 
 // The pose graph's edge between two nodes, with its Jacobians written out: it is nearly every
 // residual block of a dive's graph, and Ceres's automatic differentiation of it (14 dual numbers
 // through the quaternion algebra and the 6x6 whitening) was half of a window solve's time
-// (bench/slam/RESULTS.md, "Long dives").
+// (bench/slam/RESULTS.md, "Edges with analytic Jacobians").
 namespace uwscan::mapping {
-
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 // The measured motion T_a_b of an edge and the square root of its information.
 struct RelativePoseMeasurement {
