@@ -467,6 +467,12 @@ TEST(CliDive, CompareWritesDeviationsReportAndTableAndRefusesBadInputWithOneLine
   EXPECT_GT(report["surface"]["unchanged_m2"].get<double>(), 1.0);  // the swath, unchanged
   EXPECT_TRUE(report["alignment"]["registered"].get<bool>());
   EXPECT_NE(ReadText(md).find("| region | kind |"), std::string::npos);
+  // The map report carries the graph's information (one pose per SLAM pose), and compare takes
+  // how loosely the map placed each point against its tile from it.
+  const nlohmann::json map_report = ReadJson(d.report);
+  EXPECT_EQ(map_report["pose_graph_information"]["pose_columns"].size(),
+            map_report["trajectories"]["slam"].size());
+  EXPECT_TRUE(report["settings"]["joint_pose_uncertainty_used"].get<bool>());
 
   // The dive log itself, mapped by compare as `map` maps it, gives the findings its report gives
   // (to the float rounding of the map file).
@@ -484,6 +490,7 @@ TEST(CliDive, CompareWritesDeviationsReportAndTableAndRefusesBadInputWithOneLine
               1e-3 * unchanged_m2);
   EXPECT_NEAR(static_cast<double>(log_report["regions"].size()),
               static_cast<double>(report["regions"].size()), 2.0);
+  EXPECT_TRUE(log_report["settings"]["joint_pose_uncertainty_used"].get<bool>());
 
   // A design model in millimetres read as metres, an empty map: one line each, nothing written.
   std::filesystem::remove(ply);

@@ -167,6 +167,12 @@ void AddCompareCommand(CLI::App& app) {
                   "detection then carries the map report's pose covariances)")
       ->capture_default_str()
       ->check(kNonNegativeNumber);
+  cmd->add_option("--seen-within", a->options.seen_within_m,
+                  "metres: a point counts as swept by every pose at most this much farther from "
+                  "it than the nearest one (how loosely the map placed it against its tile, from "
+                  "the report's pose graph information)")
+      ->capture_default_str()
+      ->check(kNonNegativeNumber);
   cmd->add_option("--threads", a->threads,
                   "threads (0: all cores); the output does not depend on it")
       ->check(kNonNegativeNumber);

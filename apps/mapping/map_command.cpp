@@ -49,6 +49,21 @@ nlohmann::json Optional(const std::optional<T>& value) {
   return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
 }
 
+// The pose graph's information, from which `compare` takes how well two poses are placed
+// relative to each other: its upper triangle as [row, column, value], 6 rows per graph node
+// [rotation (rad), position (m)], each SLAM pose at its `pose_columns` entry.
+nlohmann::json InformationJson(const mapping::JointPoseUncertainty& uncertainty) {
+  const Eigen::SparseMatrix<double>& information = uncertainty.information();
+  nlohmann::json entries = nlohmann::json::array();
+  for (Eigen::Index column = 0; column < information.outerSize(); ++column) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(information, column); it; ++it)
+      if (it.row() <= it.col()) entries.push_back({it.row(), it.col(), it.value()});
+  }
+  return {{"size", information.rows()},
+          {"pose_columns", uncertainty.pose_columns()},
+          {"upper_entries", entries}};
+}
+
 // The map report (format in docs/formats.md, "Map report"): what the viewer reads.
 nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& log,
                              const std::string& map) {
@@ -80,6 +95,7 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
   report["pose_covariance"] =
       covariance;  // [t, 36 values, (x, y, z (m), roll, pitch, yaw (rad)) row-major]
   report["pose_std"] = deviation;  // [t, x, y, z (m), roll, pitch, yaw (rad)]
+  if (m.joint_uncertainty) report["pose_graph_information"] = InformationJson(*m.joint_uncertainty);
   nlohmann::json loops = nlohmann::json::array();
   for (const mapping::LoopClosure& l : m.loops) {
     const Eigen::Quaterniond q(l.T_from_to.linear());

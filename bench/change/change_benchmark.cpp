@@ -107,6 +107,7 @@ Epoch SurveyEpoch(const fs::path& scene_path, const fs::path& folder,
   epoch.map.cloud = m.map;
   for (const mapping::TimedPose& p : m.slam) epoch.map.poses.push_back(p.T_W_V);
   epoch.map.pose_covariances = m.covariances;
+  epoch.map.joint_uncertainty = m.joint_uncertainty;
   epoch.map_rms_m = RmsToScene(m.map, scanner::sim::RayCaster(epoch.scene.objects));
   return epoch;
 }
@@ -487,8 +488,14 @@ ChangeFigures RunChangeBench(const ChangeBenchOptions& options, const Progress& 
       std::sqrt(0.5 * (before.map_rms_m * before.map_rms_m + after.map_rms_m * after.map_rms_m));
   const std::vector<Change> changes = ChangesBetween(before.scene, after.scene);
   if (progress) progress("compare", 0.0);
+  // As `uwscan compare` does with two map reports.
   mapping::CompareOptions tiles;
   figures.methods["uwscan"] = UwscanMethod(after, before.map, tiles, changes);
+  // The same with each pose's marginal covariance alone (the relative placement unknown).
+  mapping::CompareOptions marginal = tiles;
+  marginal.joint_pose_uncertainty = false;
+  figures.methods["uwscan_marginal_covariances"] =
+      UwscanMethod(after, before.map, marginal, changes);
   mapping::CompareOptions whole = tiles;
   whole.alignment.tile_m = 0.0;
   figures.methods["uwscan_pose_covariances"] = UwscanMethod(after, before.map, whole, changes);

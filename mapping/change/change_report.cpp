@@ -153,7 +153,9 @@ nlohmann::json ChangeReportJson(const SurveyComparison& c, const Survey& map,
                         {"map_point_sigma_m", d.map_point_sigma_m},
                         {"reference_point_sigma_m",
                          reference.kind == SurveyKind::kDesign ? 0.0 : d.reference_point_sigma_m},
-                        {"pose_covariances_used", c.pose_covariances_used}};
+                        {"pose_covariances_used", c.pose_covariances_used},
+                        {"joint_pose_uncertainty_used", c.joint_pose_uncertainty_used},
+                        {"seen_within_m", options.seen_within_m}};
   report["surface"] = {{"core_points", c.areas.core_points},
                        {"unchanged_m2", c.areas.unchanged_m2},
                        {"changed_m2", c.areas.changed_m2},

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "mapping/change/local_statistics.hpp"
+#include "mapping/change/tile_placement.hpp"
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "perception/preprocessing/normals.hpp"
 #include "scanner/common/error.hpp"
@@ -161,6 +162,47 @@ std::vector<long> SpreadGroups(const SurveyComparison& c,
   return group_of;
 }
 
+// Each core point's registration tile (its index; -1 where the global transform placed it).
+std::vector<long> TileIndices(const SurveyComparison& c, const Eigen::Isometry3d& T_map_reference) {
+  std::vector<long> tile_of(c.deviations.size(), -1);
+  for (std::size_t i = 0; i < c.deviations.size(); ++i) {
+    const SurveyAlignment::Tile* tile =
+        c.alignment.TileOf(T_map_reference * c.deviations[i].point_W);
+    if (tile) tile_of[i] = static_cast<long>(tile - c.alignment.tiles.data());
+  }
+  return tile_of;
+}
+
+// Adds to each inspected core point's level of detection how loosely both surveys placed it
+// against the rest of its tile (TileRelativePoseSigmas), where their joint pose covariances are
+// known; the status follows.
+void AddTileRelativePlacement(SurveyComparison& c, const Survey& map, const Survey& reference,
+                              const Eigen::Isometry3d& T_map_reference, double seen_within_m,
+                              double z) {
+  if (!map.joint_uncertainty && !reference.joint_uncertainty) return;
+  c.joint_pose_uncertainty_used = true;
+  const std::vector<long> tile_of = TileIndices(c, T_map_reference);
+  std::vector<Eigen::Vector3d> points_R, normals_R, points_M, normals_M;
+  for (const CoreDeviation& d : c.deviations) {
+    points_R.push_back(d.point_W);
+    normals_R.push_back(d.normal_W);
+    points_M.push_back(T_map_reference * d.point_W);
+    normals_M.push_back(T_map_reference.linear() * d.normal_W);
+  }
+  const std::vector<double> sigma_map =
+      TileRelativePoseSigmas(map, points_M, normals_M, tile_of, seen_within_m);
+  const std::vector<double> sigma_reference =
+      TileRelativePoseSigmas(reference, points_R, normals_R, tile_of, seen_within_m);
+  for (std::size_t i = 0; i < c.deviations.size(); ++i) {
+    CoreDeviation& d = c.deviations[i];
+    if (d.status == SurfaceStatus::kNotInspected) continue;
+    d.lod_m = z * std::sqrt(std::pow(d.lod_m / z, 2) + std::pow(sigma_map[i], 2) +
+                            std::pow(sigma_reference[i], 2));
+    d.status =
+        std::abs(d.deviation_m) > d.lod_m ? SurfaceStatus::kChanged : SurfaceStatus::kUnchanged;
+  }
+}
+
 SurfaceAreas AreasOf(const std::vector<CoreDeviation>& deviations, double spacing_m) {
   SurfaceAreas areas;
   const double cell_m2 = spacing_m * spacing_m;
@@ -179,6 +221,9 @@ void CompareOptions::Check() const {
   alignment.Check();
   deviation.Check();
   regions.Check();
+  if (!(seen_within_m >= 0.0) || !std::isfinite(seen_within_m))
+    throw Error("CompareOptions: seen_within_m must be finite and >= 0, got " +
+                std::to_string(seen_within_m));
 }
 
 SurveyComparison CompareSurveys(const Survey& map, const Survey& reference,
@@ -210,6 +255,10 @@ SurveyComparison CompareSurveys(const Survey& map, const Survey& reference,
     return std::sqrt(align * align + pose_map * pose_map + pose_reference * pose_reference);
   };
   result.deviations = MeasureDeviations(aligned, target, core, deviation, placement_sigma);
+  if (!result.pose_covariances_used && options.joint_pose_uncertainty) {
+    AddTileRelativePlacement(result, map, reference, T_map_reference, options.seen_within_m,
+                             TwoSidedQuantile(deviation.confidence));
+  }
   if (deviation.local_offset_radius_m > 0.0) {
     RemoveLocalOffsets(result.deviations, deviation.local_offset_radius_m,
                        deviation.max_normal_angle_rad);

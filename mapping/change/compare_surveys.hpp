@@ -13,6 +13,15 @@ struct CompareOptions {
   SurveyAlignmentOptions alignment;
   DeviationOptions deviation;
   RegionOptions regions;
+  // With tiles, and where a survey carries its poses' joint uncertainty (a map report of this
+  // version, or a dive mapped): how loosely it placed each point against the rest of its tile
+  // adds to the level of detection (TileRelativePoseSigmas).
+  bool joint_pose_uncertainty = true;
+  // A point counts as seen from every pose at most this much farther from it than the nearest
+  // pose: the submaps whose sweeps covered it (metres, >= 0). On the change bench's dives (the
+  // galvanometer scanner 1 m over the seabed) 95 % of the submaps that put a point in a map
+  // voxel lie within 0.39 m of that (bench/change/RESULTS.md).
+  double seen_within_m = 0.4;
   void Check() const;
 };
 
@@ -34,6 +43,9 @@ struct SurveyComparison {
   // as a whole) or the tiles' registration covariances (tile by tile, which absorbs the slowly
   // varying pose errors the covariances describe).
   bool pose_covariances_used = false;
+  // Whether, tile by tile, the level of detection also carries how loosely either survey placed
+  // each point against the rest of its tile (its joint pose uncertainty known).
+  bool joint_pose_uncertainty_used = false;
   double seconds = 0.0;
 };
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "scanner/common/error.hpp"
@@ -194,6 +195,37 @@ TEST(CompareSurveys, BadInputGetsAOneLineErrorNamingWhatIsWrong) {
   m = MessageOf([&] { ReadSurvey(faceless); });
   EXPECT_NE(m.find("without faces"), std::string::npos) << m;
   for (const std::string& message : {m}) EXPECT_EQ(message.find('\n'), std::string::npos);
+}
+
+// A map report's pose graph information is read as the joint uncertainty of its poses; a report
+// without it (an older version) reads as before; a damaged one names the entry.
+TEST(CompareSurveys, AMapReportsPoseGraphInformationIsReadOrNamedWhereDamaged) {
+  const TempFile map("report_map.xyz"), report("report.json");
+  std::ofstream(map.path) << "0 0 10\n1 0 10\n0 1 10\n";
+  nlohmann::json row = {0.0};
+  for (int k = 0; k < 36; ++k) row.push_back(k % 7 == 0 ? 1e-4 : 0.0);
+  nlohmann::json json = {{"uwscan_format", 1},
+                         {"kind", "map_report"},
+                         {"map", map.path.string()},
+                         {"trajectories", {{"slam", {{0.0, 0, 0, 9, 0, 0, 0, 1}}}}},
+                         {"pose_covariance", {row}}};
+  const auto write_and_read = [&] {
+    std::ofstream(report.path) << json.dump();
+    return ReadSurvey(report.path);
+  };
+  EXPECT_EQ(write_and_read().joint_uncertainty, nullptr);
+  nlohmann::json entries = nlohmann::json::array();
+  for (int k = 0; k < 6; ++k) entries.push_back({k, k, 1e4});
+  json["pose_graph_information"] = {{"size", 6}, {"pose_columns", {0}}, {"upper_entries", entries}};
+  const Survey survey = write_and_read();
+  ASSERT_NE(survey.joint_uncertainty, nullptr);
+  const std::optional<Eigen::MatrixXd> covariance = survey.joint_uncertainty->Covariance({0});
+  ASSERT_TRUE(covariance.has_value());
+  EXPECT_NEAR((*covariance)(3, 3), 1e-4, 1e-15);
+  json["pose_graph_information"]["upper_entries"][2] = {3, 2, 5.0};
+  const std::string m = MessageOf(write_and_read);
+  EXPECT_NE(m.find("pose_graph_information.upper_entries[2]"), std::string::npos) << m;
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
 }
 
 }  // namespace

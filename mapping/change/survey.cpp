@@ -46,6 +46,45 @@ Matrix6d GraphOrder(const std::vector<double>& row) {
   return ordered;
 }
 
+// The pose graph's information a report of this version carries (InformationJson in the map
+// command); null for an older report.
+std::shared_ptr<const JointPoseUncertainty> ReadJointUncertainty(const nlohmann::json& report,
+                                                                 const Field& root) {
+  if (!report.contains("pose_graph_information")) return nullptr;
+  const Field field = root["pose_graph_information"];
+  const nlohmann::json& block = report["pose_graph_information"];
+  const nlohmann::json& size = json_fields::Require(block, "size", field);
+  const nlohmann::json& columns = json_fields::Require(block, "pose_columns", field);
+  const nlohmann::json& entries = json_fields::Require(block, "upper_entries", field);
+  if (!size.is_number_integer() || size.get<long long>() < 0 || size.get<long long>() > 1e8)
+    field["size"].Fail("expected the information's number of rows");
+  const auto n = static_cast<Eigen::Index>(size.get<long long>());
+  if (!columns.is_array() || !entries.is_array())
+    field.Fail("expected pose_columns and upper_entries arrays");
+  std::vector<int> pose_columns;
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (!columns[i].is_number_integer()) field["pose_columns"][i].Fail("expected a column");
+    pose_columns.push_back(columns[i].get<int>());
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const std::vector<double> e = json_fields::Numbers(entries[i], 3, field["upper_entries"][i]);
+    const auto r = static_cast<Eigen::Index>(e[0]), c = static_cast<Eigen::Index>(e[1]);
+    if (r != e[0] || c != e[1] || r < 0 || c < r || c >= n)
+      field["upper_entries"][i].Fail("expected [row, column, value] with row <= column < size");
+    triplets.emplace_back(r, c, e[2]);
+    if (r != c) triplets.emplace_back(c, r, e[2]);
+  }
+  Eigen::SparseMatrix<double> information(n, n);
+  information.setFromTriplets(triplets.begin(), triplets.end());
+  try {
+    return std::make_shared<const JointPoseUncertainty>(std::move(information),
+                                                        std::move(pose_columns));
+  } catch (const Error& e) {
+    field.Fail(e.what());
+  }
+}
+
 Survey ReadMapReport(const fs::path& path, const SurveyReadOptions& options) {
   const std::string name = path.string();
   const Field root{name, ""};
@@ -73,6 +112,9 @@ Survey ReadMapReport(const fs::path& path, const SurveyReadOptions& options) {
         GraphOrder(json_fields::Numbers(covariance[i], 37, root["pose_covariance"][i])));
   }
   if (options.units_to_m != 1.0) root.Fail("a map report is in metres (no --units)");
+  survey.joint_uncertainty = ReadJointUncertainty(report, root);
+  if (survey.joint_uncertainty && survey.joint_uncertainty->pose_count() != survey.poses.size())
+    root["pose_graph_information"]["pose_columns"].Fail("expected one per SLAM pose");
   return survey;
 }
 
@@ -162,6 +204,7 @@ Survey SurveyOfDive(const DiveMapping& mapping, const std::string& name) {
     survey.poses.push_back(mapping.slam[i].T_W_V);
     survey.pose_covariances.push_back(mapping.covariances[i]);
   }
+  survey.joint_uncertainty = mapping.joint_uncertainty;
   return survey;
 }
 

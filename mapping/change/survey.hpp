@@ -3,10 +3,12 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "mapping/slam/dive_mapping.hpp"
+#include "mapping/slam/joint_pose_uncertainty.hpp"
 #include "mapping/slam/pose_graph.hpp"
 #include "perception/cloud/point_cloud.hpp"
 
@@ -29,6 +31,9 @@ struct Survey {
   // rotation about the pose's position, pose_graph.hpp), as the map report lists them.
   std::vector<Eigen::Isometry3d> poses;
   std::vector<Matrix6d> pose_covariances;
+  // kMap, when known: how well the poses are placed relative to each other (their joint
+  // covariance on demand); null when the report does not carry it.
+  std::shared_ptr<const JointPoseUncertainty> joint_uncertainty;
 };
 
 struct SurveyReadOptions {

@@ -142,6 +142,7 @@ void AddExpectedErrors(const Mapper& mapper, DiveMapping& result) {
   const std::optional<Mapper::SubmapCovariances> covariances = mapper.Covariances();
   if (!covariances) return;
   result.covariances = covariances->anchors;
+  result.joint_uncertainty = mapper.JointUncertainty();
   result.expected_position_error_m = ExpectedPositionErrorRms(covariances->anchors);
   ExpectedSurfaceError error(kExpectedErrorStride);
   for (int i = 0; i < mapper.submap_count(); ++i) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mapping/log/dive_log.hpp"
+#include "mapping/slam/joint_pose_uncertainty.hpp"
 #include "mapping/slam/mapper.hpp"
 #include "mapping/slam/trajectory_metrics.hpp"
 #include "perception/cloud/point_cloud.hpp"
@@ -30,6 +31,9 @@ struct DiveMapping {
   std::vector<TimedPose> dead_reckoning;  // the navigation at the same times
   std::vector<TimedPose> truth;           // the truth at the same times (simulated logs only)
   std::vector<Matrix6d> covariances;      // per pose, [rotation, position] (empty: not computed)
+  // How well the poses (slam, in order) are placed relative to each other: the graph's
+  // information (Mapper::JointUncertainty); null with the covariances.
+  std::shared_ptr<const JointPoseUncertainty> joint_uncertainty;
   // The map's expected distance to the true surfaces from its poses' uncertainty alone (RMS
   // along the normals, ExpectedSurfaceErrorRms); empty with the covariances.
   std::optional<double> expected_map_error_m;

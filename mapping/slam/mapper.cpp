@@ -486,6 +486,14 @@ std::optional<Mapper::SubmapCovariances> Mapper::Covariances() const {
   return out;
 }
 
+std::shared_ptr<const JointPoseUncertainty> Mapper::JointUncertainty() const {
+  std::optional<Eigen::SparseMatrix<double>> information = impl_->graph.Information();
+  if (!information) return nullptr;
+  std::vector<int> columns;
+  for (int i = 0; i < submap_count(); ++i) columns.push_back(6 * impl_->ScanNode(i));
+  return std::make_shared<const JointPoseUncertainty>(std::move(*information), std::move(columns));
+}
+
 std::shared_ptr<const SubmapClouds> Mapper::submap_clouds(int index) const {
   if (index < 0 || index >= submap_count())
     throw Error("mapper: no submap " + std::to_string(index));

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "mapping/log/dive_log.hpp"
+#include "mapping/slam/joint_pose_uncertainty.hpp"
 #include "mapping/slam/pose_graph.hpp"
 #include "mapping/slam/submap.hpp"
 #include "mapping/slam/submap_store.hpp"
@@ -240,6 +241,9 @@ class Mapper {
     std::vector<Matrix6d> anchors, scans;
   };
   std::optional<SubmapCovariances> Covariances() const;
+  // The anchors' joint uncertainty (the graph's information, each submap's anchor a pose in
+  // order). Null when the graph cannot be evaluated.
+  std::shared_ptr<const JointPoseUncertainty> JointUncertainty() const;
   // Every submap's cloud placed with the current estimates, voxelised at `voxel_m`, origin at
   // the first submap's position; the clouds are merged one at a time, so the memory it takes is
   // the map's.

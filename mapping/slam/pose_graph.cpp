@@ -401,4 +401,18 @@ std::optional<std::vector<Matrix6d>> PoseGraph::Covariances(const std::vector<in
   return out;
 }
 
+std::optional<Eigen::SparseMatrix<double>> PoseGraph::Information() const {
+  std::optional<Eigen::SparseMatrix<double>> information = impl_->Information();
+  if (!information) return std::nullopt;
+  // Ceres's quaternion tangent is half the rotation vector: in radians the information is
+  // S^-1 H S^-1 with S = 2 on the rotations' rows and columns.
+  const Eigen::Index rotations = 6 * static_cast<Eigen::Index>(node_count());
+  const auto scale = [&](Eigen::Index i) { return i < rotations && i % 6 < 3 ? 0.5 : 1.0; };
+  for (Eigen::Index column = 0; column < information->outerSize(); ++column) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(*information, column); it; ++it)
+      it.valueRef() *= scale(it.row()) * scale(it.col());
+  }
+  return information;
+}
+
 }  // namespace uwscan::mapping

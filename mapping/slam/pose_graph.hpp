@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <Eigen/SparseCore>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -110,6 +111,11 @@ class PoseGraph {
   std::optional<std::vector<Matrix6d>> Covariances() const;
   // The same for the given nodes only, in their order.
   std::optional<std::vector<Matrix6d>> Covariances(const std::vector<int>& nodes) const;
+  // The information J^T J at the current estimate (the inverse of the joint covariance, cross
+  // terms included): 6 rows and columns per node, node i at 6 i, [rotation (rad), position (m)]
+  // as above, then the dead reckoning's calibration when estimated (2). std::nullopt when a
+  // measurement cannot be evaluated there.
+  std::optional<Eigen::SparseMatrix<double>> Information() const;
 
  private:
   struct Impl;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mapping/log/dive_log_test_support.hpp"
+#include "mapping/slam/joint_pose_uncertainty.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping::test {
@@ -31,32 +32,57 @@ TEST(PoseGraph, ACovarianceIsTheInverseOfItsOnlyPrior) {
 
 // Node 0 at the origin held by a prior, node 1 measured from it by one edge: to first order
 // node 1's [w, v] is A (e_0 + e_edge) with A = [[I, 0], [-[t]x, I]] (a turn of node 0 swings
-// node 1 about it), so its covariance is A (C_0 + C_edge) A^T.
-TEST(PoseGraph, ACovarianceCarriesThePriorAndTheEdgeAlongTheLever) {
-  const Eigen::Vector3d t(2.0, -1.0, 0.5);
-  Eigen::Isometry3d T_0_1 = Eigen::Isometry3d::Identity();
-  T_0_1.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  T_0_1.translation() = t;
-  Matrix6d prior = Matrix6d::Zero(), edge = Matrix6d::Zero();
-  prior.diagonal() << 1e4, 2e4, 3e4, 1e3, 2e3, 5e3;
-  prior(1, 4) = prior(4, 1) = 300.0;
-  edge.diagonal() << 4e4, 1e4, 2e4, 3e3, 1e3, 2e3;
-  edge(0, 5) = edge(5, 0) = -500.0;
+// node 1 about it), so its covariance is A (C_0 + C_edge) A^T and it shares A C_0 with node 0.
+struct TwoNodeGraph {
+  Eigen::Vector3d t{2.0, -1.0, 0.5};
+  Matrix6d prior = Matrix6d::Zero(), edge = Matrix6d::Zero(), A = Matrix6d::Identity();
   PoseGraph graph;
-  graph.AddNode(Eigen::Isometry3d::Identity());
-  graph.AddNode(T_0_1);
-  graph.AddPrior({.node = 0, .information = prior});
-  graph.AddEdge({.from = 0, .to = 1, .T_from_to = T_0_1, .information = edge});
-  graph.Solve({});
-  const std::optional<std::vector<Matrix6d>> covariance = graph.Covariances();
+
+  TwoNodeGraph() {
+    Eigen::Isometry3d T_0_1 = Eigen::Isometry3d::Identity();
+    T_0_1.linear() =
+        Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    T_0_1.translation() = t;
+    prior.diagonal() << 1e4, 2e4, 3e4, 1e3, 2e3, 5e3;
+    prior(1, 4) = prior(4, 1) = 300.0;
+    edge.diagonal() << 4e4, 1e4, 2e4, 3e3, 1e3, 2e3;
+    edge(0, 5) = edge(5, 0) = -500.0;
+    graph.AddNode(Eigen::Isometry3d::Identity());
+    graph.AddNode(T_0_1);
+    graph.AddPrior({.node = 0, .information = prior});
+    graph.AddEdge({.from = 0, .to = 1, .T_from_to = T_0_1, .information = edge});
+    graph.Solve({});
+    A.block<3, 3>(3, 0) << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;  // -[t]x
+  }
+  Matrix6d C0() const { return prior.inverse(); }
+  Matrix6d C1() const { return A * (prior.inverse() + edge.inverse()) * A.transpose(); }
+  Matrix6d C10() const { return A * prior.inverse(); }
+};
+
+TEST(PoseGraph, ACovarianceCarriesThePriorAndTheEdgeAlongTheLever) {
+  const TwoNodeGraph g;
+  const std::optional<std::vector<Matrix6d>> covariance = g.graph.Covariances();
   ASSERT_TRUE(covariance.has_value());
-  Matrix6d A = Matrix6d::Identity();
-  A.block<3, 3>(3, 0) << 0.0, t.z(), -t.y(), -t.z(), 0.0, t.x(), t.y(), -t.x(), 0.0;  // -[t]x
-  const Matrix6d expected = A * (prior.inverse() + edge.inverse()) * A.transpose();
-  EXPECT_LT(((*covariance)[0] - prior.inverse()).norm(), 1e-9 * prior.inverse().norm());
-  EXPECT_LT(((*covariance)[1] - expected).norm(), 1e-9 * expected.norm())
-      << (*covariance)[1] << "\n\n"
-      << expected;
+  EXPECT_LT(((*covariance)[0] - g.C0()).norm(), 1e-9 * g.C0().norm());
+  EXPECT_LT(((*covariance)[1] - g.C1()).norm(), 1e-9 * g.C1().norm()) << (*covariance)[1] << "\n\n"
+                                                                      << g.C1();
+}
+
+// The same graph's joint covariance from its information, the poses in the order asked for.
+TEST(PoseGraph, AJointCovarianceHoldsWhatTwoNodesShare) {
+  const TwoNodeGraph g;
+  const std::optional<Eigen::SparseMatrix<double>> information = g.graph.Information();
+  ASSERT_TRUE(information.has_value());
+  const JointPoseUncertainty uncertainty(*information, {0, 6});
+  const std::optional<Eigen::MatrixXd> joint = uncertainty.Covariance({1, 0});
+  ASSERT_TRUE(joint.has_value());
+  ASSERT_EQ(joint->rows(), 12);
+  EXPECT_LT((joint->block<6, 6>(0, 0) - g.C1()).norm(), 1e-9 * g.C1().norm());
+  EXPECT_LT((joint->block<6, 6>(6, 6) - g.C0()).norm(), 1e-9 * g.C0().norm());
+  EXPECT_LT((joint->block<6, 6>(0, 6) - g.C10()).norm(), 1e-9 * g.C10().norm())
+      << joint->block<6, 6>(0, 6) << "\n\n"
+      << g.C10();
+  EXPECT_LT((joint->block<6, 6>(6, 0) - g.C10().transpose()).norm(), 1e-9 * g.C10().norm());
 }
 
 TEST(PoseGraph, RecoversAChainFromExactEdgesAndAPrior) {
