@@ -38,25 +38,36 @@ JointPoseUncertainty::JointPoseUncertainty(Eigen::SparseMatrix<double> informati
 
 JointPoseUncertainty::~JointPoseUncertainty() = default;
 
-std::optional<Eigen::MatrixXd> JointPoseUncertainty::Covariance(
+std::optional<Eigen::MatrixXd> JointPoseUncertainty::CovarianceColumns(
     const std::vector<std::size_t>& poses) const {
-  std::vector<Eigen::Index> index;
   for (const std::size_t pose : poses) {
     if (pose >= pose_columns_.size()) {
       throw Error("joint pose uncertainty: no pose " + std::to_string(pose) + " of " +
                   std::to_string(pose_columns_.size()));
     }
-    for (int k = 0; k < 6; ++k) index.push_back(pose_columns_[pose] + k);
   }
   if (!factor_->positive_definite) return std::nullopt;
-  // The inverse's columns for the poses, one solve each, then their rows.
-  const Eigen::Index m = std::ssize(index);
+  const Eigen::Index m = 6 * std::ssize(poses);
   Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(information_.rows(), m);
-  for (Eigen::Index k = 0; k < m; ++k) unit(index[static_cast<std::size_t>(k)], k) = 1.0;
+  for (Eigen::Index k = 0; k < m; ++k)
+    unit(pose_columns_[poses[static_cast<std::size_t>(k / 6)]] + k % 6, k) = 1.0;
   const Eigen::MatrixXd columns = factor_->ldlt.solve(unit);
+  Eigen::MatrixXd out(6 * std::ssize(pose_columns_), m);
+  for (std::size_t pose = 0; pose < pose_columns_.size(); ++pose)
+    out.middleRows(6 * static_cast<Eigen::Index>(pose), 6) =
+        columns.middleRows(pose_columns_[pose], 6);
+  return out;
+}
+
+std::optional<Eigen::MatrixXd> JointPoseUncertainty::Covariance(
+    const std::vector<std::size_t>& poses) const {
+  const std::optional<Eigen::MatrixXd> columns = CovarianceColumns(poses);
+  if (!columns) return std::nullopt;
+  const Eigen::Index m = 6 * std::ssize(poses);
   Eigen::MatrixXd joint(m, m);
-  for (Eigen::Index r = 0; r < m; ++r)
-    joint.row(r) = columns.row(index[static_cast<std::size_t>(r)]);
+  for (Eigen::Index r = 0; r < std::ssize(poses); ++r)
+    joint.middleRows(6 * r, 6) =
+        columns->middleRows(6 * static_cast<Eigen::Index>(poses[static_cast<std::size_t>(r)]), 6);
   return Eigen::MatrixXd(0.5 * (joint + joint.transpose()));
 }
 

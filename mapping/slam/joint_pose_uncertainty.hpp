@@ -33,6 +33,10 @@ class JointPoseUncertainty {
   // nothing constrains). Throws uwscan::Error for a pose outside [0, pose_count()). Safe to call
   // from several threads at once.
   std::optional<Eigen::MatrixXd> Covariance(const std::vector<std::size_t>& poses) const;
+  // The covariance of every pose with the given ones: 6 rows per pose of the graph, in order, by
+  // 6 columns per given pose. One solve per column: what a caller that needs many poses' blocks
+  // asks once per pose. std::nullopt and throws as Covariance.
+  std::optional<Eigen::MatrixXd> CovarianceColumns(const std::vector<std::size_t>& poses) const;
 
  private:
   struct Factor;
