@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <set>
 
 #include "mapping/log/dive_log.hpp"
@@ -263,6 +264,46 @@ FrameRecord HeavyFrame(std::int64_t i) {
   for (std::size_t b = 0; b < image.bytes.size(); ++b) image.bytes[b] = std::uint8_t(b * 7 + i);
   frame.image = std::move(image);
   return frame;
+}
+
+// A writer killed while checkpointing: the file's header already gives the size the checkpoint
+// was making, its last pages still only in the WAL. The log is whole (SQLite reads those pages
+// from the WAL), and the check says so; the same header without the WAL is a truncated file.
+TEST_F(DiveLogTest, AHeaderAheadOfItsPagesWithTheWalBesideItIsWhole) {
+  const fs::path path = dir_ / "checkpointing.db";
+  const fs::path copy = dir_ / "killed.db";
+  {
+    // 1 MB frames: SQLite checkpoints every 4 MB or so, so the file holds the first frames and
+    // the WAL the last ones.
+    DiveLogWriter writer(path, TestHeader());
+    for (int i = 0; i < 6; ++i) writer.AppendFrame(HeavyFrame(i));
+    // The files as a kill would leave them: the writer never closes them.
+    fs::copy_file(path, copy);
+    fs::copy_file(path.string() + "-wal", copy.string() + "-wal");
+  }
+  ASSERT_GT(fs::file_size(copy.string() + "-wal"), 32u);
+  // The header's page count 10 pages past the file's end, made valid as SQLite writes it.
+  std::fstream file(copy, std::ios::in | std::ios::out | std::ios::binary);
+  unsigned char h[100];
+  file.read(reinterpret_cast<char*>(h), sizeof h);
+  const std::uint32_t page_bytes = (std::uint32_t(h[16]) << 8) | h[17];
+  const std::uint32_t pages = static_cast<std::uint32_t>(fs::file_size(copy) / page_bytes) + 10;
+  for (int k = 0; k < 4; ++k) {
+    h[28 + k] = static_cast<unsigned char>(pages >> (24 - 8 * k));
+    h[92 + k] = h[24 + k];  // version-valid-for = the change counter
+  }
+  file.seekp(0);
+  file.write(reinterpret_cast<const char*>(h), sizeof h);
+  file.close();
+
+  const DiveLogCheck check = DiveLogReader(copy, DiveLogOpening::kDamaged).Check({}, {});
+  EXPECT_TRUE(check.ok()) << (check.integrity.empty() ? "" : check.integrity.front());
+  EXPECT_EQ(check.frames_intact, 6);
+  fs::remove(copy.string() + "-wal");
+  const DiveLogCheck without_wal = DiveLogReader(copy, DiveLogOpening::kDamaged).Check({}, {});
+  ASSERT_FALSE(without_wal.integrity.empty());
+  EXPECT_EQ(without_wal.integrity.front().rfind("the file is truncated: ", 0), 0u)
+      << without_wal.integrity.front();
 }
 
 // Reports on the pipe between the killed writer and the test: 2i when frame i is about to be
