@@ -205,10 +205,10 @@ class CovarianceSums {
     }
   }
 
-  std::map<long, TilePoses>& tiles_;
-  std::map<std::size_t, std::vector<std::pair<TilePoses*, std::size_t>>> tiles_of_pose_;
   std::size_t Key(std::size_t a, std::size_t b) const { return a * pose_count_ + b; }
 
+  std::map<long, TilePoses>& tiles_;
+  std::map<std::size_t, std::vector<std::pair<TilePoses*, std::size_t>>> tiles_of_pose_;
   std::size_t pose_count_ = 0;
   std::vector<bool> co_seen_;                        // Key(a, b): one point seen from both
   std::unordered_map<std::size_t, Matrix6d> pairs_;  // Key(a, b): Cov(e_a, e_b), when co_seen_
