@@ -219,7 +219,8 @@ TEST(CompareSurveys, AMapReportsPoseGraphInformationIsReadOrNamedWhereDamaged) {
   json["pose_graph_information"] = {{"size", 6}, {"pose_columns", {0}}, {"upper_entries", entries}};
   const Survey survey = write_and_read();
   ASSERT_NE(survey.joint_uncertainty, nullptr);
-  const std::optional<Eigen::MatrixXd> covariance = survey.joint_uncertainty->Covariance({0});
+  const std::optional<Eigen::MatrixXd> covariance =
+      survey.joint_uncertainty->CovarianceColumns({0});
   ASSERT_TRUE(covariance.has_value());
   EXPECT_NEAR((*covariance)(3, 3), 1e-4, 1e-15);
   json["pose_graph_information"]["upper_entries"][2] = {3, 2, 5.0};

@@ -2,6 +2,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <cmath>
+#include <mutex>
 #include <string>
 #include <utility>
 
@@ -9,7 +10,10 @@
 
 namespace uwscan::mapping {
 
+// Made on the first covariance asked for: `map` keeps and writes the information, only `compare`
+// solves with it.
 struct JointPoseUncertainty::Factor {
+  std::once_flag made;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   bool positive_definite = false;
 };
@@ -30,10 +34,6 @@ JointPoseUncertainty::JointPoseUncertainty(Eigen::SparseMatrix<double> informati
                   ", outside the information's " + std::to_string(information_.rows()));
     }
   }
-  if (information_.rows() == 0) return;
-  factor_->ldlt.compute(information_);
-  factor_->positive_definite =
-      factor_->ldlt.info() == Eigen::Success && (factor_->ldlt.vectorD().array() > 0.0).all();
 }
 
 JointPoseUncertainty::~JointPoseUncertainty() = default;
@@ -46,6 +46,12 @@ std::optional<Eigen::MatrixXd> JointPoseUncertainty::CovarianceColumns(
                   std::to_string(pose_columns_.size()));
     }
   }
+  std::call_once(factor_->made, [this] {
+    if (information_.rows() == 0) return;
+    factor_->ldlt.compute(information_);
+    factor_->positive_definite =
+        factor_->ldlt.info() == Eigen::Success && (factor_->ldlt.vectorD().array() > 0.0).all();
+  });
   if (!factor_->positive_definite) return std::nullopt;
   const Eigen::Index m = 6 * std::ssize(poses);
   Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(information_.rows(), m);
@@ -57,18 +63,6 @@ std::optional<Eigen::MatrixXd> JointPoseUncertainty::CovarianceColumns(
     out.middleRows(6 * static_cast<Eigen::Index>(pose), 6) =
         columns.middleRows(pose_columns_[pose], 6);
   return out;
-}
-
-std::optional<Eigen::MatrixXd> JointPoseUncertainty::Covariance(
-    const std::vector<std::size_t>& poses) const {
-  const std::optional<Eigen::MatrixXd> columns = CovarianceColumns(poses);
-  if (!columns) return std::nullopt;
-  const Eigen::Index m = 6 * std::ssize(poses);
-  Eigen::MatrixXd joint(m, m);
-  for (Eigen::Index r = 0; r < std::ssize(poses); ++r)
-    joint.middleRows(6 * r, 6) =
-        columns->middleRows(6 * static_cast<Eigen::Index>(poses[static_cast<std::size_t>(r)]), 6);
-  return Eigen::MatrixXd(0.5 * (joint + joint.transpose()));
 }
 
 }  // namespace uwscan::mapping

@@ -20,7 +20,7 @@ namespace uwscan::mapping {
 class JointPoseUncertainty {
  public:
   // Throws uwscan::Error when the information is not square, not finite, or a pose's columns lie
-  // outside it. Factors it once (sparse LDL^T).
+  // outside it.
   JointPoseUncertainty(Eigen::SparseMatrix<double> information, std::vector<int> pose_columns);
   ~JointPoseUncertainty();
 
@@ -28,14 +28,11 @@ class JointPoseUncertainty {
   const Eigen::SparseMatrix<double>& information() const { return information_; }
   const std::vector<int>& pose_columns() const { return pose_columns_; }
 
-  // The joint covariance of the given poses: 6 rows and columns per pose, in their order, each
-  // [rotation (rad), position (m)]. std::nullopt when the information is singular (a direction
-  // nothing constrains). Throws uwscan::Error for a pose outside [0, pose_count()). Safe to call
-  // from several threads at once.
-  std::optional<Eigen::MatrixXd> Covariance(const std::vector<std::size_t>& poses) const;
   // The covariance of every pose with the given ones: 6 rows per pose of the graph, in order, by
-  // 6 columns per given pose. One solve per column: what a caller that needs many poses' blocks
-  // asks once per pose. std::nullopt and throws as Covariance.
+  // 6 columns per given pose, each [rotation (rad), position (m)]. One sparse solve per column
+  // (the information factored, sparse LDL^T, on the first call). std::nullopt when the
+  // information is singular (a direction nothing constrains). Throws uwscan::Error for a pose
+  // outside [0, pose_count()). Safe to call from several threads at once.
   std::optional<Eigen::MatrixXd> CovarianceColumns(const std::vector<std::size_t>& poses) const;
 
  private:

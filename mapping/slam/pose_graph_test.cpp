@@ -68,21 +68,24 @@ TEST(PoseGraph, ACovarianceCarriesThePriorAndTheEdgeAlongTheLever) {
                                                                       << g.C1();
 }
 
-// The same graph's joint covariance from its information, the poses in the order asked for.
+// The same graph's joint covariance from its information: the rows in pose order, the columns in
+// the order asked for.
 TEST(PoseGraph, AJointCovarianceHoldsWhatTwoNodesShare) {
   const TwoNodeGraph g;
   const std::optional<Eigen::SparseMatrix<double>> information = g.graph.Information();
   ASSERT_TRUE(information.has_value());
   const JointPoseUncertainty uncertainty(*information, {0, 6});
-  const std::optional<Eigen::MatrixXd> joint = uncertainty.Covariance({1, 0});
+  // Rows: poses 0 and 1 in order; columns: pose 1, then pose 0.
+  const std::optional<Eigen::MatrixXd> joint = uncertainty.CovarianceColumns({1, 0});
   ASSERT_TRUE(joint.has_value());
   ASSERT_EQ(joint->rows(), 12);
-  EXPECT_LT((joint->block<6, 6>(0, 0) - g.C1()).norm(), 1e-9 * g.C1().norm());
-  EXPECT_LT((joint->block<6, 6>(6, 6) - g.C0()).norm(), 1e-9 * g.C0().norm());
-  EXPECT_LT((joint->block<6, 6>(0, 6) - g.C10()).norm(), 1e-9 * g.C10().norm())
-      << joint->block<6, 6>(0, 6) << "\n\n"
+  ASSERT_EQ(joint->cols(), 12);
+  EXPECT_LT((joint->block<6, 6>(6, 0) - g.C1()).norm(), 1e-9 * g.C1().norm());
+  EXPECT_LT((joint->block<6, 6>(0, 6) - g.C0()).norm(), 1e-9 * g.C0().norm());
+  EXPECT_LT((joint->block<6, 6>(6, 6) - g.C10()).norm(), 1e-9 * g.C10().norm())
+      << joint->block<6, 6>(6, 6) << "\n\n"
       << g.C10();
-  EXPECT_LT((joint->block<6, 6>(6, 0) - g.C10().transpose()).norm(), 1e-9 * g.C10().norm());
+  EXPECT_LT((joint->block<6, 6>(0, 0) - g.C10().transpose()).norm(), 1e-9 * g.C10().norm());
 }
 
 TEST(PoseGraph, RecoversAChainFromExactEdgesAndAPrior) {
