@@ -10,6 +10,7 @@
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
+#include "scanner/common/parallel_tasks.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -135,6 +136,7 @@ SurveyAlignment::Tile AlignTile(const PointCloud& source_W, const PointCloud& re
   if (static_cast<int>(source_W.size()) < options.min_tile_points || target.size() < 3) return tile;
   perception::IcpOptions icp = PointToPlane(options.tile_max_correspondence_m);
   icp.prior = TilePrior(options);
+  icp.threads = 1;  // the tiles run in parallel
   const perception::RegistrationResult r =
       perception::AlignIcp(source_W, target, Eigen::Isometry3d::Identity(), icp);
   // A tile the reference barely covers, or whose registration wandered beyond the first stage's
@@ -224,13 +226,18 @@ SurveyAlignment AlignSurveys(const PointCloud& map, const PointCloud& reference,
   std::map<Key, std::vector<std::size_t>> by_tile;
   for (std::size_t i = 0; i < source.size(); ++i)
     by_tile[KeyOf(source.Point(i), options.tile_m)].push_back(i);
-  for (const auto& [key, indices] : by_tile) {
+  const std::vector<std::pair<Key, std::vector<std::size_t>>> tiles(by_tile.begin(), by_tile.end());
+  alignment.tiles.resize(tiles.size());
+  // Each tile's registration on one thread (its ICP's search too): they are independent.
+  RunParallelTasks(std::ssize(tiles), 0, [&](std::ptrdiff_t t) {
+    const auto& [key, indices] = tiles[static_cast<std::size_t>(t)];
     const PointCloud tile_W = Recentred(
         perception::Transformed(perception::Subset(source, indices), alignment.T_reference_map));
-    SurveyAlignment::Tile tile = AlignTile(tile_W, reference, key, alignment, options);
+    alignment.tiles[static_cast<std::size_t>(t)] =
+        AlignTile(tile_W, reference, key, alignment, options);
+  });
+  for (const SurveyAlignment::Tile& tile : alignment.tiles)
     if (!tile.registered) ++alignment.tiles_kept_global;
-    alignment.tiles.push_back(tile);
-  }
   return alignment;
 }
 

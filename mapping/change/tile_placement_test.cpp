@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "scanner/common/error.hpp"
 
@@ -69,6 +70,91 @@ TEST(TileRelativePoseSigmas, PointsSeenFromEveryPoseOfTheirTileLeaveNothing) {
   for (double sigma :
        TileRelativePoseSigmas(legs.survey, legs.points, legs.normals, legs.tile_of, 2.0))
     EXPECT_NEAR(sigma, 0.0, 1e-12);
+}
+
+// The header's formula evaluated directly: for each point, the poses within seen_within_m of the
+// nearest, each pose's weight in the point's tile, and the variance of
+// n . sum_i c_i (w_i x (p - t_i) + v_i) under the joint covariance.
+std::vector<double> DirectSigmas(const std::vector<Eigen::Isometry3d>& poses,
+                                 const Eigen::MatrixXd& covariance,
+                                 const std::vector<Eigen::Vector3d>& points,
+                                 const std::vector<Eigen::Vector3d>& normals,
+                                 const std::vector<long>& tile_of, double seen_within_m) {
+  const std::size_t n = poses.size();
+  std::vector<Eigen::VectorXd> shares;  // per point, per pose
+  for (const Eigen::Vector3d& p : points) {
+    Eigen::VectorXd distance(static_cast<Eigen::Index>(n));
+    for (std::size_t i = 0; i < n; ++i)
+      distance(static_cast<Eigen::Index>(i)) = (p - poses[i].translation()).norm();
+    const Eigen::VectorXd seen =
+        (distance.array() <= distance.minCoeff() + seen_within_m).cast<double>();
+    shares.push_back(seen / seen.sum());
+  }
+  std::vector<double> sigma;
+  for (std::size_t c = 0; c < points.size(); ++c) {
+    Eigen::VectorXd weight = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+    int in_tile = 0;
+    for (std::size_t d = 0; d < points.size(); ++d) {
+      if (tile_of[d] != tile_of[c]) continue;
+      weight += shares[d];
+      ++in_tile;
+    }
+    const Eigen::VectorXd coefficient = shares[c] - weight / in_tile;
+    Eigen::RowVectorXd h(static_cast<Eigen::Index>(6 * n));
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d lever = (points[c] - poses[i].translation()).cross(normals[c]);
+      h.segment<3>(static_cast<Eigen::Index>(6 * i)) = lever.transpose();
+      h.segment<3>(static_cast<Eigen::Index>(6 * i + 3)) = normals[c].transpose();
+      h.segment<6>(static_cast<Eigen::Index>(6 * i)) *= coefficient(static_cast<Eigen::Index>(i));
+    }
+    sigma.push_back(std::sqrt(static_cast<double>(h * covariance * h.transpose())));
+  }
+  return sigma;
+}
+
+// Three passes over a seabed (out, back beside it, out again over the first), a random joint
+// covariance, points in two tiles each seen from poses of two or three passes (runs of pose
+// indices that are not consecutive): every sigma as the formula gives it directly.
+TEST(TileRelativePoseSigmas, ManyPassesGiveWhatTheFormulaGivesDirectly) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Survey survey;
+  survey.name = "three passes";
+  survey.kind = SurveyKind::kMap;
+  for (int pass = 0; pass < 3; ++pass) {
+    for (int k = 0; k < 8; ++k) {
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      const double along = pass == 1 ? 0.25 * (7 - k) : 0.25 * k;
+      T.translation() << along, pass == 1 ? 0.3 : 0.02 * pass, 0.0;
+      survey.poses.push_back(T);
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(survey.poses.size());
+  Eigen::MatrixXd root(6 * n, 6 * n);
+  for (Eigen::Index r = 0; r < root.rows(); ++r)
+    for (Eigen::Index c = 0; c < root.cols(); ++c) root(r, c) = 0.01 * uniform(random);
+  const Eigen::MatrixXd covariance =
+      root * root.transpose() + 1e-6 * Eigen::MatrixXd::Identity(6 * n, 6 * n);
+  std::vector<int> columns;
+  for (int i = 0; i < n; ++i) columns.push_back(6 * i);
+  survey.joint_uncertainty = std::make_shared<const JointPoseUncertainty>(
+      Eigen::MatrixXd(covariance.inverse()).sparseView(), columns);
+  std::vector<Eigen::Vector3d> points, normals;
+  std::vector<long> tile_of;
+  for (int k = 0; k < 30; ++k) {
+    points.emplace_back(0.06 * k, 0.15 + 0.1 * uniform(random), 1.0);
+    normals.push_back(
+        Eigen::Vector3d(0.2 * uniform(random), 0.2 * uniform(random), -1.0).normalized());
+    tile_of.push_back(k < 15 ? 4 : 9);
+  }
+  const std::vector<double> expected =
+      DirectSigmas(survey.poses, covariance, points, normals, tile_of, 0.12);
+  const std::vector<double> sigma = TileRelativePoseSigmas(survey, points, normals, tile_of, 0.12);
+  ASSERT_EQ(sigma.size(), expected.size());
+  for (std::size_t c = 0; c < sigma.size(); ++c) {
+    EXPECT_GT(expected[c], 1e-4) << "point " << c << " tests nothing";
+    EXPECT_NEAR(sigma[c], expected[c], 1e-9 * (1.0 + expected[c])) << "point " << c;
+  }
 }
 
 TEST(TileRelativePoseSigmas, WithoutAJointUncertaintyNothingIsAdded) {
