@@ -1,6 +1,13 @@
 # Every find_package of the project lives here; targets link imported targets only.
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(Ceres REQUIRED)
+# CHOLMOD (SuiteSparse, which Ceres is built with): the supernodal Cholesky that `compare` solves a
+# map's joint pose covariance with (mapping/slam/joint_pose_uncertainty.cpp).
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+add_library(uwscan_cholmod INTERFACE IMPORTED)
+target_include_directories(uwscan_cholmod SYSTEM INTERFACE ${CHOLMOD_INCLUDE_DIR})
+target_link_libraries(uwscan_cholmod INTERFACE ${CHOLMOD_LIBRARY})
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs calib3d aruco surface_matching)
 find_package(yaml-cpp REQUIRED)
 find_package(LibXml2 REQUIRED)  # OpenCV calibration files in XML (scanner/calibration)

@@ -30,7 +30,7 @@ class JointPoseUncertainty {
 
   // The covariance of every pose with the given ones: 6 rows per pose of the graph, in order, by
   // 6 columns per given pose, each [rotation (rad), position (m)]. One sparse solve per column
-  // (the information factored, sparse LDL^T, on the first call). std::nullopt when the
+  // (the information factored, CHOLMOD's sparse Cholesky, on the first call). std::nullopt when the
   // information is singular (a direction nothing constrains). Throws uwscan::Error for a pose
   // outside [0, pose_count()). Safe to call from several threads at once.
   std::optional<Eigen::MatrixXd> CovarianceColumns(const std::vector<std::size_t>& poses) const;
