@@ -114,6 +114,30 @@ TEST(CliDive, MapRefusesAnUnusableLogWithOneLine) {
   std::filesystem::remove(log);
 }
 
+// bench slam --long with two seeds: one dive per length and seed, each its own drift draw, the
+// windowed and whole-graph runs on the same dive, and the layout issue 52 asks for.
+TEST(CliDive, LongSlamBenchDivesOncePerSeed) {
+  const std::filesystem::path json = TempPath("slam_long.json");
+  const CommandRun run =
+      RunUwscan("bench slam --long --minutes 0.3 --seeds 2 --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("over the seeds"), std::string::npos) << run.output;
+  const nlohmann::json j = ReadJson(json);
+  ASSERT_EQ(j["dives"].size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const nlohmann::json& d = j["dives"][k];
+    EXPECT_EQ(d["name"], "manifold_0.3min");
+    EXPECT_EQ(d["seed"].get<int>(), 41 + static_cast<int>(k));
+    ASSERT_TRUE(d["full_solve"].is_object());
+    for (const char* figure : {"ate_m", "map_rms_m", "real_time_factor"})
+      EXPECT_GT(d[figure].get<double>(), 0.0) << figure;
+    EXPECT_GT(d["submap_seconds"]["last_tenth"]["median"].get<double>(), 0.0);
+  }
+  EXPECT_NE(j["dives"][0]["dead_reckoning_ate_m"].get<double>(),
+            j["dives"][1]["dead_reckoning_ate_m"].get<double>());
+  std::filesystem::remove(json);
+}
+
 // bench slam on the short test lap: every figure issue 10 asks of a dive is in the JSON, and
 // the ones with a ground truth to hold them to are sane.
 TEST(CliDive, SlamBenchWritesEveryFigureOfADive) {

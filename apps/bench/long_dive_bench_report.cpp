@@ -1,6 +1,12 @@
 #include "apps/bench/long_dive_bench_report.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <string>
+#include <vector>
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/data_folder.hpp"
@@ -56,6 +62,7 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
 nlohmann::json DiveJson(const bench::LongDiveFigures& f) {
   nlohmann::json dive = RunJson(f.windowed);
   dive["name"] = f.name;
+  dive["seed"] = f.seed;
   dive["duration_s"] = f.duration_s;
   dive["submaps"] = f.submaps;
   dive["dead_reckoning_ate_m"] = f.dead_reckoning_ate_m;
@@ -87,14 +94,47 @@ void PrintStages(const std::string& name, const bench::LongDiveRun& r) {
       b.loop_s * 1e3, a.graph_s * 1e3, b.graph_s * 1e3);
 }
 
+// Per dive length over its seeds: the windowed solves' ATE and map RMS against the whole-graph
+// solves' (mean ratio, and the range), the last tenth's median time per submap against the
+// first's, the lowest real-time factor.
+void PrintOverSeeds(const std::vector<bench::LongDiveFigures>& dives) {
+  std::printf(
+      "\nover the seeds (windowed against whole-graph solves):\n"
+      "| dive | seeds | ATE ratio: mean (range) | map RMS ratio: mean (range) | last / first tenth "
+      "(range) | real time, lowest |\n|---|---:|---:|---:|---:|---:|\n");
+  std::map<std::string, std::vector<const bench::LongDiveFigures*>> by_name;
+  for (const bench::LongDiveFigures& f : dives)
+    if (f.whole) by_name[f.name].push_back(&f);
+  for (const auto& [name, runs] : by_name) {
+    std::vector<double> ate, rms, growth;
+    double slowest = std::numeric_limits<double>::infinity();
+    for (const bench::LongDiveFigures* f : runs) {
+      ate.push_back(f->windowed.ate_m / f->whole->ate_m);
+      rms.push_back(f->windowed.map_rms_m / f->whole->map_rms_m);
+      growth.push_back(f->windowed.last_tenth.median_s / f->windowed.first_tenth.median_s);
+      slowest = std::min(slowest, f->windowed.real_time_factor);
+    }
+    const auto summary = [](const std::vector<double>& v) {
+      char text[64];
+      std::snprintf(text, sizeof text, "%.3f (%.3f-%.3f)",
+                    std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()),
+                    *std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end()));
+      return std::string(text);
+    };
+    std::printf("| %s | %zu | %s | %s | %s | %.1fx |\n", name.c_str(), runs.size(),
+                summary(ate).c_str(), summary(rms).c_str(), summary(growth).c_str(), slowest);
+  }
+}
+
 }  // namespace
 
-void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whole_solves,
+void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whole_solves, int seeds,
                       const std::string& json) {
   bench::LongDiveBenchOptions options;
   options.minutes = minutes;
   options.threads = threads;
   options.whole_solves = whole_solves;
+  options.seeds = seeds;
   options.scenes_folder = DataFolder() / "scenes";
   options.table_cache = TableCache();
   std::vector<bench::LongDiveFigures> dives;
@@ -110,14 +150,19 @@ void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whol
       "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json out = {{"bench", "slam_long"}, {"dives", nlohmann::json::array()}};
   for (const bench::LongDiveFigures& f : dives) {
-    std::printf("| %s (%.0f s, %d submaps, dead reckoning ATE %.1f mm) | | | | | | | | | | | |\n",
-                f.name.c_str(), f.duration_s, f.submaps, f.dead_reckoning_ate_m * 1e3);
+    std::printf(
+        "| %s, seed %llu (%.0f s, %d submaps, dead reckoning ATE %.1f mm) | | | | | | | | | | | "
+        "|\n",
+        f.name.c_str(), static_cast<unsigned long long>(f.seed), f.duration_s, f.submaps,
+        f.dead_reckoning_ate_m * 1e3);
     PrintRow("windowed", f.windowed);
     if (f.whole) PrintRow("whole graph", *f.whole);
     out["dives"].push_back(DiveJson(f));
   }
   std::printf("\nmean ms per submap by stage, first tenth -> last tenth (windowed):\n");
-  for (const bench::LongDiveFigures& f : dives) PrintStages(f.name, f.windowed);
+  for (const bench::LongDiveFigures& f : dives)
+    PrintStages(f.name + " seed " + std::to_string(f.seed), f.windowed);
+  if (seeds > 1) PrintOverSeeds(dives);
   if (!json.empty()) WriteJsonFile(json, out);
 }
 

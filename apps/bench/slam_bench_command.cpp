@@ -256,7 +256,8 @@ void AddSlamBenchCommand(CLI::App& bench) {
                   "scanner, from scenes/ in the data folder, `uwscan --data-dir`)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--seeds", a->seeds,
-                  "dives per scene: its own seed and the next ones (default 1)")
+                  "dives per scene (with --long: per length, from seed 41): its own seed and the "
+                  "next ones (default 1)")
       ->check(kPositiveNumber);
   cmd->add_option("--threads", a->threads, "threads")->check(kPositiveNumber);
   cmd->add_option("--walk-scale", a->walk_scale,
@@ -276,7 +277,7 @@ void AddSlamBenchCommand(CLI::App& bench) {
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] {
     if (a->long_dives) {
-      RunLongDiveBench(a->minutes, a->threads, !a->no_whole_solves, a->json);
+      RunLongDiveBench(a->minutes, a->threads, !a->no_whole_solves, a->seeds, a->json);
     } else {
       RunSlamBench(*a);
     }

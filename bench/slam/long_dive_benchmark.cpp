@@ -116,16 +116,18 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   return run;
 }
 
-LongDiveFigures BenchLongDive(double minutes, const LongDiveBenchOptions& options,
+LongDiveFigures BenchLongDive(double minutes, std::uint64_t seed,
+                              const LongDiveBenchOptions& options,
                               const std::filesystem::path& folder, const Progress& progress) {
   LongDiveFigures f;
   char name[32];
   std::snprintf(name, sizeof name, "manifold_%gmin", minutes);
   f.name = name;
-  const std::string scene_text = LongDiveSceneYaml(60.0 * minutes, options.seed);
+  f.seed = seed;
+  const std::string scene_text = LongDiveSceneYaml(60.0 * minutes, seed);
   const scanner::sim::Scene scene =
       scanner::sim::ParseScene(scene_text, f.name, options.scenes_folder);
-  const std::filesystem::path log_path = folder / (f.name + ".db");
+  const std::filesystem::path log_path = folder / (f.name + "_" + std::to_string(seed) + ".db");
   {
     const scanner::sim::Simulator simulator(scene);
     mapping::DiveSimulationOptions sim_options;
@@ -158,6 +160,7 @@ void LongDiveBenchOptions::Check() const {
   check.Require(!minutes.empty(), "minutes", "at least one dive length", "none");
   for (const double m : minutes) check.Positive("minutes", m);
   check.GreaterThan("threads", threads, 0);
+  check.GreaterThan("seeds", seeds, 0);
   check.Require(std::filesystem::is_directory(scenes_folder), "scenes_folder", "a folder",
                 scenes_folder.string());
 }
@@ -180,8 +183,12 @@ std::vector<LongDiveFigures> RunLongDiveBench(const LongDiveBenchOptions& option
   options.Check();
   ScratchFolder scratch("bench-slam-long");
   std::vector<LongDiveFigures> dives;
-  for (const double minutes : options.minutes)
-    dives.push_back(BenchLongDive(minutes, options, scratch.path(), progress));
+  for (const double minutes : options.minutes) {
+    for (int k = 0; k < options.seeds; ++k) {
+      const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(k);
+      dives.push_back(BenchLongDive(minutes, seed, options, scratch.path(), progress));
+    }
+  }
   return dives;
 }
 

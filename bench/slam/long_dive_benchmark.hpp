@@ -19,6 +19,7 @@ struct LongDiveBenchOptions {
   std::vector<double> minutes = {4.0, 15.0, 30.0};  // dive lengths, each > 0
   std::filesystem::path scenes_folder;  // the data folder's scenes/ (the scanner file is there)
   std::uint64_t seed = 41;              // draws the navigation's drift and the peaks' noise
+  int seeds = 1;  // dives per length, > 0: seed, seed + 1, ... (one seed's drift is one draw)
   int threads = 2;
   bool whole_solves = true;  // also map each dive with whole-graph solves
   std::filesystem::path table_cache;
@@ -62,6 +63,7 @@ struct LongDiveRun {
 
 struct LongDiveFigures {
   std::string name;
+  std::uint64_t seed = 0;
   double duration_s = 0.0;
   int submaps = 0;
   double dead_reckoning_ate_m = 0.0;
