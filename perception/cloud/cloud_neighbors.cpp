@@ -42,37 +42,58 @@ RadiusGrid::RadiusGrid(std::span<const Eigen::Vector3f> points, double radius_m)
     return;
   }
 
-  const std::size_t n = points.size();
-  std::vector<Eigen::Array<std::int64_t, 3, 1>> cells(n);
+  SetExtent(points);
+  std::vector<std::uint32_t> order = SortByCell(CellKeys(points));
+  // Structure of arrays in cell order: a query's distances read three contiguous runs.
+  x_.resize(points.size());
+  y_.resize(points.size());
+  z_.resize(points.size());
+  for (std::size_t s = 0; s < order.size(); ++s) {
+    const Eigen::Vector3f& p = points[order[s]];
+    x_[s] = p.x();
+    y_[s] = p.y();
+    z_[s] = p.z();
+  }
+  index_ = std::move(order);
+}
+
+void RadiusGrid::SetExtent(std::span<const Eigen::Vector3f> points) {
   Eigen::Array<double, 3, 1> lo =
       Eigen::Array<double, 3, 1>::Constant(std::numeric_limits<double>::infinity());
   Eigen::Array<double, 3, 1> hi = -lo;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Array<double, 3, 1> c =
-        (points[i].cast<double>().array() * inverse_cell_m_).floor();
+  for (const Eigen::Vector3f& p : points) {
+    const Eigen::Array<double, 3, 1> c = (p.cast<double>().array() * inverse_cell_m_).floor();
     lo = lo.min(c);
     hi = hi.max(c);
   }
   const Eigen::Array<double, 3, 1> extent = hi - lo + 1.0;
   if (!(lo.abs().maxCoeff() < 1e9 && hi.abs().maxCoeff() < 1e9 &&
         extent.maxCoeff() <= static_cast<double>(kMaxCellsPerAxis))) {
-    throw Error("RadiusGrid: radius " + std::to_string(radius_m) +
+    throw Error("RadiusGrid: radius " + std::to_string(radius_m_) +
                 " m is too small for the cloud's extent (more than 2^21 cells along an axis)");
   }
   min_cell_ = lo.cast<int>();
   num_cells_ = extent.cast<int>();
+}
+
+std::vector<std::uint64_t> RadiusGrid::CellKeys(std::span<const Eigen::Vector3f> points) const {
   const std::uint64_t ny = static_cast<std::uint64_t>(num_cells_.y());
   const std::uint64_t nz = static_cast<std::uint64_t>(num_cells_.z());
-  const std::uint64_t total_cells = static_cast<std::uint64_t>(num_cells_.x()) * ny * nz;
-
-  std::vector<std::uint64_t> keys(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::uint64_t> keys(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Array3i c =
         (points[i].cast<double>().array() * inverse_cell_m_).floor().cast<int>() - min_cell_;
     keys[i] = (static_cast<std::uint64_t>(c.x()) * ny + static_cast<std::uint64_t>(c.y())) * nz +
               static_cast<std::uint64_t>(c.z());
   }
+  return keys;
+}
 
+std::vector<std::uint32_t> RadiusGrid::SortByCell(const std::vector<std::uint64_t>& keys) {
+  const std::size_t n = keys.size();
+  const std::uint64_t total_cells = static_cast<std::uint64_t>(num_cells_.x()) *
+                                    static_cast<std::uint64_t>(num_cells_.y()) *
+                                    static_cast<std::uint64_t>(num_cells_.z());
   std::vector<std::uint32_t> order(n);
   dense_ = total_cells <= std::max<std::uint64_t>(8 * n, 4096);
   if (dense_) {
@@ -82,31 +103,21 @@ RadiusGrid::RadiusGrid(std::span<const Eigen::Vector3f> points, double radius_m)
     for (std::uint64_t c = 0; c < total_cells; ++c) cell_start_[c + 1] += cell_start_[c];
     std::vector<std::uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) order[next[keys[i]]++] = static_cast<std::uint32_t>(i);
-  } else {
-    for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
-    });
-    for (std::size_t s = 0; s < n; ++s) {
-      const std::uint64_t key = keys[order[s]];
-      if (cell_keys_.empty() || cell_keys_.back() != key) {
-        cell_keys_.push_back(key);
-        cell_start_.push_back(static_cast<std::uint32_t>(s));
-      }
-    }
-    cell_start_.push_back(static_cast<std::uint32_t>(n));
+    return order;
   }
-
-  x_.resize(n);
-  y_.resize(n);
-  z_.resize(n);
-  index_ = std::move(order);
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
+  });
   for (std::size_t s = 0; s < n; ++s) {
-    const Eigen::Vector3f& p = points[index_[s]];
-    x_[s] = p.x();
-    y_[s] = p.y();
-    z_[s] = p.z();
+    const std::uint64_t key = keys[order[s]];
+    if (cell_keys_.empty() || cell_keys_.back() != key) {
+      cell_keys_.push_back(key);
+      cell_start_.push_back(static_cast<std::uint32_t>(s));
+    }
   }
+  cell_start_.push_back(static_cast<std::uint32_t>(n));
+  return order;
 }
 
 void RadiusGrid::CellRange(std::uint64_t key_lo, std::uint64_t key_hi, std::uint32_t& begin,

@@ -34,6 +34,11 @@ class RadiusGrid {
   std::size_t size() const { return index_.size(); }
 
  private:
+  // The constructor's steps: the block of cells the points occupy (throws when it is too wide),
+  // each point's linear cell key, and the points' order sorted by key (the cell table filled).
+  void SetExtent(std::span<const Eigen::Vector3f> points);
+  std::vector<std::uint64_t> CellKeys(std::span<const Eigen::Vector3f> points) const;
+  std::vector<std::uint32_t> SortByCell(const std::vector<std::uint64_t>& keys);
   // Range [begin, end) of sorted point positions of the cells with linear keys [key_lo, key_hi].
   void CellRange(std::uint64_t key_lo, std::uint64_t key_hi, std::uint32_t& begin,
                  std::uint32_t& end) const;
