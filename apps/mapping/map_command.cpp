@@ -194,9 +194,10 @@ void PrintMapWork(const MapArgs& a, const mapping::DiveMapping& m, const mapping
   }
   std::printf(
       "registrations %d (%d left to navigation, %d of them inconsistent with it), loops accepted "
-      "%d, rejected %d\n",
+      "%d, rejected %d, not tried on %d submaps too plain to pin one\n",
       m.stats.registrations, m.stats.registrations_failed + m.stats.registrations_inconsistent,
-      m.stats.registrations_inconsistent, s.loops_accepted, s.loops_rejected);
+      m.stats.registrations_inconsistent, s.loops_accepted, s.loops_rejected,
+      m.stats.loops_not_tried_plain);
   std::printf("dead reckoning as estimated: speed scale error %+.2f %%, misalignment %+.2f mrad\n",
               100.0 * m.calibration.scale_error, 1000.0 * m.calibration.misalignment_rad);
   std::printf(

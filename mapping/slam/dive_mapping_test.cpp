@@ -20,6 +20,7 @@
 #include "mapping/log/dive_simulation.hpp"
 #include "mapping/slam/map_report.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
+#include "mapping/slam/registration_information.hpp"
 #include "mapping/slam/trajectory_metrics.hpp"
 #include "scanner/sim/ray_caster.hpp"
 #include "scanner/sim/scene.hpp"
@@ -505,6 +506,28 @@ TEST(NavigationUncertainty, OdometryLeavesDepthRollAndPitchToThePriors) {
   Vector6d yaw = Vector6d::Zero();
   yaw(2) = 1.0;
   EXPECT_GT(yaw.dot(info * yaw), 1e5);
+}
+
+// A submap whose own surface pins two directions fewer than a loop must (a registration may pin
+// one more than the whole surface) is not tried: on the pipe dive the turn over bare seabed
+// (three directions) is passed over, and the loops back over the pipe (five) are still tried and
+// closed.
+TEST_F(DiveMappingTest, LoopsAreTriedOnlyFromSubmapsWhoseSurfaceCanPinThem) {
+  DiveMappingOptions options = Options();
+  options.keep_submaps = true;
+  const DiveMapping m =
+      MapDive(DiveLogReader(Simulate(OutAndBackOverAPipe(), "pipe_loop.db")), options);
+  ASSERT_EQ(m.submap_clouds.size(), static_cast<std::size_t>(m.submaps));
+  EXPECT_GT(m.stats.loops_not_tried_plain, 0);
+  int accepted = 0;
+  for (const LoopClosure& loop : m.loops) {
+    EXPECT_GE(SurfaceDirections(m.submap_clouds[static_cast<std::size_t>(loop.to)],
+                                options.mapper.weak_direction_ratio),
+              options.mapper.loop_min_directions - 1)
+        << loop.from << " -> " << loop.to;
+    accepted += loop.accepted ? 1 : 0;
+  }
+  EXPECT_GT(accepted, 5);
 }
 
 // A loop frees the submaps back to its older end only when the graph misses it by more than

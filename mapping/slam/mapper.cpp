@@ -249,6 +249,7 @@ std::vector<Matrix6d> Mapper::Impl::ChainCovariancesTo(int to, int oldest) const
 void Mapper::Impl::AddToGraph(Submap submap) {
   const int k = static_cast<int>(submaps.size());
   submap.index = k;
+  submap.surface_directions = SurfaceDirections(submap.cloud, options.weak_direction_ratio);
   store.Add({std::move(submap.cloud), std::move(submap.sparse)});
   submap.cloud = {};
   submap.sparse = {};

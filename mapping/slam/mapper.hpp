@@ -179,6 +179,9 @@ struct MapperStats {
   int whole_solves = 0;                // of the whole graph
   int window_solves = 0;               // of the last submaps only (MapperOptions::windowed_solves)
   int loop_window_solves = 0;          // of those, freed back to a correcting loop's older end
+  // Loop closures not tried: the submap's own surface pins two directions fewer than a loop
+  // must (Submap::surface_directions, MapperOptions::loop_min_directions).
+  int loops_not_tried_plain = 0;
 };
 
 // Frames (stripe peaks) and navigation in, a pose graph of submaps out. Frames are queued until

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "scanner/common/error.hpp"
 #include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
@@ -78,6 +79,20 @@ KeptDirections WithoutWeakDirections(const Matrix6d& information,
   const Matrix6d projected = P * kept * P;
   out.information = Symmetrized(projected);
   return out;
+}
+
+int SurfaceDirections(const perception::PointCloud& cloud, double ratio) {
+  if (cloud.empty()) return 0;
+  if (!cloud.has_normals()) throw Error("SurfaceDirections: the cloud has no normals");
+  Matrix6d information = Matrix6d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d p = cloud.Point(i);
+    const Eigen::Vector3d n = cloud.normals[i].cast<double>();
+    Vector6d row;
+    row << p.cross(n), n;  // d(n . (R p + t)) / d[w, v]
+    information.noalias() += row * row.transpose();
+  }
+  return WithoutWeakDirections(information, cloud, Eigen::Isometry3d::Identity(), ratio).count;
 }
 
 Matrix6d SlideCovariance(const std::vector<Eigen::Vector3d>& slides,

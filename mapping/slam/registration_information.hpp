@@ -29,6 +29,12 @@ KeptDirections WithoutWeakDirections(const Matrix6d& information,
                                      const perception::PointCloud& source,
                                      const Eigen::Isometry3d& T_target_source, double ratio);
 
+// How many directions a cloud's own surface pins: the point-to-plane information of its points
+// on their own normals, with the weak directions counted out as WithoutWeakDirections does. A
+// registration of this cloud as the source pins at most about as many, whatever the target: a
+// bare seabed gives 3 (depth, roll, pitch), a pipe without its ends 5. The cloud must have normals.
+int SurfaceDirections(const perception::PointCloud& cloud, double ratio);
+
 // Where a registration leaves a slide free (a pipe seen without its ends), the scan's position
 // along it is not measured at all: it is tied to its anchor there only with sigma_m, so that
 // what the pairs leak along the slide moves the scan and not the vehicle (through the anchor,

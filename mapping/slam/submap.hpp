@@ -28,6 +28,9 @@ struct Submap {
   Eigen::Vector3d centroid_V = Eigen::Vector3d::Zero();  // of the cloud, in {V_k}
   double radius_m = 0.0;      // largest distance of a point from the centroid
   double rms_radius_m = 0.0;  // root mean square distance of the points from the centroid
+  // Directions the cloud's own surface pins (SurfaceDirections), set by the Mapper: a submap
+  // that pins two fewer than a loop must is not tried for loops.
+  int surface_directions = 6;
 };
 
 struct SubmapCloudOptions {
