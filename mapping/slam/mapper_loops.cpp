@@ -37,8 +37,8 @@ double LargestStd(const Eigen::Matrix3d& covariance) {
 void Mapper::Impl::TryLoopClosures(int k) {
   if (options.max_loop_candidates == 0 || k % options.loop_every_submaps != 0) return;
   // Over a bare seabed no loop can pin the directions the gate asks for, however long ICP slides
-  // about (bench/slam/RESULTS.md: a third of the loops' time). A registration weighs only the
-  // pairs it makes, so it can pin one direction more than the submap's whole surface does.
+  // about (bench/slam/RESULTS.md: two fifths of the loops' ICP time). A registration weighs only
+  // the pairs it makes, so it can pin one direction more than the submap's whole surface does.
   if (submaps[static_cast<size_t>(k)].surface_directions < options.loop_min_directions - 1) {
     ++stats.loops_not_tried_plain;
     return;
