@@ -95,7 +95,7 @@ struct MapperOptions {
   // both are treated as noise of each motion.
   bool estimate_dead_reckoning_calibration = true;
   // Registration directions whose normalised information is below this fraction of the
-  // strongest are left to the navigation (Conditioning in mapper.cpp).
+  // strongest are left to the navigation (WithoutWeakDirections, registration_information.hpp).
   double weak_direction_ratio = 0.02;
   // A scan whose registration leaves a slide free (a pipe without its ends in view) is tied to
   // its anchor along that slide only this loosely (metres): its place there is not measured,
