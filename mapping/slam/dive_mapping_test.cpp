@@ -152,12 +152,18 @@ TEST_F(DiveMappingTest, WindowedSolvesMapAsWholeGraphSolvesDo) {
   EXPECT_LT(ate_windowed, 1.05 * ate_whole);
 }
 
-// The clouds of all but the last few submaps spilled to disk and read back for loops and the
-// map: the same bits as with every cloud in memory.
+// The clouds of all but the last few submaps, and the graph's measurements among submaps no
+// window frees any more, spilled to disk and read back for loops, the whole solves and the map:
+// the same bits as with everything in memory.
 TEST_F(DiveMappingTest, SpilledSubmapsMapToTheSameBits) {
   const fs::path log = Simulate(ShortScene(), "drift.db");
   DiveMappingOptions options = Options();
+  // Windows short enough for this dive to leave measurements behind them (PoseGraph retires a
+  // few hundred at once: about fifty submaps' worth).
+  options.mapper.solve_window_submaps = 4;
+  options.mapper.solve_window_max_submaps = 8;
   const DiveMapping in_memory = MapDive(DiveLogReader(log), options);
+  ASSERT_GT(in_memory.submaps, 8 + 2 * static_cast<int>(PoseGraph::kRetireAtOnce) / 5);
   options.mapper.spill_folder = dir_;
   options.mapper.resident_submaps = 4;
   const DiveMapping spilled = MapDive(DiveLogReader(log), options);

@@ -14,6 +14,7 @@
 #include "perception/registration/icp.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/option_checks.hpp"
+#include "scanner/common/resident_memory.hpp"
 #include "scanner/common/symmetrized.hpp"
 #include "scanner/triangulation/triangulator_factory.hpp"
 
@@ -258,6 +259,10 @@ void Mapper::Impl::AddToGraph(Submap submap) {
   submaps.push_back(std::move(submap));
   increment_covariance.push_back(Symmetrized(c.increment_cov));
   CloseLoopsAndSolve(k);
+  // No later window frees a submap before k + 1 - solve_window_max_submaps (FirstFreeSubmap):
+  // what the graph measured among those goes to the spill file, read back by the whole solves.
+  if (options.windowed_solves)
+    graph.RetireBefore(AnchorNode(k + 1 - options.solve_window_max_submaps));
 }
 
 Mapper::Impl::ConsecutiveRegistration Mapper::Impl::RegisterToPrevious(const Submap& submap,
@@ -380,6 +385,10 @@ void Mapper::Impl::Solve(int first_free_submap, bool last) {
   if (!last) solve.function_tolerance = options.running_solve_tolerance;
   if (first_free_submap == 0) {
     graph.Solve(solve);
+    // The whole graph's problem (tens of megabytes on a long dive) is gone; its pages would
+    // otherwise stay resident, a step up at every whole solve (bench/slam/RESULTS.md, "A graph
+    // held as records").
+    ReturnFreePages();
     ++stats.whole_solves;
     const double grown = options.full_solve_growth * static_cast<double>(submaps.size());
     next_whole_solve_submaps = static_cast<int>(std::ceil(grown));

@@ -115,7 +115,9 @@ struct MapperOptions {
   int threads = 0;  // OpenMP threads of ICP and normals, 0 = default
   // Memory that does not grow with the dive: the clouds of all but the newest resident_submaps
   // submaps (> local_map_submaps) go to a spill file in this folder and are read back when a
-  // loop or the map needs them (SubmapStore); empty: every cloud stays in memory.
+  // loop or the map needs them (SubmapStore), and with windowed solves the graph's measurements
+  // among submaps no window frees any more to another, read back by the whole solves
+  // (PoseGraph::RetireBefore); empty: everything stays in memory.
   std::filesystem::path spill_folder;
   int resident_submaps = 64;
   void Check() const;

@@ -77,7 +77,11 @@ struct Mapper::Impl {
   int next_whole_solve_submaps = 0;  // the graph's size at which the next solve is whole
 
   Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
-      : options(o), T_V_C(mount), uncertainty(noise), store(o.spill_folder, o.resident_submaps) {}
+      : options(o),
+        T_V_C(mount),
+        uncertainty(noise),
+        store(o.spill_folder, o.resident_submaps),
+        graph(o.spill_folder) {}
 
   // Places the waiting frames the navigation covers, leaves out those it never will; at the
   // end of the dive (`finishing`) also those after its last sample.

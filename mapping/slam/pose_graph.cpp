@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
+#include "mapping/slam/graph_measurements.hpp"
 #include "mapping/slam/inverse_blocks.hpp"
 #include "mapping/slam/relative_pose_cost.hpp"
 #include "scanner/common/error.hpp"
@@ -112,65 +114,97 @@ Matrix6d SqrtPsd(const Matrix6d& information) {
 }
 
 struct PoseGraph::Impl {
-  // Parameter blocks: one quaternion (x, y, z, w as Eigen stores it) and one position per node,
-  // each in its own allocation so their addresses never move.
-  std::vector<std::unique_ptr<std::array<double, 4>>> rotations;
-  std::vector<std::unique_ptr<std::array<double, 3>>> positions;
-  std::unique_ptr<ceres::Problem> problem;
-  // The dead reckoning's [scale error, misalignment], a parameter block once estimated.
-  std::unique_ptr<std::array<double, 2>> calibration;
-  // Every measurement as the problem holds it (the problem owns its cost and loss), and those of
-  // each node, so that a window's problem can be built from them alone (SolveWindow).
-  struct Measurement {
-    ceres::CostFunction* cost = nullptr;
-    ceres::LossFunction* loss = nullptr;
-    std::vector<double*> blocks;
-    std::vector<int> nodes;
+  // Each node's estimate: its quaternion (x, y, z, w as Eigen stores it) and its position, the
+  // parameter blocks of the problem each solve builds (no node is added while one runs).
+  struct Node {
+    std::array<double, 4> q;
+    std::array<double, 3> p;
   };
-  std::vector<Measurement> measurements;
-  std::vector<std::vector<int>> measurements_of_node;
-  ceres::EigenQuaternionManifold quaternion_manifold;  // shared by the windows' problems
-
-  Impl() {
-    ceres::Problem::Options options;
-    options.manifold_ownership = ceres::TAKE_OWNERSHIP;
-    problem = std::make_unique<ceres::Problem>(options);
-  }
+  std::vector<Node> nodes;
+  // The dead reckoning's [scale error, misalignment] and its zero-mean prior, once estimated.
+  std::unique_ptr<std::array<double, 2>> calibration;
+  CalibrationPriorCost calibration_prior{};
+  // The measurements in memory, and those moved to the spill file (RetireBefore), which come
+  // before them.
+  GraphMeasurements measurements;
+  std::unique_ptr<MeasurementSpill> spill;
+  std::filesystem::path spill_folder;
+  int retired_before = 0;  // every measurement spilled touches only nodes before this one
+  ceres::EigenQuaternionManifold quaternion_manifold;  // shared by every problem built
 
   void RequireNode(int node, const std::string& what) const {
-    if (node < 0 || node >= static_cast<int>(rotations.size())) {
+    if (node < 0 || node >= static_cast<int>(nodes.size())) {
       throw Error("pose graph: " + what + ": no node " + std::to_string(node));
     }
   }
-  double* q(int node) { return rotations[static_cast<size_t>(node)]->data(); }
-  double* p(int node) { return positions[static_cast<size_t>(node)]->data(); }
+  double* q(int node) { return nodes[static_cast<size_t>(node)].q.data(); }
+  double* p(int node) { return nodes[static_cast<size_t>(node)].p.data(); }
 
-  // Adds a measurement of the given nodes (their rotation and position blocks in that order,
-  // then `extra`, the calibration, when given) to the problem and to the record.
-  void AddMeasurement(ceres::CostFunction* cost, ceres::LossFunction* loss,
-                      const std::vector<int>& nodes, bool with_rotation, bool with_position,
-                      double* extra = nullptr) {
-    Measurement m{cost, loss, {}, nodes};
-    for (const int node : nodes) {
-      if (with_rotation) m.blocks.push_back(q(node));
-      if (with_position) m.blocks.push_back(p(node));
+  // Adds measurement `i` of `from` to `problem`, which owns the cost and loss made for it.
+  void AddTo(const GraphMeasurements& from, std::size_t i, ceres::Problem* problem) {
+    const GraphMeasurements::Entry& entry = from.entries[i];
+    const auto at = static_cast<size_t>(entry.index);
+    switch (entry.kind) {
+      case GraphMeasurements::Kind::kEdge: {
+        const GraphMeasurements::Edge& e = from.edges[at];
+        const RelativePoseMeasurement measurement{e.q_from_to, e.t_from_to, e.sqrt_information};
+        ceres::LossFunction* loss = e.robust ? new ceres::HuberLoss(e.huber_scale) : nullptr;
+        if (e.dead_reckoned) {
+          problem->AddResidualBlock(new DeadReckonedPoseCost(measurement), loss, q(e.from),
+                                    p(e.from), q(e.to), p(e.to), calibration->data());
+        } else {
+          problem->AddResidualBlock(new RelativePoseCost(measurement), loss, q(e.from), p(e.from),
+                                    q(e.to), p(e.to));
+        }
+        return;
+      }
+      case GraphMeasurements::Kind::kDepth: {
+        const DepthPrior& d = from.depths[at];
+        problem->AddResidualBlock(
+            new ceres::AutoDiffCostFunction<DepthCost, 1, 3>(new DepthCost{d.z_m, d.sigma_m}),
+            nullptr, p(d.node));
+        return;
+      }
+      case GraphMeasurements::Kind::kGravity: {
+        const GravityPrior& g = from.gravities[at];
+        problem->AddResidualBlock(new ceres::AutoDiffCostFunction<GravityCost, 3, 4>(
+                                      new GravityCost{g.down_in_V, g.sigma_rad}),
+                                  nullptr, q(g.node));
+        return;
+      }
+      case GraphMeasurements::Kind::kPrior: {
+        const GraphMeasurements::Prior& r = from.priors[at];
+        problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 6, 4, 3>(
+                                      new PriorCost{r.q_W_V, r.t_W_V, r.sqrt_information}),
+                                  nullptr, q(r.node), p(r.node));
+        return;
+      }
     }
-    if (extra) m.blocks.push_back(extra);
-    problem->AddResidualBlock(cost, loss, m.blocks);
-    const int index = static_cast<int>(measurements.size());
-    for (const int node : nodes) measurements_of_node[static_cast<size_t>(node)].push_back(index);
-    measurements.push_back(std::move(m));
   }
 
-  // The measurements that touch a node from first_node on, each once, in the order added.
-  std::vector<int> MeasurementsFrom(int first_node) const {
-    std::vector<int> indices;
-    for (size_t node = static_cast<size_t>(first_node); node < measurements_of_node.size(); ++node)
-      indices.insert(indices.end(), measurements_of_node[node].begin(),
-                     measurements_of_node[node].end());
-    std::sort(indices.begin(), indices.end());
-    indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
-    return indices;
+  // Every measurement in one problem: the calibration and its prior first (a mapper estimates it
+  // before its first node), then each node's rotation and position, then the measurements in the
+  // order they were added, the spilled ones read back first.
+  std::unique_ptr<ceres::Problem> WholeProblem() {
+    ceres::Problem::Options options;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    auto problem = std::make_unique<ceres::Problem>(options);
+    if (calibration) {
+      problem->AddParameterBlock(calibration->data(), 2);
+      problem->AddResidualBlock(new ceres::AutoDiffCostFunction<CalibrationPriorCost, 2, 2>(
+                                    new CalibrationPriorCost(calibration_prior)),
+                                nullptr, calibration->data());
+    }
+    for (int node = 0; node < static_cast<int>(nodes.size()); ++node) {
+      problem->AddParameterBlock(q(node), 4, &quaternion_manifold);
+      problem->AddParameterBlock(p(node), 3);
+    }
+    if (spill) {
+      const GraphMeasurements spilled = spill->ReadAll();
+      for (std::size_t i = 0; i < spilled.size(); ++i) AddTo(spilled, i, problem.get());
+    }
+    for (std::size_t i = 0; i < measurements.size(); ++i) AddTo(measurements, i, problem.get());
+    return problem;
   }
 
   // The information J^T J at the current estimate, J the whitened residuals' Jacobian (robust
@@ -178,8 +212,9 @@ struct PoseGraph::Impl {
   // calibration]: node i at 6 i, its rotation (Ceres's quaternion tangent) then its position.
   // std::nullopt when a residual cannot be evaluated there.
   std::optional<Eigen::SparseMatrix<double>> Information() {
+    const std::unique_ptr<ceres::Problem> problem = WholeProblem();
     ceres::Problem::EvaluateOptions options;
-    for (int i = 0; i < static_cast<int>(rotations.size()); ++i) {
+    for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
       options.parameter_blocks.push_back(q(i));
       options.parameter_blocks.push_back(p(i));
     }
@@ -196,21 +231,18 @@ struct PoseGraph::Impl {
   }
 };
 
-PoseGraph::PoseGraph() : impl_(std::make_unique<Impl>()) {}
+PoseGraph::PoseGraph(const std::filesystem::path& spill_folder) : impl_(std::make_unique<Impl>()) {
+  impl_->spill_folder = spill_folder;
+}
 PoseGraph::~PoseGraph() = default;
 PoseGraph::PoseGraph(PoseGraph&&) noexcept = default;
 PoseGraph& PoseGraph::operator=(PoseGraph&&) noexcept = default;
 
 int PoseGraph::AddNode(const Eigen::Isometry3d& T_W_V) {
   RequireRigid(T_W_V, "AddNode");
-  Impl& m = *impl_;
-  m.rotations.push_back(std::make_unique<std::array<double, 4>>());
-  m.positions.push_back(std::make_unique<std::array<double, 3>>());
-  const int node = static_cast<int>(m.rotations.size()) - 1;
+  impl_->nodes.emplace_back();
+  const int node = node_count() - 1;
   set_pose(node, T_W_V);
-  m.problem->AddParameterBlock(m.q(node), 4, new ceres::EigenQuaternionManifold);
-  m.problem->AddParameterBlock(m.p(node), 3);
-  m.measurements_of_node.emplace_back();
   return node;
 }
 
@@ -226,18 +258,15 @@ void PoseGraph::AddEdge(const RelativePoseEdge& edge) {
     throw Error(
         "pose graph: AddEdge: a dead-reckoned edge needs EstimateDeadReckoningCalibration first");
   }
-  // The problem owns each loss (one per edge: Ceres deletes them one by one).
-  ceres::LossFunction* loss = edge.robust ? new ceres::HuberLoss(edge.huber_scale) : nullptr;
-  const RelativePoseMeasurement measurement{Eigen::Quaterniond(edge.T_from_to.linear()),
-                                            edge.T_from_to.translation(),
-                                            SqrtPsd(edge.information)};
-  if (edge.dead_reckoned) {
-    auto* cost = new DeadReckonedPoseCost(measurement);
-    m.AddMeasurement(cost, loss, {edge.from, edge.to}, true, true, m.calibration->data());
-    return;
-  }
-  auto* cost = new RelativePoseCost(measurement);
-  m.AddMeasurement(cost, loss, {edge.from, edge.to}, true, true);
+  m.measurements.Add(
+      GraphMeasurements::Edge{.from = edge.from,
+                              .to = edge.to,
+                              .q_from_to = Eigen::Quaterniond(edge.T_from_to.linear()),
+                              .t_from_to = edge.T_from_to.translation(),
+                              .sqrt_information = SqrtPsd(edge.information),
+                              .robust = edge.robust,
+                              .dead_reckoned = edge.dead_reckoned,
+                              .huber_scale = edge.huber_scale});
 }
 
 void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma,
@@ -249,10 +278,7 @@ void PoseGraph::EstimateDeadReckoningCalibration(double scale_sigma,
     throw Error("pose graph: EstimateDeadReckoningCalibration: expected finite sigmas > 0");
   }
   m.calibration = std::make_unique<std::array<double, 2>>(std::array<double, 2>{0.0, 0.0});
-  m.problem->AddParameterBlock(m.calibration->data(), 2);
-  m.AddMeasurement(new ceres::AutoDiffCostFunction<CalibrationPriorCost, 2, 2>(
-                       new CalibrationPriorCost{scale_sigma, misalignment_sigma_rad}),
-                   nullptr, {}, false, false, m.calibration->data());
+  m.calibration_prior = {scale_sigma, misalignment_sigma_rad};
 }
 
 bool PoseGraph::estimates_calibration() const { return impl_->calibration != nullptr; }
@@ -268,9 +294,7 @@ void PoseGraph::AddDepth(const DepthPrior& prior) {
   if (!std::isfinite(prior.z_m) || !(prior.sigma_m > 0.0)) {
     throw Error("pose graph: AddDepth: expected a finite depth and sigma_m > 0");
   }
-  m.AddMeasurement(
-      new ceres::AutoDiffCostFunction<DepthCost, 1, 3>(new DepthCost{prior.z_m, prior.sigma_m}),
-      nullptr, {prior.node}, false, true);
+  m.measurements.Add(prior);
 }
 
 void PoseGraph::AddGravity(const GravityPrior& prior) {
@@ -280,9 +304,7 @@ void PoseGraph::AddGravity(const GravityPrior& prior) {
       !(prior.sigma_rad > 0.0)) {
     throw Error("pose graph: AddGravity: expected a unit down vector and sigma_rad > 0");
   }
-  m.AddMeasurement(new ceres::AutoDiffCostFunction<GravityCost, 3, 4>(
-                       new GravityCost{prior.down_in_V, prior.sigma_rad}),
-                   nullptr, {prior.node}, true, false);
+  m.measurements.Add(prior);
 }
 
 void PoseGraph::AddPrior(const PosePrior& prior) {
@@ -290,13 +312,29 @@ void PoseGraph::AddPrior(const PosePrior& prior) {
   m.RequireNode(prior.node, "AddPrior");
   RequireRigid(prior.T_W_V, "AddPrior");
   RequireInformation(prior.information, "AddPrior");
-  m.AddMeasurement(new ceres::AutoDiffCostFunction<PriorCost, 6, 4, 3>(
-                       new PriorCost{Eigen::Quaterniond(prior.T_W_V.linear()),
-                                     prior.T_W_V.translation(), SqrtPsd(prior.information)}),
-                   nullptr, {prior.node}, true, true);
+  m.measurements.Add(GraphMeasurements::Prior{.node = prior.node,
+                                              .q_W_V = Eigen::Quaterniond(prior.T_W_V.linear()),
+                                              .t_W_V = prior.T_W_V.translation(),
+                                              .sqrt_information = SqrtPsd(prior.information)});
 }
 
-int PoseGraph::node_count() const { return static_cast<int>(impl_->rotations.size()); }
+void PoseGraph::RetireBefore(int first_node) {
+  Impl& m = *impl_;
+  if (m.spill_folder.empty() || first_node <= m.retired_before) return;
+  const std::size_t older = m.measurements.OlderThan(first_node);
+  if (older < kRetireAtOnce) return;
+  if (!m.spill) m.spill = std::make_unique<MeasurementSpill>(m.spill_folder);
+  m.spill->Append(m.measurements, older);
+  m.measurements.DropFirst(older);
+  m.retired_before = first_node;
+}
+
+std::int64_t PoseGraph::memory_bytes() const {
+  return static_cast<std::int64_t>(impl_->nodes.capacity() * sizeof(Impl::Node)) +
+         impl_->measurements.memory_bytes();
+}
+
+int PoseGraph::node_count() const { return static_cast<int>(impl_->nodes.size()); }
 
 Eigen::Isometry3d PoseGraph::pose(int node) const {
   impl_->RequireNode(node, "pose");
@@ -338,7 +376,9 @@ PoseGraphSolve SolveProblem(ceres::Problem* problem, const PoseGraphOptions& opt
 }  // namespace
 
 PoseGraphSolve PoseGraph::Solve(const PoseGraphOptions& options) {
-  return SolveProblem(impl_->problem.get(), options);
+  options.Check();
+  const std::unique_ptr<ceres::Problem> problem = impl_->WholeProblem();
+  return SolveProblem(problem.get(), options);
 }
 
 PoseGraphSolve PoseGraph::SolveWindow(int first_free_node, const PoseGraphOptions& options) {
@@ -348,18 +388,19 @@ PoseGraphSolve PoseGraph::SolveWindow(int first_free_node, const PoseGraphOption
     throw Error("pose graph: SolveWindow: first free node " + std::to_string(first_free_node) +
                 " outside [0, " + std::to_string(node_count()) + ")");
   }
-  // The window's problem borrows the costs, losses and manifold: the whole graph's problem and
-  // Impl own them.
-  ceres::Problem::Options borrowed;
-  borrowed.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  borrowed.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  borrowed.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem window(borrowed);
+  if (first_free_node < m.retired_before) {
+    throw Error("pose graph: SolveWindow: first free node " + std::to_string(first_free_node) +
+                " is before node " + std::to_string(m.retired_before) +
+                ", whose measurements were moved out of memory (RetireBefore)");
+  }
+  ceres::Problem::Options options_shared_manifold;
+  options_shared_manifold.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem window(options_shared_manifold);
   std::vector<int> nodes;
-  for (const int index : m.MeasurementsFrom(first_free_node)) {
-    const Impl::Measurement& measurement = m.measurements[static_cast<size_t>(index)];
-    window.AddResidualBlock(measurement.cost, measurement.loss, measurement.blocks);
-    nodes.insert(nodes.end(), measurement.nodes.begin(), measurement.nodes.end());
+  for (const std::size_t i : m.measurements.From(first_free_node)) {
+    m.AddTo(m.measurements, i, &window);
+    for (const int node : m.measurements.NodesOf(i))
+      if (node >= 0) nodes.push_back(node);
   }
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());

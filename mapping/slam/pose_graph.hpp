@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
+#include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -71,7 +73,11 @@ struct PoseGraphSolve {
 
 class PoseGraph {
  public:
-  PoseGraph();
+  // Measurements retired at once (RetireBefore): writes of about 25 kB, a dozen submaps' worth.
+  static constexpr std::size_t kRetireAtOnce = 64;
+
+  // spill_folder: where RetireBefore moves old measurements (empty: they all stay in memory).
+  explicit PoseGraph(const std::filesystem::path& spill_folder = {});
   ~PoseGraph();
   PoseGraph(PoseGraph&&) noexcept;
   PoseGraph& operator=(PoseGraph&&) noexcept;
@@ -85,7 +91,7 @@ class PoseGraph {
   void AddPrior(const PosePrior& prior);
   // Estimates the dead reckoning's speed scale error and misalignment with the poses, from a
   // zero-mean prior with these standard deviations (> 0). Call once, before the first
-  // dead-reckoned edge.
+  // dead-reckoned edge (before the first node keeps the solves' order of blocks as added).
   void EstimateDeadReckoningCalibration(double scale_sigma, double misalignment_sigma_rad);
   bool estimates_calibration() const;
   // The current estimate (zero until estimated).
@@ -103,6 +109,16 @@ class PoseGraph {
   // graph's size (a long dive's running solves). SolveWindow(0) differs from Solve only in
   // holding the calibration.
   PoseGraphSolve SolveWindow(int first_free_node, const PoseGraphOptions& options);
+
+  // Memory that does not grow with the graph: the measurements that touch only nodes before
+  // first_node, and come before every one that touches a later node, go to a spill file in the
+  // spill folder, once at least kRetireAtOnce of them do (nothing without a spill folder). They
+  // are read back for Solve, Covariances and Information, with the same bits; SolveWindow from a
+  // node before first_node is then refused. The nodes' poses stay in memory (56 bytes each).
+  // Throws uwscan::Error when the spill file cannot be created or written.
+  void RetireBefore(int first_node);
+  // The bytes the nodes and the measurements in memory take.
+  std::int64_t memory_bytes() const;
 
   // Marginal covariance of every node at the current estimate, ordered [rotation (rad),
   // position (m)], both in the world frame: T_W_V = exp([w, 0]) applied to the rotation,

@@ -1,11 +1,15 @@
 #include "mapping/slam/pose_graph.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
+#include <random>
+#include <string>
 #include <vector>
 
 #include "mapping/log/dive_log_test_support.hpp"
@@ -212,6 +216,152 @@ TEST(PoseGraph, AWindowOutsideTheGraphIsRefused) {
   PoseGraph graph = ExactChain(3, &truth);
   EXPECT_THROW(graph.SolveWindow(3, {}), Error);
   EXPECT_THROW(graph.SolveWindow(-1, {}), Error);
+}
+
+// A dive's graph grown node by node: noisy dead-reckoned motions (the calibration estimated),
+// depth and roll/pitch priors on every node, and from node 150 on, every 7th node tied by a
+// robust edge to the node 150 before it (a loop).
+class GrowingGraph {
+ public:
+  explicit GrowingGraph(PoseGraph* graph) : graph_(graph) {
+    graph_->EstimateDeadReckoningCalibration(0.01, 0.01);
+  }
+  void AddNode(int i) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(i));
+    std::normal_distribution<double> noise(0.0, 1e-3);
+    graph_->AddNode(Truth(i) * Noisy(&rng, &noise, 20.0));
+    if (i == 0) {
+      graph_->AddPrior({.node = 0, .T_W_V = Truth(0), .information = Matrix6d::Identity() * 1e6});
+    } else {
+      AddMeasuredEdge(i - 1, i, &rng, &noise, false);
+    }
+    if (i >= 150 && i % 7 == 0) AddMeasuredEdge(i - 150, i, &rng, &noise, true);
+    graph_->AddDepth({.node = i, .z_m = Truth(i).translation().z() + noise(rng), .sigma_m = 1e-3});
+    graph_->AddGravity({.node = i,
+                        .down_in_V = Truth(i).linear().transpose() * Eigen::Vector3d::UnitZ(),
+                        .sigma_rad = 1e-3});
+  }
+
+ private:
+  static Eigen::Isometry3d Truth(int i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(0.002 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(0.1 * i, 5.0 * std::sin(0.01 * i), 10.0);
+    return T;
+  }
+  static Eigen::Isometry3d Noisy(std::mt19937_64* rng, std::normal_distribution<double>* noise,
+                                 double scale) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d w(scale * (*noise)(*rng), scale * (*noise)(*rng), scale * (*noise)(*rng));
+    T.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    T.translation() = scale * Eigen::Vector3d((*noise)(*rng), (*noise)(*rng), (*noise)(*rng));
+    return T;
+  }
+  void AddMeasuredEdge(int from, int to, std::mt19937_64* rng,
+                       std::normal_distribution<double>* noise, bool loop) {
+    graph_->AddEdge({.from = from,
+                     .to = to,
+                     .T_from_to = Truth(from).inverse() * Truth(to) * Noisy(rng, noise, 1.0),
+                     .information = Matrix6d::Identity() * (loop ? 1e5 : 1e4),
+                     .robust = loop,
+                     .dead_reckoned = !loop});
+  }
+  PoseGraph* graph_;
+};
+
+class PoseGraphSpillTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("uwscan_pose_graph_test_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+};
+
+// Two graphs fed the same measurements, one moving those older than its last 100 nodes to disk:
+// their window solves, whole solve and information agree to the bit, and the spilling one's
+// memory grows by its nodes' poses alone.
+TEST_F(PoseGraphSpillTest, RetiredMeasurementsComeBackWithTheSameBitsAndLeaveMemoryFlat) {
+  constexpr int kNodes = 3000, kWindow = 100;
+  PoseGraph in_memory, spilling(dir_);
+  GrowingGraph grow_in_memory(&in_memory), grow_spilling(&spilling);
+  std::int64_t memory_half = 0, spilling_memory_half = 0;
+  for (int i = 0; i < kNodes; ++i) {
+    grow_in_memory.AddNode(i);
+    grow_spilling.AddNode(i);
+    spilling.RetireBefore(i + 1 - kWindow);
+    if (i % 50 == 49) {
+      const PoseGraphSolve a = in_memory.SolveWindow(i + 1 - 40, {});
+      const PoseGraphSolve b = spilling.SolveWindow(i + 1 - 40, {});
+      ASSERT_EQ(a.measurements, b.measurements) << "node " << i;
+      for (int node = i + 1 - 40; node <= i; ++node)
+        ExpectSameBits(in_memory.pose(node), spilling.pose(node), node);
+    }
+    if (i + 1 == kNodes / 2) {
+      memory_half = in_memory.memory_bytes();
+      spilling_memory_half = spilling.memory_bytes();
+    }
+  }
+  EXPECT_THROW(spilling.SolveWindow(1, {}), Error);
+  const PoseGraphSolve whole = spilling.Solve({});
+  EXPECT_TRUE(whole.converged);
+  EXPECT_EQ(whole.measurements, in_memory.Solve({}).measurements);
+  for (int node = 0; node < kNodes; ++node)
+    ExpectSameBits(in_memory.pose(node), spilling.pose(node), node);
+  EXPECT_EQ(in_memory.calibration().scale_error, spilling.calibration().scale_error);
+  const std::optional<Eigen::SparseMatrix<double>> a = in_memory.Information();
+  const std::optional<Eigen::SparseMatrix<double>> b = spilling.Information();
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(Eigen::SparseMatrix<double>(*a - *b).norm(), 0.0);
+
+  // Per node from the middle of the dive to its end: a few hundred bytes of measurements held,
+  // against the nodes' poses alone (56 bytes, at most twice that as a vector doubles).
+  const double per_node =
+      static_cast<double>(in_memory.memory_bytes() - memory_half) / (kNodes / 2);
+  const double spilling_per_node =
+      static_cast<double>(spilling.memory_bytes() - spilling_memory_half) / (kNodes / 2);
+  EXPECT_GT(per_node, 300.0);
+  EXPECT_LE(spilling_per_node, 2.0 * 56.0);
+}
+
+TEST_F(PoseGraphSpillTest, TheSpillFileGoesWithTheGraph) {
+  {
+    PoseGraph graph(dir_);
+    GrowingGraph grow(&graph);
+    for (int i = 0; i < 600; ++i) {
+      grow.AddNode(i);
+      graph.RetireBefore(i + 1 - 50);
+    }
+    EXPECT_FALSE(std::filesystem::is_empty(dir_));
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+TEST_F(PoseGraphSpillTest, AGraphWithoutASpillFolderKeepsEverything) {
+  PoseGraph graph;
+  GrowingGraph grow(&graph);
+  for (int i = 0; i < 600; ++i) {
+    grow.AddNode(i);
+    graph.RetireBefore(i + 1 - 50);
+  }
+  EXPECT_NO_THROW(graph.SolveWindow(1, {.max_iterations = 1}));
+}
+
+TEST_F(PoseGraphSpillTest, AFolderThatCannotHoldTheSpillIsNamed) {
+  PoseGraph graph(dir_ / "missing");
+  GrowingGraph grow(&graph);
+  try {
+    for (int i = 0; i < 600; ++i) {
+      grow.AddNode(i);
+      graph.RetireBefore(i + 1 - 50);
+    }
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -29,4 +29,6 @@ HeapBytes CurrentHeapBytes() {
           static_cast<std::int64_t>(info.arena + info.hblkhd)};
 }
 
+void ReturnFreePages() { malloc_trim(0); }
+
 }  // namespace uwscan

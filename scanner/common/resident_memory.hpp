@@ -19,4 +19,10 @@ struct HeapBytes {
 };
 HeapBytes CurrentHeapBytes();
 
+// Gives the pages the allocator holds free back to the system (glibc's malloc_trim, which also
+// releases free pages between blocks in use). After a large short-lived allocation, such as the
+// problem of a whole pose graph's solve, they would otherwise stay resident: the blocks allocated
+// after it keep the heap from shrinking.
+void ReturnFreePages();
+
 }  // namespace uwscan
