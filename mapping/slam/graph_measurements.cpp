@@ -115,30 +115,28 @@ std::filesystem::path NewSpillPath(const std::filesystem::path& folder) {
 
 void GraphMeasurements::Add(const Edge& edge) {
   edges.push_back(edge);
-  const int newest = std::max(edge.from, edge.to);
-  const int so_far = entries.empty() ? newest : std::max(entries.back().newest_so_far, newest);
-  entries.push_back({Kind::kEdge, static_cast<int>(edges.size()) - 1, newest, so_far});
+  Record(Kind::kEdge, edges.size(), std::max(edge.from, edge.to));
 }
 
 void GraphMeasurements::Add(const DepthPrior& depth) {
   depths.push_back(depth);
-  const int so_far =
-      entries.empty() ? depth.node : std::max(entries.back().newest_so_far, depth.node);
-  entries.push_back({Kind::kDepth, static_cast<int>(depths.size()) - 1, depth.node, so_far});
+  Record(Kind::kDepth, depths.size(), depth.node);
 }
 
 void GraphMeasurements::Add(const GravityPrior& gravity) {
   gravities.push_back(gravity);
-  const int so_far =
-      entries.empty() ? gravity.node : std::max(entries.back().newest_so_far, gravity.node);
-  entries.push_back({Kind::kGravity, static_cast<int>(gravities.size()) - 1, gravity.node, so_far});
+  Record(Kind::kGravity, gravities.size(), gravity.node);
 }
 
 void GraphMeasurements::Add(const Prior& prior) {
   priors.push_back(prior);
+  Record(Kind::kPrior, priors.size(), prior.node);
+}
+
+void GraphMeasurements::Record(Kind kind, std::size_t records_of_kind, int newest_node) {
   const int so_far =
-      entries.empty() ? prior.node : std::max(entries.back().newest_so_far, prior.node);
-  entries.push_back({Kind::kPrior, static_cast<int>(priors.size()) - 1, prior.node, so_far});
+      entries.empty() ? newest_node : std::max(entries.back().newest_so_far, newest_node);
+  entries.push_back({kind, static_cast<int>(records_of_kind) - 1, newest_node, so_far});
 }
 
 std::array<int, 2> GraphMeasurements::NodesOf(std::size_t i) const {
@@ -158,7 +156,7 @@ std::array<int, 2> GraphMeasurements::NodesOf(std::size_t i) const {
 }
 
 // The measurements before OlderThan(first_node) touch none from first_node on: the search
-// starts there, so a window's costs what the newest measurements hold, not the whole graph.
+// starts there, so a window costs what the newest measurements hold, not the whole graph.
 std::vector<std::size_t> GraphMeasurements::From(int first_node) const {
   std::vector<std::size_t> indices;
   for (std::size_t i = OlderThan(first_node); i < entries.size(); ++i)

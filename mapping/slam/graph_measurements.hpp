@@ -63,6 +63,10 @@ struct GraphMeasurements {
   void DropFirst(std::size_t count);
   // The bytes the records take in memory (the vectors' capacities).
   std::int64_t memory_bytes() const;
+
+ private:
+  // The entry of the record just added, the last of the `records_of_kind` of its kind.
+  void Record(Kind kind, std::size_t records_of_kind, int newest_node);
 };
 
 // The measurements a long dive's graph no longer needs in memory (GraphMeasurements::OlderThan
