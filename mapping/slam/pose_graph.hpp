@@ -91,7 +91,7 @@ class PoseGraph {
   void AddPrior(const PosePrior& prior);
   // Estimates the dead reckoning's speed scale error and misalignment with the poses, from a
   // zero-mean prior with these standard deviations (> 0). Call once, before the first
-  // dead-reckoned edge (before the first node keeps the solves' order of blocks as added).
+  // dead-reckoned edge.
   void EstimateDeadReckoningCalibration(double scale_sigma, double misalignment_sigma_rad);
   bool estimates_calibration() const;
   // The current estimate (zero until estimated).
