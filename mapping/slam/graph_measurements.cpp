@@ -1,13 +1,11 @@
 #include "mapping/slam/graph_measurements.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <fstream>
 #include <iterator>
 #include <string>
 
+#include "mapping/slam/spill_file.hpp"
 #include "scanner/common/byte_io.hpp"
 #include "scanner/common/error.hpp"
 
@@ -104,13 +102,6 @@ GraphMeasurements::Prior GetPrior(ByteReader* in) {
   return p;
 }
 
-// Each spill file is its own, even with several graphs in one process.
-std::filesystem::path NewSpillPath(const std::filesystem::path& folder) {
-  static std::atomic<int> counter{0};
-  return folder / ("uwscan-graph-" + std::to_string(::getpid()) + "-" +
-                   std::to_string(counter.fetch_add(1)) + ".bin");
-}
-
 }  // namespace
 
 void GraphMeasurements::Add(const Edge& edge) {
@@ -187,13 +178,7 @@ std::int64_t GraphMeasurements::memory_bytes() const {
 }
 
 MeasurementSpill::MeasurementSpill(const std::filesystem::path& folder)
-    : path_(NewSpillPath(folder)) {
-  std::ofstream create(path_, std::ios::binary | std::ios::trunc);
-  if (!create) {
-    throw Error("pose graph: cannot create the spill file " + path_.string() +
-                " (is the folder there and writable?)");
-  }
-}
+    : path_(NewSpillFile(folder, "uwscan-graph", "pose graph")) {}
 
 MeasurementSpill::~MeasurementSpill() {
   std::error_code ignored;

@@ -84,7 +84,6 @@ class MeasurementSpill {
   void Append(const GraphMeasurements& measurements, std::size_t count);
   // Every measurement appended, in order. Throws uwscan::Error when the file cannot be read.
   GraphMeasurements ReadAll() const;
-  std::size_t size() const { return size_; }
 
  private:
   std::filesystem::path path_;

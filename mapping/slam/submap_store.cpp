@@ -1,24 +1,15 @@
 #include "mapping/slam/submap_store.hpp"
 
-#include <unistd.h>
-
-#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <string>
 
+#include "mapping/slam/spill_file.hpp"
 #include "scanner/common/byte_io.hpp"
 #include "scanner/common/error.hpp"
 
 namespace uwscan::mapping {
 namespace {
-
-// Each store's spill file is its own, even with several mappers in one process.
-std::filesystem::path NewSpillPath(const std::filesystem::path& folder) {
-  static std::atomic<int> counter{0};
-  return folder / ("uwscan-submaps-" + std::to_string(::getpid()) + "-" +
-                   std::to_string(counter.fetch_add(1)) + ".bin");
-}
 
 // A cloud as uwscan's own binary encoding (scanner/common/byte_io.hpp): origin, then each array
 // with its count.
@@ -56,13 +47,8 @@ SubmapStore::SubmapStore(const std::filesystem::path& spill_folder, int resident
     : resident_(resident) {
   if (resident <= 0)
     throw Error("submap store: resident must be > 0, got " + std::to_string(resident));
-  if (spill_folder.empty()) return;
-  spill_path_ = NewSpillPath(spill_folder);
-  std::ofstream create(spill_path_, std::ios::binary | std::ios::trunc);
-  if (!create) {
-    throw Error("submap store: cannot create the spill file " + spill_path_.string() +
-                " (is the folder there and writable?)");
-  }
+  if (!spill_folder.empty())
+    spill_path_ = NewSpillFile(spill_folder, "uwscan-submaps", "submap store");
 }
 
 SubmapStore::~SubmapStore() {
