@@ -11,16 +11,17 @@ namespace uwscan::bench {
 
 // Speed and accuracy of every stripe detection method. Speed: frames per second on one core
 // over `frames` distinct 2048x1088 Mono8 frames of a mildly noisy stripe (sigma 1.5 px),
-// the fastest of `repeats` passes. Accuracy: RMSE of the detected centre against the renderer's
-// exact centre over every column of `frames` clean Mono8 frames per stripe width (sigma 1.5 and
-// 3 px), each frame with a different smooth curve, so sub-pixel offsets are spread evenly.
-// Every method runs with the same default StripeDetectorOptions except its method.
+// the fastest of `repeats` passes, the methods and the limit in turn within each pass. Accuracy:
+// RMSE of the detected centre against the renderer's exact centre over every column of `frames`
+// clean Mono8 frames per stripe width (sigma 1.5 and 3 px), each frame with a different smooth
+// curve, so sub-pixel offsets are spread evenly. Every method runs with the same default
+// StripeDetectorOptions except its method.
 struct StripeBenchOptions {
   int width_px = 2048;
   int height_px = 1088;
   int frames = 8;                  // distinct frames per measurement, >= 1
-  double min_seconds = 0.3;        // each speed pass runs at least this long, seconds
-  int repeats = 3;                 // speed passes per method; the fastest is reported, >= 1
+  double min_seconds = 0.1;        // each method's share of a pass runs at least this long, s
+  int repeats = 10;                // speed passes; each method's fastest is reported, >= 1
   double amplitude = 200.0;        // stripe height over the background, image units
   double background = 10.0;        // image units
   double speed_noise_sigma = 2.0;  // noise of the speed frames, image units

@@ -23,11 +23,15 @@ constexpr std::array<StripeMethod, 6> kAllMethods = {
 constexpr int kBlockRows = 16;
 constexpr std::uint16_t kNoBlock = 0xFFFF;
 
+// Lines handled together: a group of columns whose rows around the stripe are read row by row
+// (GroupArgs, GroupSecondPeaks), and the lines whose refinement waits for a batch (StegerBatch),
+// whose samples and slopes (15 + 5 doubles a line for sigma 1.5) stay in the first-level cache.
+constexpr int kBatchLines = 128;
+
 // Buffers of the column scan, reused from frame to frame.
 template <typename Pixel>
 struct ColumnScratch {
-  std::vector<Pixel> block_max;         // [block * width + u]
-  std::vector<std::uint8_t> block_arg;  // first row in the block reaching block_max, from its start
+  std::vector<Pixel> block_max;  // [block * width + u]
   std::vector<Pixel> max;
   std::vector<std::uint16_t> first_block;  // first block reaching max[u]
   std::vector<std::uint16_t> arg;
@@ -35,10 +39,13 @@ struct ColumnScratch {
   // last block whose maximum reaches it (kNoBlock: none).
   std::vector<Pixel> cut;
   std::vector<std::uint16_t> first_candidate, last_candidate;
+  // For the group of columns at hand: the end of each one's first block reaching its maximum,
+  // the rows around its brightest pixel that the second-peak test skips, and its verdict.
+  std::array<std::uint16_t, kBatchLines> group_end, group_below, group_above;
+  std::array<std::uint8_t, kBatchLines> group_reject;
 
   void Resize(int width, int blocks) {
     block_max.resize(static_cast<std::size_t>(width) * blocks);
-    block_arg.resize(static_cast<std::size_t>(width) * blocks);
     max.resize(width);
     first_block.resize(width);
     arg.resize(width);
@@ -166,6 +173,128 @@ std::optional<double> StegerOffset(const Profile& p, std::span<const double> ste
   return ZeroCrossingNear(d);
 }
 
+// The zero crossing of ZeroCrossingNear for a batch of lines, from their slopes d(k),
+// slopes[(k + kCrossingReach) * kBatchLines + line]: the same pair of samples chosen and the
+// same arithmetic, without a branch (which way the crossing lies is a coin toss per line).
+// found[line] says whether there is one; offset[line] is it.
+[[gnu::always_inline]] inline void BatchCrossings(const double* __restrict slopes, int lines,
+                                                  double* __restrict offset,
+                                                  std::uint8_t* __restrict found) {
+  static_assert(kCrossingReach == 2);
+  const double* __restrict back2 = slopes;
+  const double* __restrict back1 = slopes + kBatchLines;
+  const double* __restrict at0 = slopes + 2 * kBatchLines;
+  const double* __restrict ahead1 = slopes + 3 * kBatchLines;
+  const double* __restrict ahead2 = slopes + 4 * kBatchLines;
+  for (int line = 0; line < lines; ++line) {
+    const double sm2 = back2[line];
+    const double sm1 = back1[line];
+    const double s0 = at0[line];
+    const double s1 = ahead1[line];
+    const double s2 = ahead2[line];
+    const bool rising = s0 > 0.0;
+    // Rising: between 0 and 1 when d(1) <= 0, else between 1 and 2 when d(2) <= 0.
+    const bool near_ahead = s1 <= 0.0;
+    const double ahead_base = near_ahead ? 0.0 : 1.0;
+    const double ahead_previous = near_ahead ? s0 : s1;
+    const double ahead_next = near_ahead ? s1 : s2;
+    const bool ahead_found = near_ahead | (s2 <= 0.0);
+    // Falling: between -1 and 0 when d(-1) > 0, else between -2 and -1 when d(-2) > 0.
+    const bool near_back = sm1 > 0.0;
+    const double back_base = near_back ? -1.0 : -2.0;
+    const double back_previous = near_back ? sm1 : sm2;
+    const double back_next = near_back ? s0 : sm1;
+    const bool back_found = near_back | (sm2 > 0.0);
+    const double base = rising ? ahead_base : back_base;
+    const double previous = rising ? ahead_previous : back_previous;
+    const double next = rising ? ahead_next : back_next;
+    offset[line] = base + previous / (previous - next);
+    found[line] = static_cast<std::uint8_t>((rising & ahead_found) | (!rising & back_found));
+  }
+}
+
+constexpr int kSlopeLanes = 8;
+
+// The slopes d(k), |k| <= kCrossingReach, of a batch of lines, each as StegerOffset sums it
+// (the same products added in the same order from 0, so the same bits), and their zero
+// crossings (BatchCrossings). One line's sum is a chain of dependent additions; across lines
+// they are independent, and the compiler vectorises them.
+// samples[(k + support) * kBatchLines + line], |k| <= support = r + kCrossingReach, and values
+// the same as doubles; slopes[(k + kCrossingReach) * kBatchLines + line]; d1 holds 2r + 1
+// weights. kSlopeLanes lines are summed together, held in registers across the kernel's taps.
+__attribute__((target_clones("avx2", "default"))) void BatchSlopes(
+    const std::uint16_t* __restrict samples, const double* __restrict d1, int r, int lines,
+    double* __restrict values, double* __restrict slopes, double* __restrict offset,
+    std::uint8_t* __restrict found) {
+  const int support = r + kCrossingReach;
+  // Whole groups of lanes: the lines past `lines` hold earlier batches' samples, unused.
+  const int padded = (lines + kSlopeLanes - 1) / kSlopeLanes * kSlopeLanes;
+  for (int i = 0; i < (2 * support + 1) * kBatchLines; ++i) {
+    values[i] = static_cast<double>(samples[i]);
+  }
+  for (int k = -kCrossingReach; k <= kCrossingReach; ++k) {
+    for (int first = 0; first < padded; first += kSlopeLanes) {
+      std::array<double, kSlopeLanes> sum{};
+      for (int j = -r; j <= r; ++j) {
+        const double* __restrict p = values + (k + j + support) * kBatchLines + first;
+        const double w = d1[j + r];
+        for (int lane = 0; lane < kSlopeLanes; ++lane) sum[lane] += p[lane] * w;
+      }
+      std::copy(sum.begin(), sum.end(), slopes + (k + kCrossingReach) * kBatchLines + first);
+    }
+  }
+  BatchCrossings(slopes, lines, offset, found);
+}
+
+// Steger's refinement of many lines at once (BatchSlopes): a line whose brightest sample is a
+// single or double top below saturation, with its support inside the image, is added with its
+// samples; the offsets come once the batch is computed.
+class StegerBatch {
+ public:
+  explicit StegerBatch(std::span<const double> d1)
+      : d1_(d1.begin(), d1.end()),
+        r_(static_cast<int>(d1.size() / 2)),
+        support_(r_ + kCrossingReach),
+        samples_(static_cast<std::size_t>(2 * support_ + 1) * kBatchLines),
+        values_(samples_.size()),
+        slopes_(static_cast<std::size_t>(2 * kCrossingReach + 1) * kBatchLines) {}
+
+  int support() const { return support_; }
+  void Clear() { lines_ = 0; }
+
+  // Adds the line whose brightest sample is *centre, its neighbours `step` apart; returns its
+  // place in the batch.
+  template <typename Pixel>
+  int Add(const Pixel* centre, std::ptrdiff_t step) {
+    std::uint16_t* out = samples_.data() + lines_;
+    const Pixel* p = centre - support_ * step;
+    for (int k = -support_; k <= support_; ++k, p += step, out += kBatchLines) *out = *p;
+    return lines_++;
+  }
+
+  void Compute() {
+    BatchSlopes(samples_.data(), d1_.data(), r_, lines_, values_.data(), slopes_.data(),
+                offset_.data(), found_.data());
+  }
+
+  // Whether the line's crossing was found, and then where (*offset).
+  bool Refined(int line, double* offset) const {
+    *offset = offset_[static_cast<std::size_t>(line)];
+    return found_[static_cast<std::size_t>(line)] != 0;
+  }
+
+ private:
+  std::vector<double> d1_;
+  int r_;
+  int support_;
+  int lines_ = 0;
+  std::vector<std::uint16_t> samples_;
+  std::vector<double> values_;  // the samples as BatchSlopes multiplies them
+  std::vector<double> slopes_;
+  std::array<double, kBatchLines> offset_{};
+  std::array<std::uint8_t, kBatchLines> found_{};
+};
+
 // The sub-pixel offset of a peak that is not flat by rp.method, its samples p(k) reaching h
 // each side.
 template <typename Profile>
@@ -216,50 +345,144 @@ std::optional<double> RefineLine(const RefineParams& rp, const Get& at, int n, i
   return PeakOffset(rp, p, std::min({rp.half_window, available_left, available_right}));
 }
 
+// One line of a batch: what the scan found and what became of it.
+struct BatchLine {
+  enum class Kind : std::uint8_t { kBelowThreshold, kMultiplePeaks, kRefined, kBatched };
+  Kind kind = Kind::kBelowThreshold;
+  int i0 = 0;        // its brightest sample
+  double top = 0.0;  // and that sample's value
+  // kRefined: RefineLine's answer (refined: whether there is one); kBatched: its place in the
+  // StegerBatch.
+  bool refined = false;
+  double offset = 0.0;
+  int slot = 0;
+};
+
+// Refines `line` now, or adds it to `batch` (when given) if its refinement is Steger's slopes:
+// the same answer RefineLine gives, later.
+// The line's samples are first[i * step], i in [0, n).
+template <typename Pixel>
+void RefineOrBatch(const RefineParams& rp, const Pixel* first, std::ptrdiff_t step, int n,
+                   double saturation, StegerBatch* batch, BatchLine* line) {
+  const int i0 = line->i0;
+  const Pixel* centre = first + i0 * step;
+  const Pixel top = *centre;
+  if (batch != nullptr && top < saturation && i0 >= batch->support() &&
+      n - 1 - i0 >= batch->support() && !(centre[step] == top && centre[2 * step] == top)) {
+    line->kind = BatchLine::Kind::kBatched;
+    line->slot = batch->Add(centre, step);
+    return;
+  }
+  line->kind = BatchLine::Kind::kRefined;
+  const auto at = [first, step](int i) { return static_cast<double>(first[i * step]); };
+  const std::optional<double> offset = RefineLine(rp, at, n, i0, saturation);
+  line->refined = offset.has_value();
+  line->offset = offset.value_or(0.0);
+}
+
+// Whether a line of a computed batch carries a peak, and if so its offset; the reason counted
+// when it does not.
+bool CountedOffset(const BatchLine& line, const StegerBatch& batch, StripeDetection* result,
+                   double* offset) {
+  bool refined = false;
+  switch (line.kind) {
+    case BatchLine::Kind::kBelowThreshold:
+      ++result->below_threshold;
+      return false;
+    case BatchLine::Kind::kMultiplePeaks:
+      ++result->multiple_peaks;
+      return false;
+    case BatchLine::Kind::kRefined:
+      refined = line.refined;
+      *offset = line.offset;
+      break;
+    case BatchLine::Kind::kBatched:
+      refined = batch.Refined(line.slot, offset);
+      break;
+  }
+  if (!refined) ++result->unrefined;
+  return refined;
+}
+
 // The one pass over the frame, in row order: each column's maximum over each block of
-// kBlockRows rows and the first row of the block reaching it (a row strictly brighter than the
-// block's maximum so far moves both), then each column's maximum and the first block reaching
-// it, hence arg: the first row of the column with its brightest value.
+// kBlockRows rows, and, while the block's maxima are in the first-level cache, each column's
+// maximum so far and the first block reaching it.
 template <typename Pixel>
 [[gnu::always_inline]] inline void ColumnMaxima(const StripeImage& image,
                                                 ColumnScratch<Pixel>& scratch) {
   const int width = image.width_px;
   const int height = image.height_px;
   const int blocks = (height + kBlockRows - 1) / kBlockRows;
-  for (int b = 0; b < blocks; ++b) {
-    Pixel* __restrict out = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
-    std::uint8_t* __restrict at = scratch.block_arg.data() + static_cast<std::size_t>(b) * width;
-    const int v_begin = b * kBlockRows;
-    const int v_end = std::min(height, v_begin + kBlockRows);
-    const Pixel* __restrict first = image.Row<Pixel>(v_begin);
-    std::copy(first, first + width, out);
-    std::fill(at, at + width, std::uint8_t{0});
-    for (int v = v_begin + 1; v < v_end; ++v) {
-      const Pixel* __restrict row = image.Row<Pixel>(v);
-      const std::uint8_t k = static_cast<std::uint8_t>(v - v_begin);
-      for (int u = 0; u < width; ++u) {
-        const bool brighter = row[u] > out[u];
-        out[u] = brighter ? row[u] : out[u];
-        at[u] = brighter ? k : at[u];
-      }
-    }
-  }
   Pixel* __restrict max = scratch.max.data();
   std::uint16_t* __restrict first_block = scratch.first_block.data();
   std::fill(max, max + width, Pixel{0});
   std::fill(first_block, first_block + width, std::uint16_t{0});
   for (int b = 0; b < blocks; ++b) {
-    const Pixel* __restrict block = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
+    Pixel* __restrict out = scratch.block_max.data() + static_cast<std::size_t>(b) * width;
+    const int v_begin = b * kBlockRows;
+    const int v_end = std::min(height, v_begin + kBlockRows);
+    const Pixel* __restrict first = image.Row<Pixel>(v_begin);
+    std::copy(first, first + width, out);
+    for (int v = v_begin + 1; v < v_end; ++v) {
+      const Pixel* __restrict row = image.Row<Pixel>(v);
+      for (int u = 0; u < width; ++u) out[u] = std::max(out[u], row[u]);
+    }
     const std::uint16_t bb = static_cast<std::uint16_t>(b);
     for (int u = 0; u < width; ++u) {
-      const bool brighter = block[u] > max[u];
-      max[u] = brighter ? block[u] : max[u];
+      const bool brighter = out[u] > max[u];
+      max[u] = brighter ? out[u] : max[u];
       first_block[u] = brighter ? bb : first_block[u];
     }
   }
-  for (int u = 0; u < width; ++u) {
-    const std::size_t b = first_block[u];
-    scratch.arg[u] = static_cast<std::uint16_t>(b * kBlockRows + scratch.block_arg[b * width + u]);
+}
+
+// Rows a group of columns (kBatchLines) reads row by row at most; a group whose columns need
+// rows farther apart (their brightest blocks, or their candidate blocks) is read column by
+// column. A stripe crosses a group within a block or two.
+constexpr int kGroupRows = 4 * kBlockRows;
+
+// The least and the greatest of values[i], i in [0, n): two reductions the compiler vectorises.
+inline std::pair<int, int> LeastAndGreatest(const std::uint16_t* __restrict values, int n) {
+  std::uint16_t least = 0xFFFF;
+  std::uint16_t greatest = 0;
+  for (int i = 0; i < n; ++i) least = std::min(least, values[i]);
+  for (int i = 0; i < n; ++i) greatest = std::max(greatest, values[i]);
+  return {least, greatest};
+}
+
+// arg[u] for the columns [u_begin, u_end): the first row of u with its maximum, which lies in
+// its first block reaching it (rows before that block are darker). Rows read from the last up,
+// so that the first row matching is written last.
+template <typename Pixel>
+[[gnu::always_inline]] inline void GroupArgs(const StripeImage& image, int u_begin, int u_end,
+                                             ColumnScratch<Pixel>& scratch) {
+  const int height = image.height_px;
+  const std::uint16_t* first_block = scratch.first_block.data();
+  const auto block_end = [&](int u) { return std::min(height, (first_block[u] + 1) * kBlockRows); };
+  const auto [first, last] = LeastAndGreatest(first_block + u_begin, u_end - u_begin);
+  const int begin = first * kBlockRows;
+  const int end = std::min(height, (last + 1) * kBlockRows);
+  const Pixel* __restrict max = scratch.max.data();
+  std::uint16_t* __restrict arg = scratch.arg.data();
+  if (end - begin <= kGroupRows) {
+    std::uint16_t* __restrict ends = scratch.group_end.data();
+    for (int u = u_begin; u < u_end; ++u)
+      ends[u - u_begin] = static_cast<std::uint16_t>(block_end(u));
+    for (int v = end - 1; v >= begin; --v) {
+      const Pixel* __restrict row = image.Row<Pixel>(v);
+      const std::uint16_t vv = static_cast<std::uint16_t>(v);
+      for (int u = u_begin; u < u_end; ++u) {
+        const bool here = (row[u] == max[u]) & (vv < ends[u - u_begin]);
+        arg[u] = here ? vv : arg[u];
+      }
+    }
+    return;
+  }
+  const std::ptrdiff_t step = image.stride_bytes / static_cast<std::ptrdiff_t>(sizeof(Pixel));
+  for (int u = u_begin; u < u_end; ++u) {
+    int v = first_block[u] * kBlockRows;
+    for (const Pixel* p = image.Row<Pixel>(v) + u; *p != max[u]; p += step) ++v;
+    arg[u] = static_cast<std::uint16_t>(v);
   }
 }
 
@@ -391,11 +614,90 @@ bool HasSecondPeak(const StripeImage& image, const ColumnScratch<Pixel>& scratch
          peak_in(std::max(v_begin, arg + separation + 1), v_end);
 }
 
+// Whether each column of [u_begin, u_end) holds a second peak (HasSecondPeak), into
+// group_reject: the rows of the columns' candidate blocks read row by row for the whole group,
+// or column by column when they lie far apart. Outside a column's candidate blocks no value
+// reaches its cut, so the rows it would not read add nothing.
+template <typename Pixel>
+[[gnu::always_inline]] inline void GroupSecondPeaks(const StripeImage& image, int u_begin,
+                                                    int u_end, int separation,
+                                                    ColumnScratch<Pixel>& scratch) {
+  const int n = u_end - u_begin;
+  // kNoBlock (no candidate) is the greatest first block and a column's last is kNoBlock with
+  // it: the least first block is that of a column with candidates, if any, and the greatest last
+  // block below kNoBlock is found among those columns alone.
+  const std::uint16_t first = LeastAndGreatest(scratch.first_candidate.data() + u_begin, n).first;
+  if (first == kNoBlock) {
+    std::fill(scratch.group_reject.begin(), scratch.group_reject.begin() + n, std::uint8_t{0});
+    return;
+  }
+  std::uint16_t* __restrict ends = scratch.group_end.data();
+  for (int i = 0; i < n; ++i) {
+    const std::uint16_t last = scratch.last_candidate[u_begin + i];
+    ends[i] = last == kNoBlock ? std::uint16_t{0} : last;
+  }
+  const int last = LeastAndGreatest(ends, n).second;
+  const int begin = std::max(1, first * kBlockRows);
+  const int end = std::min(image.height_px - 1, (last + 1) * kBlockRows);
+  std::uint8_t* __restrict reject = scratch.group_reject.data();
+  if (end - begin > kGroupRows) {
+    for (int u = u_begin; u < u_end; ++u) {
+      reject[u - u_begin] = HasSecondPeak(image, scratch, u, separation) ? 1 : 0;
+    }
+    return;
+  }
+  std::fill(reject, reject + n, std::uint8_t{0});
+  std::uint16_t* __restrict below = scratch.group_below.data();
+  std::uint16_t* __restrict above = scratch.group_above.data();
+  const int reach = std::min(separation, 0xFFFF);  // rows are 16-bit
+  for (int i = 0; i < n; ++i) {
+    const int arg = scratch.arg[u_begin + i];
+    below[i] = static_cast<std::uint16_t>(std::max(arg - reach, 0));
+    above[i] = static_cast<std::uint16_t>(std::min(arg + reach, 0xFFFF));
+  }
+  const Pixel* __restrict cut = scratch.cut.data() + u_begin;
+  for (int v = begin; v < end; ++v) {
+    const Pixel* __restrict up = image.Row<Pixel>(v - 1) + u_begin;
+    const Pixel* __restrict row = image.Row<Pixel>(v) + u_begin;
+    const Pixel* __restrict down = image.Row<Pixel>(v + 1) + u_begin;
+    const std::uint16_t vv = static_cast<std::uint16_t>(v);
+    for (int i = 0; i < n; ++i) {
+      const bool peak = (row[i] > up[i]) & (row[i] >= down[i]) & (row[i] >= cut[i]);
+      const bool apart = (vv < below[i]) | (vv > above[i]);
+      reject[i] |= static_cast<std::uint8_t>(peak & apart);
+    }
+  }
+}
+
+// The row-wise passes of a group of columns, compiled for AVX2 too and chosen at run time.
+template <typename Pixel>
+[[gnu::always_inline]] inline void ScanGroup(const StripeImage& image, int u_begin, int u_end,
+                                             bool reject_multiple, int separation,
+                                             ColumnScratch<Pixel>& scratch) {
+  GroupArgs(image, u_begin, u_end, scratch);
+  if (reject_multiple) GroupSecondPeaks(image, u_begin, u_end, separation, scratch);
+}
+
+__attribute__((target_clones("avx2", "default"))) void ScanGroup8(
+    const StripeImage& image, int u_begin, int u_end, bool reject_multiple, int separation,
+    ColumnScratch<std::uint8_t>& scratch) {
+  ScanGroup(image, u_begin, u_end, reject_multiple, separation, scratch);
+}
+
+__attribute__((target_clones("avx2", "default"))) void ScanGroup16(
+    const StripeImage& image, int u_begin, int u_end, bool reject_multiple, int separation,
+    ColumnScratch<std::uint16_t>& scratch) {
+  ScanGroup(image, u_begin, u_end, reject_multiple, separation, scratch);
+}
+
 }  // namespace
 
 struct StripeDetector::Scratch {
   ColumnScratch<std::uint8_t> mono8;
   ColumnScratch<std::uint16_t> mono16;
+  std::optional<StegerBatch> steger_batch;  // built with the detector's kernel
+  std::array<BatchLine, kBatchLines> lines;
+  StegerBatch& steger() { return *steger_batch; }
 };
 
 StripeDetector::~StripeDetector() = default;
@@ -462,6 +764,7 @@ StripeDetector::StripeDetector(const StripeDetectorOptions& options)
   for (int j = -steger_radius_; j <= steger_radius_; ++j) {
     steger_d1_[j + steger_radius_] = gauss(j - 0.5) - gauss(j + 0.5);
   }
+  scratch_->steger_batch.emplace(steger_d1_);
   switch (options_.method) {
     case StripeMethod::kMaximum:
       support_radius_ = 0;
@@ -516,61 +819,80 @@ void StripeDetector::DetectColumns(const StripeImage& image, StripeDetection* re
   const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
   const double saturation = MaxPixelValue(image.format);
   const Pixel* __restrict max = scratch->max.data();
-  for (int u = 0; u < width; ++u) {
-    const double top = max[u];
-    if (top < options_.threshold) {
-      ++result->below_threshold;
-      continue;
+  const std::ptrdiff_t step = image.stride_bytes / static_cast<std::ptrdiff_t>(sizeof(Pixel));
+  StegerBatch* batch = options_.method == StripeMethod::kSteger ? &scratch_->steger() : nullptr;
+  std::array<BatchLine, kBatchLines>& lines = scratch_->lines;
+  for (int begin = 0; begin < width; begin += kBatchLines) {
+    const int end = std::min(width, begin + kBatchLines);
+    if (batch != nullptr) batch->Clear();
+    if constexpr (sizeof(Pixel) == 1) {
+      ScanGroup8(image, begin, end, reject_multiple, options_.min_separation_px, *scratch);
+    } else {
+      ScanGroup16(image, begin, end, reject_multiple, options_.min_separation_px, *scratch);
     }
-    if (reject_multiple && HasSecondPeak(image, *scratch, u, options_.min_separation_px)) {
-      ++result->multiple_peaks;
-      continue;
+    for (int u = begin; u < end; ++u) {
+      BatchLine& line = lines[static_cast<std::size_t>(u - begin)];
+      line.i0 = arg[u];
+      line.top = max[u];
+      if (line.top < options_.threshold) {
+        line.kind = BatchLine::Kind::kBelowThreshold;
+      } else if (reject_multiple && scratch->group_reject[static_cast<std::size_t>(u - begin)]) {
+        line.kind = BatchLine::Kind::kMultiplePeaks;
+      } else {
+        RefineOrBatch(rp, image.Row<Pixel>(0) + u, step, height, saturation, batch, &line);
+      }
     }
-    const Pixel* column = image.Row<Pixel>(0) + u;
-    const std::ptrdiff_t step = image.stride_bytes / static_cast<std::ptrdiff_t>(sizeof(Pixel));
-    const auto at = [column, step](int v) { return static_cast<double>(column[v * step]); };
-    const int v0 = arg[u];
-    const std::optional<double> offset = RefineLine(rp, at, height, v0, saturation);
-    if (!offset) {
-      ++result->unrefined;
-      continue;
+    if (batch != nullptr) batch->Compute();
+    for (int u = begin; u < end; ++u) {
+      const BatchLine& line = lines[static_cast<std::size_t>(u - begin)];
+      double offset = 0.0;
+      if (CountedOffset(line, scratch_->steger(), result, &offset)) {
+        result->peaks.push_back({static_cast<double>(u), line.i0 + offset, line.top});
+      }
     }
-    result->peaks.push_back({static_cast<double>(u), v0 + *offset, top});
   }
 }
 
 template <typename Pixel>
 void StripeDetector::DetectRows(const StripeImage& image, StripeDetection* result) {
   const int width = image.width_px;
+  const int height = image.height_px;
   const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
   const double saturation = MaxPixelValue(image.format);
   const bool reject_multiple = options_.max_second_peak_ratio < 1.0;
-  for (int v = 0; v < image.height_px; ++v) {
-    const Pixel* row = image.Row<Pixel>(v);
-    RowScan<Pixel> scan;
-    if constexpr (sizeof(Pixel) == 1) {
-      scan = ScanRow8(row, width, options_.min_separation_px, reject_multiple);
-    } else {
-      scan = ScanRow16(row, width, options_.min_separation_px, reject_multiple);
+  StegerBatch* batch = options_.method == StripeMethod::kSteger ? &scratch_->steger() : nullptr;
+  std::array<BatchLine, kBatchLines>& lines = scratch_->lines;
+  for (int begin = 0; begin < height; begin += kBatchLines) {
+    const int end = std::min(height, begin + kBatchLines);
+    if (batch != nullptr) batch->Clear();
+    for (int v = begin; v < end; ++v) {
+      BatchLine& line = lines[static_cast<std::size_t>(v - begin)];
+      const Pixel* row = image.Row<Pixel>(v);
+      RowScan<Pixel> scan;
+      if constexpr (sizeof(Pixel) == 1) {
+        scan = ScanRow8(row, width, options_.min_separation_px, reject_multiple);
+      } else {
+        scan = ScanRow16(row, width, options_.min_separation_px, reject_multiple);
+      }
+      line.i0 = scan.u0;
+      line.top = scan.top;
+      if (line.top < options_.threshold) {
+        line.kind = BatchLine::Kind::kBelowThreshold;
+      } else if (reject_multiple && scan.second >= options_.threshold &&
+                 scan.second > options_.max_second_peak_ratio * line.top) {
+        line.kind = BatchLine::Kind::kMultiplePeaks;
+      } else {
+        RefineOrBatch(rp, row, 1, width, saturation, batch, &line);
+      }
     }
-    const int u0 = scan.u0;
-    const double top = scan.top;
-    if (top < options_.threshold) {
-      ++result->below_threshold;
-      continue;
+    if (batch != nullptr) batch->Compute();
+    for (int v = begin; v < end; ++v) {
+      const BatchLine& line = lines[static_cast<std::size_t>(v - begin)];
+      double offset = 0.0;
+      if (CountedOffset(line, scratch_->steger(), result, &offset)) {
+        result->peaks.push_back({line.i0 + offset, static_cast<double>(v), line.top});
+      }
     }
-    if (reject_multiple && scan.second >= options_.threshold &&
-        scan.second > options_.max_second_peak_ratio * top) {
-      ++result->multiple_peaks;
-      continue;
-    }
-    const auto at = [row](int u) { return static_cast<double>(row[u]); };
-    const std::optional<double> offset = RefineLine(rp, at, width, u0, saturation);
-    if (!offset) {
-      ++result->unrefined;
-      continue;
-    }
-    result->peaks.push_back({u0 + *offset, static_cast<double>(v), top});
   }
 }
 

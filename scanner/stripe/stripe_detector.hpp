@@ -85,13 +85,15 @@ struct StripeDetection {
 // Finds at most one stripe peak per image column (or row) of Mono8 and Mono16 frames.
 //
 // For kColumns the frame is read once, row by row, keeping each column's maximum over every
-// block of 16 rows and the first row of the block reaching it (loops over contiguous rows that
-// the compiler vectorises); hence each column's maximum and the first row reaching it. With
-// multiple-peak rejection on, only the blocks whose maximum could reject a column are read
-// again, in that column, for a local maximum outside min_separation_px of its brightest pixel.
-// Only then is each column's profile
-// read around its maximum and refined to sub-pixel by the configured method. kRows reads each
-// row directly. Nothing is allocated per pixel; buffers are reused from frame to frame.
+// block of 16 rows (loops over contiguous rows that the compiler vectorises); hence each
+// column's maximum and the first block reaching it. Then, for groups of 128 columns, the few
+// rows around the stripe are read again row by row: for the first row with each column's
+// maximum and, with multiple-peak rejection on, in the blocks whose maximum could reject a
+// column, for a local maximum outside min_separation_px of its brightest pixel (a group whose
+// columns need rows far apart is read column by column). Only then is each column's profile
+// read around its maximum and refined to sub-pixel by the configured method; Steger's slopes
+// are summed for a group's lines together, in the same order as for one, so with the same
+// bits. kRows reads each row directly. Nothing is allocated per frame; buffers are reused.
 //
 // Edges: a line whose refinement needs pixels beyond the image (a stripe whose brightest pixel
 // lies within the method's support of the border: 1 px for the 3-point methods, 4 for
