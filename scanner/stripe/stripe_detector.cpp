@@ -567,10 +567,27 @@ template <typename Pixel>
                                                           int end) {
   Pixel best = 0;
   for (int u = begin; u < end; ++u) {
-    const bool peak = (row[u] > row[u - 1]) & (row[u] >= row[u + 1]);
-    best = std::max(best, peak ? row[u] : Pixel{0});
+    // All ones where row[u] is a local maximum: GCC vectorises the mask, not a select on a bool.
+    const Pixel peak =
+        static_cast<Pixel>(-static_cast<int>((row[u] > row[u - 1]) & (row[u] >= row[u + 1])));
+    best = std::max<Pixel>(best, row[u] & peak);
   }
   return best;
+}
+
+// The first u with row[u] == top (which the row holds): chunks of kChunk pixels compared at once
+// until one holds it, then that chunk pixel by pixel.
+template <typename Pixel>
+[[gnu::always_inline]] inline int FirstEqual(const Pixel* __restrict row, int width, Pixel top) {
+  constexpr int kChunk = 64;
+  int u = 0;
+  for (; u + kChunk <= width; u += kChunk) {
+    Pixel hits = 0;  // of the pixels' width, so that the vector compares stay as wide
+    for (int i = 0; i < kChunk; ++i) hits |= static_cast<Pixel>(-static_cast<int>(row[u + i] == top));
+    if (hits != 0) break;
+  }
+  while (row[u] != top) ++u;
+  return u;
 }
 
 template <typename Pixel>
@@ -578,7 +595,7 @@ template <typename Pixel>
                                                      int separation, bool second_peak) {
   RowScan<Pixel> r;
   for (int u = 0; u < width; ++u) r.top = std::max(r.top, row[u]);
-  while (row[r.u0] != r.top) ++r.u0;
+  r.u0 = FirstEqual(row, width, r.top);
   if (second_peak) {
     r.second = std::max(BrightestLocalMaximum(row, 1, std::max(1, r.u0 - separation)),
                         BrightestLocalMaximum(row, r.u0 + separation + 1, width - 1));
