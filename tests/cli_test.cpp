@@ -154,6 +154,12 @@ TEST(Cli, StripeBenchReportsEachMethodBesideItsLimit) {
       EXPECT_LT(m["rmse_px_sigma1_5"].get<double>(), 0.05) << name;
     }
   }
+  // Along rows, beside its own limit.
+  const nlohmann::json& rows = j.at("rows");
+  EXPECT_GT(rows.at("frames_per_s").get<double>(), 0.0);
+  EXPECT_NEAR(rows.at("fraction_of_limit").get<double>(),
+              rows["frames_per_s"].get<double>() / rows.at("limit_frames_per_s").get<double>(),
+              1e-9);
   std::filesystem::remove(json);
 }
 

@@ -74,6 +74,10 @@ void RunStripe(const StripeArgs& args) {
   const double default_fraction = result.methods.at(result.default_method).fraction_of_limit;
   std::printf("| limit: one pass, running maximum per column | %.0f | 1 | | | | | | |\n",
               result.limit_frames_per_s);
+  std::printf(
+      "\nAlong rows (the frames transposed): default method %.0f frames/s, %.3f of its limit (one "
+      "pass, maximum per row: %.0f frames/s)\n",
+      result.rows.frames_per_s, result.rows.fraction_of_limit, result.rows.limit_frames_per_s);
   std::printf("\nCPU: %s\n", cpu.c_str());
   std::printf(
       "default method %s: %.0f frames/s (target %.0f: %s), %.3f of the limit (target %.1f: %s)\n",
@@ -88,6 +92,13 @@ void RunStripe(const StripeArgs& args) {
          {"limit",
           {{"frames_per_s", result.limit_frames_per_s},
            {"what", "one pass over every pixel in row order, running maximum per column"}}},
+         {"rows",
+          {{"frames_per_s", result.rows.frames_per_s},
+           {"fraction_of_limit", result.rows.fraction_of_limit},
+           {"limit_frames_per_s", result.rows.limit_frames_per_s},
+           {"what",
+            "the default method along rows on the frames transposed; limit: one pass, "
+            "maximum per row"}}},
          {"cpu", cpu},
          {"targets",
           {{"frames_per_s", kTargetFramesPerS},

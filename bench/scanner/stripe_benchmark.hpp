@@ -40,8 +40,18 @@ struct StripeMethodFigures {
   double fraction_of_limit = 0.0;  // frames_per_s / StripeBenchResult::limit_frames_per_s
 };
 
+// The default method along rows (StripeAxis::kRows) on the speed frames transposed (1088 wide,
+// 2048 tall: one stripe crossing every row), beside its own limit: one pass in row order keeping
+// each row's maximum. The two are timed in turn, in passes of their own after the columns'.
+struct StripeRowsFigures {
+  double frames_per_s = 0.0;
+  double limit_frames_per_s = 0.0;
+  double fraction_of_limit = 0.0;  // frames_per_s / limit_frames_per_s
+};
+
 struct StripeBenchResult {
   std::string default_method;  // ToString(StripeDetectorOptions{}.method)
+  StripeRowsFigures rows;
   // The floor of any per-column detector, measured on the same frames in the same run: one
   // pass reading every pixel in row order (the detectors' memory order) that keeps each
   // column's running maximum, and nothing else.
