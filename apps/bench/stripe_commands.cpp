@@ -25,6 +25,31 @@ struct StripeArgs {
   std::string json_path;
 };
 
+// The figures as JSON: the table's, the limits', the targets and the frames'.
+nlohmann::json StripeJson(const bench::StripeBenchResult& result, const nlohmann::json& methods,
+                          const std::string& cpu, const bench::StripeBenchOptions& options) {
+  return {
+      {"default", result.default_method},
+      {"methods", methods},
+      {"limit",
+       {{"frames_per_s", result.limit_frames_per_s},
+        {"what", "one pass over every pixel in row order, running maximum per column"}}},
+      {"rows",
+       {{"frames_per_s", result.rows.frames_per_s},
+        {"fraction_of_limit", result.rows.fraction_of_limit},
+        {"limit_frames_per_s", result.rows.limit_frames_per_s},
+        {"what",
+         "the default method along rows on the frames transposed; limit: one pass, "
+         "maximum per row"}}},
+      {"cpu", cpu},
+      {"targets",
+       {{"frames_per_s", kTargetFramesPerS},
+        {"rmse_px", kTargetRmsePx},
+        {"fraction_of_limit", kTargetFractionOfLimit}}},
+      {"image",
+       {{"width_px", options.width_px}, {"height_px", options.height_px}, {"format", "Mono8"}}}};
+}
+
 void RunStripe(const StripeArgs& args) {
   if (!args.json_path.empty()) {
     const std::filesystem::path parent = std::filesystem::path(args.json_path).parent_path();
@@ -85,29 +110,7 @@ void RunStripe(const StripeArgs& args) {
       default_fps >= kTargetFramesPerS ? "met" : "missed", default_fraction, kTargetFractionOfLimit,
       default_fraction >= kTargetFractionOfLimit ? "met" : "missed");
   if (!args.json_path.empty()) {
-    WriteJsonFile(
-        args.json_path,
-        {{"default", result.default_method},
-         {"methods", methods},
-         {"limit",
-          {{"frames_per_s", result.limit_frames_per_s},
-           {"what", "one pass over every pixel in row order, running maximum per column"}}},
-         {"rows",
-          {{"frames_per_s", result.rows.frames_per_s},
-           {"fraction_of_limit", result.rows.fraction_of_limit},
-           {"limit_frames_per_s", result.rows.limit_frames_per_s},
-           {"what",
-            "the default method along rows on the frames transposed; limit: one pass, "
-            "maximum per row"}}},
-         {"cpu", cpu},
-         {"targets",
-          {{"frames_per_s", kTargetFramesPerS},
-           {"rmse_px", kTargetRmsePx},
-           {"fraction_of_limit", kTargetFractionOfLimit}}},
-         {"image",
-          {{"width_px", options.width_px},
-           {"height_px", options.height_px},
-           {"format", "Mono8"}}}});
+    WriteJsonFile(args.json_path, StripeJson(result, methods, cpu, options));
   }
 }
 
