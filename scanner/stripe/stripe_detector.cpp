@@ -28,6 +28,16 @@ constexpr std::uint16_t kNoBlock = 0xFFFF;
 // whose samples and slopes (15 + 5 doubles a line for sigma 1.5) stay in the first-level cache.
 constexpr int kBatchLines = 128;
 
+// The lowest value that rejects a line whose brightest pixel is `top` as holding a second peak
+// (at least `threshold` and above ratio * top): for integer values c, c >= threshold and
+// c >= floor(ratio * top) + 1, at most the format's largest value.
+template <typename Pixel>
+Pixel SecondPeakCut(double top, int threshold, double ratio) {
+  constexpr double kTop = static_cast<double>(std::numeric_limits<Pixel>::max());
+  const double lowest = std::max<double>(threshold, std::floor(ratio * top) + 1.0);
+  return static_cast<Pixel>(std::min(lowest, kTop));
+}
+
 // Buffers of the column scan, reused from frame to frame.
 template <typename Pixel>
 struct ColumnScratch {
@@ -503,11 +513,8 @@ template <typename Pixel>
 [[gnu::always_inline]] inline void SecondPeakCandidates(int width, int blocks, int threshold,
                                                         double ratio,
                                                         ColumnScratch<Pixel>& scratch) {
-  constexpr double kTop = static_cast<double>(std::numeric_limits<Pixel>::max());
   for (int u = 0; u < width; ++u) {
-    // Integer values c with c >= threshold and c > ratio * top: c >= floor(ratio * top) + 1.
-    const double lowest = std::max<double>(threshold, std::floor(ratio * scratch.max[u]) + 1.0);
-    scratch.cut[u] = static_cast<Pixel>(std::min(lowest, kTop));
+    scratch.cut[u] = SecondPeakCut<Pixel>(scratch.max[u], threshold, ratio);
   }
   std::uint16_t* __restrict first = scratch.first_candidate.data();
   std::uint16_t* __restrict last = scratch.last_candidate.data();
@@ -551,28 +558,33 @@ __attribute__((target_clones("avx2", "default"))) void ScanColumns16(
   ScanColumns(image, reject_multiple, threshold, ratio, scratch);
 }
 
-// A row's brightest pixel (the first of equal maxima) and the brightest of its other local
-// maxima (brighter than the pixel before, at least as bright as the one after: a flat top
-// counts once) farther than `separation` from it; 0 when there is none. Branch-free loops the
-// compiler vectorises.
+// A row's brightest pixel (the first of equal maxima) and whether it holds a second peak: a
+// local maximum (brighter than the pixel before, at least as bright as the one after: a flat top
+// counts once) farther than `separation` from it that reaches the cut (SecondPeakCut).
+// Branch-free loops the compiler vectorises.
 template <typename Pixel>
 struct RowScan {
   int u0 = 0;
   Pixel top = 0;
-  Pixel second = 0;
+  bool second_peak = false;
 };
 
+// Whether row[u], u in [begin, end), holds a local maximum of at least `cut`; the local maxima
+// are looked for only where a pixel reaches the cut (one compare a pixel), on most rows nowhere.
 template <typename Pixel>
-[[gnu::always_inline]] inline Pixel BrightestLocalMaximum(const Pixel* __restrict row, int begin,
-                                                          int end) {
+[[gnu::always_inline]] inline bool HasLocalMaximumFrom(const Pixel* __restrict row, int begin,
+                                                       int end, Pixel cut) {
+  Pixel reaching = 0;  // masks of the pixels' width, which GCC vectorises (a bool it does not)
+  for (int u = begin; u < end; ++u)
+    reaching |= static_cast<Pixel>(-static_cast<int>(row[u] >= cut));
+  if (reaching == 0) return false;
   Pixel best = 0;
   for (int u = begin; u < end; ++u) {
-    // All ones where row[u] is a local maximum: GCC vectorises the mask, not a select on a bool.
     const Pixel peak =
         static_cast<Pixel>(-static_cast<int>((row[u] > row[u - 1]) & (row[u] >= row[u + 1])));
     best = std::max<Pixel>(best, row[u] & peak);
   }
-  return best;
+  return best >= cut;
 }
 
 // The first u with row[u] == top (which the row holds): chunks of kChunk pixels compared at once
@@ -582,35 +594,63 @@ template <typename Pixel>
   constexpr int kChunk = 64;
   int u = 0;
   for (; u + kChunk <= width; u += kChunk) {
-    Pixel hits = 0;  // of the pixels' width, so that the vector compares stay as wide
-    for (int i = 0; i < kChunk; ++i) hits |= static_cast<Pixel>(-static_cast<int>(row[u + i] == top));
+    Pixel hits = 0;
+    for (int i = 0; i < kChunk; ++i)
+      hits |= static_cast<Pixel>(-static_cast<int>(row[u + i] == top));
     if (hits != 0) break;
   }
   while (row[u] != top) ++u;
   return u;
 }
 
+// The second-peak test runs when ratio < 1 (StripeDetectorOptions::max_second_peak_ratio) on a
+// row whose top reaches the threshold.
 template <typename Pixel>
 [[gnu::always_inline]] inline RowScan<Pixel> ScanRow(const Pixel* __restrict row, int width,
-                                                     int separation, bool second_peak) {
+                                                     int separation, int threshold, double ratio) {
   RowScan<Pixel> r;
   for (int u = 0; u < width; ++u) r.top = std::max(r.top, row[u]);
   r.u0 = FirstEqual(row, width, r.top);
-  if (second_peak) {
-    r.second = std::max(BrightestLocalMaximum(row, 1, std::max(1, r.u0 - separation)),
-                        BrightestLocalMaximum(row, r.u0 + separation + 1, width - 1));
+  if (ratio < 1.0 && r.top >= threshold) {
+    const Pixel cut = SecondPeakCut<Pixel>(r.top, threshold, ratio);
+    const int reach = std::min(separation, width);  // no overflow past the row
+    r.second_peak = HasLocalMaximumFrom(row, 1, std::max(1, r.u0 - reach), cut) ||
+                    HasLocalMaximumFrom(row, r.u0 + reach + 1, width - 1, cut);
   }
   return r;
 }
 
-__attribute__((target_clones("avx2", "default"))) RowScan<std::uint8_t> ScanRow8(
-    const std::uint8_t* row, int width, int separation, bool second_peak) {
-  return ScanRow(row, width, separation, second_peak);
+// The scans of rows [begin, end) into lines[v - begin]: the brightest pixel, and whether the
+// row is below the threshold, holds a second peak, or is to be refined (kRefined). One call for
+// many rows, compiled for AVX2 too and chosen at run time.
+template <typename Pixel>
+[[gnu::always_inline]] inline void ScanRows(const StripeImage& image, int begin, int end,
+                                            int separation, int threshold, double ratio,
+                                            BatchLine* lines) {
+  for (int v = begin; v < end; ++v) {
+    const RowScan<Pixel> scan =
+        ScanRow(image.Row<Pixel>(v), image.width_px, separation, threshold, ratio);
+    BatchLine& line = lines[v - begin];
+    line.i0 = scan.u0;
+    line.top = scan.top;
+    line.kind = scan.top < threshold ? BatchLine::Kind::kBelowThreshold
+                : scan.second_peak   ? BatchLine::Kind::kMultiplePeaks
+                                     : BatchLine::Kind::kRefined;
+  }
 }
 
-__attribute__((target_clones("avx2", "default"))) RowScan<std::uint16_t> ScanRow16(
-    const std::uint16_t* row, int width, int separation, bool second_peak) {
-  return ScanRow(row, width, separation, second_peak);
+__attribute__((target_clones("avx2", "default"))) void ScanRows8(const StripeImage& image,
+                                                                 int begin, int end, int separation,
+                                                                 int threshold, double ratio,
+                                                                 BatchLine* lines) {
+  ScanRows<std::uint8_t>(image, begin, end, separation, threshold, ratio, lines);
+}
+
+__attribute__((target_clones("avx2", "default"))) void ScanRows16(const StripeImage& image,
+                                                                  int begin, int end,
+                                                                  int separation, int threshold,
+                                                                  double ratio, BatchLine* lines) {
+  ScanRows<std::uint16_t>(image, begin, end, separation, threshold, ratio, lines);
 }
 
 // Whether column u holds a second peak that rejects it: an interior local maximum (brighter
@@ -886,30 +926,22 @@ void StripeDetector::DetectRows(const StripeImage& image, StripeDetection* resul
   const int height = image.height_px;
   const RefineParams rp{options_.method, options_.window_px / 2, support_radius_, steger_d1_};
   const double saturation = MaxPixelValue(image.format);
-  const bool reject_multiple = options_.max_second_peak_ratio < 1.0;
   StegerBatch* batch = options_.method == StripeMethod::kSteger ? &scratch_->steger() : nullptr;
   std::array<BatchLine, kBatchLines>& lines = scratch_->lines;
   for (int begin = 0; begin < height; begin += kBatchLines) {
     const int end = std::min(height, begin + kBatchLines);
     if (batch != nullptr) batch->Clear();
+    if constexpr (sizeof(Pixel) == 1) {
+      ScanRows8(image, begin, end, options_.min_separation_px, options_.threshold,
+                options_.max_second_peak_ratio, lines.data());
+    } else {
+      ScanRows16(image, begin, end, options_.min_separation_px, options_.threshold,
+                 options_.max_second_peak_ratio, lines.data());
+    }
     for (int v = begin; v < end; ++v) {
       BatchLine& line = lines[static_cast<std::size_t>(v - begin)];
-      const Pixel* row = image.Row<Pixel>(v);
-      RowScan<Pixel> scan;
-      if constexpr (sizeof(Pixel) == 1) {
-        scan = ScanRow8(row, width, options_.min_separation_px, reject_multiple);
-      } else {
-        scan = ScanRow16(row, width, options_.min_separation_px, reject_multiple);
-      }
-      line.i0 = scan.u0;
-      line.top = scan.top;
-      if (line.top < options_.threshold) {
-        line.kind = BatchLine::Kind::kBelowThreshold;
-      } else if (reject_multiple && scan.second >= options_.threshold &&
-                 scan.second > options_.max_second_peak_ratio * line.top) {
-        line.kind = BatchLine::Kind::kMultiplePeaks;
-      } else {
-        RefineOrBatch(rp, row, 1, width, saturation, batch, &line);
+      if (line.kind == BatchLine::Kind::kRefined) {
+        RefineOrBatch(rp, image.Row<Pixel>(v), 1, width, saturation, batch, &line);
       }
     }
     if (batch != nullptr) batch->Compute();
