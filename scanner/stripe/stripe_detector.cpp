@@ -8,25 +8,30 @@
 #include <vector>
 
 #include "scanner/common/option_checks.hpp"
+#include "scanner/stripe/steger_batch.hpp"
+#include "scanner/stripe/zero_crossing.hpp"
 
 namespace uwscan::scanner {
 namespace {
+
+using stripe_detail::kCrossingReach;
+using stripe_detail::StegerBatch;
+using stripe_detail::ZeroCrossingNear;
 
 constexpr std::array<StripeMethod, 6> kAllMethods = {
     StripeMethod::kMaximum,  StripeMethod::kCentreOfMass, StripeMethod::kGaussian,
     StripeMethod::kParabola, StripeMethod::kBlaisRioux,   StripeMethod::kSteger};
 
 // Rows per block of the column scan. The one pass over the frame keeps each column's maximum
-// per block and the row of the block reaching it first (for 2048x1088 Mono8, 68 blocks: 2 x 139
-// KB, in cache); the few blocks that can hold a second peak are then read again, only in that
-// column.
+// per block (for 2048x1088 Mono8, 68 blocks: 139 KB, in cache); the rows of the blocks that hold
+// a column's maximum or could hold a second peak are then read again (GroupArgs,
+// GroupSecondPeaks).
 constexpr int kBlockRows = 16;
 constexpr std::uint16_t kNoBlock = 0xFFFF;
 
 // Lines handled together: a group of columns whose rows around the stripe are read row by row
-// (GroupArgs, GroupSecondPeaks), and the lines whose refinement waits for a batch (StegerBatch),
-// whose samples and slopes (15 + 5 doubles a line for sigma 1.5) stay in the first-level cache.
-constexpr int kBatchLines = 128;
+// (GroupArgs, GroupSecondPeaks), and the lines whose refinement waits for a StegerBatch.
+constexpr int kBatchLines = StegerBatch::kLines;
 
 // The lowest value that rejects a line whose brightest pixel is `top` as holding a second peak
 // (at least `threshold` and above ratio * top): for integer values c, c >= threshold and
@@ -73,31 +78,6 @@ struct RefineParams {
   int support;                        // pixels needed each side of the brightest one
   std::span<const double> steger_d1;  // k = -R..R
 };
-
-// Where a slope-like response s(k) (positive before the peak, negative after) falls through zero
-// within kCrossingReach samples of 0, linearly interpolated; std::nullopt if it does not.
-constexpr int kCrossingReach = 2;
-
-template <typename Slope>
-std::optional<double> ZeroCrossingNear(const Slope& s) {
-  const double s0 = s(0);
-  if (s0 > 0.0) {
-    double previous = s0;
-    for (int k = 1; k <= kCrossingReach; ++k) {
-      const double next = s(k);
-      if (next <= 0.0) return k - 1 + previous / (previous - next);
-      previous = next;
-    }
-    return std::nullopt;
-  }
-  double next = s0;
-  for (int k = -1; k >= -kCrossingReach; --k) {
-    const double previous = s(k);
-    if (previous > 0.0) return k + previous / (previous - next);
-    next = previous;
-  }
-  return std::nullopt;
-}
 
 // The lowest of the samples p(k), k in [-left, right], and `top`.
 template <typename Profile>
@@ -182,138 +162,6 @@ std::optional<double> StegerOffset(const Profile& p, std::span<const double> ste
   };
   return ZeroCrossingNear(d);
 }
-
-// The zero crossing of ZeroCrossingNear for a batch of lines, from their slopes d(k),
-// slopes[(k + kCrossingReach) * kBatchLines + line]: the same pair of samples chosen and the
-// same arithmetic, without a branch (which way the crossing lies is a coin toss per line).
-// found[line] says whether there is one; offset[line] is it.
-[[gnu::always_inline]] inline void BatchCrossings(const double* __restrict slopes, int lines,
-                                                  double* __restrict offset,
-                                                  std::uint8_t* __restrict found) {
-  static_assert(kCrossingReach == 2);
-  const double* __restrict back2 = slopes;
-  const double* __restrict back1 = slopes + kBatchLines;
-  const double* __restrict at0 = slopes + 2 * kBatchLines;
-  const double* __restrict ahead1 = slopes + 3 * kBatchLines;
-  const double* __restrict ahead2 = slopes + 4 * kBatchLines;
-  for (int line = 0; line < lines; ++line) {
-    const double sm2 = back2[line];
-    const double sm1 = back1[line];
-    const double s0 = at0[line];
-    const double s1 = ahead1[line];
-    const double s2 = ahead2[line];
-    const bool rising = s0 > 0.0;
-    // Rising: between 0 and 1 when d(1) <= 0, else between 1 and 2 when d(2) <= 0.
-    const bool near_ahead = s1 <= 0.0;
-    const double ahead_base = near_ahead ? 0.0 : 1.0;
-    const double ahead_previous = near_ahead ? s0 : s1;
-    const double ahead_next = near_ahead ? s1 : s2;
-    const bool ahead_found = near_ahead | (s2 <= 0.0);
-    // Falling: between -1 and 0 when d(-1) > 0, else between -2 and -1 when d(-2) > 0.
-    const bool near_back = sm1 > 0.0;
-    const double back_base = near_back ? -1.0 : -2.0;
-    const double back_previous = near_back ? sm1 : sm2;
-    const double back_next = near_back ? s0 : sm1;
-    const bool back_found = near_back | (sm2 > 0.0);
-    const double base = rising ? ahead_base : back_base;
-    const double previous = rising ? ahead_previous : back_previous;
-    const double next = rising ? ahead_next : back_next;
-    offset[line] = base + previous / (previous - next);
-    found[line] = static_cast<std::uint8_t>((rising & ahead_found) | (!rising & back_found));
-  }
-}
-
-constexpr int kSlopeLanes = 8;
-
-// The slopes d(k), |k| <= kCrossingReach, of a batch of lines, each as StegerOffset sums it
-// (the same products added in the same order from 0, so the same bits), and their zero
-// crossings (BatchCrossings). One line's sum is a chain of dependent additions; across lines
-// they are independent, and the compiler vectorises them.
-// samples[(k + support) * kBatchLines + line], |k| <= support = r + kCrossingReach, and values
-// the same as doubles; slopes[(k + kCrossingReach) * kBatchLines + line]; d1 holds 2r + 1
-// weights. kSlopeLanes lines are summed together, held in registers across the kernel's taps.
-__attribute__((target_clones("avx2", "default"))) void BatchSlopes(
-    const std::uint16_t* __restrict samples, const double* __restrict d1, int r, int lines,
-    double* __restrict values, double* __restrict slopes, double* __restrict offset,
-    std::uint8_t* __restrict found) {
-  const int support = r + kCrossingReach;
-  // Whole groups of lanes: the lines past `lines` hold earlier batches' samples, unused.
-  const int padded = (lines + kSlopeLanes - 1) / kSlopeLanes * kSlopeLanes;
-  for (int i = 0; i < (2 * support + 1) * kBatchLines; ++i) {
-    values[i] = static_cast<double>(samples[i]);
-  }
-  for (int k = -kCrossingReach; k <= kCrossingReach; ++k) {
-    for (int first = 0; first < padded; first += kSlopeLanes) {
-      std::array<double, kSlopeLanes> sum{};
-      for (int j = -r; j <= r; ++j) {
-        const double* __restrict p = values + (k + j + support) * kBatchLines + first;
-        const double w = d1[j + r];
-        for (int lane = 0; lane < kSlopeLanes; ++lane) sum[lane] += p[lane] * w;
-      }
-      std::copy(sum.begin(), sum.end(), slopes + (k + kCrossingReach) * kBatchLines + first);
-    }
-  }
-  BatchCrossings(slopes, lines, offset, found);
-}
-
-// Steger's refinement of many lines at once (BatchSlopes): a line whose brightest sample is a
-// single or double top below saturation, with its support inside the image, is added with its
-// samples; the offsets come once the batch is computed.
-class StegerBatch {
-  // The samples each side of the peak for the default steger_sigma_px of 1.5: a kernel radius
-  // of ceil(3 sigma) = 5 and the crossing's reach.
-  static constexpr int kDefaultSupport = 5 + kCrossingReach;
-
- public:
-  explicit StegerBatch(std::span<const double> d1)
-      : d1_(d1.begin(), d1.end()),
-        r_(static_cast<int>(d1.size() / 2)),
-        support_(r_ + kCrossingReach),
-        samples_(static_cast<std::size_t>(2 * support_ + 1) * kBatchLines),
-        values_(samples_.size()),
-        slopes_(static_cast<std::size_t>(2 * kCrossingReach + 1) * kBatchLines) {}
-
-  int support() const { return support_; }
-  void Clear() { lines_ = 0; }
-
-  // Adds the line whose brightest sample is *centre, its neighbours `step` apart; returns its
-  // place in the batch.
-  template <typename Pixel>
-  int Add(const Pixel* centre, std::ptrdiff_t step) {
-    std::uint16_t* out = samples_.data() + lines_;
-    if (support_ == kDefaultSupport) {  // the loop unrolled: 7 % more frames per second
-      for (int k = -kDefaultSupport; k <= kDefaultSupport; ++k) {
-        out[(k + kDefaultSupport) * kBatchLines] = centre[k * step];
-      }
-      return lines_++;
-    }
-    const Pixel* p = centre - support_ * step;
-    for (int k = -support_; k <= support_; ++k, p += step, out += kBatchLines) *out = *p;
-    return lines_++;
-  }
-
-  void Compute() {
-    BatchSlopes(samples_.data(), d1_.data(), r_, lines_, values_.data(), slopes_.data(),
-                offset_.data(), found_.data());
-  }
-
-  // Whether the line's crossing was found, and then where (*offset).
-  bool Refined(int line, double* offset) const {
-    *offset = offset_[static_cast<std::size_t>(line)];
-    return found_[static_cast<std::size_t>(line)] != 0;
-  }
-
- private:
-  std::vector<double> d1_;
-  int r_;
-  int support_;
-  int lines_ = 0;
-  std::vector<std::uint16_t> samples_;
-  std::vector<double> values_;  // the samples as BatchSlopes multiplies them
-  std::vector<double> slopes_;
-  std::array<double, kBatchLines> offset_{};
-  std::array<std::uint8_t, kBatchLines> found_{};
-};
 
 // The sub-pixel offset of a peak that is not flat by rp.method, its samples p(k) reaching h
 // each side.
