@@ -1,5 +1,6 @@
 #include "scanner/stripe/column_scan.hpp"
 
+#include <array>
 #include <cstddef>
 #include <utility>
 
@@ -67,7 +68,7 @@ template <typename Pixel>
   const Pixel* __restrict max = scratch.max.data();
   std::uint16_t* __restrict arg = scratch.arg.data();
   if (end - begin <= kGroupRows) {
-    std::uint16_t* __restrict ends = scratch.group_end.data();
+    std::array<std::uint16_t, kGroupColumns> ends;  // of each column's first block at its max
     for (int u = u_begin; u < u_end; ++u)
       ends[u - u_begin] = static_cast<std::uint16_t>(block_end(u));
     for (int v = end - 1; v >= begin; --v) {
@@ -138,8 +139,9 @@ bool HasSecondPeak(const StripeImage& image, const ColumnScratch<Pixel>& scratch
   const int v_begin = std::max(1, first * kBlockRows);
   const int v_end = std::min(image.height_px - 1, (last + 1) * kBlockRows);
   const int arg = scratch.arg[u];
-  return peak_in(v_begin, std::min(v_end, arg - separation)) ||
-         peak_in(std::max(v_begin, arg + separation + 1), v_end);
+  const int reach = std::min(separation, 0xFFFF);  // rows are 16-bit: no overflow
+  return peak_in(v_begin, std::min(v_end, arg - reach)) ||
+         peak_in(std::max(v_begin, arg + reach + 1), v_end);
 }
 
 // Whether each column of [u_begin, u_end) holds a second peak (HasSecondPeak), into
@@ -159,12 +161,12 @@ template <typename Pixel>
     std::fill(scratch.group_reject.begin(), scratch.group_reject.begin() + n, std::uint8_t{0});
     return;
   }
-  std::uint16_t* __restrict ends = scratch.group_end.data();
+  std::array<std::uint16_t, kGroupColumns> lasts;  // each column's last candidate block, or 0
   for (int i = 0; i < n; ++i) {
     const std::uint16_t last = scratch.last_candidate[u_begin + i];
-    ends[i] = last == kNoBlock ? std::uint16_t{0} : last;
+    lasts[i] = last == kNoBlock ? std::uint16_t{0} : last;
   }
-  const int last = LeastAndGreatest(ends, n).second;
+  const int last = LeastAndGreatest(lasts.data(), n).second;
   const int begin = std::max(1, first * kBlockRows);
   const int end = std::min(image.height_px - 1, (last + 1) * kBlockRows);
   std::uint8_t* __restrict reject = scratch.group_reject.data();
@@ -175,8 +177,8 @@ template <typename Pixel>
     return;
   }
   std::fill(reject, reject + n, std::uint8_t{0});
-  std::uint16_t* __restrict below = scratch.group_below.data();
-  std::uint16_t* __restrict above = scratch.group_above.data();
+  // The rows around each column's brightest pixel that the test skips: those in [below, above].
+  std::array<std::uint16_t, kGroupColumns> below, above;
   const int reach = std::min(separation, 0xFFFF);  // rows are 16-bit
   for (int i = 0; i < n; ++i) {
     const int arg = scratch.arg[u_begin + i];

@@ -45,9 +45,7 @@ struct ColumnScratch {
   // last block whose maximum reaches it (kNoBlock: none).
   std::vector<Pixel> cut;
   std::vector<std::uint16_t> first_candidate, last_candidate;
-  // For the group of columns at hand: the end of each one's first block reaching its maximum,
-  // the rows around its brightest pixel that the second-peak test skips, and its verdict.
-  std::array<std::uint16_t, kGroupColumns> group_end, group_below, group_above;
+  // For the group of columns at hand (ScanGroup): whether each holds a second peak.
   std::array<std::uint8_t, kGroupColumns> group_reject;
 
   void Resize(int width, int blocks) {

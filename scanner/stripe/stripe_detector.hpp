@@ -93,7 +93,8 @@ struct StripeDetection {
 // columns need rows far apart is read column by column). Only then is each column's profile
 // read around its maximum and refined to sub-pixel by the configured method; Steger's slopes
 // are summed for a group's lines together, in the same order as for one, so with the same
-// bits. kRows reads each row directly. Nothing is allocated per frame; buffers are reused.
+// bits. kRows reads each row directly. Buffers are reused from frame to frame: once grown to
+// the frame size, nothing more is allocated.
 //
 // Edges: a line whose refinement needs pixels beyond the image (a stripe whose brightest pixel
 // lies within the method's support of the border: 1 px for the 3-point methods, 4 for
