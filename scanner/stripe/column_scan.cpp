@@ -186,6 +186,8 @@ template <typename Pixel>
     above[i] = static_cast<std::uint16_t>(std::min(arg + reach, 0xFFFF));
   }
   const Pixel* __restrict cut = scratch.cut.data() + u_begin;
+  const std::uint16_t* __restrict skip_from = below.data();
+  const std::uint16_t* __restrict skip_to = above.data();
   for (int v = begin; v < end; ++v) {
     const Pixel* __restrict up = image.Row<Pixel>(v - 1) + u_begin;
     const Pixel* __restrict row = image.Row<Pixel>(v) + u_begin;
@@ -193,7 +195,7 @@ template <typename Pixel>
     const std::uint16_t vv = static_cast<std::uint16_t>(v);
     for (int i = 0; i < n; ++i) {
       const bool peak = (row[i] > up[i]) & (row[i] >= down[i]) & (row[i] >= cut[i]);
-      const bool apart = (vv < below[i]) | (vv > above[i]);
+      const bool apart = (vv < skip_from[i]) | (vv > skip_to[i]);
       reject[i] |= static_cast<std::uint8_t>(peak & apart);
     }
   }
