@@ -9,6 +9,7 @@
 
 #include "scanner/common/option_checks.hpp"
 #include "scanner/stripe/column_scan.hpp"
+#include "scanner/stripe/row_scan.hpp"
 #include "scanner/stripe/steger_batch.hpp"
 #include "scanner/stripe/zero_crossing.hpp"
 
@@ -232,101 +233,6 @@ bool CountedOffset(const BatchLine& line, const StegerBatch& batch, StripeDetect
   return refined;
 }
 
-// A row's brightest pixel (the first of equal maxima) and whether it holds a second peak: a
-// local maximum (brighter than the pixel before, at least as bright as the one after: a flat top
-// counts once) farther than `separation` from it that reaches the cut (SecondPeakCut).
-// Branch-free loops the compiler vectorises.
-template <typename Pixel>
-struct RowScan {
-  int u0 = 0;
-  Pixel top = 0;
-  bool second_peak = false;
-};
-
-// Whether row[u], u in [begin, end), holds a local maximum of at least `cut`; the local maxima
-// are looked for only where a pixel reaches the cut (one compare a pixel), on most rows nowhere.
-template <typename Pixel>
-[[gnu::always_inline]] inline bool HasLocalMaximumFrom(const Pixel* __restrict row, int begin,
-                                                       int end, Pixel cut) {
-  Pixel reaching = 0;  // masks of the pixels' width, which GCC vectorises (a bool it does not)
-  for (int u = begin; u < end; ++u)
-    reaching |= static_cast<Pixel>(-static_cast<int>(row[u] >= cut));
-  if (reaching == 0) return false;
-  Pixel best = 0;
-  for (int u = begin; u < end; ++u) {
-    const Pixel peak =
-        static_cast<Pixel>(-static_cast<int>((row[u] > row[u - 1]) & (row[u] >= row[u + 1])));
-    best = std::max<Pixel>(best, row[u] & peak);
-  }
-  return best >= cut;
-}
-
-// The first u with row[u] == top (which the row holds): chunks of kChunk pixels compared at once
-// until one holds it, then that chunk pixel by pixel.
-template <typename Pixel>
-[[gnu::always_inline]] inline int FirstEqual(const Pixel* __restrict row, int width, Pixel top) {
-  constexpr int kChunk = 64;
-  int u = 0;
-  for (; u + kChunk <= width; u += kChunk) {
-    Pixel hits = 0;
-    for (int i = 0; i < kChunk; ++i)
-      hits |= static_cast<Pixel>(-static_cast<int>(row[u + i] == top));
-    if (hits != 0) break;
-  }
-  while (row[u] != top) ++u;
-  return u;
-}
-
-// The second-peak test runs when ratio < 1 (StripeDetectorOptions::max_second_peak_ratio) on a
-// row whose top reaches the threshold.
-template <typename Pixel>
-[[gnu::always_inline]] inline RowScan<Pixel> ScanRow(const Pixel* __restrict row, int width,
-                                                     int separation, int threshold, double ratio) {
-  RowScan<Pixel> r;
-  for (int u = 0; u < width; ++u) r.top = std::max(r.top, row[u]);
-  r.u0 = FirstEqual(row, width, r.top);
-  if (ratio < 1.0 && r.top >= threshold) {
-    const Pixel cut = SecondPeakCut<Pixel>(r.top, threshold, ratio);
-    const int reach = std::min(separation, width);  // no overflow past the row
-    r.second_peak = HasLocalMaximumFrom(row, 1, std::max(1, r.u0 - reach), cut) ||
-                    HasLocalMaximumFrom(row, r.u0 + reach + 1, width - 1, cut);
-  }
-  return r;
-}
-
-// The scans of rows [begin, end) into lines[v - begin]: the brightest pixel, and whether the
-// row is below the threshold, holds a second peak, or is to be refined (kRefined). One call for
-// many rows, compiled for AVX2 too and chosen at run time.
-template <typename Pixel>
-[[gnu::always_inline]] inline void ScanRows(const StripeImage& image, int begin, int end,
-                                            int separation, int threshold, double ratio,
-                                            BatchLine* lines) {
-  for (int v = begin; v < end; ++v) {
-    const RowScan<Pixel> scan =
-        ScanRow(image.Row<Pixel>(v), image.width_px, separation, threshold, ratio);
-    BatchLine& line = lines[v - begin];
-    line.i0 = scan.u0;
-    line.top = scan.top;
-    line.kind = scan.top < threshold ? BatchLine::Kind::kBelowThreshold
-                : scan.second_peak   ? BatchLine::Kind::kMultiplePeaks
-                                     : BatchLine::Kind::kRefined;
-  }
-}
-
-__attribute__((target_clones("avx2", "default"))) void ScanRows8(const StripeImage& image,
-                                                                 int begin, int end, int separation,
-                                                                 int threshold, double ratio,
-                                                                 BatchLine* lines) {
-  ScanRows<std::uint8_t>(image, begin, end, separation, threshold, ratio, lines);
-}
-
-__attribute__((target_clones("avx2", "default"))) void ScanRows16(const StripeImage& image,
-                                                                  int begin, int end,
-                                                                  int separation, int threshold,
-                                                                  double ratio, BatchLine* lines) {
-  ScanRows<std::uint16_t>(image, begin, end, separation, threshold, ratio, lines);
-}
-
 }  // namespace
 
 struct StripeDetector::Scratch {
@@ -334,6 +240,7 @@ struct StripeDetector::Scratch {
   ColumnScratch<std::uint16_t> mono16;
   std::optional<StegerBatch> steger_batch;  // built with the detector's kernel
   std::array<BatchLine, kBatchLines> lines;
+  std::array<stripe_detail::RowFound, kBatchLines> rows;
   StegerBatch& steger() { return *steger_batch; }
 };
 
@@ -490,19 +397,22 @@ void StripeDetector::DetectRows(const StripeImage& image, StripeDetection* resul
   const double saturation = MaxPixelValue(image.format);
   StegerBatch* batch = options_.method == StripeMethod::kSteger ? &scratch_->steger() : nullptr;
   std::array<BatchLine, kBatchLines>& lines = scratch_->lines;
+  std::array<stripe_detail::RowFound, kBatchLines>& rows = scratch_->rows;
   for (int begin = 0; begin < height; begin += kBatchLines) {
     const int end = std::min(height, begin + kBatchLines);
     if (batch != nullptr) batch->Clear();
-    if constexpr (sizeof(Pixel) == 1) {
-      ScanRows8(image, begin, end, options_.min_separation_px, options_.threshold,
-                options_.max_second_peak_ratio, lines.data());
-    } else {
-      ScanRows16(image, begin, end, options_.min_separation_px, options_.threshold,
-                 options_.max_second_peak_ratio, lines.data());
-    }
+    stripe_detail::ScanRows(image, begin, end, options_.min_separation_px, options_.threshold,
+                            options_.max_second_peak_ratio, rows.data());
     for (int v = begin; v < end; ++v) {
+      const stripe_detail::RowFound& found = rows[static_cast<std::size_t>(v - begin)];
       BatchLine& line = lines[static_cast<std::size_t>(v - begin)];
-      if (line.kind == BatchLine::Kind::kRefined) {
+      line.i0 = found.u0;
+      line.top = found.top;
+      if (found.top < options_.threshold) {
+        line.kind = BatchLine::Kind::kBelowThreshold;
+      } else if (found.second_peak) {
+        line.kind = BatchLine::Kind::kMultiplePeaks;
+      } else {
         RefineOrBatch(rp, image.Row<Pixel>(v), 1, width, saturation, batch, &line);
       }
     }

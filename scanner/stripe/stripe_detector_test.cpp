@@ -331,10 +331,11 @@ StripeDetection NaiveColumns(const StripeImage& image, const StripeDetectorOptio
 
 // A cluttered frame: noise, a stripe, a second stripe on part of the image, random spikes,
 // saturated blobs and dark columns, so every branch of the scan is taken.
-StripeFrame Cluttered(PixelFormat format, std::uint64_t seed) {
+StripeFrame Cluttered(PixelFormat format, std::uint64_t seed, int width_px = 301,
+                      int height_px = 77) {
   StripeRenderOptions o;
-  o.width_px = 301;  // not a multiple of any vector width
-  o.height_px = 77;
+  o.width_px = width_px;  // 301: not a multiple of any vector width
+  o.height_px = height_px;
   o.format = format;
   o.noise_sigma = format == PixelFormat::kMono8 ? 6.0 : 1500.0;
   o.background = format == PixelFormat::kMono8 ? 20.0 : 5000.0;
@@ -356,7 +357,7 @@ StripeFrame Cluttered(PixelFormat format, std::uint64_t seed) {
     }
   }
   for (int v = 0; v < o.height_px; ++v) {
-    for (int u = 100; u < 110; ++u) {
+    for (int u = 100; u < std::min(110, o.width_px); ++u) {
       if (format == PixelFormat::kMono8) {
         frame.mono8[v * o.width_px + u] = 3;
       } else {
@@ -453,6 +454,31 @@ TEST(StripeDetector, FastRowScanMatchesNaiveReference) {
             EXPECT_GT(rows.multiple_peaks, 0);
           }
         }
+      }
+    }
+  }
+}
+
+// Rows of every length around the scan's vectors (32 Mono8 pixels, 16 Mono16) and separations
+// under and over a vector: the row scan's searches and its second-peak test take each path.
+TEST(StripeDetector, RowScanMatchesNaiveReferenceAtEveryRowLengthAndSeparation) {
+  for (PixelFormat f : {PixelFormat::kMono8, PixelFormat::kMono16}) {
+    for (int row_px : {3, 17, 31, 32, 33, 64, 65, 127, 128, 200, 517}) {
+      const StripeFrame frame = Cluttered(f, 7, 113, row_px);
+      const StripeFrame transposed = Transposed(frame);
+      for (int separation : {1, 8, 31, 40, 100}) {
+        StripeDetectorOptions o = With(StripeMethod::kSteger);
+        o.min_separation_px = separation;
+        o.threshold = f == PixelFormat::kMono8 ? 60 : 15000;
+        StripeDetector reference(o);
+        const StripeDetection naive = f == PixelFormat::kMono8
+                                          ? NaiveColumns<std::uint8_t>(frame.view(), o, reference)
+                                          : NaiveColumns<std::uint16_t>(frame.view(), o, reference);
+        o.axis = StripeAxis::kRows;
+        StripeDetector detector(o);
+        SCOPED_TRACE("row of " + std::to_string(row_px) + " px, separation " +
+                     std::to_string(separation));
+        ExpectSameDetection(detector.Detect(transposed.view()), naive, /*transposed=*/true);
       }
     }
   }
