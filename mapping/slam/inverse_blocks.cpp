@@ -57,55 +57,58 @@ SelectedInverse CopyFactor(const Eigen::SparseMatrix<double>& L) {
   return s;
 }
 
-// The position of row `row` in column `column` from position `from` on (rows ascend within a
-// column). Every entry read lies on the pattern (a column's rows are a clique of the factor's
-// graph; the blocks were made structural): a miss is a broken invariant, never wrong numbers.
-int FindRowFrom(const SelectedInverse& s, int column, int from, int row) {
-  const int end = s.column_start[static_cast<size_t>(column) + 1];
-  while (from < end && s.rows[static_cast<size_t>(from)] < row) ++from;
-  if (from == end || s.rows[static_cast<size_t>(from)] != row)
-    throw std::logic_error("InverseBlocks: an entry off the factor's pattern");
-  return from;
-}
-
 // Z(i, j) = delta_ij / d_j - sum_{k > j, L(k, j) != 0} Z(i, k) L(k, j), for i >= j on the pattern.
 // The rows of column j form a clique of the factor's graph, so every Z(i, k) it reads lies on
 // the pattern, in a column already done.
 //
 // For column j with rows r_0 < ... < r_{c-1}, each sum over q takes its terms Z(r_p, r_q) L(r_q, j)
 // in the order of q, as written above (so the bits are those of the formula summed term by term).
-// The terms are found by walking columns, not by searching them: Z(r_p, r_q) lies in column r_p
-// at row r_q when p < q, and those rows ascend with q, so each p keeps a cursor in its column;
-// when p > q it lies in column r_q at row r_p, and those rows ascend with p.
+// The terms are found by reading the columns r_0, r_1, ... once each, not by searching: column
+// r_q holds Z(r_p, r_q) for the rows r_p > r_q, which is the term q of sum p and, Z being
+// symmetric, the term p of sum q. Sum p thus receives its terms q < p from the columns before
+// its own, then its diagonal term, then its terms q > p from its own column, in order.
 void FillInverseOnPattern(SelectedInverse& s, const Eigen::VectorXd& d) {
   const int n = static_cast<int>(d.size());
   std::vector<double> sums;
-  std::vector<int> cursors;  // cursors[p]: where column r_p was last read
+  std::vector<int> position(static_cast<size_t>(n), -1);  // a row's place in column j, or -1
   for (int j = n - 1; j >= 0; --j) {
     const int begin = s.column_start[static_cast<size_t>(j)];
     const int end = s.column_start[static_cast<size_t>(j) + 1];
-    const auto row = [&](int p) { return s.rows[static_cast<size_t>(begin + p)]; };
     const int c = end - begin;
+    if (c == 0) {
+      s.z_diagonal[j] = 1.0 / d[j];
+      continue;
+    }
+    const auto row = [&](int p) { return s.rows[static_cast<size_t>(begin + p)]; };
+    const auto l = [&](int p) { return s.l[static_cast<size_t>(begin + p)]; };
+    const int last_row = row(c - 1);
+    for (int p = 0; p < c; ++p) position[static_cast<size_t>(row(p))] = p;
     sums.assign(static_cast<size_t>(c), 0.0);
-    cursors.resize(static_cast<size_t>(c));
-    for (int p = 0; p < c; ++p)
-      cursors[static_cast<size_t>(p)] = s.column_start[static_cast<size_t>(row(p))];
     for (int q = 0; q < c; ++q) {
       const int k = row(q);
-      const double l_q = s.l[static_cast<size_t>(begin + q)];
-      for (int p = 0; p < q; ++p) {
-        int& cursor = cursors[static_cast<size_t>(p)];
-        cursor = FindRowFrom(s, row(p), cursor, k);
-        sums[static_cast<size_t>(p)] += s.z[static_cast<size_t>(cursor)] * l_q;
+      double own = sums[static_cast<size_t>(q)] + s.z_diagonal[k] * l(q);  // sum q, in a register
+      int found = 0;
+      for (int e = s.column_start[static_cast<size_t>(k)];
+           e < s.column_start[static_cast<size_t>(k) + 1]; ++e) {
+        const int i = s.rows[static_cast<size_t>(e)];
+        if (i > last_row) break;
+        const int p = position[static_cast<size_t>(i)];
+        if (p < 0) continue;
+        ++found;
+        const double z = s.z[static_cast<size_t>(e)];
+        sums[static_cast<size_t>(p)] += z * l(q);
+        own += z * l(p);
       }
-      sums[static_cast<size_t>(q)] += s.z_diagonal[k] * l_q;
-      int walk = s.column_start[static_cast<size_t>(k)];
-      for (int p = q + 1; p < c; ++p) {
-        walk = FindRowFrom(s, k, walk, row(p));
-        sums[static_cast<size_t>(p)] += s.z[static_cast<size_t>(walk)] * l_q;
-      }
+      sums[static_cast<size_t>(q)] = own;
+      // Every entry needed lies on the pattern: a miss is a broken invariant, never wrong
+      // numbers.
+      if (found != c - 1 - q)
+        throw std::logic_error("InverseBlocks: an entry off the factor's pattern");
     }
-    for (int p = 0; p < c; ++p) s.z[static_cast<size_t>(begin + p)] = -sums[static_cast<size_t>(p)];
+    for (int p = 0; p < c; ++p) {
+      position[static_cast<size_t>(row(p))] = -1;
+      s.z[static_cast<size_t>(begin + p)] = -sums[static_cast<size_t>(p)];
+    }
     double sum = 0.0;
     for (int p = begin; p < end; ++p)
       sum += s.z[static_cast<size_t>(p)] * s.l[static_cast<size_t>(p)];
