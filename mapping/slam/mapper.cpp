@@ -235,18 +235,6 @@ Matrix6d Mapper::Impl::MotionCovariance(const Submap& a, const Submap& b) const 
   return Symmetrized(covariance);
 }
 
-std::vector<Matrix6d> Mapper::Impl::ChainCovariancesTo(int to, int oldest) const {
-  // C(j, to) = increment(j + 1) + Ad(T_j_j+1) C(j + 1, to) Ad(T_j_j+1)^T, C(to, to) = 0.
-  std::vector<Matrix6d> chain(static_cast<size_t>(to - oldest + 1), Matrix6d::Zero());
-  for (int j = to - 1; j >= oldest; --j) {
-    const Matrix6d ad = Adjoint(ScanPose(j).inverse() * ScanPose(j + 1));
-    chain[static_cast<size_t>(j - oldest)] =
-        increment_covariance[static_cast<size_t>(j + 1)] +
-        ad * chain[static_cast<size_t>(j + 1 - oldest)] * ad.transpose();
-  }
-  return chain;
-}
-
 void Mapper::Impl::AddToGraph(Submap submap) {
   const int k = static_cast<int>(submaps.size());
   submap.index = k;

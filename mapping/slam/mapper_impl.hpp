@@ -117,10 +117,6 @@ struct Mapper::Impl {
   // Everything it may be off by: the scale error and misalignment as noise, as the
   // calibration may still be settling.
   Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
-  // The covariance C(j, to) of the scans' motion T_j_to along the chain of consecutive
-  // increments, sum over i in (j, to] of Ad(T_j_i-1) increment(i) Ad(T_j_i-1)^T, for every j in
-  // [oldest, to] (indexed j - oldest), in one pass from `to` down.
-  std::vector<Matrix6d> ChainCovariancesTo(int to, int oldest) const;
   // Loop closures (TryLoopClosures), step by step.
   struct LoopCandidate {
     int j;                // the earlier submap

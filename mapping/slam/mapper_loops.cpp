@@ -73,16 +73,30 @@ std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) con
     const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
     if (distance - overlap <= 2.0) near.emplace_back(j, distance);
   }
+  // Candidates are tried nearest first (of equally near ones, the older): the gate is asked of
+  // the near submaps in that order until enough pass. Late in a long dive hundreds of earlier
+  // submaps lie near a revisit, and the nearest usually passes.
+  std::stable_sort(near.begin(), near.end(),
+                   [](const auto& a, const auto& b) { return a.second < b.second; });
+  // C(j, k), the covariance of the scans' motion T_j_k along the chain of consecutive increments
+  // (sum over i in (j, k] of Ad(T_j_i-1) increment(i) Ad(T_j_i-1)^T), walked down from k one
+  // submap at a time as far as the gated submaps need: chain[k - j].
+  std::vector<Matrix6d> chain{Matrix6d::Zero()};
+  const auto chain_to = [&](int j) {
+    for (int i = k - static_cast<int>(chain.size()); i >= j; --i) {
+      const Matrix6d ad = Adjoint(ScanPose(i).inverse() * ScanPose(i + 1));
+      chain.push_back(increment_covariance[static_cast<size_t>(i) + 1] +
+                      ad * chain.back() * ad.transpose());
+    }
+    return chain[static_cast<size_t>(k - j)];
+  };
   std::vector<LoopCandidate> candidates;
-  if (near.empty()) return candidates;
-  // The chain's covariance from each near submap back to k, built from k down to the oldest
-  // (ChainCovariancesTo: one step per submap, so a long dive pays once per candidate search).
-  const std::vector<Matrix6d> chain = ChainCovariancesTo(k, near.front().first);
   for (const auto& [j, distance] : near) {
+    if (candidates.size() >= static_cast<size_t>(options.max_loop_candidates)) break;
     const Submap& old = submaps[static_cast<size_t>(j)];
     const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
     // In j's frame: how far k's centre is predicted from j's, and how uncertain that is.
-    const Matrix6d& covariance = chain[static_cast<size_t>(j - near.front().first)];
+    const Matrix6d covariance = chain_to(j);
     const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
     const Eigen::Vector3d gap_m = centre_k_in_j - old.centroid_V;
     if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <=
@@ -90,12 +104,6 @@ std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) con
       continue;
     }
     candidates.push_back({j, distance, covariance});
-  }
-  std::stable_sort(
-      candidates.begin(), candidates.end(),
-      [](const LoopCandidate& a, const LoopCandidate& b) { return a.distance < b.distance; });
-  if (candidates.size() > static_cast<size_t>(options.max_loop_candidates)) {
-    candidates.resize(static_cast<size_t>(options.max_loop_candidates));
   }
   return candidates;
 }
