@@ -132,6 +132,10 @@ TEST(CliDive, LongSlamBenchDivesOncePerSeed) {
     for (const char* figure : {"ate_m", "map_rms_m", "real_time_factor"})
       EXPECT_GT(d[figure].get<double>(), 0.0) << figure;
     EXPECT_GT(d["submap_seconds"]["last_tenth"]["median"].get<double>(), 0.0);
+    // The accepted loops the truth puts off: counted, and part of the accepted.
+    ASSERT_TRUE(d["loops_false"].is_number_integer());
+    EXPECT_GE(d["loops_false"].get<int>(), 0);
+    EXPECT_LE(d["loops_false"].get<int>(), d["loops_accepted"].get<int>());
   }
   EXPECT_NE(j["dives"][0]["dead_reckoning_ate_m"].get<double>(),
             j["dives"][1]["dead_reckoning_ate_m"].get<double>());
