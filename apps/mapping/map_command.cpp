@@ -107,6 +107,7 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
                      {"fitness", l.fitness},
                      {"chi2", l.chi2},
                      {"constrained_directions", l.constrained_directions},
+                     {"prediction_std_m", l.prediction_std_m},
                      {"T_from_to", {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}}});
   }
   report["loops"] = loops;

@@ -293,6 +293,15 @@ TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {
     EXPECT_GT(std::abs(free(3)), std::cos(0.02)) << loop.from << " -> " << loop.to;
   }
   EXPECT_GT(accepted, 5);
+  // Coming back, each loop spans a longer chain than the one before (to the start of the dive).
+  // Along that chain the prediction would widen twofold by the last loop (19 -> 39 mm); through
+  // the loop before it, by a fifth: the slide along the pipe, which loops leave to the chain.
+  std::vector<double> prediction_std_m;
+  for (const LoopClosure& loop : m.loops) {
+    if (loop.accepted) prediction_std_m.push_back(loop.prediction_std_m);
+  }
+  ASSERT_GT(prediction_std_m.size(), 5u);
+  EXPECT_LT(prediction_std_m.back(), 1.5 * prediction_std_m.front());
   EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 0);
   double slam_sideways = 0.0, dr_sideways = 0.0;
   for (std::size_t i = 0; i < m.slam.size(); ++i) {

@@ -135,6 +135,9 @@ struct LoopClosure {
   // every loop tried; used for accepted ones (MapperOptions' windowed solves).
   double correction_chi2 = 0.0;
   int constrained_directions = 0;  // directions the registration pins (the rest are left free)
+  // How far the graph's prediction of `to` in `from`'s frame may be off (m): the largest std of
+  // its position, along the chain between them or through a loop accepted before.
+  double prediction_std_m = 0.0;
   Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered
   // What it measures ([w, v] in `from`'s frame, pose_graph.hpp): zero along the directions it
   // leaves free (the slide along a pipe), where T_from_to is only the prediction.

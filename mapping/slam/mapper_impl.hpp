@@ -72,6 +72,14 @@ struct Mapper::Impl {
       increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
   PoseGraph graph;
   std::vector<LoopClosure> loops;
+  // The accepted loops as shortcuts for later predictions: the covariance of T_a_b, that of the
+  // prediction it was tested against fused with its registration. In the order accepted.
+  struct LoopShortcut {
+    int a;  // the earlier submap
+    int b;  // the later one
+    Matrix6d covariance;
+  };
+  std::vector<LoopShortcut> shortcuts;
   MapperStats stats;
   int since_solve = 0;
   int next_whole_solve_submaps = 0;  // the graph's size at which the next solve is whole
@@ -118,19 +126,40 @@ struct Mapper::Impl {
   // calibration may still be settling.
   Matrix6d MotionCovariance(const Submap& a, const Submap& b) const;
   // Loop closures (TryLoopClosures), step by step.
+  // Where k is expected in j's frame, and how uncertain that is.
+  struct LoopPrediction {
+    Eigen::Isometry3d T_j_k;
+    Matrix6d covariance;
+  };
   struct LoopCandidate {
-    int j;                // the earlier submap
-    double distance;      // between the two centres, as the graph places them now
-    Matrix6d covariance;  // of T_j_k, predicted along the chain between them
+    int j;            // the earlier submap
+    double distance;  // between the two centres, as the graph places them now
+    LoopPrediction predicted;
+  };
+  // C(j, k), the covariance of the scans' motion T_j_k along the chain of consecutive
+  // increments (sum over i in (j, k] of Ad(T_j_i-1) increment(i) Ad(T_j_i-1)^T), walked down
+  // from k one submap at a time as far as asked, and kept for the next question.
+  class ChainBack {
+   public:
+    ChainBack(const Impl& mapper, int k) : mapper_(mapper), k_(k) {}
+    const Matrix6d& To(int j);
+
+   private:
+    const Impl& mapper_;
+    int k_;
+    std::vector<Matrix6d> chain_{Matrix6d::Zero()};  // chain_[k - j]
   };
   void TryLoopClosures(int k);
   std::vector<LoopCandidate> LoopCandidates(int k) const;
+  // T_j_k as the graph has it, with its covariance: along the chain between them, or through
+  // the accepted loop that leaves the fewest consecutive steps to walk (j to its earlier end,
+  // its later end to k).
+  LoopPrediction Predict(int j, int k, ChainBack* back_from_k) const;
   perception::PointCloud LoopTarget(int j,
                                     int k) const;  // submap j with its neighbours, in j's frame
-  std::vector<double> LoopIcpDistances(const LoopCandidate& c,
-                                       const Eigen::Isometry3d& T_pred) const;
-  LoopClosure JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c, int k,
-                        const Eigen::Isometry3d& T_pred) const;
+  std::vector<double> LoopIcpDistances(const LoopPrediction& predicted) const;
+  LoopClosure JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c,
+                        int k) const;
   std::string LoopRejection(const perception::RegistrationResult& r, const KeptDirections& kept,
                             const Matrix6d& information, const Matrix6d& prediction_covariance,
                             const Vector6d& miss, double* chi2) const;

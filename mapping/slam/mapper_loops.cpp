@@ -6,6 +6,7 @@
 #include "mapping/slam/mapper_impl.hpp"
 #include "mapping/slam/overlap_gate.hpp"
 #include "perception/registration/icp.hpp"
+#include "scanner/common/symmetrized.hpp"
 
 namespace uwscan::mapping {
 namespace {
@@ -24,9 +25,19 @@ Eigen::Matrix3d PositionCovariance(const Matrix6d& covariance, const Eigen::Vect
   return J * covariance * J.transpose();
 }
 
+// The covariance of a motion predicted to `covariance` and measured with `information`.
+Matrix6d Fused(const Matrix6d& covariance, const Matrix6d& information) {
+  return Symmetrized(Matrix6d((covariance.inverse() + information).inverse()));
+}
+
 double LargestStd(const Eigen::Matrix3d& covariance) {
   return std::sqrt(
       std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(2)));
+}
+
+// How far the prediction of k's origin may be off: its largest position std.
+double PredictionStd(const Matrix6d& covariance, const Eigen::Isometry3d& T_j_k) {
+  return LargestStd(PositionCovariance(covariance, T_j_k.translation()));
 }
 
 }  // namespace
@@ -45,17 +56,18 @@ void Mapper::Impl::TryLoopClosures(int k) {
   }
   const Clock::time_point start = Clock::now();
   for (const LoopCandidate& c : LoopCandidates(k)) {
-    const Eigen::Isometry3d T_pred = ScanPose(c.j).inverse() * ScanPose(k);
     const perception::RegistrationResult r =
-        Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), T_pred, c.covariance,
-                 LoopIcpDistances(c, T_pred));
-    const LoopClosure loop = JudgeLoop(r, c, k, T_pred);
+        Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), c.predicted.T_j_k,
+                 c.predicted.covariance, LoopIcpDistances(c.predicted));
+    const LoopClosure loop = JudgeLoop(r, c, k);
     if (loop.accepted) {
       graph.AddEdge({.from = ScanNode(c.j),
                      .to = ScanNode(k),
                      .T_from_to = r.T_target_source,
                      .information = loop.information,
                      .robust = true});
+      shortcuts.push_back(
+          {.a = c.j, .b = k, .covariance = Fused(c.predicted.covariance, loop.information)});
     }
     loops.push_back(loop);
   }
@@ -64,7 +76,7 @@ void Mapper::Impl::TryLoopClosures(int k) {
 
 std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) const {
   const Submap& current = submaps[static_cast<size_t>(k)];
-  const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;
+  const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;  // in the world
   // The cheap first cut, far beyond any gate here: centres within 2 m of overlapping.
   std::vector<std::pair<int, double>> near;  // submap, distance
   for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
@@ -78,34 +90,63 @@ std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) con
   // submaps lie near a revisit, and the nearest usually passes.
   std::stable_sort(near.begin(), near.end(),
                    [](const auto& a, const auto& b) { return a.second < b.second; });
-  // C(j, k), the covariance of the scans' motion T_j_k along the chain of consecutive increments
-  // (sum over i in (j, k] of Ad(T_j_i-1) increment(i) Ad(T_j_i-1)^T), walked down from k one
-  // submap at a time as far as the gated submaps need: chain[k - j].
-  std::vector<Matrix6d> chain{Matrix6d::Zero()};
-  const auto chain_to = [&](int j) {
-    for (int i = k - static_cast<int>(chain.size()); i >= j; --i) {
-      const Matrix6d ad = Adjoint(ScanPose(i).inverse() * ScanPose(i + 1));
-      chain.push_back(increment_covariance[static_cast<size_t>(i) + 1] +
-                      ad * chain.back() * ad.transpose());
-    }
-    return chain[static_cast<size_t>(k - j)];
-  };
+  ChainBack back_from_k(*this, k);
   std::vector<LoopCandidate> candidates;
   for (const auto& [j, distance] : near) {
     if (candidates.size() >= static_cast<size_t>(options.max_loop_candidates)) break;
     const Submap& old = submaps[static_cast<size_t>(j)];
     const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
     // In j's frame: how far k's centre is predicted from j's, and how uncertain that is.
-    const Matrix6d covariance = chain_to(j);
-    const Eigen::Vector3d centre_k_in_j = ScanPose(j).inverse() * centre_k;
+    const LoopPrediction predicted = Predict(j, k, &back_from_k);
+    const Eigen::Vector3d centre_k_in_j = predicted.T_j_k * current.centroid_V;
     const Eigen::Vector3d gap_m = centre_k_in_j - old.centroid_V;
-    if (!(MahalanobisGapToOverlap(gap_m, overlap, PositionCovariance(covariance, centre_k_in_j)) <=
-          options.gate_sigmas)) {
+    const Eigen::Matrix3d centre_covariance =
+        PositionCovariance(predicted.covariance, centre_k_in_j);
+    if (!(MahalanobisGapToOverlap(gap_m, overlap, centre_covariance) <= options.gate_sigmas)) {
       continue;
     }
-    candidates.push_back({j, distance, covariance});
+    candidates.push_back({j, distance, predicted});
   }
   return candidates;
+}
+
+const Matrix6d& Mapper::Impl::ChainBack::To(int j) {
+  for (int i = k_ - static_cast<int>(chain_.size()); i >= j; --i) {
+    const Matrix6d ad = Adjoint(mapper_.ScanPose(i).inverse() * mapper_.ScanPose(i + 1));
+    chain_.push_back(mapper_.increment_covariance[static_cast<size_t>(i) + 1] +
+                     ad * chain_.back() * ad.transpose());
+  }
+  return chain_[static_cast<size_t>(k_ - j)];
+}
+
+// Late in a dive the chain between a revisit and the submap it revisits is a thousand steps
+// long, its position std near a metre: it would let a registration 10 cm off pass as consistent
+// (bench/slam/RESULTS.md, "False loops on long dives"). The loops accepted since know the two
+// places' relation far better; one of them, with the few steps from its ends to j and k, is the
+// prediction's path. Where j lies between the loop's ends, the steps from its earlier end to j
+// count in both factors, where their errors cancel: the sum overstates the covariance, the safe
+// side for a gate.
+Mapper::Impl::LoopPrediction Mapper::Impl::Predict(int j, int k, ChainBack* back_from_k) const {
+  const LoopShortcut* best = nullptr;
+  int fewest_steps = k - j;
+  for (auto s = shortcuts.rbegin(); s != shortcuts.rend() && k - s->b < fewest_steps; ++s) {
+    const int steps = (k - s->b) + std::abs(j - s->a);
+    if (steps < fewest_steps) {
+      best = &*s;
+      fewest_steps = steps;
+    }
+  }
+  const Eigen::Isometry3d T_j_k = ScanPose(j).inverse() * ScanPose(k);
+  if (best == nullptr) return {T_j_k, back_from_k->To(j)};
+  // T_j_k = T_j_a T_a_b T_b_k, each factor's covariance moved into j's frame.
+  const Eigen::Isometry3d T_j_a = ScanPose(j).inverse() * ScanPose(best->a);
+  const Matrix6d ad_j_a = Adjoint(T_j_a);
+  const Matrix6d ad_j_b = Adjoint(ScanPose(j).inverse() * ScanPose(best->b));
+  const Matrix6d j_to_a =
+      best->a >= j ? ChainBack(*this, best->a).To(j)
+                   : Matrix6d(ad_j_a * ChainBack(*this, j).To(best->a) * ad_j_a.transpose());
+  return {T_j_k, Symmetrized(j_to_a + ad_j_a * best->covariance * ad_j_a.transpose() +
+                             ad_j_b * back_from_k->To(best->b) * ad_j_b.transpose())};
 }
 
 perception::PointCloud Mapper::Impl::LoopTarget(int j, int k) const {
@@ -116,20 +157,18 @@ perception::PointCloud Mapper::Impl::LoopTarget(int j, int k) const {
   return target;
 }
 
-std::vector<double> Mapper::Impl::LoopIcpDistances(const LoopCandidate& c,
-                                                   const Eigen::Isometry3d& T_pred) const {
+std::vector<double> Mapper::Impl::LoopIcpDistances(const LoopPrediction& predicted) const {
   // The first stage reaches as far as the prediction may be off: three times the largest
   // position std of the scan's origin (the gate asked the narrower question, whether the two
   // centres can meet at all).
   std::vector<double> distances = options.loop_icp_distances_m;
-  const double reach =
-      options.gate_sigmas * LargestStd(PositionCovariance(c.covariance, T_pred.translation()));
+  const double reach = options.gate_sigmas * PredictionStd(predicted.covariance, predicted.T_j_k);
   if (reach > distances.front()) distances.insert(distances.begin(), reach);
   return distances;
 }
 
 LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, const LoopCandidate& c,
-                                    int k, const Eigen::Isometry3d& T_pred) const {
+                                    int k) const {
   LoopClosure loop;
   loop.from = c.j;
   loop.to = k;
@@ -139,9 +178,10 @@ LoopClosure Mapper::Impl::JudgeLoop(const perception::RegistrationResult& r, con
   loop.information = RegistrationInformation(r, submaps[static_cast<size_t>(c.j)],
                                              submaps[static_cast<size_t>(k)], &kept);
   loop.constrained_directions = kept.count;
+  loop.prediction_std_m = PredictionStd(c.predicted.covariance, c.predicted.T_j_k);
   // Where the registration puts k against where the graph does.
-  const Vector6d miss = PoseError(r.T_target_source, T_pred);
-  loop.reason = LoopRejection(r, kept, loop.information, c.covariance, miss, &loop.chi2);
+  const Vector6d miss = PoseError(r.T_target_source, c.predicted.T_j_k);
+  loop.reason = LoopRejection(r, kept, loop.information, c.predicted.covariance, miss, &loop.chi2);
   loop.accepted = loop.reason.empty();
   loop.correction_chi2 = miss.dot(loop.information * miss);
   return loop;
