@@ -46,6 +46,7 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"heap_held_bytes_last_tenth", r.heap_held_bytes_last_tenth},
           {"loops_accepted", r.loops_accepted},
           {"loops_false", r.loops_false},
+          {"loops_missed", r.loops_missed},
           {"whole_solves", r.whole_solves},
           {"window_solves", r.window_solves},
           {"loop_window_solves", r.loop_window_solves},
@@ -75,15 +76,15 @@ void PrintRow(const char* method, const bench::LongDiveRun& r) {
   std::printf(
       "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f / %.0f MB | %.0f MB | %.0f / %.0f MB | %.1fx "
       "| "
-      "%.1f mm | %.2f mm | %d (%d) | %d + %d (%d back to a loop) |\n",
+      "%.1f mm | %.2f mm | %d (%d, %d) | %d + %d (%d back to a loop) |\n",
       method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3, r.last_tenth.median_s * 1e3,
       r.last_tenth.p95_s * 1e3, static_cast<double>(r.rss_bytes_at_start) / 1e6,
       static_cast<double>(r.peak_rss_bytes) / 1e6,
       static_cast<double>(r.rss_bytes_last_tenth) / 1e6,
       static_cast<double>(r.heap_in_use_bytes_last_tenth) / 1e6,
       static_cast<double>(r.heap_held_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
-      r.map_rms_m * 1e3, r.loops_accepted, r.loops_false, r.whole_solves, r.window_solves,
-      r.loop_window_solves);
+      r.map_rms_m * 1e3, r.loops_accepted, r.loops_false, r.loops_missed, r.whole_solves,
+      r.window_solves, r.loop_window_solves);
 }
 
 void PrintStages(const std::string& name, const bench::LongDiveRun& r) {
@@ -147,7 +148,7 @@ void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whol
   std::printf(
       "| dive | solves | time per submap, first tenth: median / p95 | last tenth | RSS at start / "
       "peak | RSS, last tenth | heap in use / held, last tenth | real time | ATE | map RMS | loops "
-      "(false) | whole + window solves (back to a loop) |\n"
+      "(false, right ones rejected) | whole + window solves (back to a loop) |\n"
       "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   nlohmann::json out = {{"bench", "slam_long"}, {"dives", nlohmann::json::array()}};
   for (const bench::LongDiveFigures& f : dives) {

@@ -62,11 +62,12 @@ void Print(const bench::DiveFigures& f) {
   std::printf("| true poses (the sensor's floor) | | | %.2f mm | %.2f mm | %.2f mm | |\n",
               floor.mean_m * 1e3, floor.rms_m * 1e3, floor.p95_m * 1e3);
   std::printf(
-      "SLAM/DR: ATE %.3f, map rms %.3f; loops accepted %d (false %d), rejected %d; NEES %.2f (6 = "
+      "SLAM/DR: ATE %.3f, map rms %.3f; loops accepted %d (false %d), rejected %d (right but "
+      "inconsistent with the prediction %d); NEES %.2f (6 = "
       "consistent); "
       "%.1fx real time\n",
       f.slam.ate_m / f.dead_reckoning.ate_m, f.slam.map.rms_m / f.dead_reckoning.map.rms_m,
-      f.loops_accepted, f.loops_false, f.loops_rejected, f.nees_mean.value_or(NAN),
+      f.loops_accepted, f.loops_false, f.loops_rejected, f.loops_missed, f.nees_mean.value_or(NAN),
       f.real_time_factor);
   if (f.expected_map_error_m) {
     std::printf(
@@ -95,7 +96,7 @@ struct SceneSummary {
   double ate_mean_m = 0.0, expected_ate_mean_m = 0.0;  // SLAM's, measured and predicted
   double map_rms_mean_m = 0.0, map_ratio_mean = 0.0, expected_map_error_mean_m = 0.0;
   double nees_mean = 0.0, real_time_factor_mean = 0.0, real_time_factor_min = 0.0;
-  int loops_false = 0;
+  int loops_false = 0, loops_missed = 0;
   std::optional<double> open3d_ate_ratio_mean, open3d_time_ratio_mean;  // uwscan / Open3D
 };
 
@@ -123,6 +124,7 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
     it->real_time_factor_mean += f.real_time_factor;
     it->real_time_factor_min = std::min(it->real_time_factor_min, f.real_time_factor);
     it->loops_false += f.loops_false;
+    it->loops_missed += f.loops_missed;
     if (f.open3d) {
       it->open3d_ate_ratio_mean =
           it->open3d_ate_ratio_mean.value_or(0.0) + f.slam.ate_m / f.open3d->ate_m;
@@ -149,16 +151,17 @@ void Print(const std::vector<SceneSummary>& scenes) {
   std::printf(
       "| dive | seeds | ATE ratio (worst) | SLAM ATE | predicted ATE | map rms | map ratio | "
       "predicted map rms "
-      "| NEES | real time (worst) | false loops | uwscan/Open3D ATE, time |\n"
-      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| NEES | real time (worst) | false loops | right loops rejected | uwscan/Open3D ATE, time "
+      "|\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const SceneSummary& s : scenes) {
     std::printf(
         "| %s | %d | %.3f (%.3f) | %.1f mm | %.1f mm | %.2f mm | %.3f | %.2f mm | %.2f | %.1fx "
-        "(%.1fx) | %d | ",
+        "(%.1fx) | %d | %d | ",
         s.name.c_str(), s.seeds, s.ate_ratio_mean, s.ate_ratio_max, s.ate_mean_m * 1e3,
         s.expected_ate_mean_m * 1e3, s.map_rms_mean_m * 1e3, s.map_ratio_mean,
         s.expected_map_error_mean_m * 1e3, s.nees_mean, s.real_time_factor_mean,
-        s.real_time_factor_min, s.loops_false);
+        s.real_time_factor_min, s.loops_false, s.loops_missed);
     if (s.open3d_ate_ratio_mean) {
       std::printf("%.3f, %.2f |\n", *s.open3d_ate_ratio_mean,
                   s.open3d_time_ratio_mean.value_or(NAN));
@@ -183,6 +186,7 @@ nlohmann::json SummaryJson(const SceneSummary& s) {
       {"real_time_factor_mean", s.real_time_factor_mean},
       {"real_time_factor_min", s.real_time_factor_min},
       {"loops_false", s.loops_false},
+      {"loops_missed", s.loops_missed},
       {"open3d_ate_ratio_mean", s.open3d_ate_ratio_mean ? nlohmann::json(*s.open3d_ate_ratio_mean)
                                                         : nlohmann::json(nullptr)},
       {"open3d_time_ratio_mean", s.open3d_time_ratio_mean
@@ -218,6 +222,7 @@ void RunSlamBench(const SlamBenchArgs& a) {
     slam["loops_accepted"] = f.loops_accepted;
     slam["loops_rejected"] = f.loops_rejected;
     slam["loops_false"] = f.loops_false;
+    slam["loops_missed"] = f.loops_missed;
     slam["nees_mean"] = f.nees_mean ? nlohmann::json(*f.nees_mean) : nlohmann::json(nullptr);
     slam["real_time_factor"] = f.real_time_factor;
     slam["expected_map_error_m"] =

@@ -127,6 +127,7 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
                        {"loops_accepted", s.loops_accepted},
                        {"loops_rejected", s.loops_rejected},
                        {"loops_false", Optional(s.loops_false)},
+                       {"loops_missed", Optional(s.loops_missed)},
                        {"navigation_noise_assumed", m.navigation_noise_assumed},
                        {"ate_slam_m", Optional(s.ate_slam_m)},
                        {"ate_dead_reckoning_m", Optional(s.ate_dead_reckoning_m)},

@@ -154,10 +154,11 @@ TimedKernel LimitKernel(const scanner::CameraRayTable& rays, Points* results) {
             const std::vector<Eigen::Vector2d>& px = frame.peaks_px;
             const double s = 1.0 + 1e-3 * frame.step;
             constexpr size_t kAhead = scanner::CameraRayTable::kPrefetchAhead;
+            const scanner::CameraRayTable::Grid table = rays.grid();
             scanner::Ray ray;
             for (size_t i = 0; i < px.size(); ++i) {
-              if (i + kAhead < px.size()) rays.Prefetch(px[i + kAhead].x(), px[i + kAhead].y());
-              const bool in = rays.Lookup(px[i].x(), px[i].y(), &ray);
+              if (i + kAhead < px.size()) table.Prefetch(px[i + kAhead].x(), px[i + kAhead].y());
+              const bool in = table.Lookup(px[i].x(), px[i].y(), &ray);
               out[i].p_C = ray.origin + s * ray.direction;
               out[i].status = in ? scanner::HitStatus::kHit : scanner::HitStatus::kNoIntersection;
             }

@@ -110,6 +110,7 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   run.heap_held_bytes_last_tenth = MeanFrom(run.heap_held_bytes, from);
   run.loops_accepted = s.loops_accepted;
   run.loops_false = s.loops_false.value_or(0);
+  run.loops_missed = s.loops_missed.value_or(0);
   run.whole_solves = m.stats.whole_solves;
   run.window_solves = m.stats.window_solves;
   run.loop_window_solves = m.stats.loop_window_solves;

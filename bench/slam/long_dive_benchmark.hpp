@@ -48,7 +48,8 @@ struct LongDiveRun {
   std::int64_t heap_in_use_bytes_last_tenth = 0;  // the same for the heap (CurrentHeapBytes)
   std::int64_t heap_held_bytes_last_tenth = 0;
   int loops_accepted = 0;
-  int loops_false = 0;  // of those, the ones the truth puts off (MapSummary::loops_false)
+  int loops_false = 0;   // of those, the ones the truth puts off (MapSummary::loops_false)
+  int loops_missed = 0;  // right loops the chi-square turned away (MapSummary::loops_missed)
   int whole_solves = 0, window_solves = 0;
   int loop_window_solves = 0;  // window solves freed back to a correcting loop's older end
   // Over the dive (seconds of dive time): the mean time per submap in each of about 60 stretches,

@@ -334,6 +334,34 @@ TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
   EXPECT_EQ(Summarise(m).loops_false.value_or(-1), 1);
 }
 
+TEST(MapSummary, ARightLoopTurnedAwayByThePredictionCountsAsMissed) {
+  DiveMapping m;
+  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
+  far.translation().x() = 1.0;
+  m.truth = {{0.0, Eigen::Isometry3d::Identity()}, {1.0, far}};
+  m.slam = m.dead_reckoning = m.truth;
+  LoopClosure right;  // 1 cm off: within the tolerance
+  right.from = 0;
+  right.to = 1;
+  right.T_from_to = far;
+  right.T_from_to.translation().y() += 0.01;
+  right.information.diagonal().setConstant(1e6);
+  right.reason = std::string(kInconsistentLoop) + ": chi2 30 in 6 directions";
+  LoopClosure wrong = right;  // 20 cm off: rightly rejected
+  wrong.T_from_to.translation().y() += 0.2;
+  LoopClosure unfit = right;  // rejected for another reason: not the chi-square's doing
+  unfit.reason = "fitness 0.3 below 0.5";
+  LoopClosure kept = right;
+  kept.accepted = true;
+  kept.reason.clear();
+  m.loops = {right, wrong, unfit, kept};
+  const MapSummary s = Summarise(m);
+  EXPECT_EQ(s.loops_missed.value_or(-1), 1);
+  EXPECT_EQ(s.loops_false.value_or(-1), 0);
+  m.truth.clear();
+  EXPECT_FALSE(Summarise(m).loops_missed.has_value());
+}
+
 // A log of the short dive's first `frames` frames, with the navigation samples `keep` accepts.
 // The navigation the simulator gives at 20 Hz (the samples `keep` passes) and its first
 // `frames` frames, appended to `writer` as a recorder would.

@@ -27,6 +27,17 @@ Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& erro
   return measured;
 }
 
+// Whether a loop's registered motion is the true one in the directions it measures, within the
+// false-loop tolerance.
+bool IsRight(const LoopClosure& loop, const std::vector<TimedPose>& truth) {
+  const Eigen::Isometry3d T_true = truth[static_cast<size_t>(loop.from)].T_W_V.inverse() *
+                                   truth[static_cast<size_t>(loop.to)].T_W_V;
+  const Eigen::Matrix<double, 6, 1> error =
+      MeasuredPart(PoseError(loop.T_from_to, T_true), loop.information);
+  return error.tail<3>().norm() <= kFalseLoopTranslation_m &&
+         error.head<3>().norm() <= kFalseLoopRotation_rad;
+}
+
 }  // namespace
 
 MapSummary Summarise(const DiveMapping& m) {
@@ -40,18 +51,14 @@ MapSummary Summarise(const DiveMapping& m) {
   s.rpe_dead_reckoning_per_m = RelativeErrorPerMetre(m.dead_reckoning, m.truth);
   if (!m.covariances.empty()) s.nees_mean = MeanNees(m.slam, m.truth, m.covariances);
   int false_loops = 0;
+  int missed_loops = 0;
   for (const LoopClosure& loop : m.loops) {
-    if (!loop.accepted) continue;
-    const Eigen::Isometry3d truth = m.truth[static_cast<size_t>(loop.from)].T_W_V.inverse() *
-                                    m.truth[static_cast<size_t>(loop.to)].T_W_V;
-    const Eigen::Matrix<double, 6, 1> error =
-        MeasuredPart(PoseError(loop.T_from_to, truth), loop.information);
-    if (error.tail<3>().norm() > kFalseLoopTranslation_m ||
-        error.head<3>().norm() > kFalseLoopRotation_rad) {
-      ++false_loops;
-    }
+    const bool right = IsRight(loop, m.truth);
+    if (loop.accepted && !right) ++false_loops;
+    if (!loop.accepted && right && loop.reason.starts_with(kInconsistentLoop)) ++missed_loops;
   }
   s.loops_false = false_loops;
+  s.loops_missed = missed_loops;
   return s;
 }
 

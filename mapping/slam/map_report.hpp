@@ -16,6 +16,10 @@ struct MapSummary {
   int loops_accepted = 0;
   int loops_rejected = 0;
   std::optional<int> loops_false;  // accepted loops that are false (truth needed)
+  // Rejected loops whose registration the truth puts within the same tolerance and that failed
+  // only the chi-square against the graph's prediction: right loops the test turned away, where
+  // the prediction's covariance was too small (truth needed).
+  std::optional<int> loops_missed;
   std::optional<double> ate_slam_m, ate_dead_reckoning_m;
   std::optional<double> rpe_slam_per_m, rpe_dead_reckoning_per_m;
   std::optional<double> nees_mean;  // of the SLAM covariances, 6 when consistent

@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "mapping/log/dive_log.hpp"
@@ -122,6 +123,10 @@ struct MapperOptions {
   int resident_submaps = 64;
   void Check() const;
 };
+
+// How a LoopClosure's reason begins when the registration failed only the chi-square against the
+// graph's prediction.
+inline constexpr std::string_view kInconsistentLoop = "inconsistent with the prediction";
 
 struct LoopClosure {
   int from = 0;  // the earlier submap

@@ -211,7 +211,7 @@ std::string Mapper::Impl::LoopRejection(const perception::RegistrationResult& r,
   }
   *chi2 = miss.dot(InformationOfSum(information, prediction_covariance) * miss);
   if (!(*chi2 <= Chi2Quantile999(constrained))) {
-    return "inconsistent with the prediction: chi2 " + std::to_string(*chi2) + " in " +
+    return std::string(kInconsistentLoop) + ": chi2 " + std::to_string(*chi2) + " in " +
            std::to_string(constrained) + " directions";
   }
   return "";
