@@ -21,15 +21,15 @@ class CameraRayTable {
   // inside the image).
   CameraRayTable(const RefractiveCamera& camera, int grid_px = 4);
 
-  struct Node {
+  struct Node {  // the ray at a grid point
     double origin[3];
     double direction[3];
   };
 
-  // The table as plain values, for the triangulators' hot loops. Copied into a local, its fields
-  // stay in registers; read through the table they are loaded again after every store of a
-  // double to the caller's output, which the compiler cannot tell from the nodes. Valid while
-  // the table lives.
+  // The table as plain values, for loops that store doubles between lookups. Copied into a
+  // local, its fields stay in registers; read through the table they are loaded again after
+  // every such store, which the compiler cannot tell from the nodes (bench/scanner/RESULTS.md,
+  // "The limit was about an eighth too slow"). Valid while the table lives.
   class Grid {
    public:
     // Ray in water for a pixel inside the image (OpenCV pixel convention). The direction is
