@@ -47,6 +47,7 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"loops_accepted", r.loops_accepted},
           {"loops_false", r.loops_false},
           {"loops_missed", r.loops_missed},
+          {"registrations_missed", r.registrations_missed},
           {"whole_solves", r.whole_solves},
           {"window_solves", r.window_solves},
           {"loop_window_solves", r.loop_window_solves},

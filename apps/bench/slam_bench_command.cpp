@@ -63,12 +63,11 @@ void Print(const bench::DiveFigures& f) {
               floor.mean_m * 1e3, floor.rms_m * 1e3, floor.p95_m * 1e3);
   std::printf(
       "SLAM/DR: ATE %.3f, map rms %.3f; loops accepted %d (false %d), rejected %d (right but "
-      "inconsistent with the prediction %d); NEES %.2f (6 = "
-      "consistent); "
-      "%.1fx real time\n",
+      "inconsistent with the prediction %d); right registrations inconsistent with the "
+      "navigation %d; NEES %.2f (6 = consistent); %.1fx real time\n",
       f.slam.ate_m / f.dead_reckoning.ate_m, f.slam.map.rms_m / f.dead_reckoning.map.rms_m,
-      f.loops_accepted, f.loops_false, f.loops_rejected, f.loops_missed, f.nees_mean.value_or(NAN),
-      f.real_time_factor);
+      f.loops_accepted, f.loops_false, f.loops_rejected, f.loops_missed, f.registrations_missed,
+      f.nees_mean.value_or(NAN), f.real_time_factor);
   if (f.expected_map_error_m) {
     std::printf(
         "SLAM map rms %.2f mm; its poses' covariance predicts %.2f mm (what the navigation and the "
@@ -96,7 +95,7 @@ struct SceneSummary {
   double ate_mean_m = 0.0, expected_ate_mean_m = 0.0;  // SLAM's, measured and predicted
   double map_rms_mean_m = 0.0, map_ratio_mean = 0.0, expected_map_error_mean_m = 0.0;
   double nees_mean = 0.0, real_time_factor_mean = 0.0, real_time_factor_min = 0.0;
-  int loops_false = 0, loops_missed = 0;
+  int loops_false = 0, loops_missed = 0, registrations_missed = 0;
   std::optional<double> open3d_ate_ratio_mean, open3d_time_ratio_mean;  // uwscan / Open3D
 };
 
@@ -125,6 +124,7 @@ std::vector<SceneSummary> Summarise(const std::vector<bench::DiveFigures>& dives
     it->real_time_factor_min = std::min(it->real_time_factor_min, f.real_time_factor);
     it->loops_false += f.loops_false;
     it->loops_missed += f.loops_missed;
+    it->registrations_missed += f.registrations_missed;
     if (f.open3d) {
       it->open3d_ate_ratio_mean =
           it->open3d_ate_ratio_mean.value_or(0.0) + f.slam.ate_m / f.open3d->ate_m;
@@ -187,6 +187,7 @@ nlohmann::json SummaryJson(const SceneSummary& s) {
       {"real_time_factor_min", s.real_time_factor_min},
       {"loops_false", s.loops_false},
       {"loops_missed", s.loops_missed},
+      {"registrations_missed", s.registrations_missed},
       {"open3d_ate_ratio_mean", s.open3d_ate_ratio_mean ? nlohmann::json(*s.open3d_ate_ratio_mean)
                                                         : nlohmann::json(nullptr)},
       {"open3d_time_ratio_mean", s.open3d_time_ratio_mean
@@ -223,6 +224,7 @@ void RunSlamBench(const SlamBenchArgs& a) {
     slam["loops_rejected"] = f.loops_rejected;
     slam["loops_false"] = f.loops_false;
     slam["loops_missed"] = f.loops_missed;
+    slam["registrations_missed"] = f.registrations_missed;
     slam["nees_mean"] = f.nees_mean ? nlohmann::json(*f.nees_mean) : nlohmann::json(nullptr);
     slam["real_time_factor"] = f.real_time_factor;
     slam["expected_map_error_m"] =

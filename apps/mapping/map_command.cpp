@@ -122,6 +122,7 @@ nlohmann::json MapReportJson(const mapping::DiveMapping& m, const std::string& l
                        {"registrations_left_to_navigation",
                         m.stats.registrations_failed + m.stats.registrations_inconsistent},
                        {"registrations_inconsistent", m.stats.registrations_inconsistent},
+                       {"registrations_missed", Optional(s.registrations_missed)},
                        {"dead_reckoning_scale_error", m.calibration.scale_error},
                        {"dead_reckoning_misalignment_rad", m.calibration.misalignment_rad},
                        {"loops_accepted", s.loops_accepted},

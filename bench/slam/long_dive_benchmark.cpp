@@ -111,6 +111,7 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   run.loops_accepted = s.loops_accepted;
   run.loops_false = s.loops_false.value_or(0);
   run.loops_missed = s.loops_missed.value_or(0);
+  run.registrations_missed = s.registrations_missed.value_or(0);
   run.whole_solves = m.stats.whole_solves;
   run.window_solves = m.stats.window_solves;
   run.loop_window_solves = m.stats.loop_window_solves;

@@ -50,6 +50,8 @@ struct LongDiveRun {
   int loops_accepted = 0;
   int loops_false = 0;   // of those, the ones the truth puts off (MapSummary::loops_false)
   int loops_missed = 0;  // right loops the chi-square turned away (MapSummary::loops_missed)
+  // Right consecutive registrations it turned away (MapSummary::registrations_missed).
+  int registrations_missed = 0;
   int whole_solves = 0, window_solves = 0;
   int loop_window_solves = 0;  // window solves freed back to a correcting loop's older end
   // Over the dive (seconds of dive time): the mean time per submap in each of about 60 stretches,

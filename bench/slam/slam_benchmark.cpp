@@ -117,6 +117,7 @@ void MapAndMeasure(const std::filesystem::path& log_path, const scanner::sim::Sc
   f.loops_rejected = s.loops_rejected;
   f.loops_false = s.loops_false.value_or(0);
   f.loops_missed = s.loops_missed.value_or(0);
+  f.registrations_missed = s.registrations_missed.value_or(0);
   f.nees_mean = s.nees_mean;
   f.real_time_factor = s.real_time_factor;
   f.expected_map_error_m = m.expected_map_error_m;

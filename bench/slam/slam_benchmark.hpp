@@ -63,6 +63,8 @@ struct DiveFigures {
   SurfaceDistance true_poses_map;
   int loops_accepted = 0, loops_rejected = 0, loops_false = 0;
   int loops_missed = 0;  // right loops the chi-square turned away (MapSummary::loops_missed)
+  // Right consecutive registrations it turned away (MapSummary::registrations_missed).
+  int registrations_missed = 0;
   std::optional<double> nees_mean;
   // What the SLAM map's distance to the true surfaces should be from its poses' uncertainty
   // alone (mapping::ExpectedSurfaceErrorRms): with a consistent covariance, what the

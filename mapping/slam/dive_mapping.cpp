@@ -174,6 +174,7 @@ DiveMapping MapDive(const DiveLogReader& log, const DiveMappingOptions& options,
   AddTrajectories(log, mapper, T_V_C, options.keep_submaps, result);
   AddExpectedErrors(mapper, result);
   result.loops = mapper.loops();
+  result.inconsistent_registrations = mapper.inconsistent_registrations();
   result.map = mapper.Map(options.map_voxel_m);
   result.stats = mapper.stats();
   result.calibration = mapper.calibration();

@@ -41,6 +41,7 @@ struct DiveMapping {
   // come to, ExpectedPositionErrorRms); empty with them.
   std::optional<double> expected_position_error_m;
   std::vector<LoopClosure> loops;
+  std::vector<InconsistentRegistration> inconsistent_registrations;  // left to the navigation
   perception::PointCloud map;  // voxelised, world frame (SLAM poses)
   // Each submap's cloud in its own frame (normals attached), for peers that take the same
   // submaps; filled only when DiveMappingOptions::keep_submaps.

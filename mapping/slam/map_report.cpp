@@ -27,15 +27,29 @@ Eigen::Matrix<double, 6, 1> MeasuredPart(const Eigen::Matrix<double, 6, 1>& erro
   return measured;
 }
 
-// Whether a loop's registered motion is the true one in the directions it measures, within the
-// false-loop tolerance.
-bool IsRight(const LoopClosure& loop, const std::vector<TimedPose>& truth) {
-  const Eigen::Isometry3d T_true = truth[static_cast<size_t>(loop.from)].T_W_V.inverse() *
-                                   truth[static_cast<size_t>(loop.to)].T_W_V;
-  const Eigen::Matrix<double, 6, 1> error =
-      MeasuredPart(PoseError(loop.T_from_to, T_true), loop.information);
+// How far a motion between two submaps is from the true one, in the directions `information`
+// measures ([w, v]).
+Eigen::Matrix<double, 6, 1> MeasuredError(int from, int to, const Eigen::Isometry3d& T_from_to,
+                                          const Matrix6d& information,
+                                          const std::vector<TimedPose>& truth) {
+  const Eigen::Isometry3d T_true =
+      truth[static_cast<size_t>(from)].T_W_V.inverse() * truth[static_cast<size_t>(to)].T_W_V;
+  return MeasuredPart(PoseError(T_from_to, T_true), information);
+}
+
+bool WithinFalseLoopTolerance(const Eigen::Matrix<double, 6, 1>& error) {
   return error.tail<3>().norm() <= kFalseLoopTranslation_m &&
          error.head<3>().norm() <= kFalseLoopRotation_rad;
+}
+
+// A consecutive registration the gate turned away although it was right and nearer the truth
+// than the navigation's motion that stood in for it. (The false-loop tolerance alone is too wide
+// for one step of a few centimetres: a registration 3 cm off is a wrong one there.)
+bool IsMissed(const InconsistentRegistration& r, const std::vector<TimedPose>& truth) {
+  const auto registered = MeasuredError(r.from, r.to, r.T_from_to, r.information, truth);
+  const auto predicted = MeasuredError(r.from, r.to, r.T_predicted, r.information, truth);
+  return WithinFalseLoopTolerance(registered) &&
+         registered.tail<3>().norm() < predicted.tail<3>().norm();
 }
 
 }  // namespace
@@ -53,12 +67,16 @@ MapSummary Summarise(const DiveMapping& m) {
   int false_loops = 0;
   int missed_loops = 0;
   for (const LoopClosure& loop : m.loops) {
-    const bool right = IsRight(loop, m.truth);
+    const bool right = WithinFalseLoopTolerance(
+        MeasuredError(loop.from, loop.to, loop.T_from_to, loop.information, m.truth));
     if (loop.accepted && !right) ++false_loops;
     if (!loop.accepted && right && loop.reason.starts_with(kInconsistentLoop)) ++missed_loops;
   }
   s.loops_false = false_loops;
   s.loops_missed = missed_loops;
+  s.registrations_missed = static_cast<int>(
+      std::count_if(m.inconsistent_registrations.begin(), m.inconsistent_registrations.end(),
+                    [&](const InconsistentRegistration& r) { return IsMissed(r, m.truth); }));
   return s;
 }
 

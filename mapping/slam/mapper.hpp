@@ -149,6 +149,21 @@ struct LoopClosure {
   Matrix6d information = Matrix6d::Zero();
 };
 
+// A submap's registration to the previous ones that its fitness allowed but the chi-square
+// against the navigation's motion turned away (MapperStats::registrations_inconsistent): the
+// submap was left to the navigation there. Kept so that a simulated dive's truth can tell a wrong
+// registration from a right one judged against a prediction too sure of itself.
+struct InconsistentRegistration {
+  int from = 0;  // the previous submap
+  int to = 0;    // the new one
+  double fitness = 0.0;
+  double chi2 = 0.0;                                            // against the navigation's motion
+  int constrained_directions = 0;                               // directions the registration pins
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered (scan to scan)
+  Eigen::Isometry3d T_predicted = Eigen::Isometry3d::Identity();  // the navigation's motion
+  Matrix6d information = Matrix6d::Zero();  // [w, v] in `from`'s frame, zero where it is free
+};
+
 // Processing time by stage (seconds): frames triangulated and placed, submaps voxelised with
 // normals, registered to the last ones, loops tried, the graph solved.
 struct MapperStageSeconds {
@@ -244,6 +259,7 @@ class Mapper {
   // placed its frames (SubmapDistortionCovariance in navigation_uncertainty.hpp).
   Eigen::Isometry3d scan_pose(int index) const;
   const std::vector<LoopClosure>& loops() const;
+  const std::vector<InconsistentRegistration>& inconsistent_registrations() const;
   const MapperStats& stats() const;
   // The dead reckoning's calibration as currently estimated (zero when not estimated).
   DeadReckoningCalibration calibration() const;

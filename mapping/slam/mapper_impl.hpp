@@ -72,6 +72,7 @@ struct Mapper::Impl {
       increment_covariance;  // of scan motion T_{i-1,i} in frame i-1 (0 for i = 0)
   PoseGraph graph;
   std::vector<LoopClosure> loops;
+  std::vector<InconsistentRegistration> inconsistent_registrations;
   // The accepted loops as shortcuts for later predictions: the covariance of T_a_b, that of the
   // prediction it was tested against fused with its registration. In the order accepted.
   struct LoopShortcut {
