@@ -42,9 +42,9 @@ bool WithinFalseLoopTolerance(const Eigen::Matrix<double, 6, 1>& error) {
          error.head<3>().norm() <= kFalseLoopRotation_rad;
 }
 
-// A consecutive registration the gate turned away although it was right and nearer the truth
-// than the navigation's motion that stood in for it. (The false-loop tolerance alone is too wide
-// for one step of a few centimetres: a registration 3 cm off is a wrong one there.)
+// A consecutive registration the gate turned away although it was right and nearer the truth in
+// position than the navigation's motion that stood in for it. (The false-loop tolerance alone is
+// too wide for one step of a few centimetres: a registration 3 cm off is a wrong one there.)
 bool IsMissed(const InconsistentRegistration& r, const std::vector<TimedPose>& truth) {
   const auto registered = MeasuredError(r.from, r.to, r.T_from_to, r.information, truth);
   const auto predicted = MeasuredError(r.from, r.to, r.T_predicted, r.information, truth);

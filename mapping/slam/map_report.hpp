@@ -21,8 +21,8 @@ struct MapSummary {
   // the prediction's covariance was too small (truth needed).
   std::optional<int> loops_missed;
   // Consecutive registrations the chi-square against the navigation turned away although the
-  // truth puts them within that tolerance and nearer it than the navigation's motion, in the
-  // directions they measure (DiveMapping::inconsistent_registrations; truth needed).
+  // truth puts them within that tolerance and nearer it in position than the navigation's motion,
+  // in the directions they measure (DiveMapping::inconsistent_registrations; truth needed).
   std::optional<int> registrations_missed;
   std::optional<double> ate_slam_m, ate_dead_reckoning_m;
   std::optional<double> rpe_slam_per_m, rpe_dead_reckoning_per_m;

@@ -299,9 +299,6 @@ Mapper::Impl::ConsecutiveRegistration Mapper::Impl::RegisterToPrevious(const Sub
     ++stats.registrations_inconsistent;
     inconsistent_registrations.push_back({.from = k - 1,
                                           .to = k,
-                                          .fitness = r.fitness,
-                                          .chi2 = chi2,
-                                          .constrained_directions = kept.count,
                                           .T_from_to = r.T_target_source,
                                           .T_predicted = T_nav,
                                           .information = information});

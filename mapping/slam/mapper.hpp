@@ -154,12 +154,9 @@ struct LoopClosure {
 // submap was left to the navigation there. Kept so that a simulated dive's truth can tell a wrong
 // registration from a right one judged against a prediction too sure of itself.
 struct InconsistentRegistration {
-  int from = 0;  // the previous submap
-  int to = 0;    // the new one
-  double fitness = 0.0;
-  double chi2 = 0.0;                                            // against the navigation's motion
-  int constrained_directions = 0;                               // directions the registration pins
-  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();  // as registered (scan to scan)
+  int from = 0;                                                   // the previous submap
+  int to = 0;                                                     // the new one
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();    // as registered (scan to scan)
   Eigen::Isometry3d T_predicted = Eigen::Isometry3d::Identity();  // the navigation's motion
   Matrix6d information = Matrix6d::Zero();  // [w, v] in `from`'s frame, zero where it is free
 };
