@@ -395,6 +395,7 @@ void Mapper::Impl::Solve(int first_free_submap, bool last) {
     graph.SolveWindow(AnchorNode(first_free_submap), solve);
     ++stats.window_solves;
   }
+  PlaceCentres(first_free_submap, centres.held() - 1);
   since_solve = 0;
   stats.stage_seconds.graph_s += Since(start);
 }

@@ -16,6 +16,7 @@
 #include "mapping/slam/navigation_buffer.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
 #include "mapping/slam/registration_information.hpp"
+#include "mapping/slam/submap_centre_grid.hpp"
 #include "mapping/slam/submap_store.hpp"
 #include "perception/registration/registration_result.hpp"
 
@@ -81,6 +82,13 @@ struct Mapper::Impl {
     Matrix6d covariance;
   };
   std::vector<LoopShortcut> shortcuts;
+  // The centres of the submaps a loop search may ask (loop_min_index_gap or more behind the
+  // newest) where the graph has them now: placed as they come within the search's reach
+  // (PlaceCentres), moved again after every solve that freed them. The largest of their radii
+  // bounds the search's first cut.
+  SubmapCentreGrid centres{2.0};
+  double largest_radius_m = 0.0;
+  void PlaceCentres(int from, int to);
   MapperStats stats;
   int since_solve = 0;
   int next_whole_solve_submaps = 0;  // the graph's size at which the next solve is whole

@@ -55,6 +55,7 @@ void Mapper::Impl::TryLoopClosures(int k) {
     return;
   }
   const Clock::time_point start = Clock::now();
+  PlaceCentres(centres.held(), k - options.loop_min_index_gap);
   for (const LoopCandidate& c : LoopCandidates(k)) {
     const perception::RegistrationResult r =
         Register(submaps[static_cast<size_t>(k)], LoopTarget(c.j, k), c.predicted.T_j_k,
@@ -77,13 +78,19 @@ void Mapper::Impl::TryLoopClosures(int k) {
 std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) const {
   const Submap& current = submaps[static_cast<size_t>(k)];
   const Eigen::Vector3d centre_k = ScanPose(k) * current.centroid_V;  // in the world
-  // The cheap first cut, far beyond any gate here: centres within 2 m of overlapping.
-  std::vector<std::pair<int, double>> near;  // submap, distance
-  for (int j = 0; j + options.loop_min_index_gap <= k; ++j) {
+  // The cheap first cut, far beyond any gate here: centres within 2 m of overlapping, from the
+  // grid's cells around k (every submap it holds is loop_min_index_gap or more behind k).
+  // The grid is asked a millimetre further, so that rounding cannot leave out a centre on the
+  // edge.
+  constexpr double kFirstCutSlackM = 2.0;
+  const double reach_m =
+      kFirstCutSlackM + 0.001 + options.loop_overlap_ratio * (largest_radius_m + current.radius_m);
+  std::vector<std::pair<int, double>> near;  // submap, distance, in ascending submap order
+  for (const int j : centres.Near(centre_k, reach_m)) {
     const Submap& old = submaps[static_cast<size_t>(j)];
     const double distance = (ScanPose(j) * old.centroid_V - centre_k).norm();
     const double overlap = options.loop_overlap_ratio * (old.radius_m + current.radius_m);
-    if (distance - overlap <= 2.0) near.emplace_back(j, distance);
+    if (distance - overlap <= kFirstCutSlackM) near.emplace_back(j, distance);
   }
   // Candidates are tried nearest first (of equally near ones, the older): the gate is asked of
   // the near submaps in that order until enough pass. Late in a long dive hundreds of earlier
@@ -108,6 +115,14 @@ std::vector<Mapper::Impl::LoopCandidate> Mapper::Impl::LoopCandidates(int k) con
     candidates.push_back({j, distance, predicted});
   }
   return candidates;
+}
+
+void Mapper::Impl::PlaceCentres(int from, int to) {
+  for (int j = from; j <= to; ++j) {
+    const Submap& s = submaps[static_cast<size_t>(j)];
+    centres.Place(j, ScanPose(j) * s.centroid_V);
+    largest_radius_m = std::max(largest_radius_m, s.radius_m);
+  }
 }
 
 const Matrix6d& Mapper::Impl::ChainBack::To(int j) {
