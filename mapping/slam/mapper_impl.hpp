@@ -85,7 +85,8 @@ struct Mapper::Impl {
   // The centres of the submaps a loop search may ask (loop_min_index_gap or more behind the
   // newest) where the graph has them now: placed as they come within the search's reach
   // (PlaceCentres), moved again after every solve that freed them. The largest of their radii
-  // bounds the search's first cut.
+  // bounds the search's first cut (so one wide submap widens every later query: a cost, never a
+  // candidate lost).
   SubmapCentreGrid centres{2.0};
   double largest_radius_m = 0.0;
   void PlaceCentres(int from, int to);

@@ -70,8 +70,8 @@ std::vector<int> SubmapCentreGrid::Near(const Eigen::Vector3d& centre_W, double 
   std::vector<int> near;
   for (std::int64_t x = CellCoordinate(low.x(), cell_m_); x <= CellCoordinate(high.x(), cell_m_);
        ++x) {
-    for (std::int64_t y = CellCoordinate(low.y(), cell_m_);
-         y <= CellCoordinate(high.y(), cell_m_); ++y) {
+    for (std::int64_t y = CellCoordinate(low.y(), cell_m_); y <= CellCoordinate(high.y(), cell_m_);
+         ++y) {
       for (std::int64_t z = CellCoordinate(low.z(), cell_m_);
            z <= CellCoordinate(high.z(), cell_m_); ++z) {
         const auto cell = cells_.find(KeyOfCell(x, y, z));

@@ -33,8 +33,8 @@ class SubmapCentreGrid {
 
   double cell_m_;
   std::unordered_map<Key, std::vector<int>> cells_;
-  std::vector<Key> key_of_;     // per index, where it is held
-  std::vector<bool> is_held_;   // per index
+  std::vector<Key> key_of_;    // per index, where it is held
+  std::vector<bool> is_held_;  // per index
   int held_ = 0;
 };
 

@@ -51,6 +51,7 @@ TEST(SubmapCentreGrid, FindsEveryCentreWithinReachAsTheyMove) {
     const double radius_m = 0.5 + 3.0 * (k % 7) / 7.0;
     const std::vector<int> near = grid.Near(centres[static_cast<std::size_t>(k / 2)], radius_m);
     ASSERT_TRUE(std::is_sorted(near.begin(), near.end()));
+    ASSERT_EQ(std::adjacent_find(near.begin(), near.end()), near.end()) << "a centre held twice";
     for (const int i : WithinByScan(centres, centres[static_cast<std::size_t>(k / 2)], radius_m))
       ASSERT_TRUE(Contains(near, i)) << "submap " << i << " missed at step " << k;
   }
