@@ -312,12 +312,20 @@ TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {
   EXPECT_LT(slam_sideways, 0.5 * dr_sideways);
 }
 
-TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
+// A dive of two submaps, the second `x_m` along x and `dt_s` after the first, mapped exactly: what
+// the summary's truth checks read.
+DiveMapping TwoSubmapDive(double x_m, double dt_s) {
   DiveMapping m;
-  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
-  far.translation().x() = 1.0;
-  m.truth = {{0.0, Eigen::Isometry3d::Identity()}, {1.0, far}};
+  Eigen::Isometry3d second = Eigen::Isometry3d::Identity();
+  second.translation().x() = x_m;
+  m.truth = {{0.0, Eigen::Isometry3d::Identity()}, {dt_s, second}};
   m.slam = m.dead_reckoning = m.truth;
+  return m;
+}
+
+TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
+  DiveMapping m = TwoSubmapDive(1.0, 1.0);
+  const Eigen::Isometry3d far = m.truth[1].T_W_V;
   LoopClosure slid;  // off by 20 cm along the pipe it cannot see along
   slid.from = 0;
   slid.to = 1;
@@ -335,11 +343,8 @@ TEST(MapSummary, ALoopIsJudgedOnlyInTheDirectionsItMeasures) {
 }
 
 TEST(MapSummary, ARightLoopTurnedAwayByThePredictionCountsAsMissed) {
-  DiveMapping m;
-  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
-  far.translation().x() = 1.0;
-  m.truth = {{0.0, Eigen::Isometry3d::Identity()}, {1.0, far}};
-  m.slam = m.dead_reckoning = m.truth;
+  DiveMapping m = TwoSubmapDive(1.0, 1.0);
+  const Eigen::Isometry3d far = m.truth[1].T_W_V;
   LoopClosure right;  // 1 cm off: within the tolerance
   right.from = 0;
   right.to = 1;
@@ -363,11 +368,8 @@ TEST(MapSummary, ARightLoopTurnedAwayByThePredictionCountsAsMissed) {
 }
 
 TEST(MapSummary, ARightRegistrationTurnedAwayCountsAsMissedOnlyWhereTheNavigationWasFurtherOff) {
-  DiveMapping m;
-  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-  step.translation().x() = 0.3;
-  m.truth = {{0.0, Eigen::Isometry3d::Identity()}, {0.5, step}};
-  m.slam = m.dead_reckoning = m.truth;
+  DiveMapping m = TwoSubmapDive(0.3, 0.5);
+  const Eigen::Isometry3d step = m.truth[1].T_W_V;
   InconsistentRegistration right;  // 1 mm off, the navigation 24 mm
   right.from = 0;
   right.to = 1;
