@@ -1,9 +1,12 @@
 // uwscan: the command-line program. Parses arguments and calls the libraries; errors end with
 // a one-line reason on stderr and a non-zero exit.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <string>
 
 #include "apps/bench/accuracy_command.hpp"
 #include "apps/bench/acquisition_bench_command.hpp"
@@ -40,20 +43,34 @@
 // OpenMP's threads wait for work by sleeping, not spinning, unless the user asks otherwise:
 // libgomp's default spin-wait made 2 threads slower than 1 whenever the other core was busy
 // (a vehicle's computer always runs something else; docs/reliability.md, "Threads under load").
-// libgomp reads OMP_WAIT_POLICY in its own constructor, before main; an entry in the program's
-// .preinit_array runs before any shared library's constructor, so the default is set there.
+// libgomp reads OMP_WAIT_POLICY once, while the program loads, before any of uwscan's code runs.
+// Even an entry in the program's .preinit_array is too early: it runs before libc installs the
+// environment the program was started with, which drops what the entry set (the policy stayed
+// libgomp's own). So without the variable the program starts itself again with it set: one more
+// start (0.4 s here, most of it the dynamic loader), never when OMP_WAIT_POLICY is set (./run
+// sets it).
 namespace {
-void PassiveOpenMpWaitByDefault(int, char**, char**) {
+void PassiveOpenMpWaitByDefault(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
   setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0);
+  execv("/proc/self/exe", argv);
+  // Not started again (no /proc): the threads keep libgomp's own policy, and say so (--version).
+  unsetenv("OMP_WAIT_POLICY");
+}
+
+// The OpenMP wait policy this process runs with, as --version reports it.
+std::string OpenMpWaitPolicy() {
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  return policy != nullptr ? std::string("OMP_WAIT_POLICY=") + policy
+                           : std::string("libgomp's default wait policy");
 }
 }  // namespace
-__attribute__((section(".preinit_array"),
-               used)) static void (*const kPreinit)(int, char**,
-                                                    char**) = &PassiveOpenMpWaitByDefault;
 
 int main(int argc, char** argv) {
+  PassiveOpenMpWaitByDefault(argv);
   CLI::App app{"uwscan: underwater laser scanner perception toolkit"};
-  app.set_version_flag("--version", std::string("uwscan ") + UWSCAN_VERSION);
+  app.set_version_flag("--version", std::string("uwscan ") + UWSCAN_VERSION +
+                                        "\nOpenMP threads: " + OpenMpWaitPolicy());
   // For paths to the shipped scenes and scanners in scripts: "$(uwscan --data-dir)/scenes/...".
   app.add_flag_callback(
       "--data-dir",

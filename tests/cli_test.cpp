@@ -40,6 +40,23 @@ TEST(Cli, VersionAndHelp) {
   EXPECT_NE(help.output.find("--points"), std::string::npos);
 }
 
+// OpenMP's threads sleep while they wait unless the environment says otherwise: libgomp reads
+// the policy while the program loads, so uwscan starts itself again with it set (main.cpp).
+TEST(Cli, OpenMpThreadsWaitPassivelyUnlessTheEnvironmentSaysOtherwise) {
+  const std::string bin = UWSCAN_BIN;
+  const CommandRun unset = RunCommand("env -u OMP_WAIT_POLICY " + bin + " --version");
+  EXPECT_EQ(unset.exit_code, 0);
+  EXPECT_NE(unset.output.find("OpenMP threads: OMP_WAIT_POLICY=PASSIVE"), std::string::npos)
+      << unset.output;
+  const CommandRun active = RunCommand("env OMP_WAIT_POLICY=active " + bin + " --version");
+  EXPECT_NE(active.output.find("OpenMP threads: OMP_WAIT_POLICY=active"), std::string::npos)
+      << active.output;
+  // A command's work and its exit status come through the second start unchanged.
+  const CommandRun failing = RunCommand("env -u OMP_WAIT_POLICY " + bin + " frobnicate");
+  EXPECT_EQ(failing.exit_code, 2) << failing.output;
+  EXPECT_EQ(failing.output.rfind("uwscan: error: ", 0), 0u) << failing.output;
+}
+
 TEST(Cli, BadInputEndsWithOneLineReason) {
   const CommandRun no_command = RunUwscan("");
   EXPECT_NE(no_command.exit_code, 0);
