@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <fstream>
 #include <string>
 
 #include "apps/bench/accuracy_command.hpp"
@@ -58,11 +59,15 @@ void PassiveOpenMpWaitByDefault(char** argv) {
   unsetenv("OMP_WAIT_POLICY");
 }
 
-// The OpenMP wait policy this process runs with, as --version reports it.
+// The OpenMP wait policy this process runs with, as --version reports it: the variable as the
+// process was started with it (/proc/self/environ, what libgomp read), not as set since.
 std::string OpenMpWaitPolicy() {
-  const char* policy = std::getenv("OMP_WAIT_POLICY");
-  return policy != nullptr ? std::string("OMP_WAIT_POLICY=") + policy
-                           : std::string("libgomp's default wait policy");
+  std::ifstream environ_file("/proc/self/environ", std::ios::binary);
+  const std::string prefix = "OMP_WAIT_POLICY=";
+  for (std::string entry; std::getline(environ_file, entry, '\0');) {
+    if (entry.rfind(prefix, 0) == 0) return entry;
+  }
+  return "libgomp's default wait policy";
 }
 }  // namespace
 
