@@ -254,10 +254,14 @@ TEST_F(CliFaults, KilledAtAnyMomentTheOutputIsTheOldFileOrACompleteNewOne) {
                           (dir_ / "old.ply").string() + " -o " + registered.string(),
                       {{registered, old_bytes, ""}}, 8);
 
-  const fs::path map = dir_ / "map.ply", trajectory = dir_ / "slam.tum";
-  KillAtRandomMoments(
-      bin + " map " + dive + " -o " + map.string() + " --trajectory " + trajectory.string(),
-      {{map, old_bytes, ""}, {trajectory, "0 0 0 0 0 0 0 1\n", ""}}, 8);
+  // The mapper's spill files (old clouds and measurements) go to TMPDIR: a killed mapper must
+  // leave none there (mapping/slam/spill_file.hpp).
+  const fs::path map = dir_ / "map.ply", trajectory = dir_ / "slam.tum", spill = dir_ / "spill";
+  fs::create_directories(spill);
+  KillAtRandomMoments("env TMPDIR=" + spill.string() + " " + bin + " map " + dive + " -o " +
+                          map.string() + " --trajectory " + trajectory.string(),
+                      {{map, old_bytes, ""}, {trajectory, "0 0 0 0 0 0 0 1\n", ""}}, 8);
+  EXPECT_TRUE(fs::is_empty(spill)) << fs::directory_iterator(spill)->path();
 
   const fs::path database = dir_ / "objects.db";
   KillAtRandomMoments(bin + " build-db pipe -o " + database.string(),

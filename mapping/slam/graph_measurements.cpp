@@ -1,11 +1,8 @@
 #include "mapping/slam/graph_measurements.hpp"
 
 #include <algorithm>
-#include <fstream>
-#include <iterator>
 #include <string>
 
-#include "mapping/slam/spill_file.hpp"
 #include "scanner/common/byte_io.hpp"
 #include "scanner/common/error.hpp"
 
@@ -178,12 +175,7 @@ std::int64_t GraphMeasurements::memory_bytes() const {
 }
 
 MeasurementSpill::MeasurementSpill(const std::filesystem::path& folder)
-    : path_(NewSpillFile(folder, "uwscan-graph", "pose graph")) {}
-
-MeasurementSpill::~MeasurementSpill() {
-  std::error_code ignored;
-  std::filesystem::remove(path_, ignored);
-}
+    : file_(folder, "pose graph") {}
 
 void MeasurementSpill::Append(const GraphMeasurements& measurements, std::size_t count) {
   ByteWriter record;
@@ -206,18 +198,13 @@ void MeasurementSpill::Append(const GraphMeasurements& measurements, std::size_t
         break;
     }
   }
-  std::ofstream out(path_, std::ios::binary | std::ios::app);
-  out.write(record.bytes().data(), static_cast<std::streamsize>(record.bytes().size()));
-  out.flush();
-  if (!out) throw Error("pose graph: cannot write to " + path_.string() + " (disk full?)");
+  file_.Append(record.bytes());
   size_ += count;
 }
 
 GraphMeasurements MeasurementSpill::ReadAll() const {
-  std::ifstream in(path_, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.eof() && !in) throw Error("pose graph: cannot read " + path_.string() + " back");
-  ByteReader reader(bytes, 0, bytes.size(), path_.string());
+  const std::string bytes = file_.Read(0, file_.size());
+  ByteReader reader(bytes, 0, bytes.size(), "the pose graph's spilled measurements");
   GraphMeasurements measurements;
   while (!reader.at_end()) {
     switch (static_cast<GraphMeasurements::Kind>(reader.Get<std::uint8_t>("kind"))) {

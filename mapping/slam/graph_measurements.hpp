@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mapping/slam/pose_graph.hpp"
+#include "mapping/slam/spill_file.hpp"
 
 // The pose graph's measurements as plain records, in the order they were added, and the file
 // that the old ones move to on a long dive (MeasurementSpill). Each solve builds its Ceres
@@ -70,13 +71,13 @@ struct GraphMeasurements {
 };
 
 // The measurements a long dive's graph no longer needs in memory (GraphMeasurements::OlderThan
-// the oldest node a window may free), appended in order to a file in a folder, read back whole
-// for the solves of the whole graph. The file is removed when the spill is destroyed.
+// the oldest node a window may free), appended in order to a SpillFile in a folder (nameless
+// there: it goes with the spill, or with the process), read back whole for the solves of the
+// whole graph.
 class MeasurementSpill {
  public:
   // Throws uwscan::Error when the file cannot be created in `folder`.
   explicit MeasurementSpill(const std::filesystem::path& folder);
-  ~MeasurementSpill();
   MeasurementSpill(const MeasurementSpill&) = delete;
   MeasurementSpill& operator=(const MeasurementSpill&) = delete;
 
@@ -86,7 +87,7 @@ class MeasurementSpill {
   GraphMeasurements ReadAll() const;
 
  private:
-  std::filesystem::path path_;
+  SpillFile file_;
   std::size_t size_ = 0;
 };
 

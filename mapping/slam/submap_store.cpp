@@ -1,7 +1,5 @@
 #include "mapping/slam/submap_store.hpp"
 
-#include <cstdio>
-#include <fstream>
 #include <string>
 
 #include "mapping/slam/spill_file.hpp"
@@ -47,19 +45,14 @@ SubmapStore::SubmapStore(const std::filesystem::path& spill_folder, int resident
     : resident_(resident) {
   if (resident <= 0)
     throw Error("submap store: resident must be > 0, got " + std::to_string(resident));
-  if (!spill_folder.empty())
-    spill_path_ = NewSpillFile(spill_folder, "uwscan-submaps", "submap store");
+  if (!spill_folder.empty()) spill_ = std::make_unique<SpillFile>(spill_folder, "submap store");
 }
 
-SubmapStore::~SubmapStore() {
-  if (spill_path_.empty()) return;
-  std::error_code ignored;
-  std::filesystem::remove(spill_path_, ignored);
-}
+SubmapStore::~SubmapStore() = default;
 
 void SubmapStore::Add(SubmapClouds clouds) {
   slots_.push_back({std::make_shared<const SubmapClouds>(std::move(clouds)), -1});
-  if (!spill_path_.empty() && size() > resident_) Spill(size() - 1 - resident_);
+  if (spill_ && size() > resident_) Spill(size() - 1 - resident_);
 }
 
 void SubmapStore::Spill(int index) {
@@ -67,15 +60,7 @@ void SubmapStore::Spill(int index) {
   ByteWriter record;
   PutCloud(slot.clouds->cloud, &record);
   PutCloud(slot.clouds->sparse, &record);
-  std::ofstream out(spill_path_, std::ios::binary | std::ios::app);
-  const std::int64_t offset = static_cast<std::int64_t>(std::filesystem::file_size(spill_path_));
-  out.write(record.bytes().data(), static_cast<std::streamsize>(record.bytes().size()));
-  out.flush();
-  if (!out) {
-    throw Error("submap store: cannot write submap " + std::to_string(index) + " to " +
-                spill_path_.string() + " (disk full?)");
-  }
-  slot.offset = offset;
+  slot.offset = spill_->Append(record.bytes());
   slot.bytes = static_cast<std::int64_t>(record.bytes().size());
   slot.clouds.reset();
 }
@@ -91,15 +76,8 @@ std::shared_ptr<const SubmapClouds> SubmapStore::Get(int index) const {
     read_back_.splice(read_back_.begin(), read_back_, it);
     return it->second;
   }
-  std::ifstream in(spill_path_, std::ios::binary);
-  in.seekg(slot.offset);
-  std::string record(static_cast<size_t>(slot.bytes), '\0');
-  in.read(record.data(), static_cast<std::streamsize>(record.size()));
-  if (!in) {
-    throw Error("submap store: cannot read submap " + std::to_string(index) + " back from " +
-                spill_path_.string());
-  }
-  ByteReader reader(record, 0, record.size(), spill_path_.string());
+  const std::string record = spill_->Read(slot.offset, slot.bytes);
+  ByteReader reader(record, 0, record.size(), "submap " + std::to_string(index) + " read back");
   auto clouds = std::make_shared<SubmapClouds>();
   GetCloud(&reader, &clouds->cloud);
   GetCloud(&reader, &clouds->sparse);

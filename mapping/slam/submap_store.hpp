@@ -9,6 +9,10 @@
 #include "perception/cloud/point_cloud.hpp"
 
 namespace uwscan::mapping {
+class SpillFile;
+}  // namespace uwscan::mapping
+
+namespace uwscan::mapping {
 
 // A submap's two clouds (Submap::cloud and Submap::sparse).
 struct SubmapClouds {
@@ -18,10 +22,10 @@ struct SubmapClouds {
 
 // The clouds of a dive's submaps, so that a long dive's memory does not grow with it: the newest
 // `resident` submaps' clouds stay in memory, older ones are written once to a spill file in
-// `spill_folder` and read back when asked for (a loop closure's target, the map at the end), the
-// last few read kept in memory. Without a spill folder every cloud stays in memory. Clouds come
-// back with the same bits. Not thread-safe (the Mapper's thread only). The spill file is removed
-// when the store is destroyed.
+// `spill_folder` (a SpillFile: it has no name there and goes with the store, or with the process)
+// and read back when asked for (a loop closure's target, the map at the end), the last few read
+// kept in memory. Without a spill folder every cloud stays in memory. Clouds come back with the
+// same bits. Not thread-safe (the Mapper's thread only).
 class SubmapStore {
  public:
   static constexpr int kReadBackCache = 8;  // clouds read back and kept (a loop's three, twice)
@@ -49,7 +53,7 @@ class SubmapStore {
   };
   void Spill(int index);
 
-  std::filesystem::path spill_path_;  // empty: no spilling
+  std::unique_ptr<SpillFile> spill_;  // null: no spilling
   int resident_;
   std::vector<Slot> slots_;
   mutable std::list<std::pair<int, std::shared_ptr<const SubmapClouds>>> read_back_;
