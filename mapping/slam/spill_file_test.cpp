@@ -1,6 +1,7 @@
 #include "mapping/slam/spill_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -79,6 +80,36 @@ TEST_F(SpillFileTest, AKilledProcessLeavesNothingBehind) {
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "child exited " << status;
   EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+// A write the disk cannot take (here the file size limit, as a full disk would refuse it) is an
+// error naming the owner and the folder; what was appended before still reads back.
+TEST_F(SpillFileTest, AWriteTheDiskRefusesIsNamedAndTheEarlierBytesStay) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{1 << 16, 1 << 16};
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) ::_exit(2);
+    SpillFile file(dir_, "submap store");
+    const std::string first(1 << 12, 'a');
+    file.Append(first);
+    try {
+      file.Append(std::string(1 << 20, 'b'));
+      ::_exit(3);  // no error
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      if (message.find("submap store") == std::string::npos ||
+          message.find(dir_.string()) == std::string::npos) {
+        ::_exit(4);
+      }
+    }
+    ::_exit(file.Read(0, 1 << 12) == first && file.size() == (1 << 12) ? 0 : 5);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "child ended by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "2: no limit, 3: no error, 4: not named, 5: bytes lost";
 }
 
 TEST_F(SpillFileTest, AMissingFolderAndAReadPastTheEndAreNamed) {
