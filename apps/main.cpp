@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -73,6 +74,9 @@ std::string OpenMpWaitPolicy() {
 
 int main(int argc, char** argv) {
   PassiveOpenMpWaitByDefault(argv);
+  // A write past the file size limit (ulimit -f) fails with EFBIG, which the writers report as an
+  // error naming the file and leave the old one, instead of killing the program with a core dump.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"uwscan: underwater laser scanner perception toolkit"};
   app.set_version_flag("--version", std::string("uwscan ") + UWSCAN_VERSION +
                                         "\nOpenMP threads: " + OpenMpWaitPolicy());

@@ -6,15 +6,16 @@
 #include <string>
 #include <system_error>
 
+#include "scanner/common/error.hpp"
+
 namespace uwscan::bench {
 
 // A fresh folder under the system's temporary directory, named after `purpose` and the process,
 // removed on every way out (normal return or exception).
 class ScratchFolder {
  public:
-  explicit ScratchFolder(const std::string& purpose)
-      : path_(std::filesystem::temp_directory_path() /
-              ("uwscan-" + purpose + "-" + std::to_string(::getpid()))) {
+  // Throws uwscan::Error when there is no temporary folder ($TMPDIR not a folder).
+  explicit ScratchFolder(const std::string& purpose) : path_(Under(purpose)) {
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
@@ -27,6 +28,14 @@ class ScratchFolder {
   const std::filesystem::path& path() const { return path_; }
 
  private:
+  static std::filesystem::path Under(const std::string& purpose) {
+    std::error_code error;
+    const std::filesystem::path folder = std::filesystem::temp_directory_path(error);
+    if (error)
+      throw Error("bench: no temporary folder for its scratch files (" + error.message() +
+                  "; is $TMPDIR a folder?)");
+    return folder / ("uwscan-" + purpose + "-" + std::to_string(::getpid()));
+  }
   std::filesystem::path path_;
 };
 

@@ -176,6 +176,56 @@ TEST_F(CliFaults, AFullDiskGivesAClearErrorAndKeepsTheOldFile) {
       << run.output;
 }
 
+// A dive log damaged in its middle: `map` stops at the damaged frame with an error naming it, and
+// the stage it was in ends "stopped", not "done"; the old map stays.
+TEST_F(CliFaults, AStageAnErrorCutsShortEndsStoppedNotDone) {
+  const fs::path damaged = dir_ / "damaged.db", map = dir_ / "damaged_map.ply";
+  fs::copy_file(dir_ / "dive.db", damaged, fs::copy_options::overwrite_existing);
+  {
+    std::fstream file(damaged, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(static_cast<std::streamoff>(0.6 * static_cast<double>(fs::file_size(damaged))));
+    std::mt19937 rng(11);
+    for (int i = 0; i < 20000; ++i) file.put(static_cast<char>(rng() & 0xff));
+  }
+  std::ofstream(map) << "old map";
+  const CommandRun run = RunUwscan("map " + damaged.string() + " -o " + map.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("dive log"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("map: stopped"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("map: done"), std::string::npos) << run.output;
+  EXPECT_EQ(Bytes(map), "old map");
+}
+
+// The temporary folder long commands spill to, missing: a one-line error naming $TMPDIR (it was
+// an "internal error" from the standard library), nothing written.
+TEST_F(CliFaults, AMissingTemporaryFolderIsNamed) {
+  const fs::path missing = dir_ / "no_such_tmp", map = dir_ / "tmpdir_map.ply";
+  std::ofstream(map) << "old map";
+  const CommandRun run = RunCommand("env TMPDIR=" + missing.string() + " " + UWSCAN_BIN + " map " +
+                                    (dir_ / "dive.db").string() + " -o " + map.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("$TMPDIR (" + missing.string() + ")"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("internal error"), std::string::npos) << run.output;
+  EXPECT_EQ(Bytes(map), "old map");
+}
+
+// A file size limit (ulimit -f) under the new map's size: the write fails with a one-line error
+// and the old map stays, with no temporary file beside it; without SIGXFSZ ignored the program
+// was killed by the signal mid-write, with no error and its temporary file left behind.
+TEST_F(CliFaults, AFileSizeLimitIsAClearErrorNotASignal) {
+  const fs::path folder = dir_ / "limited";
+  fs::create_directories(folder);
+  const fs::path map = folder / "map.ply";
+  std::ofstream(map) << "old map";
+  const CommandRun run = RunCommand("ulimit -f 64; exec " + std::string(UWSCAN_BIN) + " map " +
+                                    (dir_ / "dive.db").string() + " -o " + map.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("File too large"), std::string::npos) << run.output;
+  EXPECT_EQ(Bytes(map), "old map");
+  EXPECT_EQ(std::distance(fs::directory_iterator(folder), fs::directory_iterator()), 1)
+      << "a temporary file was left beside the map";
+}
+
 // One output of a command killed at random moments: what it held before, and what a complete run
 // writes (with `normalise` applied: lines that differ between runs, such as timings, dropped).
 struct KilledOutput {

@@ -7,16 +7,17 @@
 
 namespace uwscan::app {
 
-ProgressBar::ProgressBar() : terminal_(isatty(fileno(stderr)) != 0) {}
+ProgressBar::ProgressBar()
+    : terminal_(isatty(fileno(stderr)) != 0), exceptions_at_start_(std::uncaught_exceptions()) {}
 
-ProgressBar::~ProgressBar() { Finish(); }
+ProgressBar::~ProgressBar() { Finish(std::uncaught_exceptions() > exceptions_at_start_); }
 
-void ProgressBar::Finish() {
+void ProgressBar::Finish(bool stopped) {
   if (stage_.empty()) return;
   if (terminal_) {
-    std::fputc('\n', stderr);
+    std::fputs(stopped ? " stopped\n" : "\n", stderr);
   } else {
-    std::fprintf(stderr, "  %s: done\n", stage_.c_str());
+    std::fprintf(stderr, "  %s: %s\n", stage_.c_str(), stopped ? "stopped" : "done");
   }
   stage_.clear();
   shown_percent_ = -1;

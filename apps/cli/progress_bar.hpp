@@ -1,5 +1,6 @@
 #pragma once
 
+#include <exception>
 #include <string>
 #include <string_view>
 
@@ -8,7 +9,8 @@
 namespace uwscan::app {
 
 // A one-line progress bar on stderr. On a terminal it redraws in place; otherwise it prints a
-// line when a stage starts and when it ends, so logs stay readable.
+// line when a stage starts and when it ends, so logs stay readable. A stage the bar is destroyed
+// in while an exception leaves the command ends "stopped", not "done": the error follows.
 class ProgressBar {
  public:
   ProgressBar();
@@ -19,8 +21,9 @@ class ProgressBar {
   }
 
  private:
-  void Finish();
+  void Finish(bool stopped = false);
   bool terminal_;
+  int exceptions_at_start_;  // std::uncaught_exceptions() when made
   std::string stage_;
   int shown_percent_ = -1;
 };

@@ -14,6 +14,7 @@
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "apps/cli/reference_options.hpp"
+#include "apps/cli/temporary_folder.hpp"
 #include "mapping/change/change_report.hpp"
 #include "mapping/change/compare_surveys.hpp"
 #include "mapping/log/dive_log.hpp"
@@ -83,7 +84,7 @@ mapping::Survey LoadSurvey(const std::string& path, const mapping::SurveyReadOpt
   const mapping::DiveLogReader log(path);
   mapping::DiveMappingOptions mapping_options;
   mapping_options.mapper.threads = threads;
-  mapping_options.mapper.spill_folder = std::filesystem::temp_directory_path();
+  mapping_options.mapper.spill_folder = TemporaryFolder();
   mapping_options.table_cache = TableCache();
   mapping::DiveMapping m;
   {

@@ -17,6 +17,7 @@
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/reference_options.hpp"
 #include "apps/cli/stop_signal.hpp"
+#include "apps/cli/temporary_folder.hpp"
 #include "apps/scanner/camera_frames.hpp"
 #include "mapping/inspection/live_inspection.hpp"
 #include "perception/cloud/cloud_io.hpp"
@@ -133,7 +134,7 @@ mapping::InspectionOptions InspectionOptionsOf(const InspectArgs& a) {
   options.map_voxel_m = a.voxel_m;
   options.mapper.sweeps_per_submap = a.sweeps_per_submap;
   options.mapper.threads = a.threads;
-  options.mapper.spill_folder = std::filesystem::temp_directory_path();
+  options.mapper.spill_folder = TemporaryFolder();
   options.table_cache = TableCache();
   options.Check();
   return options;

@@ -12,6 +12,7 @@
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
+#include "apps/cli/temporary_folder.hpp"
 #include "mapping/slam/dive_mapping.hpp"
 #include "mapping/slam/map_report.hpp"
 #include "perception/cloud/cloud_io.hpp"
@@ -165,7 +166,7 @@ mapping::DiveMappingOptions DiveMappingOptionsOf(const MapArgs& a) {
   options.mapper.max_navigation_gap_s = a.max_navigation_gap_s;
   options.mapper.windowed_solves = !a.whole_graph_solves;
   // Older submaps' clouds wait on disk, so a long dive's memory does not grow with it.
-  options.mapper.spill_folder = std::filesystem::temp_directory_path();
+  options.mapper.spill_folder = TemporaryFolder();
   options.table_cache = TableCache();
   return options;
 }

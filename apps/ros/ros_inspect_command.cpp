@@ -14,6 +14,7 @@
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/reference_options.hpp"
 #include "apps/cli/stop_signal.hpp"
+#include "apps/cli/temporary_folder.hpp"
 #include "apps/ros/ros_arguments.hpp"
 #include "apps/ros/ros_recognize_command.hpp"
 #include "apps/scanner/camera_frames.hpp"
@@ -116,7 +117,7 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
   o.inspection.map_voxel_m = ros.Param("voxel_m", o.inspection.map_voxel_m);
   o.inspection.mapper.sweeps_per_submap =
       ros.Param("sweeps_per_submap", o.inspection.mapper.sweeps_per_submap);
-  o.inspection.mapper.spill_folder = std::filesystem::temp_directory_path();
+  o.inspection.mapper.spill_folder = TemporaryFolder();
   // On the vehicle every frame should reach SLAM (a skipped frame is a hole in the map), so the
   // live queue absorbs the mapper's pauses at submaps and solves: 1024 frames are 3 s at the
   // seed camera's 339 frames/s (and about 8 MB of peaks).
