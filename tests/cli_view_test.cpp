@@ -76,6 +76,12 @@ TEST(CliView, WithoutADisplayEveryRenderingCommandFailsWithOneLine) {
     EXPECT_NE(run.output.find("uwscan: error: no X display"), std::string::npos) << run.output;
   }
   EXPECT_FALSE(fs::exists(TempPath("x.png")));
+  // A file that is not there says so first, display or not.
+  const CommandRun missing = RunCommand("env -u DISPLAY " + std::string(UWSCAN_BIN) + " view " +
+                                        TempPath("no_such_cloud.ply").string());
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("no_such_cloud.ply: no such file"), std::string::npos)
+      << missing.output;
   fs::remove(cloud);
 }
 

@@ -175,6 +175,15 @@ void AddSceneObjects(const scanner::sim::Scene& loaded, const std::string& file,
   std::printf("\n");
 }
 
+// The files and scene to show are there (a followed log may not be yet).
+void RequireInputsExist(const ViewArgs& a) {
+  std::vector<std::string> inputs = a.files;
+  if (!a.scene.empty()) inputs.push_back(a.scene);
+  for (const std::string& input : inputs) {
+    if (!std::filesystem::exists(input)) throw Error(input + ": no such file");
+  }
+}
+
 void RunView(const ViewArgs& a) {
   if (a.files.empty() && a.scene.empty()) {
     throw CLI::RequiredError(
@@ -186,7 +195,8 @@ void RunView(const ViewArgs& a) {
     if (!a.scene.empty()) inputs.emplace_back(a.scene);
     CheckOutputPath(a.screenshot, "--screenshot", inputs);
   }
-  viewer::RequireDisplay();  // so is the display
+  if (!a.follow) RequireInputsExist(a);  // a mistyped name says so, even without a display
+  viewer::RequireDisplay();              // so is the display
   if (a.follow) {
     if (!a.scene.empty())
       throw Error("--scene: not with --follow (a followed log carries its own truth)");
