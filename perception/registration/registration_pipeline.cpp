@@ -25,7 +25,20 @@ struct Prepared {
   FpfhFeatures features;
 };
 
-Prepared Prepare(const PointCloud& cloud, const Eigen::Vector3d& viewpoint,
+// At least 3 points must keep a surface normal at the voxel, or no stage has anything to pair:
+// say why in terms of the cloud, not of the stage that would fail on it.
+void RequireSurface(const PointCloud& cloud, std::size_t voxels, const CloudWithNormals& prepared,
+                    const char* name, double voxel_m) {
+  if (prepared.cloud.size() >= 3) return;
+  throw Error(std::string(name) + ": " + std::to_string(prepared.cloud.size()) + " of its " +
+              std::to_string(voxels) + " voxels of " + std::to_string(voxel_m) + " m (from " +
+              std::to_string(cloud.size()) +
+              " points) have a surface normal, at least 3 are needed: the cloud is collinear or "
+              "too sparse at this voxel (--voxel), or its coordinates are so large that the file's "
+              "32-bit floats rounded them to a coarse grid");
+}
+
+Prepared Prepare(const PointCloud& cloud, const char* name, const Eigen::Vector3d& viewpoint,
                  const RegistrationPipelineOptions& o, bool features,
                  std::map<std::string, double>* seconds) {
   Clock::time_point start = Clock::now();
@@ -42,6 +55,7 @@ Prepared Prepare(const PointCloud& cloud, const Eigen::Vector3d& viewpoint,
   Prepared out;
   out.cloud = AttachNormals(down, EstimateNormals(down, normal_options));
   (*seconds)["normals"] += Since(start);
+  RequireSurface(cloud, down.size(), out.cloud, name, o.voxel_m);
   if (!features) return out;
 
   start = Clock::now();
@@ -133,8 +147,10 @@ RegistrationPipelineResult RegisterClouds(
   RequireValidCloud(target, "registration target", 3);
   RegistrationPipelineResult result;
   const bool coarse_needed = !T_target_source_init.has_value();
-  const Prepared s = Prepare(source, o.source_viewpoint, o, coarse_needed, &result.stage_seconds);
-  const Prepared t = Prepare(target, o.target_viewpoint, o, coarse_needed, &result.stage_seconds);
+  const Prepared s = Prepare(source, "registration source", o.source_viewpoint, o, coarse_needed,
+                             &result.stage_seconds);
+  const Prepared t = Prepare(target, "registration target", o.target_viewpoint, o, coarse_needed,
+                             &result.stage_seconds);
 
   Eigen::Isometry3d start_pose = T_target_source_init.value_or(Eigen::Isometry3d::Identity());
   if (coarse_needed) {

@@ -59,8 +59,8 @@ struct RegistrationPipelineResult {
 
 // Aligns source onto target. With `T_target_source_init` the coarse stage is skipped and ICP
 // starts there. When the coarse stage fails (not converged) ICP is not run: `fine` is then the
-// coarse result, converged = false. Throws uwscan::Error on invalid clouds (empty, NaN) or
-// options.
+// coarse result, converged = false. Throws uwscan::Error on invalid clouds (empty, NaN; fewer
+// than 3 voxels with a surface normal, such as points along a line) or options.
 RegistrationPipelineResult RegisterClouds(
     const PointCloud& source, const PointCloud& target, const RegistrationPipelineOptions& options,
     const std::optional<Eigen::Isometry3d>& T_target_source_init = std::nullopt);

@@ -167,5 +167,25 @@ TEST(RegistrationPipelineOptions, ForCloudsTakesTheVoxelFromTheCloudsScaleAndSpa
                Error);
 }
 
+// A cloud none of whose voxels has a surface normal (points along a line) is refused with the
+// reason in terms of the cloud, not of the coarse stage that found nothing to pair.
+TEST(RegisterClouds, ACloudWithoutASurfaceSaysSo) {
+  std::vector<Eigen::Vector3d> line, plane;
+  for (int i = 0; i < 400; ++i) line.emplace_back(0.001 * i, 0.0, 0.0);
+  for (int i = 0; i < 20; ++i) {
+    for (int k = 0; k < 20; ++k) plane.emplace_back(0.02 * i, 0.02 * k, 0.001 * ((i * k) % 5));
+  }
+  const RegistrationPipelineOptions options = RegistrationPipelineOptions::ForObjectSize(0.4, 1, 1);
+  try {
+    RegisterClouds(MakeCloud(line), MakeCloud(plane), options);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("registration source"), std::string::npos) << message;
+    EXPECT_NE(message.find("surface normal"), std::string::npos) << message;
+    EXPECT_NE(message.find("collinear"), std::string::npos) << message;
+  }
+}
+
 }  // namespace
 }  // namespace uwscan::perception
