@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -25,6 +26,40 @@ bool Sync(const fs::path& path, int flags) {
   return synced;
 }
 
+// Whether `path` exists and is a device, a pipe or a socket: written into, never replaced.
+bool IsSpecialFile(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  return !ec && fs::exists(status) && !fs::is_regular_file(status) && !fs::is_directory(status);
+}
+
+// Writes the bytes of `temporary` into the special file `path`; "" when all were written, else
+// why not.
+std::string CopyInto(const fs::path& temporary, const fs::path& path) {
+  std::FILE* in = std::fopen(temporary.c_str(), "rb");
+  if (in == nullptr) return std::strerror(errno);
+  std::FILE* out = std::fopen(path.c_str(), "wb");
+  if (out == nullptr) {
+    const std::string reason = std::strerror(errno);
+    std::fclose(in);
+    return reason;
+  }
+  std::array<char, 1 << 16> buffer;
+  bool written = true;
+  while (const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), in)) {
+    if (std::fwrite(buffer.data(), 1, n, out) != n) {
+      written = false;
+      break;
+    }
+  }
+  const int write_errno = errno;
+  const bool read = std::ferror(in) == 0;
+  std::fclose(in);
+  const bool closed = std::fclose(out) == 0;
+  if (written && read && closed) return "";
+  return std::strerror(written ? errno : write_errno);
+}
+
 }  // namespace
 
 fs::path TemporaryBeside(const fs::path& path) {
@@ -35,11 +70,20 @@ fs::path TemporaryBeside(const fs::path& path) {
   name += std::to_string(::getpid());
   name += '-';
   name += std::to_string(count++);
-  return path.parent_path() / name;
+  if (!IsSpecialFile(path)) return path.parent_path() / name;
+  std::error_code ec;
+  const fs::path folder = fs::temp_directory_path(ec);
+  return (ec ? fs::path("/tmp") : folder) / name;
 }
 
 void ReplaceWithTemporary(const fs::path& temporary, const fs::path& path) {
   std::error_code ec;
+  if (IsSpecialFile(path)) {
+    const std::string reason = CopyInto(temporary, path);
+    fs::remove(temporary, ec);
+    if (!reason.empty()) throw Error(path.string() + ": cannot write (" + reason + ")");
+    return;
+  }
   if (!Sync(temporary, O_RDONLY)) {
     const std::string reason = std::strerror(errno);
     fs::remove(temporary, ec);

@@ -6,15 +6,18 @@
 // Files that are replaced whole or not at all: written under a temporary name beside the target
 // (same file system, so the rename is atomic) and renamed over it when complete. A failure, a
 // full disk or a process killed at any moment leaves the earlier file (or none) and never half
-// of a new one.
+// of a new one. A target that is a device or a pipe (/dev/null, a FIFO a reader waits on) is not
+// replaced, which would put a regular file in its place (as root, /dev/null itself): the
+// temporary goes to the temporary folder and its bytes are written into the target.
 namespace uwscan {
 
 // The temporary name `path` is written under: in its folder, hidden, unique to this call
-// ("folder/.name.part-PID-N").
+// ("folder/.name.part-PID-N"); in the temporary folder when `path` is a device or a pipe.
 std::filesystem::path TemporaryBeside(const std::filesystem::path& path);
 
-// Flushes `temporary` to disk, renames it over `path` and syncs the folder. On failure removes
-// the temporary and throws uwscan::Error naming `path`.
+// Flushes `temporary` to disk, renames it over `path` and syncs the folder; when `path` is a
+// device or a pipe, writes the temporary's bytes into it instead and removes the temporary. On
+// failure removes the temporary and throws uwscan::Error naming `path`.
 void ReplaceWithTemporary(const std::filesystem::path& temporary,
                           const std::filesystem::path& path);
 
