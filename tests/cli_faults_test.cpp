@@ -226,6 +226,30 @@ TEST_F(CliFaults, AFileSizeLimitIsAClearErrorNotASignal) {
       << "a temporary file was left beside the map";
 }
 
+// A scene asking for more frames than the output's disk can hold is refused at once, before the
+// work (a scene of 10^8 sweeps took 4.7 GB of memory in 8 s and would have filled the disk
+// hours later). Here 100 sweeps, 20,100 frames, onto a 1 MB disk.
+TEST_F(CliFaults, ADiveTheDiskCannotHoldIsRefusedBeforeAnyWork) {
+  std::string scene = Bytes(Scene("default.yaml"));
+  const std::string relative = "file: ../scanners/galvo_default.yaml", sweeps = "sweeps: 1\n";
+  ASSERT_NE(scene.find(relative), std::string::npos);
+  ASSERT_NE(scene.find(sweeps), std::string::npos);
+  scene.replace(scene.find(relative), relative.size(),
+                "file: " + std::string(UWSCAN_SOURCE_DIR) + "/data/scanners/galvo_default.yaml");
+  scene.replace(scene.find(sweeps), sweeps.size(), "sweeps: 100\n");
+  const fs::path long_dive = dir_ / "long_dive.yaml", small = dir_ / "small_disk";
+  std::ofstream(long_dive) << scene;
+  const CommandRun run = InTmpfs(
+      small, "size=1m",
+      std::string(UWSCAN_BIN) + " simulate " + long_dive.string() + " -o " + small.string() +
+          "/d.db; echo exit=$?; echo files: " + "$(ls -A " + small.string() + ")");
+  ASSERT_EQ(run.output.find("unshare:"), std::string::npos)
+      << "no private mount namespace: " << run.output;
+  EXPECT_NE(run.output.find("exit=1"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("20100 frames need at least"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("files:\n"), std::string::npos) << run.output;
+}
+
 // One output of a command killed at random moments: what it held before, and what a complete run
 // writes (with `normalise` applied: lines that differ between runs, such as timings, dropped).
 struct KilledOutput {

@@ -73,6 +73,27 @@ void RunSimulateCalibration(const SimulateArgs& a) {
               a.output.c_str());
 }
 
+// A dive log holds about 7 kB a frame with exact peaks (the 30-minute dive's 610,000 frames take
+// 4.5 GB) and more with images: a kilobyte a frame is a floor no dive goes under.
+constexpr double kMinLogBytesPerFrame = 1000.0;
+
+// Refuses, before any simulation, a dive that the output's disk cannot hold even at that floor (a
+// scene asking for millions of sweeps filled memory and disk hours later).
+void RequireRoomForDive(std::int64_t frames, const std::filesystem::path& output) {
+  std::error_code ec;
+  const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : ".";
+  const std::filesystem::space_info space = std::filesystem::space(folder, ec);
+  const double needed = kMinLogBytesPerFrame * static_cast<double>(frames);
+  if (ec || needed <= static_cast<double>(space.available)) return;  // no answer: the write says
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                ": the scene's %lld frames need at least %.3g GB, more than "
+                "the %.3g GB free there",
+                static_cast<long long>(frames), needed * 1e-9,
+                static_cast<double>(space.available) * 1e-9);
+  throw Error(output.string() + text);
+}
+
 void RunSimulate(const SimulateArgs& a) {
   if (IsCalibrationScene(ReadText(a.scene))) {
     if (!a.design.empty()) throw Error("--design: a calibration scene has no structure to model");
@@ -86,6 +107,7 @@ void RunSimulate(const SimulateArgs& a) {
   // Everything is checked before --force removes the old log.
   const scanner::sim::Scene scene = scanner::sim::LoadScene(a.scene);
   const scanner::sim::Simulator simulator(scene);
+  RequireRoomForDive(simulator.frame_count(), a.output);
   if (a.images && !scene.effects.AnyImageStage()) {
     throw Error("--images: scene " + a.scene +
                 " renders no frames (no image effect is on); its dive holds exact peaks");
