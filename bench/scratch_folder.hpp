@@ -6,7 +6,7 @@
 #include <string>
 #include <system_error>
 
-#include "scanner/common/error.hpp"
+#include "scanner/common/temporary_folder.hpp"
 
 namespace uwscan::bench {
 
@@ -29,12 +29,7 @@ class ScratchFolder {
 
  private:
   static std::filesystem::path Under(const std::string& purpose) {
-    std::error_code error;
-    const std::filesystem::path folder = std::filesystem::temp_directory_path(error);
-    if (error)
-      throw Error("bench: no temporary folder for its scratch files (" + error.message() +
-                  "; is $TMPDIR a folder?)");
-    return folder / ("uwscan-" + purpose + "-" + std::to_string(::getpid()));
+    return TemporaryFolder() / ("uwscan-" + purpose + "-" + std::to_string(::getpid()));
   }
   std::filesystem::path path_;
 };

@@ -14,13 +14,13 @@
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "apps/cli/reference_options.hpp"
-#include "apps/cli/temporary_folder.hpp"
 #include "mapping/change/change_report.hpp"
 #include "mapping/change/compare_surveys.hpp"
 #include "mapping/log/dive_log.hpp"
 #include "mapping/slam/dive_mapping.hpp"
 #include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/temporary_folder.hpp"
 
 namespace uwscan::app {
 namespace {

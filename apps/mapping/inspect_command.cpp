@@ -17,11 +17,11 @@
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/reference_options.hpp"
 #include "apps/cli/stop_signal.hpp"
-#include "apps/cli/temporary_folder.hpp"
 #include "apps/scanner/camera_frames.hpp"
 #include "mapping/inspection/live_inspection.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/temporary_folder.hpp"
 #include "viewer/render/display.hpp"
 #include "viewer/render/live_view.hpp"
 

@@ -12,11 +12,11 @@
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
-#include "apps/cli/temporary_folder.hpp"
 #include "mapping/slam/dive_mapping.hpp"
 #include "mapping/slam/map_report.hpp"
 #include "perception/cloud/cloud_io.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/temporary_folder.hpp"
 
 namespace uwscan::app {
 namespace {

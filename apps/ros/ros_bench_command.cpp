@@ -27,6 +27,7 @@
 #include "apps/cli/output_path.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/resident_memory.hpp"
+#include "scanner/common/temporary_folder.hpp"
 
 // The bench runs uwscan's own commands as a user would (simulate, bag export, ros inspect,
 // fake-camera, inspect), each a child process whose CPU time and peak memory wait4 reports, beside
@@ -269,8 +270,7 @@ void RunRosBench(RosBenchArgs a) {
   if (!a.json.empty()) CheckOutputPath(a.json, "--json");
   if (a.scene.empty()) a.scene = (DataFolder() / "scenes" / "inspection_short.yaml").string();
   EnterPrivateNetwork();
-  const fs::path folder =
-      fs::temp_directory_path() / ("uwscan_bench_ros_" + std::to_string(::getpid()));
+  const fs::path folder = TemporaryFolder() / ("uwscan_bench_ros_" + std::to_string(::getpid()));
   fs::create_directories(folder);
   SetRosEnvironment(folder);
   const fs::path dive = folder / "dive.db", bag = folder / "dive.bag";

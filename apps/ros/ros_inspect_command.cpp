@@ -14,7 +14,6 @@
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/reference_options.hpp"
 #include "apps/cli/stop_signal.hpp"
-#include "apps/cli/temporary_folder.hpp"
 #include "apps/ros/ros_arguments.hpp"
 #include "apps/ros/ros_recognize_command.hpp"
 #include "apps/scanner/camera_frames.hpp"
@@ -22,6 +21,7 @@
 #include "perception/cloud/cloud_io.hpp"
 #include "ros/node/inspection_node.hpp"
 #include "scanner/common/error.hpp"
+#include "scanner/common/temporary_folder.hpp"
 #include "scanner/lasers/scanner_file.hpp"
 
 namespace uwscan::app {

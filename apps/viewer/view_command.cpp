@@ -175,28 +175,23 @@ void AddSceneObjects(const scanner::sim::Scene& loaded, const std::string& file,
   std::printf("\n");
 }
 
-// The files and scene to show are there (a followed log may not be yet).
-void RequireInputsExist(const ViewArgs& a) {
-  std::vector<std::string> inputs = a.files;
-  if (!a.scene.empty()) inputs.push_back(a.scene);
-  for (const std::string& input : inputs) {
-    if (!std::filesystem::exists(input)) throw Error(input + ": no such file");
-  }
-}
-
 void RunView(const ViewArgs& a) {
   if (a.files.empty() && a.scene.empty()) {
     throw CLI::RequiredError(
         "files to show (or --scene SCENE.yaml alone, to show a scene's objects)");
   }
   const viewer::RenderOptions render = RenderOptionsFrom(a);
-  if (!a.screenshot.empty()) {  // before minutes of reading and reconstructing, not after
-    std::vector<std::filesystem::path> inputs(a.files.begin(), a.files.end());
-    if (!a.scene.empty()) inputs.emplace_back(a.scene);
-    CheckOutputPath(a.screenshot, "--screenshot", inputs);
+  std::vector<std::filesystem::path> inputs(a.files.begin(), a.files.end());
+  if (!a.scene.empty()) inputs.emplace_back(a.scene);
+  // Before minutes of reading and reconstructing, not after: the screenshot's path, the inputs
+  // (a mistyped name says so even without a display; a followed log may not be there yet), and
+  // the display.
+  if (!a.screenshot.empty()) CheckOutputPath(a.screenshot, "--screenshot", inputs);
+  for (const std::filesystem::path& input : inputs) {
+    if (!a.follow && !std::filesystem::exists(input))
+      throw Error(input.string() + ": no such file");
   }
-  if (!a.follow) RequireInputsExist(a);  // a mistyped name says so, even without a display
-  viewer::RequireDisplay();              // so is the display
+  viewer::RequireDisplay();
   if (a.follow) {
     if (!a.scene.empty())
       throw Error("--scene: not with --follow (a followed log carries its own truth)");

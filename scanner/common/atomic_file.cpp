@@ -11,6 +11,7 @@
 #include <string>
 
 #include "scanner/common/error.hpp"
+#include "scanner/common/temporary_folder.hpp"
 
 namespace uwscan {
 namespace {
@@ -70,10 +71,7 @@ fs::path TemporaryBeside(const fs::path& path) {
   name += std::to_string(::getpid());
   name += '-';
   name += std::to_string(count++);
-  if (!IsSpecialFile(path)) return path.parent_path() / name;
-  std::error_code ec;
-  const fs::path folder = fs::temp_directory_path(ec);
-  return (ec ? fs::path("/tmp") : folder) / name;
+  return (IsSpecialFile(path) ? TemporaryFolder() : path.parent_path()) / name;
 }
 
 void ReplaceWithTemporary(const fs::path& temporary, const fs::path& path) {

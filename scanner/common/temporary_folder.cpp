@@ -1,4 +1,4 @@
-#include "apps/cli/temporary_folder.hpp"
+#include "scanner/common/temporary_folder.hpp"
 
 #include <cstdlib>
 #include <string>
@@ -6,7 +6,7 @@
 
 #include "scanner/common/error.hpp"
 
-namespace uwscan::app {
+namespace uwscan {
 
 std::filesystem::path TemporaryFolder() {
   std::error_code error;
@@ -16,7 +16,7 @@ std::filesystem::path TemporaryFolder() {
   const std::string which =
       tmpdir != nullptr ? "$TMPDIR (" + std::string(tmpdir) + ")" : "the temporary folder";
   throw Error(which + " is not a folder (" + error.message() +
-              "): set TMPDIR to a writable folder with room for the dive's spilled submaps");
+              "): set TMPDIR to a writable folder with room for uwscan's temporary files");
 }
 
-}  // namespace uwscan::app
+}  // namespace uwscan
