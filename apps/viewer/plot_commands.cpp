@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +17,7 @@
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "viewer/plots/bench_plots.hpp"
 #include "viewer/plots/chart_png.hpp"
@@ -143,11 +143,7 @@ void RunReport(const ReportArgs& a) {
                 failure.empty() ? png.string().c_str() : "failed", seconds);
   }
   const fs::path index_path = fs::path(a.output) / "index.md";
-  {
-    std::ofstream out(index_path);
-    out << index;
-    if (!out.flush()) throw Error(index_path.string() + ": cannot write");
-  }
+  WriteFileAtomically(index_path, index);
   std::printf("%s: written\n", index_path.string().c_str());
   if (failed > 0)
     throw Error("report: " + std::to_string(failed) + " bench(es) failed; see " +

@@ -480,7 +480,8 @@ void WriteDiveLogAtomically(const std::filesystem::path& path,
   };
   try {
     write(temporary);
-    remove_with_sqlite_files(path, false);
+    // SQLite keeps its side files beside the file a link ends at.
+    remove_with_sqlite_files(FollowLinks(path), false);
     ReplaceWithTemporary(temporary, path);
   } catch (...) {
     remove_with_sqlite_files(temporary, true);

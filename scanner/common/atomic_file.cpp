@@ -63,7 +63,22 @@ std::string CopyInto(const fs::path& temporary, const fs::path& path) {
 
 }  // namespace
 
-fs::path TemporaryBeside(const fs::path& path) {
+fs::path FollowLinks(const fs::path& path) {
+  // Linux itself gives up after 40 links in one path.
+  constexpr int kMaxLinks = 40;
+  fs::path target = path;
+  std::error_code ec;
+  for (int links = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++links) {
+    if (links == kMaxLinks) throw Error(path.string() + ": too many levels of symbolic links");
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec) throw Error(path.string() + ": cannot read the symbolic link (" + ec.message() + ")");
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  return target;
+}
+
+fs::path TemporaryBeside(const fs::path& link_or_path) {
+  const fs::path path = FollowLinks(link_or_path);
   static std::atomic<unsigned> count{0};  // two writes of one process never share a name
   std::string name = ".";
   name += path.filename().string();
@@ -74,7 +89,8 @@ fs::path TemporaryBeside(const fs::path& path) {
   return (IsSpecialFile(path) ? TemporaryFolder() : path.parent_path()) / name;
 }
 
-void ReplaceWithTemporary(const fs::path& temporary, const fs::path& path) {
+void ReplaceWithTemporary(const fs::path& temporary, const fs::path& link_or_path) {
+  const fs::path path = FollowLinks(link_or_path);
   std::error_code ec;
   if (IsSpecialFile(path)) {
     const std::string reason = CopyInto(temporary, path);

@@ -11,6 +11,8 @@
 #include <iterator>
 #include <string>
 
+#include "scanner/common/error.hpp"
+
 namespace uwscan {
 namespace {
 
@@ -71,6 +73,40 @@ TEST_F(AtomicFileTest, ADeviceIsWrittenIntoNotReplaced) {
   WriteFileAtomically(device, std::string(100000, 'x'));
   EXPECT_TRUE(fs::is_character_file(device));
   EXPECT_EQ(FilesInFolder(), 1);
+}
+
+// A link (here two, the first relative) is written through: the file it ends at gets the bytes
+// and every link stays a link (the rename put a regular file in the first link's place, and the
+// file it pointed at kept the old bytes). A link to a file not yet there creates that file.
+TEST_F(AtomicFileTest, ALinkIsWrittenThroughNotReplaced) {
+  fs::create_directories(dir_ / "real");
+  const fs::path file = dir_ / "real" / "map.json";
+  WriteFileAtomically(file, "old");
+  fs::create_symlink(file, dir_ / "absolute_link");
+  fs::create_symlink("absolute_link", dir_ / "latest.json");
+  WriteFileAtomically(dir_ / "latest.json", "new");
+  EXPECT_EQ(Bytes(file), "new");
+  EXPECT_TRUE(fs::is_symlink(dir_ / "latest.json"));
+  EXPECT_TRUE(fs::is_symlink(dir_ / "absolute_link"));
+  EXPECT_EQ(FilesInFolder(), 3);
+
+  fs::create_symlink("real/later.json", dir_ / "dangling");
+  WriteFileAtomically(dir_ / "dangling", "made");
+  EXPECT_EQ(Bytes(dir_ / "real" / "later.json"), "made");
+  EXPECT_TRUE(fs::is_symlink(dir_ / "dangling"));
+}
+
+TEST_F(AtomicFileTest, ALoopOfLinksIsAClearError) {
+  fs::create_symlink("b", dir_ / "a");
+  fs::create_symlink("a", dir_ / "b");
+  try {
+    WriteFileAtomically(dir_ / "a", "bytes");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("too many levels of symbolic links"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(fs::is_symlink(dir_ / "a"));
 }
 
 }  // namespace
