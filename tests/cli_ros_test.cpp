@@ -277,6 +277,13 @@ TEST(CliRos, NodeMapsAPlayedBagAsMapDoesOffline) {
   EXPECT_EQ(Dump(node["frames_mapped"]), Dump(1989));
   EXPECT_TRUE(node["scanner_from_dive_description"].get<bool>());
   EXPECT_GT(node["sweeps_published"].get<int>(), 30);
+  // The 20 s dive at half speed: its sweeps' latencies in the minute or two they came in.
+  const nlohmann::json& minutes = node["sweep_latency_by_minute"];
+  ASSERT_TRUE(minutes.is_array() && !minutes.empty() && minutes.size() <= 2) << minutes.dump();
+  int sweeps = 0;
+  for (const nlohmann::json& m : minutes) sweeps += m["sweeps"].get<int>();
+  EXPECT_EQ(sweeps, node["sweeps_published"].get<int>());
+  EXPECT_GT(minutes[0]["p95_s"].get<double>(), 0.0);
 
   const MapOutput offline = Map(ShortDive(), "offline");
   const std::vector<TimedPosition> online = ReadTum(out / "node.tum");

@@ -25,6 +25,9 @@
 #include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
 #include "apps/cli/output_path.hpp"
+#include "bench/slam/long_dive_benchmark.hpp"
+#include "bench/slam/long_dive_scene.hpp"
+#include "scanner/common/atomic_file.hpp"
 #include "scanner/common/error.hpp"
 #include "scanner/common/resident_memory.hpp"
 #include "scanner/common/temporary_folder.hpp"
@@ -44,6 +47,9 @@ struct RosBenchArgs {
                                20.0};  // rosbag play's rates (the dive runs at 100 frames/s)
   double inspect_seconds = 20.0;
   double camera_fps = 339.0;
+  // > 0: a soak instead: the long-dive bench's manifold field flown for this many minutes,
+  // replayed once at the dive's own rate, figures minute by minute, no peers.
+  double long_minutes = 0.0;
 };
 
 // Figures of one replay through the node.
@@ -57,6 +63,7 @@ struct NodeFigures {
   double sweep_latency_median_s = 0.0, sweep_latency_p95_s = 0.0;
   double receive_to_map_median_s = 0.0;
   std::vector<std::pair<double, std::int64_t>> rss;  // (seconds since the node started, bytes)
+  nlohmann::json sweep_latency_by_minute;            // as the node wrote it
 };
 
 // A process's resident memory, sampled every half second on a thread of its own.
@@ -152,7 +159,7 @@ void SetRosEnvironment(const fs::path& folder) {
 }
 
 NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, double rate,
-                              const fs::path& folder) {
+                              double play_timeout_s, const fs::path& folder) {
   const std::string name = "node_" + std::to_string(static_cast<int>(rate * 100));
   const fs::path json = folder / (name + ".json"), log = folder / (name + ".log");
   ChildProcess node({Self(), "ros", "inspect", "--log", (folder / (name + ".db")).string(),
@@ -167,7 +174,7 @@ NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, d
   RssSampler memory(node.pid());
   // -d: rosbag play waits after advertising, so that the node has connected before the first frame.
   RunToEnd({"rosbag", "play", "--quiet", "-d", "1", "-r", std::to_string(rate), bag.string()},
-           folder / "play.log", 3600);
+           folder / "play.log", play_timeout_s);
   const std::vector<std::pair<double, std::int64_t>> rss = memory.Stop();
   const ChildProcess::Exit exit = node.Wait(600);
   if (exit.exit_code != 0) throw Error("bench ros: the node failed (see " + log.string() + ")");
@@ -187,6 +194,7 @@ NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, d
   f.sweep_latency_p95_s = r["sweep_latency_s"]["p95"];
   f.receive_to_map_median_s = r["receive_to_map_s"]["median"];
   f.rss = rss;
+  f.sweep_latency_by_minute = r["sweep_latency_by_minute"];
   return f;
 }
 
@@ -266,49 +274,102 @@ nlohmann::json NodeJson(const NodeFigures& f) {
           {"memory", MemoryJson(f)}};
 }
 
-void RunRosBench(RosBenchArgs a) {
-  if (!a.json.empty()) CheckOutputPath(a.json, "--json");
-  if (a.scene.empty()) a.scene = (DataFolder() / "scenes" / "inspection_short.yaml").string();
-  EnterPrivateNetwork();
-  const fs::path folder = TemporaryFolder() / ("uwscan_bench_ros_" + std::to_string(::getpid()));
-  fs::create_directories(folder);
-  SetRosEnvironment(folder);
-  const fs::path dive = folder / "dive.db", bag = folder / "dive.bag";
-  RunToEnd({Self(), "simulate", a.scene, "-o", dive.string()}, folder / "simulate.log", 600);
-  RunToEnd({Self(), "bag", "export", dive.string(), "-o", bag.string()}, folder / "export.log",
-           600);
+// The soak's figures minute by minute of the replay: the node's resident memory at each minute's
+// end (its last sample in the minute) and its sweeps' latencies in the minute.
+nlohmann::json SoakJson(const NodeFigures& f, double minutes) {
+  nlohmann::json per_minute = nlohmann::json::array();
+  const nlohmann::json& latency = f.sweep_latency_by_minute;
+  std::size_t sample = 0;
+  for (std::size_t m = 0; sample < f.rss.size() || m < latency.size(); ++m) {
+    std::int64_t rss_bytes = 0;
+    while (sample < f.rss.size() && f.rss[sample].first < 60.0 * static_cast<double>(m + 1))
+      rss_bytes = f.rss[sample++].second;
+    nlohmann::json minute = {
+        {"rss_bytes", rss_bytes}, {"sweeps", 0}, {"latency_p95_s", 0.0}, {"latency_max_s", 0.0}};
+    if (m < latency.size()) {
+      minute["sweeps"] = latency[m]["sweeps"];
+      minute["latency_p95_s"] = latency[m]["p95_s"];
+      minute["latency_max_s"] = latency[m]["max_s"];
+    }
+    per_minute.push_back(minute);
+  }
+  if (per_minute.empty()) throw Error("bench ros: the soak measured no minute");
+  // The last minute is the replay's tail and the node's finish, partial: the one before it is the
+  // dive's last whole minute.
+  const nlohmann::json& last =
+      per_minute.size() > 2 ? per_minute[per_minute.size() - 2] : per_minute.back();
+  return {{"minutes", minutes},
+          {"frames_lost", f.frames_in_bag - f.frames_received},
+          {"frames_skipped_by_mapper", f.frames_skipped},
+          {"rss_bytes",
+           {{"first_minute", per_minute.front()["rss_bytes"]}, {"last_minute", last["rss_bytes"]}}},
+          {"latency_p95_s",
+           {{"first_minute", per_minute.front()["latency_p95_s"]},
+            {"last_minute", last["latency_p95_s"]}}},
+          {"latency_measured", "a sweep's last frame arriving at the node to its PointCloud2"},
+          {"per_minute", per_minute}};
+}
+
+void PrintSoak(const nlohmann::json& soak) {
+  int minute = 0;
+  for (const nlohmann::json& m : soak["per_minute"]) {
+    std::printf("minute %3d: %4lld sweeps, latency p95 %7.1f ms (max %7.1f), %.0f MB resident\n",
+                ++minute, static_cast<long long>(m["sweeps"].get<std::int64_t>()),
+                m["latency_p95_s"].get<double>() * 1e3, m["latency_max_s"].get<double>() * 1e3,
+                static_cast<double>(m["rss_bytes"].get<std::int64_t>()) * 1e-6);
+  }
+}
+
+// The long-dive bench's scene of `minutes`, written into `folder` with the scanner file named by
+// its absolute path.
+fs::path WriteLongDiveScene(double minutes, const fs::path& folder) {
+  const fs::path scene = folder / "long_dive.yaml";
+  WriteFileAtomically(
+      scene, bench::LongDiveSceneYaml(60.0 * minutes, bench::LongDiveBenchOptions{}.seed,
+                                      (DataFolder() / "scanners" / "galvo_binned.yaml").string()));
+  return scene;
+}
+
+// The dive simulated into a log and exported as a bag, and how many frames the bag holds.
+struct DiveBag {
+  fs::path dive, bag;
+  std::int64_t frames = 0;
+};
+
+DiveBag SimulateAndExport(const std::string& scene, const fs::path& folder, double timeout_s) {
+  DiveBag d{folder / "dive.db", folder / "dive.bag"};
+  RunToEnd({Self(), "simulate", scene, "-o", d.dive.string()}, folder / "simulate.log", timeout_s);
+  RunToEnd({Self(), "bag", "export", d.dive.string(), "-o", d.bag.string()}, folder / "export.log",
+           timeout_s);
   std::ifstream export_log(folder / "export.log");
   const std::string exported((std::istreambuf_iterator<char>(export_log)),
                              std::istreambuf_iterator<char>());
-  const std::int64_t frames_in_bag =
-      std::stoll(exported.substr(exported.find("bag export: ") + 12));
-  ChildProcess master({"roscore", "-p", "11311"}, folder / "roscore.log");
-  WaitFor(MasterAnswers, 30, "roscore did not answer");
-  std::this_thread::sleep_for(std::chrono::seconds(1));
-  std::vector<NodeFigures> runs;
-  for (double rate : a.rates) {
-    runs.push_back(ReplayThroughNode(bag, frames_in_bag, rate, folder));
-    const NodeFigures& f = runs.back();
-    std::printf(
-        "bench ros: rate %.2f: %.0f frames/s through the node, %lld lost, sweep latency median "
-        "%.1f ms "
-        "(p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB, RSS %.0f -> %.0f MB from a quarter "
-        "of "
-        "the replay to its end\n",
-        f.rate, f.frames_per_s, static_cast<long long>(f.frames_in_bag - f.frames_received),
-        f.sweep_latency_median_s * 1e3, f.sweep_latency_p95_s * 1e3,
-        f.cpu_s / static_cast<double>(std::max<std::int64_t>(1, f.frames_received)) * 1e6,
-        static_cast<double>(f.peak_rss_bytes) * 1e-6,
-        f.rss.empty() ? 0.0 : static_cast<double>(f.rss[f.rss.size() / 4].second) * 1e-6,
-        f.rss.empty() ? 0.0 : static_cast<double>(f.rss.back().second) * 1e-6);
-  }
+  d.frames = std::stoll(exported.substr(exported.find("bag export: ") + 12));
+  return d;
+}
+
+void PrintRun(const NodeFigures& f) {
+  std::printf(
+      "bench ros: rate %.2f: %.0f frames/s through the node, %lld lost, sweep latency median "
+      "%.1f ms (p95 %.1f), %.1f us CPU per frame, peak RSS %.0f MB, RSS %.0f -> %.0f MB from a "
+      "quarter of the replay to its end\n",
+      f.rate, f.frames_per_s, static_cast<long long>(f.frames_in_bag - f.frames_received),
+      f.sweep_latency_median_s * 1e3, f.sweep_latency_p95_s * 1e3,
+      f.cpu_s / static_cast<double>(std::max<std::int64_t>(1, f.frames_received)) * 1e6,
+      static_cast<double>(f.peak_rss_bytes) * 1e-6,
+      f.rss.empty() ? 0.0 : static_cast<double>(f.rss[f.rss.size() / 4].second) * 1e-6,
+      f.rss.empty() ? 0.0 : static_cast<double>(f.rss.back().second) * 1e-6);
+}
+
+// The node's runs beside inspect on the fake camera and map offline: the JSON's figures.
+nlohmann::json WithPeers(const std::vector<NodeFigures>& runs, const RosBenchArgs& a,
+                         const DiveBag& d, const fs::path& folder) {
   const InspectFigures direct = DirectInspect(a, folder);
   const double inspect_cpu =
       direct.cpu_s / static_cast<double>(std::max<std::int64_t>(1, direct.frames));
   std::printf(
       "bench ros: inspect on the fake camera at %.0f frames/s: %.0f frames/s, %lld lost, %.1f us "
-      "CPU per "
-      "frame\n",
+      "CPU per frame\n",
       a.camera_fps, direct.frames_per_s, static_cast<long long>(direct.lost_frames),
       inspect_cpu * 1e6);
   // The headline: the run nearest the seed camera's 339 frames/s (3.39x the dive's 100).
@@ -321,27 +382,60 @@ void RunRosBench(RosBenchArgs a) {
   for (const NodeFigures& f : runs) node["runs"].push_back(NodeJson(f));
   const double node_cpu = node["cpu_s_per_frame"];
   const double overhead = inspect_cpu > 0 ? node_cpu / inspect_cpu - 1.0 : 0.0;
-  const double map_cpu = OfflineMapCpuPerFrame(dive, frames_in_bag, folder);
+  const double map_cpu = OfflineMapCpuPerFrame(d.dive, d.frames, folder);
   const double overhead_vs_map = map_cpu > 0 ? node_cpu / map_cpu - 1.0 : 0.0;
   std::printf(
       "bench ros: overhead against inspect %.2f, against map offline %.2f (CPU per frame, node / "
       "peer - 1)\n",
       overhead, overhead_vs_map);
+  return {{"scene", a.scene},
+          {"node", node},
+          {"direct_inspect",
+           {{"frames_per_s", direct.frames_per_s},
+            {"lost_frames", direct.lost_frames},
+            {"cpu_s_per_frame", inspect_cpu},
+            {"camera_fps", a.camera_fps}}},
+          {"offline_map", {{"cpu_s_per_frame", map_cpu}}},
+          {"overhead_ratio", overhead},
+          {"overhead_vs_map_ratio", overhead_vs_map}};
+}
+
+nlohmann::json Soak(const NodeFigures& run, double minutes) {
+  const nlohmann::json figures = SoakJson(run, minutes);
+  PrintSoak(figures);
+  return {
+      {"scene", "bench slam --long's manifold field"}, {"node", NodeJson(run)}, {"soak", figures}};
+}
+
+void RunRosBench(RosBenchArgs a) {
+  if (!a.json.empty()) CheckOutputPath(a.json, "--json");
+  if (a.scene.empty()) a.scene = (DataFolder() / "scenes" / "inspection_short.yaml").string();
+  EnterPrivateNetwork();
+  const fs::path folder = TemporaryFolder() / ("uwscan_bench_ros_" + std::to_string(::getpid()));
+  fs::create_directories(folder);
+  SetRosEnvironment(folder);
+  const bool soak = a.long_minutes > 0.0;
+  if (soak) {
+    a.scene = WriteLongDiveScene(a.long_minutes, folder).string();
+    a.rates = {1.0};
+  }
+  // Simulating, exporting and replaying a dive of hours takes about as long as the dive.
+  const double step_timeout_s = 600.0 + 60.0 * (soak ? a.long_minutes : 5.0);
+  const DiveBag d = SimulateAndExport(a.scene, folder, step_timeout_s);
+  ChildProcess master({"roscore", "-p", "11311"}, folder / "roscore.log");
+  WaitFor(MasterAnswers, 30, "roscore did not answer");
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  std::vector<NodeFigures> runs;
+  for (double rate : a.rates) {
+    runs.push_back(ReplayThroughNode(d.bag, d.frames, rate, step_timeout_s / rate, folder));
+    PrintRun(runs.back());
+  }
+  const nlohmann::json figures =
+      soak ? Soak(runs.front(), a.long_minutes) : WithPeers(runs, a, d, folder);
   master.Interrupt();
   master.Wait(30);
   fs::remove_all(folder);
-  if (!a.json.empty()) {
-    WriteJsonFile(a.json, {{"scene", a.scene},
-                           {"node", node},
-                           {"direct_inspect",
-                            {{"frames_per_s", direct.frames_per_s},
-                             {"lost_frames", direct.lost_frames},
-                             {"cpu_s_per_frame", inspect_cpu},
-                             {"camera_fps", a.camera_fps}}},
-                           {"offline_map", {{"cpu_s_per_frame", map_cpu}}},
-                           {"overhead_ratio", overhead},
-                           {"overhead_vs_map_ratio", overhead_vs_map}});
-  }
+  if (!a.json.empty()) WriteJsonFile(a.json, figures);
 }
 
 }  // namespace
@@ -363,6 +457,12 @@ void AddRosBenchCommand(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--camera-fps", a->camera_fps, "the fake camera's frame rate (profile mode)")
       ->capture_default_str();
+  cmd->add_option("--long-minutes", a->long_minutes,
+                  "a soak instead: bench slam --long's manifold field flown this many minutes, "
+                  "replayed once at its own rate; memory and latency minute by minute, no peers")
+      ->check(CLI::Range(1.0, 600.0))
+      ->excludes("--scene")
+      ->excludes("--rates");
   cmd->callback([a] { RunRosBench(*a); });
 }
 

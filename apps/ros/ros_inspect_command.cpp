@@ -160,6 +160,13 @@ void PrintStatus(const ros::InspectionNodeStatus& s) {
                s.master_reachable ? "" : "; ROS master lost", isatty(2) ? "   " : "\n");
 }
 
+nlohmann::json MinutesJson(const std::vector<ros::MinuteLatency>& minutes) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const ros::MinuteLatency& m : minutes)
+    list.push_back({{"sweeps", m.count}, {"p95_s", m.p95_s}, {"max_s", m.max_s}});
+  return list;
+}
+
 nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
   const mapping::InspectionStatistics& i = s.result.statistics;
   return {
@@ -186,6 +193,7 @@ nlohmann::json SummaryJson(const ros::InspectionNodeSummary& s) {
       {"receive_to_map_s",
        {{"median", i.receive_to_map.median_s}, {"p95", i.receive_to_map.p95_s}}},
       {"sweep_latency_s", {{"median", s.sweep_latency_median_s}, {"p95", s.sweep_latency_p95_s}}},
+      {"sweep_latency_by_minute", MinutesJson(s.sweep_latency_by_minute)},
       {"stop_reason", s.stop_reason}};
 }
 

@@ -160,7 +160,8 @@ std::vector<Waypoint> Laps(double duration_s) {
 
 }  // namespace
 
-std::string LongDiveSceneYaml(double duration_s, std::uint64_t seed) {
+std::string LongDiveSceneYaml(double duration_s, std::uint64_t seed,
+                              const std::string& scanner_file) {
   if (!(duration_s > 0.0) || !std::isfinite(duration_s))
     throw Error("long dive scene: duration_s must be finite and > 0, got " + Number(duration_s));
   std::ostringstream out;
@@ -168,7 +169,7 @@ std::string LongDiveSceneYaml(double duration_s, std::uint64_t seed) {
       << " s (bench/slam/long_dive_scene.hpp).\n"
       << "uwscan_format: 1\nseed: " << seed << "\n"
       << "water: {refractive_index: 1.33, attenuation_per_m: 0.2}\n"
-      << "scanner:\n  file: ../scanners/galvo_binned.yaml\n  sweeps: "
+      << "scanner:\n  file: " << scanner_file << "\n  sweeps: "
       << static_cast<int>(std::floor(duration_s * kFrameRate_hz / kFramesPerSweep)) << "\n"
       << "  galvo: {step_min: -100, step_max: 100, step_stride: 4, frame_rate_hz: 100}\n"
       << "trajectory:\n"

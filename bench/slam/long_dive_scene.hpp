@@ -14,8 +14,10 @@ namespace uwscan::bench {
 // third), crosses back over the pipes' ends to the first, and flies the next lap the other way
 // round, so each lap revisits the last one's swaths in the opposite direction. The galvanometer
 // scanner and navigation drift of inspection_long.yaml, with its seed. The scanner file is
-// given relative to the data folder's scenes/ (parse the text with that base folder).
+// `scanner_file`: by default relative to the data folder's scenes/ (parse the text with that base
+// folder); an absolute path lets the scene be written anywhere.
 // duration_s > 0; throws uwscan::Error otherwise.
-std::string LongDiveSceneYaml(double duration_s, std::uint64_t seed);
+std::string LongDiveSceneYaml(double duration_s, std::uint64_t seed,
+                              const std::string& scanner_file = "../scanners/galvo_binned.yaml");
 
 }  // namespace uwscan::bench

@@ -18,6 +18,7 @@
 
 #include "mapping/log/dive_log_test_support.hpp"
 #include "mapping/log/dive_simulation.hpp"
+#include "mapping/slam/live_map.hpp"
 #include "mapping/slam/map_report.hpp"
 #include "mapping/slam/navigation_uncertainty.hpp"
 #include "mapping/slam/registration_information.hpp"
@@ -169,6 +170,55 @@ TEST_F(DiveMappingTest, SpilledSubmapsMapToTheSameBits) {
   const DiveMapping spilled = MapDive(DiveLogReader(log), options);
   EXPECT_GT(spilled.loops.size(), 0u);
   ExpectSameBits(spilled, in_memory);
+}
+
+void ExpectSameCloud(const perception::PointCloud& a, const perception::PointCloud& b,
+                     const std::string& what) {
+  ASSERT_EQ(a.origin, b.origin) << what;
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(a.points[i][k]),
+                std::bit_cast<std::uint32_t>(b.points[i][k]))
+          << what << ", point " << i;
+    }
+  }
+}
+
+// The live map (what the ROS node publishes every few seconds) merges the submaps no solve moves
+// any more once, until a whole solve moves them all: after every submap of a dive with short
+// windows, several whole solves and spilled clouds, the same map to the bit as merging every
+// submap again.
+TEST_F(DiveMappingTest, TheLiveMapIsTheWholeMapToTheBit) {
+  const fs::path log = Simulate(ShortScene(), "drift.db");
+  const DiveLogReader reader(log);
+  MapperOptions options;
+  options.solve_window_submaps = 4;
+  options.solve_window_max_submaps = 8;
+  options.spill_folder = dir_;
+  options.resident_submaps = 4;
+  Mapper mapper(reader.header().scanner, reader.header().scan_pattern, *reader.vehicle_mount(),
+                *reader.header().navigation_noise, options, dir_ / "tables");
+  const double voxel_m = DiveMappingOptions{}.map_voxel_m;
+  LiveMap live(voxel_m);
+  for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
+  int compared = 0;
+  reader.ForEachFrame(
+      [&](const FrameRecord& frame, const GroundTruthRecord*) {
+        const int before = mapper.submap_count();
+        mapper.AddFrame(frame);
+        if (mapper.submap_count() == before) return;
+        ExpectSameCloud(live.Build(mapper), mapper.Map(voxel_m),
+                        "after submap " + std::to_string(mapper.submap_count()));
+        ++compared;
+      },
+      false);
+  mapper.Finish();
+  ExpectSameCloud(live.Build(mapper), mapper.Map(voxel_m), "after Finish");
+  EXPECT_GT(compared, 30);
+  // The dive had what the live map must follow: submaps settled, and whole solves after them.
+  EXPECT_GT(mapper.FirstMovableSubmap(), 25);
+  EXPECT_GE(mapper.stats().whole_solves, 3);
 }
 
 TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {

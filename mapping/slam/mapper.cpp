@@ -513,6 +513,11 @@ std::shared_ptr<const SubmapClouds> Mapper::submap_clouds(int index) const {
   return impl_->store.Get(index);
 }
 
+int Mapper::FirstMovableSubmap() const {
+  if (!impl_->options.windowed_solves) return 0;
+  return std::max(0, submap_count() - impl_->options.solve_window_max_submaps);
+}
+
 perception::PointCloud Mapper::Map(double voxel_m) const {
   if (submap_count() == 0) return {};
   // One submap at a time: the memory is the map's voxels, not every submap's points.

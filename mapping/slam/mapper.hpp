@@ -274,6 +274,11 @@ class Mapper {
   // the first submap's position; the clouds are merged one at a time, so the memory it takes is
   // the map's.
   perception::PointCloud Map(double voxel_m) const;
+  // The first submap a solve may still move before the next whole-graph solve (which moves
+  // them all: MapperStats::whole_solves counts them). Windowed solves free at most the last
+  // solve_window_max_submaps submaps of the graph as it will then be, so every submap before
+  // that many from the end stays where it is; 0 when every solve is whole.
+  int FirstMovableSubmap() const;
 
  private:
   struct Impl;

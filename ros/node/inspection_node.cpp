@@ -14,6 +14,7 @@
 #include "mapping/inspection/camera_frames.hpp"
 #include "mapping/inspection/camera_reader.hpp"
 #include "mapping/slam/dive_mapping.hpp"
+#include "mapping/slam/live_map.hpp"
 #include "mapping/slam/mapper.hpp"
 #include "ros/conversions/dive_description.hpp"
 #include "ros/conversions/frame_image.hpp"
@@ -279,7 +280,11 @@ class Outlet {
  public:
   Outlet(RosConnection& ros, const InspectionNodeOptions& o, double time_origin_s,
          int frames_per_sweep, Failure& failure)
-      : ros_(ros), options_(o), origin_s_(time_origin_s), frames_per_sweep_(frames_per_sweep) {
+      : ros_(ros),
+        options_(o),
+        origin_s_(time_origin_s),
+        frames_per_sweep_(frames_per_sweep),
+        live_map_(o.inspection.map_voxel_m) {
     const RosTopics& t = o.topics;
     sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
     map_ = std::make_unique<MapPublisher>(
@@ -313,17 +318,9 @@ class Outlet {
       navigation.push_back({m.submap(i).anchor_time_s, m.submap(i).T_W_V_nav});
     }
     PublishTrajectory(slam, navigation);
-    const int last = m.submap_count() - 1;
-    if (const std::optional<mapping::Mapper::SubmapCovariances> c = m.Covariances()) {
-      ros_.Publish(
-          pose_id_,
-          PoseMessage{Stamp(slam.back().time_s, options_.frames.map), Out(slam.back().T_W_V),
-                      WorldCovarianceInNavigationAxes(
-                          RosCovariance(c->anchors[static_cast<std::size_t>(last)]), axes())});
-    }
+    if (CovarianceDue()) PublishPose(m, slam.back());
     if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
-      map_->Submit(m.Map(options_.inspection.map_voxel_m),
-                   Stamp(slam.back().time_s, options_.frames.map));
+      map_->Submit(live_map_.Build(m), Stamp(slam.back().time_s, options_.frames.map));
       last_map_ = Clock::now();
     }
   }
@@ -348,6 +345,8 @@ class Outlet {
     return {sorted[sorted.size() / 2],
             sorted[std::min(sorted.size() - 1, sorted.size() * 95 / 100)]};
   }
+  // The same by minute of publishing; call once the mapping thread ended.
+  std::vector<MinuteLatency> SweepLatencyByMinute() const { return latency_by_minute_.Minutes(); }
 
  private:
   Header Stamp(double time_s, const std::string& frame) const {
@@ -366,7 +365,9 @@ class Outlet {
     c.points.reserve(sweep_points_W_.size());
     for (const Eigen::Vector3d& p : sweep_points_W_) c.points.push_back((T_C_W * p).cast<float>());
     ros_.Publish(sweep_id_, c);
-    sweep_latencies_s_.push_back(UnixNow() - sweep_received_s_);
+    const double now_s = UnixNow();
+    sweep_latencies_s_.push_back(now_s - sweep_received_s_);
+    latency_by_minute_.Add(now_s, now_s - sweep_received_s_);
     sweep_points_W_.clear();
     ++sweeps_;
   }
@@ -382,6 +383,26 @@ class Outlet {
         Out(slam.back().T_W_V) * Out(navigation.back().T_W_V).inverse();
     ros_.Publish(tf_id_, std::vector<TransformMessage>{
                              {Stamp(slam.back().time_s, f.map), f.odom, T_map_odom}});
+  }
+
+  // The newest anchor's marginal covariance comes from the whole graph's information, a cost
+  // that grows with the dive (1.6 s at the end of a 30-minute one): it is computed after a submap
+  // only once kPoseCpuShare of the time since the last one would have paid for that one, so that
+  // the pose takes a bounded share of the mapping thread and comes less often late in long dives.
+  bool CovarianceDue() const {
+    constexpr double kPoseCpuShare = 0.05;
+    return !last_covariance_ || SecondsSince(*last_covariance_) * kPoseCpuShare >= covariance_s_;
+  }
+
+  void PublishPose(const mapping::Mapper& m, const mapping::TimedPose& newest) {
+    const Clock::time_point start = Clock::now();
+    const std::optional<mapping::Mapper::SubmapCovariances> c = m.Covariances();
+    covariance_s_ = SecondsSince(start);
+    last_covariance_ = Clock::now();
+    if (!c) return;
+    ros_.Publish(pose_id_, PoseMessage{Stamp(newest.time_s, options_.frames.map), Out(newest.T_W_V),
+                                       WorldCovarianceInNavigationAxes(
+                                           RosCovariance(c->anchors.back()), axes())});
   }
 
   PathMessage Path(const std::vector<mapping::TimedPose>& poses) const {
@@ -404,9 +425,13 @@ class Outlet {
   double sweep_time_s_ = 0.0;
   double sweep_received_s_ = 0.0;
   std::vector<double> sweep_latencies_s_;  // one per sweep: a dive of hours holds ~10^5
+  LatencyByMinute latency_by_minute_;
   Eigen::Isometry3d T_W_C_last_ = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3d> sweep_points_W_;
   std::optional<Clock::time_point> last_map_;
+  mapping::LiveMap live_map_;
+  std::optional<Clock::time_point> last_covariance_;
+  double covariance_s_ = 0.0;  // what the last covariance took
   std::atomic<std::int64_t> sweeps_{0};
   std::unique_ptr<MapPublisher> map_;
 };
@@ -607,6 +632,7 @@ InspectionNodeSummary RunInspectionNode(
   summary.sweeps_published = node.outlet->sweeps();
   std::tie(summary.sweep_latency_median_s, summary.sweep_latency_p95_s) =
       node.outlet->SweepLatency();
+  summary.sweep_latency_by_minute = node.outlet->SweepLatencyByMinute();
   summary.maps_published = node.outlet->maps_published();
   summary.maps_replaced = node.outlet->maps_replaced();
   summary.reregistrations = ros.reregistrations();

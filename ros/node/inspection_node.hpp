@@ -6,12 +6,14 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "mapping/change/live_deviation.hpp"
 #include "mapping/inspection/live_inspection.hpp"
 #include "ros/bridge/ros_connection.hpp"
 #include "ros/conversions/navigation_input.hpp"
 #include "ros/conversions/ros_names.hpp"
+#include "ros/node/latency_by_minute.hpp"
 #include "scanner/acquisition/frame_source.hpp"
 #include "scanner/stripe/stripe_detector.hpp"
 
@@ -75,6 +77,7 @@ struct InspectionNodeSummary {
   // From the arrival of a sweep's last frame to its PointCloud2 being published, seconds.
   double sweep_latency_median_s = 0.0;
   double sweep_latency_p95_s = 0.0;
+  std::vector<MinuteLatency> sweep_latency_by_minute;  // from the first sweep's minute
   std::int64_t maps_published = 0;
   // Maps the publishing thread had not taken before a newer one came (it publishes the newest).
   std::int64_t maps_replaced = 0;
