@@ -770,6 +770,27 @@ TEST(CliRos, RosBenchWritesItsFiguresAndLosesNoFrame) {
   EXPECT_TRUE(r["overhead_ratio"].is_number());
 }
 
+// bench ros --long-minutes: the long-dive bench's field replayed through the node at its own
+// rate, its memory and sweep latency minute by minute, no frame lost.
+TEST(CliRos, RosSoakReportsMinuteByMinute) {
+  const std::filesystem::path json = TempPath("bench_ros_soak.json");
+  const CommandRun run = RunUwscan("bench ros --long-minutes 1 --json " + json.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("minute   1:"), std::string::npos) << run.output;
+  std::ifstream in(json);
+  const nlohmann::json r = nlohmann::json::parse(in);
+  const nlohmann::json& soak = r["soak"];
+  EXPECT_EQ(soak["frames_lost"].get<int>(), 0) << r.dump();
+  EXPECT_EQ(r["node"]["rate"].get<double>(), 1.0);
+  const nlohmann::json& minutes = soak["per_minute"];
+  ASSERT_GE(minutes.size(), 1u) << soak.dump();
+  // A minute at 100 frames/s and 51 frames a sweep: about 117 sweeps in the first.
+  EXPECT_GT(minutes[0]["sweeps"].get<int>(), 100) << soak.dump();
+  EXPECT_GT(soak["latency_p95_s"]["first_minute"].get<double>(), 0.0);
+  EXPECT_GT(soak["rss_bytes"]["first_minute"].get<double>(), 1e6);
+  EXPECT_GT(soak["rss_bytes"]["last_minute"].get<double>(), 1e6);
+}
+
 // The node reads the camera itself (the fake camera, profile mode) as `inspect` does, with the
 // vehicle's odometry from ROS: every frame received is logged, none is lost on the way, and the
 // frames the navigation covers are mapped.

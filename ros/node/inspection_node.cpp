@@ -312,15 +312,16 @@ class Outlet {
 
   // Mapping thread: a submap closed.
   void OnSubmapClosed(const mapping::Mapper& m) {
-    std::vector<mapping::TimedPose> slam, navigation;
-    for (int i = 0; i < m.submap_count(); ++i) {
-      slam.push_back({m.submap(i).anchor_time_s, m.pose(i)});
-      navigation.push_back({m.submap(i).anchor_time_s, m.submap(i).T_W_V_nav});
-    }
-    PublishTrajectory(slam, navigation);
-    if (CovarianceDue()) PublishPose(m, slam.back());
+    const int last = m.submap_count() - 1;
+    const double time_s = m.submap(last).anchor_time_s;
+    const mapping::TimedPose slam{time_s, m.pose(last)},
+        navigation{time_s, m.submap(last).T_W_V_nav};
+    PublishCorrection(slam, navigation);
+    if (CovarianceDue()) PublishPose(m, slam);
+    // The paths and the map hold the whole dive: published at most every map_period_s.
     if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
-      map_->Submit(live_map_.Build(m), Stamp(slam.back().time_s, options_.frames.map));
+      PublishPaths(m);
+      map_->Submit(live_map_.Build(m), Stamp(time_s, options_.frames.map));
       last_map_ = Clock::now();
     }
   }
@@ -330,7 +331,8 @@ class Outlet {
   void Finish(const mapping::InspectionResult& r) {
     if (!sweep_points_W_.empty()) PublishSweep();
     if (r.slam.empty()) return;
-    PublishTrajectory(r.slam, r.navigation);
+    PublishPaths(r.slam, r.navigation);
+    PublishCorrection(r.slam.back(), r.navigation.back());
     map_->PublishLast(r.map, Stamp(r.slam.back().time_s, options_.frames.map));
   }
 
@@ -372,17 +374,27 @@ class Outlet {
     ++sweeps_;
   }
 
-  // Both paths in the map frame (uwscan's world: the navigation's, corrected), and the
-  // correction at the latest anchor as map -> odom.
-  void PublishTrajectory(const std::vector<mapping::TimedPose>& slam,
-                         const std::vector<mapping::TimedPose>& navigation) {
-    const RosFrames& f = options_.frames;
+  // Both paths in the map frame (uwscan's world: the navigation's, corrected).
+  void PublishPaths(const std::vector<mapping::TimedPose>& slam,
+                    const std::vector<mapping::TimedPose>& navigation) {
     ros_.Publish(slam_path_id_, Path(slam));
     ros_.Publish(navigation_path_id_, Path(navigation));
-    const Eigen::Isometry3d T_map_odom =
-        Out(slam.back().T_W_V) * Out(navigation.back().T_W_V).inverse();
-    ros_.Publish(tf_id_, std::vector<TransformMessage>{
-                             {Stamp(slam.back().time_s, f.map), f.odom, T_map_odom}});
+  }
+  void PublishPaths(const mapping::Mapper& m) {
+    std::vector<mapping::TimedPose> slam, navigation;
+    for (int i = 0; i < m.submap_count(); ++i) {
+      slam.push_back({m.submap(i).anchor_time_s, m.pose(i)});
+      navigation.push_back({m.submap(i).anchor_time_s, m.submap(i).T_W_V_nav});
+    }
+    PublishPaths(slam, navigation);
+  }
+
+  // The correction at the newest anchor as map -> odom.
+  void PublishCorrection(const mapping::TimedPose& slam, const mapping::TimedPose& navigation) {
+    const RosFrames& f = options_.frames;
+    const Eigen::Isometry3d T_map_odom = Out(slam.T_W_V) * Out(navigation.T_W_V).inverse();
+    ros_.Publish(tf_id_,
+                 std::vector<TransformMessage>{{Stamp(slam.time_s, f.map), f.odom, T_map_odom}});
   }
 
   // The newest anchor's marginal covariance comes from the whole graph's information, a cost
