@@ -159,7 +159,7 @@ void SetRosEnvironment(const fs::path& folder) {
 }
 
 NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, double rate,
-                              double play_timeout_s, const fs::path& folder) {
+                              double timeout_s, const fs::path& folder) {
   const std::string name = "node_" + std::to_string(static_cast<int>(rate * 100));
   const fs::path json = folder / (name + ".json"), log = folder / (name + ".log");
   ChildProcess node({Self(), "ros", "inspect", "--log", (folder / (name + ".db")).string(),
@@ -174,9 +174,9 @@ NodeFigures ReplayThroughNode(const fs::path& bag, std::int64_t frames_in_bag, d
   RssSampler memory(node.pid());
   // -d: rosbag play waits after advertising, so that the node has connected before the first frame.
   RunToEnd({"rosbag", "play", "--quiet", "-d", "1", "-r", std::to_string(rate), bag.string()},
-           folder / "play.log", play_timeout_s);
+           folder / "play.log", timeout_s);
   const std::vector<std::pair<double, std::int64_t>> rss = memory.Stop();
-  const ChildProcess::Exit exit = node.Wait(600);
+  const ChildProcess::Exit exit = node.Wait(timeout_s);
   if (exit.exit_code != 0) throw Error("bench ros: the node failed (see " + log.string() + ")");
   const nlohmann::json r = ReadJson(json);
   NodeFigures f;
@@ -280,8 +280,8 @@ nlohmann::json SoakJson(const NodeFigures& f, double minutes) {
   nlohmann::json per_minute = nlohmann::json::array();
   const nlohmann::json& latency = f.sweep_latency_by_minute;
   std::size_t sample = 0;
+  std::int64_t rss_bytes = 0;  // a minute without a sample keeps the one before
   for (std::size_t m = 0; sample < f.rss.size() || m < latency.size(); ++m) {
-    std::int64_t rss_bytes = 0;
     while (sample < f.rss.size() && f.rss[sample].first < 60.0 * static_cast<double>(m + 1))
       rss_bytes = f.rss[sample++].second;
     nlohmann::json minute = {
@@ -295,9 +295,10 @@ nlohmann::json SoakJson(const NodeFigures& f, double minutes) {
   }
   if (per_minute.empty()) throw Error("bench ros: the soak measured no minute");
   // The last minute is the replay's tail and the node's finish, partial: the one before it is the
-  // dive's last whole minute.
+  // dive's last whole minute. (Memory minutes count from the node's start, latency minutes from
+  // its first sweep, a second or two later.)
   const nlohmann::json& last =
-      per_minute.size() > 2 ? per_minute[per_minute.size() - 2] : per_minute.back();
+      per_minute.size() >= 2 ? per_minute[per_minute.size() - 2] : per_minute.back();
   return {{"minutes", minutes},
           {"frames_lost", f.frames_in_bag - f.frames_received},
           {"frames_skipped_by_mapper", f.frames_skipped},
@@ -419,15 +420,16 @@ void RunRosBench(RosBenchArgs a) {
     a.scene = WriteLongDiveScene(a.long_minutes, folder).string();
     a.rates = {1.0};
   }
-  // Simulating, exporting and replaying a dive of hours takes about as long as the dive.
-  const double step_timeout_s = 600.0 + 60.0 * (soak ? a.long_minutes : 5.0);
+  // Simulating, exporting and replaying a dive of hours takes about as long as the dive; the
+  // node's finish (the last whole solve, the map) a few minutes. Other scenes: an hour.
+  const double step_timeout_s = soak ? 600.0 + 90.0 * a.long_minutes : 3600.0;
   const DiveBag d = SimulateAndExport(a.scene, folder, step_timeout_s);
   ChildProcess master({"roscore", "-p", "11311"}, folder / "roscore.log");
   WaitFor(MasterAnswers, 30, "roscore did not answer");
   std::this_thread::sleep_for(std::chrono::seconds(1));
   std::vector<NodeFigures> runs;
   for (double rate : a.rates) {
-    runs.push_back(ReplayThroughNode(d.bag, d.frames, rate, step_timeout_s / rate, folder));
+    runs.push_back(ReplayThroughNode(d.bag, d.frames, rate, step_timeout_s, folder));
     PrintRun(runs.back());
   }
   const nlohmann::json figures =

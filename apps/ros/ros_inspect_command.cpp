@@ -64,7 +64,7 @@ const char* const kParameterHelp =
     "  ~scanner             scanner (calibration) file when no dive description comes  []\n"
     "  ~description_wait_s  how long to wait for the dive description, s            [30]\n"
     "  ~mount_wait_s        how long to wait for base_frame -> camera_frame on /tf_static, s  [3]\n"
-    "  ~map_period_s        the map is published at most this often, s              [2]\n"
+    "  ~map_period_s        the map and paths are published at most this often, s    [2]\n"
     "  ~voxel_m             map voxel, m                                           [0.005]\n"
     "  ~sweeps_per_submap   sweeps grouped into one submap                          [1]\n"
     "  ~live_queue          frames waiting for the mapper (a newer frame skips the oldest)  "

@@ -158,6 +158,13 @@ std::vector<Waypoint> Laps(double duration_s) {
   return path;
 }
 
+// A YAML single-quoted scalar: any path, whatever characters it holds.
+std::string SingleQuoted(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+  return quoted + "'";
+}
+
 }  // namespace
 
 std::string LongDiveSceneYaml(double duration_s, std::uint64_t seed,
@@ -169,7 +176,7 @@ std::string LongDiveSceneYaml(double duration_s, std::uint64_t seed,
       << " s (bench/slam/long_dive_scene.hpp).\n"
       << "uwscan_format: 1\nseed: " << seed << "\n"
       << "water: {refractive_index: 1.33, attenuation_per_m: 0.2}\n"
-      << "scanner:\n  file: " << scanner_file << "\n  sweeps: "
+      << "scanner:\n  file: " << SingleQuoted(scanner_file) << "\n  sweeps: "
       << static_cast<int>(std::floor(duration_s * kFrameRate_hz / kFramesPerSweep)) << "\n"
       << "  galvo: {step_min: -100, step_max: 100, step_stride: 4, frame_rate_hz: 100}\n"
       << "trajectory:\n"

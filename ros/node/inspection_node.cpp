@@ -367,9 +367,10 @@ class Outlet {
     c.points.reserve(sweep_points_W_.size());
     for (const Eigen::Vector3d& p : sweep_points_W_) c.points.push_back((T_C_W * p).cast<float>());
     ros_.Publish(sweep_id_, c);
-    const double now_s = UnixNow();
-    sweep_latencies_s_.push_back(now_s - sweep_received_s_);
-    latency_by_minute_.Add(now_s, now_s - sweep_received_s_);
+    const double latency_s = UnixNow() - sweep_received_s_;
+    sweep_latencies_s_.push_back(latency_s);
+    // By the steady clock: a system clock set mid-dive (NTP) would move the minutes.
+    latency_by_minute_.Add(SecondsSince(start_), latency_s);
     sweep_points_W_.clear();
     ++sweeps_;
   }
@@ -398,7 +399,8 @@ class Outlet {
   }
 
   // The newest anchor's marginal covariance comes from the whole graph's information, a cost
-  // that grows with the dive (1.6 s at the end of a 30-minute one): it is computed after a submap
+  // that grows with the dive (its selected inverse alone: 1.6 s at the end of a 30-minute one,
+  // bench/slam/RESULTS.md): it is computed after a submap
   // only once kPoseCpuShare of the time since the last one would have paid for that one, so that
   // the pose takes a bounded share of the mapping thread and comes less often late in long dives.
   bool CovarianceDue() const {
@@ -438,6 +440,7 @@ class Outlet {
   double sweep_received_s_ = 0.0;
   std::vector<double> sweep_latencies_s_;  // one per sweep: a dive of hours holds ~10^5
   LatencyByMinute latency_by_minute_;
+  Clock::time_point start_ = Clock::now();
   Eigen::Isometry3d T_W_C_last_ = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3d> sweep_points_W_;
   std::optional<Clock::time_point> last_map_;

@@ -64,6 +64,9 @@ std::string CopyInto(const fs::path& temporary, const fs::path& path) {
 }  // namespace
 
 fs::path FollowLinks(const fs::path& path) {
+  // A link to a device or a pipe (/dev/stdout to /proc/self/fd/1 to "pipe:[N]", which is no
+  // path) is written into through the link itself.
+  if (IsSpecialFile(path)) return path;
   // Linux itself gives up after 40 links in one path.
   constexpr int kMaxLinks = 40;
   fs::path target = path;

@@ -13,7 +13,8 @@
 namespace uwscan {
 
 // Where a write to `path` lands: `path`, or the file its chain of symbolic links ends at (which
-// need not exist yet). Throws uwscan::Error on a loop of links.
+// need not exist yet); `path` itself when it leads to a device or a pipe (/dev/stdout). Throws
+// uwscan::Error on a loop of links.
 std::filesystem::path FollowLinks(const std::filesystem::path& path);
 
 // The temporary name `path` is written under: in its folder, hidden, unique to this call

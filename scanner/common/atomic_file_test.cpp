@@ -96,6 +96,23 @@ TEST_F(AtomicFileTest, ALinkIsWrittenThroughNotReplaced) {
   EXPECT_TRUE(fs::is_symlink(dir_ / "dangling"));
 }
 
+// A link to an anonymous pipe (as /dev/stdout is, through /proc/self/fd/1, when the output is
+// piped) is written into: followed to its end it gives "pipe:[N]", which is no path.
+TEST_F(AtomicFileTest, ALinkToAPipeIsWrittenInto) {
+  int ends[2];
+  ASSERT_EQ(::pipe2(ends, O_NONBLOCK), 0);
+  const fs::path stdout_like = dir_ / "stdout";
+  fs::create_symlink("/proc/self/fd/" + std::to_string(ends[1]), stdout_like);
+  WriteFileAtomically(stdout_like, "piped bytes");
+  std::string received(64, '\0');
+  const ssize_t n = ::read(ends[0], received.data(), received.size());
+  ::close(ends[0]);
+  ::close(ends[1]);
+  received.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+  EXPECT_EQ(received, "piped bytes");
+  EXPECT_TRUE(fs::is_symlink(stdout_like));
+}
+
 TEST_F(AtomicFileTest, ALoopOfLinksIsAClearError) {
   fs::create_symlink("b", dir_ / "a");
   fs::create_symlink("a", dir_ / "b");
