@@ -51,9 +51,9 @@ class Outlet {
         live_map_(o.inspection.map_voxel_m) {
     const RosTopics& t = o.topics;
     sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
-    map_ = std::make_unique<MapPublisher>(
-        ros, ros.Advertise(t.map, RosConnection::Kind::kCloud, true), o.navigation.axes,
-        o.reference, std::move(on_failure));
+    map_ =
+        std::make_unique<MapPublisher>(ros, ros.Advertise(t.map, RosConnection::Kind::kCloud, true),
+                                       o.navigation.axes, o.reference, std::move(on_failure));
     slam_path_id_ = ros.Advertise(t.slam_path, RosConnection::Kind::kPath, true);
     navigation_path_id_ = ros.Advertise(t.navigation_path, RosConnection::Kind::kPath, true);
     pose_id_ = ros.Advertise(t.pose, RosConnection::Kind::kPose, true);
