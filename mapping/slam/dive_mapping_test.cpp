@@ -185,40 +185,61 @@ void ExpectSameCloud(const perception::PointCloud& a, const perception::PointClo
   }
 }
 
-// The live map (what the ROS node publishes every few seconds) merges the submaps no solve moves
-// any more once, until a whole solve moves them all: after every submap of a dive with short
-// windows, several whole solves and spilled clouds, the same map to the bit as merging every
-// submap again.
-TEST_F(DiveMappingTest, TheLiveMapIsTheWholeMapToTheBit) {
+// The live map (what the ROS node publishes every few seconds) keeps merged what has not moved
+// since the last map: after every submap of a dive with short windows and spilled clouds, the
+// same map to the bit as merging every submap again. Two dives: one with several whole solves,
+// one where loops free the submaps back to their older end, further back than the last solve's
+// window (TheLiveMapFollowsLoopsBackToTheirOlderEnd, after OutAndBackOverAPipe).
+class LiveMapTest : public DiveMappingTest {
+ protected:
+  struct Run {
+    int compared = 0, last_first_movable = 0;
+    MapperStats stats;
+  };
+  Run CompareLiveMaps(const fs::path& log, const MapperOptions& mapper_options, const char* name) {
+    const DiveLogReader reader(log);
+    MapperOptions options = mapper_options;
+    options.spill_folder = dir_ / name;
+    fs::create_directories(options.spill_folder);
+    options.resident_submaps = 4;
+    Mapper mapper(reader.header().scanner, reader.header().scan_pattern, *reader.vehicle_mount(),
+                  *reader.header().navigation_noise, options, dir_ / name / "tables");
+    const double voxel_m = DiveMappingOptions{}.map_voxel_m;
+    // Settled submaps taken up often; and never, so that only solves move the steady part.
+    LiveMap live(voxel_m, 3), live_unsettled(voxel_m, 1000);
+    for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
+    Run run;
+    reader.ForEachFrame(
+        [&](const FrameRecord& frame, const GroundTruthRecord*) {
+          const int before = mapper.submap_count();
+          mapper.AddFrame(frame);
+          if (mapper.submap_count() == before) return;
+          const perception::PointCloud map = mapper.Map(voxel_m);
+          const std::string when = "after submap " + std::to_string(mapper.submap_count());
+          ExpectSameCloud(live.Build(mapper), map, when);
+          ExpectSameCloud(live_unsettled.Build(mapper), map, when + " (never settled)");
+          run.last_first_movable = mapper.FirstMovableSubmap();
+          ++run.compared;
+        },
+        false);
+    mapper.Finish();
+    ExpectSameCloud(live.Build(mapper), mapper.Map(voxel_m), "after Finish");
+    ExpectSameCloud(live_unsettled.Build(mapper), mapper.Map(voxel_m), "after Finish");
+    run.stats = mapper.stats();
+    return run;
+  }
+};
+
+TEST_F(LiveMapTest, TheLiveMapIsTheWholeMapToTheBit) {
   const fs::path log = Simulate(ShortScene(), "drift.db");
-  const DiveLogReader reader(log);
   MapperOptions options;
   options.solve_window_submaps = 4;
   options.solve_window_max_submaps = 8;
-  options.spill_folder = dir_;
-  options.resident_submaps = 4;
-  Mapper mapper(reader.header().scanner, reader.header().scan_pattern, *reader.vehicle_mount(),
-                *reader.header().navigation_noise, options, dir_ / "tables");
-  const double voxel_m = DiveMappingOptions{}.map_voxel_m;
-  LiveMap live(voxel_m);
-  for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
-  int compared = 0;
-  reader.ForEachFrame(
-      [&](const FrameRecord& frame, const GroundTruthRecord*) {
-        const int before = mapper.submap_count();
-        mapper.AddFrame(frame);
-        if (mapper.submap_count() == before) return;
-        ExpectSameCloud(live.Build(mapper), mapper.Map(voxel_m),
-                        "after submap " + std::to_string(mapper.submap_count()));
-        ++compared;
-      },
-      false);
-  mapper.Finish();
-  ExpectSameCloud(live.Build(mapper), mapper.Map(voxel_m), "after Finish");
-  EXPECT_GT(compared, 30);
+  const Run whole = CompareLiveMaps(log, options, "whole");
+  EXPECT_GT(whole.compared, 30);
   // The dive had what the live map must follow: submaps settled, and whole solves after them.
-  EXPECT_GT(mapper.FirstMovableSubmap(), 25);
-  EXPECT_GE(mapper.stats().whole_solves, 3);
+  EXPECT_GT(whole.last_first_movable, 25);
+  EXPECT_GE(whole.stats.whole_solves, 3);
 }
 
 TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {
@@ -321,6 +342,17 @@ scanner::sim::Scene OutAndBackOverAPipe() {
   for (std::size_t i = 1; i < 4; ++i) poses[i].T_W_V.translation().x() = 3.0;
   scene.scanner.sweeps = static_cast<int>(poses.back().time_s / 70.0 * scene.scanner.sweeps);
   return scene;
+}
+
+TEST_F(LiveMapTest, TheLiveMapFollowsLoopsBackToTheirOlderEnd) {
+  MapperOptions options;
+  options.solve_window_submaps = 2;
+  options.solve_window_max_submaps = 30;
+  options.loop_window_chi2_per_direction = 0.0;  // every loop frees back to its older end
+  options.full_solve_growth = 1e6;
+  const Run run =
+      CompareLiveMaps(Simulate(OutAndBackOverAPipe(), "pipe_loop.db"), options, "loops");
+  EXPECT_GT(run.stats.loop_window_solves, 3);
 }
 
 TEST_F(DiveMappingTest, OutAndBackOverAPipeLoopsPinAllButTheSlide) {

@@ -7,32 +7,74 @@
 
 namespace uwscan::mapping {
 
-LiveMap::LiveMap(double voxel_m) : voxel_m_(voxel_m) {
+LiveMap::LiveMap(double voxel_m, int settle_batch)
+    : voxel_m_(voxel_m), settle_batch_(settle_batch) {
   if (!(voxel_m > 0.0)) throw Error("LiveMap: voxel_m must be > 0, got " + std::to_string(voxel_m));
+  if (settle_batch < 1)
+    throw Error("LiveMap: settle_batch must be > 0, got " + std::to_string(settle_batch));
 }
 
 perception::PointCloud LiveMap::Build(const Mapper& mapper) {
-  const int count = mapper.submap_count();
-  if (count == 0) return {};
-  if (settled_ && mapper.stats().whole_solves != whole_solves_) {
-    settled_.reset();  // a whole solve moved every submap merged so far
-    settled_submaps_ = 0;
+  if (mapper.submap_count() == 0) return {};
+  // Mapper::Map's origin is the first submap's place, which only a whole solve moves once the
+  // submap is settled; a whole solve moves every submap merged so far.
+  if (!map_ || mapper.stats().whole_solves != whole_solves_ ||
+      mapper.scan_pose(0).translation() != origin_) {
+    Restart(mapper);
+  } else if (mapper.FirstMovableSubmap() - settled_ >= settle_batch_) {
+    Settle(mapper);
+  } else {
+    UndoMoved(mapper);
   }
-  const int settle_up_to = mapper.FirstMovableSubmap();
-  if (!settled_ && settle_up_to > 0) {
-    // Mapper::Map's origin: the first submap's place, which no windowed solve moves once settled.
-    settled_.emplace(voxel_m_, mapper.scan_pose(0).translation());
-    whole_solves_ = mapper.stats().whole_solves;
+  MergeMovable(mapper);
+  return map_->Cloud();
+}
+
+void LiveMap::Restart(const Mapper& mapper) {
+  origin_ = mapper.scan_pose(0).translation();
+  whole_solves_ = mapper.stats().whole_solves;
+  map_.emplace(voxel_m_, origin_);
+  settled_ = 0;
+  Settle(mapper);
+}
+
+void LiveMap::Settle(const Mapper& mapper) {
+  while (map_->marks() > 0) map_->Undo();
+  for (const int first_movable = mapper.FirstMovableSubmap(); settled_ < first_movable; ++settled_)
+    map_->Add(mapper.submap_clouds(settled_)->cloud, mapper.scan_pose(settled_));
+  map_->OrderByKey();
+  map_->Mark();  // steady
+  map_->Mark();  // recent
+  steady_ = settled_;
+  merged_poses_.clear();
+}
+
+void LiveMap::UndoMoved(const Mapper& mapper) {
+  const int merged_end = settled_ + static_cast<int>(merged_poses_.size());
+  int first_moved = settled_;
+  while (first_moved < merged_end &&
+         mapper.scan_pose(first_moved).matrix() == merged_poses_[first_moved - settled_].matrix())
+    ++first_moved;
+  if (first_moved == merged_end) return;
+  map_->Undo();  // recent: [steady_, merged_end)
+  if (first_moved < steady_) {
+    map_->Undo();  // steady: [settled_, steady_)
+    map_->Mark();
+    steady_ = settled_;
   }
-  for (; settled_submaps_ < settle_up_to; ++settled_submaps_)
-    settled_->Add(mapper.submap_clouds(settled_submaps_)->cloud,
-                  mapper.scan_pose(settled_submaps_));
-  perception::VoxelAccumulator map =
-      settled_ ? *settled_
-               : perception::VoxelAccumulator(voxel_m_, mapper.scan_pose(0).translation());
-  for (int i = settled_submaps_; i < count; ++i)
-    map.Add(mapper.submap_clouds(i)->cloud, mapper.scan_pose(i));
-  return map.Cloud();
+  // Under the steady mark again: the submaps that did not move, at their same places.
+  for (; steady_ < first_moved; ++steady_)
+    map_->Add(mapper.submap_clouds(steady_)->cloud, merged_poses_[steady_ - settled_]);
+  map_->Mark();
+  merged_poses_.resize(static_cast<std::size_t>(first_moved - settled_));
+}
+
+void LiveMap::MergeMovable(const Mapper& mapper) {
+  for (int i = settled_ + static_cast<int>(merged_poses_.size()); i < mapper.submap_count(); ++i) {
+    const Eigen::Isometry3d pose = mapper.scan_pose(i);
+    map_->Add(mapper.submap_clouds(i)->cloud, pose);
+    merged_poses_.push_back(pose);
+  }
 }
 
 }  // namespace uwscan::mapping

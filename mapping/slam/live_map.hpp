@@ -1,6 +1,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "perception/cloud/point_cloud.hpp"
 #include "perception/preprocessing/voxel_accumulator.hpp"
@@ -11,23 +12,42 @@ class Mapper;
 
 // The map of a dive as it grows (what a live node publishes every few seconds), without merging
 // every submap again each time: Mapper::Map reads back and voxelises all of them, a cost that grows
-// with the dive (on a 30-minute dive, every submap's cloud read back from the spill file twice a
-// minute). The submaps no solve can move any more until the next whole-graph solve
-// (Mapper::FirstMovableSubmap) are merged once and kept; each map adds the rest to a copy of them.
-// Submaps are merged in the same order as Mapper::Map, so the map is the same to the bit. After a
-// whole-graph solve (every submap moved) the kept part is merged again; those solves come at a
-// fixed growth of the graph, so the merging per submap stays constant on average.
+// with the dive. Three parts, merged in Mapper::Map's order so that the map is the same to the
+// bit:
+// - settled: the submaps no solve can move any more until the next whole-graph solve
+//   (Mapper::FirstMovableSubmap), merged once for good, taken up in batches;
+// - steady: movable submaps that have not moved since they were merged, under a mark;
+// - recent: from the first submap that moved since the last map on (after most submaps, the
+//   windowed solve's last few dozen; after a loop, up to all movable ones), under a second mark,
+//   taken out (VoxelAccumulator::Undo) and merged again at their new places.
+// The map is never copied. After a whole-graph solve (every submap moved) it is merged anew;
+// those solves come at a fixed growth of the graph, so the work per submap stays bounded.
 class LiveMap {
  public:
-  explicit LiveMap(double voxel_m);  // voxel_m > 0 (Mapper::Map's)
+  // voxel_m > 0 (Mapper::Map's). Settled submaps are taken up settle_batch (> 0) at a time:
+  // each time every mark is undone (voxels are put in key order only without marks) and the
+  // movable submaps are merged again, so a larger batch costs that less often, and keeps more
+  // sums saved under the marks.
+  explicit LiveMap(double voxel_m, int settle_batch = 100);
   // Mapper::Map(voxel_m) of `mapper` as it stands. Always called with the same mapper.
   perception::PointCloud Build(const Mapper& mapper);
 
  private:
+  void Restart(const Mapper& mapper);
+  void Settle(const Mapper& mapper);
+  // Takes out the merged movable submaps from the first one placed differently now on.
+  void UndoMoved(const Mapper& mapper);
+  void MergeMovable(const Mapper& mapper);
+
+  // Submaps [0, settled_) merged for good, then [settled_, steady_) under the first mark and
+  // [steady_, settled_ + merged_poses_.size()) under the second.
+  std::optional<perception::VoxelAccumulator> map_;
+  int settled_ = 0, steady_ = 0;
+  std::vector<Eigen::Isometry3d> merged_poses_;  // of the movable submaps merged, from settled_
+  int whole_solves_ = 0;                         // the mapper's count when map_ was started
+  Eigen::Vector3d origin_;                       // map_'s: the first submap's place then
   double voxel_m_;
-  std::optional<perception::VoxelAccumulator> settled_;  // submaps [0, settled_submaps_)
-  int settled_submaps_ = 0;
-  int whole_solves_ = 0;  // the mapper's count when settled_ was started
+  int settle_batch_;
 };
 
 }  // namespace uwscan::mapping

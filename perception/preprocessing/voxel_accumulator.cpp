@@ -1,6 +1,7 @@
 #include "perception/preprocessing/voxel_accumulator.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -37,8 +38,16 @@ void VoxelAccumulator::Add(const PointCloud& cloud, const Eigen::Isometry3d& T) 
     }
     const std::uint32_t id = voxels_.Insert(key);
     // resize, not emplace_back: a failed allocation leaves no id without its sum.
-    if (id >= sums_.size()) sums_.resize(id + std::size_t{1});
+    if (id >= sums_.size()) {
+      sums_.resize(id + std::size_t{1});
+      saved_depth_.resize(sums_.size(), 0);
+    }
     Sum& voxel = sums_[id];
+    const auto depth = static_cast<std::uint8_t>(mark_starts_.size());
+    if (saved_depth_[id] < depth) {
+      saved_.push_back({id, saved_depth_[id], voxel});
+      saved_depth_[id] = depth;
+    }
     voxel.sum += p.cast<double>();
     ++voxel.count;
   }
@@ -48,9 +57,59 @@ PointCloud VoxelAccumulator::Cloud() const {
   PointCloud out;
   out.origin = origin_;
   out.points.reserve(sums_.size());
-  for (const std::uint32_t id : voxels_.IdsByKey())
+  for (const std::uint32_t id : IdsByKey())
     out.points.push_back((sums_[id].sum / static_cast<double>(sums_[id].count)).cast<float>());
   return out;
+}
+
+std::vector<std::uint32_t> VoxelAccumulator::IdsByKey() const {
+  const std::vector<std::uint32_t> rest = voxels_.IdsByKey(key_ordered_);
+  std::vector<std::uint32_t> ids(voxels_.size());
+  // The ordered ids are 0, 1, ..., key_ordered_ - 1: merged with the rest without reading a list.
+  std::uint32_t ordered = 0;
+  std::size_t next = 0, out = 0;
+  while (ordered < key_ordered_ || next < rest.size()) {
+    const bool take_rest = next < rest.size() &&
+                           (ordered == key_ordered_ ||
+                            VoxelIndex::KeyBefore(voxels_.key(rest[next]), voxels_.key(ordered)));
+    ids[out++] = take_rest ? rest[next++] : ordered++;
+  }
+  return ids;
+}
+
+void VoxelAccumulator::OrderByKey() {
+  assert(mark_starts_.empty());
+  if (key_ordered_ == voxels_.size()) return;
+  // In place: a copy of the whole map is what a live map must not need.
+  const std::vector<std::uint32_t> old_ids = IdsByKey();
+  voxels_.Renumber(old_ids, key_ordered_);
+  ApplyMergeOrder(old_ids, key_ordered_, sums_);
+  key_ordered_ = static_cast<std::uint32_t>(voxels_.size());
+}
+
+void VoxelAccumulator::Mark() {
+  if (mark_starts_.size() == 255) throw Error("VoxelAccumulator: more than 255 marks");
+  mark_starts_.push_back(saved_.size());
+}
+
+void VoxelAccumulator::Undo() {
+  assert(!mark_starts_.empty());
+  // Newest first, so that a voxel the mark added is the newest key when it is taken out.
+  for (std::size_t i = saved_.size(); i-- > mark_starts_.back();) {
+    const Saved& s = saved_[i];
+    saved_depth_[s.id] = s.depth;
+    if (s.sum.count > 0) {
+      sums_[s.id] = s.sum;
+      continue;
+    }
+    assert(s.id + std::size_t{1} == voxels_.size());
+    voxels_.RemoveNewest();
+    sums_.pop_back();
+    saved_depth_.pop_back();
+  }
+  saved_.resize(mark_starts_.back());
+  mark_starts_.pop_back();
+  assert(key_ordered_ <= voxels_.size());  // ordered before any mark, so never taken out
 }
 
 }  // namespace uwscan::perception

@@ -1,6 +1,7 @@
 #include "perception/preprocessing/voxel_index.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <limits>
 #include <numeric>
 
@@ -12,12 +13,6 @@ namespace {
 // Element by element: std::array's own comparisons call memcmp.
 bool SameKey(const VoxelKey& a, const VoxelKey& b) {
   return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
-}
-
-bool KeyBefore(const VoxelKey& a, const VoxelKey& b) {
-  if (a[0] != b[0]) return a[0] < b[0];
-  if (a[1] != b[1]) return a[1] < b[1];
-  return a[2] < b[2];
 }
 
 // Neighbouring voxels spread over the whole table: each axis by its own large odd multiplier,
@@ -32,6 +27,12 @@ std::uint64_t Hash(const VoxelKey& k) {
 }
 
 }  // namespace
+
+bool VoxelIndex::KeyBefore(const VoxelKey& a, const VoxelKey& b) {
+  if (a[0] != b[0]) return a[0] < b[0];
+  if (a[1] != b[1]) return a[1] < b[1];
+  return a[2] < b[2];
+}
 
 std::uint32_t VoxelIndex::Insert(const VoxelKey& key) {
   if (2 * (keys_.size() + 1) > slots_.size()) Grow();
@@ -69,12 +70,35 @@ void VoxelIndex::Grow() {
   }
 }
 
-std::vector<std::uint32_t> VoxelIndex::IdsByKey() const {
-  std::vector<std::uint32_t> ids(keys_.size());
-  std::iota(ids.begin(), ids.end(), 0u);
+std::vector<std::uint32_t> VoxelIndex::IdsByKey() const { return IdsByKey(0); }
+
+std::vector<std::uint32_t> VoxelIndex::IdsByKey(std::uint32_t first) const {
+  std::vector<std::uint32_t> ids(keys_.size() - std::min<std::size_t>(first, keys_.size()));
+  std::iota(ids.begin(), ids.end(), first);
   std::sort(ids.begin(), ids.end(),
             [&](std::uint32_t a, std::uint32_t b) { return KeyBefore(keys_[a], keys_[b]); });
   return ids;
+}
+
+void VoxelIndex::RemoveNewest() {
+  assert(!keys_.empty());
+  const std::size_t mask = slots_.size() - 1;
+  const auto newest = static_cast<std::uint32_t>(keys_.size());  // its slot's value
+  std::size_t s = Hash(keys_.back()) & mask;
+  while (slots_[s] != newest) s = (s + 1) & mask;
+  slots_[s] = 0;
+  keys_.pop_back();
+}
+
+void VoxelIndex::Renumber(const std::vector<std::uint32_t>& old_ids, std::uint32_t first_new) {
+  assert(old_ids.size() == keys_.size());
+  std::vector<std::uint32_t> new_id(keys_.size());
+  for (std::uint32_t i = 0; i < old_ids.size(); ++i) new_id[old_ids[i]] = i;
+  ApplyMergeOrder(old_ids, first_new, keys_);
+  // The slots no longer say in which order the keys were inserted, which RemoveNewest does not
+  // need: every key inserted from now on is placed after all of these.
+  for (std::uint32_t& slot : slots_)
+    if (slot != 0) slot = new_id[slot - 1] + 1;
 }
 
 }  // namespace uwscan::perception
