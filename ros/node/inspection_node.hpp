@@ -23,9 +23,9 @@
 // is placed with the navigation interpolated at its own stamp (frames wait for it). Publishes
 // each sweep (PointCloud2 in the camera frame at its last frame), the map (PointCloud2, latched)
 // and the SLAM and the navigation's paths at the submaps' anchors (nav_msgs/Path, both in the
-// map frame, which is the navigation's world corrected) at most every map_period_s, the
-// correction map -> odom on /tf after every submap, and the latest anchor's pose with its
-// covariance (the covariance at most 5 % of the mapping thread).
+// map frame, which is the navigation's world corrected) at most every map_period_s and within
+// 10 % of the mapping thread, the correction map -> odom on /tf after every submap, and the
+// latest anchor's pose with its covariance (the covariance within 5 % of the mapping thread).
 namespace uwscan::ros {
 
 // Frames straight from a camera (Aravis), as `uwscan inspect` reads them, instead of the image
@@ -52,8 +52,10 @@ struct InspectionNodeOptions {
   // The camera's mount is looked up on /tf_static (frames.base_link -> frames.camera) for up to
   // this long before the camera is taken at the vehicle's origin, seconds, >= 0.
   double mount_wait_s = 3.0;
-  double map_period_s = 2.0;  // the map and the paths are published at most this often, s, > 0
-  int frame_queue = 4096;     // frames roscpp holds while the node is busy, > 0
+  // The map and the paths are published at most this often, s, > 0; less often when they take
+  // over a tenth of the time between them (late in long dives).
+  double map_period_s = 2.0;
+  int frame_queue = 4096;                   // frames roscpp holds while the node is busy, > 0
   scanner::StripeDetectorOptions detector;  // how image-mode frames are searched
   bool keep_images = false;                 // image-mode frames: log the images with the peaks
   mapping::InspectionOptions inspection;    // fixed_scanner is set false (navigation comes)

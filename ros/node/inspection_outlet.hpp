@@ -18,6 +18,7 @@
 #include "ros/node/inspection_node.hpp"
 #include "ros/node/latency_by_minute.hpp"
 #include "ros/node/map_publisher.hpp"
+#include "ros/node/thread_share.hpp"
 
 namespace uwscan::ros::inspection_detail {
 
@@ -48,7 +49,8 @@ class Outlet {
         options_(o),
         origin_s_(time_origin_s),
         frames_per_sweep_(frames_per_sweep),
-        live_map_(o.inspection.map_voxel_m) {
+        live_map_(o.inspection.map_voxel_m),
+        map_share_(0.1, o.map_period_s) {
     const RosTopics& t = o.topics;
     sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
     map_ =
@@ -81,12 +83,16 @@ class Outlet {
     const mapping::TimedPose slam{time_s, m.pose(last)},
         navigation{time_s, m.submap(last).T_W_V_nav};
     PublishCorrection(slam, navigation);
-    if (CovarianceDue()) PublishPose(m, slam);
-    // The paths and the map hold the whole dive: published at most every map_period_s.
-    if (!last_map_ || SecondsSince(*last_map_) >= options_.map_period_s) {
+    if (pose_share_.Due(Now())) {
+      const double start_s = Now();
+      PublishPose(m, slam);
+      pose_share_.Done(start_s, Now());
+    }
+    if (map_share_.Due(Now())) {
+      const double start_s = Now();
       PublishPaths(m);
       map_->Submit(live_map_.Build(m), Stamp(time_s, options_.frames.map));
-      last_map_ = Clock::now();
+      map_share_.Done(start_s, Now());
     }
   }
 
@@ -115,6 +121,7 @@ class Outlet {
   std::vector<MinuteLatency> SweepLatencyByMinute() const { return latency_by_minute_.Minutes(); }
 
  private:
+  double Now() const { return SecondsSince(start_); }  // steady
   Header Stamp(double time_s, const std::string& frame) const {
     return {origin_s_ + time_s, frame};
   }
@@ -162,21 +169,8 @@ class Outlet {
                  std::vector<TransformMessage>{{Stamp(slam.time_s, f.map), f.odom, T_map_odom}});
   }
 
-  // The newest anchor's marginal covariance comes from the whole graph's information, a cost
-  // that grows with the dive (its selected inverse alone: 1.6 s at the end of a 30-minute one,
-  // bench/slam/RESULTS.md): it is computed after a submap
-  // only once kPoseCpuShare of the time since the last one would have paid for that one, so that
-  // the pose takes a bounded share of the mapping thread and comes less often late in long dives.
-  bool CovarianceDue() const {
-    constexpr double kPoseCpuShare = 0.05;
-    return !last_covariance_ || SecondsSince(*last_covariance_) * kPoseCpuShare >= covariance_s_;
-  }
-
   void PublishPose(const mapping::Mapper& m, const mapping::TimedPose& newest) {
-    const Clock::time_point start = Clock::now();
     const std::optional<mapping::Mapper::SubmapCovariances> c = m.Covariances();
-    covariance_s_ = SecondsSince(start);
-    last_covariance_ = Clock::now();
     if (!c) return;
     ros_.Publish(pose_id_, PoseMessage{Stamp(newest.time_s, options_.frames.map), Out(newest.T_W_V),
                                        WorldCovarianceInNavigationAxes(
@@ -207,10 +201,15 @@ class Outlet {
   Clock::time_point start_ = Clock::now();
   Eigen::Isometry3d T_W_C_last_ = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3d> sweep_points_W_;
-  std::optional<Clock::time_point> last_map_;
   mapping::LiveMap live_map_;
-  std::optional<Clock::time_point> last_covariance_;
-  double covariance_s_ = 0.0;  // what the last covariance took
+  // Both grow with the dive; each takes a bounded share of the mapping thread (ThreadShare). The
+  // newest anchor's marginal covariance comes from the whole graph's information (its selected
+  // inverse alone: 1.6 s at the end of a 30-minute dive, bench/slam/RESULTS.md): on short dives
+  // after every submap, late in long ones every half minute or so. The paths and the map hold the
+  // whole dive, and the live map merges again for each map what the solves moved since the last
+  // one (up to every submap a loop may free): at most every map_period_s.
+  ThreadShare pose_share_{0.05, 0.0};
+  ThreadShare map_share_;
   std::atomic<std::int64_t> sweeps_{0};
   std::unique_ptr<MapPublisher> map_;
 };
