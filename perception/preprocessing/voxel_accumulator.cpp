@@ -38,12 +38,12 @@ void VoxelAccumulator::Add(const PointCloud& cloud, const Eigen::Isometry3d& T) 
     }
     const std::uint32_t id = voxels_.Insert(key);
     // resize, not emplace_back: a failed allocation leaves no id without its sum.
+    const auto depth = static_cast<std::uint8_t>(marks_.size());
     if (id >= sums_.size()) {
       sums_.resize(id + std::size_t{1});
-      saved_depth_.resize(sums_.size(), 0);
+      saved_depth_.resize(sums_.size(), depth);
     }
     Sum& voxel = sums_[id];
-    const auto depth = static_cast<std::uint8_t>(mark_starts_.size());
     if (saved_depth_[id] < depth) {
       saved_.push_back({id, saved_depth_[id], voxel});
       saved_depth_[id] = depth;
@@ -78,7 +78,7 @@ std::vector<std::uint32_t> VoxelAccumulator::IdsByKey() const {
 }
 
 void VoxelAccumulator::OrderByKey() {
-  assert(mark_starts_.empty());
+  assert(marks_.empty());
   if (key_ordered_ == voxels_.size()) return;
   // In place: a copy of the whole map is what a live map must not need.
   const std::vector<std::uint32_t> old_ids = IdsByKey();
@@ -88,27 +88,23 @@ void VoxelAccumulator::OrderByKey() {
 }
 
 void VoxelAccumulator::Mark() {
-  if (mark_starts_.size() == 255) throw Error("VoxelAccumulator: more than 255 marks");
-  mark_starts_.push_back(saved_.size());
+  if (marks_.size() == 255) throw Error("VoxelAccumulator: more than 255 marks");
+  marks_.push_back({saved_.size(), static_cast<std::uint32_t>(voxels_.size())});
 }
 
 void VoxelAccumulator::Undo() {
-  assert(!mark_starts_.empty());
-  // Newest first, so that a voxel the mark added is the newest key when it is taken out.
-  for (std::size_t i = saved_.size(); i-- > mark_starts_.back();) {
-    const Saved& s = saved_[i];
-    saved_depth_[s.id] = s.depth;
-    if (s.sum.count > 0) {
-      sums_[s.id] = s.sum;
-      continue;
-    }
-    assert(s.id + std::size_t{1} == voxels_.size());
-    voxels_.RemoveNewest();
-    sums_.pop_back();
-    saved_depth_.pop_back();
+  assert(!marks_.empty());
+  const MarkState mark = marks_.back();
+  for (std::size_t i = mark.first_saved; i < saved_.size(); ++i) {
+    sums_[saved_[i].id] = saved_[i].sum;
+    saved_depth_[saved_[i].id] = saved_[i].depth;
   }
-  saved_.resize(mark_starts_.back());
-  mark_starts_.pop_back();
+  saved_.resize(mark.first_saved);
+  // Newest first: the only order in which VoxelIndex takes keys out.
+  while (voxels_.size() > mark.voxels) voxels_.RemoveNewest();
+  sums_.resize(mark.voxels);
+  saved_depth_.resize(mark.voxels);
+  marks_.pop_back();
   assert(key_ordered_ <= voxels_.size());  // ordered before any mark, so never taken out
 }
 

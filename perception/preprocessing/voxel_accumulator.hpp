@@ -25,11 +25,11 @@ class VoxelAccumulator {
 
   // Marks the state that Undo returns to, bit for bit: what a live map needs to add the part of
   // a dive that may still move, publish, and take that part out again without a copy of the whole
-  // map. Marks nest (at most 255): Undo returns to the newest and drops it. Each mark keeps every
-  // voxel's sum before the mark's first change to it.
+  // map. Marks nest (at most 255): Undo returns to the newest and drops it. Each mark keeps the
+  // sum of every voxel it changed as it was before, and takes the voxels it made out again.
   void Mark();
   void Undo();  // requires a mark
-  std::size_t marks() const { return mark_starts_.size(); }
+  std::size_t marks() const { return marks_.size(); }
   // Numbers the voxels in key order, so that Cloud() sorts only the voxels added afterwards.
   // Requires no mark (the kept sums are by voxel number).
   void OrderByKey();
@@ -42,7 +42,7 @@ class VoxelAccumulator {
   struct Saved {
     std::uint32_t id;
     std::uint8_t depth;  // saved_depth_[id] before it was saved here
-    Sum sum;             // count 0: the voxel was new
+    Sum sum;
   };
   // Every voxel id in key order: the key-ordered ones [0, key_ordered_) merged with the rest.
   std::vector<std::uint32_t> IdsByKey() const;
@@ -52,9 +52,13 @@ class VoxelAccumulator {
   VoxelIndex voxels_;
   std::vector<Sum> sums_;          // by voxel id
   std::uint32_t key_ordered_ = 0;  // ids below it are numbered in key order
-  // saved_[mark_starts_[m] ..] were saved under mark m (depth m + 1). A voxel is saved under the
-  // newest mark once: when its saved_depth_ is below that mark's depth.
-  std::vector<std::size_t> mark_starts_;
+  struct MarkState {
+    std::size_t first_saved;  // saved_[first_saved ..] were saved under this mark
+    std::uint32_t voxels;     // voxel_count() at the mark: newer voxels are taken out, not saved
+  };
+  // An older voxel is saved under the newest mark once: when its saved_depth_ is below that
+  // mark's depth (its place in marks_ + 1). A voxel is new at the depth it was made at.
+  std::vector<MarkState> marks_;
   std::vector<Saved> saved_;
   std::vector<std::uint8_t> saved_depth_;  // by voxel id
 };
