@@ -138,26 +138,27 @@ std::vector<char> FacingTheSensor(const CorePoints& core, const Survey& referenc
   return visible;
 }
 
-// Each map point placed by its tile's transform (the global one outside the tiles).
+// Each map point placed by the tiles around it (the global transform outside the tiles).
 PointCloud AlignedMap(const PointCloud& map, const SurveyAlignment& alignment) {
   std::vector<Eigen::Vector3d> points(map.size());
-  for (std::size_t i = 0; i < map.size(); ++i)
-    points[i] = alignment.TransformOf(map.Point(i)) * map.Point(i);
+  for (std::size_t i = 0; i < map.size(); ++i) points[i] = alignment.Place(map.Point(i));
   return perception::MakeCloud(points);
 }
 
 // The groups AddGroupSpread measures: per registration tile (one for the whole map without
 // tiles), the surfaces facing up (within 30 degrees: seabed, tops) apart from the rest (flanks
-// of pipes, walls, the sides of objects), which the surveys place less reproducibly.
-std::vector<long> SpreadGroups(const SurveyComparison& c,
-                               const Eigen::Isometry3d& T_map_reference) {
+// of pipes, walls, the sides of objects), which the surveys place less reproducibly, and the
+// surface near an edge apart from the whole (AtSurfaceEdge).
+std::vector<long> SpreadGroups(const SurveyComparison& c, const Eigen::Isometry3d& T_map_reference,
+                               double edge_radius_m) {
+  const std::vector<char> edge = AtSurfaceEdge(c.deviations, edge_radius_m);
   std::vector<long> group_of(c.deviations.size(), -1);
   for (std::size_t i = 0; i < c.deviations.size(); ++i) {
     const CoreDeviation& d = c.deviations[i];
     const SurveyAlignment::Tile* tile = c.alignment.TileOf(T_map_reference * d.point_W);
     const long tile_index = tile ? static_cast<long>(tile - c.alignment.tiles.data()) : -1;
     const bool up = -d.normal_W.z() > std::cos(M_PI / 6);  // NED: up is -z
-    group_of[i] = 2 * (tile_index + 1) + (up ? 0 : 1);
+    group_of[i] = 4 * (tile_index + 1) + 2 * edge[i] + (up ? 0 : 1);
   }
   return group_of;
 }
@@ -263,7 +264,7 @@ SurveyComparison CompareSurveys(const Survey& map, const Survey& reference,
     RemoveLocalOffsets(result.deviations, deviation.local_offset_radius_m,
                        deviation.max_normal_angle_rad);
   }
-  AddGroupSpread(result.deviations, SpreadGroups(result, T_map_reference),
+  AddGroupSpread(result.deviations, SpreadGroups(result, T_map_reference, deviation.edge_radius_m),
                  TwoSidedQuantile(deviation.confidence));
   result.core_spacing_m = deviation.core_spacing_m;
   result.regions = FindChangeRegions(result.deviations, result.core_spacing_m, options.regions,

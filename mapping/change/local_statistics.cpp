@@ -101,6 +101,36 @@ void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
   for (std::size_t i = 0; i < deviations.size(); ++i) deviations[i].deviation_m -= offsets[i];
 }
 
+std::vector<char> AtSurfaceEdge(const std::vector<CoreDeviation>& deviations, double radius_m) {
+  // A disc missing 15 % of its area is cut by an edge about 0.6 radii from its centre.
+  constexpr double kWholeShare = 0.85;
+  if (!(radius_m > 0.0)) throw Error("AtSurfaceEdge: radius_m must be > 0");
+  std::vector<std::size_t> inspected;
+  for (std::size_t i = 0; i < deviations.size(); ++i)
+    if (deviations[i].status != SurfaceStatus::kNotInspected) inspected.push_back(i);
+  std::vector<char> edge(deviations.size(), 0);
+  if (inspected.empty()) return edge;
+  const Eigen::Vector3d origin = deviations[inspected.front()].point_W;
+  std::vector<Eigen::Vector3f> points;
+  for (std::size_t i : inspected) points.push_back((deviations[i].point_W - origin).cast<float>());
+  const perception::RadiusGrid grid(points, radius_m);
+  std::vector<double> counts(points.size());
+#pragma omp parallel
+  {
+    std::vector<std::uint32_t> found;
+    std::vector<float> d2;
+#pragma omp for schedule(static)
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      grid.Query(points[k], found, d2);
+      counts[k] = static_cast<double>(found.size());
+    }
+  }
+  std::vector<double> sorted = counts;
+  const double whole = kWholeShare * MedianOf(sorted);
+  for (std::size_t k = 0; k < points.size(); ++k) edge[inspected[k]] = counts[k] < whole;
+  return edge;
+}
+
 void AddGroupSpread(std::vector<CoreDeviation>& deviations, const std::vector<long>& group_of,
                     double z) {
   std::map<long, std::vector<std::size_t>> groups;

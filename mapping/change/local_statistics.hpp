@@ -18,6 +18,14 @@ namespace uwscan::mapping {
 void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
                         double max_normal_angle_rad);
 
+// Whether each core point lies near an edge of the compared surface: inspected, with fewer than
+// 85 % of the median count of inspected core points within radius_m (an edge within about 0.6
+// radii) because a swath ends there, a shadow or a hole begins, or the reference stops. The last
+// centimetres of a swath are where the two surveys agree least (on the change bench 12 % of the
+// unchanged points within 3 cm of an edge fell in false regions, against 1.4 % elsewhere), so
+// they form spread groups of their own (AddGroupSpread). radius_m > 0.
+std::vector<char> AtSurfaceEdge(const std::vector<CoreDeviation>& deviations, double radius_m);
+
 // Adds to each inspected core point's level of detection the spread of its group's deviations
 // that their own levels do not explain: the robust spread (the third quartile of the absolute
 // deviations from their median, over 1.1503, its value for a Gaussian of unit sigma) squared, less

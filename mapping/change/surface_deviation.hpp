@@ -38,6 +38,9 @@ struct DeviationOptions {
   // radius (RemoveLocalOffsets; metres, >= 0, 0 = off): changes up to about this size across
   // keep their depth.
   double local_offset_radius_m = 0.2;
+  // Core points with an edge of the inspected surface within about 0.6 times this radius (a
+  // swath's end, a shadow) have their own spread of deviations (AtSurfaceEdge), metres, > 0.
+  double edge_radius_m = 0.05;
   double confidence = 0.95;  // two-sided, of the level of detection, in (0, 1)
   int threads = 0;  // OpenMP threads, 0 = OpenMP's default; the result does not depend on it
   void Check() const;

@@ -200,20 +200,63 @@ const SurveyAlignment::Tile* SurveyAlignment::TileOf(const Eigen::Vector3d& p_ma
   return it != tiles.end() && it->key == key ? &*it : nullptr;
 }
 
-Eigen::Isometry3d SurveyAlignment::TransformOf(const Eigen::Vector3d& p_map) const {
-  const Tile* tile = TileOf(p_map);
-  return tile ? tile->T_reference_map : T_reference_map;
+namespace {
+
+// A tile's share in placing a point (BlendedTiles).
+struct TileWeight {
+  const SurveyAlignment::Tile* tile;
+  double weight;
+};
+
+// The existing tiles among the eight whose centres surround p_map, with trilinear weights
+// renormalised to sum to 1 over them (empty when none of the eight exists).
+std::vector<TileWeight> BlendedTiles(const SurveyAlignment& a, const Eigen::Vector3d& p_map) {
+  std::vector<TileWeight> blend;
+  if (a.tiles.empty()) return blend;
+  const Eigen::Vector3d u = p_map / a.tile_m - Eigen::Vector3d::Constant(0.5);
+  const Eigen::Vector3d base = u.array().floor();
+  const Eigen::Vector3d f = u - base;
+  double total = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    Eigen::Vector3d centre_m, weight;
+    for (int axis = 0; axis < 3; ++axis) {
+      const int step = (corner >> axis) & 1;
+      centre_m(axis) = (base(axis) + step + 0.5) * a.tile_m;
+      weight(axis) = step ? f(axis) : 1.0 - f(axis);
+    }
+    const double w = weight.prod();
+    if (w <= 0.0) continue;
+    if (const SurveyAlignment::Tile* tile = a.TileOf(centre_m)) {
+      blend.push_back({tile, w});
+      total += w;
+    }
+  }
+  for (TileWeight& t : blend) t.weight /= total;
+  return blend;
+}
+
+}  // namespace
+
+Eigen::Vector3d SurveyAlignment::Place(const Eigen::Vector3d& p_map) const {
+  const std::vector<TileWeight> blend = BlendedTiles(*this, p_map);
+  if (blend.empty()) return T_reference_map * p_map;
+  Eigen::Vector3d placed = Eigen::Vector3d::Zero();
+  for (const TileWeight& t : blend) placed += t.weight * (t.tile->T_reference_map * p_map);
+  return placed;
 }
 
 double SurveyAlignment::SigmaAlongNormal(const Eigen::Vector3d& p_map,
                                          const Eigen::Vector3d& q_reference,
                                          const Eigen::Vector3d& normal_W) const {
-  const Tile* tile = TileOf(p_map);
-  if (!tile || !tile->registered) return 0.0;
-  const Eigen::Vector3d lever = q_reference - tile->origin_W;
-  Eigen::Matrix<double, 1, 6> j;
-  j << lever.cross(normal_W).transpose(), normal_W.transpose();
-  return std::sqrt(std::max(0.0, static_cast<double>(j * tile->covariance * j.transpose())));
+  double variance = 0.0;
+  for (const TileWeight& t : BlendedTiles(*this, p_map)) {
+    if (!t.tile->registered) continue;
+    const Eigen::Vector3d lever = q_reference - t.tile->origin_W;
+    Eigen::Matrix<double, 1, 6> j;
+    j << lever.cross(normal_W).transpose(), normal_W.transpose();
+    variance += t.weight * t.weight * std::max(0.0, (j * t.tile->covariance * j.transpose())(0));
+  }
+  return std::sqrt(variance);
 }
 
 SurveyAlignment AlignSurveys(const PointCloud& map, const PointCloud& reference,

@@ -53,12 +53,19 @@ struct SurveyAlignment {
   std::vector<Tile> tiles;  // sorted by key
   int tiles_kept_global = 0;
 
-  // The transform and covariance that place map point p_W (map frame), and the standard
-  // deviation of that placement along normal_W (reference frame).
+  // The tile map point p_map lies in (nullptr outside every tile).
   const Tile* TileOf(const Eigen::Vector3d& p_map) const;
+  // Map point p_map placed on the reference. Each tile's transform holds at its centre; between
+  // centres the transforms of the tiles around the point (those that exist) are blended with
+  // trilinear weights, so the placement has no step at a tile's border, where two independent
+  // registrations meet (a step of a millimetre there would read as a change along the border).
+  // The global transform where no tile is near.
+  Eigen::Vector3d Place(const Eigen::Vector3d& p_map) const;
+  // The standard deviation along normal_W (reference frame) of that placement at q_reference:
+  // the blended tiles' registrations are independent, so their variances add with the squared
+  // weights.
   double SigmaAlongNormal(const Eigen::Vector3d& p_map, const Eigen::Vector3d& q_reference,
                           const Eigen::Vector3d& normal_W) const;
-  Eigen::Isometry3d TransformOf(const Eigen::Vector3d& p_map) const;
 };
 
 // Registers the map onto the reference (which needs normals). Throws uwscan::Error when the
