@@ -185,6 +185,7 @@ void SurveyAlignmentOptions::Check() const {
   check.Positive("tile_point_sigma_m", tile_point_sigma_m, "m");
   check.AtLeast("min_tile_points", min_tile_points, 3);
   check.Positive("source_voxel_m", source_voxel_m, "m");
+  check.Positive("global_voxel_m", global_voxel_m, "m");
   check.Require(!T_reference_map || T_reference_map->matrix().allFinite(), "T_reference_map",
                 "a finite transform");
 }
@@ -263,7 +264,8 @@ SurveyAlignment AlignSurveys(const PointCloud& map, const PointCloud& reference,
                              const SurveyAlignmentOptions& options) {
   options.Check();
   const PointCloud source = perception::VoxelDownsample(map, {.leaf_m = options.source_voxel_m});
-  SurveyAlignment alignment = AlignGlobally(source, reference, options);
+  SurveyAlignment alignment = AlignGlobally(
+      perception::VoxelDownsample(map, {.leaf_m = options.global_voxel_m}), reference, options);
   if (options.tile_m == 0.0) return alignment;
   alignment.tile_m = options.tile_m;
   std::map<Key, std::vector<std::size_t>> by_tile;
