@@ -8,7 +8,6 @@
 #include <cmath>
 #include <functional>
 #include <map>
-#include <set>
 
 #include "perception/cloud/cloud_neighbors.hpp"
 #include "scanner/common/error.hpp"
@@ -35,23 +34,25 @@ double QuantileOf(std::vector<double>& values, double q) {
 // |z| of a standard Gaussian at its third quartile: P(|z| < 1.1503) = 0.75.
 constexpr double kGaussianThirdQuartileOfAbs = 1.1503;
 
-// Calls visit(i, neighbours) for each inspected core point i with its neighbourhood: the
-// inspected core points within radius_m facing the same way, taken from a sample of them one per
-// cell of a grid (a tenth of the radius), so a wide neighbourhood costs a few hundred points, not
-// thousands. In parallel; visit must only write to what belongs to i.
-void ForEachNeighbourhood(
+// The inspected core points sampled one per cell of a grid (a tenth of the radius) and way of
+// facing, so that a wide neighbourhood costs a few hundred points, not thousands: calls
+// visit(s, neighbours) for each sample s with its neighbourhood, the samples within radius_m
+// facing the same way, and returns each core point's sample (-1 where not inspected). What varies
+// over the radius barely changes within a cell, so a core point takes its sample's. In parallel;
+// visit must only write to what belongs to s.
+std::vector<std::ptrdiff_t> ForEachNeighbourhood(
     const std::vector<CoreDeviation>& deviations, double radius_m, double max_normal_angle_rad,
     const std::function<void(std::size_t, const std::vector<std::size_t>&)>& visit) {
   if (!(radius_m > 0.0)) throw Error("local statistics: radius_m must be > 0");
-  std::vector<std::size_t> inspected, sample;
-  for (std::size_t i = 0; i < deviations.size(); ++i)
-    if (deviations[i].status != SurfaceStatus::kNotInspected) inspected.push_back(i);
-  if (inspected.empty()) return;
-  const Eigen::Vector3d origin = deviations[inspected.front()].point_W;
-  const double cell_m = 0.1 * radius_m;
-  std::set<std::array<long, 4>> taken;
+  std::vector<std::ptrdiff_t> sample_of(deviations.size(), -1);
+  std::vector<std::size_t> sample;
   std::vector<Eigen::Vector3f> points;
-  for (std::size_t i : inspected) {
+  std::map<std::array<long, 4>, std::size_t> taken;
+  const double cell_m = 0.1 * radius_m;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < deviations.size(); ++i) {
+    if (deviations[i].status == SurfaceStatus::kNotInspected) continue;
+    if (sample.empty()) origin = deviations[i].point_W;
     const Eigen::Vector3d p = deviations[i].point_W - origin;
     // One per cell and per way of facing (the normal's largest component and its sign): a box's
     // side and the seabed at its foot share cells, not samples.
@@ -61,10 +62,13 @@ void ForEachNeighbourhood(
     const std::array<long, 4> key = {std::lround(std::floor(p.x() / cell_m)),
                                      std::lround(std::floor(p.y() / cell_m)),
                                      std::lround(std::floor(p.z() / cell_m)), facing};
-    if (!taken.insert(key).second) continue;
+    const auto [it, added] = taken.emplace(key, i);
+    sample_of[i] = static_cast<std::ptrdiff_t>(it->second);
+    if (!added) continue;
     sample.push_back(i);
     points.push_back(p.cast<float>());
   }
+  if (sample.empty()) return sample_of;
   const perception::RadiusGrid grid(points, radius_m);
   const double min_cos = std::cos(max_normal_angle_rad);
 #pragma omp parallel
@@ -72,18 +76,19 @@ void ForEachNeighbourhood(
     std::vector<std::uint32_t> found;
     std::vector<float> d2;
     std::vector<std::size_t> neighbours;
-#pragma omp for schedule(dynamic, 256)
-    for (std::size_t k = 0; k < inspected.size(); ++k) {
-      const CoreDeviation& d = deviations[inspected[k]];
-      grid.Query((d.point_W - origin).cast<float>(), found, d2);
+#pragma omp for schedule(dynamic, 64)
+    for (std::size_t k = 0; k < sample.size(); ++k) {
+      const CoreDeviation& d = deviations[sample[k]];
+      grid.Query(points[k], found, d2);
       neighbours.clear();
       for (std::uint32_t j : found) {
         if (deviations[sample[j]].normal_W.dot(d.normal_W) >= min_cos)
           neighbours.push_back(sample[j]);
       }
-      if (!neighbours.empty()) visit(inspected[k], neighbours);
+      visit(sample[k], neighbours);  // never empty: the sample itself is among them
     }
   }
+  return sample_of;
 }
 
 }  // namespace
@@ -91,14 +96,18 @@ void ForEachNeighbourhood(
 void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
                         double max_normal_angle_rad) {
   std::vector<double> offsets(deviations.size(), 0.0);
-  ForEachNeighbourhood(deviations, radius_m, max_normal_angle_rad,
-                       [&](std::size_t i, const std::vector<std::size_t>& neighbours) {
-                         std::vector<double> values;
-                         for (std::size_t n : neighbours)
-                           values.push_back(deviations[n].deviation_m);
-                         offsets[i] = MedianOf(values);
-                       });
-  for (std::size_t i = 0; i < deviations.size(); ++i) deviations[i].deviation_m -= offsets[i];
+  const std::vector<std::ptrdiff_t> sample_of =
+      ForEachNeighbourhood(deviations, radius_m, max_normal_angle_rad,
+                           [&](std::size_t s, const std::vector<std::size_t>& neighbours) {
+                             std::vector<double> values;
+                             for (std::size_t n : neighbours)
+                               values.push_back(deviations[n].deviation_m);
+                             offsets[s] = MedianOf(values);
+                           });
+  for (std::size_t i = 0; i < deviations.size(); ++i) {
+    if (sample_of[i] >= 0)
+      deviations[i].deviation_m -= offsets[static_cast<std::size_t>(sample_of[i])];
+  }
 }
 
 std::vector<char> AtSurfaceEdge(const std::vector<CoreDeviation>& deviations, double radius_m) {
