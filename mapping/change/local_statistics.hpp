@@ -10,11 +10,12 @@ namespace uwscan::mapping {
 // inspected core points whose normals lie within an angle of its own (the same surface, not the
 // pipe beside the seabed), one per cell of a grid a tenth of the radius wide.
 
-// Takes out, at each inspected core point, the median deviation of its neighbourhood: the slowly
-// varying offsets the two surveys' placement errors leave after registration (a millimetre or
-// two at the far edges of a swath, where a small tilt of the sensor moves the surface most). A
-// change covering less than half the neighbourhood keeps its depth; a wider one is taken for an
-// offset and shrinks. The status is not touched. radius_m > 0.
+// Takes out, at each inspected core point, the median deviation of its neighbourhood (that of its
+// cell's sample, which the points of one cell share): the slowly varying offsets the two surveys'
+// placement errors leave after registration (a millimetre or two at the far edges of a swath, where
+// a small tilt of the sensor moves the surface most). A change covering less than half the
+// neighbourhood keeps its depth; a wider one is taken for an offset and shrinks. The status is not
+// touched. radius_m > 0.
 void RemoveLocalOffsets(std::vector<CoreDeviation>& deviations, double radius_m,
                         double max_normal_angle_rad);
 

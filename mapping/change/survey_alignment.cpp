@@ -184,7 +184,7 @@ void SurveyAlignmentOptions::Check() const {
   check.Positive("tile_prior_translation_m", tile_prior_translation_m, "m");
   check.Positive("tile_point_sigma_m", tile_point_sigma_m, "m");
   check.AtLeast("min_tile_points", min_tile_points, 3);
-  check.Positive("source_voxel_m", source_voxel_m, "m");
+  check.Positive("tile_voxel_m", tile_voxel_m, "m");
   check.Positive("global_voxel_m", global_voxel_m, "m");
   check.Require(!T_reference_map || T_reference_map->matrix().allFinite(), "T_reference_map",
                 "a finite transform");
@@ -263,7 +263,7 @@ double SurveyAlignment::SigmaAlongNormal(const Eigen::Vector3d& p_map,
 SurveyAlignment AlignSurveys(const PointCloud& map, const PointCloud& reference,
                              const SurveyAlignmentOptions& options) {
   options.Check();
-  const PointCloud source = perception::VoxelDownsample(map, {.leaf_m = options.source_voxel_m});
+  const PointCloud source = perception::VoxelDownsample(map, {.leaf_m = options.tile_voxel_m});
   SurveyAlignment alignment = AlignGlobally(
       perception::VoxelDownsample(map, {.leaf_m = options.global_voxel_m}), reference, options);
   if (options.tile_m == 0.0) return alignment;

@@ -27,11 +27,10 @@ struct SurveyAlignmentOptions {
   double tile_prior_rotation_rad = 0.01;
   double tile_prior_translation_m = 0.02;
   double tile_point_sigma_m = 0.001;
-  int min_tile_points = 200;     // a tile with fewer map points keeps the global transform, >= 3
-  double source_voxel_m = 0.01;  // the tiles are registered voxelised at this size, metres, > 0
-  // The whole map is registered voxelised at this size (metres, > 0): the tiles start from it
-  // within their first stage's reach and refine it (on the change bench 2 cm instead of 1 cm took
-  // a quarter of `compare`'s time and changed no detection).
+  int min_tile_points = 200;   // a tile with fewer map points keeps the global transform, >= 3
+  double tile_voxel_m = 0.01;  // the tiles are registered voxelised at this size, metres, > 0
+  // The whole map is registered voxelised at this size (metres, > 0): coarser than the tiles',
+  // since they start from it within their first stage's reach and refine it.
   double global_voxel_m = 0.02;
   void Check() const;
 };
