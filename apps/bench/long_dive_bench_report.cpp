@@ -49,6 +49,7 @@ nlohmann::json RunJson(const bench::LongDiveRun& r) {
           {"loops_missed", r.loops_missed},
           {"registrations_missed", r.registrations_missed},
           {"whole_solves", r.whole_solves},
+          {"whole_solves_beside", r.whole_solves_beside},
           {"window_solves", r.window_solves},
           {"loop_window_solves", r.loop_window_solves},
           {"series",
@@ -77,7 +78,7 @@ void PrintRow(const char* method, const bench::LongDiveRun& r) {
   std::printf(
       "| %s | %.1f / %.1f ms | %.1f / %.1f ms | %.0f / %.0f MB | %.0f MB | %.0f / %.0f MB | %.1fx "
       "| "
-      "%.1f mm | %.2f mm | %d (%d, %d) | %d + %d (%d back to a loop) |\n",
+      "%.1f mm | %.2f mm | %d (%d, %d) | %d (%d beside) + %d (%d back to a loop) |\n",
       method, r.first_tenth.median_s * 1e3, r.first_tenth.p95_s * 1e3, r.last_tenth.median_s * 1e3,
       r.last_tenth.p95_s * 1e3, static_cast<double>(r.rss_bytes_at_start) / 1e6,
       static_cast<double>(r.peak_rss_bytes) / 1e6,
@@ -85,7 +86,7 @@ void PrintRow(const char* method, const bench::LongDiveRun& r) {
       static_cast<double>(r.heap_in_use_bytes_last_tenth) / 1e6,
       static_cast<double>(r.heap_held_bytes_last_tenth) / 1e6, r.real_time_factor, r.ate_m * 1e3,
       r.map_rms_m * 1e3, r.loops_accepted, r.loops_false, r.loops_missed, r.whole_solves,
-      r.window_solves, r.loop_window_solves);
+      r.whole_solves_beside, r.window_solves, r.loop_window_solves);
 }
 
 void PrintStages(const std::string& name, const bench::LongDiveRun& r) {
@@ -132,12 +133,13 @@ void PrintOverSeeds(const std::vector<bench::LongDiveFigures>& dives) {
 
 }  // namespace
 
-void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whole_solves, int seeds,
-                      const std::string& json) {
+void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whole_solves,
+                      double whole_solve_lag_s, int seeds, const std::string& json) {
   bench::LongDiveBenchOptions options;
   options.minutes = minutes;
   options.threads = threads;
   options.whole_solves = whole_solves;
+  options.whole_solve_lag_s = whole_solve_lag_s;
   options.seeds = seeds;
   options.scenes_folder = DataFolder() / "scenes";
   options.table_cache = TableCache();
@@ -151,7 +153,9 @@ void RunLongDiveBench(const std::vector<double>& minutes, int threads, bool whol
       "peak | RSS, last tenth | heap in use / held, last tenth | real time | ATE | map RMS | loops "
       "(false, right ones rejected) | whole + window solves (back to a loop) |\n"
       "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  nlohmann::json out = {{"bench", "slam_long"}, {"dives", nlohmann::json::array()}};
+  nlohmann::json out = {{"bench", "slam_long"},
+                        {"whole_solve_lag_s", whole_solve_lag_s},
+                        {"dives", nlohmann::json::array()}};
   for (const bench::LongDiveFigures& f : dives) {
     std::printf(
         "| %s, seed %llu (%.0f s, %d submaps, dead reckoning ATE %.1f mm) | | | | | | | | | | | "

@@ -30,6 +30,7 @@ struct SlamBenchArgs {
   bool long_dives = false;
   std::vector<double> minutes = {4.0, 15.0, 30.0};
   bool no_whole_solves = false;
+  double whole_solve_lag_s = mapping::MapperOptions{}.whole_solve_lag_s;
 };
 
 nlohmann::json MapJson(const bench::SurfaceDistance& d) {
@@ -281,10 +282,16 @@ void AddSlamBenchCommand(CLI::App& bench) {
       ->check(kPositiveNumber);
   cmd->add_flag("--no-whole-solves", a->no_whole_solves,
                 "with --long: skip the whole-graph solves beside the windowed ones");
+  cmd->add_option("--whole-solve-lag", a->whole_solve_lag_s,
+                  "with --long: seconds of dive after which a whole-graph solve made beside the "
+                  "windowed mapping is applied (0: on the mapping thread, at once)")
+      ->capture_default_str()
+      ->check(kNonNegativeNumber);
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] {
     if (a->long_dives) {
-      RunLongDiveBench(a->minutes, a->threads, !a->no_whole_solves, a->seeds, a->json);
+      RunLongDiveBench(a->minutes, a->threads, !a->no_whole_solves, a->whole_solve_lag_s, a->seeds,
+                       a->json);
     } else {
       RunSlamBench(*a);
     }

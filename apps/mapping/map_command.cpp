@@ -32,6 +32,7 @@ struct MapArgs {
   int sweeps_per_submap = mapping::MapperOptions{}.sweeps_per_submap;
   double max_navigation_gap_s = mapping::MapperOptions{}.max_navigation_gap_s;
   bool whole_graph_solves = false;
+  double whole_solve_lag_s = mapping::MapperOptions{}.whole_solve_lag_s;
   int threads = 0;
 };
 
@@ -165,6 +166,7 @@ mapping::DiveMappingOptions DiveMappingOptionsOf(const MapArgs& a) {
   options.mapper.threads = a.threads;
   options.mapper.max_navigation_gap_s = a.max_navigation_gap_s;
   options.mapper.windowed_solves = !a.whole_graph_solves;
+  options.mapper.whole_solve_lag_s = a.whole_solve_lag_s;
   // Older submaps' clouds wait on disk, so a long dive's memory does not grow with it.
   options.mapper.spill_folder = TemporaryFolder();
   options.table_cache = TableCache();
@@ -206,11 +208,12 @@ void PrintMapWork(const MapArgs& a, const mapping::DiveMapping& m, const mapping
               100.0 * m.calibration.scale_error, 1000.0 * m.calibration.misalignment_rad);
   std::printf(
       "time: triangulation %.2f s, submaps %.2f s, registration %.2f s, loop closures %.2f s, "
-      "graph %.2f s (%d whole solves, %d of the last submaps, %d of them back to a loop)\n",
+      "graph %.2f s (%d whole solves, %d of them beside the dive, %d of the last submaps, %d of "
+      "them back to a loop)\n",
       m.stats.stage_seconds.triangulation_s, m.stats.stage_seconds.submap_s,
       m.stats.stage_seconds.registration_s, m.stats.stage_seconds.loop_s,
-      m.stats.stage_seconds.graph_s, m.stats.whole_solves, m.stats.window_solves,
-      m.stats.loop_window_solves);
+      m.stats.stage_seconds.graph_s, m.stats.whole_solves, m.stats.whole_solves_beside,
+      m.stats.window_solves, m.stats.loop_window_solves);
 }
 
 // What the map is worth: the errors its poses' uncertainty predicts and, for a simulated dive,
@@ -292,6 +295,12 @@ void AddMapCommand(CLI::App& app) {
   cmd->add_flag("--whole-graph-solves", args->whole_graph_solves,
                 "solve the whole pose graph at every loop and every few submaps, not only the last "
                 "submaps and the loop's (slower as the dive grows; the map differs little)");
+  cmd->add_option("--whole-solve-lag", args->whole_solve_lag_s,
+                  "seconds of dive: a long dive's whole-graph solves run beside the mapping and "
+                  "their answers are applied this much later (0: on the mapping thread, at once; "
+                  "online inspection uses 10)")
+      ->capture_default_str()
+      ->check(kNonNegativeNumber);
   cmd->add_option("--threads", args->threads,
                   "threads (0: all cores); the output does not depend on it")
       ->check(kNonNegativeNumber);

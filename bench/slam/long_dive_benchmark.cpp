@@ -67,6 +67,7 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   mapping::DiveMappingOptions map_options;
   map_options.mapper.threads = options.threads;
   map_options.mapper.windowed_solves = windowed;
+  map_options.mapper.whole_solve_lag_s = options.whole_solve_lag_s;
   map_options.mapper.spill_folder = log_path.parent_path();
   map_options.table_cache = options.table_cache;
   omp_set_num_threads(options.threads);
@@ -113,6 +114,7 @@ LongDiveRun MapLongDive(const std::filesystem::path& log_path,
   run.loops_missed = s.loops_missed.value_or(0);
   run.registrations_missed = s.registrations_missed.value_or(0);
   run.whole_solves = m.stats.whole_solves;
+  run.whole_solves_beside = m.stats.whole_solves_beside;
   run.window_solves = m.stats.window_solves;
   run.loop_window_solves = m.stats.loop_window_solves;
   AddTimeSeries(m, run);
@@ -164,6 +166,7 @@ void LongDiveBenchOptions::Check() const {
   for (const double m : minutes) check.Positive("minutes", m);
   check.GreaterThan("threads", threads, 0);
   check.GreaterThan("seeds", seeds, 0);
+  check.NonNegative("whole_solve_lag_s", whole_solve_lag_s, "s");
   check.Require(std::filesystem::is_directory(scenes_folder), "scenes_folder", "a folder",
                 scenes_folder.string());
 }

@@ -22,6 +22,8 @@ struct LongDiveBenchOptions {
   int seeds = 1;  // dives per length, > 0: seed, seed + 1, ... (one seed's drift is one draw)
   int threads = 2;
   bool whole_solves = true;  // also map each dive with whole-graph solves
+  // MapperOptions::whole_solve_lag_s of the windowed mapping (seconds, >= 0).
+  double whole_solve_lag_s = mapping::MapperOptions{}.whole_solve_lag_s;
   std::filesystem::path table_cache;
   void Check() const;
 };
@@ -52,7 +54,7 @@ struct LongDiveRun {
   int loops_missed = 0;  // right loops the chi-square turned away (MapSummary::loops_missed)
   // Right consecutive registrations it turned away (MapSummary::registrations_missed).
   int registrations_missed = 0;
-  int whole_solves = 0, window_solves = 0;
+  int whole_solves = 0, whole_solves_beside = 0, window_solves = 0;
   int loop_window_solves = 0;  // window solves freed back to a correcting loop's older end
   // Over the dive (seconds of dive time): the mean time per submap in each of about 60 stretches,
   // and the resident memory sampled as the frames went by.

@@ -42,7 +42,13 @@ struct InspectionOptions {
   // which must not lose one, keep them, and the live map, which takes the newest frames and
   // skips the rest anyway, gets what is left.
   int mapper_nice = 10;
-  MapperOptions mapper;
+  // Online, a long dive's whole-graph solves run beside the mapping thread
+  // (MapperOptions::whole_solve_lag_s), so that the live map does not stall for seconds.
+  MapperOptions mapper = [] {
+    MapperOptions online;
+    online.whole_solve_lag_s = 10.0;
+    return online;
+  }();
   // Voxel of the map Finish() returns, metres, > 0; also the submaps' (it replaces
   // mapper.clouds.map_voxel_m: the map cannot be finer than its submaps).
   double map_voxel_m = 0.005;

@@ -79,6 +79,17 @@ void ExpectSameBits(const DiveMapping& a, const DiveMapping& b) {
             std::bit_cast<std::uint64_t>(*b.expected_map_error_m));
 }
 
+// The largest distance between two mappings' positions of the same submap (metres).
+double LargestPositionDifference(const DiveMapping& a, const DiveMapping& b) {
+  EXPECT_EQ(a.slam.size(), b.slam.size());
+  double largest_m = 0.0;
+  for (std::size_t i = 0; i < std::min(a.slam.size(), b.slam.size()); ++i) {
+    largest_m =
+        std::max(largest_m, (a.slam[i].T_W_V.translation() - b.slam[i].T_W_V.translation()).norm());
+  }
+  return largest_m;
+}
+
 TEST_F(DiveMappingTest, WithoutDriftTheMapLiesOnTheTruth) {
   scanner::sim::Scene scene = ShortScene();
   scene.effects.navigation_drift.on = false;
@@ -138,19 +149,44 @@ TEST_F(DiveMappingTest, WindowedSolvesMapAsWholeGraphSolvesDo) {
   const DiveMapping whole = MapDive(DiveLogReader(log), options);
   EXPECT_GT(windowed.stats.window_solves, windowed.stats.whole_solves);
   EXPECT_EQ(whole.stats.window_solves, 0);
-  ASSERT_EQ(windowed.slam.size(), whole.slam.size());
-  double largest_m = 0.0;
-  for (std::size_t i = 0; i < whole.slam.size(); ++i) {
-    largest_m =
-        std::max(largest_m,
-                 (windowed.slam[i].T_W_V.translation() - whole.slam[i].T_W_V.translation()).norm());
-  }
+  const double largest_m = LargestPositionDifference(windowed, whole);
   const double ate_whole = AbsoluteTrajectoryError(whole.slam, whole.truth);
   const double ate_windowed = AbsoluteTrajectoryError(windowed.slam, windowed.truth);
   std::printf("largest difference %.2f mm; ATE %.2f mm windowed, %.2f mm whole\n", largest_m * 1e3,
               ate_windowed * 1e3, ate_whole * 1e3);
   EXPECT_LT(largest_m, 0.5 * ate_whole);
   EXPECT_LT(ate_windowed, 1.05 * ate_whole);
+}
+
+// A long dive's whole solves beside the mapping (MapperOptions::whole_solve_lag_s; the short
+// windows make this dive's graph long enough for them): the same bits whether the mapping runs
+// on one thread or two (so however fast it runs against the solving thread), and the same
+// trajectory as whole solves made at once on the mapping thread, to a fraction of its error.
+TEST_F(DiveMappingTest, WholeSolvesBesideTheDiveMapAsThoseMadeAtOnce) {
+  const fs::path log = Simulate(ShortScene(), "drift.db");
+  auto map_with = [&](double lag_s, int threads) {
+    DiveMappingOptions options = Options(threads);
+    options.mapper.solve_window_submaps = 4;
+    options.mapper.solve_window_max_submaps = 8;
+    options.mapper.whole_solve_lag_s = lag_s;
+    return MapDive(DiveLogReader(log), options);
+  };
+  const DiveMapping at_once = map_with(0.0, 2), beside = map_with(2.0, 2),
+                    beside_one_thread = map_with(2.0, 1);
+  EXPECT_EQ(at_once.stats.whole_solves_beside, 0);
+  EXPECT_GE(beside.stats.whole_solves_beside, 3);
+  EXPECT_EQ(beside.stats.whole_solves, at_once.stats.whole_solves);
+  ExpectSameBits(beside, beside_one_thread);
+  const double largest_m = LargestPositionDifference(beside, at_once);
+  const double ate_at_once = AbsoluteTrajectoryError(at_once.slam, at_once.truth);
+  const double ate_beside = AbsoluteTrajectoryError(beside.slam, beside.truth);
+  std::printf(
+      "whole solves %d (%d beside); largest difference %.2f mm; ATE %.2f mm beside, %.2f mm "
+      "at once\n",
+      beside.stats.whole_solves, beside.stats.whole_solves_beside, largest_m * 1e3,
+      ate_beside * 1e3, ate_at_once * 1e3);
+  EXPECT_LT(largest_m, 0.5 * ate_at_once);
+  EXPECT_LT(ate_beside, 1.05 * ate_at_once);
 }
 
 // The clouds of all but the last few submaps, and the graph's measurements among submaps no

@@ -121,6 +121,26 @@ void GraphMeasurements::Add(const Prior& prior) {
   Record(Kind::kPrior, priors.size(), prior.node);
 }
 
+void GraphMeasurements::AddAll(const GraphMeasurements& other) {
+  for (const Entry& entry : other.entries) {
+    const auto at = static_cast<std::size_t>(entry.index);
+    switch (entry.kind) {
+      case Kind::kEdge:
+        Add(other.edges[at]);
+        break;
+      case Kind::kDepth:
+        Add(other.depths[at]);
+        break;
+      case Kind::kGravity:
+        Add(other.gravities[at]);
+        break;
+      case Kind::kPrior:
+        Add(other.priors[at]);
+        break;
+    }
+  }
+}
+
 void GraphMeasurements::Record(Kind kind, std::size_t records_of_kind, int newest_node) {
   const int so_far =
       entries.empty() ? newest_node : std::max(entries.back().newest_so_far, newest_node);

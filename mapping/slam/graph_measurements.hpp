@@ -52,6 +52,8 @@ struct GraphMeasurements {
   void Add(const DepthPrior& depth);
   void Add(const GravityPrior& gravity);
   void Add(const Prior& prior);
+  // Adds every measurement of `other` after these, in its order.
+  void AddAll(const GraphMeasurements& other);
   std::size_t size() const { return entries.size(); }
   // The nodes measurement i touches (-1: none).
   std::array<int, 2> NodesOf(std::size_t i) const;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <future>
 
 #include "mapping/slam/mapper_impl.hpp"
 #include "mapping/slam/navigation_buffer.hpp"
@@ -24,6 +25,7 @@ namespace {
 using mapper_steps::AppendMoved;
 using mapper_steps::Clock;
 using mapper_steps::Since;
+using mapper_steps::SolvedGraph;
 
 // Frames waiting for navigation beyond this many mean the navigation has stopped.
 constexpr std::size_t kMaxWaitingFrames = 20000;
@@ -80,6 +82,7 @@ void MapperOptions::Check() const {
   check.AtLeast("solve_window_max_submaps", solve_window_max_submaps, solve_window_submaps);
   check.AtLeast("loop_window_chi2_per_direction", loop_window_chi2_per_direction, 0.0);
   check.GreaterThan("full_solve_growth", full_solve_growth, 1.0);
+  check.NonNegative("whole_solve_lag_s", whole_solve_lag_s, "s");
   check.GreaterThan("resident_submaps", resident_submaps, local_map_submaps);
   check.InRange("running_solve_tolerance", running_solve_tolerance, 0.0, 1.0, Interval::kOpen);
   check.InRange("weak_direction_ratio", weak_direction_ratio, 0.0, 1.0, Interval::kOpenHigh);
@@ -348,7 +351,8 @@ void Mapper::Impl::AddNodesAndEdges(const Submap& submap, int k, const Consecuti
                     .sigma_rad = noise.roll_pitch_sigma_rad});
 }
 
-// A solve after an accepted loop, else every solve_every_submaps submaps.
+// A solve after an accepted loop, else every solve_every_submaps submaps; a whole solve beside
+// the dive applied when its time has come (or when the next one is due).
 void Mapper::Impl::CloseLoopsAndSolve(int k) {
   const size_t tried_before = loops.size();
   TryLoopClosures(k);
@@ -362,10 +366,76 @@ void Mapper::Impl::CloseLoopsAndSolve(int k) {
     if (loop.accepted && loop.correction_chi2 > corrects)
       oldest_loop = std::min(oldest_loop.value_or(k), loop.from);
   }
-  if (!accepted && ++since_solve < options.solve_every_submaps) return;
-  const int first = FirstFreeSubmap(k, oldest_loop);
+  bool solve = accepted || ++since_solve >= options.solve_every_submaps;
+  if (beside) {
+    if (oldest_loop) beside->oldest_loop = std::min(beside->oldest_loop.value_or(k), *oldest_loop);
+    const double anchor_s = submaps[static_cast<size_t>(k)].anchor_time_s;
+    if (anchor_s >= beside->apply_at_s || FirstFreeSubmap(k, std::nullopt) == 0) {
+      // The loops accepted since it was started were solved against the old poses.
+      if (beside->oldest_loop)
+        oldest_loop = std::min(oldest_loop.value_or(k), *beside->oldest_loop);
+      ApplyWholeSolveBeside();
+      solve = true;
+    }
+  }
+  if (!solve) return;
+  int first = FirstFreeSubmap(k, oldest_loop);
+  if (first == 0 && SolvesBeside(k)) {
+    StartWholeSolveBeside(k);
+    first = FirstFreeSubmap(k, oldest_loop);
+  }
   if (first > 0 && first < FirstFreeSubmap(k, std::nullopt)) ++stats.loop_window_solves;
   Solve(first);
+}
+
+bool Mapper::Impl::SolvesBeside(int k) const {
+  return options.windowed_solves && options.whole_solve_lag_s > 0.0 && !beside &&
+         k + 1 > options.solve_window_max_submaps;
+}
+
+// A copy of the graph solved whole on a thread of its own; the next whole solve is then due as
+// if this one had been made now.
+void Mapper::Impl::StartWholeSolveBeside(int k) {
+  const Clock::time_point start = Clock::now();
+  PoseGraphOptions solve;
+  solve.function_tolerance = options.running_solve_tolerance;
+  beside.emplace();
+  beside->apply_at_s = submaps[static_cast<size_t>(k)].anchor_time_s + options.whole_solve_lag_s;
+  // The copy is made here, where the graph does not grow meanwhile, and freed where it is solved.
+  beside->solved = std::async(std::launch::async, [copy = graph.InMemoryCopy(), solve]() mutable {
+    copy.Solve(solve);
+    SolvedGraph solved{.poses = {}, .calibration = copy.calibration()};
+    for (int node = 0; node < copy.node_count(); ++node) solved.poses.push_back(copy.pose(node));
+    copy = PoseGraph();
+    return solved;
+  });
+  const double grown = options.full_solve_growth * static_cast<double>(submaps.size());
+  next_whole_solve_submaps = static_cast<int>(std::ceil(grown));
+  stats.stage_seconds.graph_s += Since(start);
+}
+
+// Every node the copy held takes its solved pose; the nodes added since keep their place
+// relative to the newest anchor it solved, moved with it. Waits for the solve if it runs still.
+void Mapper::Impl::ApplyWholeSolveBeside() {
+  const Clock::time_point start = Clock::now();
+  {
+    const SolvedGraph solved = beside->solved.get();
+    const int nodes = static_cast<int>(solved.poses.size());
+    // The newest submap's anchor in the copy carries the nodes added since.
+    const Eigen::Isometry3d correction =
+        solved.poses[static_cast<size_t>(nodes - 2)] * graph.pose(nodes - 2).inverse();
+    for (int node = 0; node < graph.node_count(); ++node) {
+      graph.set_pose(node, node < nodes ? solved.poses[static_cast<size_t>(node)]
+                                        : correction * graph.pose(node));
+    }
+    if (graph.estimates_calibration()) graph.set_calibration(solved.calibration);
+  }
+  beside.reset();
+  ReturnFreePages();  // as after a whole solve on this thread (Solve)
+  ++stats.whole_solves;
+  ++stats.whole_solves_beside;
+  PlaceCentres(0, centres.held() - 1);
+  stats.stage_seconds.graph_s += Since(start);
 }
 
 // The first submap a solve after submap k frees (MapperOptions::windowed_solves); 0: the whole
@@ -462,6 +532,7 @@ void Mapper::Finish() {
   m.Drain(true);
   m.CloseSubmap();
   m.finished = true;
+  if (m.beside) m.ApplyWholeSolveBeside();  // the last solve starts from its answer
   if (!m.submaps.empty()) m.Solve(/*first_free_submap=*/0, /*last=*/true);
 }
 

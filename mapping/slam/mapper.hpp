@@ -87,6 +87,17 @@ struct MapperOptions {
   int solve_window_max_submaps = 400;
   double loop_window_chi2_per_direction = 0.5;
   double full_solve_growth = 1.5;
+  // A whole solve of a graph of more than solve_window_max_submaps submaps (seconds of work on a
+  // long dive) runs on a thread of its own, on a copy of the graph, while the dive goes on with
+  // its window solves; its answer is applied at the first submap anchored this many seconds of
+  // dive after the one that called for it (the mapper waits for it there if it is not done yet):
+  // every submap it solved takes its pose, the newer ones keep theirs relative to the newest it
+  // solved, and a window solve back to the oldest correcting loop since ties them together. The
+  // same inputs give the same maps however fast that thread runs. Seconds, >= 0; 0: every whole
+  // solve on the mapping thread, when called for (offline, where the total time counts, not a
+  // stall: on two cores the solving thread slows the mapping by what it takes). Online
+  // inspection and the ROS node use 10 s (InspectionOptions).
+  double whole_solve_lag_s = 0.0;
   // The solves during the dive stop once an iteration lowers the cost by less than this
   // fraction (they only have to predict the next registrations and loops); the last one, in
   // Finish, goes to PoseGraphOptions' default. In (0, 1).
@@ -199,6 +210,7 @@ struct MapperStats {
   int registrations_inconsistent = 0;  // left to odometry alone: too far from the navigation
   MapperStageSeconds stage_seconds;    // summed over the dive so far
   int whole_solves = 0;                // of the whole graph
+  int whole_solves_beside = 0;         // of those, solved beside the dive (whole_solve_lag_s)
   int window_solves = 0;               // of the last submaps only (MapperOptions::windowed_solves)
   int loop_window_solves = 0;          // of those, freed back to a correcting loop's older end
   // Loop closures not tried: the submap's own surface pins two directions fewer than a loop

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <deque>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -38,6 +39,18 @@ inline void AppendMoved(const perception::PointCloud& cloud, const Eigen::Isomet
     if (cloud.has_normals()) out->normals.push_back(R * cloud.normals[i]);
   }
 }
+
+// What a copy of the pose graph solved to, on a thread of its own.
+struct SolvedGraph {
+  std::vector<Eigen::Isometry3d> poses;  // every node the copy held, in order
+  DeadReckoningCalibration calibration;
+};
+// A whole solve running beside the dive (MapperOptions::whole_solve_lag_s).
+struct WholeSolveBeside {
+  std::future<SolvedGraph> solved;  // what the graph's copy solved to (the copy is gone)
+  double apply_at_s = 0.0;          // applied at the first submap anchored this late or later
+  std::optional<int> oldest_loop;   // the older end of the oldest correcting loop since
+};
 
 }  // namespace mapper_steps
 
@@ -93,6 +106,8 @@ struct Mapper::Impl {
   MapperStats stats;
   int since_solve = 0;
   int next_whole_solve_submaps = 0;  // the graph's size at which the next solve is whole
+  // A whole solve running beside the dive (MapperOptions::whole_solve_lag_s).
+  std::optional<mapper_steps::WholeSolveBeside> beside;
 
   Impl(const MapperOptions& o, const Eigen::Isometry3d& mount, const NavigationNoise& noise)
       : options(o),
@@ -174,6 +189,9 @@ struct Mapper::Impl {
                             const Matrix6d& information, const Matrix6d& prediction_covariance,
                             const Vector6d& miss, double* chi2) const;
   int FirstFreeSubmap(int k, std::optional<int> oldest_loop) const;
+  bool SolvesBeside(int k) const;
+  void StartWholeSolveBeside(int k);
+  void ApplyWholeSolveBeside();
   // Solves the submaps from first_free_submap on (0: the whole graph); last: the solve at
   // Finish, to the full tolerance.
   void Solve(int first_free_submap, bool last = false);

@@ -288,6 +288,14 @@ DeadReckoningCalibration PoseGraph::calibration() const {
   return {(*impl_->calibration)[0], (*impl_->calibration)[1]};
 }
 
+void PoseGraph::set_calibration(const DeadReckoningCalibration& calibration) {
+  if (!impl_->calibration)
+    throw Error("pose graph: set_calibration: the calibration is not estimated");
+  if (!std::isfinite(calibration.scale_error) || !std::isfinite(calibration.misalignment_rad))
+    throw Error("pose graph: set_calibration: expected finite values");
+  *impl_->calibration = {calibration.scale_error, calibration.misalignment_rad};
+}
+
 void PoseGraph::AddDepth(const DepthPrior& prior) {
   Impl& m = *impl_;
   m.RequireNode(prior.node, "AddDepth");
@@ -327,6 +335,18 @@ void PoseGraph::RetireBefore(int first_node) {
   m.spill->Append(m.measurements, older);
   m.measurements.DropFirst(older);
   m.retired_before = first_node;
+}
+
+PoseGraph PoseGraph::InMemoryCopy() const {
+  const Impl& m = *impl_;
+  PoseGraph copy;
+  Impl& c = *copy.impl_;
+  c.nodes = m.nodes;
+  if (m.calibration) c.calibration = std::make_unique<std::array<double, 2>>(*m.calibration);
+  c.calibration_prior = m.calibration_prior;
+  if (m.spill) c.measurements = m.spill->ReadAll();
+  c.measurements.AddAll(m.measurements);
+  return copy;
 }
 
 std::int64_t PoseGraph::memory_bytes() const {

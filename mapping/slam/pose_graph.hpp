@@ -96,6 +96,9 @@ class PoseGraph {
   bool estimates_calibration() const;
   // The current estimate (zero until estimated).
   DeadReckoningCalibration calibration() const;
+  // Sets the estimate (e.g. from a solved copy, InMemoryCopy). Throws uwscan::Error when the
+  // graph does not estimate it or a value is not finite.
+  void set_calibration(const DeadReckoningCalibration& calibration);
 
   int node_count() const;
   Eigen::Isometry3d pose(int node) const;
@@ -117,6 +120,12 @@ class PoseGraph {
   // node before first_node is then refused. The nodes' poses stay in memory (56 bytes each).
   // Throws uwscan::Error when the spill file cannot be created or written.
   void RetireBefore(int first_node);
+  // A copy of the graph, its nodes, calibration and every measurement, the spilled ones read back
+  // into memory, with no spill folder: its Solve gives the bits this graph's Solve would give now.
+  // It shares nothing with this graph, so it can be solved on another thread while this one
+  // grows (Mapper's whole solves beside the dive). Throws uwscan::Error when the spill file
+  // cannot be read.
+  PoseGraph InMemoryCopy() const;
   // The bytes the nodes and the measurements in memory take.
   std::int64_t memory_bytes() const;
 

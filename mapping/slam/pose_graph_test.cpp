@@ -10,6 +10,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "mapping/log/dive_log_test_support.hpp"
@@ -325,6 +326,45 @@ TEST_F(PoseGraphSpillTest, RetiredMeasurementsComeBackWithTheSameBitsAndLeaveMem
       static_cast<double>(spilling.memory_bytes() - spilling_memory_half) / (kNodes / 2);
   EXPECT_GT(per_node, 300.0);
   EXPECT_LE(spilling_per_node, 2.0 * 56.0);
+}
+
+// A copy made while the graph spills (its old measurements read back) solves to the bits the
+// graph itself solves to at that moment, on another thread while the graph grows, and the copy
+// sees nothing the graph gets after it was made.
+TEST_F(PoseGraphSpillTest, AnInMemoryCopySolvesToTheBitsOfTheGraphOnAnotherThread) {
+  constexpr int kNodes = 600, kWindow = 100;
+  PoseGraph graph(dir_);
+  GrowingGraph grow(&graph);
+  for (int i = 0; i < kNodes; ++i) {
+    grow.AddNode(i);
+    graph.RetireBefore(i + 1 - kWindow);
+  }
+  PoseGraph copy = graph.InMemoryCopy();
+  std::thread solving([&copy] { copy.Solve({}); });
+  for (int i = kNodes; i < kNodes + 200; ++i) {
+    grow.AddNode(i);
+    graph.RetireBefore(i + 1 - kWindow);
+    if (i % 50 == 49) graph.SolveWindow(i + 1 - 40, {});
+  }
+  solving.join();
+  ASSERT_EQ(copy.node_count(), kNodes);
+  EXPECT_GT(copy.memory_bytes(), graph.memory_bytes());  // every measurement in memory
+  PoseGraph same(dir_ / "same");
+  std::filesystem::create_directories(dir_ / "same");
+  GrowingGraph grow_same(&same);
+  for (int i = 0; i < kNodes; ++i) {
+    grow_same.AddNode(i);
+    same.RetireBefore(i + 1 - kWindow);
+  }
+  same.Solve({});
+  for (int node = 0; node < kNodes; ++node) ExpectSameBits(same.pose(node), copy.pose(node), node);
+  EXPECT_EQ(same.calibration().scale_error, copy.calibration().scale_error);
+  EXPECT_EQ(same.calibration().misalignment_rad, copy.calibration().misalignment_rad);
+  // The graph takes the copy's calibration; one that estimates none refuses it.
+  graph.set_calibration(copy.calibration());
+  EXPECT_EQ(graph.calibration().scale_error, copy.calibration().scale_error);
+  PoseGraph plain;
+  EXPECT_THROW(plain.set_calibration({}), Error);
 }
 
 // The spill is a SpillFile (spill_file_test: nameless, gone with its owner or its process).
