@@ -230,6 +230,7 @@ class LiveMapTest : public DiveMappingTest {
  protected:
   struct Run {
     int compared = 0, last_first_movable = 0;
+    int rebuilding = 0;  // submaps after which the map rebuilt in batches was not complete yet
     MapperStats stats;
   };
   Run CompareLiveMaps(const fs::path& log, const MapperOptions& mapper_options, const char* name) {
@@ -243,6 +244,9 @@ class LiveMapTest : public DiveMappingTest {
     const double voxel_m = DiveMappingOptions{}.map_voxel_m;
     // Settled submaps taken up often; and never, so that only solves move the steady part.
     LiveMap live(voxel_m, 3), live_unsettled(voxel_m, 1000);
+    // After a whole solve the settled part merged anew 3 submaps per Build: the whole map again
+    // once that is done, and meanwhile (rebuilding) never for longer than the batches need.
+    LiveMap live_in_batches(voxel_m, 3, 3);
     for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
     Run run;
     reader.ForEachFrame(
@@ -254,6 +258,12 @@ class LiveMapTest : public DiveMappingTest {
           const std::string when = "after submap " + std::to_string(mapper.submap_count());
           ExpectSameCloud(live.Build(mapper), map, when);
           ExpectSameCloud(live_unsettled.Build(mapper), map, when + " (never settled)");
+          const perception::PointCloud batched = live_in_batches.Build(mapper);
+          if (live_in_batches.rebuilding()) {
+            ++run.rebuilding;
+          } else {
+            ExpectSameCloud(batched, map, when + " (rebuilt in batches)");
+          }
           run.last_first_movable = mapper.FirstMovableSubmap();
           ++run.compared;
         },
@@ -261,6 +271,11 @@ class LiveMapTest : public DiveMappingTest {
     mapper.Finish();
     ExpectSameCloud(live.Build(mapper), mapper.Map(voxel_m), "after Finish");
     ExpectSameCloud(live_unsettled.Build(mapper), mapper.Map(voxel_m), "after Finish");
+    perception::PointCloud batched = live_in_batches.Build(mapper);
+    for (int build = 0; live_in_batches.rebuilding() && build <= mapper.submap_count() / 3; ++build)
+      batched = live_in_batches.Build(mapper);
+    EXPECT_FALSE(live_in_batches.rebuilding());
+    ExpectSameCloud(batched, mapper.Map(voxel_m), "after Finish (rebuilt in batches)");
     run.stats = mapper.stats();
     return run;
   }
@@ -276,6 +291,7 @@ TEST_F(LiveMapTest, TheLiveMapIsTheWholeMapToTheBit) {
   // The dive had what the live map must follow: submaps settled, and whole solves after them.
   EXPECT_GT(whole.last_first_movable, 25);
   EXPECT_GE(whole.stats.whole_solves, 3);
+  EXPECT_GT(whole.rebuilding, 0);
 }
 
 TEST_F(DiveMappingTest, TheCovarianceIsConsistentAndNoLoopIsFalse) {

@@ -7,19 +7,24 @@
 
 namespace uwscan::mapping {
 
-LiveMap::LiveMap(double voxel_m, int settle_batch)
-    : voxel_m_(voxel_m), settle_batch_(settle_batch) {
+LiveMap::LiveMap(double voxel_m, int settle_batch, int rebuild_batch)
+    : voxel_m_(voxel_m), settle_batch_(settle_batch), rebuild_batch_(rebuild_batch) {
   if (!(voxel_m > 0.0)) throw Error("LiveMap: voxel_m must be > 0, got " + std::to_string(voxel_m));
   if (settle_batch < 1)
     throw Error("LiveMap: settle_batch must be > 0, got " + std::to_string(settle_batch));
+  if (rebuild_batch < 0)
+    throw Error("LiveMap: rebuild_batch must be >= 0, got " + std::to_string(rebuild_batch));
 }
 
 perception::PointCloud LiveMap::Build(const Mapper& mapper) {
   if (mapper.submap_count() == 0) return {};
   // Mapper::Map's origin is the first submap's place, which only a whole solve moves once the
   // submap is settled; a whole solve moves every submap merged so far.
-  if (!map_ || mapper.stats().whole_solves != whole_solves_ ||
-      mapper.scan_pose(0).translation() != origin_) {
+  const bool moved = map_ && (mapper.stats().whole_solves != whole_solves_ ||
+                              mapper.scan_pose(0).translation() != origin_);
+  if (moved && rebuild_batch_ > 0) BeginRebuild(mapper);
+  if (rebuild_) ContinueRebuild(mapper);
+  if (!map_ || (moved && rebuild_batch_ == 0)) {
     Restart(mapper);
   } else if (mapper.FirstMovableSubmap() - settled_ >= settle_batch_) {
     Settle(mapper);
@@ -28,6 +33,33 @@ perception::PointCloud LiveMap::Build(const Mapper& mapper) {
   }
   MergeMovable(mapper);
   return map_->Cloud();
+}
+
+void LiveMap::BeginRebuild(const Mapper& mapper) {
+  const int whole_solves = mapper.stats().whole_solves;
+  const Eigen::Vector3d origin = mapper.scan_pose(0).translation();
+  if (rebuild_ && rebuild_->whole_solves == whole_solves && rebuild_->origin == origin) return;
+  rebuild_.emplace(
+      Rebuild{perception::VoxelAccumulator(voxel_m_, origin), whole_solves, origin, 0});
+}
+
+// Restart's work, spread over Builds: the same submaps added in the same order at the same
+// places (settled ones do not move before the next whole solve), so the same map to the bit.
+void LiveMap::ContinueRebuild(const Mapper& mapper) {
+  Rebuild& r = *rebuild_;
+  const int first_movable = mapper.FirstMovableSubmap();
+  for (int n = 0; n < rebuild_batch_ && r.merged < first_movable; ++n, ++r.merged)
+    r.map.Add(mapper.submap_clouds(r.merged)->cloud, mapper.scan_pose(r.merged));
+  if (r.merged < first_movable) return;
+  map_.emplace(std::move(r.map));
+  map_->OrderByKey();
+  map_->Mark();  // steady
+  map_->Mark();  // recent
+  settled_ = steady_ = r.merged;
+  merged_poses_.clear();
+  whole_solves_ = r.whole_solves;
+  origin_ = r.origin;
+  rebuild_.reset();
 }
 
 void LiveMap::Restart(const Mapper& mapper) {

@@ -40,6 +40,11 @@ inline Covariance6d RosCovariance(const mapping::Matrix6d& c) {
   return out;
 }
 
+// After a whole-graph solve the live map's settled part is merged anew this many submaps per map
+// (LiveMap's rebuild_batch): a tenth of a second or so, where all of them at once took seconds
+// late in a long dive, with the sweeps waiting behind.
+constexpr int kLiveMapRebuildBatch = 400;
+
 // Publishes what the mapper makes: sweeps, paths, pose, TF and map.
 class Outlet {
  public:
@@ -49,7 +54,7 @@ class Outlet {
         options_(o),
         origin_s_(time_origin_s),
         frames_per_sweep_(frames_per_sweep),
-        live_map_(o.inspection.map_voxel_m),
+        live_map_(o.inspection.map_voxel_m, /*settle_batch=*/100, kLiveMapRebuildBatch),
         map_share_(0.1, o.map_period_s) {
     const RosTopics& t = o.topics;
     sweep_id_ = ros.Advertise(t.sweeps, RosConnection::Kind::kCloud, false);
