@@ -68,6 +68,8 @@ const char* const kParameterHelp =
     "once they take over a tenth of it), s  [2]\n"
     "  ~voxel_m             map voxel, m                                           [0.005]\n"
     "  ~sweeps_per_submap   sweeps grouped into one submap                          [1]\n"
+    "  ~whole_solve_lag_s   a long dive's whole-graph solves run beside the mapping, applied "
+    "this much dive time later (0: at once, on the mapping thread), s  [10]\n"
     "  ~live_queue          frames waiting for the mapper (a newer frame skips the oldest)  "
     "[1024]\n"
     "  ~frame_queue         frames roscpp holds while the node is busy              [4096]\n"
@@ -118,6 +120,8 @@ ros::InspectionNodeOptions NodeOptions(const ros::RosConnection& ros, const RosI
   o.inspection.map_voxel_m = ros.Param("voxel_m", o.inspection.map_voxel_m);
   o.inspection.mapper.sweeps_per_submap =
       ros.Param("sweeps_per_submap", o.inspection.mapper.sweeps_per_submap);
+  o.inspection.mapper.whole_solve_lag_s =
+      ros.Param("whole_solve_lag_s", o.inspection.mapper.whole_solve_lag_s);
   o.inspection.mapper.spill_folder = TemporaryFolder();
   // On the vehicle every frame should reach SLAM (a skipped frame is a hole in the map), so the
   // live queue absorbs the mapper's pauses at submaps and solves: 1024 frames are 3 s at the
