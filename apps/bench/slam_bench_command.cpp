@@ -13,6 +13,7 @@
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/data_folder.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/malloc_arena.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/progress_bar.hpp"
 #include "bench/slam/slam_benchmark.hpp"
@@ -290,6 +291,7 @@ void AddSlamBenchCommand(CLI::App& bench) {
   cmd->add_option("--json", a->json, "write the figures as JSON");
   cmd->callback([a] {
     if (a->long_dives) {
+      if (a->whole_solve_lag_s > 0.0) UseOneMallocArena();  // as `map` and the online mapping
       RunLongDiveBench(a->minutes, a->threads, !a->no_whole_solves, a->whole_solve_lag_s, a->seeds,
                        a->json);
     } else {

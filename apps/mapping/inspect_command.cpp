@@ -13,6 +13,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/malloc_arena.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/reference_options.hpp"
@@ -207,6 +208,7 @@ void RunInspect(const InspectArgs& a) {
   const std::unique_ptr<mapping::LiveDeviation> reference = LoadReference(a, view);
   const acq::CameraSettings settings = MakeCameraSettings(a.camera);
   const mapping::InspectionOptions options = InspectionOptionsOf(a);
+  if (options.mapper.whole_solve_lag_s > 0.0) UseOneMallocArena();
 
   InstallStopHandlers();
   acq::FrameSource source(settings);

@@ -9,6 +9,7 @@
 
 #include "apps/cli/data_cache.hpp"
 #include "apps/cli/json_output.hpp"
+#include "apps/cli/malloc_arena.hpp"
 #include "apps/cli/number_validators.hpp"
 #include "apps/cli/output_path.hpp"
 #include "apps/cli/progress_bar.hpp"
@@ -242,6 +243,7 @@ void PrintMapAccuracy(const mapping::DiveMapping& m, const mapping::MapSummary& 
 
 void RunMap(const MapArgs& a) {
   CheckMapOutputs(a);
+  if (a.whole_solve_lag_s > 0.0) UseOneMallocArena();
   if (a.threads > 0) omp_set_num_threads(a.threads);
   const mapping::DiveLogReader log(a.log);
   // Refused before anything is mapped or written: a real log has no truth to write.
