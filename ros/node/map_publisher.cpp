@@ -1,7 +1,10 @@
 #include "ros/node/map_publisher.hpp"
 
+#include <optional>
 #include <utility>
 #include <vector>
+
+#include "scanner/common/resident_memory.hpp"
 
 namespace uwscan::ros {
 
@@ -68,16 +71,21 @@ void MapPublisher::Run() {
   while (true) {
     changed_.wait(lock, [this] { return stopping_ || (pending_ && !busy_); });
     if (stopping_) return;
-    Pending next = std::move(*pending_);
+    std::optional<Pending> next = std::move(pending_);
     pending_.reset();
     busy_ = true;
     lock.unlock();
     std::exception_ptr failure;
     try {
-      Publish(next);
+      Publish(*next);
     } catch (...) {
       failure = std::current_exception();
     }
+    // Late in a long dive a map, its message and the message's serialised copy are tens of
+    // megabytes each, freed here between blocks that live on: without giving their pages back the
+    // node's resident memory stayed at the high-water mark of these (bench/ros/RESULTS.md).
+    next.reset();
+    ReturnFreePages();
     lock.lock();
     busy_ = false;
     if (failure) {
@@ -95,13 +103,12 @@ void MapPublisher::Publish(const Pending& p) {
   CloudMessage c;
   c.header = p.header;
   c.points.reserve(p.map_W.size());
-  std::vector<Eigen::Vector3d> points_W;
-  points_W.reserve(p.map_W.size());
   for (std::size_t i = 0; i < p.map_W.size(); ++i) {
-    points_W.push_back(p.map_W.Point(i));
-    c.points.push_back(WorldPointInNavigationAxes(points_W.back(), axes_).cast<float>());
+    c.points.push_back(WorldPointInNavigationAxes(p.map_W.Point(i), axes_).cast<float>());
   }
   if (reference_) {
+    std::vector<Eigen::Vector3d> points_W(p.map_W.size());
+    for (std::size_t i = 0; i < p.map_W.size(); ++i) points_W[i] = p.map_W.Point(i);
     c.scalar_name = "deviation";
     c.scalars = reference_->Deviations(points_W);
   }
