@@ -203,12 +203,13 @@ void PrintInspectSummary(const InspectArgs& a, const ReadSummary& read,
 
 void RunInspect(const InspectArgs& a) {
   CheckInspectArgs(a);
+  const mapping::InspectionOptions options = InspectionOptionsOf(a);
+  // Before the reference's normals or the camera start any thread.
+  if (options.mapper.whole_solve_lag_s > 0.0) UseOneMallocArena();
   const bool view = a.view || !a.screenshot.empty();
   if (view) viewer::RequireDisplay();  // before the camera, not after the dive
   const std::unique_ptr<mapping::LiveDeviation> reference = LoadReference(a, view);
   const acq::CameraSettings settings = MakeCameraSettings(a.camera);
-  const mapping::InspectionOptions options = InspectionOptionsOf(a);
-  if (options.mapper.whole_solve_lag_s > 0.0) UseOneMallocArena();
 
   InstallStopHandlers();
   acq::FrameSource source(settings);
