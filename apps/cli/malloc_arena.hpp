@@ -12,4 +12,16 @@ namespace uwscan::app {
 // ignore the setting: then its own policy stands, which costs memory, not correctness.
 void UseOneMallocArena();
 
+// Serves every block of at least kLargeBlockBytes from pages of its own (glibc's
+// M_MMAP_THRESHOLD, fixed), given back to the system when it is freed. For the ROS node, whose map
+// publications late in a long dive allocate and free tens of megabytes each (the map's cloud, its
+// message, the serialised copy): in the heap, their freed pages stayed resident between blocks
+// that live on, and the node's memory grew with the map (bench/ros/RESULTS.md, "Large blocks on
+// pages of their own": flat from minute 6 of the 30-minute soak, as with malloc_trim after each
+// publication, without its walk of the heap under the arena's lock). glibc's own threshold would
+// rise to each such block's size when it is freed, up to 32 MB, and serve the next ones from the
+// heap again. Call before the command starts threads.
+constexpr int kLargeBlockBytes = 4 << 20;
+void MapLargeBlocksAlone();
+
 }  // namespace uwscan::app

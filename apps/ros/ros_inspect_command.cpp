@@ -212,8 +212,10 @@ void RunRosInspect(const RosInspectArgs& a) {
   if (!a.json.empty()) CheckOutputPath(a.json, "--json");
   CheckRosArguments(a.ros_arguments);
   // Before ROS starts its threads; the whole-graph solves are beside the mapping unless
-  // ~whole_solve_lag_s is 0, and one arena costs nothing measurable then.
+  // ~whole_solve_lag_s is 0, and one arena costs nothing measurable then. The map's publications
+  // free large buffers all through the dive.
   UseOneMallocArena();
+  MapLargeBlocksAlone();
   InstallStopHandlers();
   ros::RosConnection ros("uwscan_inspection", a.ros_arguments, a.master_wait_s);
   const ros::InspectionNodeOptions options = NodeOptions(ros, a);

@@ -4,8 +4,6 @@
 #include <utility>
 #include <vector>
 
-#include "scanner/common/resident_memory.hpp"
-
 namespace uwscan::ros {
 
 MapPublisher::MapPublisher(RosConnection& ros, int map_id, NavigationAxes axes,
@@ -81,11 +79,7 @@ void MapPublisher::Run() {
     } catch (...) {
       failure = std::current_exception();
     }
-    // Late in a long dive a map, its message and the message's serialised copy are tens of
-    // megabytes each, freed here between blocks that live on: without giving their pages back the
-    // node's resident memory stayed at the high-water mark of these (bench/ros/RESULTS.md).
     next.reset();
-    ReturnFreePages();
     lock.lock();
     busy_ = false;
     if (failure) {
