@@ -17,6 +17,7 @@
 
 #include "mapping/log/dive_log.hpp"
 #include "perception/cloud/cloud_io.hpp"
+#include "perception/cloud/point_cloud.hpp"
 #include "tests/cli_run.hpp"
 
 namespace {
@@ -307,6 +308,15 @@ TEST(CliRos, NodeMapsAPlayedBagAsMapDoesOffline) {
   EXPECT_EQ(Dump(published["/uwscan/map"]["type"]), Dump("sensor_msgs/PointCloud2"));
   EXPECT_EQ(Dump(published["/uwscan/map"]["last_fields"]),
             Dump(nlohmann::json::array({"x", "y", "z"})));
+  // The last map published (the publishing thread's, after the maps of the dive) is the map
+  // written (NED axes: the same coordinates).
+  EXPECT_GT(published["/uwscan/map"]["count"].get<int>(), 1);
+  EXPECT_EQ(Dump(published["/uwscan/map"]["last_points"]), Dump(node_map.size()));
+  const Eigen::Vector3d node_map_centroid = uwscan::perception::Centroid(node_map);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(published["/uwscan/map"]["last_centroid"][k].get<double>(), node_map_centroid(k),
+                1e-4);
+  }
   EXPECT_EQ(Dump(published["/uwscan/pose"]["type"]),
             Dump("geometry_msgs/PoseWithCovarianceStamped"));
   const nlohmann::json& transforms =

@@ -3,8 +3,8 @@
 and prints one JSON line per topic: type, message count, first and last header stamp, frame ids
 seen, whether header stamps never go back, and for some types what they hold (the last path's
 positions, the last marker array's labels, every pose's position, the last cloud's point
-count and fields (and the share of finite values of a "deviation" field) and the last pose
-array's size). Used by tests/cli_ros_test.cpp."""
+count, fields and centroid (and the share of finite values of a "deviation" field) and the last
+pose array's size). Used by tests/cli_ros_test.cpp."""
 import json
 import sys
 
@@ -15,6 +15,7 @@ from sensor_msgs import point_cloud2
 def main():
     bag = rosbag.Bag(sys.argv[1])
     topics = {}
+    last_clouds = {}
     for topic, message, _ in bag.read_messages():
         entry = topics.setdefault(topic, {"type": message._type, "count": 0, "frame_ids": [],
                                           "first_stamp": None, "last_stamp": None, "ordered": True,
@@ -44,6 +45,7 @@ def main():
         if message._type == "sensor_msgs/PointCloud2":
             entry["last_points"] = message.width * message.height
             entry["last_fields"] = [f.name for f in message.fields]
+            last_clouds[topic] = message
             if "deviation" in entry["last_fields"]:
                 values = [v[0] for v in point_cloud2.read_points(message, field_names=["deviation"])]
                 finite = [v for v in values if v == v]
@@ -54,6 +56,10 @@ def main():
             entry["last_path"] = [[p.header.stamp.to_sec(), p.pose.position.x, p.pose.position.y,
                                    p.pose.position.z] for p in message.poses]
     bag.close()
+    for topic, message in last_clouds.items():
+        xyz = list(point_cloud2.read_points(message, field_names=["x", "y", "z"]))
+        topics[topic]["last_centroid"] = [sum(p[k] for p in xyz) / max(1, len(xyz))
+                                          for k in range(3)]
     print(json.dumps(topics))
 
 
