@@ -18,10 +18,11 @@ void UseOneMallocArena();
 // message, the serialised copy): in the heap, their freed pages stayed resident between blocks
 // that live on, and the node's memory grew with the map (bench/ros/RESULTS.md, "Large blocks on
 // pages of their own": flat from minute 6 of the 30-minute soak, as with malloc_trim after each
-// publication, without its walk of the heap under the arena's lock; both cost 10-15 % CPU per
-// frame against memory left to grow, the pages being faulted in again). glibc's own threshold would
-// rise to each such block's size when it is freed, up to 32 MB, and serve the next ones from the
-// heap again. Call before the command starts threads.
+// publication, without its walk of the heap under the arena's lock). A block made anew for every
+// map is faulted in anew, page by page: the mapping thread keeps its map's cloud from one map to
+// the next (MapPublisher::TakeSpare) for that reason. glibc's own threshold would rise to each such
+// block's size when it is freed, up to 32 MB, and serve the next ones from the heap again. Call
+// before the command starts threads.
 constexpr int kLargeBlockBytes = 4 << 20;
 void MapLargeBlocksAlone();
 

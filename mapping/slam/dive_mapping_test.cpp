@@ -245,8 +245,10 @@ class LiveMapTest : public DiveMappingTest {
     // Settled submaps taken up often; and never, so that only solves move the steady part.
     LiveMap live(voxel_m, 3), live_unsettled(voxel_m, 1000);
     // After a whole solve the settled part merged anew 3 submaps per Build: the whole map again
-    // once that is done, and meanwhile (rebuilding) never for longer than the batches need.
+    // once that is done, and meanwhile (rebuilding) never for longer than the batches need. Built
+    // into one cloud from start to end, as the node does.
     LiveMap live_in_batches(voxel_m, 3, 3);
+    perception::PointCloud batched;
     for (const NavigationRecord& nav : reader.ReadNavigation()) mapper.AddNavigation(nav);
     Run run;
     reader.ForEachFrame(
@@ -258,7 +260,7 @@ class LiveMapTest : public DiveMappingTest {
           const std::string when = "after submap " + std::to_string(mapper.submap_count());
           ExpectSameCloud(live.Build(mapper), map, when);
           ExpectSameCloud(live_unsettled.Build(mapper), map, when + " (never settled)");
-          const perception::PointCloud batched = live_in_batches.Build(mapper);
+          live_in_batches.Build(mapper, batched);
           if (live_in_batches.rebuilding()) {
             ++run.rebuilding;
           } else {
@@ -271,9 +273,9 @@ class LiveMapTest : public DiveMappingTest {
     mapper.Finish();
     ExpectSameCloud(live.Build(mapper), mapper.Map(voxel_m), "after Finish");
     ExpectSameCloud(live_unsettled.Build(mapper), mapper.Map(voxel_m), "after Finish");
-    perception::PointCloud batched = live_in_batches.Build(mapper);
+    live_in_batches.Build(mapper, batched);
     for (int build = 0; live_in_batches.rebuilding() && build <= mapper.submap_count() / 3; ++build)
-      batched = live_in_batches.Build(mapper);
+      live_in_batches.Build(mapper, batched);
     EXPECT_FALSE(live_in_batches.rebuilding());
     ExpectSameCloud(batched, mapper.Map(voxel_m), "after Finish (rebuilt in batches)");
     run.stats = mapper.stats();

@@ -17,7 +17,16 @@ LiveMap::LiveMap(double voxel_m, int settle_batch, int rebuild_batch)
 }
 
 perception::PointCloud LiveMap::Build(const Mapper& mapper) {
-  if (mapper.submap_count() == 0) return {};
+  perception::PointCloud map;
+  Build(mapper, map);
+  return map;
+}
+
+void LiveMap::Build(const Mapper& mapper, perception::PointCloud& map) {
+  if (mapper.submap_count() == 0) {
+    map = {};
+    return;
+  }
   // Mapper::Map's origin is the first submap's place, which only a whole solve moves once the
   // submap is settled; a whole solve moves every submap merged so far.
   const bool moved = map_ && (mapper.stats().whole_solves != whole_solves_ ||
@@ -32,7 +41,7 @@ perception::PointCloud LiveMap::Build(const Mapper& mapper) {
     UndoMoved(mapper);
   }
   MergeMovable(mapper);
-  return map_->Cloud();
+  map_->CloudInto(map);
 }
 
 void LiveMap::BeginRebuild(const Mapper& mapper) {

@@ -37,6 +37,8 @@ class LiveMap {
   // Mapper::Map(voxel_m) of `mapper` as it stands, unless rebuilding() (then the settled part is
   // where the last whole-graph solve but one placed it). Always called with the same mapper.
   perception::PointCloud Build(const Mapper& mapper);
+  // The same into `map` (replacing what it held), whose storage is reused.
+  void Build(const Mapper& mapper, perception::PointCloud& map);
   // Whether the settled part is being merged anew after a whole-graph solve (rebuild_batch).
   bool rebuilding() const { return rebuild_.has_value(); }
 

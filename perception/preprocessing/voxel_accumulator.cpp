@@ -53,27 +53,44 @@ void VoxelAccumulator::Add(const PointCloud& cloud, const Eigen::Isometry3d& T) 
   }
 }
 
-PointCloud VoxelAccumulator::Cloud() const {
-  PointCloud out;
-  out.origin = origin_;
-  out.points.reserve(sums_.size());
-  for (const std::uint32_t id : IdsByKey())
-    out.points.push_back((sums_[id].sum / static_cast<double>(sums_[id].count)).cast<float>());
-  return out;
-}
-
-std::vector<std::uint32_t> VoxelAccumulator::IdsByKey() const {
+template <typename Visit>
+void VoxelAccumulator::ForEachIdByKey(Visit&& visit) const {
   const std::vector<std::uint32_t> rest = voxels_.IdsByKey(key_ordered_);
-  std::vector<std::uint32_t> ids(voxels_.size());
   // The ordered ids are 0, 1, ..., key_ordered_ - 1: merged with the rest without reading a list.
   std::uint32_t ordered = 0;
-  std::size_t next = 0, out = 0;
+  std::size_t next = 0;
   while (ordered < key_ordered_ || next < rest.size()) {
     const bool take_rest = next < rest.size() &&
                            (ordered == key_ordered_ ||
                             VoxelIndex::KeyBefore(voxels_.key(rest[next]), voxels_.key(ordered)));
-    ids[out++] = take_rest ? rest[next++] : ordered++;
+    visit(take_rest ? rest[next++] : ordered++);
   }
+}
+
+PointCloud VoxelAccumulator::Cloud() const {
+  PointCloud out;
+  CloudInto(out);
+  return out;
+}
+
+void VoxelAccumulator::CloudInto(PointCloud& out) const {
+  out.origin = origin_;
+  out.points.clear();
+  out.normals.clear();
+  out.intensity.clear();
+  // A cloud given again (a live map's, every few seconds) has grown since: room for half as
+  // much again, so that it is not asked for anew each time.
+  const std::size_t n = sums_.size();
+  if (out.points.capacity() < n) out.points.reserve(out.points.capacity() == 0 ? n : n + n / 2);
+  ForEachIdByKey([&](std::uint32_t id) {
+    out.points.push_back((sums_[id].sum / static_cast<double>(sums_[id].count)).cast<float>());
+  });
+}
+
+std::vector<std::uint32_t> VoxelAccumulator::IdsByKey() const {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(voxels_.size());
+  ForEachIdByKey([&](std::uint32_t id) { ids.push_back(id); });
   return ids;
 }
 

@@ -21,6 +21,10 @@ class VoxelAccumulator {
   void Add(const PointCloud& cloud, const Eigen::Isometry3d& T);
   // Each voxel's centroid, in VoxelDownsample's order (by voxel key), normals dropped.
   PointCloud Cloud() const;
+  // The same into `out` (replacing what it held), whose storage is reused, with room to grow
+  // when it had to grow: a live map built every few seconds then asks for no new block of the
+  // map's size each time.
+  void CloudInto(PointCloud& out) const;
   std::size_t voxel_count() const { return voxels_.size(); }
 
   // Marks the state that Undo returns to, bit for bit: what a live map needs to add the part of
@@ -46,6 +50,9 @@ class VoxelAccumulator {
   };
   // Every voxel id in key order: the key-ordered ones [0, key_ordered_) merged with the rest.
   std::vector<std::uint32_t> IdsByKey() const;
+  // Calls visit(id) for each in that order, without a list of them all.
+  template <typename Visit>
+  void ForEachIdByKey(Visit&& visit) const;
 
   double leaf_m_;
   Eigen::Vector3d origin_;

@@ -148,5 +148,33 @@ TEST(VoxelAccumulator, UndoReturnsToEachNestedMarkBitForBit) {
   }
 }
 
+// A live map built into the same cloud again and again as it grows: the same bits as Cloud() each
+// time, whatever the cloud held before, and its storage kept while the map grows within the room
+// left when it last had to grow.
+TEST(VoxelAccumulator, CloudIntoReusesTheCloudItIsGiven) {
+  const Eigen::Vector3d origin(3.5, -1.25, 10.0);
+  VoxelAccumulator live(0.01, origin);
+  PointCloud into;
+  into.points.assign(7, Eigen::Vector3f::Ones());
+  into.normals.assign(7, Eigen::Vector3f::UnitZ());
+  into.intensity.assign(7, 1.0f);
+  live.Add(RandomCloud(70, 20000, Eigen::Vector3d::Zero()), Pose(0.1, origin));
+  live.CloudInto(into);
+  ExpectSameBits(into, live.Cloud(), "first");
+  EXPECT_FALSE(into.has_normals());
+  EXPECT_FALSE(into.has_intensity());
+  // Grown beyond the first map's size: asked for anew, with room for half as much again.
+  live.Add(RandomCloud(71, 20000, Eigen::Vector3d(0.7, 0, 0)), Pose(0.2, origin));
+  live.CloudInto(into);
+  ExpectSameBits(into, live.Cloud(), "grown");
+  EXPECT_GE(into.points.capacity(), into.size() + into.size() / 2);
+  // Grown within that room: the same storage.
+  const Eigen::Vector3f* storage = into.points.data();
+  live.Add(RandomCloud(72, 4000, Eigen::Vector3d(0, 0.7, 0)), Pose(0.3, origin));
+  live.CloudInto(into);
+  ExpectSameBits(into, live.Cloud(), "grown within the room");
+  EXPECT_EQ(into.points.data(), storage);
+}
+
 }  // namespace
 }  // namespace uwscan::perception

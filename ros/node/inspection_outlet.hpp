@@ -96,7 +96,9 @@ class Outlet {
     if (map_share_.Due(Now())) {
       const double start_s = Now();
       PublishPaths(m);
-      map_->Submit(live_map_.Build(m), Stamp(time_s, options_.frames.map));
+      perception::PointCloud map_W = map_->TakeSpare();
+      live_map_.Build(m, map_W);
+      map_->Submit(std::move(map_W), Stamp(time_s, options_.frames.map));
       map_share_.Done(start_s, Now());
     }
   }

@@ -29,7 +29,10 @@ void MapPublisher::Submit(perception::PointCloud map_W, Header header) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (failure_ || stopping_) return;
-    if (pending_) ++replaced_;
+    if (pending_) {
+      ++replaced_;
+      spare_ = std::move(pending_->map_W);
+    }
     pending_ = Pending{std::move(map_W), std::move(header)};
   }
   changed_.notify_all();
@@ -52,6 +55,11 @@ void MapPublisher::PublishLast(perception::PointCloud map_W, Header header) {
   lock.lock();
   busy_ = false;
   if (failure) std::rethrow_exception(failure);
+}
+
+perception::PointCloud MapPublisher::TakeSpare() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return std::exchange(spare_, {});
 }
 
 std::int64_t MapPublisher::published() const {
@@ -79,8 +87,9 @@ void MapPublisher::Run() {
     } catch (...) {
       failure = std::current_exception();
     }
-    next.reset();
     lock.lock();
+    spare_ = std::move(next->map_W);
+    next.reset();
     busy_ = false;
     if (failure) {
       failure_ = failure;

@@ -37,6 +37,12 @@ class MapPublisher {
   // once it is out: the last map of a dive. Rethrows a failure of the thread.
   void PublishLast(perception::PointCloud map_W, Header header);
 
+  // A map already published (or replaced), to build the next one in: its storage, the map's
+  // size, is then reused rather than asked for anew, and faulted in anew, for every map (the node
+  // serves blocks that large from pages of their own, MapLargeBlocksAlone). Empty when none has
+  // come back.
+  perception::PointCloud TakeSpare();
+
   std::int64_t published() const;
   std::int64_t replaced() const;  // maps handed over but replaced by a newer one before their turn
 
@@ -56,6 +62,7 @@ class MapPublisher {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::optional<Pending> pending_;
+  perception::PointCloud spare_;
   bool busy_ = false, stopping_ = false;
   std::exception_ptr failure_;
   std::int64_t published_ = 0, replaced_ = 0;
